@@ -1,0 +1,41 @@
+"""The analytic model of the two-module inchworm robot (numpy + scipy only).
+
+This package never imports MuJoCo or ``ipir_mujoco``: it is the independent
+half of the cross-check. It holds the shared parameter set
+(:class:`RobotParams`) and result container (:class:`RunResult`), the
+slider-crank kinematics and the paper's hybrid model.
+"""
+
+from .errors import ParameterError, SimulationError
+from .kinematic_clutch import simulate_kinematic
+from .kinematics import Geometry, Linkage
+from .params import PARAMETER_NAMES, RobotParams, load_params
+from .results import COLUMNS, MODE_NAMES, Mode, RunResult
+
+CLUTCH_RULES = ("kinematic", "unilateral")
+
+
+def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinematic",
+             t_end: float = 1.0, **options) -> RunResult:
+    """Run the analytic model; ``options`` go to the chosen solver.
+
+    ``geometry``: 'approx' (the paper's first order) or 'exact'.
+    ``clutch``: 'kinematic' (the paper's rule). The one-way ('unilateral')
+    clutch model is not built yet.
+    """
+    try:
+        geometry = Geometry(geometry).value
+    except ValueError:
+        raise ParameterError(f"geometry={geometry!r} is unknown; allowed: approx, exact") from None
+    if clutch not in CLUTCH_RULES:
+        raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(CLUTCH_RULES)}")
+    if clutch == "unilateral":
+        raise ParameterError("clutch='unilateral' is not available yet in the analytic engine; use 'kinematic'")
+    return simulate_kinematic(params, geometry, t_end, **options)
+
+
+__all__ = [
+    "COLUMNS", "CLUTCH_RULES", "Geometry", "Linkage", "MODE_NAMES", "Mode", "PARAMETER_NAMES",
+    "ParameterError", "RobotParams", "RunResult", "SimulationError", "load_params",
+    "simulate", "simulate_kinematic",
+]

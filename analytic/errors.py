@@ -1,0 +1,19 @@
+"""Exceptions shared by every engine.
+
+Bad input is a :class:`ValueError` (the command line maps it to exit status 2);
+a simulation that cannot go on is a :class:`SimulationError` (exit status 1).
+"""
+
+
+class ParameterError(ValueError):
+    """A parameter value, name, option or file is not acceptable.
+
+    The message names the offending value and what is allowed.
+    """
+
+
+class SimulationError(RuntimeError):
+    """A simulation failed (solver failure, instability, chattering).
+
+    The message gives the simulated time and the reason.
+    """

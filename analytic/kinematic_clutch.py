@@ -1,0 +1,235 @@
+"""The paper's hybrid model: ideal clutches locked by the sign of S_dot.
+
+The mode lives in the integration loop, not in the right-hand side: one mode
+is integrated with ``solve_ivp`` until a terminal event (S_dot = K(phi) *
+omega reaching zero), the next mode is chosen at that point, and integration
+restarts. Each event function only watches the crossing that ends its mode
+(direction +1 in contraction, -1 in expansion), so a restart on a root that
+solve_ivp placed a hair on either side never re-triggers.
+
+Choosing the next mode where S_dot = 0: a mode is consistent if the motion it
+produces gives S_dot the sign it needs (negative in contraction, positive in
+expansion). Its first non-vanishing time derivative decides:
+
+* S_ddot = K' omega^2 + K alpha_mode, computed with each mode's own alpha.
+  At a dead centre with the crank turning (K = 0) this is K' omega^2; with the
+  crank at rest (omega = 0) it is K alpha_mode. For F_r1, F_r2 >= 0 at most
+  one mode is consistent (shown in the module's tests), so no tie-break is
+  ever needed.
+* If S_ddot vanishes in both modes the crank is at rest on a dead centre
+  (K = omega = 0; e.g. the start from rest at phi = 0). Both modes then give
+  alpha = M / J_eff, and S - S0 = K' (phi - phi0)^2 / 2 + O(phi^3): the gap
+  shrinks (contraction) where K' < 0, as at phi = 0, and grows where K' > 0.
+* If no mode is consistent the robot stalls: both clutches hold, the crank
+  stays at rest, and under constant loads it stays so (``BOTH_LOCKED``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .dynamics import OneDofDynamics
+from .errors import ParameterError, SimulationError
+from .kinematics import Geometry
+from .params import RobotParams
+from .results import COLUMNS, Mode, RunResult
+
+# |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
+# zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
+# a real S_ddot far above.
+_ZERO_SDD = 1e-9
+# |S_dot| below this fraction of r * |omega| at the start counts as a dead centre.
+_ZERO_SD = 1e-10
+
+
+def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float) -> Mode:
+    """Next mode at a state where S_dot = 0 (see the module docstring)."""
+    tr = dyn.linkage.transfer(phi)
+    alpha_c = float(dyn.acceleration(phi, omega, Mode.CONTRACTION))
+    alpha_e = float(dyn.acceleration(phi, omega, Mode.EXPANSION))
+    sdd_c = tr.dK * omega**2 + tr.K * alpha_c
+    sdd_e = tr.dK * omega**2 + tr.K * alpha_e
+    tol = _ZERO_SDD * dyn.linkage.r * (omega**2 + abs(alpha_c) + abs(alpha_e))
+    contraction_ok, expansion_ok = sdd_c < -tol, sdd_e > tol
+    if contraction_ok and expansion_ok:
+        raise SimulationError(
+            f"both modes consistent at phi={phi:.6g} rad, omega={omega:.6g} rad/s "
+            "(impossible for non-negative resistances)"
+        )
+    if contraction_ok:
+        return Mode.CONTRACTION
+    if expansion_ok:
+        return Mode.EXPANSION
+    if abs(sdd_c) <= tol and abs(sdd_e) <= tol and alpha_c != 0.0:
+        return Mode.CONTRACTION if tr.dK < 0 else Mode.EXPANSION
+    return Mode.BOTH_LOCKED
+
+
+def choose_initial_mode(dyn: OneDofDynamics, phi: float, omega: float) -> Mode:
+    """Mode at the start: by the sign of S_dot, or by the next order where it is zero."""
+    S_dot = float(dyn.linkage.transfer(phi).K) * omega
+    if abs(S_dot) > _ZERO_SD * dyn.linkage.r * abs(omega):
+        return Mode.CONTRACTION if S_dot < 0 else Mode.EXPANSION
+    return choose_mode_at_rest_gap(dyn, phi, omega)
+
+
+def _sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
+    """Segment [t0, t1]: its end points and the output grid strictly inside."""
+    inside = grid[(grid > t0) & (grid < t1)]
+    return np.concatenate([[t0], inside, [t1]]) if t1 > t0 else np.array([t0])
+
+
+def simulate_kinematic(
+    params: RobotParams,
+    geometry: Geometry | str = Geometry.APPROX,
+    t_end: float = 1.0,
+    *,
+    dt_out: float = 1e-4,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    max_switches: int = 100_000,
+) -> RunResult:
+    """Simulate the robot with the paper's clutch rule.
+
+    ``geometry`` 'approx' is the paper's model (rod ignored); 'exact' uses the
+    exact slider-crank with the rod's mass and inertia. ``dt_out`` [s] is the
+    output grid; mode-switch instants are added to it (twice: once per mode).
+    ``rtol``/``atol`` go to ``solve_ivp`` (DOP853) on the state
+    (phi [rad], omega [rad/s], x1 [m], x2 [m]).
+    """
+    _check_run_options(t_end, dt_out, rtol, atol)
+    started = time.perf_counter()
+    dyn = OneDofDynamics(params, geometry)
+    n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
+    grid = np.linspace(0.0, t_end, n_out + 1)
+
+    t = 0.0
+    y = np.array([params.phi0, params.omega0, 0.0, 0.0])
+    mode = choose_initial_mode(dyn, params.phi0, params.omega0)
+    initial_mode = mode
+    pieces: list[dict[str, np.ndarray]] = []
+    switches = 0
+    while True:
+        if mode is Mode.BOTH_LOCKED:
+            # Everything at rest under constant loads: nothing changes any more.
+            pieces.append(_stalled_piece(dyn, _sample_times(t, t_end, grid), y))
+            break
+        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol)
+        t_stop = float(sol.t[-1])
+        pieces.append(_mode_piece(dyn, mode, _sample_times(t, t_stop, grid), sol.sol))
+        if sol.status != 1:
+            break
+        t, y = float(sol.t_events[0][0]), sol.y_events[0][0].copy()
+        switches += 1
+        if switches > max_switches:
+            raise SimulationError(f"more than {max_switches} mode switches by t={t:.6g} s: the clutch rule chatters")
+        mode = choose_mode_at_rest_gap(dyn, float(y[0]), float(y[1]))
+        if t >= t_end:
+            break
+
+    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in COLUMNS}
+    energy = _energy_audit(dyn, params, series, initial_mode)
+    _check_finite(series)
+    return RunResult(
+        engine="analytic",
+        geometry=dyn.geometry.value,
+        clutch="kinematic",
+        params=params,
+        t_end=t_end,
+        series=series,
+        energy=energy,
+        wall_time_s=time.perf_counter() - started,
+        settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
+                  "rod_modelled": dyn.include_rod},
+    )
+
+
+def _check_run_options(t_end: float, dt_out: float, rtol: float, atol: float) -> None:
+    for name, value in (("t_end", t_end), ("dt_out", dt_out), ("rtol", rtol), ("atol", atol)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
+    if dt_out > t_end:
+        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: dt_out <= t_end ({t_end} s)")
+    if rtol < 1e-13:
+        raise ParameterError(f"rtol={rtol} is out of range; allowed: rtol >= 1e-13 (DOP853's floor)")
+
+
+def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol):
+    """Integrate one mode from t0 until its switch event or t_end."""
+    linkage = dyn.linkage
+
+    def rhs(_t, y):
+        phi, omega = y[0], y[1]
+        K = linkage.transfer(phi).K
+        e = -K if mode is Mode.CONTRACTION else 0.0
+        return [omega, dyn.acceleration(phi, omega, mode), e * omega, (e + K) * omega]
+
+    def gap_rate(_t, y):
+        return linkage.transfer(y[0]).K * y[1]
+
+    gap_rate.terminal = True
+    gap_rate.direction = 1.0 if mode is Mode.CONTRACTION else -1.0
+    sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
+                    events=gap_rate, dense_output=True)
+    if sol.status < 0:
+        raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
+    return sol
+
+
+def _mode_piece(dyn, mode, times, dense) -> dict[str, np.ndarray]:
+    phi, omega, x1, x2 = dense(times)
+    st = dyn.state(phi, omega, mode)
+    return {
+        "t": times, "phi": phi, "omega": omega, "alpha": st.alpha, "x1": x1, "x2": x2,
+        "v1": st.v1, "v2": st.v2, "a1": st.a1, "a2": st.a2, "S": st.S, "S_dot": st.S_dot,
+        "lambda1": st.lambda1, "lambda2": st.lambda2,
+        "mode": np.full(times.shape, int(mode)),
+    }
+
+
+def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
+    n = times.shape
+    lam1, lam2 = dyn.stalled_reactions(y[0])
+    zeros = np.zeros(n)
+    return {
+        "t": times, "phi": np.full(n, y[0]), "omega": zeros, "alpha": zeros,
+        "x1": np.full(n, y[2]), "x2": np.full(n, y[3]), "v1": zeros, "v2": zeros,
+        "a1": zeros, "a2": zeros, "S": np.full(n, dyn.linkage.gap(y[0])), "S_dot": zeros,
+        "lambda1": np.full(n, lam1), "lambda2": np.full(n, lam2),
+        "mode": np.full(n, int(Mode.BOTH_LOCKED)),
+    }
+
+
+def _kinetic(dyn, phi, omega, mode) -> float:
+    return 0.0 if mode is Mode.BOTH_LOCKED else float(dyn.state(phi, omega, mode).kinetic)
+
+
+def _energy_audit(dyn, params, series, initial_mode) -> dict[str, float]:
+    """Motor work = kinetic energy gained + friction work + residual [J].
+
+    Under this clutch rule a module moves only forward, so the work against
+    its constant resistance is F_r times its displacement.
+    """
+    phi, omega = series["phi"], series["omega"]
+    mode_end = Mode(int(series["mode"][-1]))
+    motor = params.M * (phi[-1] - phi[0])
+    kinetic = _kinetic(dyn, phi[-1], omega[-1], mode_end) - _kinetic(dyn, phi[0], omega[0], initial_mode)
+    friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
+    return {
+        "motor_work_j": float(motor),
+        "kinetic_j": float(kinetic),
+        "friction_j": float(friction),
+        "residual_j": float(motor - kinetic - friction),
+    }
+
+
+def _check_finite(series: dict[str, np.ndarray]) -> None:
+    for name, values in series.items():
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            t_bad = series["t"][bad[0]]
+            raise SimulationError(f"non-finite {name} at t={t_bad:.6g} s")

@@ -1,0 +1,104 @@
+"""Slider-crank kinematics: first-order (the paper's, L >> r) and exact.
+
+Frame: x along the pipe (forward), y across it in the plane of the crank; the
+origin is the crank axis A. The crank angle ``phi`` is measured from +x, so
+phi = 0 is full extension. C (the rod's pin on module 2) stays on the x axis.
+
+Every function takes ``phi`` as a float or an ndarray of any shape [rad] and
+returns values of the same shape; lengths are in metres.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Geometry(str, Enum):
+    """Which kinematics relate the crank angle to the module gap."""
+
+    APPROX = "approx"  # the paper's first order: S = L + r cos(phi)
+    EXACT = "exact"  # in-line slider-crank: S = r cos(phi) + sqrt(L^2 - r^2 sin^2(phi))
+
+
+class Transfer(NamedTuple):
+    """Gap and its derivatives with respect to the crank angle."""
+
+    S: np.ndarray  # gap x2 - x1 [m]
+    K: np.ndarray  # dS/dphi [m/rad]
+    dK: np.ndarray  # d2S/dphi2 [m/rad^2]
+
+
+class RodMotion(NamedTuple):
+    """Rod centre-of-mass and angle velocities per unit crank speed, relative to A.
+
+    With x1 fixed: G_x_dot = a * phi_dot, G_y_dot = b * phi_dot,
+    beta_dot = g * phi_dot (beta = rod angle from +x). ``da``, ``db``, ``dg``
+    are their derivatives with respect to phi. Only the exact geometry has a
+    rod of fixed length, so only it defines these.
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    g: np.ndarray
+    da: np.ndarray
+    db: np.ndarray
+    dg: np.ndarray
+
+
+class Linkage:
+    """The crank AB (length r) and rod BC (length L) in one geometry."""
+
+    def __init__(self, r: float, L: float, geometry: Geometry | str):
+        self.r = float(r)
+        self.L = float(L)
+        self.geometry = Geometry(geometry)
+        if self.geometry is Geometry.EXACT and not self.L > self.r:
+            raise ValueError(f"exact slider-crank needs L > r, got L={L} m, r={r} m")
+
+    def _root(self, phi):
+        """sqrt(L^2 - r^2 sin^2 phi): the rod's projection on x [m] (exact geometry)."""
+        return np.sqrt(self.L**2 - (self.r * np.sin(phi)) ** 2)
+
+    def transfer(self, phi) -> Transfer:
+        """S(phi), K = dS/dphi and dK/dphi."""
+        r, s, c = self.r, np.sin(phi), np.cos(phi)
+        if self.geometry is Geometry.APPROX:
+            return Transfer(self.L + r * c, -r * s, -r * c)
+        D = self._root(phi)
+        S = r * c + D
+        K = -r * s - r**2 * s * c / D
+        dK = -r * c - r**2 * (c**2 - s**2) / D - r**4 * s**2 * c**2 / D**3
+        return Transfer(S, K, dK)
+
+    def gap(self, phi):
+        """Module gap S = x2 - x1 [m]."""
+        return self.transfer(phi).S
+
+    def crank_pin(self, phi) -> tuple[np.ndarray, np.ndarray]:
+        """Position of B relative to A, (x, y) [m]."""
+        return self.r * np.cos(phi), self.r * np.sin(phi)
+
+    def rod_com(self, phi) -> tuple[np.ndarray, np.ndarray]:
+        """Position of the rod's centre of mass (mid-point of BC) relative to A, (x, y) [m]."""
+        bx, by = self.crank_pin(phi)
+        return 0.5 * (bx + self.gap(phi)), 0.5 * by
+
+    def rod_motion(self, phi) -> RodMotion:
+        """Velocity coefficients of the rod (exact geometry only; see :class:`RodMotion`)."""
+        if self.geometry is not Geometry.EXACT:
+            raise ValueError("the first-order geometry has no rigid rod; rod motion needs geometry 'exact'")
+        r, s, c = self.r, np.sin(phi), np.cos(phi)
+        D = self._root(phi)
+        _, K, dK = self.transfer(phi)
+        # G = (B + C)/2 with B = (r c, r s), C = (S, 0).
+        a = 0.5 * (-r * s + K)
+        b = 0.5 * r * c
+        da = 0.5 * (-r * c + dK)
+        db = -0.5 * r * s
+        # sin(beta) = -r s / L and L cos(beta) = D, so beta_dot = -r c / D * phi_dot.
+        g = -r * c / D
+        dg = r * s / D - r**3 * s * c**2 / D**3
+        return RodMotion(a, b, g, da, db, dg)

@@ -1,0 +1,178 @@
+"""One result container for every engine: time series, energy audit, summary.
+
+Engines fill :class:`RunResult`; compare, report and sweep read it and never
+care which engine produced a run. The summary is computed here, from the time
+series, the same way for every engine.
+
+Time series columns (each an ndarray of shape (n,)):
+
+=========  ========  ======================================================
+column     units     meaning
+=========  ========  ======================================================
+t          s         time; non-decreasing. An instant where the mode
+                     switches appears twice, once per mode, because
+                     accelerations and reactions jump there.
+phi        rad       crank angle (0 = full extension)
+omega      rad/s     crank speed
+alpha      rad/s^2   crank angular acceleration
+x1, x2     m         displacement of module 1 (rear) / 2 (front) from t = 0
+v1, v2     m/s       module velocities
+a1, a2     m/s^2     module accelerations
+S          m         gap x2_abs - x1_abs between A and C
+S_dot      m/s       gap rate
+lambda1/2  N         clutch reaction on module 1 / 2, positive pushing the
+                     module forward; 0 while the module moves
+mode       -         :class:`Mode` as an integer
+=========  ========  ======================================================
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from enum import IntEnum
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .params import RobotParams
+
+COLUMNS: tuple[str, ...] = (
+    "t", "phi", "omega", "alpha", "x1", "x2", "v1", "v2", "a1", "a2",
+    "S", "S_dot", "lambda1", "lambda2", "mode",
+)
+
+
+class Mode(IntEnum):
+    """Which clutches hold their module."""
+
+    BOTH_LOCKED = 0  # nothing moves (stall)
+    CONTRACTION = 1  # front locked, rear moves forward (S_dot < 0)
+    EXPANSION = 2  # rear locked, front moves forward (S_dot > 0)
+    BOTH_MOVING = 3  # neither clutch engaged (one-way clutches only)
+
+    @property
+    def rear_locked(self) -> bool:
+        return self in (Mode.BOTH_LOCKED, Mode.EXPANSION)
+
+    @property
+    def front_locked(self) -> bool:
+        return self in (Mode.BOTH_LOCKED, Mode.CONTRACTION)
+
+
+MODE_NAMES: dict[int, str] = {int(m): m.name.lower() for m in Mode}
+
+
+@dataclass
+class RunResult:
+    """A run of one engine.
+
+    ``series`` maps every name in :data:`COLUMNS` to an ndarray of shape (n,).
+    ``energy`` holds the engine's energy audit in joules: ``motor_work_j``
+    (work of the motor torque), ``kinetic_j`` (kinetic energy gained),
+    ``friction_j`` (work against the resistances) and ``residual_j`` (motor
+    work minus the other two; the integration or solver error), plus any
+    engine-specific terms. ``settings`` records solver settings.
+    """
+
+    engine: str
+    geometry: str
+    clutch: str
+    params: RobotParams
+    t_end: float
+    series: dict[str, np.ndarray]
+    energy: dict[str, float]
+    wall_time_s: float = 0.0
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        missing = [c for c in COLUMNS if c not in self.series]
+        if missing:
+            raise ValueError(f"time series lacks columns {missing}")
+        n = len(self.series["t"])
+        bad = [c for c, v in self.series.items() if np.shape(v) != (n,)]
+        if bad:
+            raise ValueError(f"time series columns {bad} do not have shape ({n},)")
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        """The contract's summary figures (see ``CONTRACT.md``)."""
+        return summarize(self.series, self.energy)
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The object ``simulate --json`` prints."""
+        return {
+            "engine": self.engine,
+            "geometry": self.geometry,
+            "clutch": self.clutch,
+            "params": self.params.as_dict(),
+            "t_end": self.t_end,
+            "summary": self.summary,
+            "wall_time_s": self.wall_time_s,
+            "settings": self.settings,
+            "mode_names": {str(k): v for k, v in MODE_NAMES.items()},
+        }
+
+    def write_csv(self, path: str | Path) -> None:
+        """Write the time series as CSV with a header row of :data:`COLUMNS`."""
+        extra = [c for c in self.series if c not in COLUMNS]
+        names = list(COLUMNS) + extra
+        table = np.column_stack([np.asarray(self.series[c], dtype=float) for c in names])
+        fmt = ["%d" if c == "mode" else "%.12g" for c in names]
+        np.savetxt(path, table, delimiter=",", header=",".join(names), comments="", fmt=fmt)
+
+
+def read_csv(path: str | Path) -> dict[str, np.ndarray]:
+    """Read a time series written by :meth:`RunResult.write_csv`."""
+    table = np.genfromtxt(path, delimiter=",", names=True)
+    series = {name: np.atleast_1d(table[name]).astype(float) for name in table.dtype.names}
+    series["mode"] = series["mode"].astype(int)
+    return series
+
+
+def first_gap_minimum(t: np.ndarray, S_dot: np.ndarray) -> float | None:
+    """Time of the first minimum of S [s]: where S_dot first turns from < 0 to >= 0.
+
+    Linear interpolation between samples; None if S never reaches a minimum.
+    """
+    falling = S_dot[:-1] < 0
+    rising = S_dot[1:] >= 0
+    hits = np.flatnonzero(falling & rising)
+    if hits.size == 0:
+        return None
+    i = hits[0]
+    s0, s1 = S_dot[i], S_dot[i + 1]
+    return float(t[i] + (t[i + 1] - t[i]) * (-s0) / (s1 - s0))
+
+
+def min_locked_reaction(series: dict[str, np.ndarray]) -> float | None:
+    """Smallest reaction of a locked clutch over the run [N]; None if none locked."""
+    modes = np.asarray(series["mode"], dtype=int)
+    rear = np.isin(modes, [Mode.BOTH_LOCKED, Mode.EXPANSION])
+    front = np.isin(modes, [Mode.BOTH_LOCKED, Mode.CONTRACTION])
+    values = np.concatenate([series["lambda1"][rear], series["lambda2"][front]])
+    return float(values.min()) if values.size else None
+
+
+def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[str, Any]:
+    """The summary figures of a run, computed from its time series."""
+    t, phi = series["t"], series["phi"]
+    modes = np.asarray(series["mode"], dtype=int)
+    return {
+        "revolutions": float((phi[-1] - phi[0]) / (2 * math.pi)),
+        "x1_final": float(series["x1"][-1] - series["x1"][0]),
+        "x2_final": float(series["x2"][-1] - series["x2"][0]),
+        "v1_max": float(np.max(series["v1"])),
+        "v2_max": float(np.max(series["v2"])),
+        "first_contraction_end_s": first_gap_minimum(t, series["S_dot"]),
+        "mode_switches": int(np.count_nonzero(np.diff(modes))),
+        "min_clutch_reaction_n": min_locked_reaction(series),
+        "energy": dict(energy),
+    }
+
+
+def write_json(path: str | Path, data: dict[str, Any]) -> None:
+    """Write ``data`` as indented JSON (NaN is not valid JSON: refuse it)."""
+    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
