@@ -1,0 +1,137 @@
+"""Command line: ``ipir-mujoco`` (see ``shared/CONTRACT.md``).
+
+Exit status: 0 success, 2 bad input (one line on stderr naming the value and
+what is allowed), 1 a failure of the simulation itself (with the reason).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Sequence
+
+import analytic
+from analytic.errors import ParameterError, SimulationError
+from analytic.params import PARAMETER_NAMES, load_params
+from analytic.results import RunResult, write_json
+
+from . import __version__
+from .output import check_output_dir, staged_output
+from .plots import write_paper_figures
+
+EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line error message and exit status 2."""
+
+    def error(self, message: str):  # noqa: D102 (argparse API)
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def _add_model_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                        help=f"set a parameter (SI units); names: {' '.join(PARAMETER_NAMES)}")
+    parser.add_argument("--config", metavar="FILE.toml",
+                        help="TOML file of parameters (top level or a [params] table); --set wins over it")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="ipir-mujoco",
+                     description="Cross-check the analytic model of a two-module inchworm in-pipe robot "
+                                 "against MuJoCo physics.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    sim = commands.add_parser("simulate", help="run one engine on one parameter set",
+                              description="Run one engine on one parameter set and print or write its results. "
+                                          "Defaults: the paper's model and case for 1 s.")
+    sim.add_argument("--engine", choices=("analytic", "mujoco"), default="analytic",
+                     help="analytic equations or MuJoCo physics (default: analytic)")
+    sim.add_argument("--geometry", choices=("approx", "exact"), default=None,
+                     help="first-order kinematics as in the paper (approx; analytic default) or the exact "
+                          "slider-crank (exact; MuJoCo always models it)")
+    sim.add_argument("--clutch", choices=analytic.CLUTCH_RULES, default="kinematic",
+                     help="kinematic: the paper's rule, lock by the sign of S_dot (default); "
+                          "unilateral: one-way clutches that can only push")
+    sim.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+                     help="MuJoCo clutch implementation: joint-limit ratchet or velocity-triggered lock")
+    _add_model_options(sim)
+    sim.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS", help="simulated time (default 1 s)")
+    sim.add_argument("--dt-out", type=float, default=1e-4, metavar="SECONDS",
+                     help="output sample interval (default 1e-4 s); mode switches are sampled exactly")
+    sim.add_argument("--out", metavar="DIR",
+                     help="write DIR/timeseries.csv, DIR/summary.json and the paper's figures as PNG")
+    sim.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    sim.set_defaults(handler=cmd_simulate)
+    return parser
+
+
+def run_simulation(args: argparse.Namespace) -> RunResult:
+    """The run ``simulate`` asks for (raises ParameterError on bad input)."""
+    params = load_params(args.config, args.overrides)
+    if args.engine == "mujoco":
+        if args.geometry == "approx":
+            raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real "
+                                 "linkage; allowed: --geometry exact (or leave it out)")
+        raise ParameterError("--engine mujoco is not available yet; allowed now: --engine analytic")
+    if args.mujoco_clutch is not None:
+        raise ParameterError(f"--mujoco-clutch {args.mujoco_clutch} applies only to --engine mujoco")
+    return analytic.simulate(params, args.geometry or "approx", args.clutch, args.t_end, dt_out=args.dt_out)
+
+
+def _format_summary(run: RunResult) -> str:
+    s = run.summary
+    e = s["energy"]
+    first = s["first_contraction_end_s"]
+    lines = [
+        f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
+        f"({run.wall_time_s:.2f} s wall)",
+        f"  crank revolutions        {s['revolutions']:.4f}",
+        f"  module 1 (rear) moved    {s['x1_final']:.4f} m   peak speed {s['v1_max']:.3f} m/s",
+        f"  module 2 (front) moved   {s['x2_final']:.4f} m   peak speed {s['v2_max']:.3f} m/s",
+        "  first minimum of S       " + ("none" if first is None else f"{first:.4f} s"),
+        f"  mode switches            {s['mode_switches']}",
+        f"  min clutch reaction      {s['min_clutch_reaction_n']:.4g} N"
+        + ("   (negative: the lock would have to pull)" if (s['min_clutch_reaction_n'] or 0) < 0 else ""),
+        f"  energy [J]: motor {e['motor_work_j']:.6g} = kinetic {e['kinetic_j']:.6g} "
+        f"+ friction {e['friction_j']:.6g} + residual {e['residual_j']:.2e}",
+    ]
+    return "\n".join(lines)
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    if args.out is not None:
+        check_output_dir(args.out)
+    run = run_simulation(args)
+    record = run.to_json_dict()
+    if args.out is not None:
+        with staged_output(args.out) as staging:
+            run.write_csv(staging / "timeseries.csv")
+            write_json(staging / "summary.json", record)
+            write_paper_figures([run], staging)
+    if args.json:
+        print(json.dumps(record, allow_nan=False))
+    else:
+        print(_format_summary(run))
+        if args.out is not None:
+            print(f"  wrote {args.out}/timeseries.csv, summary.json and fig2-4 PNG")
+    return EXIT_OK
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.handler(args)
+    except ParameterError as exc:
+        print(f"ipir-mujoco {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except SimulationError as exc:
+        print(f"ipir-mujoco {args.command}: simulation failed: {exc}", file=sys.stderr)
+        return EXIT_FAILURE
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

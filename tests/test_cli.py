@@ -1,0 +1,128 @@
+"""The command-line contract (shared/CONTRACT.md) for `simulate`."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from analytic.results import COLUMNS, read_csv
+from ipir_mujoco.cli import main
+
+SUMMARY_KEYS = {"revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
+                "mode_switches", "min_clutch_reaction_n", "energy"}
+ENERGY_KEYS = {"motor_work_j", "kinetic_j", "friction_j", "residual_j"}
+
+
+def exit_code(argv) -> int:
+    """main()'s exit status, whether it returns it or argparse exits with it."""
+    try:
+        return main(list(argv))
+    except SystemExit as exc:
+        return exc.code
+
+
+def run_cli(capsys, *argv):
+    code = exit_code(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_simulate_json_follows_the_contract(capsys):
+    code, out, err = run_cli(capsys, "simulate", "--json")
+    assert code == 0 and err == ""
+    record = json.loads(out)
+    assert (record["engine"], record["geometry"], record["clutch"], record["t_end"]) == \
+        ("analytic", "approx", "kinematic", 1.0)
+    assert SUMMARY_KEYS <= set(record["summary"]) and ENERGY_KEYS <= set(record["summary"]["energy"])
+    assert record["params"]["L"] == 0.2 and record["wall_time_s"] > 0
+    assert record["summary"]["revolutions"] == pytest.approx(8.43, abs=0.01)
+
+
+def test_set_and_config_reach_the_model(capsys, tmp_path):
+    config = tmp_path / "c.toml"
+    config.write_text("[params]\nL = 0.5\nm2 = 3\n")
+    code, out, _ = run_cli(capsys, "simulate", "--json", "--config", str(config), "--set", "m2=2",
+                           "--geometry", "exact", "--t-end", "0.3")
+    record = json.loads(out)
+    assert code == 0 and record["params"]["L"] == 0.5 and record["params"]["m2"] == 2.0
+    assert record["geometry"] == "exact" and record["t_end"] == 0.3
+
+
+def test_out_writes_csv_summary_and_figures(capsys, tmp_path):
+    out_dir = tmp_path / "run"
+    code, out, _ = run_cli(capsys, "simulate", "--out", str(out_dir), "--t-end", "0.5")
+    assert code == 0 and "crank revolutions" in out
+    series = read_csv(out_dir / "timeseries.csv")
+    assert list(series) == list(COLUMNS)
+    assert series["t"][0] == 0 and series["t"][-1] == 0.5 and np.all(np.diff(series["t"]) >= 0)
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["summary"]["x1_final"] == pytest.approx(series["x1"][-1], abs=1e-11)
+    for name in ("fig2_crank.png", "fig3_modules.png", "fig4_gap.png"):
+        assert (out_dir / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # no staging folder left behind
+
+
+@pytest.mark.parametrize("argv,fragment", [
+    (["--geometry", "exact", "--set", "L=0.04"], "L=0.04"),
+    (["--set", "m1=-1"], "m1=-1.0"),
+    (["--set", "M=nan"], "M=nan"),
+    (["--set", "foo=1"], "'foo'"),
+    (["--set", "L"], "NAME=VALUE"),
+    (["--t-end", "-1"], "t_end=-1.0"),
+    (["--t-end", "nan"], "t_end=nan"),
+    (["--t-end", "abc"], "'abc'"),
+    (["--geometry", "sideways"], "'sideways'"),
+    (["--engine", "mujoco", "--geometry", "approx"], "--geometry approx"),
+    (["--mujoco-clutch", "lock"], "--mujoco-clutch"),
+])
+def test_bad_input_exits_2_with_one_line_naming_the_value(capsys, tmp_path, argv, fragment):
+    out_dir = tmp_path / "never"
+    code, _, err = run_cli(capsys, "simulate", "--out", str(out_dir), *argv)
+    assert code == 2
+    assert err.count("\n") == 1 and fragment in err
+    assert not out_dir.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_malformed_toml_exits_2_and_names_the_file(capsys, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("L = = 3\n")
+    code, _, err = run_cli(capsys, "simulate", "--config", str(bad))
+    assert code == 2 and "bad.toml" in err and "not valid TOML" in err and err.count("\n") == 1
+
+
+def test_out_that_is_a_file_is_bad_input(capsys, tmp_path):
+    target = tmp_path / "file"
+    target.write_text("keep me")
+    code, _, err = run_cli(capsys, "simulate", "--out", str(target))
+    assert code == 2 and "not a folder" in err and target.read_text() == "keep me"
+
+
+def test_console_script_and_module_behave_the_same(tmp_path):
+    script = shutil.which("ipir-mujoco", path=str(Path(sys.executable).parent)) or shutil.which("ipir-mujoco")
+    if script is None:
+        pytest.skip("console script not on PATH (package not installed in this environment)")
+    outputs = []
+    for command in ([script], [sys.executable, "-m", "ipir_mujoco"]):
+        done = subprocess.run([*command, "simulate", "--json", "--t-end", "0.2"], cwd=tmp_path,
+                              capture_output=True, text=True, check=False)
+        assert done.returncode == 0, done.stderr
+        outputs.append(json.loads(done.stdout)["summary"])
+        bad = subprocess.run([*command, "simulate", "--set", "m1=-1"], cwd=tmp_path,
+                             capture_output=True, text=True, check=False)
+        assert bad.returncode == 2 and "m1=-1.0" in bad.stderr
+    assert outputs[0] == outputs[1]
+    assert list(tmp_path.iterdir()) == []  # nothing written into the working folder
+
+
+def test_every_subcommand_has_help(capsys):
+    for argv in (["--help"], ["simulate", "--help"]):
+        with pytest.raises(SystemExit) as info:
+            main(argv)
+        assert info.value.code == 0
+    assert "NAME=VALUE" in capsys.readouterr().out

@@ -1,0 +1,73 @@
+"""The shared result container, on synthetic series with known answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from analytic import RobotParams
+from analytic.results import COLUMNS, Mode, RunResult, first_gap_minimum, min_locked_reaction, read_csv, write_json
+
+
+def synthetic_series(n=2001, t_end=2.0):
+    """S = cos(pi t): first minimum at t = 1 s exactly; modes follow the sign of S_dot."""
+    t = np.linspace(0.0, t_end, n)
+    S_dot = -math.pi * np.sin(math.pi * t)
+    series = {c: np.zeros(n) for c in COLUMNS}
+    series.update(t=t, S=np.cos(math.pi * t), S_dot=S_dot, phi=2 * math.pi * 1.5 * t / t_end,
+                  x1=0.1 * t, x2=0.2 * t, v1=np.linspace(0, 3, n), v2=np.linspace(2, 0, n))
+    series["mode"] = np.where(S_dot <= 0, int(Mode.CONTRACTION), int(Mode.EXPANSION))
+    series["lambda2"] = np.where(series["mode"] == Mode.CONTRACTION, 5.0 - t, -99.0)  # -99: not locked
+    series["lambda1"] = np.where(series["mode"] == Mode.EXPANSION, 3.0 + t, -99.0)
+    return series
+
+
+def test_first_gap_minimum_interpolates_the_sign_change():
+    series = synthetic_series()
+    # linear interpolation of S_dot ~ pi^2 (t - 1) near the root is exact to O(dt^2)
+    assert first_gap_minimum(series["t"], series["S_dot"]) == pytest.approx(1.0, abs=1e-9)
+    assert first_gap_minimum(series["t"], -np.abs(series["S_dot"]) - 1) is None
+
+
+def test_min_locked_reaction_ignores_clutches_that_are_not_locked():
+    series = synthetic_series()
+    # contraction lasts to t = 1 (lambda2 = 5 - t >= 4), expansion after (lambda1 = 3 + t >= 4)
+    assert min_locked_reaction(series) == pytest.approx(4.0, abs=2e-3)
+
+
+def test_summary_from_a_synthetic_run():
+    run = RunResult("test", "exact", "kinematic", RobotParams(), 2.0, synthetic_series(),
+                    {"motor_work_j": 1.0, "kinetic_j": 0.5, "friction_j": 0.5, "residual_j": 0.0})
+    s = run.summary
+    assert s["revolutions"] == pytest.approx(1.5)
+    assert (s["x1_final"], s["x2_final"]) == pytest.approx((0.2, 0.4))
+    assert (s["v1_max"], s["v2_max"]) == (3.0, 2.0)
+    assert s["mode_switches"] == 1
+
+
+def test_csv_round_trip_keeps_columns_and_values(tmp_path):
+    series = synthetic_series(n=101)
+    run = RunResult("test", "exact", "kinematic", RobotParams(), 2.0, series, {})
+    run.write_csv(tmp_path / "ts.csv")
+    back = read_csv(tmp_path / "ts.csv")
+    assert list(back) == list(COLUMNS)
+    for c in COLUMNS:
+        np.testing.assert_allclose(back[c], series[c], rtol=1e-11, atol=1e-15)  # written with 12 digits
+
+
+def test_container_refuses_missing_or_ragged_columns():
+    series = synthetic_series()
+    del series["lambda1"]
+    with pytest.raises(ValueError, match="lambda1"):
+        RunResult("test", "exact", "kinematic", RobotParams(), 2.0, series, {})
+    series = synthetic_series()
+    series["v1"] = series["v1"][:-1]
+    with pytest.raises(ValueError, match="v1"):
+        RunResult("test", "exact", "kinematic", RobotParams(), 2.0, series, {})
+
+
+def test_json_refuses_nan(tmp_path):
+    with pytest.raises(ValueError):
+        write_json(tmp_path / "x.json", {"a": float("nan")})
