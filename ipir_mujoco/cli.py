@@ -65,6 +65,16 @@ def build_parser() -> argparse.ArgumentParser:
                      help="write DIR/timeseries.csv, DIR/summary.json and the paper's figures as PNG")
     sim.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     sim.set_defaults(handler=cmd_simulate)
+
+    val = commands.add_parser("validate", help="the analytic-vs-physics validation report (the main job)",
+                              description="Run the model ladder at the paper's case and write a report: "
+                                          "DIR/index.html, DIR/report.md, DIR/metrics.json, DIR/figures/.")
+    val.add_argument("--out", metavar="DIR", default="report", help="report folder (default: ./report)")
+    val.add_argument("--config", metavar="FILE.toml", help="TOML file of parameters (default: the paper's case)")
+    val.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                     help="set a parameter (SI units)")
+    val.add_argument("--quick", action="store_true", help="reduced version for tests and CI (coarser output)")
+    val.set_defaults(handler=cmd_validate)
     return parser
 
 
@@ -117,6 +127,27 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(_format_summary(run))
         if args.out is not None:
             print(f"  wrote {args.out}/timeseries.csv, summary.json and fig2-4 PNG")
+    return EXIT_OK
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from .report import write_report
+    from .validate import validate
+
+    check_output_dir(args.out)
+    params = load_params(args.config, args.overrides)
+
+    def progress(message: str) -> None:
+        print(f"validate: {message}", file=sys.stderr, flush=True)
+
+    metrics, rungs = validate(params, quick=args.quick, progress=progress)
+    progress("writing report ...")
+    with staged_output(args.out) as staging:
+        write_json(staging / "metrics.json", metrics)
+        write_report(staging, metrics, rungs)
+    for verdict in metrics["verdicts"]:
+        print(f"{verdict['question']}\n  {verdict['answer']}")
+    print(f"report: {args.out}/index.html (also report.md, metrics.json, figures/)")
     return EXIT_OK
 
 

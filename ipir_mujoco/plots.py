@@ -27,24 +27,26 @@ def run_label(run: RunResult) -> str:
     return f"{run.engine}/{run.geometry}/{run.clutch}"
 
 
-def _new_figure(rows: int, height: float = 2.6) -> tuple[Figure, list]:
+def new_figure(rows: int, height: float = 2.6) -> tuple[Figure, list]:
     fig = Figure(figsize=(8.0, 0.6 + height * rows), layout="constrained")
     FigureCanvasAgg(fig)
     axes = [fig.add_subplot(rows, 1, i + 1) for i in range(rows)]
     return fig, axes
 
 
-def _legend_label(runs: Sequence[RunResult], run: RunResult, what: str) -> str:
-    return what if len(runs) == 1 else f"{what} ({run_label(run)})"
+def _legend_label(runs: Sequence[RunResult], labels: Sequence[str] | None, i: int, what: str) -> str:
+    if len(runs) == 1:
+        return what
+    return f"{what} ({labels[i] if labels else run_label(runs[i])})"
 
 
-def figure_crank(runs: Sequence[RunResult]) -> Figure:
+def figure_crank(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -> Figure:
     """Paper's Fig. 2: crank angle in revolutions (a) and cos(phi) (b) against time."""
-    fig, (ax_rev, ax_cos) = _new_figure(2)
-    for style, run in zip(STYLES, runs):
+    fig, (ax_rev, ax_cos) = new_figure(2)
+    for i, (style, run) in enumerate(zip(STYLES, runs)):
         t, phi = run.series["t"], run.series["phi"]
-        ax_rev.plot(t, phi / (2 * math.pi), style, color=REAR, label=_legend_label(runs, run, "phi"))
-        ax_cos.plot(t, np.cos(phi), style, color=REAR, lw=0.8, label=_legend_label(runs, run, "cos phi"))
+        ax_rev.plot(t, phi / (2 * math.pi), style, color=REAR, label=_legend_label(runs, labels, i, "phi"))
+        ax_cos.plot(t, np.cos(phi), style, color=REAR, lw=0.8, label=_legend_label(runs, labels, i, "cos phi"))
     ax_rev.set(ylabel="crank angle phi [rev]", title="(a) crank rotation")
     ax_cos.set(xlabel="time t [s]", ylabel="cos phi [-]", title="(b) cos of the crank angle")
     for ax in (ax_rev, ax_cos):
@@ -54,19 +56,19 @@ def figure_crank(runs: Sequence[RunResult]) -> Figure:
     return fig
 
 
-def figure_modules(runs: Sequence[RunResult]) -> Figure:
+def figure_modules(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -> Figure:
     """Paper's Fig. 3: module displacements (a), velocities (b), accelerations (c)."""
-    fig, axes = _new_figure(3)
+    fig, axes = new_figure(3)
     quantities = (("x", "displacement from start [m]", "(a) displacements"),
                   ("v", "velocity [m/s]", "(b) velocities"),
                   ("a", "acceleration [m/s^2]", "(c) accelerations"))
     for ax, (key, ylabel, title) in zip(axes, quantities):
-        for style, run in zip(STYLES, runs):
+        for i, (style, run) in enumerate(zip(STYLES, runs)):
             t = run.series["t"]
             ax.plot(t, run.series[key + "1"], style, color=REAR, lw=0.9,
-                    label=_legend_label(runs, run, f"module 1 (rear) {key}1"))
+                    label=_legend_label(runs, labels, i, f"module 1 (rear) {key}1"))
             ax.plot(t, run.series[key + "2"], style, color=FRONT, lw=0.9,
-                    label=_legend_label(runs, run, f"module 2 (front) {key}2"))
+                    label=_legend_label(runs, labels, i, f"module 2 (front) {key}2"))
         ax.set(ylabel=ylabel, title=title)
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
@@ -74,14 +76,14 @@ def figure_modules(runs: Sequence[RunResult]) -> Figure:
     return fig
 
 
-def figure_gap(runs: Sequence[RunResult]) -> Figure:
+def figure_gap(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -> Figure:
     """Paper's Fig. 4: gap S in dm (left axis) and its rate S_dot in m/s (right axis)."""
-    fig, (ax,) = _new_figure(1, height=3.4)
+    fig, (ax,) = new_figure(1, height=3.4)
     ax_rate = ax.twinx()
-    for style, run in zip(STYLES, runs):
+    for i, (style, run) in enumerate(zip(STYLES, runs)):
         t = run.series["t"]
-        ax.plot(t, run.series["S"] * 10.0, style, color=REAR, label=_legend_label(runs, run, "S"))
-        ax_rate.plot(t, run.series["S_dot"], style, color=FRONT, lw=0.8, label=_legend_label(runs, run, "S_dot"))
+        ax.plot(t, run.series["S"] * 10.0, style, color=REAR, label=_legend_label(runs, labels, i, "S"))
+        ax_rate.plot(t, run.series["S_dot"], style, color=FRONT, lw=0.8, label=_legend_label(runs, labels, i, "S_dot"))
     ax.set(xlabel="time t [s]", ylabel="gap S = x2 - x1 [dm]", title="gap between the modules and its rate")
     ax_rate.set_ylabel("gap rate S_dot [m/s]", color=FRONT)
     ax.grid(alpha=0.3)
@@ -97,12 +99,13 @@ PAPER_FIGURES = {
 }
 
 
-def write_paper_figures(runs: Sequence[RunResult], directory: str | Path, dpi: int = 120) -> list[Path]:
-    """Save the paper's Fig. 2-4 for ``runs`` as PNG files in ``directory``."""
+def write_paper_figures(runs: Sequence[RunResult], directory: str | Path, labels: Sequence[str] | None = None,
+                        dpi: int = 120) -> list[Path]:
+    """Save the paper's Fig. 2-4 for ``runs`` (legend ``labels``) as PNG files in ``directory``."""
     directory = Path(directory)
     written = []
     for name, build in PAPER_FIGURES.items():
         path = directory / name
-        build(runs).savefig(path, dpi=dpi)
+        build(runs, labels).savefig(path, dpi=dpi)
         written.append(path)
     return written

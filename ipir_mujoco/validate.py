@@ -1,0 +1,178 @@
+"""The validation job: the model ladder at the paper's case, checked and measured.
+
+Each rung of the ladder removes one idealization of the paper, so the change
+from one rung to the next is what that idealization costs. This version runs
+the analytic rungs; the MuJoCo and one-way-clutch rungs join as their engines
+land.
+
+``metrics.json`` (schema version 1)::
+
+    schema_version        int, 1
+    verdicts              list of {question, answer, evidence}: the report's opening
+    paper_checks          list of {key, label, reported, value, low, high, units,
+                          why, reproduced}: the paper's model against each figure
+                          the paper reports (see ipir_mujoco.paper_reference)
+    ladder                list of {name, engine, geometry, clutch, isolates,
+                          summary, change_vs_previous}; summary as CONTRACT.md;
+                          change_vs_previous maps each ladder figure to the
+                          relative change (new - old) / |old| against the rung
+                          before (null for the first rung or a zero reference)
+    clutch_pull           {fraction_of_time, min_reaction_n}: how much of the
+                          paper-model run has a locked clutch that would have to pull
+    params                the parameter set used (SI units)
+    settings              {t_end_s, quick, dt_out_s, rtol, atol}
+    versions              software versions
+    not_yet_evaluated     list of rungs whose engines are not built yet
+"""
+
+from __future__ import annotations
+
+import platform
+import sys
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+import analytic
+from analytic.params import RobotParams
+from analytic.results import Mode, RunResult
+
+from . import __version__
+from .paper_reference import check_paper_figures
+
+LADDER_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
+                  "min_clutch_reaction_n")
+
+PENDING_RUNGS = (
+    "MuJoCo, locks with the paper's rule (engine against equations)",
+    "analytic, one-way clutches that only push",
+    "MuJoCo, joint-limit ratchet (physics)",
+)
+
+
+@dataclass
+class Rung:
+    """One step of the model ladder."""
+
+    name: str
+    isolates: str  # the assumption this rung removes, in words
+    run: RunResult
+
+
+def run_ladder(params: RobotParams, t_end: float, dt_out: float, rtol: float, atol: float,
+               progress: Callable[[str], None]) -> list[Rung]:
+    """Run the rungs that exist, from the paper's model up."""
+    plan = (
+        ("paper model", "nothing: first-order kinematics (L >> r), massless rod, ideal locks",
+         params.replace(rod_mass=0.0, rod_inertia=0.0), "approx"),
+        ("exact geometry", "L >> r: the exact slider-crank", params.replace(rod_mass=0.0, rod_inertia=0.0),
+         "exact"),
+        ("with rod mass", f"the massless rod: rod of {params.rod_mass:g} kg", params, "exact"),
+    )
+    rungs = []
+    for i, (name, isolates, rung_params, geometry) in enumerate(plan, start=1):
+        started = time.perf_counter()
+        progress(f"[{i}/{len(plan)}] {name} ...")
+        run = analytic.simulate(rung_params, geometry, "kinematic", t_end, dt_out=dt_out, rtol=rtol, atol=atol)
+        progress(f"[{i}/{len(plan)}] {name}: {run.summary['revolutions']:.3f} rev "
+                 f"({time.perf_counter() - started:.2f} s)")
+        rungs.append(Rung(name, isolates, run))
+    return rungs
+
+
+def relative_change(new: float | None, old: float | None) -> float | None:
+    """(new - old) / |old|, or None where either is missing or old is zero."""
+    if new is None or old is None or old == 0:
+        return None
+    return (new - old) / abs(old)
+
+
+def clutch_pull(run: RunResult) -> dict:
+    """How much of the run has a locked clutch whose reaction is negative (would have to pull)."""
+    s = run.series
+    locked_reaction = np.where(s["mode"] == Mode.CONTRACTION, s["lambda2"],
+                               np.where(s["mode"] == Mode.EXPANSION, s["lambda1"], np.inf))
+    pulling = locked_reaction < 0
+    dt = np.diff(s["t"])
+    fraction = float(np.sum(dt * pulling[:-1]) / np.sum(dt))
+    return {"fraction_of_time": fraction, "min_reaction_n": run.summary["min_clutch_reaction_n"]}
+
+
+def software_versions() -> dict[str, str]:
+    import matplotlib
+    import mujoco
+    import scipy
+
+    return {"ipir_mujoco": __version__, "python": sys.version.split()[0], "numpy": np.__version__,
+            "scipy": scipy.__version__, "matplotlib": matplotlib.__version__, "mujoco": mujoco.__version__,
+            "platform": platform.platform()}
+
+
+def _percent(x: float | None) -> str:
+    return "n/a" if x is None else f"{100 * x:+.2f} %"
+
+
+def verdicts(checks: list[dict], rungs: list[Rung], pull: dict) -> list[dict]:
+    """The report's opening: plain questions, plain answers, the numbers behind them."""
+    n_ok = sum(c["reproduced"] for c in checks)
+    missed = [c["label"] for c in checks if not c["reproduced"]]
+    reproduce = {
+        "question": "Does the paper's model reproduce the paper's own figures?",
+        "answer": ("Yes" if not missed else "No") + f": {n_ok} of {len(checks)} reported figures land within "
+                  "the reading precision of the paper's plots" + ("" if not missed else f"; missed: {', '.join(missed)}"),
+        "evidence": "paper_checks",
+    }
+    engine = {
+        "question": "Does MuJoCo reproduce the paper's model when given the paper's assumptions?",
+        "answer": "Not evaluated yet: the MuJoCo engine is not part of this version.",
+        "evidence": "not_yet_evaluated",
+    }
+    paper, exact, rod = (r.run.summary for r in rungs[:3])
+    costs = {
+        "question": "What do the idealizations cost?",
+        "answer": (
+            f"First-order kinematics (L/r = {rungs[0].run.params.L / rungs[0].run.params.r:g}): the exact "
+            f"slider-crank changes crank revolutions by {_percent(relative_change(exact['revolutions'], paper['revolutions']))}, "
+            f"module 1 displacement by {_percent(relative_change(exact['x1_final'], paper['x1_final']))} and the "
+            f"end of the first contraction by {_percent(relative_change(exact['first_contraction_end_s'], paper['first_contraction_end_s']))}. "
+            f"The rod's mass changes revolutions by a further {_percent(relative_change(rod['revolutions'], exact['revolutions']))}. "
+            f"Ideal locks: in {100 * pull['fraction_of_time']:.1f} % of the paper-model run a locked clutch would "
+            f"have to pull, with up to {-pull['min_reaction_n']:.0f} N; a one-way clutch cannot, so the paper's "
+            "mode sequence is not physical there (the one-way-clutch model that quantifies this is not built yet)."
+        ),
+        "evidence": "ladder, clutch_pull",
+    }
+    return [reproduce, engine, costs]
+
+
+def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict) -> dict:
+    checks = check_paper_figures(rungs[0].run)
+    pull = clutch_pull(rungs[0].run)
+    ladder, previous = [], None
+    for rung in rungs:
+        summary = rung.run.summary
+        change = {k: (None if previous is None else relative_change(summary[k], previous[k])) for k in LADDER_FIGURES}
+        ladder.append({"name": rung.name, "engine": rung.run.engine, "geometry": rung.run.geometry,
+                       "clutch": rung.run.clutch, "isolates": rung.isolates, "params": rung.run.params.as_dict(),
+                       "summary": summary, "change_vs_previous": change})
+        previous = summary
+    return {
+        "schema_version": 1,
+        "verdicts": verdicts(checks, rungs, pull),
+        "paper_checks": checks,
+        "ladder": ladder,
+        "clutch_pull": pull,
+        "params": params.as_dict(),
+        "settings": settings,
+        "versions": software_versions(),
+        "not_yet_evaluated": list(PENDING_RUNGS),
+    }
+
+
+def validate(params: RobotParams, quick: bool = False, progress: Callable[[str], None] = lambda _m: None):
+    """Run the ladder and return (metrics, rungs). ``quick`` samples outputs 10x coarser."""
+    settings = {"t_end_s": 1.0, "quick": quick, "dt_out_s": 1e-3 if quick else 1e-4, "rtol": 1e-10, "atol": 1e-12}
+    rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
+    return build_metrics(params, rungs, settings), rungs

@@ -1,0 +1,73 @@
+"""The validation job: its numbers come from the runs, its report renders offline."""
+
+from __future__ import annotations
+
+import html
+import json
+import re
+
+import pytest
+
+import analytic
+from analytic import RobotParams
+from ipir_mujoco.cli import main
+from ipir_mujoco.paper_reference import REPORTED, check_paper_figures
+from ipir_mujoco.validate import validate
+
+
+@pytest.fixture(scope="module")
+def quick_validation():
+    return validate(RobotParams(), quick=True)
+
+
+def test_paper_checks_all_pass_for_the_papers_model(quick_validation):
+    metrics, _ = quick_validation
+    assert [c["key"] for c in metrics["paper_checks"]] == [f.key for f in REPORTED]
+    assert all(c["reproduced"] for c in metrics["paper_checks"])
+    assert metrics["verdicts"][0]["answer"].startswith("Yes: 8 of 8")
+
+
+def test_a_wrong_model_fails_the_paper_checks():
+    """The checks can fail: double the torque and the paper's figures are no longer reproduced."""
+    run = analytic.simulate(RobotParams(M=0.5), "approx")
+    failed = {c["key"] for c in check_paper_figures(run) if not c["reproduced"]}
+    assert {"revolutions", "peak_speed", "first_contraction_end_s"} <= failed
+
+
+def test_verdict_numbers_are_recomputed_from_independent_runs(quick_validation):
+    metrics, _ = quick_validation
+    base = RobotParams(rod_mass=0.0, rod_inertia=0.0)
+    paper = analytic.simulate(base, "approx").summary
+    exact = analytic.simulate(base, "exact").summary
+    expected = (exact["revolutions"] - paper["revolutions"]) / paper["revolutions"]
+    stated = metrics["ladder"][1]["change_vs_previous"]["revolutions"]
+    # same solver and tolerance (rtol 1e-10): only the output grid differs, which
+    # does not touch the end state, so the two agree to a few rtol
+    assert stated == pytest.approx(expected, abs=1e-8)
+    assert f"{100 * expected:+.2f} %" in metrics["verdicts"][2]["answer"]
+    # the largest pull of a lock: min over locked samples, which include every switch instant
+    assert metrics["clutch_pull"]["min_reaction_n"] == pytest.approx(paper["min_clutch_reaction_n"], rel=1e-8)
+    assert f"{-paper['min_clutch_reaction_n']:.0f} N" in metrics["verdicts"][2]["answer"]
+
+
+def test_validate_writes_a_self_contained_report(tmp_path, capsys):
+    out = tmp_path / "report"
+    assert main(["validate", "--quick", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "[3/3]" in captured.err  # progress shown
+    page = (out / "index.html").read_text()
+    assert "<script" not in page and "http://" not in page and "https://" not in page
+    assert page.count('src="data:image/png;base64,') == 4
+    markdown = (out / "report.md").read_text()
+    for name in re.findall(r"\]\((figures/[^)]+)\)", markdown):
+        assert (out / name).is_file()
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["schema_version"] == 1 and len(metrics["ladder"]) == 3
+    for verdict in metrics["verdicts"]:
+        assert html.escape(verdict["question"]) in page
+
+
+def test_validate_bad_parameter_exits_2_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "report"
+    assert main(["validate", "--quick", "--out", str(out), "--set", "L=0.01"]) == 2
+    assert "L=0.01" in capsys.readouterr().err and not out.exists()
