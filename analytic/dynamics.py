@@ -30,7 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .kinematics import Geometry, Linkage
+from .kinematics import Geometry, Linkage, Transfer
 from .params import RobotParams
 from .results import Mode
 
@@ -50,6 +50,17 @@ class ModeState(NamedTuple):
     kinetic: np.ndarray  # kinetic energy [J]
 
 
+class MassTerms(NamedTuple):
+    """Mass matrix entries in the coordinates (x1, phi) and their phi-derivatives."""
+
+    m11: np.ndarray  # total translating mass [kg]
+    m12: np.ndarray  # [kg m/rad]
+    m22: np.ndarray  # [kg m^2]
+    dm12: np.ndarray  # dM12/dphi (M11 is constant)
+    dm22: np.ndarray  # dM22/dphi
+    transfer: Transfer
+
+
 class OneDofDynamics:
     """The robot with one clutch locked, in a given geometry.
 
@@ -67,11 +78,37 @@ class OneDofDynamics:
             raise ValueError("rod mass needs the exact geometry; the first-order model has no rigid rod")
         self.include_rod = include_rod and (params.rod_mass > 0 or params.rod_inertia_value > 0)
 
-    def _terms(self, phi, mode: Mode):
-        """J_eff, dJ_eff/dphi, Q, P, dP/dphi and the transfer (S, K, dK)."""
+    def mass_terms(self, phi) -> MassTerms:
+        """The 2x2 mass matrix in (x1, phi) and its derivatives in phi.
+
+        T = 1/2 [x1_dot, omega] M [x1_dot, omega]^T with
+        M11 = m1 + m2 + m_rod, M12 = m2 K + m_rod a,
+        M22 = J_A + m2 K^2 + m_rod (a^2 + b^2) + I_rod g^2.
+        """
         p = self.params
         tr = self.linkage.transfer(phi)
         K, dK = tr.K, tr.dK
+        m11 = p.m1 + p.m2 + 0.0 * K
+        m12, dm12 = p.m2 * K, p.m2 * dK
+        m22, dm22 = p.J_A + p.m2 * K**2, 2.0 * p.m2 * K * dK
+        if self.include_rod:
+            rod = self.linkage.rod_motion(phi)
+            m, inertia = p.rod_mass, p.rod_inertia_value
+            m11 = m11 + m
+            m12, dm12 = m12 + m * rod.a, dm12 + m * rod.da
+            m22 = m22 + m * (rod.a**2 + rod.b**2) + inertia * rod.g**2
+            dm22 = dm22 + 2.0 * (m * (rod.a * rod.da + rod.b * rod.db) + inertia * rod.g * rod.dg)
+        return MassTerms(m11, m12, m22, dm12, dm22, tr)
+
+    def _terms(self, phi, mode: Mode):
+        """J_eff, dJ_eff/dphi, Q, P, dP/dphi, e, de, f, df and the transfer.
+
+        With x1_dot = e omega the locked-module system has J_eff = [e, 1] M [e, 1]^T
+        and total momentum P omega with P = M11 e + M12.
+        """
+        p = self.params
+        mt = self.mass_terms(phi)
+        K, dK = mt.transfer.K, mt.transfer.dK
         if mode is Mode.CONTRACTION:
             e, de = -K, -dK
         elif mode is Mode.EXPANSION:
@@ -79,20 +116,12 @@ class OneDofDynamics:
         else:
             raise ValueError(f"one-DOF dynamics needs a single locked module, got mode {mode.name}")
         f, df = e + K, de + dK  # front-module velocity coefficient and its derivative
-        J = p.J_A + p.m1 * e**2 + p.m2 * f**2
-        dJ = 2.0 * (p.m1 * e * de + p.m2 * f * df)
-        P = p.m1 * e + p.m2 * f
-        dP = p.m1 * de + p.m2 * df
-        if self.include_rod:
-            rod = self.linkage.rod_motion(phi)
-            m, inertia = p.rod_mass, p.rod_inertia_value
-            gx, dgx = e + rod.a, de + rod.da
-            J = J + m * (gx**2 + rod.b**2) + inertia * rod.g**2
-            dJ = dJ + 2.0 * (m * (gx * dgx + rod.b * rod.db) + inertia * rod.g * rod.dg)
-            P = P + m * gx
-            dP = dP + m * dgx
+        J = mt.m11 * e**2 + 2.0 * mt.m12 * e + mt.m22
+        dJ = 2.0 * mt.m11 * e * de + 2.0 * (mt.dm12 * e + mt.m12 * de) + mt.dm22
+        P = mt.m11 * e + mt.m12
+        dP = mt.m11 * de + mt.dm12
         Q = p.M - p.F_r1 * e - p.F_r2 * f
-        return J, dJ, Q, P, dP, e, de, f, df, tr
+        return J, dJ, Q, P, dP, e, de, f, df, mt.transfer
 
     def acceleration(self, phi, omega, mode: Mode):
         """Crank angular acceleration alpha [rad/s^2] in ``mode``."""

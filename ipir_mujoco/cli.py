@@ -56,7 +56,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="kinematic: the paper's rule, lock by the sign of S_dot (default); "
                           "unilateral: one-way clutches that can only push")
     sim.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
-                     help="MuJoCo clutch implementation: joint-limit ratchet or velocity-triggered lock")
+                     help="MuJoCo clutch implementation: joint-limit ratchet (default with --clutch unilateral) "
+                          "or velocity-triggered lock (default with --clutch kinematic)")
+    sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
+                     help="MuJoCo timestep (default 1e-4 s, converged for the paper's case; see mjcf/README.md)")
+    sim.add_argument("--mjcf", metavar="FILE.xml", default=None,
+                     help="MJCF template for --engine mujoco (default: the shipped mjcf/inchworm.xml)")
     _add_model_options(sim)
     sim.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS", help="simulated time (default 1 s)")
     sim.add_argument("--dt-out", type=float, default=1e-4, metavar="SECONDS",
@@ -85,10 +90,42 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
         if args.geometry == "approx":
             raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real "
                                  "linkage; allowed: --geometry exact (or leave it out)")
-        raise ParameterError("--engine mujoco is not available yet; allowed now: --engine analytic")
+        from .engine import simulate_mujoco
+        from .model import SolverSettings
+
+        implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
+        settings = SolverSettings() if args.timestep is None else SolverSettings(timestep=args.timestep)
+        progress = _progress_printer(args.t_end) if not args.json else None
+        return simulate_mujoco(params, args.clutch, implementation, args.t_end, dt_out=args.dt_out,
+                               settings=settings, mjcf=args.mjcf, progress=progress)
+    for option, value in (("--mjcf", args.mjcf), ("--timestep", args.timestep)):
+        if value is not None:
+            raise ParameterError(f"{option} {value} applies only to --engine mujoco")
     if args.mujoco_clutch is not None:
         raise ParameterError(f"--mujoco-clutch {args.mujoco_clutch} applies only to --engine mujoco")
     return analytic.simulate(params, args.geometry or "approx", args.clutch, args.t_end, dt_out=args.dt_out)
+
+
+def _progress_printer(t_end: float):
+    """Progress on stderr for runs long enough to wait for (simulated time > 2 s)."""
+    if t_end <= 2.0:
+        return None
+
+    if sys.stderr.isatty():
+        def report(t: float) -> None:
+            print(f"\rsimulated {t:6.2f} / {t_end:g} s", end="" if t < t_end - 0.05 else "\n",
+                  file=sys.stderr, flush=True)
+        return report
+
+    milestones = iter([t_end * k / 10 for k in range(1, 11)])
+    state = {"next": next(milestones)}
+
+    def report_lines(t: float) -> None:  # a log file gets one line per tenth of the run
+        if t >= state["next"] - 1e-9:
+            print(f"simulated {t:.2f} / {t_end:g} s", file=sys.stderr, flush=True)
+            state["next"] = next(milestones, float("inf"))
+
+    return report_lines
 
 
 def _format_summary(run: RunResult) -> str:

@@ -1,0 +1,91 @@
+"""The robot with no clutches and no resistance: both modules slide freely.
+
+Two degrees of freedom (x1, phi) with the mass matrix of
+:meth:`analytic.dynamics.OneDofDynamics.mass_terms`:
+
+    M11 x1_ddot + M12 alpha + M12' omega^2       = 0
+    M12 x1_ddot + M22 alpha + 1/2 M22' omega^2   = M
+
+The first row is conservation of momentum along the pipe: nothing outside the
+robot pushes along x. A check case for the physics engine, not a robot that
+walks (it only shakes in place).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .dynamics import OneDofDynamics
+from .errors import ParameterError, SimulationError
+from .kinematic_clutch import _check_run_options
+from .kinematics import Geometry
+from .params import RobotParams
+from .results import Mode, RunResult
+
+
+def free_accelerations(dyn: OneDofDynamics, phi, omega):
+    """(x1_ddot [m/s^2], alpha [rad/s^2]) of the free mechanism; arrays of phi's shape."""
+    mt = dyn.mass_terms(phi)
+    rhs1 = -mt.dm12 * omega**2
+    rhs2 = dyn.params.M - 0.5 * mt.dm22 * omega**2
+    det = mt.m11 * mt.m22 - mt.m12**2
+    return (mt.m22 * rhs1 - mt.m12 * rhs2) / det, (mt.m11 * rhs2 - mt.m12 * rhs1) / det
+
+
+def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT, t_end: float = 1.0, *,
+                  dt_out: float = 1e-4, rtol: float = 1e-10, atol: float = 1e-12) -> RunResult:
+    """Simulate the clutch-free, resistance-free mechanism from (phi0, omega0).
+
+    Initial module velocities: module 1 at rest unless the gap shrinks, as in
+    the MuJoCo engine's start (the same split, so both start identically).
+    """
+    if params.F_r1 != 0 or params.F_r2 != 0:
+        raise ParameterError(f"F_r1={params.F_r1}, F_r2={params.F_r2}: the free mechanism has no clutches, so "
+                             "modules also move backward, where a forward-only resistance is undefined; "
+                             "allowed: F_r1 = F_r2 = 0")
+    _check_run_options(t_end, dt_out, rtol, atol)
+    started = time.perf_counter()
+    dyn = OneDofDynamics(params, geometry)
+    link = dyn.linkage
+    K0 = float(link.transfer(params.phi0).K)
+    v10 = max(-K0 * params.omega0, 0.0)
+
+    def rhs(_t, y):
+        phi, omega, _x1, v1 = y
+        x1dd, alpha = free_accelerations(dyn, phi, omega)
+        return [omega, alpha, v1, x1dd]
+
+    n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
+    times = np.linspace(0.0, t_end, n_out + 1)
+    sol = solve_ivp(rhs, (0.0, t_end), [params.phi0, params.omega0, 0.0, v10], method="DOP853",
+                    rtol=rtol, atol=atol, t_eval=times)
+    if sol.status != 0:
+        raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s: {sol.message}")
+    phi, omega, x1, v1 = sol.y
+    tr = link.transfer(phi)
+    x1dd, alpha = free_accelerations(dyn, phi, omega)
+    S_dot = tr.K * omega
+    zeros = np.zeros_like(phi)
+    series = {
+        "t": sol.t, "phi": phi, "omega": omega, "alpha": alpha, "x1": x1, "x2": x1 + tr.S - tr.S[0],
+        "v1": v1, "v2": v1 + S_dot, "a1": x1dd, "a2": x1dd + tr.dK * omega**2 + tr.K * alpha,
+        "S": tr.S, "S_dot": S_dot, "lambda1": zeros, "lambda2": zeros,
+        "mode": np.full(phi.shape, int(Mode.BOTH_MOVING)),
+    }
+    mt0, mt1 = dyn.mass_terms(phi[0]), dyn.mass_terms(phi[-1])
+
+    def kinetic(mt, v, w):
+        return 0.5 * (mt.m11 * v**2 + 2 * mt.m12 * v * w + mt.m22 * w**2)
+
+    motor = params.M * (phi[-1] - phi[0])
+    gained = float(kinetic(mt1, v1[-1], omega[-1]) - kinetic(mt0, v1[0], omega[0]))
+    energy = {"motor_work_j": float(motor), "kinetic_j": gained, "friction_j": 0.0,
+              "residual_j": float(motor - gained)}
+    return RunResult(engine="analytic", geometry=dyn.geometry.value, clutch="none", params=params, t_end=t_end,
+                     series=series, energy=energy, wall_time_s=time.perf_counter() - started,
+                     settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
+                               "rod_modelled": dyn.include_rod})

@@ -1,0 +1,262 @@
+"""Simulate the robot in MuJoCo and fill the shared result container.
+
+The stepping loop: before each ``mj_step`` the clutch controller updates its
+limits or locks; after it, the loop accumulates the energy terms and, every
+output interval, records a sample. MuJoCo warnings are intercepted (nothing is
+written to ``MUJOCO_LOG.TXT``) and turn into a :class:`SimulationError` with the
+time and MuJoCo's message, as does a non-finite state.
+
+Sampling: a sample at time t_{n+1} holds the state after step n, the module
+accelerations of that step ((v_{n+1} - v_n) / dt) and the constraint forces
+MuJoCo computed for it.
+
+Energy audit, per step with the velocities v_{n+1} that move the positions:
+motor work M * (phi - phi0) (exact for MuJoCo's update), friction work from
+the frictionloss rows, the work absorbed by the clutch rows (``clutch_j``),
+and the kinetic energy from ``mj_energyVel``. ``residual_j`` = motor - kinetic
+- friction is what the soft constraints (clutches and loop) and the time
+discretization took together. The loop's own share is not reported: its
+constraint power measured this way carries an O(dt) bookkeeping term (J(q_n)
+v_{n+1} != 0 on a curved constraint) that the discretization term cancels, so
+the split would be noise, not physics.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import time
+from typing import Callable, Iterator
+
+import mujoco
+import numpy as np
+
+from analytic.errors import ParameterError, SimulationError
+from analytic.params import RobotParams
+from analytic.results import COLUMNS, Mode, RunResult
+
+from .clutches import EQUALITY_ROW, LIMIT_ROW, Locks, NoClutch, Ratchet
+from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_HINGE, SolverSettings, build_model,
+                    dof_address, qpos_address, set_closed_loop_state)
+
+FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+# Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
+# along the rod), motor power M omega [W], total momentum along x [kg m/s].
+EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum")
+IMPLEMENTATIONS = ("ratchet", "lock", "none")
+
+
+@contextlib.contextmanager
+def captured_warnings() -> Iterator[list[str]]:
+    """Route MuJoCo's warning text into a list instead of MUJOCO_LOG.TXT and stderr."""
+    messages: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(messages.append)
+    try:
+        yield messages
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def _warning_count(data: mujoco.MjData) -> int:
+    return sum(int(w.number) for w in data.warning)
+
+
+def _mode(rear_held: bool, front_held: bool) -> int:
+    if rear_held and front_held:
+        return int(Mode.BOTH_LOCKED)
+    if front_held:
+        return int(Mode.CONTRACTION)
+    if rear_held:
+        return int(Mode.EXPANSION)
+    return int(Mode.BOTH_MOVING)
+
+
+def simulate_mujoco(
+    params: RobotParams,
+    clutch: str = "unilateral",
+    implementation: str = "ratchet",
+    t_end: float = 1.0,
+    *,
+    dt_out: float = 1e-4,
+    settings: SolverSettings = SolverSettings(),
+    mjcf=None,
+    progress: Callable[[float], None] | None = None,
+) -> RunResult:
+    """Run MuJoCo on the real linkage.
+
+    ``implementation``: 'ratchet' (joint-limit ratchet; one-way by
+    construction, so ``clutch`` must be 'unilateral'), 'lock' (velocity-
+    triggered locks released by ``clutch`` = 'kinematic', the paper's rule, or
+    'unilateral', a lock that would pull lets go), or 'none' (no clutches).
+    ``dt_out`` [s] must be a whole number of timesteps. ``progress`` is called
+    with the simulated time about every 0.1 s of it.
+    """
+    if implementation not in IMPLEMENTATIONS:
+        raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
+    if clutch not in ("kinematic", "unilateral"):
+        raise ParameterError(f"clutch={clutch!r} is unknown; allowed: kinematic, unilateral")
+    if implementation == "ratchet" and clutch == "kinematic":
+        raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
+                             "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
+    for name, value in (("t_end", t_end), ("dt_out", dt_out)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
+    steps_per_sample = round(dt_out / settings.timestep)
+    if steps_per_sample < 1 or abs(steps_per_sample * settings.timestep - dt_out) > 1e-9 * dt_out:
+        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
+                             f"({settings.timestep} s)")
+    n_samples = max(1, math.ceil(t_end / dt_out - 1e-9))
+
+    started = time.perf_counter()
+    model = build_model(params, settings, mjcf, ratchet=implementation == "ratchet")
+    data = mujoco.MjData(model)
+    with captured_warnings() as messages:
+        set_closed_loop_state(model, data, params)
+        if implementation == "ratchet":
+            controller = Ratchet(model, data)
+        elif implementation == "lock":
+            controller = Locks(model, data, clutch, params.r, params.L)
+        else:
+            controller = NoClutch(model, data)
+        recorder = _Recorder(model, data, params, n_samples + 1)
+        data.ctrl[model.actuator(MOTOR).id] = params.M
+        mujoco.mj_forward(model, data)
+        _check(data, messages, 0.0)
+        recorder.start(controller)
+        next_report = 0.1
+        for _sample in range(n_samples):
+            for _step in range(steps_per_sample):
+                controller.before_step()
+                recorder.before_step()
+                mujoco.mj_step(model, data)
+                controller.after_step()
+                recorder.after_step()
+            _check(data, messages, recorder.last_time)
+            recorder.sample(controller)
+            if progress is not None and data.time >= next_report:
+                progress(float(data.time))
+                next_report += 0.1
+        mujoco.mj_forward(model, data)  # energy terms at the final state
+        _check(data, messages, recorder.last_time, recorder.warnings_seen)
+        energy = recorder.energy()
+
+    label = {"ratchet": "unilateral", "lock": clutch, "none": "none"}[implementation]
+    return RunResult(
+        engine="mujoco",
+        geometry="exact",
+        clutch=label,
+        params=params,
+        t_end=float(data.time),
+        series=recorder.series(),
+        energy=energy,
+        wall_time_s=time.perf_counter() - started,
+        settings={"mujoco_clutch": implementation, "clutch_rule": clutch, "dt_out": dt_out,
+                  "mujoco_version": mujoco.__version__, **settings.as_dict()},
+    )
+
+
+def _check(data: mujoco.MjData, messages: list[str], t_good: float, seen: int | None = None) -> None:
+    """Raise on a MuJoCo warning or a non-finite state.
+
+    MuJoCo passes the first occurrence of each warning to the user handler, so
+    ``messages`` catches every warning of a fresh MjData; the counters
+    (``seen``: the count at the start) are read only when asked, as reading
+    them costs more than a step. ``t_good`` [s] is the last sample known good:
+    MuJoCo resets the state, clock included, when it detects a bad one.
+    """
+    if messages or (seen is not None and _warning_count(data) > seen):
+        reason = messages[0] if messages else "MuJoCo raised a warning"
+        raise SimulationError(f"MuJoCo became unstable after t={t_good:.6g} s: {reason} "
+                              "(a smaller --timestep may carry the run further)")
+    if not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))):
+        raise SimulationError(f"non-finite state after t={t_good:.6g} s")
+
+
+class _Recorder:
+    """Samples, energy accumulators and constraint-force bookkeeping."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int):
+        self.model, self.data, self.params = model, data, params
+        self.q = [qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)]
+        self.v = [dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
+        self.slide_dofs = np.array(self.v[1:])
+        self.loop_id = model.equality(LOOP).id
+        self.dt = model.opt.timestep
+        self.table = {c: np.empty(capacity) for c in COLUMNS + EXTRA_COLUMNS}
+        self.count = 0
+        self.v_before = np.zeros(model.nv)
+        self.work = {"friction": 0.0, "clutch": 0.0}
+        self.warnings_seen = 0
+
+    def start(self, controller) -> None:
+        self.phi0 = float(self.data.qpos[self.q[0]])
+        self.x0 = self.data.qpos[[self.q[1], self.q[2]]].copy()
+        self.kinetic0 = float(self.data.energy[1])
+        self.v_before[:] = self.data.qvel
+        self.warnings_seen = _warning_count(self.data)
+        self.sample(controller, initial=True)
+
+    def before_step(self) -> None:
+        self.v_before[:] = self.data.qvel
+
+    def after_step(self) -> None:
+        d = self.data
+        n = d.nefc
+        types, ids, forces = d.efc_type[:n], d.efc_id[:n], d.efc_force[:n]
+        v = d.qvel
+        # Constraint power with the velocities that moved the positions.
+        friction = float(np.sum(forces[types == FRICTION_ROW] * v[ids[types == FRICTION_ROW]]))
+        clutch = 0.0
+        limit = types == LIMIT_ROW
+        if limit.any():
+            clutch += float(np.sum(forces[limit] * v[self.model.jnt_dofadr[ids[limit]]]))
+        lock = (types == EQUALITY_ROW) & (ids != self.loop_id)
+        if lock.any():
+            lock_dofs = self.model.jnt_dofadr[self.model.eq_obj1id[ids[lock]]]
+            clutch += float(np.sum(forces[lock] * v[lock_dofs]))
+        self.work["friction"] -= friction * self.dt
+        self.work["clutch"] -= clutch * self.dt
+
+    def sample(self, controller, initial: bool = False) -> None:
+        d, p, i = self.data, self.params, self.count
+        q, v = d.qpos, d.qvel
+        phi, omega = q[self.q[0]], v[self.v[0]]
+        x1, x2 = q[self.q[1]] - self.x0[0], q[self.q[2]] - self.x0[1]
+        accel = np.zeros(3) if initial else (v[self.v] - self.v_before[self.v]) / self.dt
+        held, reactions = controller.reactions()
+        beta = phi + q[self.q[3]]
+        rod_axis = np.array([math.cos(beta), math.sin(beta), 0.0])
+        loop_rows = np.flatnonzero((d.efc_type[:d.nefc] == EQUALITY_ROW) & (d.efc_id[:d.nefc] == self.loop_id))
+        rod_force = float(d.efc_force[loop_rows] @ rod_axis) if loop_rows.size == 3 else 0.0
+        row = {
+            "t": d.time, "phi": phi, "omega": omega, "alpha": accel[0], "x1": x1, "x2": x2,
+            "v1": v[self.v[1]], "v2": v[self.v[2]], "a1": accel[1], "a2": accel[2],
+            "S": q[self.q[2]] + p.r + p.L - q[self.q[1]], "S_dot": v[self.v[2]] - v[self.v[1]],
+            "lambda1": reactions[0], "lambda2": reactions[1], "mode": _mode(*held),
+            "rod_force": rod_force, "motor_power": p.M * omega, "momentum": self._momentum_x(),
+        }
+        for name, value in row.items():
+            self.table[name][i] = value
+        self.count += 1
+        self.last_time = float(d.time)
+
+    def _momentum_x(self) -> float:
+        """Total linear momentum of the robot along the pipe [kg m/s]."""
+        mujoco.mj_subtreeVel(self.model, self.data)
+        return float(self.data.subtree_linvel[0, 0] * self.model.body_subtreemass[0])
+
+    def series(self) -> dict[str, np.ndarray]:
+        out = {name: values[: self.count].copy() for name, values in self.table.items()}
+        out["mode"] = out["mode"].astype(int)
+        return out
+
+    def energy(self) -> dict[str, float]:
+        motor = self.params.M * (float(self.data.qpos[self.q[0]]) - self.phi0)
+        kinetic = float(self.data.energy[1]) - self.kinetic0
+        friction = self.work["friction"]
+        residual = motor - kinetic - friction
+        return {
+            "motor_work_j": motor, "kinetic_j": kinetic, "friction_j": friction, "residual_j": residual,
+            "clutch_j": self.work["clutch"],
+        }

@@ -1,0 +1,225 @@
+"""Build the MuJoCo model of the robot from a parameter set, through MjSpec.
+
+The shipped ``mjcf/inchworm.xml`` is the template: it names every element and
+sets the structure (slides, crank hinge, rod hinge, the loop-closing
+``connect``, clutch locks, motor). :func:`build_model` loads it with
+``mujoco.MjSpec`` and writes every number of the parameter set into it (masses,
+inertias, lengths, resistances) and the solver settings, then compiles. No XML
+text is edited.
+
+Element names used by the engine (read by name, never by index) are the
+constants below.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from analytic.errors import ParameterError
+from analytic.params import RobotParams
+
+from .resources import mjcf_dir
+
+REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "crank_hinge", "rod_hinge"
+REAR_LOCK, FRONT_LOCK, LOOP = "rear_lock", "front_lock", "rod_to_front"
+MOTOR, ROD_END = "crank_motor", "rod_end"
+# Share of m1 carried by the crank body; the rest is the module body. Both
+# translate with module 1, so the split changes nothing but must keep each > 0.
+CRANK_MASS_SHARE = 0.01
+# Slide range far beyond any run (1000 km): only the lower bound ever acts.
+RANGE_FAR = 1e6
+
+INTEGRATORS = {"euler": mujoco.mjtIntegrator.mjINT_EULER, "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+               "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT, "rk4": mujoco.mjtIntegrator.mjINT_RK4}
+
+
+def default_mjcf() -> Path:
+    """The shipped MJCF template."""
+    return mjcf_dir() / "inchworm.xml"
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """MuJoCo settings; the defaults are the converged ones (see ``mjcf/README.md``).
+
+    ``constraint_time_constant`` [s] (default: 2 timesteps) is the solref time
+    constant of every constraint: the loop, clutch limits and locks, and the
+    resistances' friction rows. ``solimp`` is MuJoCo's impedance triple.
+    """
+
+    timestep: float = 1e-4
+    integrator: str = "implicitfast"
+    constraint_time_constant: float | None = None
+    solimp: tuple[float, float, float] = (0.99, 0.999, 0.001)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.timestep) and 0 < self.timestep <= 1e-2):
+            raise ParameterError(f"timestep={self.timestep} s is out of range; allowed: 0 < timestep <= 0.01 s")
+        if self.integrator not in INTEGRATORS:
+            raise ParameterError(f"integrator={self.integrator!r} is unknown; allowed: {', '.join(INTEGRATORS)}")
+        tc = self.time_constant
+        if not (math.isfinite(tc) and tc >= 2 * self.timestep * (1 - 1e-12)):
+            raise ParameterError(f"constraint_time_constant={tc} s is out of range; allowed: >= 2 timesteps "
+                                 f"({2 * self.timestep} s), MuJoCo's stability limit")
+        d0, d1, width = self.solimp
+        if not (0 < d0 <= d1 < 1 and width > 0):
+            raise ParameterError(f"solimp={self.solimp} is out of range; allowed: 0 < d0 <= d1 < 1, width > 0")
+
+    @property
+    def time_constant(self) -> float:
+        return 2 * self.timestep if self.constraint_time_constant is None else self.constraint_time_constant
+
+    def as_dict(self) -> dict:
+        return {**asdict(self), "constraint_time_constant": self.time_constant}
+
+
+def _check_params(params: RobotParams) -> None:
+    if params.rod_mass <= 0:
+        raise ParameterError(f"rod_mass={params.rod_mass} kg is out of range for the MuJoCo engine; allowed: "
+                             "rod_mass > 0 (the rod is a body in the loop)")
+    if params.rod_inertia_value <= 0:
+        raise ParameterError(f"rod_inertia={params.rod_inertia_value} kg m^2 is out of range for the MuJoCo "
+                             "engine; allowed: rod_inertia > 0")
+
+
+def load_spec(mjcf: str | Path | None = None) -> mujoco.MjSpec:
+    """Parse an MJCF file into an MjSpec; a missing or broken file is a ParameterError."""
+    path = Path(mjcf) if mjcf is not None else default_mjcf()
+    if not path.is_file():
+        raise ParameterError(f"MJCF file {str(path)!r} does not exist")
+    try:
+        return mujoco.MjSpec.from_file(str(path))
+    except ValueError as exc:
+        message = " ".join(str(exc).split())
+        raise ParameterError(f"MJCF file {str(path)!r} is not a valid model: {message}") from None
+
+
+def _element(getter, name: str, path_hint: str):
+    element = getter(name)
+    if element is None:
+        raise ParameterError(f"MJCF {path_hint} has no element named {name!r}, which the engine needs")
+    return element
+
+
+def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
+               mjcf: str | Path | None = None, ratchet: bool = False) -> mujoco.MjSpec:
+    """The template with ``params`` and ``settings`` written in (not compiled).
+
+    ``ratchet`` makes both slides limited (the joint-limit ratchet clutch); the
+    engine raises their lower bounds as the modules advance.
+    """
+    _check_params(params)
+    spec = load_spec(mjcf)
+    hint = str(mjcf or default_mjcf())
+    body = lambda name: _element(spec.body, name, hint)  # noqa: E731
+    joint = lambda name: _element(spec.joint, name, hint)  # noqa: E731
+    r, L = params.r, params.L
+
+    rear, crank, rod, front = body("rear_module"), body("crank"), body("rod"), body("front_module")
+    rear.mass = (1 - CRANK_MASS_SHARE) * params.m1
+    crank.mass = CRANK_MASS_SHARE * params.m1
+    crank.ipos = [0, 0, 0]
+    crank.inertia = [params.J_A / 2, params.J_A / 2, params.J_A]  # a disc: J_A about the axis
+    _element(spec.geom, "crank_arm", hint).fromto = [0, 0, 0, r, 0, 0]
+
+    rod.pos = [r, 0, 0]
+    rod.mass = params.rod_mass
+    rod.ipos = [L / 2, 0, 0]
+    i_rod = params.rod_inertia_value
+    rod.inertia = [1e-3 * i_rod, i_rod, i_rod]  # slender: tiny about its own axis
+    _element(spec.geom, "rod_bar", hint).fromto = [0, 0, 0, L, 0, 0]
+    _element(spec.site, ROD_END, hint).pos = [L, 0, 0]
+
+    front.pos = [r + L, 0, 0]  # reference pose (all joints 0): crank points at C, S = r + L
+    front.mass = params.m2
+    loop = _element(spec.equality, LOOP, hint)
+    loop.data[0:3] = [L, 0, 0]  # C in the rod's frame
+
+    joint(REAR_SLIDE).frictionloss = params.F_r1
+    joint(FRONT_SLIDE).frictionloss = params.F_r2
+
+    spec.option.timestep = settings.timestep
+    spec.option.integrator = INTEGRATORS[settings.integrator]
+    solref = [settings.time_constant, 1.0]
+    solimp = [*settings.solimp, 0.5, 2.0]
+    for name in (REAR_SLIDE, FRONT_SLIDE):
+        j = joint(name)
+        if ratchet:
+            j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+            j.range = [-RANGE_FAR, RANGE_FAR]  # the engine sets the lower bound before the first step
+        j.solref_limit, j.solimp_limit = solref, solimp
+        j.solref_friction, j.solimp_friction = solref, solimp
+    for name in (LOOP, REAR_LOCK, FRONT_LOCK):
+        eq = _element(spec.equality, name, hint)
+        eq.solref, eq.solimp = solref, solimp
+    return spec
+
+
+def build_model(params: RobotParams, settings: SolverSettings = SolverSettings(),
+                mjcf: str | Path | None = None, ratchet: bool = False) -> mujoco.MjModel:
+    """Compile the robot for ``params`` (see :func:`build_spec`)."""
+    spec = build_spec(params, settings, mjcf, ratchet)
+    try:
+        return spec.compile()
+    except ValueError as exc:
+        message = " ".join(str(exc).split())
+        raise ParameterError(f"the MuJoCo model does not compile for these parameters: {message}") from None
+
+
+def closed_loop_pose(params: RobotParams, phi: float) -> dict[str, float]:
+    """Joint positions that close the loop at crank angle ``phi`` with module 1 at 0.
+
+    Plane geometry of the MuJoCo model itself: the rod leaves B = r (cos phi,
+    sin phi) and ends at C on the x axis, so its absolute angle is
+    beta = asin(-r sin(phi) / L); the rod hinge holds beta - phi, and module 2's
+    slide, measured from the reference pose at x = r + L, holds C_x - (r + L).
+    """
+    r, L = params.r, params.L
+    beta = math.asin(-r * math.sin(phi) / L)
+    c_x = r * math.cos(phi) + L * math.cos(beta)
+    return {REAR_SLIDE: 0.0, CRANK_HINGE: phi, ROD_HINGE: beta - phi, FRONT_SLIDE: c_x - (r + L)}
+
+
+def qpos_address(model: mujoco.MjModel, joint_name: str) -> int:
+    return int(model.jnt_qposadr[model.joint(joint_name).id])
+
+
+def dof_address(model: mujoco.MjModel, joint_name: str) -> int:
+    return int(model.jnt_dofadr[model.joint(joint_name).id])
+
+
+def set_closed_loop_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
+    """Loop-consistent pose and velocities for (phi0, omega0) from rest or motion.
+
+    Velocities: the crank turns at omega0, the rod hinge follows from the
+    loop, and the gap rate that motion implies goes to the module the paper's
+    clutch rule would free (module 1 if the gap shrinks, module 2 if it grows);
+    the gap rate is read from MuJoCo's own kinematics (the rod end's velocity).
+    """
+    mujoco.mj_resetData(model, data)
+    for name, value in closed_loop_pose(params, params.phi0).items():
+        data.qpos[qpos_address(model, name)] = value
+    if params.omega0 != 0.0:
+        r, L, phi = params.r, params.L, params.phi0
+        beta = math.asin(-r * math.sin(phi) / L)
+        beta_rate = -r * math.cos(phi) * params.omega0 / (L * math.cos(beta))
+        data.qvel[dof_address(model, CRANK_HINGE)] = params.omega0
+        data.qvel[dof_address(model, ROD_HINGE)] = beta_rate - params.omega0
+        mujoco.mj_forward(model, data)
+        gap_rate = site_velocity_x(model, data, ROD_END)  # module 1 at rest: C's speed is the gap rate
+        target = REAR_SLIDE if gap_rate < 0 else FRONT_SLIDE
+        # freeing module 1 at -gap_rate carries A forward and leaves C (module 2) at rest
+        data.qvel[dof_address(model, target)] = abs(gap_rate)
+    mujoco.mj_forward(model, data)
+
+
+def site_velocity_x(model: mujoco.MjModel, data: mujoco.MjData, site: str) -> float:
+    """World-frame x velocity of a site [m/s] (needs mj_forward or a step first)."""
+    velocity = np.zeros(6)
+    mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_SITE, model.site(site).id, velocity, 0)
+    return float(velocity[3])
