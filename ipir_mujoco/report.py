@@ -20,7 +20,7 @@ import numpy as np
 from analytic.results import Mode
 
 from .plots import new_figure, write_paper_figures
-from .validate import LADDER_FIGURES, Rung
+from .validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
 
 
 @dataclass
@@ -93,7 +93,8 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
           "yes" if c["reproduced"] else "NO", c["why"]] for c in metrics["paper_checks"]]))
     for key in ("fig2_crank.png", "fig3_modules.png", "fig4_gap.png"):
         blocks.append(Image(figures[key], {
-            "fig2_crank.png": "Paper's Fig. 2: crank angle in revolutions and cos phi; every rung overlaid.",
+            "fig2_crank.png": "Paper's Fig. 2: crank angle in revolutions and cos phi; the paper's model (solid), "
+                              "MuJoCo with the paper's locks (dashed) and with one-way clutches (dotted).",
             "fig3_modules.png": "Paper's Fig. 3: module displacements (from the start), velocities, accelerations.",
             "fig4_gap.png": "Paper's Fig. 4: gap S in dm and its rate."}[key]))
 
@@ -109,7 +110,7 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
             cells.append(_fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
     blocks.append(Table(header, rows))
-    blocks.append(Paragraph("Not evaluated yet (their engines are not built in this version): "
+    blocks.append(Paragraph("Not evaluated yet (not built in this version): "
                             + "; ".join(metrics["not_yet_evaluated"]) + "."))
 
     pull = metrics["clutch_pull"]
@@ -121,6 +122,8 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
     blocks.append(Image(figures["clutch_reactions.png"], "Locked-clutch reactions against crank angle."))
 
     blocks.append(Heading("Energy audit"))
+    blocks.append(Paragraph("For the equations the residual is the integration error; for MuJoCo it is what "
+                            "the soft constraints and the time stepping took."))
     blocks.append(Table(["rung", "motor work [J]", "kinetic [J]", "friction [J]", "residual [J]",
                          "residual / motor work"],
                         [[r["name"], _fmt(e["motor_work_j"], 8), _fmt(e["kinetic_j"], 8), _fmt(e["friction_j"], 8),
@@ -132,7 +135,10 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
     settings = metrics["settings"]
     blocks.append(Paragraph(f"Analytic solver: DOP853, rtol {settings['rtol']:g}, atol {settings['atol']:g}, "
                             f"output every {settings['dt_out_s']:g} s plus every mode switch"
-                            + (" (quick run)." if settings["quick"] else ".")))
+                            + (" (quick run)." if settings["quick"] else ".")
+                            + f" MuJoCo: {settings['mujoco']['integrator']}, timestep {settings['mujoco']['timestep']:g} s, "
+                            f"constraint time constant {settings['mujoco']['constraint_time_constant']:g} s, "
+                            f"solimp {tuple(settings['mujoco']['solimp'])} (evidence: mjcf/README.md)."))
     blocks.append(Table(["software", "version"], [[k, v] for k, v in metrics["versions"].items()]))
     blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/validate.py)."))
     return blocks
@@ -191,7 +197,8 @@ def write_report(folder: Path, metrics: dict, rungs: list[Rung]) -> None:
     """Write figures/, report.md and index.html into ``folder`` (metrics.json is the caller's)."""
     figures_dir = folder / "figures"
     figures_dir.mkdir(parents=True, exist_ok=True)
-    write_paper_figures([r.run for r in rungs], figures_dir, labels=[r.name for r in rungs])
+    drawn = [r for r in rungs if r.name in FIGURE_RUNGS]
+    write_paper_figures([r.run for r in drawn], figures_dir, labels=[r.name for r in drawn])
     figure_clutch_reactions(rungs[0], figures_dir / "clutch_reactions.png")
     figures = {p.name: f"figures/{p.name}" for p in figures_dir.iterdir()}
     blocks = build_blocks(metrics, figures)
