@@ -10,6 +10,7 @@ from .errors import ParameterError, SimulationError
 from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
 from .params import PARAMETER_NAMES, RobotParams, load_params
+from .unilateral_clutch import simulate_unilateral
 from .results import COLUMNS, MODE_NAMES, Mode, RunResult
 
 CLUTCH_RULES = ("kinematic", "unilateral")
@@ -20,8 +21,8 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     """Run the analytic model; ``options`` go to the chosen solver.
 
     ``geometry``: 'approx' (the paper's first order) or 'exact'.
-    ``clutch``: 'kinematic' (the paper's rule). The one-way ('unilateral')
-    clutch model is not built yet.
+    ``clutch``: 'kinematic' (the paper's rule: lock by the sign of S_dot) or
+    'unilateral' (one-way clutches that can only push).
     """
     try:
         geometry = Geometry(geometry).value
@@ -30,12 +31,12 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     if clutch not in CLUTCH_RULES:
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(CLUTCH_RULES)}")
     if clutch == "unilateral":
-        raise ParameterError("clutch='unilateral' is not available yet in the analytic engine; use 'kinematic'")
+        return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
 
 
 __all__ = [
     "COLUMNS", "CLUTCH_RULES", "Geometry", "Linkage", "MODE_NAMES", "Mode", "PARAMETER_NAMES",
     "ParameterError", "RobotParams", "RunResult", "SimulationError", "load_params",
-    "simulate", "simulate_kinematic",
+    "simulate", "simulate_kinematic", "simulate_unilateral",
 ]

@@ -100,7 +100,7 @@ class OneDofDynamics:
             dm22 = dm22 + 2.0 * (m * (rod.a * rod.da + rod.b * rod.db) + inertia * rod.g * rod.dg)
         return MassTerms(m11, m12, m22, dm12, dm22, tr)
 
-    def _terms(self, phi, mode: Mode):
+    def _terms(self, phi, mode: Mode, M=None):
         """J_eff, dJ_eff/dphi, Q, P, dP/dphi, e, de, f, df and the transfer.
 
         With x1_dot = e omega the locked-module system has J_eff = [e, 1] M [e, 1]^T
@@ -120,17 +120,29 @@ class OneDofDynamics:
         dJ = 2.0 * mt.m11 * e * de + 2.0 * (mt.dm12 * e + mt.m12 * de) + mt.dm22
         P = mt.m11 * e + mt.m12
         dP = mt.m11 * de + mt.dm12
-        Q = p.M - p.F_r1 * e - p.F_r2 * f
+        Q = (p.M if M is None else M) - p.F_r1 * e - p.F_r2 * f
         return J, dJ, Q, P, dP, e, de, f, df, mt.transfer
 
-    def acceleration(self, phi, omega, mode: Mode):
-        """Crank angular acceleration alpha [rad/s^2] in ``mode``."""
-        J, dJ, Q, *_ = self._terms(phi, mode)
+    def both_moving(self, phi, omega, M=None):
+        """(x1_ddot [m/s^2], alpha [rad/s^2]) with both modules sliding forward against F_r1, F_r2.
+
+        M [x1_ddot, alpha]^T + [M12' omega^2, 1/2 M22' omega^2]^T = [-F_r1 - F_r2, M - F_r2 K]^T.
+        """
+        p = self.params
+        mt = self.mass_terms(phi)
+        rhs1 = -p.F_r1 - p.F_r2 - mt.dm12 * omega**2
+        rhs2 = (p.M if M is None else M) - p.F_r2 * mt.transfer.K - 0.5 * mt.dm22 * omega**2
+        det = mt.m11 * mt.m22 - mt.m12**2
+        return (mt.m22 * rhs1 - mt.m12 * rhs2) / det, (mt.m11 * rhs2 - mt.m12 * rhs1) / det
+
+    def acceleration(self, phi, omega, mode: Mode, M=None):
+        """Crank angular acceleration alpha [rad/s^2] in ``mode``; ``M`` [N m] overrides params.M."""
+        J, dJ, Q, *_ = self._terms(phi, mode, M)
         return (Q - 0.5 * dJ * omega**2) / J
 
-    def state(self, phi, omega, mode: Mode) -> ModeState:
-        """Accelerations, module velocities, reactions and energy in ``mode``."""
-        J, dJ, Q, P, dP, e, de, f, df, tr = self._terms(phi, mode)
+    def state(self, phi, omega, mode: Mode, M=None) -> ModeState:
+        """Accelerations, module velocities, reactions and energy in ``mode`` (``M`` overrides params.M)."""
+        J, dJ, Q, P, dP, e, de, f, df, tr = self._terms(phi, mode, M)
         alpha = (Q - 0.5 * dJ * omega**2) / J
         momentum_rate = dP * omega**2 + P * alpha
         zero = 0.0 * alpha
@@ -150,6 +162,15 @@ class OneDofDynamics:
             lambda2=lambda2,
             kinetic=0.5 * J * omega**2,
         )
+
+    def motor_torque(self, phi, omega, alpha, a1, front_external):
+        """Torque [N m] the motor must apply for crank motion (omega, alpha) and module-1 acceleration a1.
+
+        The phi-row of the two-DOF equations: M = M12 a1 + M22 alpha + 1/2 M22' omega^2 - K H2,
+        with H2 [N] the external force on module 2 (its hold, or -F_r2 while it moves).
+        """
+        mt = self.mass_terms(phi)
+        return mt.m12 * a1 + mt.m22 * alpha + 0.5 * mt.dm22 * omega**2 - mt.transfer.K * front_external
 
     def stalled_reactions(self, phi):
         """Clutch reactions holding a robot at rest with both modules locked [N].

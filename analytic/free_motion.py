@@ -23,17 +23,14 @@ from .dynamics import OneDofDynamics
 from .errors import ParameterError, SimulationError
 from .kinematic_clutch import _check_run_options
 from .kinematics import Geometry
+from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
 
 
 def free_accelerations(dyn: OneDofDynamics, phi, omega):
-    """(x1_ddot [m/s^2], alpha [rad/s^2]) of the free mechanism; arrays of phi's shape."""
-    mt = dyn.mass_terms(phi)
-    rhs1 = -mt.dm12 * omega**2
-    rhs2 = dyn.params.M - 0.5 * mt.dm22 * omega**2
-    det = mt.m11 * mt.m22 - mt.m12**2
-    return (mt.m22 * rhs1 - mt.m12 * rhs2) / det, (mt.m11 * rhs2 - mt.m12 * rhs1) / det
+    """(x1_ddot [m/s^2], alpha [rad/s^2]) of the free mechanism (F_r1 = F_r2 = 0)."""
+    return dyn.both_moving(phi, omega)
 
 
 def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT, t_end: float = 1.0, *,
@@ -75,7 +72,9 @@ def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT
         "v1": v1, "v2": v1 + S_dot, "a1": x1dd, "a2": x1dd + tr.dK * omega**2 + tr.K * alpha,
         "S": tr.S, "S_dot": S_dot, "lambda1": zeros, "lambda2": zeros,
         "mode": np.full(phi.shape, int(Mode.BOTH_MOVING)),
+        "resistance1": zeros, "resistance2": zeros,
     }
+    add_kinetostatics(series, dyn)
     mt0, mt1 = dyn.mass_terms(phi[0]), dyn.mass_terms(phi[-1])
 
     def kinetic(mt, v, w):

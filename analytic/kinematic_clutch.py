@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -35,8 +36,9 @@ from scipy.integrate import solve_ivp
 from .dynamics import OneDofDynamics
 from .errors import ParameterError, SimulationError
 from .kinematics import Geometry
+from .kinetostatics import add_kinetostatics
 from .params import RobotParams
-from .results import COLUMNS, Mode, RunResult
+from .results import Mode, RunResult
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -46,11 +48,11 @@ _ZERO_SDD = 1e-9
 _ZERO_SD = 1e-10
 
 
-def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float) -> Mode:
-    """Next mode at a state where S_dot = 0 (see the module docstring)."""
+def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float, M: float | None = None) -> Mode:
+    """Next mode at a state where S_dot = 0 (see the module docstring); ``M`` overrides params.M."""
     tr = dyn.linkage.transfer(phi)
-    alpha_c = float(dyn.acceleration(phi, omega, Mode.CONTRACTION))
-    alpha_e = float(dyn.acceleration(phi, omega, Mode.EXPANSION))
+    alpha_c = float(dyn.acceleration(phi, omega, Mode.CONTRACTION, M))
+    alpha_e = float(dyn.acceleration(phi, omega, Mode.EXPANSION, M))
     sdd_c = tr.dK * omega**2 + tr.K * alpha_c
     sdd_e = tr.dK * omega**2 + tr.K * alpha_e
     tol = _ZERO_SDD * dyn.linkage.r * (omega**2 + abs(alpha_c) + abs(alpha_e))
@@ -69,12 +71,12 @@ def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float) -> Mo
     return Mode.BOTH_LOCKED
 
 
-def choose_initial_mode(dyn: OneDofDynamics, phi: float, omega: float) -> Mode:
+def choose_initial_mode(dyn: OneDofDynamics, phi: float, omega: float, M: float | None = None) -> Mode:
     """Mode at the start: by the sign of S_dot, or by the next order where it is zero."""
     S_dot = float(dyn.linkage.transfer(phi).K) * omega
     if abs(S_dot) > _ZERO_SD * dyn.linkage.r * abs(omega):
         return Mode.CONTRACTION if S_dot < 0 else Mode.EXPANSION
-    return choose_mode_at_rest_gap(dyn, phi, omega)
+    return choose_mode_at_rest_gap(dyn, phi, omega, M)
 
 
 def _sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
@@ -92,6 +94,7 @@ def simulate_kinematic(
     rtol: float = 1e-10,
     atol: float = 1e-12,
     max_switches: int = 100_000,
+    torque: Callable | None = None,
 ) -> RunResult:
     """Simulate the robot with the paper's clutch rule.
 
@@ -99,7 +102,10 @@ def simulate_kinematic(
     exact slider-crank with the rod's mass and inertia. ``dt_out`` [s] is the
     output grid; mode-switch instants are added to it (twice: once per mode).
     ``rtol``/``atol`` go to ``solve_ivp`` (DOP853) on the state
-    (phi [rad], omega [rad/s], x1 [m], x2 [m]).
+    (phi [rad], omega [rad/s], x1 [m], x2 [m], motor work [J]).
+    ``torque(t, phi, omega)`` [N m], vectorized, replaces the constant M
+    (e.g. a torque from inverse kinetostatics); a stall under it is an error,
+    since a stall is only final under constant loads.
     """
     _check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
@@ -108,31 +114,40 @@ def simulate_kinematic(
     grid = np.linspace(0.0, t_end, n_out + 1)
 
     t = 0.0
-    y = np.array([params.phi0, params.omega0, 0.0, 0.0])
-    mode = choose_initial_mode(dyn, params.phi0, params.omega0)
+    y = np.array([params.phi0, params.omega0, 0.0, 0.0, 0.0])
+    mode = choose_initial_mode(dyn, params.phi0, params.omega0, _torque_at(torque, 0.0, y))
     initial_mode = mode
     pieces: list[dict[str, np.ndarray]] = []
     switches = 0
     while True:
         if mode is Mode.BOTH_LOCKED:
+            if torque is not None:
+                raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
+                                      "restarting from a stall is modelled only for a constant torque")
             # Everything at rest under constant loads: nothing changes any more.
             pieces.append(_stalled_piece(dyn, _sample_times(t, t_end, grid), y))
             break
-        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol)
+        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque)
         t_stop = float(sol.t[-1])
-        pieces.append(_mode_piece(dyn, mode, _sample_times(t, t_stop, grid), sol.sol))
+        pieces.append(_mode_piece(dyn, mode, _sample_times(t, t_stop, grid), sol.sol, torque))
         if sol.status != 1:
             break
         t, y = float(sol.t_events[0][0]), sol.y_events[0][0].copy()
         switches += 1
         if switches > max_switches:
             raise SimulationError(f"more than {max_switches} mode switches by t={t:.6g} s: the clutch rule chatters")
-        mode = choose_mode_at_rest_gap(dyn, float(y[0]), float(y[1]))
+        mode = choose_mode_at_rest_gap(dyn, float(y[0]), float(y[1]), _torque_at(torque, t, y))
         if t >= t_end:
             break
 
-    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in COLUMNS}
-    energy = _energy_audit(dyn, params, series, initial_mode)
+    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    motor_work = float(series.pop("motor_work")[-1])
+    add_kinetostatics(series, dyn)
+    if torque is not None:
+        series["motor_power"] = series.pop("motor_torque") * series["omega"]
+    else:
+        series.pop("motor_torque")
+    energy = _energy_audit(dyn, params, series, initial_mode, motor_work)
     _check_finite(series)
     return RunResult(
         engine="analytic",
@@ -158,15 +173,21 @@ def _check_run_options(t_end: float, dt_out: float, rtol: float, atol: float) ->
         raise ParameterError(f"rtol={rtol} is out of range; allowed: rtol >= 1e-13 (DOP853's floor)")
 
 
-def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol):
+def _torque_at(torque, t, y):
+    return None if torque is None else float(torque(t, y[0], y[1]))
+
+
+def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None):
     """Integrate one mode from t0 until its switch event or t_end."""
     linkage = dyn.linkage
+    constant = dyn.params.M
 
-    def rhs(_t, y):
+    def rhs(t, y):
         phi, omega = y[0], y[1]
         K = linkage.transfer(phi).K
         e = -K if mode is Mode.CONTRACTION else 0.0
-        return [omega, dyn.acceleration(phi, omega, mode), e * omega, (e + K) * omega]
+        M = constant if torque is None else torque(t, phi, omega)
+        return [omega, dyn.acceleration(phi, omega, mode, M), e * omega, (e + K) * omega, M * omega]
 
     def gap_rate(_t, y):
         return linkage.transfer(y[0]).K * y[1]
@@ -180,14 +201,19 @@ def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol):
     return sol
 
 
-def _mode_piece(dyn, mode, times, dense) -> dict[str, np.ndarray]:
-    phi, omega, x1, x2 = dense(times)
-    st = dyn.state(phi, omega, mode)
+def _mode_piece(dyn, mode, times, dense, torque=None) -> dict[str, np.ndarray]:
+    phi, omega, x1, x2, work = dense(times)
+    M = np.full(times.shape, dyn.params.M) if torque is None else torque(times, phi, omega)
+    st = dyn.state(phi, omega, mode, M)
     return {
         "t": times, "phi": phi, "omega": omega, "alpha": st.alpha, "x1": x1, "x2": x2,
         "v1": st.v1, "v2": st.v2, "a1": st.a1, "a2": st.a2, "S": st.S, "S_dot": st.S_dot,
         "lambda1": st.lambda1, "lambda2": st.lambda2,
         "mode": np.full(times.shape, int(mode)),
+        # the paper's lock takes the whole holding force; a moving module feels -F_r
+        "resistance1": np.zeros(times.shape) if mode is Mode.EXPANSION else np.full(times.shape, -dyn.params.F_r1),
+        "resistance2": np.zeros(times.shape) if mode is Mode.CONTRACTION else np.full(times.shape, -dyn.params.F_r2),
+        "motor_work": work, "motor_torque": M,
     }
 
 
@@ -201,6 +227,9 @@ def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
         "a1": zeros, "a2": zeros, "S": np.full(n, dyn.linkage.gap(y[0])), "S_dot": zeros,
         "lambda1": np.full(n, lam1), "lambda2": np.full(n, lam2),
         "mode": np.full(n, int(Mode.BOTH_LOCKED)),
+        # the module pushed forward is held by its resistance (see stalled_reactions)
+        "resistance1": np.full(n, -lam2), "resistance2": np.full(n, -lam1),
+        "motor_work": np.full(n, y[4]), "motor_torque": np.full(n, dyn.params.M),
     }
 
 
@@ -208,15 +237,14 @@ def _kinetic(dyn, phi, omega, mode) -> float:
     return 0.0 if mode is Mode.BOTH_LOCKED else float(dyn.state(phi, omega, mode).kinetic)
 
 
-def _energy_audit(dyn, params, series, initial_mode) -> dict[str, float]:
-    """Motor work = kinetic energy gained + friction work + residual [J].
+def _energy_audit(dyn, params, series, initial_mode, motor) -> dict[str, float]:
+    """Motor work (integrated with the motion) = kinetic energy gained + friction work + residual [J].
 
     Under this clutch rule a module moves only forward, so the work against
     its constant resistance is F_r times its displacement.
     """
     phi, omega = series["phi"], series["omega"]
     mode_end = Mode(int(series["mode"][-1]))
-    motor = params.M * (phi[-1] - phi[0])
     kinetic = _kinetic(dyn, phi[-1], omega[-1], mode_end) - _kinetic(dyn, phi[0], omega[0], initial_mode)
     friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
     return {

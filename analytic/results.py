@@ -132,6 +132,26 @@ def read_csv(path: str | Path) -> dict[str, np.ndarray]:
     return series
 
 
+def mode_changes(series: dict[str, np.ndarray]) -> list[dict[str, Any]]:
+    """Every change of mode: time [s], crank angle [rad] and its position in the turn [deg], from, to."""
+    modes = np.asarray(series["mode"], dtype=int)
+    changes = []
+    for i in np.flatnonzero(np.diff(modes)):
+        phi = float(series["phi"][i + 1])
+        changes.append({"t": float(series["t"][i + 1]), "phi": phi,
+                        "phi_deg_in_turn": math.degrees(phi % (2 * math.pi)),
+                        "from": MODE_NAMES[int(modes[i])], "to": MODE_NAMES[int(modes[i + 1])]})
+    return changes
+
+
+def write_mode_changes(path: str | Path, series: dict[str, np.ndarray]) -> None:
+    """Write :func:`mode_changes` as CSV."""
+    lines = ["t,phi,phi_deg_in_turn,from,to"]
+    lines += [f"{c['t']:.12g},{c['phi']:.12g},{c['phi_deg_in_turn']:.6f},{c['from']},{c['to']}"
+              for c in mode_changes(series)]
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
 def first_gap_minimum(t: np.ndarray, S_dot: np.ndarray) -> float | None:
     """Time of the first minimum of S [s]: where S_dot first turns from < 0 to >= 0.
 

@@ -14,7 +14,7 @@ from typing import Sequence
 import analytic
 from analytic.errors import ParameterError, SimulationError
 from analytic.params import PARAMETER_NAMES, load_params
-from analytic.results import RunResult, write_json
+from analytic.results import RunResult, write_json, write_mode_changes
 
 from . import __version__
 from .output import check_output_dir, staged_output
@@ -67,7 +67,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--dt-out", type=float, default=1e-4, metavar="SECONDS",
                      help="output sample interval (default 1e-4 s); mode switches are sampled exactly")
     sim.add_argument("--out", metavar="DIR",
-                     help="write DIR/timeseries.csv, DIR/summary.json and the paper's figures as PNG")
+                     help="write DIR/timeseries.csv, DIR/mode_changes.csv (time and crank angle of each mode "
+                          "change), DIR/summary.json and the paper's figures as PNG")
     sim.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     sim.set_defaults(handler=cmd_simulate)
 
@@ -156,6 +157,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.out is not None:
         with staged_output(args.out) as staging:
             run.write_csv(staging / "timeseries.csv")
+            write_mode_changes(staging / "mode_changes.csv", run.series)
             write_json(staging / "summary.json", record)
             write_paper_figures([run], staging)
     if args.json:
@@ -163,7 +165,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     else:
         print(_format_summary(run))
         if args.out is not None:
-            print(f"  wrote {args.out}/timeseries.csv, summary.json and fig2-4 PNG")
+            print(f"  wrote {args.out}/timeseries.csv, mode_changes.csv, summary.json and fig2-4 PNG")
     return EXIT_OK
 
 

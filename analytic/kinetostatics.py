@@ -1,0 +1,57 @@
+"""Forces the motion needs: rod force, crank-pin force, motor power.
+
+Given a run's accelerations and the external forces on module 2 (clutch
+reaction plus resistance), the force the rod exerts on module 2 along x
+follows from module 2's Newton equation; the rod's own Newton-Euler equations
+then give the pin forces at C and B. Columns added to a time series:
+
+=================  =====  ===========================================================
+rod_force          N      axial force in the rod at C, tension > 0 (the pin force at
+                          C along the rod; MuJoCo reports the same quantity)
+crank_pin_force    N      magnitude of the force between crank and rod at B
+motor_power        W      M * omega
+=================  =====  ===========================================================
+
+Frame and symbols as in :mod:`analytic.kinematics`: e = (C - B) / L is the
+rod's unit vector, beta its angle. In the first-order geometry the rod is
+massless and taken along x (L >> r), as in the paper.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .dynamics import OneDofDynamics
+
+
+def add_kinetostatics(series: dict[str, np.ndarray], dyn: OneDofDynamics) -> None:
+    """Add ``rod_force``, ``crank_pin_force`` and ``motor_power`` to ``series`` (in place).
+
+    Needs the columns phi, omega, alpha, a1, a2, lambda2 and resistance2.
+    """
+    p, link = dyn.params, dyn.linkage
+    phi, omega, alpha = series["phi"], series["omega"], series["alpha"]
+    held_force = series["lambda2"] + series["resistance2"]  # external x-force on module 2 but the rod's
+    on_rod_x = held_force - p.m2 * series["a2"]  # force on the rod at C, x: minus the rod's pull on module 2
+    if link.geometry.value == "approx":
+        series["rod_force"] = on_rod_x
+        series["crank_pin_force"] = np.abs(on_rod_x)
+    else:
+        r, s, c = p.r, np.sin(phi), np.cos(phi)
+        D = np.sqrt(p.L**2 - (r * s) ** 2)
+        cb_x, cb_y = D, -r * s  # C - B
+        if dyn.include_rod:
+            rod = link.rod_motion(phi)
+            a_gx = series["a1"] + rod.da * omega**2 + rod.a * alpha
+            a_gy = rod.db * omega**2 + rod.b * alpha
+            beta_acc = rod.dg * omega**2 + rod.g * alpha
+            # moment about B of the rod: I_G beta_ddot + m (G - B) x a_G = (C - B) x F_C, G - B = (C - B) / 2
+            moment = p.rod_inertia_value * beta_acc + p.rod_mass * 0.5 * (cb_x * a_gy - cb_y * a_gx)
+            on_rod_y = (moment + cb_y * on_rod_x) / cb_x
+            pin_x, pin_y = p.rod_mass * a_gx - on_rod_x, p.rod_mass * a_gy - on_rod_y  # crank on rod at B
+        else:
+            on_rod_y = cb_y * on_rod_x / cb_x  # massless rod: the pin force lies along it
+            pin_x, pin_y = -on_rod_x, -on_rod_y
+        series["rod_force"] = (on_rod_x * cb_x + on_rod_y * cb_y) / p.L
+        series["crank_pin_force"] = np.hypot(pin_x, pin_y)
+    series["motor_power"] = p.M * omega

@@ -1,0 +1,300 @@
+"""One-way clutches that can only push: the event-driven unilateral model.
+
+Coordinates (x1, phi); x2 follows through S(phi). Each module either slides
+forward (v_i > 0, resistance -F_ri) or stands still, held by a total force R_i
+from its clutch (pushing forward, no limit) and its resistance (holding back a
+forward push up to F_ri; a module at rest pushed forward by less than F_ri
+cannot move, since sliding would brake it at once). So with mu_i = R_i + F_ri:
+
+    moving:  v_i > 0, mu_i = 0          at rest:  mu_i >= 0,  a_i >= 0,  mu_i * a_i = 0
+
+Four modes: ``CONTRACTION`` (front held, rear moves), ``EXPANSION`` (rear
+held, front moves), ``BOTH_MOVING``, ``BOTH_LOCKED`` (a static stall). Within
+a mode the motion is smooth and is integrated with ``solve_ivp``; terminal
+events end it where a moving module's velocity reaches zero or a held module's
+margin mu_i does. At each event the next mode solves the complementarity
+problem on accelerations and holding forces by enumeration: every mode whose
+held modules are at rest is a candidate, and a candidate is consistent if its
+held modules have mu_i >= 0 and its free modules at rest have a_i >= 0.
+
+Ties (a condition exactly zero) are broken by what the event says and by the
+next order, never by an arbitrary choice:
+
+* the mode whose own event just fired is dropped when another is consistent
+  (its condition is crossing zero in the wrong direction);
+* a hold whose margin just reached zero is released; a module whose velocity
+  just reached zero is held, where both choices are consistent;
+* at rest on a dead centre (K = omega = 0) both single-hold modes have zero
+  module acceleration; the gap then moves as K' (phi - phi0)^2 / 2, so it
+  shrinks (contraction) where K' < 0 and grows where K' > 0;
+* a robot at rest that statics can hold (both margins >= 0) stays at rest:
+  nothing drives it out.
+
+Reported clutch reaction: lambda_i = max(R_i, 0) while held (a clutch only
+pushes; a backward hold is the resistance's), 0 while moving; the resistance
+force is in ``resistance1/2`` (-F_ri moving, min(R_i, 0) held).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .dynamics import OneDofDynamics
+from .errors import SimulationError
+from .kinematic_clutch import _check_finite, _check_run_options, _sample_times
+from .kinematics import Geometry
+from .kinetostatics import add_kinetostatics
+from .params import RobotParams
+from .results import COLUMNS, Mode, RunResult
+
+HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
+        Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
+# relative tolerances of the sign tests: far above the event-location and
+# dense-output error (~rtol), far below any physical margin
+_TOL_V, _TOL_A, _TOL_F = 1e-8, 1e-7, 1e-7
+# more zero-length segments in a row than this is chatter, not motion
+_MAX_STALLED_SEGMENTS = 50
+
+
+class UnilateralModel:
+    """Mode kinematics, accelerations and holding forces of the one-way-clutch robot."""
+
+    def __init__(self, params: RobotParams, geometry: Geometry | str):
+        self.params = params
+        self.dyn = OneDofDynamics(params, geometry)
+        self.linkage = self.dyn.linkage
+
+    # --- the state in each mode: y = [phi, omega, x1, x2, v1] ---------------------------
+    def velocities(self, y, mode: Mode):
+        """(v1, v2) [m/s] of the modules in ``mode``."""
+        K = self.linkage.transfer(y[0]).K
+        if mode is Mode.CONTRACTION:
+            return -K * y[1], 0.0 * K
+        if mode is Mode.EXPANSION:
+            return 0.0 * K, K * y[1]
+        if mode is Mode.BOTH_MOVING:
+            return y[4], y[4] + K * y[1]
+        return 0.0 * K, 0.0 * K
+
+    def motion(self, phi, omega, v1, mode: Mode) -> dict:
+        """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``."""
+        p = self.params
+        nan = np.nan * np.asarray(phi, dtype=float)
+        if mode in (Mode.CONTRACTION, Mode.EXPANSION):
+            st = self.dyn.state(phi, omega, mode)
+            R1 = st.lambda1 if mode is Mode.EXPANSION else nan
+            R2 = st.lambda2 if mode is Mode.CONTRACTION else nan
+            return {"alpha": st.alpha, "a1": st.a1, "a2": st.a2, "R1": R1, "R2": R2}
+        if mode is Mode.BOTH_MOVING:
+            a1, alpha = self.dyn.both_moving(phi, omega)
+            tr = self.linkage.transfer(phi)
+            return {"alpha": alpha, "a1": a1, "a2": a1 + tr.dK * omega**2 + tr.K * alpha, "R1": nan, "R2": nan}
+        # static stall: the linkage pushes module 2 with M / K and module 1 with -M / K
+        K = self.linkage.transfer(phi).K
+        with np.errstate(divide="ignore", invalid="ignore"):
+            push = np.where(K != 0, p.M / np.where(K != 0, K, 1.0), 0.0)
+        zero = np.zeros_like(nan)
+        return {"alpha": zero, "a1": zero, "a2": zero, "R1": push, "R2": -push}
+
+    def rhs(self, mode: Mode):
+        def f(_t, y):
+            phi, omega, _x1, _x2, v1 = y
+            m = self.motion(phi, omega, v1, mode)
+            w1, w2 = self.velocities(y, mode)
+            return [omega, m["alpha"], w1, w2, m["a1"]]
+        return f
+
+    def events(self, mode: Mode):
+        """Terminal events of ``mode`` and what each means: ('velocity'|'margin', module index)."""
+        p = self.params
+        found = []
+        for i in (0, 1):
+            if HELD[mode][i]:
+                def margin(_t, y, i=i):
+                    m = self.motion(y[0], y[1], y[4], mode)
+                    return (m["R1"] if i == 0 else m["R2"]) + (p.F_r1 if i == 0 else p.F_r2)
+                margin.terminal, margin.direction = True, -1.0
+                found.append((margin, ("margin", i)))
+            else:
+                def velocity(_t, y, i=i):
+                    return self.velocities(y, mode)[i]
+                velocity.terminal, velocity.direction = True, -1.0
+                found.append((velocity, ("velocity", i)))
+        return found
+
+    # --- choosing the next mode ----------------------------------------------------------
+    def choose(self, y, velocities, fired: tuple[str, int] | None = None, previous: Mode | None = None) -> Mode:
+        """Solve the complementarity problem at state ``y`` with module velocities ``velocities``."""
+        p, r = self.params, self.linkage.r
+        phi, omega = float(y[0]), float(y[1])
+        tr = self.linkage.transfer(phi)
+        v1, v2 = (float(v) for v in velocities)
+        v_scale = r * abs(omega) + abs(v1) + abs(v2)
+        at_rest = [abs(v) <= _TOL_V * v_scale + 1e-14 for v in (v1, v2)]
+        if not at_rest[0] and v1 < 0 or not at_rest[1] and v2 < 0:
+            raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
+        motions = {mode: self.motion(phi, omega, v1, mode) for mode in Mode}
+        a_scale = r * (omega**2 + max(abs(m["alpha"]) for m in motions.values())) \
+            + (p.F_r1 + p.F_r2 + abs(p.M) / r) / min(p.m1, p.m2)
+        a_scale = max(a_scale, 1e-300)  # nothing drives the robot at all: every test is 0 / tiny = 0
+        f_scale = p.F_r1 + p.F_r2 + (p.m1 + p.m2) * a_scale
+        F = (p.F_r1, p.F_r2)
+
+        margins = {}
+        for mode, held in HELD.items():
+            if any(h and not z for h, z in zip(held, at_rest)):
+                continue  # a held module must stand still
+            if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + 1e-14
+                                             or (abs(tr.K) <= 1e-12 * r and p.M != 0)):
+                continue  # a static hold needs the crank at rest, and a torque the linkage can resist
+            m = motions[mode]
+            tests = []
+            for i in (0, 1):
+                if held[i]:
+                    tests.append(((m["R1"], m["R2"])[i] + F[i]) / f_scale)
+                elif at_rest[i]:
+                    tests.append((m["a1"], m["a2"])[i] / a_scale)
+            margins[mode] = min(tests) if tests else math.inf
+        consistent = [mode for mode, margin in margins.items() if margin >= -_TOL_F]
+        if Mode.BOTH_LOCKED in consistent:
+            # at rest and statics can hold it: every motion candidate then has zero
+            # acceleration at best (uniqueness of the complementarity solution), so
+            # nothing drives the robot out of rest
+            return Mode.BOTH_LOCKED
+        if len(consistent) > 1 and previous in consistent and fired is not None:
+            consistent.remove(previous)
+        if len(consistent) > 1 and fired is not None:
+            kind, i = fired
+            keep = [m for m in consistent if HELD[m][i] == (kind == "velocity")]
+            consistent = keep or consistent
+        if len(consistent) > 1 and {Mode.CONTRACTION, Mode.EXPANSION} <= set(consistent):
+            consistent = [Mode.CONTRACTION if tr.dK < 0 else Mode.EXPANSION]
+        if len(consistent) > 1:
+            # remaining ties: every candidate holds its conditions with equality; the
+            # one with the largest margin is the one the motion moves into
+            consistent = [max(consistent, key=lambda mode: margins[mode])]
+        if not consistent:
+            raise SimulationError(
+                f"no consistent clutch mode at phi={phi:.6g} rad, omega={omega:.6g} rad/s, "
+                f"v1={v1:.3g}, v2={v2:.3g} m/s (margins {({m.name: f'{v:.3g}' for m, v in margins.items()})})")
+        return consistent[0]
+
+    def project(self, y, mode: Mode, velocities) -> np.ndarray:
+        """The state with the mode's constraints exact (held velocities zero)."""
+        y = np.array(y, dtype=float)
+        K = float(self.linkage.transfer(y[0]).K)
+        if mode is Mode.CONTRACTION:
+            y[4] = -K * y[1]
+        elif mode is Mode.EXPANSION:
+            y[4] = 0.0
+        elif mode is Mode.BOTH_MOVING:
+            y[4] = float(velocities[0])
+        else:
+            y[1], y[4] = 0.0, 0.0
+        return y
+
+
+def simulate_unilateral(
+    params: RobotParams,
+    geometry: Geometry | str = Geometry.EXACT,
+    t_end: float = 1.0,
+    *,
+    dt_out: float = 1e-4,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    max_switches: int = 100_000,
+) -> RunResult:
+    """Simulate the robot with one-way clutches (see the module docstring).
+
+    Initial module velocities from (phi0, omega0) follow the MuJoCo engine's
+    start: module 1 at rest unless the gap shrinks.
+    """
+    _check_run_options(t_end, dt_out, rtol, atol)
+    started = time.perf_counter()
+    model = UnilateralModel(params, geometry)
+    n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
+    grid = np.linspace(0.0, t_end, n_out + 1)
+
+    K0 = float(model.linkage.transfer(params.phi0).K)
+    S_dot0 = K0 * params.omega0
+    v1_0 = max(-S_dot0, 0.0)
+    y = np.array([params.phi0, params.omega0, 0.0, 0.0, v1_0])
+    mode = model.choose(y, (v1_0, v1_0 + S_dot0))
+    y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
+    t, pieces, switches, short_run = 0.0, [], 0, 0
+    while True:
+        if mode is Mode.BOTH_LOCKED:
+            pieces.append(_piece(model, Mode.BOTH_LOCKED, _sample_times(t, t_end, grid), lambda ts: np.repeat(
+                y[:, None], np.size(ts), axis=1)))
+            break
+        events = model.events(mode)
+        sol = solve_ivp(model.rhs(mode), (t, t_end), y, method="DOP853", rtol=rtol, atol=atol,
+                        events=[e for e, _ in events], dense_output=True)
+        if sol.status < 0:
+            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
+        t_stop = float(sol.t[-1])
+        pieces.append(_piece(model, mode, _sample_times(t, t_stop, grid), sol.sol))
+        if sol.status != 1:
+            break
+        hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
+        short_run = short_run + 1 if t_stop - t <= 1e-12 * (1.0 + t) else 0
+        if short_run > _MAX_STALLED_SEGMENTS:
+            raise SimulationError(f"the clutch modes chatter at t={t:.6g} s (phi={y[0]:.6g} rad)")
+        t, y_event = float(sol.t_events[hit][0]), sol.y_events[hit][0]
+        velocities = model.velocities(y_event, mode)
+        previous, mode = mode, model.choose(y_event, velocities, events[hit][1], mode)
+        y = model.project(y_event, mode, velocities)
+        switches += 1
+        if switches > max_switches:
+            raise SimulationError(f"more than {max_switches} mode switches by t={t:.6g} s")
+        if t >= t_end:
+            break
+
+    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    add_kinetostatics(series, model.dyn)
+    _check_finite(series)
+    mt0, mt1 = model.dyn.mass_terms(series["phi"][0]), model.dyn.mass_terms(series["phi"][-1])
+
+    def kinetic(mt, v, w):
+        return 0.5 * (mt.m11 * v**2 + 2 * mt.m12 * v * w + mt.m22 * w**2)
+
+    motor = params.M * (series["phi"][-1] - series["phi"][0])
+    gained = float(kinetic(mt1, series["v1"][-1], series["omega"][-1])
+                   - kinetic(mt0, series["v1"][0], series["omega"][0]))
+    friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
+    energy = {"motor_work_j": float(motor), "kinetic_j": gained, "friction_j": float(friction),
+              "residual_j": float(motor - gained - friction)}
+    return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
+                     t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,
+                     settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
+                               "rod_modelled": model.dyn.include_rod})
+
+
+def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.ndarray]:
+    y = dense(times)
+    phi, omega = y[0], y[1]
+    v1, v2 = model.velocities(y, mode)
+    v1 = np.broadcast_to(v1, phi.shape).astype(float)
+    v2 = np.broadcast_to(v2, phi.shape).astype(float)
+    m = model.motion(phi, omega, v1, mode)
+    tr = model.linkage.transfer(phi)
+    F = (model.params.F_r1, model.params.F_r2)
+    held = HELD[mode]
+    clutch, resistance = [], []
+    for i, R in enumerate((m["R1"], m["R2"])):
+        R = np.broadcast_to(R, phi.shape)
+        clutch.append(np.maximum(R, 0.0) if held[i] else np.zeros(phi.shape))
+        resistance.append(np.minimum(R, 0.0) if held[i] else np.full(phi.shape, -F[i]))
+    piece = {
+        "t": times, "phi": phi, "omega": omega, "alpha": np.broadcast_to(m["alpha"], phi.shape).astype(float),
+        "x1": y[2], "x2": y[3], "v1": v1, "v2": v2,
+        "a1": np.broadcast_to(m["a1"], phi.shape).astype(float), "a2": np.broadcast_to(m["a2"], phi.shape).astype(float),
+        "S": tr.S, "S_dot": tr.K * omega, "lambda1": clutch[0], "lambda2": clutch[1],
+        "mode": np.full(phi.shape, int(mode)), "resistance1": resistance[0], "resistance2": resistance[1],
+    }
+    assert set(COLUMNS) <= set(piece)
+    return piece
