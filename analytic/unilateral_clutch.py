@@ -63,10 +63,17 @@ _MAX_STALLED_SEGMENTS = 50
 class UnilateralModel:
     """Mode kinematics, accelerations and holding forces of the one-way-clutch robot."""
 
-    def __init__(self, params: RobotParams, geometry: Geometry | str):
+    def __init__(self, params: RobotParams, geometry: Geometry | str, torque=None):
         self.params = params
         self.dyn = OneDofDynamics(params, geometry)
         self.linkage = self.dyn.linkage
+        self.torque = torque  # (t, phi, omega) -> N m, or None for the constant params.M
+
+    def motor(self, t, phi, omega):
+        """Motor torque [N m] at time t (array-friendly)."""
+        if self.torque is None:
+            return self.params.M + 0.0 * np.asarray(phi, dtype=float)
+        return self.torque(t, phi, omega)
 
     # --- the state in each mode: y = [phi, omega, x1, x2, v1] ---------------------------
     def velocities(self, y, mode: Mode):
@@ -80,32 +87,34 @@ class UnilateralModel:
             return y[4], y[4] + K * y[1]
         return 0.0 * K, 0.0 * K
 
-    def motion(self, phi, omega, v1, mode: Mode) -> dict:
-        """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``."""
+    def motion(self, phi, omega, v1, mode: Mode, M=None) -> dict:
+        """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``; M [N m] the torque."""
         p = self.params
+        M = p.M if M is None else M
         nan = np.nan * np.asarray(phi, dtype=float)
         if mode in (Mode.CONTRACTION, Mode.EXPANSION):
-            st = self.dyn.state(phi, omega, mode)
+            st = self.dyn.state(phi, omega, mode, M)
             R1 = st.lambda1 if mode is Mode.EXPANSION else nan
             R2 = st.lambda2 if mode is Mode.CONTRACTION else nan
             return {"alpha": st.alpha, "a1": st.a1, "a2": st.a2, "R1": R1, "R2": R2}
         if mode is Mode.BOTH_MOVING:
-            a1, alpha = self.dyn.both_moving(phi, omega)
+            a1, alpha = self.dyn.both_moving(phi, omega, M)
             tr = self.linkage.transfer(phi)
             return {"alpha": alpha, "a1": a1, "a2": a1 + tr.dK * omega**2 + tr.K * alpha, "R1": nan, "R2": nan}
         # static stall: the linkage pushes module 2 with M / K and module 1 with -M / K
         K = self.linkage.transfer(phi).K
         with np.errstate(divide="ignore", invalid="ignore"):
-            push = np.where(K != 0, p.M / np.where(K != 0, K, 1.0), 0.0)
+            push = np.where(K != 0, M / np.where(K != 0, K, 1.0), 0.0)
         zero = np.zeros_like(nan)
         return {"alpha": zero, "a1": zero, "a2": zero, "R1": push, "R2": -push}
 
     def rhs(self, mode: Mode):
-        def f(_t, y):
-            phi, omega, _x1, _x2, v1 = y
-            m = self.motion(phi, omega, v1, mode)
+        def f(t, y):
+            phi, omega, _x1, _x2, v1, _work = y
+            M = self.motor(t, phi, omega)
+            m = self.motion(phi, omega, v1, mode, M)
             w1, w2 = self.velocities(y, mode)
-            return [omega, m["alpha"], w1, w2, m["a1"]]
+            return [omega, m["alpha"], w1, w2, m["a1"], M * omega]
         return f
 
     def events(self, mode: Mode):
@@ -114,8 +123,8 @@ class UnilateralModel:
         found = []
         for i in (0, 1):
             if HELD[mode][i]:
-                def margin(_t, y, i=i):
-                    m = self.motion(y[0], y[1], y[4], mode)
+                def margin(t, y, i=i):
+                    m = self.motion(y[0], y[1], y[4], mode, self.motor(t, y[0], y[1]))
                     return (m["R1"] if i == 0 else m["R2"]) + (p.F_r1 if i == 0 else p.F_r2)
                 margin.terminal, margin.direction = True, -1.0
                 found.append((margin, ("margin", i)))
@@ -127,19 +136,20 @@ class UnilateralModel:
         return found
 
     # --- choosing the next mode ----------------------------------------------------------
-    def choose(self, y, velocities, fired: tuple[str, int] | None = None, previous: Mode | None = None) -> Mode:
-        """Solve the complementarity problem at state ``y`` with module velocities ``velocities``."""
+    def choose(self, t, y, velocities, fired: tuple[str, int] | None = None, previous: Mode | None = None) -> Mode:
+        """Solve the complementarity problem at time t, state ``y``, module velocities ``velocities``."""
         p, r = self.params, self.linkage.r
         phi, omega = float(y[0]), float(y[1])
+        M = float(self.motor(t, phi, omega))
         tr = self.linkage.transfer(phi)
         v1, v2 = (float(v) for v in velocities)
         v_scale = r * abs(omega) + abs(v1) + abs(v2)
         at_rest = [abs(v) <= _TOL_V * v_scale + 1e-14 for v in (v1, v2)]
         if not at_rest[0] and v1 < 0 or not at_rest[1] and v2 < 0:
             raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
-        motions = {mode: self.motion(phi, omega, v1, mode) for mode in Mode}
+        motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode}
         a_scale = r * (omega**2 + max(abs(m["alpha"]) for m in motions.values())) \
-            + (p.F_r1 + p.F_r2 + abs(p.M) / r) / min(p.m1, p.m2)
+            + (p.F_r1 + p.F_r2 + abs(M) / r) / min(p.m1, p.m2)
         a_scale = max(a_scale, 1e-300)  # nothing drives the robot at all: every test is 0 / tiny = 0
         f_scale = p.F_r1 + p.F_r2 + (p.m1 + p.m2) * a_scale
         F = (p.F_r1, p.F_r2)
@@ -149,7 +159,7 @@ class UnilateralModel:
             if any(h and not z for h, z in zip(held, at_rest)):
                 continue  # a held module must stand still
             if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + 1e-14
-                                             or (abs(tr.K) <= 1e-12 * r and p.M != 0)):
+                                             or (abs(tr.K) <= 1e-12 * r and M != 0)):
                 continue  # a static hold needs the crank at rest, and a torque the linkage can resist
             m = motions[mode]
             tests = []
@@ -207,27 +217,33 @@ def simulate_unilateral(
     rtol: float = 1e-10,
     atol: float = 1e-12,
     max_switches: int = 100_000,
+    torque=None,
 ) -> RunResult:
     """Simulate the robot with one-way clutches (see the module docstring).
 
     Initial module velocities from (phi0, omega0) follow the MuJoCo engine's
-    start: module 1 at rest unless the gap shrinks.
+    start: module 1 at rest unless the gap shrinks. ``torque(t, phi, omega)``
+    [N m], vectorized, replaces the constant M; a stall under it is an error
+    (a stall is only final under constant loads).
     """
     _check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
-    model = UnilateralModel(params, geometry)
+    model = UnilateralModel(params, geometry, torque)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)
 
     K0 = float(model.linkage.transfer(params.phi0).K)
     S_dot0 = K0 * params.omega0
     v1_0 = max(-S_dot0, 0.0)
-    y = np.array([params.phi0, params.omega0, 0.0, 0.0, v1_0])
-    mode = model.choose(y, (v1_0, v1_0 + S_dot0))
+    y = np.array([params.phi0, params.omega0, 0.0, 0.0, v1_0, 0.0])
+    mode = model.choose(0.0, y, (v1_0, v1_0 + S_dot0))
     y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
     t, pieces, switches, short_run = 0.0, [], 0, 0
     while True:
         if mode is Mode.BOTH_LOCKED:
+            if torque is not None:
+                raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
+                                      "restarting from a stall is modelled only for a constant torque")
             pieces.append(_piece(model, Mode.BOTH_LOCKED, _sample_times(t, t_end, grid), lambda ts: np.repeat(
                 y[:, None], np.size(ts), axis=1)))
             break
@@ -246,7 +262,7 @@ def simulate_unilateral(
             raise SimulationError(f"the clutch modes chatter at t={t:.6g} s (phi={y[0]:.6g} rad)")
         t, y_event = float(sol.t_events[hit][0]), sol.y_events[hit][0]
         velocities = model.velocities(y_event, mode)
-        previous, mode = mode, model.choose(y_event, velocities, events[hit][1], mode)
+        previous, mode = mode, model.choose(t, y_event, velocities, events[hit][1], mode)
         y = model.project(y_event, mode, velocities)
         switches += 1
         if switches > max_switches:
@@ -255,14 +271,16 @@ def simulate_unilateral(
             break
 
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    motor = float(series.pop("motor_work")[-1])
+    torque_used = series.pop("motor_torque")
     add_kinetostatics(series, model.dyn)
+    series["motor_power"] = torque_used * series["omega"]
     _check_finite(series)
     mt0, mt1 = model.dyn.mass_terms(series["phi"][0]), model.dyn.mass_terms(series["phi"][-1])
 
     def kinetic(mt, v, w):
         return 0.5 * (mt.m11 * v**2 + 2 * mt.m12 * v * w + mt.m22 * w**2)
 
-    motor = params.M * (series["phi"][-1] - series["phi"][0])
     gained = float(kinetic(mt1, series["v1"][-1], series["omega"][-1])
                    - kinetic(mt0, series["v1"][0], series["omega"][0]))
     friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
@@ -280,7 +298,8 @@ def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.nda
     v1, v2 = model.velocities(y, mode)
     v1 = np.broadcast_to(v1, phi.shape).astype(float)
     v2 = np.broadcast_to(v2, phi.shape).astype(float)
-    m = model.motion(phi, omega, v1, mode)
+    M = np.broadcast_to(model.motor(times, phi, omega), phi.shape).astype(float)
+    m = model.motion(phi, omega, v1, mode, M)
     tr = model.linkage.transfer(phi)
     F = (model.params.F_r1, model.params.F_r2)
     held = HELD[mode]
@@ -295,6 +314,7 @@ def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.nda
         "a1": np.broadcast_to(m["a1"], phi.shape).astype(float), "a2": np.broadcast_to(m["a2"], phi.shape).astype(float),
         "S": tr.S, "S_dot": tr.K * omega, "lambda1": clutch[0], "lambda2": clutch[1],
         "mode": np.full(phi.shape, int(mode)), "resistance1": resistance[0], "resistance2": resistance[1],
+        "motor_work": y[5], "motor_torque": M,
     }
     assert set(COLUMNS) <= set(piece)
     return piece

@@ -11,7 +11,7 @@ accelerations of that step ((v_{n+1} - v_n) / dt) and the constraint forces
 MuJoCo computed for it.
 
 Energy audit, per step with the velocities v_{n+1} that move the positions:
-motor work M * (phi - phi0) (exact for MuJoCo's update), friction work from
+motor work ctrl * (phi_{n+1} - phi_n) (exact for MuJoCo's update), friction work from
 the frictionloss rows, the work absorbed by the clutch rows (``clutch_j``),
 and the kinetic energy from ``mj_energyVel``. ``residual_j`` = motor - kinetic
 - friction is what the soft constraints (clutches and loop) and the time
@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
+from dataclasses import dataclass
 from typing import Callable, Iterator
 
 import mujoco
@@ -40,9 +41,28 @@ from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_HINGE
                     dof_address, qpos_address, set_closed_loop_state)
 
 FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+
+
+@dataclass(frozen=True)
+class CrankServo:
+    """A stiff PD servo that makes the crank follow phi_ref(t), omega_ref(t).
+
+    Motor torque = kp (phi_ref - phi) + kv (omega_ref - omega), recomputed every
+    step; no feedforward, so the torque MuJoCo reports is what its own physics
+    needs to follow the reference (inverse kinetostatics by simulation).
+    Defaults: natural frequency 1000 rad/s, critical damping, for J = 1e-3 kg m^2.
+    """
+
+    phi_ref: Callable[[float], float]
+    omega_ref: Callable[[float], float]
+    kp: float = 1000.0  # N m / rad
+    kv: float = 2.0  # N m s / rad
+
+    def torque(self, t: float, phi: float, omega: float) -> float:
+        return self.kp * (float(self.phi_ref(t)) - phi) + self.kv * (float(self.omega_ref(t)) - omega)
 # Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
-# along the rod), motor power M omega [W], total momentum along x [kg m/s].
-EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum")
+# along the rod), motor power [W], total momentum along x [kg m/s], motor torque [N m].
+EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque")
 IMPLEMENTATIONS = ("ratchet", "lock", "none")
 
 
@@ -82,6 +102,7 @@ def simulate_mujoco(
     settings: SolverSettings = SolverSettings(),
     mjcf=None,
     progress: Callable[[float], None] | None = None,
+    servo: CrankServo | None = None,
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -90,7 +111,8 @@ def simulate_mujoco(
     triggered locks released by ``clutch`` = 'kinematic', the paper's rule, or
     'unilateral', a lock that would pull lets go), or 'none' (no clutches).
     ``dt_out`` [s] must be a whole number of timesteps. ``progress`` is called
-    with the simulated time about every 0.1 s of it.
+    with the simulated time about every 0.1 s of it. ``servo`` replaces the
+    constant torque M by a crank servo (:class:`CrankServo`).
     """
     if implementation not in IMPLEMENTATIONS:
         raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
@@ -120,13 +142,17 @@ def simulate_mujoco(
         else:
             controller = NoClutch(model, data)
         recorder = _Recorder(model, data, params, n_samples + 1)
-        data.ctrl[model.actuator(MOTOR).id] = params.M
+        motor = model.actuator(MOTOR).id
+        crank_q, crank_v = qpos_address(model, CRANK_HINGE), dof_address(model, CRANK_HINGE)
+        data.ctrl[motor] = params.M if servo is None else servo.torque(0.0, data.qpos[crank_q], data.qvel[crank_v])
         mujoco.mj_forward(model, data)
         _check(data, messages, 0.0)
         recorder.start(controller)
         next_report = 0.1
         for _sample in range(n_samples):
             for _step in range(steps_per_sample):
+                if servo is not None:
+                    data.ctrl[motor] = servo.torque(data.time, data.qpos[crank_q], data.qvel[crank_v])
                 controller.before_step()
                 recorder.before_step()
                 mujoco.mj_step(model, data)
@@ -186,7 +212,8 @@ class _Recorder:
         self.table = {c: np.empty(capacity) for c in COLUMNS + EXTRA_COLUMNS}
         self.count = 0
         self.v_before = np.zeros(model.nv)
-        self.work = {"friction": 0.0, "clutch": 0.0}
+        self.work = {"friction": 0.0, "clutch": 0.0, "motor": 0.0}
+        self.motor_id = model.actuator(MOTOR).id
         self.warnings_seen = 0
 
     def start(self, controller) -> None:
@@ -217,6 +244,7 @@ class _Recorder:
             clutch += float(np.sum(forces[lock] * v[lock_dofs]))
         self.work["friction"] -= friction * self.dt
         self.work["clutch"] -= clutch * self.dt
+        self.work["motor"] += float(d.ctrl[self.motor_id]) * v[self.v[0]] * self.dt  # = ctrl * (phi change)
 
     def sample(self, controller, initial: bool = False) -> None:
         d, p, i = self.data, self.params, self.count
@@ -234,7 +262,8 @@ class _Recorder:
             "v1": v[self.v[1]], "v2": v[self.v[2]], "a1": accel[1], "a2": accel[2],
             "S": q[self.q[2]] + p.r + p.L - q[self.q[1]], "S_dot": v[self.v[2]] - v[self.v[1]],
             "lambda1": reactions[0], "lambda2": reactions[1], "mode": _mode(*held),
-            "rod_force": rod_force, "motor_power": p.M * omega, "momentum": self._momentum_x(),
+            "rod_force": rod_force, "motor_power": d.ctrl[self.motor_id] * omega, "momentum": self._momentum_x(),
+            "motor_torque": d.ctrl[self.motor_id],
         }
         for name, value in row.items():
             self.table[name][i] = value
@@ -252,7 +281,7 @@ class _Recorder:
         return out
 
     def energy(self) -> dict[str, float]:
-        motor = self.params.M * (float(self.data.qpos[self.q[0]]) - self.phi0)
+        motor = self.work["motor"]
         kinetic = float(self.data.energy[1]) - self.kinetic0
         friction = self.work["friction"]
         residual = motor - kinetic - friction

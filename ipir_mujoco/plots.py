@@ -109,3 +109,24 @@ def write_paper_figures(runs: Sequence[RunResult], directory: str | Path, labels
         build(runs, labels).savefig(path, dpi=dpi)
         written.append(path)
     return written
+
+
+def figure_kinetostatics(run: RunResult) -> Figure:
+    """Torque, clutch reactions and rod force against crank angle for a prescribed crank motion."""
+    fig, (ax_torque, ax_clutch, ax_rod) = new_figure(3)
+    s = run.series
+    angle = np.degrees(s["phi"] - s["phi"][0])
+    ax_torque.plot(angle, s["motor_torque"], color="tab:blue", lw=1.0)
+    ax_torque.set(ylabel="motor torque [N m]", title=f"what the motion needs ({run.settings.get('motion', '')}, "
+                                                     f"{run.clutch} clutches, {run.geometry} geometry)")
+    ax_clutch.plot(angle, s["lambda1"], color=REAR, lw=1.0, label="rear clutch lambda1")
+    ax_clutch.plot(angle, s["lambda2"], color=FRONT, lw=1.0, label="front clutch lambda2")
+    ax_clutch.axhline(0.0, color="grey", lw=0.8)
+    ax_clutch.set(ylabel="clutch reaction [N]")
+    ax_clutch.legend(fontsize="small")
+    ax_rod.plot(angle, s["rod_force"], color="tab:green", lw=1.0)
+    ax_rod.axhline(0.0, color="grey", lw=0.8)
+    ax_rod.set(xlabel="crank angle from start [deg]", ylabel="rod force [N] (tension > 0)")
+    for ax in (ax_torque, ax_clutch, ax_rod):
+        ax.grid(alpha=0.3)
+    return fig

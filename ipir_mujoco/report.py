@@ -110,8 +110,9 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
             cells.append(_fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
     blocks.append(Table(header, rows))
-    blocks.append(Paragraph("Not evaluated yet (not built in this version): "
-                            + "; ".join(metrics["not_yet_evaluated"]) + "."))
+    if metrics["not_yet_evaluated"]:
+        blocks.append(Paragraph("Not evaluated yet (not built in this version): "
+                                + "; ".join(metrics["not_yet_evaluated"]) + "."))
 
     pull = metrics["clutch_pull"]
     blocks.append(Heading("Clutch forces under the paper's rule"))

@@ -119,7 +119,9 @@ finite = dict(allow_nan=False, allow_infinity=False)
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(m1=st.floats(0.2, 5, **finite), m2=st.floats(0.2, 5, **finite), ratio=st.floats(1.2, 12, **finite),
        J_A=st.floats(2e-4, 5e-3, **finite), F_r1=st.floats(0, 4, **finite), F_r2=st.floats(0, 4, **finite),
-       M=st.floats(0.0, 0.6, **finite), rod_mass=st.floats(0, 0.2, **finite),
+       # torques below 1 uN m are not physical here; at a denormal M (1e-308) the motion underflows
+       # and the solver stops with a "chatter" error rather than hang (seen, and acceptable)
+       M=st.one_of(st.just(0.0), st.floats(1e-6, 0.6, **finite)), rod_mass=st.floats(0, 0.2, **finite),
        phi0=st.floats(0, 2 * math.pi, **finite), geometry=st.sampled_from(["approx", "exact"]))
 def test_properties_over_a_wide_range_of_designs(m1, m2, ratio, J_A, F_r1, F_r2, M, rod_mass, phi0, geometry):
     params = RobotParams(m1=m1, m2=m2, r=0.05, L=0.05 * ratio, J_A=J_A, F_r1=F_r1, F_r2=F_r2, M=M,

@@ -54,7 +54,7 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     out = tmp_path / "report"
     assert main(["validate", "--quick", "--out", str(out)]) == 0
     captured = capsys.readouterr()
-    assert "[5/5]" in captured.err  # progress shown
+    assert "[6/6]" in captured.err  # progress shown
     page = (out / "index.html").read_text()
     assert "<script" not in page and "http://" not in page and "https://" not in page
     assert page.count('src="data:image/png;base64,') == 4  # Fig. 2, 3, 4 and the clutch reactions
@@ -62,7 +62,7 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     for name in re.findall(r"\]\((figures/[^)]+)\)", markdown):
         assert (out / name).is_file()
     metrics = json.loads((out / "metrics.json").read_text())
-    assert metrics["schema_version"] == 1 and len(metrics["ladder"]) == 5
+    assert metrics["schema_version"] == 1 and len(metrics["ladder"]) == 6
     for verdict in metrics["verdicts"]:
         assert html.escape(verdict["question"]) in page
 

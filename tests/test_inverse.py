@@ -1,0 +1,97 @@
+"""Inverse kinetostatics, checked by the forward models and by MuJoCo."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import analytic
+from analytic import ParameterError, RobotParams
+from analytic.inverse import CrankMotion, inverse_kinetostatics
+from analytic.unilateral_clutch import simulate_unilateral
+from ipir_mujoco.cli import main
+from ipir_mujoco.engine import CrankServo, simulate_mujoco
+
+OMEGA = 30.0  # rad/s
+MOTION = CrankMotion.constant_speed(OMEGA, revolutions=3)
+PARAMS = RobotParams()
+FORWARD = {"kinematic": lambda p, t_end, torque: analytic.simulate_kinematic(p, "exact", t_end, torque=torque),
+           "unilateral": lambda p, t_end, torque: simulate_unilateral(p, "exact", t_end, torque=torque)}
+
+
+@pytest.fixture(scope="module", params=["kinematic", "unilateral"])
+def inverse_run(request):
+    return inverse_kinetostatics(PARAMS, MOTION, "exact", request.param, dt_out=1e-5)
+
+
+def test_inverse_energy_balances(inverse_run):
+    e = inverse_run.summary["energy"]
+    assert abs(e["residual_j"]) < 1e-8 * e["motor_work_j"]
+
+
+def test_feeding_the_torque_forward_reproduces_the_prescribed_motion(inverse_run):
+    s = inverse_run.series
+    torque = lambda t, phi, omega: np.interp(t, s["t"], s["motor_torque"])  # noqa: E731
+    forward = FORWARD[inverse_run.clutch](PARAMS.replace(omega0=OMEGA), inverse_run.t_end, torque).series
+    # The torque jumps at mode switches; linear interpolation smears each jump dM (< 3 N m)
+    # over one sample interval h = 1e-5 s, moving the crank by at most dM h^2 / J_A = 3e-7 rad
+    # per jump; a dozen jumps bound the drift by ~4e-6 rad: 1e-5 rad leaves margin.
+    assert np.max(np.abs(forward["phi"] - OMEGA * forward["t"])) < 1e-5
+    for column in ("x1", "x2"):
+        assert forward[column][-1] == pytest.approx(s[column][-1], rel=1e-4, abs=1e-9)
+
+
+def test_mujoco_servo_needs_the_same_torque(inverse_run):
+    implementation = "lock" if inverse_run.clutch == "kinematic" else "ratchet"
+    servo = CrankServo(MOTION.phi, MOTION.omega)
+    mj = simulate_mujoco(PARAMS.replace(omega0=OMEGA), inverse_run.clutch, implementation, MOTION.t_end,
+                         servo=servo).series
+    expected = np.interp(mj["phi"], inverse_run.series["phi"], inverse_run.series["motor_torque"])
+    difference = np.abs(mj["motor_torque"] - expected)
+    # A PD servo without feedforward lags by e = M / kp (1.5e-3 rad here); its torque then
+    # differs from the need by the inertia times that lag's acceleration, J_eff * M'' / kp with
+    # J_eff <= J_A + m r^2 and M'' ~ (2 omega)^2 max|M|. Switches make brief transients, so
+    # the bound holds for the median and the 90th percentile, not the maximum.
+    J_eff = PARAMS.J_A + max(PARAMS.m1, PARAMS.m2) * PARAMS.r**2
+    bound = J_eff * (2 * OMEGA) ** 2 * np.abs(expected).max() / servo.kp
+    assert np.median(difference) < bound and np.percentile(difference, 90) < 2 * bound
+    assert np.max(np.abs(mj["phi"] - OMEGA * mj["t"])) < 2 * np.abs(expected).max() / servo.kp
+
+
+def test_sampled_motion_of_a_forward_run_needs_its_constant_torque():
+    """Round trip: a forward run's phi(t), given as samples, must need the run's own torque M."""
+    forward = analytic.simulate(PARAMS, "exact", "kinematic", 0.3, dt_out=1e-4).series
+    keep = np.concatenate([[True], np.diff(forward["t"]) > 0])  # samples need distinct times
+    motion = CrankMotion.from_samples(forward["t"][keep], forward["phi"][keep])
+    inverse = inverse_kinetostatics(PARAMS, motion, "exact", "kinematic", dt_out=1e-4).series
+    inside = (inverse["t"] > 0.01) & (inverse["t"] < 0.29)
+    # the spline's alpha is exact to O(h^2 phi'''') away from the switches, where alpha jumps
+    assert np.median(np.abs(inverse["motor_torque"][inside] - PARAMS.M)) < 1e-3 * PARAMS.M
+
+
+def test_prescribed_motion_is_validated():
+    with pytest.raises(ParameterError, match="omega=0"):
+        CrankMotion.constant_speed(0.0)
+    with pytest.raises(ParameterError, match="increase strictly"):
+        CrankMotion.from_samples([0, 1, 1, 2], [0, 1, 2, 3])
+    with pytest.raises(ParameterError, match="at least 4"):
+        CrankMotion.from_samples([0, 1], [0, 1])
+
+
+def test_kinetostatics_command(tmp_path, capsys):
+    out = tmp_path / "k"
+    assert main(["kinetostatics", "--omega", "30", "--clutch", "unilateral", "--out", str(out)]) == 0
+    assert "motor torque" in capsys.readouterr().out
+    assert (out / "kinetostatics.png").read_bytes()[:4] == b"\x89PNG"
+    header = (out / "kinetostatics.csv").read_text().splitlines()[0].split(",")
+    assert {"motor_torque", "lambda1", "lambda2", "rod_force", "phi"} <= set(header)
+    samples = tmp_path / "phi.csv"
+    samples.write_text("t,phi\n" + "\n".join(f"{t:.3f},{20 * t + 5 * t * t:.6f}" for t in np.linspace(0, 0.5, 51)))
+    assert main(["kinetostatics", "--samples", str(samples), "--out", str(tmp_path / "s")]) == 0
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time,angle\n0,0\n1,1\n")
+    for argv, fragment in ((["--omega", "0"], "omega=0"), (["--samples", str(tmp_path / "none.csv")], "none.csv"),
+                           (["--samples", str(bad)], "columns t and phi")):
+        assert main(["kinetostatics", *argv, "--out", str(tmp_path / "never")]) == 2
+        assert fragment in capsys.readouterr().err
+    assert not (tmp_path / "never").exists()
