@@ -3,7 +3,8 @@
 This package never imports MuJoCo or ``ipir_mujoco``: it is the independent
 half of the cross-check. It holds the shared parameter set
 (:class:`RobotParams`) and result container (:class:`RunResult`), the
-slider-crank kinematics and the paper's hybrid model.
+slider-crank kinematics, the paper's hybrid model, the one-way-clutch model,
+kinetostatics and inverse kinetostatics.
 """
 
 from .errors import ParameterError, SimulationError
