@@ -89,6 +89,17 @@ def build_parser() -> argparse.ArgumentParser:
                      help="writes DIR/kinetostatics.csv and DIR/kinetostatics.png (default ./kinetostatics)")
     kin.set_defaults(handler=cmd_kinetostatics)
 
+    cmp_ = commands.add_parser("compare", help="compare two runs written by 'simulate --out'",
+                               description="Compare run B against run A: summary figures, RMS and largest "
+                                           "differences at matching time and at matching crank angle, mode "
+                                           "switches matched one by one, and when a tolerance is first exceeded.")
+    cmp_.add_argument("run_a", metavar="RUN_A", help="reference run folder")
+    cmp_.add_argument("run_b", metavar="RUN_B", help="run folder compared against it")
+    cmp_.add_argument("--tolerance", type=float, default=0.01,
+                      help="relative tolerance for 'first exceeded' (fraction of each quantity's scale; default 0.01)")
+    cmp_.add_argument("--json", action="store_true", help="print the comparison as one JSON object")
+    cmp_.set_defaults(handler=cmd_compare)
+
     val = commands.add_parser("validate", help="the analytic-vs-physics validation report (the main job)",
                               description="Run the model ladder at the paper's case and write a report: "
                                           "DIR/index.html, DIR/report.md, DIR/metrics.json, DIR/figures/.")
@@ -223,6 +234,14 @@ def cmd_kinetostatics(args: argparse.Namespace) -> int:
           f"front {s['lambda2'].min():+.4g} .. {s['lambda2'].max():+.4g} N")
     print(f"  rod force        {s['rod_force'].min():+.4g} .. {s['rod_force'].max():+.4g} N (tension > 0)")
     print(f"  wrote {args.out}/kinetostatics.csv, kinetostatics.png, summary.json")
+    return EXIT_OK
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from .compare import compare_runs, format_comparison, load_run
+
+    result = compare_runs(load_run(args.run_a), load_run(args.run_b), tolerance=args.tolerance)
+    print(json.dumps(result, allow_nan=False) if args.json else format_comparison(result))
     return EXIT_OK
 
 

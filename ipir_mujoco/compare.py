@@ -1,0 +1,154 @@
+"""Compare two runs of any engines: where and by how much they diverge.
+
+Both runs are resampled on a common time grid and, when both cranks turn
+forward monotonically, on a common crank-angle grid too: comparing at matching
+crank angle removes the error a small phase lag inflates at matching time
+(there ``phi`` itself is replaced by the time t(phi) each run needs to reach it).
+
+:func:`compare_runs` returns a plain dict (JSON-ready)::
+
+    time_grid / angle_grid   {quantity: {rms, max, scale}}: RMS and largest
+                             |a - b| and the scale (largest |a|) they compare to;
+                             angle_grid is null when a crank does not turn monotonically
+    summary                  {figure: {a, b, relative}}: (b - a) / |a| for revolutions,
+                             x1_final, x2_final, v1_max, v2_max, first_contraction_end_s
+    switches                 {matched, unmatched_a, unmatched_b, dt: [...], max_abs_dt}:
+                             mode changes matched one by one (same from->to, in order)
+    first_exceedance         {quantity: t or null}: first time |a - b| exceeds
+                             tolerance * scale on the time grid
+    tolerance                the relative tolerance used there
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from analytic.errors import ParameterError
+from analytic.params import RobotParams
+from analytic.results import RunResult, mode_changes, read_csv
+
+QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S")
+SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
+
+
+def load_run(folder: str | Path) -> RunResult:
+    """A run written by ``simulate --out`` (timeseries.csv and summary.json)."""
+    folder = Path(folder)
+    csv, summary = folder / "timeseries.csv", folder / "summary.json"
+    for path in (csv, summary):
+        if not path.is_file():
+            raise ParameterError(f"{str(folder)!r} is not a run folder: {path.name} is missing "
+                                 "(write one with 'ipir-mujoco simulate --out DIR')")
+    try:
+        record = json.loads(summary.read_text())
+        series = read_csv(csv)
+        params = RobotParams(**record["params"])
+        return RunResult(record["engine"], record["geometry"], record["clutch"], params, float(record["t_end"]),
+                         series, record["summary"]["energy"], record.get("wall_time_s", 0.0),
+                         record.get("settings", {}))
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ParameterError(f"run folder {str(folder)!r} cannot be read: {exc}") from None
+
+
+def _unique_times(t: np.ndarray, values: np.ndarray):
+    """Drop the second sample of a duplicated instant (a mode switch sampled once per mode)."""
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    return t[keep], values[keep]
+
+
+def _errors(a: np.ndarray, b: np.ndarray) -> dict:
+    difference = b - a
+    return {"rms": float(np.sqrt(np.mean(difference**2))), "max": float(np.max(np.abs(difference))),
+            "scale": float(np.max(np.abs(a)))}
+
+
+def _monotonic(phi: np.ndarray) -> bool:
+    return bool(np.all(np.diff(phi) >= 0) and phi[-1] > phi[0])
+
+
+def match_switches(a: RunResult, b: RunResult) -> dict:
+    """Pair the mode changes of two runs in order, each with the next of the same kind in the other."""
+    changes_a, changes_b = mode_changes(a.series), mode_changes(b.series)
+    dts, j = [], 0
+    unmatched_a = 0
+    for change in changes_a:
+        k = j
+        while k < len(changes_b) and (changes_b[k]["from"], changes_b[k]["to"]) != (change["from"], change["to"]):
+            k += 1
+        if k == len(changes_b):
+            unmatched_a += 1
+            continue
+        dts.append(changes_b[k]["t"] - change["t"])
+        j = k + 1
+    return {"matched": len(dts), "unmatched_a": unmatched_a, "unmatched_b": len(changes_b) - len(dts),
+            "dt": dts, "max_abs_dt": float(np.max(np.abs(dts))) if dts else None}
+
+
+def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: int = 2000) -> dict:
+    """Compare run ``b`` against run ``a`` (see the module docstring)."""
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ParameterError(f"tolerance={tolerance} is out of range; allowed: > 0")
+    t_end = min(a.series["t"][-1], b.series["t"][-1])
+    grid = np.linspace(0.0, t_end, n_grid)
+    on_time = {}
+    for run in (a, b):
+        on_time[id(run)] = {q: np.interp(grid, *_unique_times(run.series["t"], run.series[q])) for q in QUANTITIES}
+    time_errors = {q: _errors(on_time[id(a)][q], on_time[id(b)][q]) for q in QUANTITIES}
+
+    angle_errors = None
+    if _monotonic(a.series["phi"]) and _monotonic(b.series["phi"]):
+        lo = max(a.series["phi"][0], b.series["phi"][0])
+        hi = min(a.series["phi"][-1], b.series["phi"][-1])
+        angles = np.linspace(lo, hi, n_grid)
+        resampled = {}
+        for run in (a, b):
+            t, phi = _unique_times(run.series["t"], run.series["phi"])
+            resampled[id(run)] = {"t": np.interp(angles, phi, t)}
+            for q in QUANTITIES[1:]:
+                resampled[id(run)][q] = np.interp(angles, phi, _unique_times(run.series["t"], run.series[q])[1])
+        angle_errors = {q: _errors(resampled[id(a)][q], resampled[id(b)][q]) for q in ("t",) + QUANTITIES[1:]}
+
+    summary = {}
+    for key in SUMMARY_FIGURES:
+        va, vb = a.summary[key], b.summary[key]
+        relative = None if va in (None, 0) or vb is None else (vb - va) / abs(va)
+        summary[key] = {"a": va, "b": vb, "relative": relative}
+
+    first = {}
+    for q in QUANTITIES:
+        scale = time_errors[q]["scale"]
+        over = np.flatnonzero(np.abs(on_time[id(b)][q] - on_time[id(a)][q]) > tolerance * scale)
+        first[q] = float(grid[over[0]]) if over.size else None
+
+    return {"a": f"{a.engine}/{a.geometry}/{a.clutch}", "b": f"{b.engine}/{b.geometry}/{b.clutch}",
+            "t_compared_s": float(t_end), "time_grid": time_errors, "angle_grid": angle_errors,
+            "summary": summary, "switches": match_switches(a, b), "first_exceedance": first,
+            "tolerance": tolerance}
+
+
+def format_comparison(result: dict) -> str:
+    """A readable table of :func:`compare_runs`' result."""
+    lines = [f"b = {result['b']} against a = {result['a']}, over {result['t_compared_s']:.4g} s"]
+    lines.append("  summary figure              a            b       (b-a)/|a|")
+    for key, v in result["summary"].items():
+        rel = "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"
+        fa = "none" if v["a"] is None else f"{v['a']:.6g}"
+        fb = "none" if v["b"] is None else f"{v['b']:.6g}"
+        lines.append(f"  {key:25s} {fa:>12s} {fb:>12s} {rel:>12s}")
+    lines.append("  quantity   max|b-a| at same time   at same crank angle   first > tolerance")
+    for q in QUANTITIES:
+        at_time = result["time_grid"][q]["max"]
+        angle_key = "t" if q == "phi" else q
+        at_angle = "n/a" if result["angle_grid"] is None else f"{result['angle_grid'][angle_key]['max']:.4g}"
+        if q == "phi" and result["angle_grid"] is not None:
+            at_angle += " s (time)"
+        first = result["first_exceedance"][q]
+        lines.append(f"  {q:8s} {at_time:>20.4g}   {at_angle:>20s}   {'never' if first is None else f'{first:.4g} s'}")
+    sw = result["switches"]
+    lines.append(f"  mode switches: {sw['matched']} matched, largest time difference "
+                 + ("n/a" if sw["max_abs_dt"] is None else f"{sw['max_abs_dt']:.3g} s")
+                 + f"; unmatched: {sw['unmatched_a']} in a, {sw['unmatched_b']} in b")
+    return "\n".join(lines)
