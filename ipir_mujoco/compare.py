@@ -7,7 +7,7 @@ crank angle removes the error a small phase lag inflates at matching time
 
 :func:`compare_runs` returns a plain dict (JSON-ready)::
 
-    time_grid / angle_grid   {quantity: {rms, max, scale}}: RMS and largest
+    time_grid / angle_grid   {quantity: {rms, max, scale}} for phi omega x1 x2 v1 v2 S S_dot: RMS and largest
                              |a - b| and the scale (largest |a|) they compare to;
                              angle_grid is null when a crank does not turn monotonically
     summary                  {figure: {a, b, relative}}: (b - a) / |a| for revolutions,
@@ -30,7 +30,7 @@ from analytic.errors import ParameterError
 from analytic.params import RobotParams
 from analytic.results import RunResult, mode_changes, read_csv
 
-QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S")
+QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 
 

@@ -17,8 +17,20 @@ land.
                           change_vs_previous maps each ladder figure to the
                           relative change (new - old) / |old| against the rung
                           before (null for the first rung or a zero reference)
-    clutch_pull           {fraction_of_time, min_reaction_n}: how much of the
-                          paper-model run has a locked clutch that would have to pull
+    clutch_pull           {fraction_of_time, min_reaction_n, per_stroke: [{mode, t_start,
+                          t_end, mean_crank_speed, pull_fraction}]}: how much of the
+                          paper-model run (and of each stroke) has a locked clutch
+                          that would have to pull
+    lr_study              {ratios, rows: [{ratio, L, first_order, exact, mujoco,
+                          divergence, mujoco_vs_exact}], thresholds: {figure: {"1%"|"5%":
+                          {between: [lo, hi]} | {below_sweep} | {whole_sweep}}}}: see
+                          ipir_mujoco.lr_study; divergence = (first order - exact) / |exact|,
+                          S_at_angle / S_dot_at_angle as fractions of 2r / max|S_dot|
+    convergence           {mujoco: [rows of ipir_mujoco.convergence], equations: [{rtol,
+                          revolutions, x1_final, x2_final, residual_fraction}],
+                          mujoco_default_error, equations_default_error}: largest
+                          relative change of revolutions/x1/x2 from the default setting
+                          to the finest one tried
     params                the parameter set used (SI units)
     settings              {t_end_s, quick, dt_out_s, rtol, atol, mujoco: {timestep,
                           integrator, constraint_time_constant, solimp}}
@@ -38,7 +50,7 @@ import numpy as np
 
 import analytic
 from analytic.params import RobotParams
-from analytic.results import Mode, RunResult
+from analytic.results import MODE_NAMES, Mode, RunResult
 
 from . import __version__
 from .engine import simulate_mujoco
@@ -129,8 +141,10 @@ def _percent(x: float | None) -> str:
     return "n/a" if x is None else f"{100 * x:+.2f} %"
 
 
-def verdicts(checks: list[dict], rungs: list[Rung], pull: dict) -> list[dict]:
+def verdicts(checks: list[dict], rungs: list[Rung], pull: dict, study: dict, ladder: list[dict],
+             convergence: dict) -> list[dict]:
     """The report's opening: plain questions, plain answers, the numbers behind them."""
+    from .lr_study import describe_threshold
     n_ok = sum(c["reproduced"] for c in checks)
     missed = [c["label"] for c in checks if not c["reproduced"]]
     reproduce = {
@@ -156,7 +170,11 @@ def verdicts(checks: list[dict], rungs: list[Rung], pull: dict) -> list[dict]:
     costs = {
         "question": "What do the idealizations cost?",
         "answer": (
-            f"First-order kinematics (L/r = {rungs[0].run.params.L / rungs[0].run.params.r:g}): the exact "
+            f"First-order kinematics is off by more than 1 % in crank revolutions "
+            f"{describe_threshold(study['thresholds']['revolutions']['1%'])} and by more than 5 % "
+            f"{describe_threshold(study['thresholds']['revolutions']['5%'])}; module 1's travel is more sensitive "
+            f"(1 % {describe_threshold(study['thresholds']['x1_final']['1%'])}). "
+            f"At the paper's L/r = {rungs[0].run.params.L / rungs[0].run.params.r:g} the exact "
             f"slider-crank changes crank revolutions by {_percent(relative_change(exact['revolutions'], paper['revolutions']))}, "
             f"module 1 displacement by {_percent(relative_change(exact['x1_final'], paper['x1_final']))} and the "
             f"end of the first contraction by {_percent(relative_change(exact['first_contraction_end_s'], paper['first_contraction_end_s']))}. "
@@ -172,12 +190,28 @@ def verdicts(checks: list[dict], rungs: list[Rung], pull: dict) -> list[dict]:
         ),
         "evidence": "ladder, clutch_pull",
     }
-    return [reproduce, engine, costs]
+    modelling = {r["name"]: max(abs(r["change_vs_previous"][k]) for k in ("revolutions", "x1_final", "x2_final")
+                                if r["change_vs_previous"][k] is not None)
+                 for r in ladder if r["name"] in ("exact geometry", "with rod mass", "one-way clutches")}
+    smallest_name = min(modelling, key=modelling.get)
+    smallest = modelling[smallest_name]
+    numerical = max(convergence["mujoco_default_error"], convergence["equations_default_error"])
+    trust = {
+        "question": "Is the numerical error small against the modelling differences?",
+        "answer": ("Yes" if numerical < 0.2 * smallest else "No") + ": halving MuJoCo's timestep from its default "
+                  f"moves the summary figures by at most {100 * convergence['mujoco_default_error']:.3f} %, and "
+                  f"tightening the equations' tolerance 100-fold by {100 * convergence['equations_default_error']:.1e} %; the "
+                  f"smallest modelling effect in the ladder ({smallest_name}) changes them by up to "
+                  f"{100 * smallest:.2f} %.",
+        "evidence": "convergence",
+    }
+    return [reproduce, engine, costs, trust]
 
 
-def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict) -> dict:
+def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict, study: dict, convergence: dict) -> dict:
     checks = check_paper_figures(rungs[0].run)
     pull = clutch_pull(rungs[0].run)
+    pull["per_stroke"] = pull_per_stroke(rungs[0].run)
     ladder, previous = [], None
     for rung in rungs:
         summary = rung.run.summary
@@ -188,10 +222,12 @@ def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict) -> dic
         previous = summary
     return {
         "schema_version": 1,
-        "verdicts": verdicts(checks, rungs, pull),
+        "verdicts": verdicts(checks, rungs, pull, study, ladder, convergence),
         "paper_checks": checks,
         "ladder": ladder,
         "clutch_pull": pull,
+        "lr_study": study,
+        "convergence": convergence,
         "params": params.as_dict(),
         "settings": settings,
         "versions": software_versions(),
@@ -200,8 +236,60 @@ def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict) -> dic
 
 
 def validate(params: RobotParams, quick: bool = False, progress: Callable[[str], None] = lambda _m: None):
-    """Run the ladder and return (metrics, rungs). ``quick`` samples outputs 10x coarser."""
+    """Run everything the report needs and return (metrics, rungs).
+
+    ``quick`` samples outputs 10x coarser and sweeps L/r, timesteps and
+    tolerances on coarser grids (for tests and CI).
+    """
+    from .lr_study import RATIOS_FULL, RATIOS_QUICK, lr_study
+
     settings = {"t_end_s": 1.0, "quick": quick, "dt_out_s": 1e-3 if quick else 1e-4, "rtol": 1e-10, "atol": 1e-12,
                 "mujoco": SolverSettings().as_dict()}
     rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
-    return build_metrics(params, rungs, settings), rungs
+    study = lr_study(params, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
+    convergence = convergence_evidence(params, quick, lambda m: progress(f"convergence: {m}"))
+    return build_metrics(params, rungs, settings, study, convergence), rungs
+
+
+def pull_per_stroke(run: RunResult) -> list[dict]:
+    """Per stroke of the paper's model: mean crank speed and the fraction of its time a lock would pull."""
+    s = run.series
+    locked = np.where(s["mode"] == Mode.CONTRACTION, s["lambda2"],
+                      np.where(s["mode"] == Mode.EXPANSION, s["lambda1"], np.inf))
+    strokes, start = [], 0
+    changes = np.flatnonzero(np.diff(s["mode"]) != 0)
+    for end in list(changes + 1) + [len(s["t"])]:
+        t, reaction = s["t"][start:end], locked[start:end]
+        if end - start > 2 and t[-1] > t[0]:
+            dt = np.diff(t)
+            strokes.append({"mode": MODE_NAMES[int(s["mode"][start])], "t_start": float(t[0]), "t_end": float(t[-1]),
+                            "mean_crank_speed": float((s["phi"][end - 1] - s["phi"][start]) / (t[-1] - t[0])),
+                            "pull_fraction": float(np.sum(dt * (reaction[:-1] < 0)) / np.sum(dt))})
+        start = end
+    return strokes
+
+
+def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[str], None]) -> dict:
+    """MuJoCo's figures against its timestep, the equations' against their tolerance (paper's case)."""
+    from .convergence import timestep_study
+
+    timesteps = (1e-4, 5e-5) if quick else (4e-4, 2e-4, 1e-4, 5e-5)
+    rows = timestep_study({"paper's case": params}, timesteps, progress=progress)
+    equations = []
+    for rtol in ((1e-10, 1e-12) if quick else (1e-6, 1e-8, 1e-10, 1e-12)):
+        run = analytic.simulate(params, "exact", "unilateral", 1.0, rtol=rtol, atol=rtol * 1e-2, dt_out=1e-3)
+        equations.append({"rtol": rtol, **{k: run.summary[k] for k in ("revolutions", "x1_final", "x2_final")},
+                          "residual_fraction": run.summary["energy"]["residual_j"] / run.summary["energy"]["motor_work_j"]})
+    default = SolverSettings().timestep
+
+    def spread(items, key_filter):
+        chosen = [r for r in items if key_filter(r)]
+        return max(abs(a[k] - b[k]) / abs(b[k]) for a in chosen for b in chosen
+                   for k in ("revolutions", "x1_final", "x2_final"))
+
+    # numerical error of the defaults: change from the default setting to the finest one tried
+    mj_error = max(spread(rows, lambda r, c=c: r["clutch"] == c and r["timestep"] <= default)
+                   for c in ("lock", "ratchet"))
+    eq_error = spread(equations, lambda r: r["rtol"] <= 1e-10)
+    return {"mujoco": rows, "equations": equations, "mujoco_default_error": mj_error,
+            "equations_default_error": eq_error}
