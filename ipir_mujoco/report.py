@@ -160,8 +160,10 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
         f"L/r swept from {study['ratios'][0]:.3g} to {study['ratios'][-1]:.3g} ({len(study['ratios'])} ratios, "
         "log-spaced; r and everything else as in the parameters below), each with the first-order equations, the "
         "exact slider-crank equations with the same massless rod (their difference is the L >> r assumption "
-        "alone) and MuJoCo's real linkage, all under the paper's clutch rule. Each threshold is bracketed by "
-        "two neighbouring ratios of the sweep: that bracket is its resolution."))
+        "alone) and MuJoCo's real linkage, all under the paper's clutch rule. Summary figures diverge by "
+        "(first order - exact) / |exact|; the gap S and its rate at the same crank angle by their largest "
+        "difference over the run, as a share of the stroke 2r and of the largest |S_dot|. Each threshold is "
+        "bracketed by two neighbouring ratios of the sweep: that bracket is its resolution."))
     blocks.append(Image(figures["lr_study.png"], "Divergence of the first-order model from the exact linkage "
                                                  "against L/r (log axes)."))
     blocks.append(Table(["figure", "off by more than 1 %", "off by more than 5 %"],
