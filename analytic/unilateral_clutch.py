@@ -58,6 +58,9 @@ HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
 _TOL_V, _TOL_A, _TOL_F = 1e-8, 1e-7, 1e-7
 # more zero-length segments in a row than this is chatter, not motion
 _MAX_STALLED_SEGMENTS = 50
+# a speed below this [m/s] (a nanometre in a quarter hour) counts as rest; without a floor a crank
+# started at 1e-12 rad/s with no torque is neither at rest nor able to move in any mode
+_REST_SPEED = 1e-12
 
 
 class UnilateralModel:
@@ -144,7 +147,7 @@ class UnilateralModel:
         tr = self.linkage.transfer(phi)
         v1, v2 = (float(v) for v in velocities)
         v_scale = r * abs(omega) + abs(v1) + abs(v2)
-        at_rest = [abs(v) <= _TOL_V * v_scale + 1e-14 for v in (v1, v2)]
+        at_rest = [abs(v) <= _TOL_V * v_scale + _REST_SPEED for v in (v1, v2)]
         if not at_rest[0] and v1 < 0 or not at_rest[1] and v2 < 0:
             raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
         motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode}
@@ -158,7 +161,7 @@ class UnilateralModel:
         for mode, held in HELD.items():
             if any(h and not z for h, z in zip(held, at_rest)):
                 continue  # a held module must stand still
-            if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + 1e-14
+            if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + _REST_SPEED
                                              or (abs(tr.K) <= 1e-12 * r and M != 0)):
                 continue  # a static hold needs the crank at rest, and a torque the linkage can resist
             m = motions[mode]
