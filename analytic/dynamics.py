@@ -163,6 +163,24 @@ class OneDofDynamics:
             kinetic=0.5 * J * omega**2,
         )
 
+    def kinetic_energy(self, phi, v1, omega):
+        """Kinetic energy [J] at crank angle phi with module-1 speed v1 and crank speed omega, any mode."""
+        mt = self.mass_terms(phi)
+        return 0.5 * (mt.m11 * v1**2 + 2.0 * mt.m12 * v1 * omega + mt.m22 * omega**2)
+
+    def energy_audit(self, series: dict, motor_work: float) -> dict[str, float]:
+        """Motor work = kinetic energy gained + friction work + residual [J] over a run's series.
+
+        Modules only move forward (or, in the free mechanism, feel no resistance),
+        so the work against the constant resistances is F_r times the displacements.
+        """
+        p = self.params
+        phi, v1, omega = series["phi"], series["v1"], series["omega"]
+        gained = float(self.kinetic_energy(phi[-1], v1[-1], omega[-1]) - self.kinetic_energy(phi[0], v1[0], omega[0]))
+        friction = float(p.F_r1 * series["x1"][-1] + p.F_r2 * series["x2"][-1])
+        return {"motor_work_j": float(motor_work), "kinetic_j": gained, "friction_j": friction,
+                "residual_j": float(motor_work - gained - friction)}
+
     def motor_torque(self, phi, omega, alpha, a1, front_external):
         """Torque [N m] the motor must apply for crank motion (omega, alpha) and module-1 acceleration a1.
 

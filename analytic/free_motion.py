@@ -75,15 +75,7 @@ def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT
         "resistance1": zeros, "resistance2": zeros,
     }
     add_kinetostatics(series, dyn)
-    mt0, mt1 = dyn.mass_terms(phi[0]), dyn.mass_terms(phi[-1])
-
-    def kinetic(mt, v, w):
-        return 0.5 * (mt.m11 * v**2 + 2 * mt.m12 * v * w + mt.m22 * w**2)
-
-    motor = params.M * (phi[-1] - phi[0])
-    gained = float(kinetic(mt1, v1[-1], omega[-1]) - kinetic(mt0, v1[0], omega[0]))
-    energy = {"motor_work_j": float(motor), "kinetic_j": gained, "friction_j": 0.0,
-              "residual_j": float(motor - gained)}
+    energy = dyn.energy_audit(series, params.M * (phi[-1] - phi[0]))  # constant M: work = M dphi
     return RunResult(engine="analytic", geometry=dyn.geometry.value, clutch="none", params=params, t_end=t_end,
                      series=series, energy=energy, wall_time_s=time.perf_counter() - started,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,

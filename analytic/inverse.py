@@ -207,7 +207,7 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
         t, y_event = float(sol.t_events[hit][0]), sol.y_events[hit][0]
         e = model.evaluate(t, y_event, mode)
         velocities = (float(e["v1"]), float(e["v2"]))
-        previous, mode = mode, model.choose(t, velocities, events[hit][1], mode)
+        mode = model.choose(t, velocities, events[hit][1], previous=mode)
         y = y_event.copy()
         y[2] = float(model.evaluate(t, y, mode)["v1"]) if mode is not Mode.BOTH_MOVING else velocities[0]
         if t >= t_end:
@@ -216,13 +216,7 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
     motor_work = float(series.pop("motor_work")[-1])
     add_kinetostatics(series, model.dyn)
     series["motor_power"] = series["motor_torque"] * series["omega"]
-    mt0, mt1 = model.dyn.mass_terms(series["phi"][0]), model.dyn.mass_terms(series["phi"][-1])
-    kinetic = [0.5 * (mt.m11 * v**2 + 2 * mt.m12 * v * w + mt.m22 * w**2)
-               for mt, v, w in ((mt0, series["v1"][0], series["omega"][0]), (mt1, series["v1"][-1], series["omega"][-1]))]
-    friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
-    gained = float(kinetic[1] - kinetic[0])
-    energy = {"motor_work_j": motor_work, "kinetic_j": gained, "friction_j": float(friction),
-              "residual_j": float(motor_work - gained - friction)}
+    energy = model.dyn.energy_audit(series, motor_work)
     return RunResult(engine="analytic-inverse", geometry=model.dyn.geometry.value, clutch=clutch, params=params,
                      t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,
                      settings={"motion": motion.description, "rtol": rtol, "atol": atol, "dt_out": dt_out})

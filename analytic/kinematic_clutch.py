@@ -116,7 +116,6 @@ def simulate_kinematic(
     t = 0.0
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, 0.0])
     mode = choose_initial_mode(dyn, params.phi0, params.omega0, _torque_at(torque, 0.0, y))
-    initial_mode = mode
     pieces: list[dict[str, np.ndarray]] = []
     switches = 0
     while True:
@@ -147,7 +146,7 @@ def simulate_kinematic(
         series["motor_power"] = series.pop("motor_torque") * series["omega"]
     else:
         series.pop("motor_torque")
-    energy = _energy_audit(dyn, params, series, initial_mode, motor_work)
+    energy = dyn.energy_audit(series, motor_work)
     _check_finite(series)
     return RunResult(
         engine="analytic",
@@ -230,28 +229,6 @@ def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
         # the module pushed forward is held by its resistance (see stalled_reactions)
         "resistance1": np.full(n, -lam2), "resistance2": np.full(n, -lam1),
         "motor_work": np.full(n, y[4]), "motor_torque": np.full(n, dyn.params.M),
-    }
-
-
-def _kinetic(dyn, phi, omega, mode) -> float:
-    return 0.0 if mode is Mode.BOTH_LOCKED else float(dyn.state(phi, omega, mode).kinetic)
-
-
-def _energy_audit(dyn, params, series, initial_mode, motor) -> dict[str, float]:
-    """Motor work (integrated with the motion) = kinetic energy gained + friction work + residual [J].
-
-    Under this clutch rule a module moves only forward, so the work against
-    its constant resistance is F_r times its displacement.
-    """
-    phi, omega = series["phi"], series["omega"]
-    mode_end = Mode(int(series["mode"][-1]))
-    kinetic = _kinetic(dyn, phi[-1], omega[-1], mode_end) - _kinetic(dyn, phi[0], omega[0], initial_mode)
-    friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
-    return {
-        "motor_work_j": float(motor),
-        "kinetic_j": float(kinetic),
-        "friction_j": float(friction),
-        "residual_j": float(motor - kinetic - friction),
     }
 
 

@@ -37,7 +37,7 @@ def add_kinetostatics(series: dict[str, np.ndarray], dyn: OneDofDynamics) -> Non
         series["rod_force"] = on_rod_x
         series["crank_pin_force"] = np.abs(on_rod_x)
     else:
-        r, s, c = p.r, np.sin(phi), np.cos(phi)
+        r, s = p.r, np.sin(phi)
         D = np.sqrt(p.L**2 - (r * s) ** 2)
         cb_x, cb_y = D, -r * s  # C - B
         if dyn.include_rod:

@@ -265,7 +265,7 @@ def simulate_unilateral(
             raise SimulationError(f"the clutch modes chatter at t={t:.6g} s (phi={y[0]:.6g} rad)")
         t, y_event = float(sol.t_events[hit][0]), sol.y_events[hit][0]
         velocities = model.velocities(y_event, mode)
-        previous, mode = mode, model.choose(t, y_event, velocities, events[hit][1], mode)
+        mode = model.choose(t, y_event, velocities, events[hit][1], previous=mode)
         y = model.project(y_event, mode, velocities)
         switches += 1
         if switches > max_switches:
@@ -279,16 +279,7 @@ def simulate_unilateral(
     add_kinetostatics(series, model.dyn)
     series["motor_power"] = torque_used * series["omega"]
     _check_finite(series)
-    mt0, mt1 = model.dyn.mass_terms(series["phi"][0]), model.dyn.mass_terms(series["phi"][-1])
-
-    def kinetic(mt, v, w):
-        return 0.5 * (mt.m11 * v**2 + 2 * mt.m12 * v * w + mt.m22 * w**2)
-
-    gained = float(kinetic(mt1, series["v1"][-1], series["omega"][-1])
-                   - kinetic(mt0, series["v1"][0], series["omega"][0]))
-    friction = params.F_r1 * series["x1"][-1] + params.F_r2 * series["x2"][-1]
-    energy = {"motor_work_j": float(motor), "kinetic_j": gained, "friction_j": float(friction),
-              "residual_j": float(motor - gained - friction)}
+    energy = model.dyn.energy_audit(series, motor)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
                      t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
