@@ -42,6 +42,7 @@ import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
@@ -137,6 +138,21 @@ class UnilateralModel:
                 velocity.terminal, velocity.direction = True, -1.0
                 found.append((velocity, ("velocity", i)))
         return found
+
+    def guards(self, t, Y, mode: Mode) -> np.ndarray:
+        """Every event function of ``mode`` at times t (n,) and states Y (6, n): array (n_events, n)."""
+        p = self.params
+        v1, v2 = self.velocities(Y, mode)
+        m = None
+        rows = []
+        for i in (0, 1):
+            if HELD[mode][i]:
+                if m is None:
+                    m = self.motion(Y[0], Y[1], Y[4], mode, self.motor(t, Y[0], Y[1]))
+                rows.append((m["R1"] if i == 0 else m["R2"]) + (p.F_r1 if i == 0 else p.F_r2))
+            else:
+                rows.append(v1 if i == 0 else v2)
+        return np.array([np.broadcast_to(r, np.shape(t)) for r in rows], dtype=float)
 
     # --- choosing the next mode ----------------------------------------------------------
     def choose(self, t, y, velocities, fired: tuple[str, int] | None = None, previous: Mode | None = None) -> Mode:
@@ -256,14 +272,18 @@ def simulate_unilateral(
         if sol.status < 0:
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
         t_stop = float(sol.t[-1])
+        grazed = _grazing_crossing(model, mode, sol, events)
+        if grazed is not None:
+            t_stop, hit, y_grazed = grazed
         pieces.append(_piece(model, mode, _sample_times(t, t_stop, grid), sol.sol))
-        if sol.status != 1:
+        if grazed is None and sol.status != 1:
             break
-        hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
+        if grazed is None:
+            hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
         short_run = short_run + 1 if t_stop - t <= 1e-12 * (1.0 + t) else 0
         if short_run > _MAX_STALLED_SEGMENTS:
             raise SimulationError(f"the clutch modes chatter at t={t:.6g} s (phi={y[0]:.6g} rad)")
-        t, y_event = float(sol.t_events[hit][0]), sol.y_events[hit][0]
+        t, y_event = (t_stop, y_grazed) if grazed is not None else (float(sol.t_events[hit][0]), sol.y_events[hit][0])
         velocities = model.velocities(y_event, mode)
         mode = model.choose(t, y_event, velocities, events[hit][1], previous=mode)
         y = model.project(y_event, mode, velocities)
@@ -284,6 +304,42 @@ def simulate_unilateral(
                      t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
                                "rod_modelled": model.dyn.include_rod})
+
+
+# interior points checked per accepted step for a guard that dipped below zero and came back
+_GRAZE_POINTS = 8
+
+
+def _grazing_crossing(model: UnilateralModel, mode: Mode, sol, events):
+    """A guard crossing that solve_ivp missed: (t, event index, state) of the first, or None.
+
+    solve_ivp sees an event only where its function changes sign between step
+    ends; a module whose speed dips below zero and recovers within one step
+    (a graze, seen when a coasting crank takes long steps) slips through. Each
+    accepted step is sampled at interior points through the dense output; where
+    a guard went clearly negative, its first root is located with brentq.
+    """
+    ends = sol.t
+    if ends.size < 2:
+        return None
+    fractions = np.arange(1, _GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)
+    times = (ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel()
+    values = model.guards(times, sol.sol(times), mode)
+    scale = np.maximum(np.abs(values).max(axis=1, keepdims=True), 1e-300)
+    negative = values < -1e-9 * scale
+    if not negative.any():
+        return None
+    k, j = min(zip(*np.nonzero(negative)), key=lambda kj: times[kj[1]])
+    event = events[k][0]
+    step = j // _GRAZE_POINTS
+    points = [ends[step], *times[step * _GRAZE_POINTS: j + 1]]  # the step's start up to the first clear dip
+    signs = [event(time, sol.sol(time)) for time in points]
+    if signs[0] < 0:  # negative at a step end already: solve_ivp's own event handling covers it
+        return None
+    first = next(i for i, value in enumerate(signs) if value < 0)
+    lo, hi = points[first - 1], points[first]
+    t_root = brentq(lambda time: event(time, sol.sol(time)), lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    return t_root, k, sol.sol(t_root)
 
 
 def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.ndarray]:
