@@ -128,9 +128,11 @@ def test_properties_over_a_wide_range_of_designs(m1, m2, ratio, J_A, F_r1, F_r2,
                          rod_mass=rod_mass, phi0=phi0)
     run = analytic.simulate(params, geometry, "unilateral", 0.3, dt_out=1e-3)
     s = run.series
-    # never hangs: the crank turns at most ~omega t / pi half-strokes and each has at most
-    # four modes, so the switch count stays below 4 * (revolutions * 2 + 1) + 4
-    assert run.summary["mode_switches"] <= 8 * abs(run.summary["revolutions"]) + 8
+    # never hangs: in each half-turn the crank travels (dead centre to dead centre) the modes can
+    # change at most four times (contraction, both moving, expansion, both moving), plus a few
+    # where the crank reverses; so the count is bounded by the angle travelled, not by time
+    travelled = np.sum(np.abs(np.diff(s["phi"])))
+    assert run.summary["mode_switches"] <= 4 * (travelled / math.pi + 2) + 4
     scale_v = params.r * np.abs(s["omega"]).max() + 1e-7  # + 1e-15 m/s absolute: roundoff at rest
     scale_f = params.F_r1 + params.F_r2 + (params.m1 + params.m2) * np.abs(np.concatenate([s["a1"], s["a2"]])).max()
     check_complementarity(run, slack_v=1e-8 * scale_v, slack_f=1e-7 * scale_f + 1e-12)

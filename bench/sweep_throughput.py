@@ -1,0 +1,63 @@
+"""Benchmark: sweep throughput on 1 and 2 cores, and batched vs serial MuJoCo steps.
+
+Run on demand (not part of the test suite):
+
+    python bench/sweep_throughput.py [--designs N] [--t-end SECONDS]
+
+Reports, measured in one run on this machine:
+- designs per second of the analytic one-way-clutch model through the process
+  pool with 1 and 2 workers;
+- designs per second of MuJoCo's ratchet through mujoco.batch with 1 and 2 threads,
+  and through the serial engine (one design after another, Python loop);
+- the cost of one batched ratcheted step per design as a ratio to one step of the
+  serial Python loop (ipir_mujoco.engine), both on one thread.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+
+from analytic import RobotParams
+from ipir_mujoco.engine import simulate_mujoco
+from ipir_mujoco.model import SolverSettings
+from ipir_mujoco.sweep import run_sweep
+from ipir_mujoco.sweep_batch import run_ratchet_batch
+from ipir_mujoco.sweep_space import Study, parse_vary
+
+
+def timed(action) -> float:
+    started = time.perf_counter()
+    action()
+    return time.perf_counter() - started
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--designs", type=int, default=32)
+    parser.add_argument("--t-end", type=float, default=0.5)
+    args = parser.parse_args()
+    n, t_end = args.designs, args.t_end
+    study = Study((parse_vary(f"L=0.06:0.5:{n}"),), engines=("analytic-unilateral",), t_end=t_end)
+    designs = [RobotParams(L=d["L"]) for d in study.designs()]
+    steps = round(t_end / SolverSettings().timestep)
+    print(f"{n} designs, {t_end:g} s simulated each ({steps} MuJoCo steps)")
+    for workers in (1, 2):
+        with tempfile.TemporaryDirectory() as folder:
+            seconds = timed(lambda: run_sweep(study, folder, workers=workers, progress=False))
+        print(f"  analytic one-way clutches, process pool, {workers} worker(s): {n / seconds:7.2f} designs/s")
+    batched = {}
+    for threads in (1, 2):
+        batched[threads] = timed(lambda: run_ratchet_batch(designs, t_end, 1e-3, nthread=threads))
+        print(f"  MuJoCo ratchet, mujoco.batch, {threads} thread(s):          {n / batched[threads]:7.2f} designs/s")
+    serial = timed(lambda: [simulate_mujoco(p, "unilateral", "ratchet", t_end, dt_out=1e-3) for p in designs])
+    print(f"  MuJoCo ratchet, serial engine (Python loop):             {n / serial:7.2f} designs/s")
+    per_step_batch = batched[1] / (n * steps)
+    per_step_serial = serial / (n * steps)
+    print(f"  one batched step per design: {per_step_batch * 1e6:.2f} us; serial loop step: "
+          f"{per_step_serial * 1e6:.2f} us; ratio batched/serial = {per_step_batch / per_step_serial:.3f}")
+
+
+if __name__ == "__main__":
+    main()
