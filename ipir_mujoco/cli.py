@@ -108,7 +108,7 @@ def build_parser() -> argparse.ArgumentParser:
     swp.add_argument("--vary", action="append", default=[], metavar="NAME=SPEC",
                      help="NAME=START:STOP:N[:log] (grid), NAME=A,B,C (list) or NAME=LO:HI[:log] (with --sample)")
     swp.add_argument("--sample", type=int, default=None, metavar="N", help="N space-filling (Sobol) designs")
-    swp.add_argument("--seed", type=int, default=0, help="seed of the Sobol sample (default 0)")
+    swp.add_argument("--seed", type=int, default=None, help="seed of the Sobol sample (default 0)")
     swp.add_argument("--engines", default=None, metavar="LIST",
                      help="comma-separated, first one is the reference for divergence; from: analytic-approx, "
                           "analytic-exact, analytic-unilateral, mujoco-lock, mujoco-ratchet "
@@ -280,10 +280,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         options["axes"] = tuple(parse_vary(v) for v in args.vary)
     if args.engines:
         options["engines"] = tuple(e.strip() for e in args.engines.split(",") if e.strip())
-    for key in ("sample", "seed", "t_end"):
-        value = getattr(args, key)
-        if value is not None and (key != "seed" or args.seed != 0 or "seed" not in options):
-            options[key] = value
+    for key in ("sample", "seed", "t_end"):  # options given on the command line win over the study file
+        if getattr(args, key) is not None:
+            options[key] = getattr(args, key)
     options.setdefault("axes", ())
     study = Study(**options)
     if args.workers is not None and args.workers < 1:
