@@ -25,3 +25,20 @@ def test_analytic_never_imports_mujoco_or_ipir_mujoco():
                 names = [node.module or ""]
             for name in names:
                 assert not name.split(".")[0] in ("mujoco", "ipir_mujoco"), f"{path.name} imports {name}"
+
+
+def test_the_mujoco_side_never_runs_the_analytic_equations():
+    """Engine, model, clutches and batch may share the parameter set, the result container and the
+    errors with analytic/, nothing that computes dynamics."""
+    import ipir_mujoco
+
+    allowed = {"analytic.params", "analytic.results", "analytic.errors"}
+    folder = Path(ipir_mujoco.__file__).parent
+    for name in ("engine.py", "model.py", "clutches.py", "sweep_batch.py", "sweep_metrics.py", "resources.py"):
+        tree = ast.parse((folder / name).read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith("analytic"):
+                assert node.module in allowed, f"{name} imports {node.module}"
+            if isinstance(node, ast.Import):
+                assert not any(a.name == "analytic" or a.name.startswith("analytic.") and a.name not in allowed
+                               for a in node.names), f"{name} imports analytic"
