@@ -287,20 +287,25 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     study = Study(**options)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers} is out of range; allowed: >= 1")
-    executor = None
+    client = None
     if args.scheduler:
         try:
             from distributed import Client
         except ImportError:
             raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
-        client = Client(args.scheduler)
-        executor = client.get_executor()
+        try:
+            client = Client(args.scheduler, timeout="20s")
+        except (OSError, TimeoutError) as exc:
+            raise ParameterError(f"--scheduler {args.scheduler!r} cannot be reached: {exc}") from None
     try:
-        results = run_sweep(study, args.out, executor=executor, batch_mujoco=not args.no_batch, resume=args.resume,
-                            workers=args.workers)
+        results = run_sweep(study, args.out, executor=client.get_executor() if client else None,
+                            batch_mujoco=not args.no_batch, resume=args.resume, workers=args.workers)
     except SweepInterrupted as exc:
         print(f"ipir-mujoco sweep: {exc}", file=sys.stderr)
         return 130
+    finally:
+        if client is not None:
+            client.close()
     axes = [a.name for a in study.axes]
     figures = plot_sweep(results, axes, list(study.engines), args.out)
     best = best_designs(read_results(results), axes, list(study.engines))

@@ -132,7 +132,12 @@ def test_dask_gives_the_same_results_as_the_local_pool(tmp_path):
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
         with distributed.Client(cluster) as client:
             remote = rows_of(run_sweep(study, tmp_path / "dask", executor=client.get_executor(), progress=False))
-    assert sorted(local, key=lambda r: int(r["design_id"])) == sorted(remote, key=lambda r: int(r["design_id"]))
+        # and the command line's --scheduler against the same cluster
+        assert main(["sweep", "--vary", "L=0.08,0.2", "--vary", "m2=0.5,1.5", "--engines",
+                     "analytic-approx,mujoco-ratchet", "--t-end", "0.3", "--out", str(tmp_path / "cli"),
+                     "--scheduler", cluster.scheduler_address]) == 0
+    by_id = lambda rows: sorted(rows, key=lambda r: int(r["design_id"]))  # noqa: E731
+    assert by_id(local) == by_id(remote) == by_id(rows_of(tmp_path / "cli" / "results.csv"))
 
 
 def test_sweep_command_writes_results_heatmap_and_best_designs(tmp_path, capsys):
