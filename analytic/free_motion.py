@@ -21,7 +21,7 @@ from scipy.integrate import solve_ivp
 
 from .dynamics import OneDofDynamics
 from .errors import ParameterError, SimulationError
-from .kinematic_clutch import _check_run_options
+from .solver_support import check_run_options
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
@@ -44,7 +44,7 @@ def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT
         raise ParameterError(f"F_r1={params.F_r1}, F_r2={params.F_r2}: the free mechanism has no clutches, so "
                              "modules also move backward, where a forward-only resistance is undefined; "
                              "allowed: F_r1 = F_r2 = 0")
-    _check_run_options(t_end, dt_out, rtol, atol)
+    check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
     dyn = OneDofDynamics(params, geometry)
     link = dyn.linkage

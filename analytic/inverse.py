@@ -23,7 +23,7 @@ from scipy.interpolate import CubicSpline
 
 from .dynamics import OneDofDynamics
 from .errors import ParameterError, SimulationError
-from .kinematic_clutch import _check_run_options, _sample_times
+from .solver_support import check_run_options, sample_times
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
@@ -180,7 +180,7 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: kinematic, unilateral")
     t_end = motion.t_end
     dt_out = dt_out or t_end / 2000
-    _check_run_options(t_end, dt_out, rtol, atol)
+    check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
     model = _Prescribed(params, geometry, motion, clutch)
     grid = np.linspace(0.0, t_end, max(1, math.ceil(t_end / dt_out - 1e-9)) + 1)
@@ -196,7 +196,7 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
                         events=[e for e, _ in events], dense_output=True)
         if sol.status < 0:
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s: {sol.message}")
-        times = _sample_times(t, float(sol.t[-1]), grid)
+        times = sample_times(t, float(sol.t[-1]), grid)
         pieces.append(_piece(model, mode, times, sol.sol(times)))
         if sol.status != 1:
             break

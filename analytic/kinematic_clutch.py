@@ -34,11 +34,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .dynamics import OneDofDynamics
-from .errors import ParameterError, SimulationError
+from .errors import SimulationError
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
+from .solver_support import check_finite, check_run_options, sample_times
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -79,12 +80,6 @@ def choose_initial_mode(dyn: OneDofDynamics, phi: float, omega: float, M: float 
     return choose_mode_at_rest_gap(dyn, phi, omega, M)
 
 
-def _sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
-    """Segment [t0, t1]: its end points and the output grid strictly inside."""
-    inside = grid[(grid > t0) & (grid < t1)]
-    return np.concatenate([[t0], inside, [t1]]) if t1 > t0 else np.array([t0])
-
-
 def simulate_kinematic(
     params: RobotParams,
     geometry: Geometry | str = Geometry.APPROX,
@@ -107,7 +102,7 @@ def simulate_kinematic(
     (e.g. a torque from inverse kinetostatics); a stall under it is an error,
     since a stall is only final under constant loads.
     """
-    _check_run_options(t_end, dt_out, rtol, atol)
+    check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
     dyn = OneDofDynamics(params, geometry)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
@@ -124,11 +119,11 @@ def simulate_kinematic(
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque")
             # Everything at rest under constant loads: nothing changes any more.
-            pieces.append(_stalled_piece(dyn, _sample_times(t, t_end, grid), y))
+            pieces.append(_stalled_piece(dyn, sample_times(t, t_end, grid), y))
             break
         sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque)
         t_stop = float(sol.t[-1])
-        pieces.append(_mode_piece(dyn, mode, _sample_times(t, t_stop, grid), sol.sol, torque))
+        pieces.append(_mode_piece(dyn, mode, sample_times(t, t_stop, grid), sol.sol, torque))
         if sol.status != 1:
             break
         t, y = float(sol.t_events[0][0]), sol.y_events[0][0].copy()
@@ -147,7 +142,7 @@ def simulate_kinematic(
     else:
         series.pop("motor_torque")
     energy = dyn.energy_audit(series, motor_work)
-    _check_finite(series)
+    check_finite(series)
     return RunResult(
         engine="analytic",
         geometry=dyn.geometry.value,
@@ -160,16 +155,6 @@ def simulate_kinematic(
         settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
                   "rod_modelled": dyn.include_rod},
     )
-
-
-def _check_run_options(t_end: float, dt_out: float, rtol: float, atol: float) -> None:
-    for name, value in (("t_end", t_end), ("dt_out", dt_out), ("rtol", rtol), ("atol", atol)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
-    if dt_out > t_end:
-        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: dt_out <= t_end ({t_end} s)")
-    if rtol < 1e-13:
-        raise ParameterError(f"rtol={rtol} is out of range; allowed: rtol >= 1e-13 (DOP853's floor)")
 
 
 def _torque_at(torque, t, y):
@@ -230,11 +215,3 @@ def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
         "resistance1": np.full(n, -lam2), "resistance2": np.full(n, -lam1),
         "motor_work": np.full(n, y[4]), "motor_torque": np.full(n, dyn.params.M),
     }
-
-
-def _check_finite(series: dict[str, np.ndarray]) -> None:
-    for name, values in series.items():
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            t_bad = series["t"][bad[0]]
-            raise SimulationError(f"non-finite {name} at t={t_bad:.6g} s")

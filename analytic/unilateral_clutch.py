@@ -46,7 +46,7 @@ from scipy.optimize import brentq
 
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
-from .kinematic_clutch import _check_finite, _check_run_options, _sample_times
+from .solver_support import check_finite, check_run_options, sample_times
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
@@ -245,7 +245,7 @@ def simulate_unilateral(
     [N m], vectorized, replaces the constant M; a stall under it is an error
     (a stall is only final under constant loads).
     """
-    _check_run_options(t_end, dt_out, rtol, atol)
+    check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
     model = UnilateralModel(params, geometry, torque)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
@@ -263,7 +263,7 @@ def simulate_unilateral(
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque")
-            pieces.append(_piece(model, Mode.BOTH_LOCKED, _sample_times(t, t_end, grid), lambda ts: np.repeat(
+            pieces.append(_piece(model, Mode.BOTH_LOCKED, sample_times(t, t_end, grid), lambda ts: np.repeat(
                 y[:, None], np.size(ts), axis=1)))
             break
         events = model.events(mode)
@@ -275,7 +275,7 @@ def simulate_unilateral(
         grazed = _grazing_crossing(model, mode, sol, events)
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
-        pieces.append(_piece(model, mode, _sample_times(t, t_stop, grid), sol.sol))
+        pieces.append(_piece(model, mode, sample_times(t, t_stop, grid), sol.sol))
         if grazed is None and sol.status != 1:
             break
         if grazed is None:
@@ -298,7 +298,7 @@ def simulate_unilateral(
     torque_used = series.pop("motor_torque")
     add_kinetostatics(series, model.dyn)
     series["motor_power"] = torque_used * series["omega"]
-    _check_finite(series)
+    check_finite(series)
     energy = model.dyn.energy_audit(series, motor)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
                      t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,

@@ -128,9 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
                               description="Run the model ladder at the paper's case and write a report: "
                                           "DIR/index.html, DIR/report.md, DIR/metrics.json, DIR/figures/.")
     val.add_argument("--out", metavar="DIR", default="report", help="report folder (default: ./report)")
-    val.add_argument("--config", metavar="FILE.toml", help="TOML file of parameters (default: the paper's case)")
-    val.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
-                     help="set a parameter (SI units)")
+    _add_model_options(val)
     val.add_argument("--quick", action="store_true", help="reduced version for tests and CI (coarser output)")
     val.set_defaults(handler=cmd_validate)
     return parser
