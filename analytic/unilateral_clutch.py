@@ -113,12 +113,20 @@ class UnilateralModel:
         return {"alpha": zero, "a1": zero, "a2": zero, "R1": push, "R2": -push}
 
     def rhs(self, mode: Mode):
+        """d/dt of y = [phi, omega, x1, x2, v1, motor work]: only what integration needs (hot path)."""
+        dyn, linkage, constant = self.dyn, self.linkage, self.torque is None
+
         def f(t, y):
             phi, omega, _x1, _x2, v1, _work = y
-            M = self.motor(t, phi, omega)
-            m = self.motion(phi, omega, v1, mode, M)
-            w1, w2 = self.velocities(y, mode)
-            return [omega, m["alpha"], w1, w2, m["a1"], M * omega]
+            M = self.params.M if constant else self.torque(t, phi, omega)
+            tr = linkage.transfer(phi)
+            if mode is Mode.BOTH_MOVING:
+                a1, alpha = dyn.both_moving(phi, omega, M)
+                return [omega, alpha, v1, v1 + tr.K * omega, a1, M * omega]
+            alpha = dyn.acceleration(phi, omega, mode, M)
+            if mode is Mode.CONTRACTION:  # front held: x1_dot = -K omega
+                return [omega, alpha, -tr.K * omega, 0.0, -(tr.dK * omega**2 + tr.K * alpha), M * omega]
+            return [omega, alpha, 0.0, tr.K * omega, 0.0, M * omega]  # expansion: rear held
         return f
 
     def events(self, mode: Mode):
