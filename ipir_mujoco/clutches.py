@@ -1,9 +1,10 @@
 """One-way clutches in MuJoCo: a joint-limit ratchet and velocity-triggered locks.
 
 A controller is called before every ``mj_step`` (:meth:`before_step`) and
-after it (:meth:`after_step`); it reports per module whether its clutch holds
-and the clutch's reaction force [N] (positive pushes the module forward),
-read from MuJoCo's constraint forces of the step just taken.
+after it (:meth:`after_step`, with the step's :class:`StepForces`); it reports
+per module whether its clutch holds and the clutch's reaction force [N]
+(positive pushes the module forward), read from MuJoCo's constraint forces of
+the step just taken.
 
 Nothing here uses the analytic model: the lock rules read MuJoCo's state.
 """
@@ -23,10 +24,32 @@ EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 SLIDES = (REAR_SLIDE, FRONT_SLIDE)
 
 
-def constraint_rows(data: mujoco.MjData, row_type: int, element_id: int) -> np.ndarray:
-    """Indices of the active constraint rows of one type and element."""
-    n = data.nefc
-    return np.flatnonzero((data.efc_type[:n] == row_type) & (data.efc_id[:n] == element_id))
+class StepForces:
+    """The constraint forces of the step just taken, read from MuJoCo once per step.
+
+    ``by_row[(type, id)]``: the summed force of the rows of one constraint
+    element (mjtConstraint type, element id); ``loop``: the three rows of the
+    loop-closing ``connect`` (world-frame force on the rod at C). A plain
+    Python pass over the few rows (about seven) costs less than numpy masks.
+    """
+
+    __slots__ = ("by_row", "loop")
+
+    def __init__(self, data: mujoco.MjData, loop_id: int):
+        n = data.nefc
+        self.by_row: dict[tuple[int, int], float] = {}
+        self.loop: list[float] = []
+        for row_type, element, force in zip(data.efc_type[:n].tolist(), data.efc_id[:n].tolist(),
+                                            data.efc_force[:n].tolist()):
+            if row_type == EQUALITY_ROW and element == loop_id:
+                self.loop.append(force)
+            else:
+                key = (row_type, element)
+                self.by_row[key] = self.by_row.get(key, 0.0) + force
+
+    def force(self, row_type: int, element: int) -> float | None:
+        """Summed force of one element's rows, None if it has no active row."""
+        return self.by_row.get((row_type, element))
 
 
 class Ratchet:
@@ -49,22 +72,17 @@ class Ratchet:
             raise ValueError("the ratchet needs limited slides: build the model with ratchet=True")
         self.bounds = data.qpos[self.qpos_adr].copy()  # running maximum of each module's position
         model.jnt_range[self.joint_ids, 0] = self.bounds
+        self.forces = [0.0, 0.0]
 
     def before_step(self) -> None:
         np.maximum(self.bounds, self.data.qpos[self.qpos_adr], out=self.bounds)
         self.model.jnt_range[self.joint_ids, 0] = self.bounds
 
-    def after_step(self) -> None:
-        pass
+    def after_step(self, forces: StepForces) -> None:
+        self.forces = [forces.force(LIMIT_ROW, int(j)) or 0.0 for j in self.joint_ids]
 
     def reactions(self) -> tuple[list[bool], list[float]]:
-        held, forces = [], []
-        for joint_id in self.joint_ids:
-            rows = constraint_rows(self.data, LIMIT_ROW, joint_id)
-            force = float(self.data.efc_force[rows].sum()) if rows.size else 0.0
-            held.append(force > 0.0)
-            forces.append(force)
-        return held, forces
+        return [f > 0.0 for f in self.forces], list(self.forces)
 
 
 class Locks:
@@ -136,10 +154,9 @@ class Locks:
                     wanted.append(self.data.qvel[self.dof_adr[i]] < 0.0)
             self._apply(wanted)
 
-    def after_step(self) -> None:
-        for i, eq_id in enumerate(self.eq_ids):
-            rows = constraint_rows(self.data, EQUALITY_ROW, eq_id) if self.held[i] else ()
-            self.forces[i] = float(self.data.efc_force[rows].sum()) if len(rows) else 0.0
+    def after_step(self, forces: StepForces) -> None:
+        self.forces = [(forces.force(EQUALITY_ROW, eq_id) or 0.0) if held else 0.0
+                       for eq_id, held in zip(self.eq_ids, self.held)]
 
     def reactions(self) -> tuple[list[bool], list[float]]:
         return list(self.held), list(self.forces)
@@ -156,7 +173,7 @@ class NoClutch:
     def before_step(self) -> None:
         pass
 
-    def after_step(self) -> None:
+    def after_step(self, forces: StepForces) -> None:
         pass
 
     def reactions(self) -> tuple[list[bool], list[float]]:

@@ -36,7 +36,7 @@ from analytic.errors import ParameterError, SimulationError
 from analytic.params import RobotParams
 from analytic.results import COLUMNS, Mode, RunResult
 
-from .clutches import EQUALITY_ROW, LIMIT_ROW, Locks, NoClutch, Ratchet
+from .clutches import EQUALITY_ROW, LIMIT_ROW, Locks, NoClutch, Ratchet, StepForces
 from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_HINGE, SolverSettings, build_model,
                     dof_address, qpos_address, set_closed_loop_state)
 
@@ -142,6 +142,7 @@ def simulate_mujoco(
         else:
             controller = NoClutch(model, data)
         recorder = _Recorder(model, data, params, n_samples + 1)
+        loop_id = model.equality(LOOP).id
         motor = model.actuator(MOTOR).id
         crank_q, crank_v = qpos_address(model, CRANK_HINGE), dof_address(model, CRANK_HINGE)
         data.ctrl[motor] = params.M if servo is None else servo.torque(0.0, data.qpos[crank_q], data.qvel[crank_v])
@@ -156,8 +157,9 @@ def simulate_mujoco(
                 controller.before_step()
                 recorder.before_step()
                 mujoco.mj_step(model, data)
-                controller.after_step()
-                recorder.after_step()
+                forces = StepForces(data, loop_id)
+                controller.after_step(forces)
+                recorder.after_step(forces)
             _check(data, messages, recorder.last_time)
             recorder.sample(controller)
             if progress is not None and data.time >= next_report:
@@ -206,8 +208,12 @@ class _Recorder:
         self.model, self.data, self.params = model, data, params
         self.q = [qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)]
         self.v = [dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
-        self.slide_dofs = np.array(self.v[1:])
         self.loop_id = model.equality(LOOP).id
+        # the slide each clutch row acts on: limit rows by joint id, lock rows by equality id
+        self.limit_dof = {int(j): int(model.jnt_dofadr[j]) for j in range(model.njnt)}
+        self.lock_dof = {e: int(model.jnt_dofadr[model.eq_obj1id[e]]) for e in range(model.neq)
+                         if model.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT}
+        self.loop_force: list[float] = []  # the last step's connect rows
         self.dt = model.opt.timestep
         self.table = {c: np.empty(capacity) for c in COLUMNS + EXTRA_COLUMNS}
         self.count = 0
@@ -227,24 +233,22 @@ class _Recorder:
     def before_step(self) -> None:
         self.v_before[:] = self.data.qvel
 
-    def after_step(self) -> None:
+    def after_step(self, forces: StepForces) -> None:
         d = self.data
-        n = d.nefc
-        types, ids, forces = d.efc_type[:n], d.efc_id[:n], d.efc_force[:n]
         v = d.qvel
-        # Constraint power with the velocities that moved the positions.
-        friction = float(np.sum(forces[types == FRICTION_ROW] * v[ids[types == FRICTION_ROW]]))
-        clutch = 0.0
-        limit = types == LIMIT_ROW
-        if limit.any():
-            clutch += float(np.sum(forces[limit] * v[self.model.jnt_dofadr[ids[limit]]]))
-        lock = (types == EQUALITY_ROW) & (ids != self.loop_id)
-        if lock.any():
-            lock_dofs = self.model.jnt_dofadr[self.model.eq_obj1id[ids[lock]]]
-            clutch += float(np.sum(forces[lock] * v[lock_dofs]))
+        # constraint power with the velocities that moved the positions (rows act on one slide each)
+        friction = clutch = 0.0
+        for (row_type, element), force in forces.by_row.items():
+            if row_type == FRICTION_ROW:
+                friction += force * v[element]  # a dof-friction row's id is its dof
+            elif row_type == LIMIT_ROW:
+                clutch += force * v[self.limit_dof[element]]
+            elif row_type == EQUALITY_ROW:
+                clutch += force * v[self.lock_dof[element]]
         self.work["friction"] -= friction * self.dt
         self.work["clutch"] -= clutch * self.dt
         self.work["motor"] += float(d.ctrl[self.motor_id]) * v[self.v[0]] * self.dt  # = ctrl * (phi change)
+        self.loop_force = forces.loop
 
     def sample(self, controller, initial: bool = False) -> None:
         d, p, i = self.data, self.params, self.count
@@ -254,9 +258,9 @@ class _Recorder:
         accel = np.zeros(3) if initial else (v[self.v] - self.v_before[self.v]) / self.dt
         held, reactions = controller.reactions()
         beta = phi + q[self.q[3]]
-        rod_axis = np.array([math.cos(beta), math.sin(beta), 0.0])
-        loop_rows = np.flatnonzero((d.efc_type[:d.nefc] == EQUALITY_ROW) & (d.efc_id[:d.nefc] == self.loop_id))
-        rod_force = float(d.efc_force[loop_rows] @ rod_axis) if loop_rows.size == 3 else 0.0
+        loop = [] if initial else self.loop_force
+        # the pin force on the rod at C along the rod's axis: tension > 0
+        rod_force = loop[0] * math.cos(beta) + loop[1] * math.sin(beta) if len(loop) == 3 else 0.0
         row = {
             "t": d.time, "phi": phi, "omega": omega, "alpha": accel[0], "x1": x1, "x2": x2,
             "v1": v[self.v[1]], "v2": v[self.v[2]], "a1": accel[1], "a2": accel[2],
@@ -281,11 +285,11 @@ class _Recorder:
         return out
 
     def energy(self) -> dict[str, float]:
-        motor = self.work["motor"]
+        motor = float(self.work["motor"])
         kinetic = float(self.data.energy[1]) - self.kinetic0
-        friction = self.work["friction"]
+        friction = float(self.work["friction"])
         residual = motor - kinetic - friction
         return {
             "motor_work_j": motor, "kinetic_j": kinetic, "friction_j": friction, "residual_j": residual,
-            "clutch_j": self.work["clutch"],
+            "clutch_j": float(self.work["clutch"]),
         }
