@@ -190,16 +190,24 @@ class OneDofDynamics:
         mt = self.mass_terms(phi)
         return mt.m12 * a1 + mt.m22 * alpha + 0.5 * mt.dm22 * omega**2 - mt.transfer.K * front_external
 
+    def static_push(self, phi, M=None):
+        """Force [N] with which the linkage, crank at rest, pushes module 2 forward (and module 1 back).
+
+        Virtual work on the massless-at-rest linkage: M dphi = P dS, so P = M / K;
+        at a dead centre (K = 0) the torque loads neither module.
+        """
+        K = self.linkage.transfer(phi).K
+        M = self.params.M if M is None else M
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(K != 0, M / np.where(K != 0, K, 1.0), 0.0)
+
     def stalled_reactions(self, phi):
         """Clutch reactions holding a robot at rest with both modules locked [N].
 
-        The linkage pushes module 2 with P = M / K and pulls module 1 with -P.
-        The module pulled backward is held by its clutch (reaction |P|); the one
-        pushed forward by its static resistance (a stall means |P| <= F_r), so
-        its clutch carries nothing. At a dead centre with M = 0 nothing loads
-        either clutch.
+        The linkage pushes module 2 with P = M / K and pulls module 1 with -P
+        (:meth:`static_push`). The module pulled backward is held by its clutch
+        (reaction |P|); the one pushed forward by its static resistance (a stall
+        means |P| <= F_r), so its clutch carries nothing.
         """
-        K = self.linkage.transfer(phi).K
-        with np.errstate(divide="ignore", invalid="ignore"):
-            push = np.where(K != 0, self.params.M / np.where(K != 0, K, 1.0), 0.0)
+        push = self.static_push(phi)
         return np.maximum(push, 0.0), np.maximum(-push, 0.0)

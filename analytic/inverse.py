@@ -215,7 +215,6 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
     motor_work = float(series.pop("motor_work")[-1])
     add_kinetostatics(series, model.dyn)
-    series["motor_power"] = series["motor_torque"] * series["omega"]
     energy = model.dyn.energy_audit(series, motor_work)
     return RunResult(engine="analytic-inverse", geometry=model.dyn.geometry.value, clutch=clutch, params=params,
                      t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,

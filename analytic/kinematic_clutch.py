@@ -137,10 +137,7 @@ def simulate_kinematic(
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
     motor_work = float(series.pop("motor_work")[-1])
     add_kinetostatics(series, dyn)
-    if torque is not None:
-        series["motor_power"] = series.pop("motor_torque") * series["omega"]
-    else:
-        series.pop("motor_torque")
+    del series["motor_torque"]  # folded into motor_power
     energy = dyn.energy_audit(series, motor_work)
     check_finite(series)
     return RunResult(

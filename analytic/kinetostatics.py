@@ -9,7 +9,7 @@ then give the pin forces at C and B. Columns added to a time series:
 rod_force          N      axial force in the rod at C, tension > 0 (the pin force at
                           C along the rod; MuJoCo reports the same quantity)
 crank_pin_force    N      magnitude of the force between crank and rod at B
-motor_power        W      M * omega
+motor_power        W      motor torque * omega (the ``motor_torque`` column if present, else M)
 =================  =====  ===========================================================
 
 Frame and symbols as in :mod:`analytic.kinematics`: e = (C - B) / L is the
@@ -54,4 +54,5 @@ def add_kinetostatics(series: dict[str, np.ndarray], dyn: OneDofDynamics) -> Non
             pin_x, pin_y = -on_rod_x, -on_rod_y
         series["rod_force"] = (on_rod_x * cb_x + on_rod_y * cb_y) / p.L
         series["crank_pin_force"] = np.hypot(pin_x, pin_y)
-    series["motor_power"] = p.M * omega
+    torque = series.get("motor_torque", p.M)  # a torque profile where the run has one, else the constant M
+    series["motor_power"] = torque * omega

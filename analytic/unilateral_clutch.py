@@ -106,9 +106,7 @@ class UnilateralModel:
             tr = self.linkage.transfer(phi)
             return {"alpha": alpha, "a1": a1, "a2": a1 + tr.dK * omega**2 + tr.K * alpha, "R1": nan, "R2": nan}
         # static stall: the linkage pushes module 2 with M / K and module 1 with -M / K
-        K = self.linkage.transfer(phi).K
-        with np.errstate(divide="ignore", invalid="ignore"):
-            push = np.where(K != 0, M / np.where(K != 0, K, 1.0), 0.0)
+        push = self.dyn.static_push(phi, M)
         zero = np.zeros_like(nan)
         return {"alpha": zero, "a1": zero, "a2": zero, "R1": push, "R2": -push}
 
@@ -303,9 +301,8 @@ def simulate_unilateral(
 
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
     motor = float(series.pop("motor_work")[-1])
-    torque_used = series.pop("motor_torque")
     add_kinetostatics(series, model.dyn)
-    series["motor_power"] = torque_used * series["omega"]
+    del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     energy = model.dyn.energy_audit(series, motor)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,

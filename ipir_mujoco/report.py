@@ -148,9 +148,6 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
             cells.append(_fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
     blocks.append(Table(header, rows))
-    if metrics["not_yet_evaluated"]:
-        blocks.append(Paragraph("Not evaluated yet (not built in this version): "
-                                + "; ".join(metrics["not_yet_evaluated"]) + "."))
 
     from .lr_study import FIGURES as LR_FIGURES, describe_threshold
 

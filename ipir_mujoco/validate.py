@@ -35,7 +35,6 @@ land.
     settings              {t_end_s, quick, dt_out_s, rtol, atol, mujoco: {timestep,
                           integrator, constraint_time_constant, solimp}}
     versions              software versions
-    not_yet_evaluated     list of rungs whose engines are not built yet
 """
 
 from __future__ import annotations
@@ -60,7 +59,6 @@ from .paper_reference import check_paper_figures
 LADDER_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
                   "min_clutch_reaction_n")
 
-PENDING_RUNGS: tuple[str, ...] = ()
 # the rungs drawn over the paper's Fig. 2-4 (one line style each)
 FIGURE_RUNGS = ("paper model", "MuJoCo, paper's rule", "MuJoCo ratchet")
 
@@ -116,12 +114,16 @@ def relative_change(new: float | None, old: float | None) -> float | None:
     return (new - old) / abs(old)
 
 
+def locked_reaction(s: dict[str, np.ndarray]) -> np.ndarray:
+    """Reaction of the clutch the paper's rule locks at each sample [N] (inf where none is locked)."""
+    return np.where(s["mode"] == Mode.CONTRACTION, s["lambda2"],
+                    np.where(s["mode"] == Mode.EXPANSION, s["lambda1"], np.inf))
+
+
 def clutch_pull(run: RunResult) -> dict:
     """How much of the run has a locked clutch whose reaction is negative (would have to pull)."""
     s = run.series
-    locked_reaction = np.where(s["mode"] == Mode.CONTRACTION, s["lambda2"],
-                               np.where(s["mode"] == Mode.EXPANSION, s["lambda1"], np.inf))
-    pulling = locked_reaction < 0
+    pulling = locked_reaction(s) < 0
     dt = np.diff(s["t"])
     fraction = float(np.sum(dt * pulling[:-1]) / np.sum(dt))
     return {"fraction_of_time": fraction, "min_reaction_n": run.summary["min_clutch_reaction_n"]}
@@ -231,7 +233,6 @@ def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict, study:
         "params": params.as_dict(),
         "settings": settings,
         "versions": software_versions(),
-        "not_yet_evaluated": list(PENDING_RUNGS),
     }
 
 
@@ -254,8 +255,7 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
 def pull_per_stroke(run: RunResult) -> list[dict]:
     """Per stroke of the paper's model: mean crank speed and the fraction of its time a lock would pull."""
     s = run.series
-    locked = np.where(s["mode"] == Mode.CONTRACTION, s["lambda2"],
-                      np.where(s["mode"] == Mode.EXPANSION, s["lambda1"], np.inf))
+    locked = locked_reaction(s)
     strokes, start = [], 0
     changes = np.flatnonzero(np.diff(s["mode"]) != 0)
     for end in list(changes + 1) + [len(s["t"])]:
