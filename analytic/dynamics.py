@@ -11,7 +11,7 @@ x2_dot = (e + K) * omega. Lagrange's equation in phi then reads
     Q     = M - F_r1 e - F_r2 (e + K)
 
 where (a, b, g) are the rod's velocity coefficients (see
-:class:`analytic.kinematics.RodMotion`). With the first-order geometry the rod
+:class:`ipir_mujoco.analytic.kinematics.RodMotion`). With the first-order geometry the rod
 is ignored, as in the paper, and this is exactly the paper's (20)-(22):
 J_eff = J_A + m K^2, and 1/2 J_eff' = m K K'.
 

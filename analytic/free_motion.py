@@ -1,7 +1,7 @@
 """The robot with no clutches and no resistance: both modules slide freely.
 
 Two degrees of freedom (x1, phi) with the mass matrix of
-:meth:`analytic.dynamics.OneDofDynamics.mass_terms`:
+:meth:`ipir_mujoco.analytic.dynamics.OneDofDynamics.mass_terms`:
 
     M11 x1_ddot + M12 alpha + M12' omega^2       = 0
     M12 x1_ddot + M22 alpha + 1/2 M22' omega^2   = M

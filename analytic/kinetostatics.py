@@ -12,7 +12,7 @@ crank_pin_force    N      magnitude of the force between crank and rod at B
 motor_power        W      motor torque * omega (the ``motor_torque`` column if present, else M)
 =================  =====  ===========================================================
 
-Frame and symbols as in :mod:`analytic.kinematics`: e = (C - B) / L is the
+Frame and symbols as in :mod:`ipir_mujoco.analytic.kinematics`: e = (C - B) / L is the
 rod's unit vector, beta its angle. In the first-order geometry the rod is
 massless and taken along x (L >> r), as in the paper.
 """

@@ -22,10 +22,10 @@ import time
 
 import mujoco
 
-from analytic import RobotParams
-from ipir_mujoco.clutches import Ratchet
+from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.engine.clutches import Ratchet
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.model import SolverSettings, build_model, set_closed_loop_state
+from ipir_mujoco.engine.model import SolverSettings, build_model, set_closed_loop_state
 
 
 def fresh(params):

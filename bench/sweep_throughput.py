@@ -19,12 +19,12 @@ import argparse
 import tempfile
 import time
 
-from analytic import RobotParams
+from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.model import SolverSettings
-from ipir_mujoco.sweep import run_sweep
-from ipir_mujoco.sweep_batch import run_ratchet_batch
-from ipir_mujoco.sweep_space import Study, parse_vary
+from ipir_mujoco.engine.model import SolverSettings
+from ipir_mujoco.studies.sweep import run_sweep
+from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.studies.sweep_space import Study, parse_vary
 
 
 def timed(action) -> float:

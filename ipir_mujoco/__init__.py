@@ -1,9 +1,23 @@
 """ipir-mujoco: check the published analytic model of a two-module inchworm
 in-pipe robot against MuJoCo physics.
 
-The analytic model and the shared parameter set and result container live in
-the sibling package :mod:`analytic`; this package holds the MuJoCo side, the
-command line, plots and reports.
+Layers, bottom up:
+
+- :mod:`ipir_mujoco.analytic`: the parameter set, the result container and the
+  analytic model (numpy and scipy only; it never imports MuJoCo);
+- :mod:`ipir_mujoco.engine`: the MuJoCo model of the real linkage and its runs;
+- :mod:`ipir_mujoco.studies`: compare, validate, sweeps, convergence;
+- :mod:`ipir_mujoco.report`: figures and the validation report;
+- :mod:`ipir_mujoco.cli`: the ``ipir-mujoco`` command.
 """
 
-__version__ = "0.1.0"
+from pathlib import Path as _Path
+
+__version__ = "0.2.0"
+
+# Installed, the repository's analytic/ and mjcf/ folders are ipir_mujoco/analytic and
+# ipir_mujoco/mjcf. In a source checkout run without installing, they sit beside this
+# package: let the subpackage import find them there.
+_here = _Path(__file__).resolve().parent
+if not (_here / "analytic").is_dir() and (_here.parent / "analytic" / "__init__.py").is_file():
+    __path__.append(str(_here.parent))  # noqa: F821 (a package's own __path__)

@@ -8,7 +8,7 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from analytic.errors import ParameterError
+from ipir_mujoco.analytic.errors import ParameterError
 
 
 def check_output_dir(out: str | Path) -> Path:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analytic.results import COLUMNS, read_csv
+from ipir_mujoco.analytic.results import COLUMNS, read_csv
 from ipir_mujoco.cli import main
 
 SUMMARY_KEYS = {"revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",

@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from analytic import RobotParams
-from analytic.results import COLUMNS, Mode, RunResult
+from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult
 from ipir_mujoco.cli import main
-from ipir_mujoco.compare import compare_runs, load_run
+from ipir_mujoco.studies.compare import compare_runs, load_run
 
 T_END, OMEGA = 1.0, 20.0  # s, rad/s
 

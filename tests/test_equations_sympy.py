@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from analytic.dynamics import OneDofDynamics
-from analytic.params import RobotParams
-from analytic.results import Mode
+from ipir_mujoco.analytic.dynamics import OneDofDynamics
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import Mode
 
 ph, w, al, v = sp.symbols("phi omega alpha v", real=True)
 m1, m2, J_A, mr, Ir, r, L, M, F1, F2 = sp.symbols("m1 m2 J_A m_rod I_rod r L M F1 F2", positive=True)

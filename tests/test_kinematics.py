@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from analytic.kinematics import Linkage
+from ipir_mujoco.analytic.kinematics import Linkage
 
 PHI = np.linspace(-7.0, 7.0, 301)
 

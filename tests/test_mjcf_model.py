@@ -8,9 +8,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from analytic import ParameterError, RobotParams
+from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.engine import captured_warnings
-from ipir_mujoco.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, SolverSettings,
+from ipir_mujoco.engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, SolverSettings,
                                build_model, closed_loop_pose, default_mjcf, qpos_address)
 
 NAMED_KINDS = {  # object type -> count field of MjModel

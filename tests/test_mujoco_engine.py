@@ -8,13 +8,13 @@ import math
 import numpy as np
 import pytest
 
-import analytic
-from analytic import RobotParams, SimulationError
-from analytic.free_motion import simulate_free
-from analytic.results import Mode
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic import RobotParams, SimulationError
+from ipir_mujoco.analytic.free_motion import simulate_free
+from ipir_mujoco.analytic.results import Mode
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.model import SolverSettings
+from ipir_mujoco.engine.model import SolverSettings
 
 DT = SolverSettings().timestep
 FIGURES = ("revolutions", "x1_final", "x2_final")

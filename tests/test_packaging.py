@@ -1,44 +1,73 @@
-"""The installed package: data files reachable, the two models independent."""
+"""The installed package: one top-level name, data files reachable, the two models independent."""
 
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
-import analytic
+from ipir_mujoco import analytic
 from ipir_mujoco.resources import mjcf_dir
+
+
+
+def _imports(path: Path, package: str) -> list[str]:
+    """Absolute names of every module ``path`` imports (relative imports resolved against ``package``)."""
+    names = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names += [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = package.split(".")
+                base = parts[: len(parts) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module or ""
+            names.append(module)
+            names += [f"{module}.{alias.name}" for alias in node.names]
+    return names
 
 
 def test_mjcf_folder_is_reachable():
     assert (mjcf_dir() / "README.md").is_file()
 
 
-def test_analytic_never_imports_mujoco_or_ipir_mujoco():
+def test_analytic_never_imports_mujoco_or_the_physics_side():
     """The cross-check is worthless if the analytic side borrows the physics side's code."""
     for path in Path(analytic.__file__).parent.glob("*.py"):
-        tree = ast.parse(path.read_text())
-        for node in ast.walk(tree):
-            names = []
-            if isinstance(node, ast.Import):
-                names = [alias.name for alias in node.names]
-            elif isinstance(node, ast.ImportFrom) and node.level == 0:
-                names = [node.module or ""]
-            for name in names:
-                assert not name.split(".")[0] in ("mujoco", "ipir_mujoco"), f"{path.name} imports {name}"
+        for name in _imports(path, "ipir_mujoco.analytic"):
+            assert name.split(".")[0] != "mujoco", f"{path.name} imports {name}"
+            if name.startswith("ipir_mujoco."):
+                assert name.startswith("ipir_mujoco.analytic"), f"{path.name} imports {name}"
+
+
+def test_importing_the_analytic_package_does_not_load_mujoco():
+    code = "import sys, ipir_mujoco.analytic; assert 'mujoco' not in sys.modules, sorted(sys.modules)"
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
 
 
 def test_the_mujoco_side_never_runs_the_analytic_equations():
-    """Engine, model, clutches and batch may share the parameter set, the result container and the
-    errors with analytic/, nothing that computes dynamics."""
-    import ipir_mujoco
+    """The MuJoCo engine may share the parameter set, the result container and the errors with the
+    analytic package, nothing that computes dynamics."""
+    import ipir_mujoco.engine
 
-    allowed = {"analytic.params", "analytic.results", "analytic.errors"}
-    folder = Path(ipir_mujoco.__file__).parent
-    for name in ("engine.py", "model.py", "clutches.py", "sweep_batch.py", "sweep_metrics.py", "resources.py"):
-        tree = ast.parse((folder / name).read_text())
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith("analytic"):
-                assert node.module in allowed, f"{name} imports {node.module}"
-            if isinstance(node, ast.Import):
-                assert not any(a.name == "analytic" or a.name.startswith("analytic.") and a.name not in allowed
-                               for a in node.names), f"{name} imports analytic"
+    allowed = ("ipir_mujoco.analytic.params", "ipir_mujoco.analytic.results", "ipir_mujoco.analytic.errors")
+    folder = Path(ipir_mujoco.engine.__file__).parent
+    files = sorted(folder.glob("*.py"))
+    assert len(files) >= 4
+    for path in files:
+        for name in _imports(path, "ipir_mujoco.engine"):
+            if name == "ipir_mujoco.analytic" or name.startswith("ipir_mujoco.analytic."):
+                assert name.startswith(allowed), f"{path.name} imports {name}"
+            assert not name.startswith(("ipir_mujoco.studies", "ipir_mujoco.report", "ipir_mujoco.cli")), \
+                f"the engine layer {path.name} imports the layer above it: {name}"
+
+
+def test_a_local_analytic_module_does_not_shadow_the_package(tmp_path):
+    """A user's own analytic.py in the working directory must not break the tool."""
+    (tmp_path / "analytic.py").write_text("raise ImportError('this is the user\\'s own module')\n")
+    done = subprocess.run([sys.executable, "-m", "ipir_mujoco", "--version"], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr

@@ -9,10 +9,10 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from analytic import RobotParams, simulate
-from analytic.dynamics import OneDofDynamics
-from analytic.kinematic_clutch import choose_initial_mode, choose_mode_at_rest_gap
-from analytic.results import Mode
+from ipir_mujoco.analytic import RobotParams, simulate
+from ipir_mujoco.analytic.dynamics import OneDofDynamics
+from ipir_mujoco.analytic.kinematic_clutch import choose_initial_mode, choose_mode_at_rest_gap
+from ipir_mujoco.analytic.results import Mode
 
 RTOL, ATOL = 1e-10, 1e-12
 

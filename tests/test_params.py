@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from analytic import ParameterError, RobotParams, load_params
-from analytic.params import PARAMETER_NAMES, parse_overrides, read_toml
+from ipir_mujoco.analytic import ParameterError, RobotParams, load_params
+from ipir_mujoco.analytic.params import PARAMETER_NAMES, parse_overrides, read_toml
 
 CONTRACT_NAMES = "m1 m2 r L J_A F_r1 F_r2 M rod_mass rod_inertia phi0 omega0".split()
 

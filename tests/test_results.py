@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from analytic import RobotParams
-from analytic.results import COLUMNS, Mode, RunResult, first_gap_minimum, min_locked_reaction, read_csv, write_json
+from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult, first_gap_minimum, min_locked_reaction, read_csv, write_json
 
 
 def synthetic_series(n=2001, t_end=2.0):

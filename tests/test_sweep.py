@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analytic import ParameterError, RobotParams
+from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.cli import main
-from ipir_mujoco.sweep import run_sweep
-from ipir_mujoco.sweep_batch import run_ratchet_batch
-from ipir_mujoco.sweep_metrics import design_metrics
-from ipir_mujoco.sweep_plots import best_designs, read_results
-from ipir_mujoco.sweep_space import Study, parse_vary, read_study
+from ipir_mujoco.studies.sweep import run_sweep
+from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.studies.sweep_metrics import design_metrics
+from ipir_mujoco.report.sweep_plots import best_designs, read_results
+from ipir_mujoco.studies.sweep_space import Study, parse_vary, read_study
 
 
 def rows_of(path: Path) -> list[dict]:
@@ -72,7 +72,8 @@ def test_batched_mujoco_equals_the_serial_engine():
 
     designs = [RobotParams(L=0.08, m2=0.4), RobotParams(L=0.2, m2=2.0), RobotParams(L=0.35, F_r1=2.0)]
     batched = run_ratchet_batch(designs, 0.4, dt_out=1e-3)
-    for params, metrics in zip(designs, batched):
+    for params, outcome in zip(designs, batched):
+        metrics = design_metrics(outcome["series"], outcome["motor_work_j"], outcome["friction_work_j"])
         s = simulate_mujoco(params, "unilateral", "ratchet", 0.4, dt_out=1e-3).series
         motor = params.M * (s["phi"][-1] - s["phi"][0])
         serial = design_metrics(s, motor, params.F_r1 * s["x1"][-1] + params.F_r2 * s["x2"][-1])

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import analytic
-from analytic import RobotParams
-from analytic.results import Mode, mode_changes
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.analytic.results import Mode, mode_changes
 from ipir_mujoco.engine import simulate_mujoco
 
 RTOL, ATOL = 1e-10, 1e-12

@@ -9,12 +9,12 @@ import re
 import numpy as np
 import pytest
 
-import analytic
-from analytic import RobotParams
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.cli import main
-from ipir_mujoco.paper_reference import REPORTED, check_paper_figures
-from ipir_mujoco.lr_study import ANGLE_FIGURES, FIGURES, thresholds
-from ipir_mujoco.validate import validate
+from ipir_mujoco.studies.paper_reference import REPORTED, check_paper_figures
+from ipir_mujoco.studies.lr_study import ANGLE_FIGURES, FIGURES, thresholds
+from ipir_mujoco.studies.validate import validate
 
 
 @pytest.fixture(scope="module")

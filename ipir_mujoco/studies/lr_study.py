@@ -21,11 +21,11 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-import analytic
-from analytic.params import RobotParams
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.params import RobotParams
 
 from .compare import compare_runs
-from .engine import simulate_mujoco
+from ..engine import simulate_mujoco
 
 FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 ANGLE_FIGURES = ("S_at_angle", "S_dot_at_angle")

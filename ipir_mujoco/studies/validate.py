@@ -11,7 +11,7 @@ land.
     verdicts              list of {question, answer, evidence}: the report's opening
     paper_checks          list of {key, label, reported, value, low, high, units,
                           why, reproduced}: the paper's model against each figure
-                          the paper reports (see ipir_mujoco.paper_reference)
+                          the paper reports (see ipir_mujoco.studies.paper_reference)
     ladder                list of {name, engine, geometry, clutch, isolates,
                           summary, change_vs_previous}; summary as CONTRACT.md;
                           change_vs_previous maps each ladder figure to the
@@ -24,9 +24,9 @@ land.
     lr_study              {ratios, rows: [{ratio, L, first_order, exact, mujoco,
                           divergence, mujoco_vs_exact}], thresholds: {figure: {"1%"|"5%":
                           {between: [lo, hi]} | {below_sweep} | {whole_sweep}}}}: see
-                          ipir_mujoco.lr_study; divergence = (first order - exact) / |exact|,
+                          ipir_mujoco.studies.lr_study; divergence = (first order - exact) / |exact|,
                           S_at_angle / S_dot_at_angle as fractions of 2r / max|S_dot|
-    convergence           {mujoco: [rows of ipir_mujoco.convergence], equations: [{rtol,
+    convergence           {mujoco: [rows of ipir_mujoco.studies.convergence], equations: [{rtol,
                           revolutions, x1_final, x2_final, residual_fraction}],
                           mujoco_default_error, equations_default_error}: largest
                           relative change of revolutions/x1/x2 from the default setting
@@ -47,13 +47,13 @@ from typing import Callable
 
 import numpy as np
 
-import analytic
-from analytic.params import RobotParams
-from analytic.results import MODE_NAMES, Mode, RunResult
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import MODE_NAMES, Mode, RunResult
 
-from . import __version__
-from .engine import simulate_mujoco
-from .model import SolverSettings
+from .. import __version__
+from ..engine import simulate_mujoco
+from ..engine.model import SolverSettings
 from .paper_reference import check_paper_figures
 
 LADDER_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",

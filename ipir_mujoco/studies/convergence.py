@@ -13,11 +13,11 @@ import sys
 import time
 from typing import Callable, Sequence
 
-import analytic
-from analytic.params import RobotParams
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.params import RobotParams
 
-from .engine import simulate_mujoco
-from .model import SolverSettings
+from ..engine import simulate_mujoco
+from ..engine.model import SolverSettings
 
 FIGURES = ("revolutions", "x1_final", "x2_final")
 TIMESTEPS = (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5)

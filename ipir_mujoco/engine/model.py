@@ -20,10 +20,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from analytic.errors import ParameterError
-from analytic.params import RobotParams
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import RobotParams
 
-from .resources import mjcf_dir
+from ..resources import mjcf_dir
 
 REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "crank_hinge", "rod_hinge"
 REAR_LOCK, FRONT_LOCK, LOOP = "rear_lock", "front_lock", "rod_to_front"

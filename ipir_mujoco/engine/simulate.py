@@ -32,9 +32,9 @@ from typing import Callable, Iterator
 import mujoco
 import numpy as np
 
-from analytic.errors import ParameterError, SimulationError
-from analytic.params import RobotParams
-from analytic.results import COLUMNS, Mode, RunResult
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult
 
 from .clutches import EQUALITY_ROW, LIMIT_ROW, Locks, NoClutch, Ratchet, StepForces
 from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_HINGE, SolverSettings, build_model,

@@ -15,7 +15,7 @@ Where work runs:
   task on it, MuJoCo serially.
 
 Row columns: ``design_id``, the varied parameters, then ``ENGINE:METRIC`` for
-every engine and metric (:mod:`ipir_mujoco.sweep_metrics`), then
+every engine and metric (:mod:`ipir_mujoco.studies.sweep_metrics`), then
 ``divergence:ENGINE:revolutions`` and ``divergence:ENGINE:mean_speed_mps``,
 (ENGINE - first engine) / |first engine|, then ``error``.
 """
@@ -33,9 +33,9 @@ import time
 from pathlib import Path
 from typing import Callable
 
-import analytic
-from analytic.errors import ParameterError
-from analytic.params import RobotParams
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import RobotParams
 
 from .sweep_metrics import METRICS, design_metrics
 from .sweep_space import Study
@@ -56,7 +56,7 @@ def _run_engine(engine: str, params: RobotParams, t_end: float):
         return analytic.simulate(params, "exact", "kinematic", t_end, dt_out=DT_OUT)
     if engine == "analytic-unilateral":
         return analytic.simulate(params, "exact", "unilateral", t_end, dt_out=DT_OUT)
-    from .engine import simulate_mujoco
+    from ..engine import simulate_mujoco
 
     if engine == "mujoco-lock":
         return simulate_mujoco(params, "kinematic", "lock", t_end, dt_out=DT_OUT)
@@ -72,6 +72,12 @@ def engine_metrics(engine: str, params: RobotParams, t_end: float) -> dict:
     s = run.series
     useful = params.F_r1 * s["x1"][-1] + params.F_r2 * s["x2"][-1]
     return design_metrics(s, run.summary["energy"]["motor_work_j"], useful)
+
+
+def _batch_metrics(outcome: dict) -> dict:
+    if "error" in outcome:
+        return {"error": f"mujoco-ratchet: {outcome['error']}"}
+    return design_metrics(outcome["series"], outcome["motor_work_j"], outcome["friction_work_j"])
 
 
 def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end: float) -> dict[str, dict]:
@@ -212,7 +218,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             for i in todo:
                 pending[pool.submit(run_design, designs[i], study.base, pooled, study.t_end)] = i
         if batched:
-            from .sweep_batch import run_ratchet_batch
+            from ..engine.batch import run_ratchet_batch
 
             for start in range(0, len(todo), BATCH_SIZE):
                 chunk = todo[start:start + BATCH_SIZE]
@@ -225,7 +231,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
                 valid = [p for p in params if p is not None]
                 outcome = iter(run_ratchet_batch(valid, study.t_end, DT_OUT, nthread=workers or 0) if valid else [])
                 for i, p in zip(chunk, params):
-                    metrics = next(outcome) if p is not None else {"error": "invalid design"}
+                    metrics = _batch_metrics(next(outcome)) if p is not None else {"error": "invalid design"}
                     finish(i, {"mujoco-ratchet": metrics})
                 done_now, _ = futures.wait(list(pending), timeout=0)
                 for future in done_now:

@@ -17,10 +17,10 @@ from typing import Sequence
 
 import numpy as np
 
-from analytic.results import Mode
+from ipir_mujoco.analytic.results import Mode
 
 from .plots import new_figure, write_paper_figures
-from .validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
+from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
 
 
 @dataclass
@@ -149,7 +149,7 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
         rows.append(cells)
     blocks.append(Table(header, rows))
 
-    from .lr_study import FIGURES as LR_FIGURES, describe_threshold
+    from ..studies.lr_study import FIGURES as LR_FIGURES, describe_threshold
 
     study = metrics["lr_study"]
     blocks.append(Heading("Where L >> r breaks down"))
@@ -220,7 +220,7 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
                             f"constraint time constant {settings['mujoco']['constraint_time_constant']:g} s, "
                             f"solimp {tuple(settings['mujoco']['solimp'])} (evidence: mjcf/README.md)."))
     blocks.append(Table(["software", "version"], [[k, v] for k, v in metrics["versions"].items()]))
-    blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/validate.py)."))
+    blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/studies/validate.py)."))
     return blocks
 
 

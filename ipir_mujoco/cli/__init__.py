@@ -12,14 +12,14 @@ import sys
 from pathlib import Path
 from typing import Sequence
 
-import analytic
-from analytic.errors import ParameterError, SimulationError
-from analytic.params import PARAMETER_NAMES, load_params
-from analytic.results import RunResult, write_json, write_mode_changes
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.analytic.params import PARAMETER_NAMES, load_params
+from ipir_mujoco.analytic.results import RunResult, write_json, write_mode_changes
 
-from . import __version__
-from .output import check_output_dir, staged_output
-from .plots import write_paper_figures
+from .. import __version__
+from ..output import check_output_dir, staged_output
+from ..report.plots import write_paper_figures
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -141,8 +141,8 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
         if args.geometry == "approx":
             raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real "
                                  "linkage; allowed: --geometry exact (or leave it out)")
-        from .engine import simulate_mujoco
-        from .model import SolverSettings
+        from ..engine import simulate_mujoco
+        from ..engine.model import SolverSettings
 
         implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
         settings = SolverSettings() if args.timestep is None else SolverSettings(timestep=args.timestep)
@@ -233,9 +233,9 @@ def _read_crank_samples(path: str):
 
 
 def cmd_kinetostatics(args: argparse.Namespace) -> int:
-    from analytic.inverse import CrankMotion, inverse_kinetostatics
+    from ipir_mujoco.analytic.inverse import CrankMotion, inverse_kinetostatics
 
-    from .plots import figure_kinetostatics
+    from ..report.plots import figure_kinetostatics
 
     check_output_dir(args.out)
     params = load_params(args.config, args.overrides)
@@ -260,7 +260,7 @@ def cmd_kinetostatics(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from .compare import compare_runs, format_comparison, load_run
+    from ..studies.compare import compare_runs, format_comparison, load_run
 
     result = compare_runs(load_run(args.run_a), load_run(args.run_b), tolerance=args.tolerance)
     print(json.dumps(result, allow_nan=False) if args.json else format_comparison(result))
@@ -268,9 +268,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from .sweep import SweepInterrupted, run_sweep
-    from .sweep_plots import best_designs, plot_sweep, read_results
-    from .sweep_space import Study, parse_vary, read_study
+    from ..studies.sweep import SweepInterrupted, run_sweep
+    from ..report.sweep_plots import best_designs, plot_sweep, read_results
+    from ..studies.sweep_space import Study, parse_vary, read_study
 
     base = load_params(args.config, args.overrides)
     options = read_study(args.study, base) if args.study else {"base": base}
@@ -319,8 +319,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from .report import write_report
-    from .validate import validate
+    from ..report.validation import write_report
+    from ..studies.validate import validate
 
     check_output_dir(args.out)
     params = load_params(args.config, args.overrides)

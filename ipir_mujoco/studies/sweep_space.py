@@ -41,8 +41,8 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import qmc
 
-from analytic.errors import ParameterError
-from analytic.params import PARAMETER_NAMES, RobotParams
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import PARAMETER_NAMES, RobotParams
 
 ENGINES = ("analytic-approx", "analytic-exact", "analytic-unilateral", "mujoco-lock", "mujoco-ratchet")
 DEFAULT_ENGINES = ("mujoco-ratchet", "analytic-unilateral")

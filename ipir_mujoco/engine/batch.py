@@ -1,12 +1,12 @@
 """Many ratcheted MuJoCo designs at once, stepped by ``mujoco.batch`` on C threads.
 
 Each design's model is compiled by the same builder as a single run
-(:func:`ipir_mujoco.model.build_model`); the batch runs one model with
+(:func:`ipir_mujoco.engine.model.build_model`); the batch runs one model with
 per-simulation copies of every field in which the designs differ, so the
 builder stays the only place that turns parameters into a model. Between steps
 the ratchet raises each simulation's lower slide bounds to the running maximum
 of its positions, in one vectorized write (the same rule as
-:class:`ipir_mujoco.clutches.Ratchet`).
+:class:`ipir_mujoco.engine.clutches.Ratchet`).
 
 What a batch can measure is the state: positions and speeds, so speed,
 distance per revolution, efficiency (work against the resistances, F_r times
@@ -25,12 +25,11 @@ import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
 
-from analytic.params import RobotParams
+from ipir_mujoco.analytic.params import RobotParams
 
-from .engine import captured_warnings
+from .simulate import captured_warnings
 from .model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, dof_address,
                     qpos_address, set_closed_loop_state)
-from .sweep_metrics import design_metrics
 
 
 def _differing_fields(models: Sequence[mujoco.MjModel]) -> list[str]:
@@ -50,7 +49,12 @@ def _differing_fields(models: Sequence[mujoco.MjModel]) -> list[str]:
 
 def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: float = 1e-3,
                       settings: SolverSettings = SolverSettings(), nthread: int = 0) -> list[dict]:
-    """Run every design with the joint-limit ratchet; one dict of metrics (or {"error": ...}) per design."""
+    """Run every design with the joint-limit ratchet.
+
+    One dict per design: ``{"series": {column: ndarray (n,)}, "motor_work_j": J,
+    "friction_work_j": J}`` with the columns t, phi, omega, x1, x2, v1, v2, a1, a2,
+    or ``{"error": message}``.
+    """
     results: list[dict | None] = [None] * len(designs)
     models, index = [], []
     for i, params in enumerate(designs):
@@ -119,5 +123,5 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
         series = {key: values[:, k] for key, values in record.items()}
         motor = p.M * (series["phi"][-1] - series["phi"][0])
         friction = p.F_r1 * series["x1"][-1] + p.F_r2 * series["x2"][-1]
-        results[i] = design_metrics(series, motor, friction)
+        results[i] = {"series": series, "motor_work_j": motor, "friction_work_j": friction}
     return results

@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from analytic.results import RunResult
+from ipir_mujoco.analytic.results import RunResult
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .plots import new_figure
-from .sweep_metrics import METRICS
+from ..studies.sweep_metrics import METRICS
 
 # metrics where larger is better; the rest (forces, jumps) are better small
 LARGER_IS_BETTER = ("mean_speed_mps", "distance_per_rev_m", "efficiency")

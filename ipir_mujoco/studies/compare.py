@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analytic.errors import ParameterError
-from analytic.params import RobotParams
-from analytic.results import RunResult, mode_changes, read_csv
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import RunResult, mode_changes, read_csv
 
 QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")

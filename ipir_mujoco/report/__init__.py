@@ -1,0 +1,1 @@
+"""Figures and documents: the paper's figures redrawn, the validation report, sweep pictures."""

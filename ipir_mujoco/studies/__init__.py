@@ -1,0 +1,1 @@
+"""Studies that run the engines and judge them: compare, validate, sweeps, convergence, the L/r study."""
