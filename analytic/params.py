@@ -1,19 +1,29 @@
-"""The robot's parameter set, shared by every engine.
+"""The robot's parameter set, shared by every engine and every interface.
 
-One frozen dataclass, SI units throughout, validated on construction. Defaults
-are the paper's simulation case (see ``shared/paper/MODEL.md``); the rod's mass,
+One frozen dataclass, defined once: each field carries its meaning, unit,
+default and allowed range in its metadata, and everything else reads them from
+there: validation on construction, ``NAME=VALUE`` parsing, TOML files, the
+``ipir-mujoco params`` listing, ``--help`` and the reports. Units are SI except
+``incline``, which is in degrees as users state pipe slopes.
+
+Defaults are the paper's simulation case (m1 = m2 = 1 kg, r = 0.05 m,
+L = 0.2 m, J_A = 0.001 kg m^2, F_r = 1 N, M = 0.25 N m, start from rest at
+phi = 0) with a horizontal pipe and ideal, rigid clutches. The rod's mass,
 which the paper neglects, defaults to a small positive value so that the
 exact-geometry model and the MuJoCo model (which needs a body with mass) can
 agree on the same mechanism.
 
 Build one from defaults, a TOML file and ``NAME=VALUE`` overrides with
-:func:`load_params`.
+:func:`load_params`; list them with :func:`describe_parameters`.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import decimal
+import functools
 import math
+import numbers
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,55 +31,90 @@ from typing import Any, Iterable, Mapping
 
 from .errors import ParameterError
 
+DRIVES = ("torque", "motor")
 
-def _doc(units: str, text: str) -> dict[str, str]:
-    return {"units": units, "doc": text}
+
+def _number(units: str, text: str, default: float, low: float, high: float, *, low_open: bool = False,
+            high_open: bool = False, none_word: str | None = None, none_text: str = "") -> Any:
+    """A real-valued field with its unit, meaning and allowed interval (bounds finite)."""
+    meta = {"kind": "number", "units": units, "doc": text, "low": low, "high": high, "low_open": low_open,
+            "high_open": high_open, "none_word": none_word, "none_text": none_text}
+    return field(default=default, metadata=meta)
+
+
+def _choice(text: str, default: str, choices: tuple[str, ...]) -> Any:
+    return field(default=default, metadata={"kind": "choice", "units": "-", "doc": text, "choices": choices})
 
 
 @dataclass(frozen=True)
 class RobotParams:
-    """Parameters of the two-module inchworm robot (SI units).
+    """Parameters of the two-module inchworm robot (SI units; ``incline`` in degrees).
 
-    ``rod_inertia`` left as ``None`` means a uniform slender rod,
-    ``rod_mass * L**2 / 12``; read the value in use from
-    :attr:`rod_inertia_value`.
+    Run ``ipir-mujoco params`` (or see :func:`describe_parameters`) for every
+    field's meaning, unit, default and allowed range. ``rod_inertia`` left as
+    ``None`` means a uniform slender rod, ``rod_mass * L**2 / 12`` (read the
+    value in use from :attr:`rod_inertia_value`); ``clutch_stiffness`` left as
+    ``None`` means rigid, ideal clutches.
     """
 
-    m1: float = field(default=1.0, metadata=_doc("kg", "mass of module 1 (rear, carries the crank)"))
-    m2: float = field(default=1.0, metadata=_doc("kg", "mass of module 2 (front)"))
-    r: float = field(default=0.05, metadata=_doc("m", "crank length AB"))
-    L: float = field(default=0.2, metadata=_doc("m", "connecting-rod length BC"))
-    J_A: float = field(default=0.001, metadata=_doc("kg m^2", "crank + rotor inertia about A"))
-    F_r1: float = field(default=1.0, metadata=_doc("N", "resistance on module 1 while it moves forward"))
-    F_r2: float = field(default=1.0, metadata=_doc("N", "resistance on module 2 while it moves forward"))
-    M: float = field(default=0.25, metadata=_doc("N m", "constant motor torque on the crank"))
-    rod_mass: float = field(default=0.01, metadata=_doc("kg", "connecting-rod mass (paper: neglected)"))
-    rod_inertia: float | None = field(
-        default=None, metadata=_doc("kg m^2", "rod inertia about its centre of mass; default uniform rod")
-    )
-    phi0: float = field(default=0.0, metadata=_doc("rad", "initial crank angle (0 = full extension)"))
-    omega0: float = field(default=0.0, metadata=_doc("rad/s", "initial crank speed"))
+    m1: float = _number("kg", "mass of module 1 (rear, carries the crank and motor)", 1.0, 0.0, 1e4, low_open=True)
+    m2: float = _number("kg", "mass of module 2 (front)", 1.0, 0.0, 1e4, low_open=True)
+    r: float = _number("m", "crank length AB (the stroke is 2 r)", 0.05, 0.0, 10.0, low_open=True)
+    L: float = _number("m", "connecting-rod length BC (must exceed r)", 0.2, 0.0, 100.0, low_open=True)
+    J_A: float = _number("kg m^2", "inertia of crank and motor rotor about the crank axis A", 0.001, 0.0, 1e4,
+                         low_open=True)
+    F_r1: float = _number("N", "resistance on module 1 while it slides (wall-press rolling resistance)", 1.0,
+                          0.0, 1e6)
+    F_r2: float = _number("N", "resistance on module 2 while it slides (wall-press rolling resistance)", 1.0,
+                          0.0, 1e6)
+    M: float = _number("N m", "constant motor torque on the crank (drive = torque, the paper's case)", 0.25,
+                       -1e6, 1e6)
+    rod_mass: float = _number("kg", "connecting-rod mass (the paper neglects it)", 0.01, 0.0, 1e4)
+    rod_inertia: float | None = _number("kg m^2", "rod inertia about its centre of mass", None, 0.0, 1e4,
+                                        none_word="uniform", none_text="uniform slender rod, rod_mass L^2 / 12")
+    phi0: float = _number("rad", "initial crank angle (0 = crank pointing at module 2, full extension)", 0.0,
+                          -1e4, 1e4)
+    omega0: float = _number("rad/s", "initial crank speed", 0.0, -1e4, 1e4)
+    drive: str = _choice("what turns the crank: 'torque' = the constant M; 'motor' = a DC gearmotor, "
+                         "torque M_stall (1 - omega / omega_noload)", "torque", DRIVES)
+    M_stall: float = _number("N m", "motor stall torque at the crank (drive = motor)", 0.5, 0.0, 1e6, low_open=True)
+    omega_noload: float = _number("rad/s", "motor no-load crank speed (drive = motor)", 30.0, 0.0, 1e5,
+                                  low_open=True)
+    clutch_stiffness: float | None = _number("N/m", "stiffness of each one-way clutch once engaged", None, 0.0,
+                                             1e12, low_open=True, none_word="rigid",
+                                             none_text="rigid, ideal clutches")
+    clutch_damping: float = _number("N s/m", "damping of each one-way clutch while engaged", 0.0, 0.0, 1e9)
+    clutch_backlash: float = _number("m", "free play of each one-way clutch before it engages", 0.0, 0.0, 10.0)
+    incline: float = _number("deg", "pipe axis above the horizontal (90 = vertical climb, negative = downhill)",
+                             0.0, -90.0, 90.0)
+    g: float = _number("m/s^2", "gravitational acceleration", 9.81, 0.0, 100.0)
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
+            meta = f.metadata
             value = getattr(self, f.name)
-            if value is None and f.name == "rod_inertia":
+            if meta["kind"] == "choice":
+                if not isinstance(value, str) or value not in meta["choices"]:
+                    raise ParameterError(f"{f.name}={value!r} is unknown; allowed: {', '.join(meta['choices'])}")
                 continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ParameterError(f"{f.name}={value!r} is not a number; {f.name} takes a real number in {f.metadata['units']}")
-            if not math.isfinite(value):
-                raise ParameterError(f"{f.name}={value} is not finite; allowed: a finite number in {f.metadata['units']}")
-        for name in ("m1", "m2", "r", "L", "J_A"):
-            _require(name, getattr(self, name), "> 0", getattr(self, name) > 0)
-        for name in ("F_r1", "F_r2", "rod_mass"):
-            _require(name, getattr(self, name), ">= 0", getattr(self, name) >= 0)
-        if self.rod_inertia is not None:
-            _require("rod_inertia", self.rod_inertia, ">= 0", self.rod_inertia >= 0)
+            if value is None and meta["none_word"] is not None:
+                continue
+            number = as_real(value)
+            if number is None:
+                raise ParameterError(f"{f.name}={value!r} is not a number; allowed: {allowed_text(f.name)}")
+            if not math.isfinite(number):
+                raise ParameterError(f"{f.name}={number} is not finite; allowed: {allowed_text(f.name)}")
+            if not _inside(number, meta):
+                raise ParameterError(f"{f.name}={value!r} is out of range; allowed: {allowed_text(f.name)}")
+            object.__setattr__(self, f.name, number)  # one type inside: a plain float
         if not self.L > self.r:
             raise ParameterError(
                 f"L={self.L} m with r={self.r} m: the connecting rod must be longer than the crank "
-                f"(allowed: L > r), or the linkage locks or cannot close"
-            )
+                f"(allowed: L > r), or the linkage locks or cannot close")
+        if not self.clutch_backlash <= 0.5 * self.r:
+            raise ParameterError(
+                f"clutch_backlash={self.clutch_backlash} m is out of range; allowed: 0 <= clutch_backlash <= "
+                f"r / 2 = {0.5 * self.r:g} m (a quarter of the stroke 2r; more play would lose most of every stroke)")
 
     @property
     def rod_inertia_value(self) -> float:
@@ -78,90 +123,198 @@ class RobotParams:
             return self.rod_mass * self.L**2 / 12.0
         return self.rod_inertia
 
-    def as_dict(self) -> dict[str, float]:
-        """Every parameter with the value in use (rod inertia resolved)."""
+    @property
+    def rigid_clutches(self) -> bool:
+        """True for ideal clutches (no ``clutch_stiffness`` given)."""
+        return self.clutch_stiffness is None
+
+    def as_dict(self) -> dict[str, Any]:
+        """Every parameter with the value in use (rod inertia resolved; rigid clutch stiffness None)."""
         values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         values["rod_inertia"] = self.rod_inertia_value
         return values
 
     def replace(self, **changes: Any) -> "RobotParams":
         """A copy with some values changed (validated like a new set)."""
-        unknown = sorted(set(changes) - set(PARAMETER_NAMES))
-        if unknown:
-            raise ParameterError(_unknown_message(unknown[0]))
         return dataclasses.replace(self, **changes)
 
 
-def _require(name: str, value: float, allowed: str, ok: bool) -> None:
-    if not ok:
-        units = RobotParams.__dataclass_fields__[name].metadata["units"]
-        raise ParameterError(f"{name}={value} is out of range; allowed: {name} {allowed} ({units})")
+_generated_init = RobotParams.__init__
 
+
+@functools.wraps(_generated_init)
+def _init(self, *args, **kwargs):
+    # an unknown keyword is bad input like any other: a ParameterError naming it, not a TypeError
+    unknown = [name for name in kwargs if name not in PARAMETER_NAMES]
+    if unknown:
+        raise ParameterError(_unknown_message(unknown[0]))
+    if len(args) > len(PARAMETER_NAMES):
+        raise ParameterError(f"RobotParams takes at most {len(PARAMETER_NAMES)} values; give them by name")
+    _generated_init(self, *args, **kwargs)
+
+
+RobotParams.__init__ = _init
 
 PARAMETER_NAMES: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(RobotParams))
+_FIELDS = {f.name: f for f in dataclasses.fields(RobotParams)}
+
+
+def as_real(value: Any) -> float | None:
+    """``value`` as a float if it is a real number of any numeric type (int, float, numpy scalar or
+    0-d array, Fraction, Decimal); None otherwise (bool, complex, strings, containers)."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (numbers.Real, decimal.Decimal)):
+        try:
+            return float(value)
+        except (OverflowError, ValueError):
+            return math.inf
+    shape, kind = getattr(value, "shape", None), getattr(getattr(value, "dtype", None), "kind", None)
+    if shape == () and kind in ("i", "u", "f"):  # a 0-d numpy array
+        return float(value)
+    return None
+
+
+def _inside(x: float, meta: Mapping[str, Any]) -> bool:
+    low_ok = x > meta["low"] if meta["low_open"] else x >= meta["low"]
+    high_ok = x < meta["high"] if meta["high_open"] else x <= meta["high"]
+    return low_ok and high_ok
+
+
+def allowed_text(name: str) -> str:
+    """The allowed values of parameter ``name`` in words, e.g. '0 < m1 <= 10000 kg'."""
+    meta = _FIELDS[name].metadata
+    if meta["kind"] == "choice":
+        return " or ".join(meta["choices"])
+    low = f"{meta['low']:g} {'<' if meta['low_open'] else '<='} "
+    high = f" {'<' if meta['high_open'] else '<='} {meta['high']:g}"
+    text = f"{low}{name}{high} {meta['units']}"
+    if name == "L":
+        text += ", and L > r"
+    if name == "clutch_backlash":
+        text = f"0 <= clutch_backlash <= r / 2 {meta['units']}"
+    if meta["none_word"]:
+        text += f", or '{meta['none_word']}' ({meta['none_text']})"
+    return text
+
+
+def describe_parameters() -> list[dict[str, Any]]:
+    """Every parameter: name, meaning, unit, default and allowed range (for listings and reports)."""
+    rows = []
+    for name, f in _FIELDS.items():
+        meta = f.metadata
+        default = f.default
+        if default is None:
+            default_text = meta["none_word"]
+        else:
+            default_text = default if isinstance(default, str) else f"{default:g}"
+        rows.append({"name": name, "meaning": meta["doc"], "units": meta["units"], "default": default,
+                     "default_text": str(default_text), "allowed": allowed_text(name)})
+    return rows
+
+
+def parameter_units(name: str) -> str:
+    """The unit of parameter ``name`` ('-' for a choice)."""
+    return _FIELDS[name].metadata["units"]
+
+
+def parameter_meaning(name: str) -> str:
+    return _FIELDS[name].metadata["doc"]
 
 
 def _unknown_message(name: str) -> str:
-    return f"unknown parameter {name!r}; known parameters: {' '.join(PARAMETER_NAMES)}"
+    return f"unknown parameter {name!r}; known parameters: {' '.join(PARAMETER_NAMES)} (see 'ipir-mujoco params')"
 
 
-def parse_overrides(items: Iterable[str]) -> dict[str, float]:
-    """Parse ``NAME=VALUE`` strings into a dict of floats.
+def parse_value(name: str, text: str) -> Any:
+    """The value of parameter ``name`` from its text form (as on the command line)."""
+    if name not in _FIELDS:
+        raise ParameterError(_unknown_message(name))
+    meta = _FIELDS[name].metadata
+    text = text.strip()
+    if meta["kind"] == "choice":
+        return text
+    if meta["none_word"] is not None and text.lower() == meta["none_word"]:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise ParameterError(f"{name}={text!r} is not a number; allowed: {allowed_text(name)}") from None
+
+
+def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
+    """Parse ``NAME=VALUE`` strings into a dict of values.
 
     Raises :class:`ParameterError` for a malformed item, an unknown name or a
     value that is not a number. Range checks happen when the set is built.
     """
-    values: dict[str, float] = {}
+    if isinstance(items, str):
+        raise ParameterError(f"overrides={items!r} is a single string; allowed: a list of NAME=VALUE strings")
+    values: dict[str, Any] = {}
     for item in items:
-        name, sep, text = item.partition("=")
+        name, sep, text = str(item).partition("=")
         name = name.strip()
         if not sep or not name:
             raise ParameterError(f"--set {item!r} is malformed; expected NAME=VALUE, e.g. L=0.3")
-        if name not in PARAMETER_NAMES:
-            raise ParameterError(_unknown_message(name))
-        try:
-            values[name] = float(text)
-        except ValueError:
-            raise ParameterError(f"{name}={text!r} is not a number; {name} takes a real number") from None
+        values[name] = parse_value(name, text)
     return values
 
 
-def read_toml(path: str | Path) -> dict[str, float]:
+def read_text_file(path: str | Path, what: str) -> str:
+    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ParameterError(f"{what} {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise ParameterError(f"{what} {str(path)!r} is a folder; give a file") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}); "
+                             "save it as UTF-8") from None
+    except OSError as exc:
+        raise ParameterError(f"{what} {str(path)!r} cannot be read: {exc.strerror}") from None
+
+
+def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
+    """A TOML file as a dict, or a ParameterError naming the file and the problem in one line."""
+    text = read_text_file(path, what)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
     """Read parameter values from a TOML file.
 
     Parameters may stand at the top level or in a ``[params]`` table. Any other
     key is an error, so a typo never passes silently.
     """
-    path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise ParameterError(f"config file {str(path)!r} does not exist") from None
-    except OSError as exc:
-        raise ParameterError(f"config file {str(path)!r} cannot be read: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
-    table = dict(data)
+    table = dict(read_toml_file(path, "config file"))
     nested = table.pop("params", {})
     if not isinstance(nested, dict):
         raise ParameterError(f"config file {str(path)!r}: 'params' must be a table, got {nested!r}")
-    values: dict[str, float] = {}
+    values: dict[str, Any] = {}
     for name, value in list(table.items()) + list(nested.items()):
         if name not in PARAMETER_NAMES:
             raise ParameterError(f"config file {str(path)!r}: {_unknown_message(name)}")
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ParameterError(f"config file {str(path)!r}: {name}={value!r} is not a number")
-        values[name] = float(value)
+        meta = _FIELDS[name].metadata
+        if meta["kind"] == "number" and isinstance(value, str) and value.strip().lower() == meta["none_word"]:
+            value = None
+        elif meta["kind"] == "number" and as_real(value) is None:
+            raise ParameterError(f"config file {str(path)!r}: {name}={value!r} is not a number; "
+                                 f"allowed: {allowed_text(name)}")
+        values[name] = value
     return values
 
 
 def load_params(
     config: str | Path | None = None,
-    overrides: Iterable[str] | Mapping[str, float] = (),
+    overrides: Iterable[str] | Mapping[str, Any] = (),
 ) -> RobotParams:
     """Defaults, then the TOML file ``config``, then ``overrides`` (last wins)."""
-    values: dict[str, float] = {}
+    values: dict[str, Any] = {}
     if config is not None:
         values.update(read_toml(config))
     if isinstance(overrides, Mapping):
@@ -172,3 +325,11 @@ def load_params(
     else:
         values.update(parse_overrides(overrides))
     return RobotParams(**values)
+
+
+def require_params(params: Any) -> RobotParams:
+    """``params`` if it is a :class:`RobotParams`, else a ParameterError (for the Python API's entry points)."""
+    if not isinstance(params, RobotParams):
+        raise ParameterError(f"params={params!r} is not a RobotParams; build one with RobotParams(...) "
+                             "or load_params(...)")
+    return params

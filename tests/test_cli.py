@@ -127,3 +127,21 @@ def test_every_subcommand_has_help(capsys):
             main(argv)
         assert info.value.code == 0
     assert "NAME=VALUE" in capsys.readouterr().out
+
+
+def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
+    from ipir_mujoco.analytic.params import PARAMETER_NAMES
+
+    code, out, err = run_cli(capsys, "params", "--json")
+    rows = json.loads(out)
+    assert code == 0 and err == "" and [r["name"] for r in rows] == list(PARAMETER_NAMES)
+    by_name = {r["name"]: r for r in rows}
+    assert by_name["L"]["units"] == "m" and by_name["L"]["default"] == 0.2 and "L > r" in by_name["L"]["allowed"]
+    code, out, _ = run_cli(capsys, "params")
+    assert code == 0 and all(name in out for name in PARAMETER_NAMES) and "N/m" in out
+
+
+def test_drive_option_reaches_the_parameter_set(capsys):
+    code, out, _ = run_cli(capsys, "simulate", "--json", "--t-end", "0.05", "--drive", "motor")
+    assert code == 0 and json.loads(out)["params"]["drive"] == "motor"
+    assert exit_code(["simulate", "--drive", "servo"]) == 2

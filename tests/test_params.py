@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 import math
+import re
+from decimal import Decimal
+from fractions import Fraction
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from ipir_mujoco.analytic import ParameterError, RobotParams, load_params
-from ipir_mujoco.analytic.params import PARAMETER_NAMES, parse_overrides, read_toml
+from ipir_mujoco.analytic.params import PARAMETER_NAMES, describe_parameters, parse_overrides, read_toml
 
-CONTRACT_NAMES = "m1 m2 r L J_A F_r1 F_r2 M rod_mass rod_inertia phi0 omega0".split()
+CONTRACT_NAMES = ("m1 m2 r L J_A F_r1 F_r2 M rod_mass rod_inertia phi0 omega0 drive M_stall omega_noload "
+                  "clutch_stiffness clutch_damping clutch_backlash incline g").split()
 
 
 def test_contract_names_and_the_papers_defaults():
@@ -30,20 +35,25 @@ def test_default_rod_inertia_follows_the_rod_and_an_explicit_one_is_kept():
 
 
 @pytest.mark.parametrize("name,value,fragment", [
-    ("m1", -1.0, "m1=-1.0 is out of range; allowed: m1 > 0"),
-    ("m2", 0.0, "m2 > 0"),
-    ("J_A", 0.0, "J_A > 0"),
-    ("r", -0.05, "r > 0"),
-    ("F_r1", -0.1, "F_r1 >= 0"),
-    ("rod_mass", -0.01, "rod_mass >= 0"),
-    ("rod_inertia", -1e-6, "rod_inertia >= 0"),
+    ("m1", -1.0, "m1=-1.0 is out of range; allowed: 0 < m1 <= 10000 kg"),
+    ("m2", 0.0, "0 < m2"),
+    ("J_A", 0.0, "0 < J_A"),
+    ("r", -0.05, "0 < r"),
+    ("F_r1", -0.1, "0 <= F_r1"),
+    ("rod_mass", -0.01, "0 <= rod_mass"),
+    ("rod_inertia", -1e-6, "0 <= rod_inertia"),
+    ("omega0", 1e300, "omega0=1e+300 is out of range; allowed: -10000 <= omega0 <= 10000 rad/s"),
+    ("incline", 91.0, "-90 <= incline <= 90 deg"),
+    ("drive", "servo", "drive='servo' is unknown; allowed: torque, motor"),
+    ("clutch_stiffness", -1.0, "0 < clutch_stiffness <= 1e+12 N/m, or 'rigid'"),
+    ("clutch_backlash", 0.03, "clutch_backlash <= r / 2 = 0.025 m"),
     ("M", math.nan, "M=nan is not finite"),
     ("L", math.inf, "L=inf is not finite"),
     ("L", 0.04, "L=0.04 m with r=0.05 m"),
     ("L", 0.05, "allowed: L > r"),
 ])
 def test_out_of_range_values_name_the_value_and_the_allowed_range(name, value, fragment):
-    with pytest.raises(ParameterError, match="^.*" + fragment.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(ParameterError, match="^.*" + re.escape(fragment)):
         RobotParams(**{name: value})
 
 
@@ -92,3 +102,56 @@ def test_bad_toml_files_are_refused_with_the_file_named(tmp_path, text, fragment
 def test_missing_config_file_is_bad_input(tmp_path):
     with pytest.raises(ParameterError, match="does not exist"):
         load_params(tmp_path / "nope.toml")
+
+
+@pytest.mark.parametrize("value", [np.int64(2), np.float32(2.0), np.array(2.0), Fraction(2, 1), Decimal("2")])
+def test_any_real_number_type_is_a_number(value):
+    p = RobotParams(m2=value)
+    assert p.m2 == 2.0 and type(p.m2) is float
+
+
+@pytest.mark.parametrize("value", [True, 1 + 0j, "2", [2.0], np.array([2.0])])
+def test_things_that_are_not_real_numbers_are_refused_by_name(value):
+    with pytest.raises(ParameterError, match="m2=.* is not a number; allowed: 0 < m2"):
+        RobotParams(m2=value)
+
+
+def test_an_unknown_keyword_is_a_parameter_error_naming_it():
+    with pytest.raises(ParameterError, match="unknown parameter 'mass'"):
+        RobotParams(mass=1)
+    with pytest.raises(ParameterError, match="unknown parameter 'mass'"):
+        RobotParams().replace(mass=1)
+
+
+def test_optional_fields_take_their_word_on_the_command_line_and_in_toml(tmp_path):
+    assert parse_overrides(["clutch_stiffness=rigid", "rod_inertia=uniform"]) == \
+        {"clutch_stiffness": None, "rod_inertia": None}
+    path = tmp_path / "c.toml"
+    path.write_text('clutch_stiffness = "rigid"\ndrive = "motor"\n')
+    p = load_params(path)
+    assert p.rigid_clutches and p.drive == "motor"
+
+
+def test_every_parameter_is_described_with_meaning_unit_default_and_range():
+    rows = describe_parameters()
+    assert [r["name"] for r in rows] == list(PARAMETER_NAMES)
+    for row in rows:
+        assert row["meaning"] and row["units"] and row["allowed"], row
+        default = getattr(RobotParams(), row["name"])
+        assert row["default"] == default or (default is None and row["default"] is None)
+    # the described range is the one enforced: a value just outside each finite bound is refused
+    for row in rows:
+        meta = RobotParams.__dataclass_fields__[row["name"]].metadata
+        if meta["kind"] != "number" or row["name"] in ("clutch_backlash", "L", "r"):
+            continue
+        with pytest.raises(ParameterError, match=row["name"]):
+            RobotParams(**{row["name"]: meta["high"] * 1.01 + 1e-9})
+
+
+def test_config_file_that_is_not_utf8_or_is_a_folder_is_refused_in_one_line(tmp_path):
+    path = tmp_path / "latin.toml"
+    path.write_bytes("L = 0.3 # longueur \xe9\n".encode("latin-1"))
+    with pytest.raises(ParameterError, match="is not UTF-8 text"):
+        load_params(path)
+    with pytest.raises(ParameterError, match="is a folder"):
+        load_params(tmp_path)

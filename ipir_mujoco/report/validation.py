@@ -17,6 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ipir_mujoco.analytic.params import parameter_meaning, parameter_units
 from ipir_mujoco.analytic.results import Mode
 
 from .plots import new_figure, write_paper_figures
@@ -211,7 +212,9 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
                           f"{r['x2_final']:.10f}", f"{r['residual_fraction']:.1e}"] for r in conv["equations"]]))
 
     blocks.append(Heading("Parameters and software"))
-    blocks.append(Table(["parameter", "value (SI)"], [[k, _fmt(v, 6)] for k, v in metrics["params"].items()]))
+    blocks.append(Table(["parameter", "value", "unit", "meaning"],
+                        [[k, _fmt(v, 6) if not isinstance(v, str) else v, parameter_units(k), parameter_meaning(k)]
+                         for k, v in metrics["params"].items()]))
     settings = metrics["settings"]
     blocks.append(Paragraph(f"Analytic solver: DOP853, rtol {settings['rtol']:g}, atol {settings['atol']:g}, "
                             f"output every {settings['dt_out_s']:g} s plus every mode switch"

@@ -1,0 +1,64 @@
+"""What every subcommand shares: the parser class, exit codes, model options, progress lines."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ipir_mujoco.analytic.params import DRIVES, RobotParams, load_params
+
+EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with a one-line error message and exit status 2."""
+
+    def error(self, message: str):  # noqa: D102 (argparse API)
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def add_model_options(parser: argparse.ArgumentParser) -> None:
+    """--set, --config and --drive: the parameter set of the robot."""
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                        help="set a parameter (SI units; incline in degrees); 'ipir-mujoco params' lists every "
+                             "name with its meaning, unit, default and allowed range")
+    parser.add_argument("--config", metavar="FILE.toml",
+                        help="TOML file of parameters (top level or a [params] table); --set wins over it")
+    parser.add_argument("--drive", choices=DRIVES, default=None,
+                        help="what turns the crank: torque = the constant M (the paper's case, default); "
+                             "motor = a DC gearmotor, M_stall (1 - omega / omega_noload); wins over --set and "
+                             "the config file")
+
+
+def model_params(args: argparse.Namespace) -> RobotParams:
+    """The parameter set a command's options describe: defaults, --config, --set, then --drive."""
+    params = load_params(args.config, args.overrides)
+    if getattr(args, "drive", None) is not None:
+        params = params.replace(drive=args.drive)
+    return params
+
+
+def progress_printer(t_end: float):
+    """Progress on stderr for runs long enough to wait for (simulated time > 2 s); None otherwise.
+
+    On a terminal one line is rewritten in place; in a log file, one line per tenth of the run.
+    The returned callable takes the simulated time [s].
+    """
+    if t_end <= 2.0:
+        return None
+
+    if sys.stderr.isatty():
+        def report(t: float) -> None:
+            print(f"\rsimulated {t:6.2f} / {t_end:g} s", end="" if t < t_end - 0.05 else "\n",
+                  file=sys.stderr, flush=True)
+        return report
+
+    milestones = iter([t_end * k / 10 for k in range(1, 11)])
+    state = {"next": next(milestones)}
+
+    def report_lines(t: float) -> None:
+        if t >= state["next"] - 1e-9:
+            print(f"simulated {t:.2f} / {t_end:g} s", file=sys.stderr, flush=True)
+            state["next"] = next(milestones, float("inf"))
+
+    return report_lines

@@ -1,0 +1,123 @@
+"""``ipir-mujoco simulate``: one engine on one parameter set."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.results import RunResult, write_json, write_mode_changes
+
+from ..output import check_output_dir, staged_output
+from ..report.plots import write_paper_figures
+from .common import EXIT_OK, add_model_options, model_params, progress_printer
+
+
+def add_parser(commands) -> None:
+    sim = commands.add_parser("simulate", help="run one engine on one parameter set",
+                              description="Run one engine on one parameter set and print or write its results. "
+                                          "Defaults: the paper's model and case for 1 s.")
+    sim.add_argument("--engine", choices=("analytic", "mujoco"), default="analytic",
+                     help="analytic equations or MuJoCo physics (default: analytic)")
+    sim.add_argument("--geometry", choices=("approx", "exact"), default=None,
+                     help="first-order kinematics as in the paper (approx; analytic default) or the exact "
+                          "slider-crank (exact; MuJoCo always models it)")
+    sim.add_argument("--clutch", choices=analytic.CLUTCH_RULES, default="kinematic",
+                     help="kinematic: the paper's rule, lock by the sign of S_dot (default); "
+                          "unilateral: one-way clutches that can only push")
+    sim.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+                     help="MuJoCo clutch implementation: joint-limit ratchet (default with --clutch unilateral) "
+                          "or velocity-triggered lock (default with --clutch kinematic)")
+    sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
+                     help="MuJoCo timestep (default: chosen from the motion; see the docs)")
+    sim.add_argument("--accuracy", choices=("stop", "warn"), default="stop",
+                     help="MuJoCo accuracy monitor: stop the run when the energy residual or the loop gap "
+                          "exceeds its tolerance (default), or warn, record it in the summary and go on")
+    sim.add_argument("--mjcf", metavar="FILE.xml", default=None,
+                     help="MJCF template for --engine mujoco (default: the shipped inchworm.xml)")
+    add_model_options(sim)
+    sim.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS",
+                     help="simulated time (default 1 s); with --until-steady, the cap")
+    sim.add_argument("--until-steady", action="store_true",
+                     help="stop at the periodic steady state (per-revolution mean speed settled); --t-end caps it")
+    sim.add_argument("--dt-out", type=float, default=1e-4, metavar="SECONDS",
+                     help="output sample interval (default 1e-4 s); mode switches are sampled exactly")
+    sim.add_argument("--out", metavar="DIR",
+                     help="write DIR/timeseries.csv, DIR/mode_changes.csv (time and crank angle of each mode "
+                          "change), DIR/summary.json and the paper's figures as PNG")
+    sim.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    sim.set_defaults(handler=run)
+
+
+def run_simulation(args: argparse.Namespace) -> RunResult:
+    """The run ``simulate`` asks for (raises ParameterError on bad input)."""
+    params = model_params(args)
+    extra = {"until_steady": True} if args.until_steady else {}
+    if args.engine == "mujoco":
+        if args.geometry == "approx":
+            raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real "
+                                 "linkage; allowed: --geometry exact (or leave it out)")
+        from ..engine import simulate_mujoco
+        from ..engine.model import SolverSettings
+
+        implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
+        if args.timestep is not None:  # otherwise the engine's own choice
+            extra["settings"] = SolverSettings(timestep=args.timestep)
+        if args.accuracy != "stop":
+            extra["accuracy"] = args.accuracy
+        progress = progress_printer(args.t_end) if not args.json else None
+        return simulate_mujoco(params, args.clutch, implementation, args.t_end, dt_out=args.dt_out,
+                               mjcf=args.mjcf, progress=progress, **extra)
+    for option, value in (("--mjcf", args.mjcf), ("--timestep", args.timestep)):
+        if value is not None:
+            raise ParameterError(f"{option} {value} applies only to --engine mujoco")
+    if args.mujoco_clutch is not None:
+        raise ParameterError(f"--mujoco-clutch {args.mujoco_clutch} applies only to --engine mujoco")
+    if args.accuracy != "stop":
+        raise ParameterError(f"--accuracy {args.accuracy} applies only to --engine mujoco (the analytic "
+                             "engines hold their solver tolerance)")
+    return analytic.simulate(params, args.geometry or "approx", args.clutch, args.t_end, dt_out=args.dt_out,
+                             **extra)
+
+
+def format_summary(run: RunResult) -> str:
+    """The human-readable summary ``simulate`` prints."""
+    s = run.summary
+    e = s["energy"]
+    first = s["first_contraction_end_s"]
+    reaction = s["min_clutch_reaction_n"]
+    lines = [
+        f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
+        f"({run.wall_time_s:.2f} s wall)",
+        f"  crank revolutions        {s['revolutions']:.4f}",
+        f"  module 1 (rear) moved    {s['x1_final']:.4f} m   peak speed {s['v1_max']:.3f} m/s",
+        f"  module 2 (front) moved   {s['x2_final']:.4f} m   peak speed {s['v2_max']:.3f} m/s",
+        "  first minimum of S       " + ("none" if first is None else f"{first:.4f} s"),
+        f"  mode switches            {s['mode_switches']}",
+        "  min clutch reaction      " + ("none (no clutch held)" if reaction is None else f"{reaction:.4g} N"
+                                       + ("   (negative: the lock would have to pull)" if reaction < 0 else "")),
+        f"  energy [J]: motor {e['motor_work_j']:.6g} = kinetic {e['kinetic_j']:.6g} "
+        f"+ friction {e['friction_j']:.6g} + residual {e['residual_j']:.2e}",
+    ]
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.out is not None:
+        check_output_dir(args.out)
+    result = run_simulation(args)
+    record = result.to_json_dict()
+    if args.out is not None:
+        with staged_output(args.out) as staging:
+            result.write_csv(staging / "timeseries.csv")
+            write_mode_changes(staging / "mode_changes.csv", result.series)
+            write_json(staging / "summary.json", record)
+            write_paper_figures([result], staging)
+    if args.json:
+        print(json.dumps(record, allow_nan=False))
+    else:
+        print(format_summary(result))
+        if args.out is not None:
+            print(f"  wrote {args.out}/timeseries.csv, mode_changes.csv, summary.json and fig2-4 PNG")
+    return EXIT_OK

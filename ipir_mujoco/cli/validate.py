@@ -1,0 +1,42 @@
+"""``ipir-mujoco validate``: the analytic-vs-physics validation report (the main job)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ipir_mujoco.analytic.results import write_json
+
+from ..output import check_output_dir, staged_output
+from .common import EXIT_OK, add_model_options, model_params
+
+
+def add_parser(commands) -> None:
+    val = commands.add_parser("validate", help="the analytic-vs-physics validation report (the main job)",
+                              description="Run the model ladder at the paper's case and write a report: "
+                                          "DIR/index.html, DIR/report.md, DIR/metrics.json, DIR/figures/.")
+    val.add_argument("--out", metavar="DIR", default="report", help="report folder (default: ./report)")
+    add_model_options(val)
+    val.add_argument("--quick", action="store_true", help="reduced version for tests and CI (coarser output)")
+    val.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..report.validation import write_report
+    from ..studies.validate import validate
+
+    check_output_dir(args.out)
+    params = model_params(args)
+
+    def progress(message: str) -> None:
+        print(f"validate: {message}", file=sys.stderr, flush=True)
+
+    metrics, rungs = validate(params, quick=args.quick, progress=progress)
+    progress("writing report ...")
+    with staged_output(args.out) as staging:
+        write_json(staging / "metrics.json", metrics)
+        write_report(staging, metrics, rungs)
+    for verdict in metrics["verdicts"]:
+        print(f"{verdict['question']}\n  {verdict['answer']}")
+    print(f"report: {args.out}/index.html (also report.md, metrics.json, figures/)")
+    return EXIT_OK
