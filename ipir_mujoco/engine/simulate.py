@@ -114,6 +114,11 @@ def simulate_mujoco(
     with the simulated time about every 0.1 s of it. ``servo`` replaces the
     constant torque M by a crank servo (:class:`CrankServo`).
     """
+    defaults = RobotParams()
+    for name in ("drive", "clutch_stiffness", "clutch_damping", "clutch_backlash", "incline"):
+        if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
+            raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the MuJoCo engine yet; "
+                                 f"allowed: {getattr(defaults, name)!r}")
     if implementation not in IMPLEMENTATIONS:
         raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
     if clutch not in ("kinematic", "unilateral"):

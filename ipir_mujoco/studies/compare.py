@@ -48,7 +48,8 @@ def load_run(folder: str | Path) -> RunResult:
         params = RobotParams(**record["params"])
         return RunResult(record["engine"], record["geometry"], record["clutch"], params, float(record["t_end"]),
                          series, record["summary"]["energy"], record.get("wall_time_s", 0.0),
-                         record.get("settings", {}))
+                         record.get("settings", {}), stall=record["summary"].get("stall_reason"),
+                         accuracy=record["summary"].get("accuracy"))
     except (ValueError, KeyError, TypeError) as exc:
         raise ParameterError(f"run folder {str(folder)!r} cannot be read: {exc}") from None
 

@@ -1,0 +1,236 @@
+"""Per-revolution figures of a run and its periodic steady state, for every engine.
+
+A *cycle* is one crank revolution: it ends where the crank's running maximum
+angle first reaches phi(0) + 2 pi k (the running maximum, because a crank may
+rock back before it turns on). Everything here reads a run's time series, the
+same way for every engine, and computes no dynamics: it belongs with the result
+container.
+
+Columns used (each an ndarray of shape (n,)): ``t``, ``phi``, ``x1``, ``x2``,
+and where present the cumulative energy columns every engine writes:
+``motor_work`` (work done by the motor since t = 0, J), ``friction_work``
+(work done against the resistances since t = 0, J, >= 0), ``kinetic`` (kinetic
+energy, J) and ``potential`` (gravitational potential energy from the start,
+J), plus ``lambda1``/``lambda2`` (clutch reactions, N), ``rod_force`` (N) and
+``a1``/``a2`` (m/s^2) for the peaks. At a cycle boundary that falls between
+two samples the columns are interpolated linearly; engines that can (the
+analytic ones) put a sample exactly on each boundary.
+
+Steady state: the run is at its periodic steady state at the end of cycle k
+when the mean speeds of the last ``cycles`` revolutions (k - cycles + 1 .. k)
+all lie within ``tol`` * |mean of them| of each other, and that mean is > 0.
+The steady *window* is those revolutions; the steady figures are averages over
+it (totals over the window divided by its time, distance or revolutions).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
+STEADY_CYCLES = 3  # revolutions the spread is measured over
+ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential")
+
+
+def travel(series: dict[str, np.ndarray]) -> np.ndarray:
+    """Position of the robot [m]: the mean displacement of its two modules."""
+    return 0.5 * (np.asarray(series["x1"]) + np.asarray(series["x2"]))
+
+
+def cycle_boundaries(t: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Times [s] at which each whole revolution ends, and the sample index just after each.
+
+    Returns (times (k,), indices (k,)): ``times[j]`` is where the running maximum of
+    phi first reaches phi[0] + 2 pi (j + 1), linearly interpolated between samples;
+    ``indices[j]`` the first sample at or after it.
+    """
+    reach = np.maximum.accumulate(np.asarray(phi, dtype=float)) - phi[0]
+    whole = int(math.floor(reach[-1] / (2 * math.pi) + 1e-12))
+    if whole < 1:
+        return np.zeros(0), np.zeros(0, dtype=int)
+    targets = 2 * math.pi * np.arange(1, whole + 1)
+    idx = np.searchsorted(reach, targets - 1e-12 * (1 + targets), side="left")
+    idx = np.minimum(idx, len(t) - 1)
+    times = np.empty(whole)
+    for j, i in enumerate(idx):
+        if i == 0 or reach[i] <= targets[j] or reach[i] == reach[i - 1]:
+            times[j] = t[i]
+        else:
+            w = (targets[j] - reach[i - 1]) / (reach[i] - reach[i - 1])
+            times[j] = t[i - 1] + w * (t[i] - t[i - 1])
+    return times, idx
+
+
+def _at(t: np.ndarray, values: np.ndarray, when: np.ndarray) -> np.ndarray:
+    """values(t) at the times ``when`` (linear; of duplicated instants, the later sample)."""
+    keep = np.concatenate([np.diff(t) > 0, [True]])
+    return np.interp(when, t[keep], np.asarray(values, dtype=float)[keep])
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """One crank revolution. Energies in J over the revolution; None where the run has no such column."""
+
+    t_start: float  # s
+    t_end: float  # s
+    distance_m: float  # travel of the robot (mean of the modules) over the revolution
+    motor_work_j: float | None
+    friction_work_j: float | None
+    kinetic_change_j: float | None
+    potential_change_j: float | None
+    peak_clutch_force_n: float | None
+    peak_rod_force_n: float | None
+
+    @property
+    def period_s(self) -> float:
+        return self.t_end - self.t_start
+
+    @property
+    def mean_speed_m_s(self) -> float:
+        return self.distance_m / self.period_s if self.period_s > 0 else 0.0
+
+    @property
+    def residual_j(self) -> float | None:
+        """Motor work - friction work - kinetic and potential energy gained: the audit's error."""
+        parts = (self.motor_work_j, self.friction_work_j, self.kinetic_change_j)
+        if any(p is None for p in parts):
+            return None
+        return parts[0] - parts[1] - parts[2] - (self.potential_change_j or 0.0)
+
+
+def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
+    """Every whole revolution of a run (see the module docstring)."""
+    t, phi = np.asarray(series["t"], dtype=float), np.asarray(series["phi"], dtype=float)
+    ends, idx = cycle_boundaries(t, phi)
+    if ends.size == 0:
+        return []
+    starts = np.concatenate([[t[0]], ends[:-1]])
+    first = np.concatenate([[0], idx[:-1]])
+    edges = np.concatenate([[t[0]], ends])
+    pos = _at(t, travel(series), edges)
+    energy = {c: (_at(t, series[c], edges) if c in series else None) for c in ENERGY_COLUMNS}
+
+    def peak(columns, lo, hi):
+        present = [np.abs(series[c][lo:hi + 1]) if c == "rod_force" else series[c][lo:hi + 1]
+                   for c in columns if c in series]
+        return float(max(p.max() for p in present)) if present and hi >= lo else None
+
+    out = []
+    for j in range(ends.size):
+        def delta(column):
+            values = energy[column]
+            return None if values is None else float(values[j + 1] - values[j])
+        out.append(Cycle(float(starts[j]), float(ends[j]), float(pos[j + 1] - pos[j]),
+                         delta("motor_work"), delta("friction_work"), delta("kinetic"), delta("potential"),
+                         peak(("lambda1", "lambda2"), first[j], idx[j]), peak(("rod_force",), first[j], idx[j])))
+    return out
+
+
+def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> int | None:
+    """Index of the first revolution at whose end the last ``n`` mean speeds agree within ``tol``; or None."""
+    u = np.asarray(speeds, dtype=float)
+    for k in range(n - 1, u.size):
+        window = u[k - n + 1:k + 1]
+        mean = float(window.mean())
+        if mean > 0 and float(window.max() - window.min()) <= tol * mean:
+            return k
+    return None
+
+
+class SteadyWatch:
+    """Tells an engine, sample by sample, when its run has reached the periodic steady state.
+
+    Feed it the samples as they come (:meth:`update` with arrays of t [s], phi
+    [rad] and robot travel [m]); it returns True once the last ``n`` revolutions'
+    mean speeds agree within ``tol``. Cheap: work only where a revolution ends.
+    """
+
+    def __init__(self, phi0: float, tol: float = STEADY_TOL, n: int = STEADY_CYCLES):
+        if not (isinstance(n, int) and n >= 2):
+            raise ValueError(f"steady_cycles={n!r} is out of range; allowed: a whole number >= 2")
+        if not (math.isfinite(tol) and 0 < tol < 1):
+            raise ValueError(f"steady_tol={tol!r} is out of range; allowed: 0 < steady_tol < 1")
+        self.phi0, self.tol, self.n = float(phi0), float(tol), n
+        self.reach = 0.0  # running maximum of phi - phi0
+        self.last = None  # (t, reach, travel) of the previous sample
+        self.boundary = None  # (t, travel) where the current revolution began
+        self.speeds: list[float] = []
+        self.steady_at: float | None = None
+
+    def update(self, t, phi, position) -> bool:
+        t, phi, position = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, phi, position))
+        reach = np.maximum.accumulate(np.maximum(phi - self.phi0, self.reach))
+        if self.last is None:
+            self.last = (t[0], reach[0], position[0])
+            self.boundary = (t[0], position[0])
+        target = 2 * math.pi * (len(self.speeds) + 1)
+        if reach[-1] < target:  # no revolution ends in these samples: the common case
+            self.reach, self.last = float(reach[-1]), (t[-1], reach[-1], position[-1])
+            return self.steady_at is not None
+        prev_t, prev_r, prev_x = self.last
+        for ti, ri, xi in zip(t, reach, position):
+            while ri >= target:
+                w = 1.0 if ri == prev_r else (target - prev_r) / (ri - prev_r)
+                tb, xb = prev_t + w * (ti - prev_t), prev_x + w * (xi - prev_x)
+                if tb > self.boundary[0]:
+                    self.speeds.append((xb - self.boundary[1]) / (tb - self.boundary[0]))
+                self.boundary = (tb, xb)
+                if self.steady_at is None and steady_index(self.speeds[-self.n:], self.tol, self.n) is not None:
+                    self.steady_at = tb
+                target = 2 * math.pi * (len(self.speeds) + 1)
+            prev_t, prev_r, prev_x = ti, ri, xi
+        self.reach, self.last = float(reach[-1]), (t[-1], reach[-1], position[-1])
+        return self.steady_at is not None
+
+
+def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> dict:
+    """The summary's per-revolution keys.
+
+    ``steady`` (bool), ``t_steady_s``, ``steady_speed_m_s`` and
+    ``energy_per_metre_j_m`` (None unless steady); ``distance_per_rev_m``,
+    ``efficiency`` (work against the resistances / motor work) and
+    ``peak_clutch_force_n``: over the steady window when steady, else over the
+    whole run (None where the run lacks the columns); ``cycles``: whole
+    revolutions; ``cycle_energy_residual_j``: the largest |audit residual| of a
+    revolution (None without energy columns).
+    """
+    found = cycles(series)
+    speeds = [c.mean_speed_m_s for c in found]
+    k = steady_index(speeds, tol, n)
+    out = {"steady": k is not None, "t_steady_s": None, "steady_speed_m_s": None, "energy_per_metre_j_m": None,
+           "cycles": len(found)}
+    residuals = [abs(c.residual_j) for c in found if c.residual_j is not None]
+    out["cycle_energy_residual_j"] = max(residuals) if residuals else None
+    if k is not None:
+        window = found[k - n + 1:k + 1]
+        time = sum(c.period_s for c in window)
+        distance = sum(c.distance_m for c in window)
+        out["t_steady_s"] = window[-1].t_end
+        out["steady_speed_m_s"] = distance / time
+        out["distance_per_rev_m"] = distance / n
+        works = [c.motor_work_j for c in window]
+        if None not in works:
+            motor = sum(works)
+            out["energy_per_metre_j_m"] = motor / distance if distance > 0 else None
+            friction = [c.friction_work_j for c in window]
+            out["efficiency"] = sum(friction) / motor if None not in friction and motor > 0 else None
+        else:
+            out["efficiency"] = None
+        peaks = [c.peak_clutch_force_n for c in window if c.peak_clutch_force_n is not None]
+        out["peak_clutch_force_n"] = max(peaks) if peaks else None
+        return out
+    revolutions = float((series["phi"][-1] - series["phi"][0]) / (2 * math.pi))
+    moved = float(travel(series)[-1] - travel(series)[0])
+    out["distance_per_rev_m"] = moved / revolutions if revolutions > 1e-9 else None
+    if "motor_work" in series and "friction_work" in series:
+        motor = float(series["motor_work"][-1] - series["motor_work"][0])
+        friction = float(series["friction_work"][-1] - series["friction_work"][0])
+        out["efficiency"] = friction / motor if motor > 0 else None
+    else:
+        out["efficiency"] = None
+    lambdas = [series[c] for c in ("lambda1", "lambda2") if c in series]
+    out["peak_clutch_force_n"] = float(max(v.max() for v in lambdas)) if lambdas else None
+    return out

@@ -1,0 +1,84 @@
+"""Per-revolution figures and the steady-state test, on synthetic runs with known answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ipir_mujoco.analytic.cycles import SteadyWatch, cycle_boundaries, cycle_summary, cycles, steady_index
+
+
+def settling_run(t_end=6.0, n=60001, tau=0.5, omega_ss=20.0, per_rev=0.05):
+    """A crank settling exponentially to omega_ss; the robot advances per_rev per revolution.
+
+    phi = omega_ss (t - tau (1 - exp(-t / tau))): revolutions end where phi = 2 pi k. Energies:
+    the motor does 1 J per revolution plus the kinetic energy 1/2 omega^2 * 1e-3 gained; friction
+    takes 1 J per revolution, so every revolution's audit closes exactly.
+    """
+    t = np.linspace(0.0, t_end, n)
+    phi = omega_ss * (t - tau * (1 - np.exp(-t / tau)))
+    omega = omega_ss * (1 - np.exp(-t / tau))
+    x = per_rev * phi / (2 * math.pi)
+    kinetic = 0.5e-3 * omega**2
+    return {"t": t, "phi": phi, "x1": x, "x2": x, "motor_work": phi / (2 * math.pi) + kinetic,
+            "friction_work": phi / (2 * math.pi), "kinetic": kinetic, "potential": 0 * t,
+            "lambda1": np.sin(phi) ** 2 * 7.0, "lambda2": 0 * t}
+
+
+def test_boundaries_fall_where_the_crank_completes_each_turn():
+    run = settling_run()
+    ends, _ = cycle_boundaries(run["t"], run["phi"])
+    # phi(t) is known: the boundary times solve phi = 2 pi k; linear interpolation between samples
+    # 1e-4 s apart errs by at most phi'' dt^2 / (8 phi') < 1e-8 s here
+    for k, te in enumerate(ends, start=1):
+        phi_at = 20.0 * (te - 0.5 * (1 - math.exp(-te / 0.5)))
+        assert phi_at == pytest.approx(2 * math.pi * k, abs=1e-6)
+
+
+def test_a_rocking_crank_counts_a_revolution_once():
+    t = np.linspace(0, 3, 3001)
+    phi = 2 * math.pi * t / 2 - 0.5 * np.sin(6 * math.pi * t)  # turns 1.5 revolutions, rocking back on the way
+    ends, _ = cycle_boundaries(t, phi)
+    assert ends.size == 1
+
+
+def test_cycle_figures_and_audit_close_exactly():
+    found = cycles(settling_run())
+    assert len(found) > 10
+    for c in found:
+        assert c.distance_m == pytest.approx(0.05, rel=1e-9)
+        assert c.motor_work_j - c.kinetic_change_j == pytest.approx(1.0, rel=1e-9)
+        assert abs(c.residual_j) < 1e-9
+        assert c.peak_clutch_force_n == pytest.approx(7.0, rel=1e-3)
+
+
+def test_steady_state_is_found_when_the_speed_has_settled_and_not_before():
+    run = settling_run()
+    s = cycle_summary(run, tol=1e-4, n=3)
+    assert s["steady"]
+    # the per-revolution speed deficit decays like exp(-t / tau): a spread of 1e-4 over three
+    # revolutions of ~0.31 s needs roughly exp(-t/0.5) * (exp(0.94/0.5) - 1) ~ 1e-4: t ~ 5.5 s
+    assert 4.5 < s["t_steady_s"] < 6.0
+    assert s["steady_speed_m_s"] == pytest.approx(20.0 / (2 * math.pi) * 0.05, rel=1e-3)
+    assert s["distance_per_rev_m"] == pytest.approx(0.05, rel=1e-9)
+    assert s["efficiency"] == pytest.approx(1.0, rel=2e-3)  # friction / (friction + small kinetic gain)
+    assert s["energy_per_metre_j_m"] == pytest.approx(1 / 0.05, rel=2e-3)
+    assert not cycle_summary(settling_run(t_end=3.0, n=30001))["steady"]
+
+
+def test_the_watch_agrees_with_the_after_the_fact_test():
+    run = settling_run()
+    position = 0.5 * (run["x1"] + run["x2"])
+    watch = SteadyWatch(run["phi"][0])
+    for start in range(0, run["t"].size, 997):  # arbitrary chunks, as an engine feeds them
+        sl = slice(start, start + 997)
+        watch.update(run["t"][sl], run["phi"][sl], position[sl])
+    assert watch.steady_at == pytest.approx(cycle_summary(run)["t_steady_s"], abs=1e-9)
+
+
+def test_steady_index_needs_positive_speed_and_a_full_window():
+    assert steady_index([0.0, 0.0, 0.0]) is None
+    assert steady_index([1.0, 1.0]) is None
+    assert steady_index([0.5, 1.0, 1.00001, 1.00002], tol=1e-4, n=3) == 3
