@@ -11,7 +11,9 @@ and where present the cumulative energy columns every engine writes:
 ``motor_work`` (work done by the motor since t = 0, J), ``friction_work``
 (work done against the resistances since t = 0, J, >= 0), ``kinetic`` (kinetic
 energy, J) and ``potential`` (gravitational potential energy from the start,
-J), plus ``lambda1``/``lambda2`` (clutch reactions, N), ``rod_force`` (N) and
+J), and with compliant clutches ``clutch_spring_energy`` (energy stored in the
+clutch springs, J) and ``clutch_damper_work`` (cumulative work dissipated by the
+clutch dampers, J); plus ``lambda1``/``lambda2`` (clutch reactions, N), ``rod_force`` (N) and
 ``a1``/``a2`` (m/s^2) for the peaks. At a cycle boundary that falls between
 two samples the columns are interpolated linearly; engines that can (the
 analytic ones) put a sample exactly on each boundary.
@@ -32,7 +34,8 @@ import numpy as np
 
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
-ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential")
+ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential", "clutch_spring_energy",
+                  "clutch_damper_work")
 
 
 def travel(series: dict[str, np.ndarray]) -> np.ndarray:
@@ -81,6 +84,7 @@ class Cycle:
     friction_work_j: float | None
     kinetic_change_j: float | None
     potential_change_j: float | None
+    clutch_energy_change_j: float | None  # spring energy stored + damper work, compliant clutches only
     peak_clutch_force_n: float | None
     peak_rod_force_n: float | None
 
@@ -94,11 +98,11 @@ class Cycle:
 
     @property
     def residual_j(self) -> float | None:
-        """Motor work - friction work - kinetic and potential energy gained: the audit's error."""
+        """Motor work - friction work - kinetic, potential and clutch energy gained: the audit's error."""
         parts = (self.motor_work_j, self.friction_work_j, self.kinetic_change_j)
         if any(p is None for p in parts):
             return None
-        return parts[0] - parts[1] - parts[2] - (self.potential_change_j or 0.0)
+        return parts[0] - parts[1] - parts[2] - (self.potential_change_j or 0.0) - (self.clutch_energy_change_j or 0.0)
 
 
 def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
@@ -123,8 +127,10 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
         def delta(column):
             values = energy[column]
             return None if values is None else float(values[j + 1] - values[j])
+        spring, damper = delta("clutch_spring_energy"), delta("clutch_damper_work")
+        clutch = None if spring is None and damper is None else (spring or 0.0) + (damper or 0.0)
         out.append(Cycle(float(starts[j]), float(ends[j]), float(pos[j + 1] - pos[j]),
-                         delta("motor_work"), delta("friction_work"), delta("kinetic"), delta("potential"),
+                         delta("motor_work"), delta("friction_work"), delta("kinetic"), delta("potential"), clutch,
                          peak(("lambda1", "lambda2"), first[j], idx[j]), peak(("rod_force",), first[j], idx[j])))
     return out
 
