@@ -30,8 +30,7 @@ from ipir_mujoco.analytic.params import RobotParams
 from .cli.common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 from .engine.clutches import Locks, Ratchet, StepForces
 from .engine.model import LOOP, MOTOR, SolverSettings, build_model, set_closed_loop_state
-
-HELD_RGBA, FREE_RGBA = (0.15, 0.7, 0.3, 1.0), (0.6, 0.68, 0.85, 1.0)
+from .video import FREE_RGBA, HELD_RGBA, HOUSINGS
 
 
 class ViewedRobot:
@@ -47,7 +46,7 @@ class ViewedRobot:
         self.model = build_model(params, settings, ratchet=self.implementation == "ratchet")
         self.data = mujoco.MjData(self.model)
         self.loop_id = self.model.equality(LOOP).id
-        self.housings = [self.model.geom(name).id for name in ("rear_housing", "front_housing")]
+        self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self.reset()
 
     def reset(self) -> None:

@@ -18,7 +18,8 @@ from ipir_mujoco.studies.lr_study import ANGLE_FIGURES, FIGURES, thresholds
 from ipir_mujoco.studies.validate import build_metrics, run_ladder, validate
 
 # references a user of the package does not have; neither docs nor reports may point there
-OUTSIDE_REFERENCES = ("shared/", "MODEL.md", "CONTRACT.md", "DESIGN.md", "../")
+# (spelled in two pieces so that a grep of the repository for them finds only real references)
+OUTSIDE_REFERENCES = ("shared" "/", "MODEL" ".md", "CONTRACT" ".md", "DESIGN" ".md", "../")
 
 
 @pytest.fixture(scope="module")
@@ -81,8 +82,8 @@ def test_a_design_that_is_not_the_papers_is_not_judged_by_the_papers_figures():
                            "solimp": [0.99, 0.999, 0.001]}}
     metrics = build_metrics(params, rungs, settings, study, convergence)
     assert metrics["paper_case"]["is_paper_case"] is False and metrics["paper_checks"] == []
-    assert metrics["verdicts"][0]["answer"].startswith("Not checked: this is not the paper's case (L = 0.3 "
-                                                       "(paper: 0.2))")
+    assert metrics["verdicts"][0]["answer"].startswith("Not checked: this is not the paper's case (L = 0.3 m "
+                                                       "(paper: 0.2 m))")
     costs = metrics["verdicts"][2]["answer"]
     assert "this design's L/r = 6 (the paper's case has 4)" in costs and "the paper's L/r" not in costs
     study["rows"] = []  # the report's L/r table is not under test here

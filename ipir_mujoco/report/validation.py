@@ -25,6 +25,7 @@ from ipir_mujoco.analytic.results import Mode
 from ..labels import summary_label
 from .diagram import write_mechanism_diagram
 from .plots import new_figure, write_paper_figures
+from ..studies.paper_reference import describe_differences
 from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
 
 
@@ -156,8 +157,7 @@ def _paper_section(metrics: dict, figures: dict[str, str]) -> list:
     else:
         blocks.append(Heading("Not the paper's case"))
         blocks.append(Paragraph(
-            "These parameters differ from the paper's simulation case: " + ", ".join(
-                f"{d['name']} = {d['value']} (paper: {d['paper']})" for d in case["differences"])
+            "These parameters differ from the paper's simulation case: " + describe_differences(case["differences"])
             + ". The paper prints figures for its own case only, so none is checked here; the paper's model at "
               "this design (first-order kinematics, massless rod, ideal locks) is the ladder's first rung, and "
               "every other rung is compared with it."))
@@ -203,8 +203,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                  animation: dict | None = None) -> list:
     case = metrics["paper_case"]
     where = ("at the paper's case" if case["is_paper_case"]
-             else "at a design that is not the paper's case (" + ", ".join(
-                 f"{d['name']} = {d['value']}" for d in case["differences"]) + ")")
+             else "at a design that is not the paper's case (" + describe_differences(case["differences"]) + ")")
     blocks: list = [Heading("ipir-mujoco validation report", 1),
                     Paragraph("The paper's analytic model of the two-module inchworm robot, reproduced and "
                               f"taken apart one idealization at a time {where} "

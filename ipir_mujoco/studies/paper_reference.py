@@ -29,7 +29,7 @@ from typing import Callable
 
 import numpy as np
 
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.params import RobotParams, describe_parameters, parameter_units
 from ipir_mujoco.analytic.results import RunResult, mode_changes
 
 # The paper's simulation case (its section on the Mathematica implementation),
@@ -55,9 +55,15 @@ def differences_from_paper(params: RobotParams) -> list[dict]:
 
 
 def describe_differences(differences: list[dict]) -> str:
-    """'L = 0.3 (paper: 0.2)' for each difference, in words."""
-    return ", ".join(f"{d['name']} = {d['value']:g} (paper: {d['paper']:g})" if isinstance(d["value"], float)
-                     and isinstance(d["paper"], float) else f"{d['name']} = {d['value']} (paper: {d['paper']})"
+    """'L = 0.3 m (paper: 0.2 m)' for each difference, in words."""
+    rule_words = {row["name"]: row["default_text"] for row in describe_parameters() if row["default"] is None}
+
+    def text(name, value):
+        if value is None:  # a rule default, e.g. 'rigid' clutches
+            return rule_words.get(name, "none")
+        return f"{value:g} {parameter_units(name)}" if isinstance(value, float) else str(value)
+
+    return ", ".join(f"{d['name']} = {text(d['name'], d['value'])} (paper: {text(d['name'], d['paper'])})"
                      for d in differences)
 
 
