@@ -7,7 +7,8 @@ builds the model from a parameter set exactly as ``simulate --engine mujoco``
 does and steps it in a passive viewer loop that runs the same controller, in
 real time (or slower with ``--slow``), and starts the run again every
 ``--t-end`` seconds of simulated time (a constant torque accelerates the robot
-without bound). A module's housing turns green while its clutch holds it. Needs a screen (on macOS, run it with ``mjpython``); without
+without bound). A module's housing turns green while its clutch holds it; the
+camera follows module 1 (drag to turn it, scroll to zoom). Needs a screen (on macOS, run it with ``mjpython``); without
 one, use ``ipir-mujoco render`` for a video.
 
     python -m ipir_mujoco.view [--clutch unilateral|kinematic] [--mujoco-clutch ratchet|lock]
@@ -101,7 +102,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     import mujoco.viewer
 
     frame = 1.0 / 60.0  # wall-clock seconds between two viewer updates
-    with mujoco.viewer.launch_passive(robot.model, robot.data) as viewer:
+    # the panels start hidden so the robot has the window (Tab and Shift+Tab show them)
+    with mujoco.viewer.launch_passive(robot.model, robot.data, show_left_ui=False,
+                                      show_right_ui=False) as viewer:
+        with viewer.lock():  # a camera that follows module 1, close enough to see the crank turn
+            viewer.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+            viewer.cam.trackbodyid = robot.model.body("rear_module").id
+            viewer.cam.distance, viewer.cam.azimuth, viewer.cam.elevation = 0.6, 90.0, -45.0
         while viewer.is_running():
             started = time.perf_counter()
             with viewer.lock():

@@ -54,7 +54,7 @@ class Image:
 
 # The report's animation: the start of the MuJoCo ratchet run (t_end [s] simulated), ten times slower than
 # real time; --quick draws fewer, smaller frames
-ANIMATION = {"t_end": 0.5, "width": 480, "height": 270, "fps": 15.0, "speed": 0.1}
+ANIMATION = {"t_end": 0.5, "width": 480, "height": 270, "fps": 12.5, "speed": 0.1}  # 80 ms a frame
 ANIMATION_QUICK = {"t_end": 0.2, "width": 320, "height": 180, "fps": 10.0, "speed": 0.1}
 ANIMATION_RUNG = "MuJoCo ratchet"
 
