@@ -1,4 +1,4 @@
-"""The command-line contract (shared/CONTRACT.md) for `simulate`."""
+"""The command-line contract (docs/cli.md) for `simulate`."""
 
 from __future__ import annotations
 

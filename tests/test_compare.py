@@ -89,3 +89,25 @@ def test_compare_command_on_two_run_folders(tmp_path, capsys):
     assert result["angle_grid"]["S"]["max"] == pytest.approx(r**2 / (2 * L), rel=0.05)
     assert main(["compare", str(tmp_path / "a"), str(tmp_path / "missing")]) == 2
     assert "missing" in capsys.readouterr().err
+
+
+def test_format_comparison_names_units_tolerance_and_aligns_columns():
+    from ipir_mujoco.studies.compare import format_comparison
+
+    text = format_comparison(compare_runs(synthetic(), synthetic(scale=1.02), tolerance=0.005))
+    lines = text.splitlines()
+    # readable names with units instead of code names, and the tolerance stated
+    assert "module 1 (rear) travel" in text and "end of first contraction" in text and "x1_final" not in text
+    assert "tolerance 0.005 = 0.5 %" in text
+    row = next(line for line in lines if line.strip().startswith("module 1 velocity"))
+    assert row.split()[3] == "m/s"
+    # each table: header, a rule of dashes, rows; the right-aligned last column ends where the rule does
+    rules = [i for i, line in enumerate(lines) if set(line.strip()) <= {"-", " "} and line.strip()]
+    assert len(rules) == 2
+    for i in rules:
+        block = [lines[i - 1]]
+        j = i + 1
+        while j < len(lines) and lines[j].strip():
+            block.append(lines[j])
+            j += 1
+        assert len(block) > 2 and {len(line) for line in block[1:]} == {len(lines[i])}, block

@@ -71,3 +71,51 @@ def test_a_local_analytic_module_does_not_shadow_the_package(tmp_path):
     done = subprocess.run([sys.executable, "-m", "ipir_mujoco", "--version"], cwd=tmp_path,
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+
+
+def test_import_analytic_alone_fails_outside_a_checkout(tmp_path):
+    """The distribution owns one top-level name: 'analytic' is not installed as a package of its own."""
+    done = subprocess.run([sys.executable, "-c", "import analytic"], cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode != 0 and "No module named 'analytic'" in done.stderr
+
+
+def test_docs_and_code_point_only_inside_the_repository():
+    """README, docs, code, tests and the MJCF never send a user to files the package does not ship.
+
+    ipir_mujoco/engine/ is left out while another change owns it (its clutches.py docstring still
+    points at a developer note); add it back once that line is fixed.
+    """
+    forbidden = ("shared" "/", "MODEL" ".md", "CONTRACT" ".md", "DESIGN" ".md")  # in pieces: see test_validate
+    files = [REPOSITORY / "README.md"]
+    for folder, pattern in (("docs", "*.md"), ("ipir_mujoco", "*.py"), ("analytic", "*.py"), ("tests", "*.py"),
+                            ("mjcf", "*")):
+        files += [p for p in (REPOSITORY / folder).rglob(pattern) if p.is_file() and "__pycache__" not in p.parts]
+    files = [p for p in files if "engine" not in p.relative_to(REPOSITORY).parts and p.suffix != ".png"]
+    assert len(files) > 40
+    hits = [f"{p.relative_to(REPOSITORY)}: {word}" for p in files
+            for word in forbidden if word in p.read_text(encoding="utf-8")]
+    assert not hits
+
+
+def test_readme_keeps_the_fresh_machine_commands():
+    """CI (.ci/run) runs the README's second command line; the first is what a new user types."""
+    lines = (REPOSITORY / "README.md").read_text().splitlines()
+    assert "    python3 -m venv .venv && . .venv/bin/activate && pip install . && ipir-mujoco validate" in lines[:8]
+    assert "    python3 -m venv .venv && . .venv/bin/activate && pip install '.[test]' && pytest" in lines[:8]
+
+
+def test_package_metadata():
+    import tomllib
+
+    project = tomllib.loads((REPOSITORY / "pyproject.toml").read_text())["project"]
+    assert project["license"] == "MIT" and (REPOSITORY / "LICENSE").read_text().startswith("MIT License")
+    assert project["authors"] == [{"name": "ipir-mujoco developers"}]
+    mujoco = next(r for r in project["dependencies"] if r.startswith("mujoco"))
+    assert "<5" in mujoco  # 4.x is what the suite runs on; a new major version must be tested first
+    extras = project["optional-dependencies"]
+    # the Dask scheduler is its own extra; the test extra pulls it in only for the Dask test of sweep
+    assert any(r.startswith("dask[distributed]") for r in extras["dask"])
+    assert "ipir-mujoco[dask]" in extras["test"] and not any(r.startswith("dask") for r in extras["test"])

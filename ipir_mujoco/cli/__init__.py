@@ -14,12 +14,12 @@ from typing import Sequence
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 
 from .. import __version__
-from . import compare, kinetostatics, params, simulate, sweep, validate
+from . import compare, kinetostatics, params, render, simulate, sweep, validate
 from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "build_parser", "main"]
 
-COMMANDS = (simulate, validate, compare, sweep, kinetostatics, params)
+COMMANDS = (simulate, validate, compare, sweep, kinetostatics, params, render)
 
 
 def build_parser() -> Parser:

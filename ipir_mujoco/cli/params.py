@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import textwrap
 
 from ipir_mujoco.analytic.params import describe_parameters
 
@@ -19,16 +20,27 @@ def add_parser(commands) -> None:
     par.set_defaults(handler=run)
 
 
-def format_table(rows: list[dict]) -> str:
-    """A plain-text table: name, unit, default, allowed range, meaning."""
-    header = ("name", "unit", "default", "allowed", "meaning")
-    cells = [header] + [(r["name"], r["units"], r["default_text"], r["allowed"], r["meaning"]) for r in rows]
-    widths = [max(len(row[i]) for row in cells) for i in range(4)]
-    lines = []
-    for row in cells:
-        lines.append("  ".join(text.ljust(width) for text, width in zip(row[:4], widths)) + "  " + row[4])
-    lines.insert(1, "  ".join("-" * w for w in widths) + "  " + "-" * len(header[4]))
-    return "\n".join(lines)
+WIDTH = 100  # columns: the listing reads in a standard terminal and in docs/cli.md
+
+
+def format_table(rows: list[dict], width: int = WIDTH) -> str:
+    """A plain-text table no wider than ``width``: name, unit, default, then the meaning and the
+    allowed range wrapped in the last column."""
+    header = ("name", "unit", "default")
+    cells = [header] + [(r["name"], r["units"], r["default_text"]) for r in rows]
+    widths = [max(len(row[i]) for row in cells) for i in range(3)]
+    indent = sum(widths) + 2 * len(widths)
+    wrap = textwrap.TextWrapper(width=max(30, width - indent), break_on_hyphens=False)
+
+    def left(row) -> str:
+        return "  ".join(text.ljust(w) for text, w in zip(row, widths)) + "  "
+
+    lines = [left(header) + "meaning; allowed values", left(["-" * w for w in widths]) + "-" * (width - indent)]
+    for row, r in zip(cells[1:], rows):
+        text = wrap.wrap(r["meaning"]) + wrap.wrap(f"allowed: {r['allowed']}")
+        lines.append(left(row) + text[0])
+        lines += [" " * indent + line for line in text[1:]]
+    return "\n".join(line.rstrip() for line in lines)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -37,6 +49,6 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps([{k: r[k] for k in ("name", "meaning", "units", "default", "allowed")} for r in rows]))
     else:
         print(format_table(rows))
-        print("\nSet them with --set NAME=VALUE or in a TOML file (--config FILE.toml); "
-              "units are SI except incline (degrees).")
+        print("\nSet them with --set NAME=VALUE or in a TOML file (--config FILE.toml).\n"
+              "Units are SI except incline (degrees).")
     return EXIT_OK

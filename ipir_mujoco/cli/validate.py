@@ -13,7 +13,8 @@ from .common import EXIT_OK, add_model_options, model_params
 
 def add_parser(commands) -> None:
     val = commands.add_parser("validate", help="the analytic-vs-physics validation report (the main job)",
-                              description="Run the model ladder at the paper's case and write a report: "
+                              description="Run the model ladder (at the paper's case unless --set or --config "
+                                          "change it; the report says which) and write a report: "
                                           "DIR/index.html, DIR/report.md, DIR/metrics.json, DIR/figures/.")
     val.add_argument("--out", metavar="DIR", default="report", help="report folder (default: ./report)")
     add_model_options(val)

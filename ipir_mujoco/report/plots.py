@@ -3,7 +3,9 @@
 Figures are built with :class:`matplotlib.figure.Figure` and saved through the
 Agg canvas, so no display and no pyplot state are involved. Each function takes
 one or more runs: the first is drawn solid, the others dashed on top, so a
-later MuJoCo run can be overlaid on the analytic one.
+later MuJoCo run can be overlaid on the analytic one. Every figure says which
+engine (geometry, clutch rule) drew each curve: in its heading for one run, in
+its legend for several.
 """
 
 from __future__ import annotations
@@ -34,6 +36,19 @@ def new_figure(rows: int, height: float = 2.6) -> tuple[Figure, list]:
     return fig, axes
 
 
+def _engine_heading(fig: Figure, runs: Sequence[RunResult], labels: Sequence[str] | None) -> None:
+    """Say which engine drew the figure (one run) or that the legend tells (several)."""
+    if len(runs) == 1:
+        run = runs[0]
+        fig.suptitle(f"drawn from the {run.engine} engine: {run.geometry} geometry, {run.clutch} clutches",
+                     fontsize="medium")
+    else:
+        names = labels if labels else [run_label(r) for r in runs]
+        styles = ("solid", "dashed", "dotted", "dash-dot")
+        fig.suptitle("line styles: " + ", ".join(f"{name} ({style})" for name, style in zip(names, styles)),
+                     fontsize="small")
+
+
 def _legend_label(runs: Sequence[RunResult], labels: Sequence[str] | None, i: int, what: str) -> str:
     if len(runs) == 1:
         return what
@@ -53,6 +68,7 @@ def figure_crank(runs: Sequence[RunResult], labels: Sequence[str] | None = None)
         ax.grid(alpha=0.3)
     if len(runs) > 1:
         ax_rev.legend(fontsize="small")
+    _engine_heading(fig, runs, labels)
     return fig
 
 
@@ -73,6 +89,7 @@ def figure_modules(runs: Sequence[RunResult], labels: Sequence[str] | None = Non
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
     axes[-1].set_xlabel("time t [s]")
+    _engine_heading(fig, runs, labels)
     return fig
 
 
@@ -88,7 +105,10 @@ def figure_gap(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -
     ax_rate.set_ylabel("gap rate S_dot [m/s]", color=FRONT)
     ax.grid(alpha=0.3)
     lines = ax.get_lines() + ax_rate.get_lines()
-    ax.legend(lines, [line.get_label() for line in lines], fontsize="small", loc="lower left")
+    # below the axes: inside, any corner hides part of S or S_dot (lower left: the first minimum of S)
+    fig.legend(lines, [line.get_label() for line in lines], fontsize="small", loc="outside lower center",
+               ncol=min(len(lines), 3))
+    _engine_heading(fig, runs, labels)
     return fig
 
 

@@ -2,8 +2,10 @@
 
 The report is built once as a list of blocks (heading, paragraph, table,
 figure) and rendered twice, so ``report.md`` and ``index.html`` always say the
-same. The HTML embeds its figures as data URIs: one file, readable offline,
-no scripts.
+same. The HTML embeds its figures and the animation as data URIs: one file,
+readable offline, no scripts. The animation needs headless OpenGL (see
+:mod:`ipir_mujoco.video`); where there is none, the report says so in its
+place and is otherwise complete.
 """
 
 from __future__ import annotations
@@ -15,12 +17,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
+import matplotlib.ticker
 import numpy as np
 
-from ipir_mujoco.analytic.params import parameter_meaning, parameter_units
 from ipir_mujoco.analytic.results import Mode
 
+from ..labels import summary_label
+from .diagram import write_mechanism_diagram
 from .plots import new_figure, write_paper_figures
+from ..studies.paper_reference import describe_differences
 from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
 
 
@@ -43,8 +48,15 @@ class Table:
 
 @dataclass
 class Image:
-    path: str  # relative to the report folder
+    path: str  # relative to the report folder; .png or .gif
     caption: str
+
+
+# The report's animation: the start of the MuJoCo ratchet run (t_end [s] simulated), ten times slower than
+# real time; --quick draws fewer, smaller frames
+ANIMATION = {"t_end": 0.5, "width": 480, "height": 270, "fps": 12.5, "speed": 0.1}  # 80 ms a frame
+ANIMATION_QUICK = {"t_end": 0.2, "width": 320, "height": 180, "fps": 10.0, "speed": 0.1}
+ANIMATION_RUNG = "MuJoCo ratchet"
 
 
 def _fmt(value, digits: int = 4) -> str:
@@ -96,17 +108,21 @@ def figure_lr_study(study: dict, path: Path) -> None:
     for level in (1, 5):
         ax.axhline(level, color="grey", lw=0.8, ls="--")
         ax.text(ratios[-1], level * 1.08, f"{level} %", ha="right", va="bottom", fontsize="small", color="grey")
-    ax.set(xscale="log", yscale="log", xlabel="L / r", ylabel="|first order - exact| / |exact| [%]",
+    ax.set(xscale="log", yscale="log", xlabel="L / r [-]", ylabel="|first order - exact| / |exact| [%]",
            title="where L >> r breaks down: divergence of the paper's first-order model")
+    ticks = [x for x in (1.05, 1.5, 2, 3, 4, 6, 10, 15, 20) if ratios[0] <= x <= ratios[-1]]
+    ax.set_xticks(ticks, [f"{x:g}" for x in ticks])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize="x-small", loc="upper right")
     fig.savefig(path, dpi=120)
 
 
 def figure_pull_per_stroke(per_stroke: list[dict], path: Path) -> None:
+    """Pull fraction of each complete stroke (the last one, cut short by the end of the run, is left out)."""
     fig, (ax,) = new_figure(1, height=3.0)
     for mode, colour in (("contraction", "tab:red"), ("expansion", "black")):
-        rows = [s for s in per_stroke if s["mode"] == mode]
+        rows = [s for s in per_stroke if s["mode"] == mode and s.get("complete", True)]
         ax.plot([s["mean_crank_speed"] for s in rows], [100 * s["pull_fraction"] for s in rows], "o-", color=colour,
                 label=f"{mode} strokes ({'front' if mode == 'contraction' else 'rear'} clutch locked)")
     ax.set(xlabel="mean crank speed of the stroke [rad/s]", ylabel="time the lock pulls [% of stroke]",
@@ -116,31 +132,92 @@ def figure_pull_per_stroke(per_stroke: list[dict], path: Path) -> None:
     fig.savefig(path, dpi=120)
 
 
-def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
+def _paper_section(metrics: dict, figures: dict[str, str]) -> list:
+    """The paper's figures against the paper's model, or, at another design, why they are not checked."""
+    case = metrics["paper_case"]
+    blocks: list = []
+    if case["is_paper_case"]:
+        blocks.append(Heading("The paper's figures, reproduced"))
+        blocks.append(Paragraph(
+            "The paper states its results in rounded words. Each figure is checked against the values that round "
+            "to the paper's number: a number stated to 0.1 m covers +-0.05 m. A value exactly on a bound is "
+            "marked 'edge': it rounds to the paper's number under one rounding rule and to the next number under "
+            "another. Margin: the distance to the nearer bound, in units of the stated precision."))
+        status = {"inside": "inside", "edge": "EDGE", "outside": "OUTSIDE"}
+        blocks.append(Table(
+            ["figure", "paper's words", "stated precision", "accepted interval", "paper's model (this package)",
+             "verdict", "margin [precisions]", "why this precision"],
+            [[c["label"], c["reported"], f"{c['precision']:g} {c['units']}",
+              f"[{c['low']:.6g}, {c['high']:.6g}] {c['units']}", f"{c['value']:.6g} {c['units']}",
+              status[c["status"]], "" if c["margin_precisions"] is None else f"{c['margin_precisions']:.3f}",
+              c["why"]] for c in metrics["paper_checks"]]))
+        for check in metrics["paper_checks"]:
+            if check["note"]:
+                blocks.append(Paragraph(f"**{check['label']}:** {check['note']}."))
+    else:
+        blocks.append(Heading("Not the paper's case"))
+        blocks.append(Paragraph(
+            "These parameters differ from the paper's simulation case: " + describe_differences(case["differences"])
+            + ". The paper prints figures for its own case only, so none is checked here; the paper's model at "
+              "this design (first-order kinematics, massless rod, ideal locks) is the ladder's first rung, and "
+              "every other rung is compared with it."))
+        first = metrics["ladder"][0]["summary"]
+        blocks.append(Table(["figure", "paper's model at this design"],
+                            [[summary_label(k), _fmt(first[k], 6)] for k in LADDER_FIGURES]))
+    blocks.append(Paragraph("Identities: the paper also states the range of the gap, which every slider-crank "
+                            "has by construction; they hold for any run and are not counted as reproduced figures."))
+    blocks.append(Table(["identity", "paper's words", "expected [m]", "paper's model [m]", "holds"],
+                        [[i["label"], i["reported"], f"{i['expected']:.6g}", f"{i['value']:.6g}",
+                          "yes" if i["holds"] else "NO"] for i in metrics["identities"]]))
+    for key in ("fig2_crank.png", "fig3_modules.png", "fig4_gap.png"):
+        blocks.append(Image(figures[key], {
+            "fig2_crank.png": "The paper's Fig. 2: crank angle in revolutions and cos phi; the paper's model "
+                              "(solid), MuJoCo with the paper's locks (dashed) and with one-way clutches (dotted).",
+            "fig3_modules.png": "The paper's Fig. 3: module displacements (from the start), velocities, "
+                                "accelerations. Module 2 advances in whole strokes of 2r under the paper's rule.",
+            "fig4_gap.png": "The paper's Fig. 4: gap S in dm and its rate."}[key]))
+    return blocks
+
+
+def _mechanism_section(figures: dict[str, str], animation_note: str | None, settings: dict) -> list:
+    blocks: list = [Heading("The mechanism"), Paragraph(
+        "A motor turns the crank AB (length r) about A on module 1; the connecting rod BC (length L) pushes and "
+        "pulls module 2 at C. The gap S = x2 - x1 between A and C swings between L - r and L + r as the crank "
+        "turns (phi = 0: the crank points at C, S = L + r). Wheels with one-way clutches let each module move "
+        "forward only, so the oscillation of S becomes forward motion: while S shrinks (contraction) the front "
+        "clutch holds and module 1 moves; while S grows (expansion) the rear clutch holds and module 2 moves. "
+        "The symbols are those of docs/model.md.")]
+    blocks.append(Image(figures["mechanism.png"], "The robot, to scale for these parameters."))
+    if animation_note is None:
+        blocks.append(Image(figures["robot.gif"], (
+            f"MuJoCo with one-way clutches (the ratchet), the first {settings['t_end']:g} s from rest at "
+            f"{settings['speed']:g}x real time, rendered by MuJoCo offscreen. A module turns green while its clutch "
+            "holds it. The same video for any design: ipir-mujoco render --out robot.gif")))
+    else:
+        blocks.append(Paragraph(f"(No animation: {animation_note}. The rest of the report does not need it; "
+                                "'ipir-mujoco render' writes one where headless OpenGL exists.)"))
+    return blocks
+
+
+def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | None = None,
+                 animation: dict | None = None) -> list:
+    case = metrics["paper_case"]
+    where = ("at the paper's case" if case["is_paper_case"]
+             else "at a design that is not the paper's case (" + describe_differences(case["differences"]) + ")")
     blocks: list = [Heading("ipir-mujoco validation report", 1),
                     Paragraph("The paper's analytic model of the two-module inchworm robot, reproduced and "
-                              "taken apart one idealization at a time at the paper's case "
+                              f"taken apart one idealization at a time {where} "
                               f"(simulated {metrics['settings']['t_end_s']:g} s from rest).")]
     blocks.append(Heading("Verdicts"))
     for verdict in metrics["verdicts"]:
         blocks.append(Paragraph(f"**{verdict['question']}** {verdict['answer']}"))
-
-    blocks.append(Heading("The paper's figures, reproduced"))
-    blocks.append(Table(
-        ["figure", "paper reports", "this model", "accepted interval", "reproduced", "why this interval"],
-        [[c["label"], c["reported"], f"{_fmt(c['value'])} {c['units']}", f"[{_fmt(c['low'])}, {_fmt(c['high'])}]",
-          "yes" if c["reproduced"] else "NO", c["why"]] for c in metrics["paper_checks"]]))
-    for key in ("fig2_crank.png", "fig3_modules.png", "fig4_gap.png"):
-        blocks.append(Image(figures[key], {
-            "fig2_crank.png": "Paper's Fig. 2: crank angle in revolutions and cos phi; the paper's model (solid), "
-                              "MuJoCo with the paper's locks (dashed) and with one-way clutches (dotted).",
-            "fig3_modules.png": "Paper's Fig. 3: module displacements (from the start), velocities, accelerations.",
-            "fig4_gap.png": "Paper's Fig. 4: gap S in dm and its rate."}[key]))
+    blocks += _mechanism_section(figures, animation_note, animation or ANIMATION)
+    blocks += _paper_section(metrics, figures)
 
     blocks.append(Heading("The model ladder"))
-    blocks.append(Paragraph("Each rung removes one idealization; the change against the rung before is what "
-                            "that idealization costs."))
-    header = ["rung", "removes"] + list(LADDER_FIGURES)
+    blocks.append(Paragraph("Each rung removes one idealization; the change against the rung before (in brackets) "
+                            "is what that idealization costs."))
+    header = ["rung", "removes"] + [summary_label(k) for k in LADDER_FIGURES]
     rows = []
     for rung in metrics["ladder"]:
         cells = [rung["name"], rung["isolates"]]
@@ -164,11 +241,15 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
         "bracketed by two neighbouring ratios of the sweep: that bracket is its resolution."))
     blocks.append(Image(figures["lr_study.png"], "Divergence of the first-order model from the exact linkage "
                                                  "against L/r (log axes)."))
+    angle_labels = {"S_at_angle": "gap S at the same crank angle (share of 2r)",
+                    "S_dot_at_angle": "gap rate S_dot at the same crank angle (share of max |S_dot|)"}
     blocks.append(Table(["figure", "off by more than 1 %", "off by more than 5 %"],
-                        [[key, describe_threshold(study["thresholds"][key]["1%"]),
+                        [[angle_labels.get(key) or summary_label(key),
+                          describe_threshold(study["thresholds"][key]["1%"]),
                           describe_threshold(study["thresholds"][key]["5%"])]
                          for key in LR_FIGURES + ("S_at_angle", "S_dot_at_angle")]))
-    blocks.append(Table(["L/r"] + [label for _, label in LR_CURVES] + ["MuJoCo vs exact (revolutions)"],
+    blocks.append(Table(["L/r [-]"] + [f"{label}: first order vs exact" for _, label in LR_CURVES]
+                        + ["MuJoCo vs exact: crank revolutions"],
                         [[f"{row['ratio']:.3g}"] + [_pct(row["divergence"][key]) for key, _ in LR_CURVES]
                          + [_pct(row["mujoco_vs_exact"]["revolutions"])] for row in study["rows"]]))
 
@@ -182,13 +263,15 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
     blocks.append(Paragraph("The faster the crank, the more of each stroke the lock must pull: the moving module "
                             "is braked by the linkage harder than by its resistance for a growing share of the stroke."))
     blocks.append(Image(figures["pull_per_stroke.png"], "Share of each stroke in which the paper's lock would have "
-                                                        "to pull, against the stroke's mean crank speed."))
+                                                        "to pull, against the stroke's mean crank speed (complete "
+                                                        "strokes only: the last one, cut short by the end of the "
+                                                        "run, is left out)."))
 
     blocks.append(Heading("Energy audit"))
     blocks.append(Paragraph("For the equations the residual is the integration error; for MuJoCo it is what "
                             "the soft constraints and the time stepping took."))
     blocks.append(Table(["rung", "motor work [J]", "kinetic [J]", "friction [J]", "residual [J]",
-                         "residual / motor work"],
+                         "residual / motor work [-]"],
                         [[r["name"], _fmt(e["motor_work_j"], 8), _fmt(e["kinetic_j"], 8), _fmt(e["friction_j"], 8),
                           f"{e['residual_j']:.2e}", f"{e['residual_j'] / e['motor_work_j']:.1e}"]
                          for r in metrics["ladder"] for e in [r["summary"]["energy"]]]))
@@ -196,34 +279,36 @@ def build_blocks(metrics: dict, figures: dict[str, str]) -> list:
     conv = metrics["convergence"]
     blocks.append(Heading("Numerical convergence"))
     blocks.append(Paragraph(
-        f"MuJoCo at the paper's case, halving the timestep (constraint time constant two steps): the default "
+        f"MuJoCo at this design, halving the timestep (constraint time constant two steps): the default "
         f"{metrics['settings']['mujoco']['timestep']:g} s is within {100 * conv['mujoco_default_error']:.3f} % of the "
         f"finest step tried. The equations (one-way clutches) against solver tolerance: the default rtol 1e-10 is "
         f"within {100 * conv['equations_default_error']:.1e} % of the tightest. Both far below the modelling "
-        "differences above. Full study over three designs: mjcf/README.md."))
-    blocks.append(Table(["MuJoCo clutch", "timestep [s]", "revolutions", "x1 [m]", "x2 [m]", "vs equations (rev)",
-                         "energy residual / motor work"],
+        "differences above. The full study over three designs is in the package's mjcf/README.md."))
+    blocks.append(Table(["MuJoCo clutch", "timestep [s]", summary_label("revolutions"), summary_label("x1_final"),
+                         summary_label("x2_final"), "vs equations: revolutions", "energy residual / motor work [-]"],
                         [[f"{r['clutch']} ({r['rule']})", f"{r['timestep']:g}", f"{r['revolutions']:.6f}",
                           f"{r['x1_final']:.6f}", f"{r['x2_final']:.6f}",
                           _pct(r["vs_analytic"]["revolutions"]) if "vs_analytic" in r else "",
                           f"{r['residual_fraction']:.1e}"] for r in conv["mujoco"]]))
-    blocks.append(Table(["equations rtol", "revolutions", "x1 [m]", "x2 [m]", "energy residual / motor work"],
+    blocks.append(Table(["equations rtol [-]", summary_label("revolutions"), summary_label("x1_final"),
+                         summary_label("x2_final"), "energy residual / motor work [-]"],
                         [[f"{r['rtol']:g}", f"{r['revolutions']:.10f}", f"{r['x1_final']:.10f}",
                           f"{r['x2_final']:.10f}", f"{r['residual_fraction']:.1e}"] for r in conv["equations"]]))
 
     blocks.append(Heading("Parameters and software"))
     blocks.append(Table(["parameter", "value", "unit", "meaning"],
-                        [[k, _fmt(v, 6) if not isinstance(v, str) else v, parameter_units(k), parameter_meaning(k)]
-                         for k, v in metrics["params"].items()]))
+                        [[row["name"], row["text"], row["units"], row["meaning"]]
+                         for row in metrics["parameter_table"]]))
     settings = metrics["settings"]
     blocks.append(Paragraph(f"Analytic solver: DOP853, rtol {settings['rtol']:g}, atol {settings['atol']:g}, "
                             f"output every {settings['dt_out_s']:g} s plus every mode switch"
                             + (" (quick run)." if settings["quick"] else ".")
                             + f" MuJoCo: {settings['mujoco']['integrator']}, timestep {settings['mujoco']['timestep']:g} s, "
                             f"constraint time constant {settings['mujoco']['constraint_time_constant']:g} s, "
-                            f"solimp {tuple(settings['mujoco']['solimp'])} (evidence: mjcf/README.md)."))
+                            f"solimp {tuple(settings['mujoco']['solimp'])} (evidence: the package's mjcf/README.md)."))
     blocks.append(Table(["software", "version"], [[k, v] for k, v in metrics["versions"].items()]))
-    blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/studies/validate.py)."))
+    blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/studies/validate.py); "
+                            "the model and its conventions are in docs/model.md."))
     return blocks
 
 
@@ -269,11 +354,25 @@ def to_html(blocks: list, folder: Path) -> str:
             body.append(f"<table><tr>{head}</tr>{rows}</table>")
         elif isinstance(block, Image):
             data = base64.b64encode((folder / block.path).read_bytes()).decode("ascii")
-            body.append(f'<figure><img src="data:image/png;base64,{data}" alt="{html.escape(block.caption)}">'
+            mime = "image/gif" if block.path.endswith(".gif") else "image/png"
+            body.append(f'<figure><img src="data:{mime};base64,{data}" alt="{html.escape(block.caption)}">'
                         f"<figcaption>{html.escape(block.caption)}</figcaption></figure>")
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>ipir-mujoco validation report</title><style>{_CSS}</style></head><body>\n"
             + "\n".join(body) + "\n</body></html>\n")
+
+
+def write_animation(rung: Rung, path: Path, quick: bool) -> tuple[str | None, dict]:
+    """The report's animation of ``rung``'s run; (None, settings) if written, else (why not, settings)."""
+    from ..video import RenderUnavailable, VideoSettings, write_video
+
+    settings = ANIMATION_QUICK if quick else ANIMATION
+    video = VideoSettings(**{k: v for k, v in settings.items() if k != "t_end"})
+    try:
+        write_video(rung.run, path, video, t_end=settings["t_end"], title="MuJoCo, one-way clutches (ratchet)")
+    except RenderUnavailable as exc:
+        return str(exc), settings
+    return None, settings
 
 
 def write_report(folder: Path, metrics: dict, rungs: list[Rung]) -> None:
@@ -282,10 +381,13 @@ def write_report(folder: Path, metrics: dict, rungs: list[Rung]) -> None:
     figures_dir.mkdir(parents=True, exist_ok=True)
     drawn = [r for r in rungs if r.name in FIGURE_RUNGS]
     write_paper_figures([r.run for r in drawn], figures_dir, labels=[r.name for r in drawn])
+    write_mechanism_diagram(figures_dir / "mechanism.png", rungs[0].run.params)
     figure_clutch_reactions(rungs[0], figures_dir / "clutch_reactions.png")
     figure_lr_study(metrics["lr_study"], figures_dir / "lr_study.png")
     figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
+    physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
+    note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
     figures = {p.name: f"figures/{p.name}" for p in figures_dir.iterdir()}
-    blocks = build_blocks(metrics, figures)
+    blocks = build_blocks(metrics, figures, note, animation)
     (folder / "report.md").write_text(to_markdown(blocks))
     (folder / "index.html").write_text(to_html(blocks, folder))

@@ -131,25 +131,49 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
 
 
 def format_comparison(result: dict) -> str:
-    """A readable table of :func:`compare_runs`' result."""
-    lines = [f"b = {result['b']} against a = {result['a']}, over {result['t_compared_s']:.4g} s"]
-    lines.append("  summary figure              a            b       (b-a)/|a|")
+    """A readable table of :func:`compare_runs`' result: names with units, aligned columns, the tolerance."""
+    from ..labels import SERIES, SUMMARY
+
+    def unit_of(table, key):
+        name, unit = table.get(key, (key, ""))
+        return name, ("" if unit == "-" else unit)
+
+    lines = [f"b = {result['b']} against a = {result['a']}, over {result['t_compared_s']:.4g} s", ""]
+    rows = [("summary figure", "unit", "a", "b", "(b - a) / |a|")]
     for key, v in result["summary"].items():
-        rel = "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"
-        fa = "none" if v["a"] is None else f"{v['a']:.6g}"
-        fb = "none" if v["b"] is None else f"{v['b']:.6g}"
-        lines.append(f"  {key:25s} {fa:>12s} {fb:>12s} {rel:>12s}")
-    lines.append("  quantity   max|b-a| at same time   at same crank angle   first > tolerance")
+        name, unit = unit_of(SUMMARY, key)
+        rows.append((name, unit, "none" if v["a"] is None else f"{v['a']:.6g}",
+                     "none" if v["b"] is None else f"{v['b']:.6g}",
+                     "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"))
+    lines += _aligned(rows)
+    tolerance = result["tolerance"]
+    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a|;",
+              f"first over = first time |b - a| > tolerance x scale (tolerance {tolerance:g} = {100 * tolerance:g} %)"]
+    rows = [("quantity", "unit", "at same time", "at same crank angle", "scale", "first over [s]")]
     for q in QUANTITIES:
-        at_time = result["time_grid"][q]["max"]
-        angle_key = "t" if q == "phi" else q
-        at_angle = "n/a" if result["angle_grid"] is None else f"{result['angle_grid'][angle_key]['max']:.4g}"
-        if q == "phi" and result["angle_grid"] is not None:
-            at_angle += " s (time)"
+        name, unit = unit_of(SERIES, q)
+        at_angle = "n/a"
+        if result["angle_grid"] is not None:
+            at_angle = f"{result['angle_grid']['t' if q == 'phi' else q]['max']:.4g}"
+            if q == "phi":
+                at_angle += " s (time to reach it)"
         first = result["first_exceedance"][q]
-        lines.append(f"  {q:8s} {at_time:>20.4g}   {at_angle:>20s}   {'never' if first is None else f'{first:.4g} s'}")
+        rows.append((name, unit, f"{result['time_grid'][q]['max']:.4g}", at_angle,
+                     f"{result['time_grid'][q]['scale']:.4g}", "never" if first is None else f"{first:.4g}"))
+    lines += _aligned(rows)
     sw = result["switches"]
-    lines.append(f"  mode switches: {sw['matched']} matched, largest time difference "
-                 + ("n/a" if sw["max_abs_dt"] is None else f"{sw['max_abs_dt']:.3g} s")
-                 + f"; unmatched: {sw['unmatched_a']} in a, {sw['unmatched_b']} in b")
+    lines += ["", f"mode switches: {sw['matched']} matched, largest time difference "
+              + ("n/a" if sw["max_abs_dt"] is None else f"{sw['max_abs_dt']:.3g} s")
+              + f"; unmatched: {sw['unmatched_a']} in a, {sw['unmatched_b']} in b"]
     return "\n".join(lines)
+
+
+def _aligned(rows: list[tuple[str, ...]]) -> list[str]:
+    """Rows as text columns: the first two left-aligned, the numbers right-aligned, a rule under the header."""
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+
+    def line(row):
+        return "  " + "  ".join(cell.ljust(w) if i < 2 else cell.rjust(w)
+                                for i, (cell, w) in enumerate(zip(row, widths))).rstrip()
+
+    return [line(rows[0]), "  " + "  ".join("-" * w for w in widths)] + [line(row) for row in rows[1:]]

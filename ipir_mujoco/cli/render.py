@@ -1,0 +1,63 @@
+"""``ipir-mujoco render``: a video (GIF or MP4) of a MuJoCo run, rendered headless."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.errors import ParameterError
+
+from .common import EXIT_OK, add_model_options, model_params
+
+
+def add_parser(commands) -> None:
+    ren = commands.add_parser("render", help="a video of a MuJoCo run (GIF, or MP4 with the 'video' extra)",
+                              description="Run MuJoCo on one parameter set and write a video of it, rendered "
+                                          "offscreen by MuJoCo (needs EGL or OSMesa, no screen): the modules, "
+                                          "crank and rod, each clutch's state by its module's colour (green: "
+                                          "holds) and the time, playback speed and speeds as text.")
+    ren.add_argument("--out", metavar="FILE", default="inchworm.gif",
+                     help="video file, .gif (default inchworm.gif) or .mp4 (pip install 'ipir-mujoco[video]')")
+    ren.add_argument("--clutch", choices=analytic.CLUTCH_RULES, default="unilateral",
+                     help="unilateral: one-way clutches (default); kinematic: the paper's rule (locks)")
+    ren.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+                     help="ratchet (default with unilateral) or lock (default with kinematic)")
+    ren.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS", help="simulated time (default 1 s)")
+    ren.add_argument("--speed", type=float, default=0.1,
+                     help="playback speed, video seconds per simulated second (default 0.1: ten times slower)")
+    ren.add_argument("--fps", type=float, default=25.0, help="frames per second of the video (default 25)")
+    ren.add_argument("--width", type=int, default=640, help="frame width in pixels, even (default 640)")
+    ren.add_argument("--height", type=int, default=360, help="frame height in pixels, even (default 360)")
+    add_model_options(ren)
+    ren.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..video import VideoSettings, check_writer, gl_backend, write_video
+
+    settings = VideoSettings(width=args.width, height=args.height, fps=args.fps, speed=args.speed)
+    out = Path(args.out)
+    # before any work, and before MuJoCo is imported (MUJOCO_GL naming a missing library breaks that import):
+    # the suffix and its writer, the OpenGL library, the output path, the parameters
+    check_writer(out)
+    gl_backend()
+    if out.is_dir():
+        raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
+    params = model_params(args)
+    from ..engine import simulate_mujoco
+
+    implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
+    result = simulate_mujoco(params, args.clutch, implementation, args.t_end)
+    title = f"MuJoCo, {'one-way clutches' if args.clutch == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
+            f"({implementation})"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    partial = out.with_name(f".{out.name}.partial{out.suffix}")
+    try:
+        count = write_video(result, partial, settings, title=title)
+        partial.replace(out)
+    finally:
+        partial.unlink(missing_ok=True)
+    print(f"wrote {out}: {count} frames of {settings.width} x {settings.height} px at {settings.fps:g} fps, "
+          f"{result.t_end:g} s simulated shown in {count / settings.fps:.1f} s ({settings.speed:g}x real time)")
+    return EXIT_OK

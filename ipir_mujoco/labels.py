@@ -1,0 +1,51 @@
+"""Readable names and units of the summary figures and time-series quantities.
+
+Tables, reports and text output show these instead of the code names
+(``x1_final``, ``first_contraction_end_s``); the code names stay the keys of
+summary.json and metrics.json.
+"""
+
+from __future__ import annotations
+
+# summary key -> (name, unit)
+SUMMARY: dict[str, tuple[str, str]] = {
+    "revolutions": ("crank revolutions", "rev"),
+    "x1_final": ("module 1 (rear) travel", "m"),
+    "x2_final": ("module 2 (front) travel", "m"),
+    "v1_max": ("peak speed, module 1", "m/s"),
+    "v2_max": ("peak speed, module 2", "m/s"),
+    "first_contraction_end_s": ("end of first contraction", "s"),
+    "min_clutch_reaction_n": ("smallest clutch reaction", "N"),
+    "mode_switches": ("mode switches", "-"),
+    "steady_speed_m_s": ("steady forward speed", "m/s"),
+    "distance_per_rev_m": ("distance per revolution", "m"),
+    "energy_per_metre_j_m": ("energy per metre", "J/m"),
+    "efficiency": ("efficiency", "-"),
+    "peak_clutch_force_n": ("peak clutch force", "N"),
+    "t_steady_s": ("time to steady state", "s"),
+}
+
+# time-series column -> (name, unit)
+SERIES: dict[str, tuple[str, str]] = {
+    "t": ("time", "s"),
+    "phi": ("crank angle", "rad"),
+    "omega": ("crank speed", "rad/s"),
+    "x1": ("module 1 position", "m"),
+    "x2": ("module 2 position", "m"),
+    "v1": ("module 1 velocity", "m/s"),
+    "v2": ("module 2 velocity", "m/s"),
+    "S": ("gap S", "m"),
+    "S_dot": ("gap rate S_dot", "m/s"),
+}
+
+
+def summary_label(key: str) -> str:
+    """'module 1 (rear) travel [m]' for 'x1_final'; the key itself if it has no entry."""
+    name, unit = SUMMARY.get(key, (key, ""))
+    return f"{name} [{unit}]" if unit and unit != "-" else name
+
+
+def series_label(key: str) -> str:
+    """'gap S [m]' for 'S'; the key itself if it has no entry."""
+    name, unit = SERIES.get(key, (key, ""))
+    return f"{name} [{unit}]" if unit else name

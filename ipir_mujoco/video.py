@@ -1,0 +1,241 @@
+"""See the robot move: a MuJoCo run replayed through MuJoCo's offscreen renderer, headless.
+
+A run's recorded state (crank angle and module positions, from any engine's
+series) is put back into the MuJoCo model frame by frame (the rod's angle
+follows from the crank's, closing the loop), drawn with MuJoCo's own
+renderer and written as a GIF (Pillow) or an MP4 (the optional ``video``
+extra, imageio-ffmpeg). Each frame shows the modules, crank and rod, each
+module's clutch state by its colour (green: the clutch holds the module;
+grey-blue: the module moves), and the time, playback speed and speeds as text
+(in frames at least 320 px wide; in narrower ones the text would hide the robot).
+
+Rendering needs an OpenGL library that works without a screen: EGL (Debian:
+libegl1) or OSMesa (libosmesa6). ``MUJOCO_GL=egl`` or ``osmesa`` picks one;
+otherwise EGL is tried, then OSMesa. Where neither exists,
+:class:`RenderUnavailable` (a ParameterError: exit status 2 on the command
+line) names the missing piece in one line.
+"""
+
+from __future__ import annotations
+
+import ctypes.util
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import Mode, RunResult
+
+HELD_RGBA = (0.15, 0.7, 0.3, 1.0)  # the clutch holds the module to the pipe
+FREE_RGBA = (0.6, 0.68, 0.85, 1.0)  # the module slides forward (grey-blue)
+HOUSINGS = ("rear_housing", "front_housing")
+OVERLAY_MIN_WIDTH = 320  # px: narrower frames show the robot without the text
+LIBRARIES = {"egl": ("EGL", "EGL (Debian: apt-get install libegl1)"),
+             "osmesa": ("OSMesa", "OSMesa (Debian: apt-get install libosmesa6)")}
+
+
+class RenderUnavailable(ParameterError):
+    """No headless OpenGL (or no video writer) on this machine: one line naming the missing piece."""
+
+
+def gl_backend() -> str:
+    """The headless OpenGL backend to use: 'egl' or 'osmesa' (RenderUnavailable if neither is installed)."""
+    wanted = os.environ.get("MUJOCO_GL", "").strip().lower()
+    platform = os.environ.get("PYOPENGL_PLATFORM", "").strip().lower()
+    candidates = [wanted] if wanted in LIBRARIES else [platform] if platform in LIBRARIES else list(LIBRARIES)
+    for name in candidates:
+        if ctypes.util.find_library(LIBRARIES[name][0]):
+            return name
+    missing = " or ".join(LIBRARIES[name][1] for name in candidates)
+    raise RenderUnavailable(f"rendering needs a headless OpenGL library and none was found: install {missing}")
+
+
+def _open_context(width: int, height: int):
+    """A current offscreen OpenGL context of the chosen backend."""
+    backend = gl_backend()
+    try:
+        if backend == "egl":
+            from mujoco.egl import GLContext
+        else:
+            from mujoco.osmesa import GLContext
+        context = GLContext(width, height)
+        context.make_current()
+    except Exception as exc:  # a library present but unusable: report it in one line, not a traceback
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        raise RenderUnavailable(f"MuJoCo_GL={backend}: the OpenGL context cannot be created ({message[:200]})") \
+            from None
+    return context
+
+
+@dataclass(frozen=True)
+class VideoSettings:
+    """Frame size [px], frames per second of the video, and playback speed (video s per simulated s: 0.1 = 10x slow)."""
+
+    width: int = 640
+    height: int = 360
+    fps: float = 25.0
+    speed: float = 0.1
+
+    def __post_init__(self) -> None:
+        for name, low, high in (("width", 64, 1920), ("height", 64, 1080)):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and low <= value <= high and value % 2 == 0):
+                raise ParameterError(f"{name}={value!r} px is out of range; allowed: an even number, {low}..{high}")
+        if not (math.isfinite(self.fps) and 1 <= self.fps <= 60):
+            raise ParameterError(f"fps={self.fps!r} is out of range; allowed: 1 <= fps <= 60")
+        if not (math.isfinite(self.speed) and 1e-3 <= self.speed <= 10):
+            raise ParameterError(f"speed={self.speed!r} is out of range; allowed: 0.001 <= speed <= 10 "
+                                 "(video seconds per simulated second)")
+
+    @property
+    def frame_interval(self) -> float:
+        """Simulated time between two frames [s]."""
+        return self.speed / self.fps
+
+
+def frame_times(run: RunResult, settings: VideoSettings, t_end: float | None = None) -> np.ndarray:
+    """Simulated times of the frames [s], shape (n,): from the run's start every frame interval to ``t_end``."""
+    t = run.series["t"]
+    last = min(float(t[-1]), t_end if t_end is not None else float(t[-1]))
+    count = int(math.floor((last - t[0]) / settings.frame_interval + 1e-9)) + 1
+    return t[0] + settings.frame_interval * np.arange(count)
+
+
+def _render_model(params: RobotParams, settings: VideoSettings):
+    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size."""
+    import mujoco
+
+    from .engine.model import build_spec
+
+    spec = build_spec(params)
+    spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+                     width=64, height=64, rgb1=[0.92, 0.92, 0.88], rgb2=[0.78, 0.78, 0.74])
+    material = spec.add_material(name="grid", texrepeat=[10, 10], texuniform=True)  # 10 per metre: 5 cm squares
+    material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
+    spec.geom("pipe_floor").material = "grid"
+    spec.geom("pipe_floor").rgba = [1, 1, 1, 1]
+    spec.geom("pipe_floor").size = [100.0, 1.0, 0.01]  # far beyond any run, and wider than the view
+    spec.visual.headlight.ambient = [0.45, 0.45, 0.45]
+    spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]
+    spec.visual.global_.offwidth = settings.width
+    spec.visual.global_.offheight = settings.height
+    return spec.compile()
+
+
+def _held(mode: int) -> tuple[bool, bool]:
+    """(rear held, front held) for a Mode value."""
+    return (mode in (Mode.BOTH_LOCKED, Mode.EXPANSION), mode in (Mode.BOTH_LOCKED, Mode.CONTRACTION))
+
+
+def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_end: float | None = None,
+                  title: str | None = None):
+    """Yield the frames of ``run`` as uint8 arrays of shape (height, width, 3), one per frame time."""
+    import mujoco
+
+    from .engine.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, ROD_HINGE, closed_loop_pose, qpos_address
+
+    context = _open_context(settings.width, settings.height)
+    params, s = run.params, run.series
+    model = _render_model(params, settings)
+    data = mujoco.MjData(model)
+    address = {name: qpos_address(model, name) for name in (REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE)}
+    front0 = closed_loop_pose(params, float(s["phi"][0]))[FRONT_SLIDE]
+    housings = [model.geom(name).id for name in HOUSINGS]
+    scene = mujoco.MjvScene(model, maxgeom=200)
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_FREE
+    camera.distance, camera.azimuth, camera.elevation = 0.5, 90.0, -50.0
+    option, perturb = mujoco.MjvOption(), mujoco.MjvPerturb()
+    font = mujoco.mjtFontScale.mjFONTSCALE_150 if settings.width >= 600 else mujoco.mjtFontScale.mjFONTSCALE_100
+    renderer = mujoco.MjrContext(model, font)
+    mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, renderer)
+    viewport = mujoco.MjrRect(0, 0, settings.width, settings.height)
+    t = s["t"]
+    title = title or f"{run.engine}, {run.clutch} clutches"
+    try:
+        for when in frame_times(run, settings, t_end):
+            i = max(0, int(np.searchsorted(t, when, side="right")) - 1)  # the sample in force at this time
+            phi = float(np.interp(when, t, s["phi"]))
+            x1, x2 = float(np.interp(when, t, s["x1"])), float(np.interp(when, t, s["x2"]))
+            pose = closed_loop_pose(params, phi)
+            data.qpos[address[REAR_SLIDE]] = x1
+            data.qpos[address[CRANK_HINGE]] = phi
+            data.qpos[address[ROD_HINGE]] = pose[ROD_HINGE]
+            data.qpos[address[FRONT_SLIDE]] = front0 + x2
+            mujoco.mj_kinematics(model, data)
+            held = _held(int(s["mode"][i]))
+            for geom, on in zip(housings, held):
+                model.geom_rgba[geom] = HELD_RGBA if on else FREE_RGBA
+            camera.lookat[:] = [0.5 * (x1 + front0 + x2 + params.r + params.L), 0.0, -0.02]
+            mujoco.mjv_updateScene(model, data, option, perturb, camera, mujoco.mjtCatBit.mjCAT_ALL, scene)
+            mujoco.mjr_render(viewport, scene, renderer)
+            if settings.width < OVERLAY_MIN_WIDTH:  # the text would cover the robot
+                yield _read_frame(settings, viewport, renderer)
+                continue
+            words = ("holds (green)", "slides")
+            mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport,
+                               f"{title}\nt = {when:.3f} s", f"\n{settings.speed:g}x real time", renderer)
+            state = (f"{np.interp(when, t, s['omega']):.1f} rad/s, {(phi - s['phi'][0]) / (2 * math.pi):.2f} rev\n"
+                     f"{np.interp(when, t, s['v1']):.2f} m/s, clutch {words[0] if held[0] else words[1]}\n"
+                     f"{np.interp(when, t, s['v2']):.2f} m/s, clutch {words[0] if held[1] else words[1]}")
+            mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport,
+                               "crank\nmodule 1 (rear)\nmodule 2 (front)", state, renderer)
+            yield _read_frame(settings, viewport, renderer)
+    finally:
+        renderer.free()
+        context.free()
+
+
+def _read_frame(settings: VideoSettings, viewport, renderer) -> np.ndarray:
+    """The rendered frame as uint8 (height, width, 3), top row first."""
+    import mujoco
+
+    pixels = np.empty((settings.height, settings.width, 3), dtype=np.uint8)
+    mujoco.mjr_readPixels(pixels, None, viewport, renderer)
+    return np.flipud(pixels)
+
+
+def check_writer(path: str | Path) -> str:
+    """The video format for ``path`` ('gif' or 'mp4'); RenderUnavailable if its writer is not installed."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".gif":
+        return "gif"
+    if suffix == ".mp4":
+        try:
+            import imageio_ffmpeg  # noqa: F401
+        except ImportError:
+            raise RenderUnavailable(f"writing {Path(path).name} needs the MP4 writer: "
+                                    "pip install 'ipir-mujoco[video]' (or write a .gif)") from None
+        return "mp4"
+    raise ParameterError(f"video file {str(path)!r} has the suffix {suffix or '(none)'!r}; allowed: .gif, .mp4")
+
+
+def write_video(run: RunResult, path: str | Path, settings: VideoSettings = VideoSettings(),
+                t_end: float | None = None, title: str | None = None) -> int:
+    """Render ``run`` up to ``t_end`` [s] into ``path`` (.gif or .mp4); returns the number of frames."""
+    path = Path(path)
+    kind = check_writer(path)
+    frames = render_frames(run, settings, t_end, title)
+    if kind == "gif":
+        from PIL import Image
+
+        images = [Image.fromarray(frame).quantize(colors=64, method=Image.Quantize.MEDIANCUT) for frame in frames]
+        images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000 / settings.fps), loop=0,
+                       optimize=True)
+        return len(images)
+    import imageio_ffmpeg
+
+    writer = imageio_ffmpeg.write_frames(str(path), (settings.width, settings.height), fps=settings.fps,
+                                         codec="libx264", pix_fmt_out="yuv420p", macro_block_size=2,
+                                         ffmpeg_log_level="error")
+    writer.send(None)
+    count = 0
+    for frame in frames:
+        writer.send(np.ascontiguousarray(frame))
+        count += 1
+    writer.close()
+    return count

@@ -1,0 +1,152 @@
+"""The video, the viewer loop and the mechanism diagram: they show what they claim."""
+
+from __future__ import annotations
+
+import ctypes.util
+import math
+
+import numpy as np
+import pytest
+
+from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.cli import main
+from ipir_mujoco.engine import simulate_mujoco
+from ipir_mujoco.video import RenderUnavailable, VideoSettings, frame_times, write_video
+
+
+def _require_gl() -> None:
+    """Skip, saying why, where this machine has no headless OpenGL (EGL or OSMesa) for MuJoCo's renderer."""
+    from ipir_mujoco.video import _open_context
+
+    try:
+        _open_context(64, 64).free()
+    except RenderUnavailable as exc:
+        pytest.skip(f"no headless OpenGL here: {exc}")
+
+
+@pytest.fixture(scope="module")
+def short_run():
+    # 0.05 s from rest: the crank has barely started; enough for a few frames
+    return simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.05)
+
+
+def test_frames_follow_the_playback_speed(short_run):
+    settings = VideoSettings(width=96, height=64, fps=10.0, speed=0.1)  # a frame every 0.01 s simulated
+    times = frame_times(short_run, settings)
+    assert len(times) == 6 and times[0] == 0.0
+    np.testing.assert_allclose(np.diff(times), 0.01, rtol=1e-12)
+    assert len(frame_times(short_run, settings, t_end=0.02)) == 3
+
+
+def test_gif_has_the_promised_frames_size_and_clutch_colours(short_run, tmp_path):
+    _require_gl()
+    from PIL import Image
+
+    path = tmp_path / "robot.gif"
+    settings = VideoSettings(width=96, height=64, fps=10.0, speed=0.1)
+    assert write_video(short_run, path, settings) == 6
+    with Image.open(path) as gif:
+        assert gif.n_frames == 6 and gif.size == (96, 64)
+        assert gif.info["duration"] == 100  # ms per frame at 10 fps
+        frames = []
+        for i in range(gif.n_frames):
+            gif.seek(i)
+            frames.append(np.asarray(gif.convert("RGB"), dtype=int))
+    # the robot moves between the first and the last frame
+    assert np.abs(frames[-1] - frames[0]).sum() > 0
+    # a held module is drawn green: after the first step at least one clutch holds all through this run
+    # (modes 0-2); at t = 0 no constraint force has been computed yet, so no clutch shows as holding
+    assert set(short_run.series["mode"][1:].tolist()) <= {0, 1, 2}
+    for frame in frames[1:]:
+        r, g, b = frame[..., 0], frame[..., 1], frame[..., 2]
+        assert np.count_nonzero((g > r + 50) & (g > b + 50)) > 10
+
+
+def test_render_command_writes_the_video(tmp_path, capsys):
+    _require_gl()
+    from PIL import Image
+
+    out = tmp_path / "video" / "run.gif"
+    assert main(["render", "--t-end", "0.03", "--fps", "10", "--width", "80", "--height", "64",
+                 "--out", str(out)]) == 0
+    with Image.open(out) as gif:
+        assert gif.n_frames == 4 and gif.size == (80, 64)  # t = 0, 0.01, 0.02, 0.03 s
+    assert "4 frames" in capsys.readouterr().out
+    assert [p.name for p in out.parent.iterdir()] == ["run.gif"]  # no partial file left
+
+
+def test_mp4_is_readable(short_run, tmp_path):
+    imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg", reason="MP4 needs the optional 'video' extra")
+    _require_gl()
+    path = tmp_path / "robot.mp4"
+    assert write_video(short_run, path, VideoSettings(width=96, height=64, fps=10.0, speed=0.1)) == 6
+    reader = imageio_ffmpeg.read_frames(str(path))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (96, 64)
+    assert sum(1 for _ in reader) == 6
+
+
+def test_without_opengl_render_exits_2_with_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    monkeypatch.delenv("PYOPENGL_PLATFORM", raising=False)
+    monkeypatch.setattr(ctypes.util, "find_library", lambda name: None)
+    out = tmp_path / "x.gif"
+    assert main(["render", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "EGL" in err and "OSMesa" in err
+    assert not out.exists()
+
+
+def test_render_refuses_bad_video_settings(tmp_path, capsys):
+    assert main(["render", "--out", str(tmp_path / "x.avi")]) == 2
+    assert ".avi" in capsys.readouterr().err
+    assert main(["render", "--out", str(tmp_path / "x.gif"), "--width", "63"]) == 2
+    assert "width=63" in capsys.readouterr().err
+
+
+def test_viewer_loop_steps_the_robot_as_the_engine_does():
+    """The viewer runs the engine's own clutch controller: after the same steps, the same state.
+
+    Both make the same MuJoCo calls in the same order (controller, mj_step, constraint forces); the
+    engine's sampling reads the state and writes none, so they agree to round-off (1e-12 m here).
+    """
+    from ipir_mujoco.view import ViewedRobot
+
+    params = RobotParams()
+    robot = ViewedRobot(params, "unilateral")
+    for _ in range(1000):  # 0.1 s at the default 1e-4 s
+        robot.step()
+    run = simulate_mujoco(params, "unilateral", "ratchet", 0.1)
+    model, data = robot.model, robot.data
+    x1 = data.qpos[model.jnt_qposadr[model.joint("rear_slide").id]]
+    phi = data.qpos[model.jnt_qposadr[model.joint("crank_hinge").id]]
+    assert x1 == pytest.approx(run.series["x1"][-1], abs=1e-12)
+    assert phi == pytest.approx(run.series["phi"][-1], abs=1e-12)
+    assert x1 > 0.01  # and it crawls: module 1 has moved forward
+
+
+def test_viewer_without_a_screen_exits_2(monkeypatch, capsys):
+    from ipir_mujoco import view
+
+    monkeypatch.setattr(view.sys, "platform", "linux")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert view.main([]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "ipir-mujoco render" in err
+
+
+def test_mechanism_diagram_is_drawn_to_the_parameters(tmp_path):
+    from PIL import Image
+
+    from ipir_mujoco.report.diagram import figure_mechanism, write_mechanism_diagram
+
+    path = write_mechanism_diagram(tmp_path / "m.png")
+    with Image.open(path) as image:
+        assert image.size == (900, 460)  # 9 x 4.6 in at 100 dpi
+    # the drawn rod runs from B to C with the length L (scaled as r is): the geometry is the model's
+    for L in (0.2, 0.1):
+        fig = figure_mechanism(RobotParams(L=L), phi=math.radians(55))
+        rod = [line for line in fig.axes[0].get_lines() if line.get_color() == "tab:blue"][0]
+        (bx, cx), (by, cy) = rod.get_xdata(), rod.get_ydata()
+        assert math.hypot(cx - bx, cy - by) == pytest.approx(L, rel=1e-12) and cy == 0.0
