@@ -115,7 +115,7 @@ def simulate_compliant(
             break
         target = params.phi0 + 2 * math.pi * (turns + 1)
         events = model.events(regime, target, t)
-        sol = solve_ivp(budget.wrap(model.rhs(regime), t), (t, t_end), y, method=method, rtol=rtol, atol=atol,
+        sol = solve_ivp(budget.wrap(model.rhs(regime)), (t, t_end), y, method=method, rtol=rtol, atol=atol,
                         events=[e for e, _, _ in events], dense_output=True)
         if sol.status < 0:
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s: {sol.message}")
@@ -194,7 +194,7 @@ class _Budget:
         if self.limit is not None and time.perf_counter() - self.started > self.limit:
             raise SimulationError(f"wall_budget_s={self.limit:g} s exceeded at t={t:.6g} s of simulated time")
 
-    def wrap(self, rhs, t0: float):
+    def wrap(self, rhs):
         if self.limit is None:
             return rhs
         calls = [0]

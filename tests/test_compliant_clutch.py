@@ -52,7 +52,7 @@ def test_converges_to_the_rigid_one_way_clutch_at_rate_one_over_k():
 def damped_run():
     """Damping and backlash: every clutch state (tracking, free, engaged, clipped) occurs."""
     params = RobotParams(clutch_stiffness=1e6, clutch_damping=50.0, clutch_backlash=5e-4)
-    return compliant(params, 0.5)
+    return compliant(params, 0.5, dt_out=1e-5)  # fine samples for the momentum balance
 
 
 def test_energy_audit_closes_with_the_clutch_spring_and_damper(damped_run):
@@ -96,6 +96,22 @@ def test_clutch_force_is_the_spring_and_damper_and_only_pushes(damped_run):
     assert s["v1"].min() < -1e-3 and s["v2"].min() < -1e-3
     lost = np.maximum.accumulate(s["x1"]) - s["x1"]
     assert lost.max() > p.clutch_backlash and lost.max() < p.clutch_backlash + s["lambda1"].max() / k * 1.01
+
+
+def test_the_reported_forces_are_the_rate_of_change_of_momentum(damped_run):
+    """Along the pipe only the clutch forces, the resistances (a stuck module's too: the force its
+    friction must give, solved with the accelerations) and gravity act on the robot, so their impulse
+    is the change of its momentum p = M11 v1 + M12 omega: an independent check of those forces, which
+    the energy audit cannot give (a stuck module's force does no work). Tolerance: the trapezoid
+    rule's error, dt^2 / 12 |F''| over the time the clutches ring: at dt = 1e-5 s, with |F''| ~
+    (k / m) 100 N = 1e8 N/s^2 for ~0.05 s, about 4e-5 N s."""
+    s, p = damped_run.series, damped_run.params
+    mt = OneDofDynamics(p, "exact").mass_terms(s["phi"])
+    momentum = mt.m11 * s["v1"] + mt.m12 * s["omega"]
+    force = s["lambda1"] + s["lambda2"] + s["resistance1"] + s["resistance2"]  # horizontal pipe: no gravity
+    impulse = np.concatenate([[0.0], np.cumsum(0.5 * (force[1:] + force[:-1]) * np.diff(s["t"]))])
+    assert np.abs(momentum - momentum[0] - impulse).max() < 1e-4
+    assert np.ptp(momentum) > 1.0  # against a momentum that changes by 1.9 N s
 
 
 def test_backlash_costs_its_play_once_a_revolution_at_low_speed():
