@@ -246,12 +246,15 @@ def _missed_crossing(events: list, sol):
 
 
 def _cut(pieces: list, t_last: float) -> None:
-    """Drop the samples after ``t_last`` [s] (the end of the steady revolution)."""
+    """Drop the samples after the end of the steady revolution, ``t_last`` [s].
+
+    That end is a segment's last sample (a revolution event), which the steady test may place a
+    rounding error earlier (it interpolates where the crank angle reaches the whole turn, and the
+    event may land a hair past it): the first sample at or after t_last - 1e-9 s is the last kept.
+    """
     last = pieces[-1]
-    keep = last["t"] <= t_last
-    pieces[-1] = {c: v[keep] for c, v in last.items()}
-    if not keep.any():
-        pieces.pop()
+    keep = int(np.searchsorted(last["t"], t_last - 1e-9 * (1.0 + t_last), side="left")) + 1
+    pieces[-1] = {c: v[:keep] for c, v in last.items()}
 
 
 def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.ndarray]:
