@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
@@ -181,6 +183,31 @@ def test_with_backlash_the_peak_force_is_an_impact_growing_as_sqrt_k():
     # k d_max = Q + sqrt(Q^2 + k m v0^2) has log-slope 1/2 (1 - Q / (k d_max)) in k: between its values at
     # the ends, less 0.01 for v0, which varies by 1 % between runs (earlier history differs by O(1/k))
     assert 0.5 * (1 - max(share)) - 0.01 < slope < 0.5 * (1 - min(share)) + 0.01, (slope, share)
+
+
+finite = dict(allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(m1=st.floats(0.2, 5, **finite), m2=st.floats(0.2, 5, **finite), ratio=st.floats(1.2, 12, **finite),
+       F_r1=st.floats(0, 4, **finite), F_r2=st.floats(0, 4, **finite), M=st.floats(0, 0.6, **finite),
+       phi0=st.floats(0, 2 * math.pi, **finite), omega0=st.floats(-10, 10, **finite),
+       log_k=st.floats(3, 7.5, **finite), damping=st.sampled_from([0.0, 30.0]),
+       backlash=st.floats(0, 0.025, **finite), drive=st.sampled_from(["torque", "motor"]),
+       incline=st.floats(-90, 90, **finite), geometry=st.sampled_from(["approx", "exact"]))
+def test_properties_over_a_wide_range_of_designs(m1, m2, ratio, F_r1, F_r2, M, phi0, omega0, log_k, damping, backlash,
+                                                 drive, incline, geometry):
+    params = RobotParams(m1=m1, m2=m2, L=0.05 * ratio, F_r1=F_r1, F_r2=F_r2, M=M, phi0=phi0, omega0=omega0,
+                         clutch_stiffness=10**log_k, clutch_damping=damping, clutch_backlash=backlash, drive=drive,
+                         incline=incline)
+    run = analytic.simulate(params, geometry, "unilateral", 0.2, dt_out=1e-3)
+    s, e = run.series, run.energy
+    assert s["lambda1"].min() >= 0 and s["lambda2"].min() >= 0
+    assert np.all(np.abs(s["resistance1"]) <= F_r1 * (1 + 1e-9) + 1e-12)
+    assert np.all(np.abs(s["resistance2"]) <= F_r2 * (1 + 1e-9) + 1e-12)
+    # the energy that flows: work of the drive, of gravity, against friction, or the initial kinetic energy
+    flow = max(abs(e["motor_work_j"]), abs(e["potential_j"]), e["friction_j"], s["kinetic"][0], 1e-9)
+    assert abs(e["residual_j"]) <= 1e-6 * flow  # rtol 1e-10 over up to ~1e4 steps and events
 
 
 @pytest.mark.parametrize("k", [1e3, 1e5])  # the revolution event lands a hair past / short of the whole turn
