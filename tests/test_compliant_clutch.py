@@ -116,23 +116,28 @@ def test_the_reported_forces_are_the_rate_of_change_of_momentum(damped_run):
     assert np.ptp(momentum) > 1.0  # against a momentum that changes by 1.9 N s
 
 
-def test_backlash_costs_its_play_once_a_revolution_at_low_speed():
-    """Slow crank (a motor with a 4 rad/s no-load speed) and F_r1 = 1 N < F_r2 = 2 N: in expansion the
-    rod pushes the rear module back and the front forward, and the rear one (less resistance) slides
-    back through its play delta until its clutch holds; in contraction the rear one slides forward and
-    the front stays. Kinematically each module then advances 2r - delta per revolution: the travel
-    lost to the backlash is delta per revolution. Tolerance: a module held by its clutch spring and
-    friction comes to rest anywhere |k d - P| <= F_r1, an uncertainty of 2 F_r1 / k in each run's
-    position; the loss is a difference of two runs: 4 F_r1 / k = 4 um."""
-    base = dict(drive="motor", M_stall=0.5, omega_noload=4.0, F_r2=2.0, clutch_stiffness=1e6)
+@pytest.mark.parametrize("F_r2,engagements", [(2.0, 1), (1.0, 2)])
+def test_backlash_costs_its_play_at_every_engagement_at_low_speed(F_r2, engagements):
+    """Slow crank (a motor with a 4 rad/s no-load speed). In expansion the rod pushes the rear module
+    back and the front one forward with a force P; in contraction it pulls them together. A module
+    pushed back slides back through its play delta before its clutch holds, and the gap the crank
+    sets is then shared: the other module advances delta less. So each engagement costs delta of
+    travel, and each module advances 2r - engagements * delta per revolution. With F_r1 = 1 N <
+    F_r2 = 2 N only the rear clutch engages (in contraction the rear module slides on before the
+    front one can be pulled back): one engagement per revolution. With F_r1 = F_r2 both thresholds
+    are reached together and the force that accelerates the advancing module tips the held one back:
+    both clutches engage, two per revolution. Tolerance: a module held by its clutch spring and
+    friction comes to rest anywhere |k d - P| <= F_r, an uncertainty of 2 F_r / k per engagement in
+    each run; the loss is a difference of two runs: 4 F_r engagements / k (4..8 um)."""
+    base = dict(drive="motor", M_stall=0.5, omega_noload=4.0, F_r2=F_r2, clutch_stiffness=1e6)
     per_rev = {}
     for delta in (0.0, 1e-3, 2e-3):
         found = cycles(compliant(RobotParams(clutch_backlash=delta, **base), 3.8, dt_out=1e-3).series)
         assert len(found) == 2
         per_rev[delta] = np.array([c.distance_m for c in found])
-    tolerance = 4 * 1.0 / base["clutch_stiffness"]
+    tolerance = 4 * 1.0 * engagements / base["clutch_stiffness"]
     for delta in (1e-3, 2e-3):
-        np.testing.assert_allclose(per_rev[0.0] - per_rev[delta], delta, atol=tolerance)
+        np.testing.assert_allclose(per_rev[0.0] - per_rev[delta], engagements * delta, atol=tolerance)
     np.testing.assert_allclose(per_rev[0.0], 2 * 0.05, atol=tolerance)  # and without play: the stroke 2r
 
 
