@@ -3,10 +3,12 @@
 This package never imports MuJoCo or ``ipir_mujoco``: it is the independent
 half of the cross-check. It holds the shared parameter set
 (:class:`RobotParams`) and result container (:class:`RunResult`), the
-slider-crank kinematics, the paper's hybrid model, the one-way-clutch model,
-kinetostatics and inverse kinetostatics.
+slider-crank kinematics, the paper's hybrid model, the one-way-clutch model
+(rigid, or compliant with a finite ``clutch_stiffness``), kinetostatics and
+inverse kinetostatics.
 """
 
+from .compliant_run import simulate_compliant
 from .errors import ParameterError, SimulationError
 from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
@@ -23,7 +25,9 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
 
     ``geometry``: 'approx' (the paper's first order) or 'exact'.
     ``clutch``: 'kinematic' (the paper's rule: lock by the sign of S_dot) or
-    'unilateral' (one-way clutches that can only push).
+    'unilateral' (one-way clutches that can only push; with a finite
+    ``params.clutch_stiffness`` the compliant clutch model, which also models
+    clutch damping and backlash, the drive and gravity).
     """
     try:
         geometry = Geometry(geometry).value
@@ -31,6 +35,11 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"geometry={geometry!r} is unknown; allowed: approx, exact") from None
     if clutch not in CLUTCH_RULES:
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(CLUTCH_RULES)}")
+    if params.clutch_stiffness is not None:
+        if clutch != "unilateral":
+            raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
+                                 "paper's rule locks rigidly; allowed: clutch='unilateral' or clutch_stiffness=rigid")
+        return simulate_compliant(params, geometry, t_end, **options)
     _refuse_unmodelled(params)
     if clutch == "unilateral":
         return simulate_unilateral(params, geometry, t_end, **options)
@@ -40,7 +49,12 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
 def _refuse_unmodelled(params: RobotParams) -> None:
     """Parameters this engine does not model yet are refused, never silently ignored."""
     defaults = RobotParams()
-    for name in ("drive", "clutch_stiffness", "clutch_damping", "clutch_backlash", "incline"):
+    for name in ("clutch_damping", "clutch_backlash"):
+        if getattr(params, name) != getattr(defaults, name):
+            raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid clutch "
+                                 f"has no spring for it to act with); allowed: {getattr(defaults, name)!r} with "
+                                 "clutch_stiffness=rigid")
+    for name in ("drive", "incline"):
         if getattr(params, name) != getattr(defaults, name):
             raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the analytic engine yet; "
                                  f"allowed: {getattr(defaults, name)!r}")
@@ -49,5 +63,5 @@ def _refuse_unmodelled(params: RobotParams) -> None:
 __all__ = [
     "COLUMNS", "CLUTCH_RULES", "Geometry", "Linkage", "MODE_NAMES", "Mode", "PARAMETER_NAMES",
     "ParameterError", "RobotParams", "RunResult", "SimulationError", "load_params",
-    "simulate", "simulate_kinematic", "simulate_unilateral",
+    "simulate", "simulate_compliant", "simulate_kinematic", "simulate_unilateral",
 ]

@@ -1,0 +1,291 @@
+"""Running the compliant-clutch model: the event loop, the sampled series and the energy audit.
+
+The equations and the regime decisions are in :mod:`.compliant_clutch`. Here
+each regime is integrated with ``solve_ivp`` until its first event, sampled on
+the output grid (with every segment's ends: an instant where the regime
+changes appears twice), and the next regime is decided. A whole turn of the
+crank's running maximum also ends a segment, so every revolution boundary is
+a sample and the steady-state test (:class:`.cycles.SteadyWatch`) stops the
+run exactly at the end of a revolution.
+
+Series columns (ndarrays of shape (n,)): the shared ``COLUMNS`` (``lambda1``/
+``lambda2`` are the clutch forces [N], ``mode`` tells which modules are held,
+stuck or pushed by their clutch, see :attr:`.Regime.mode`), ``resistance1``/
+``resistance2`` (the friction force on each module [N]: -F_ri sign(v_i) while
+it slides, the force keeping it at rest while stuck), ``clutch_overlap1``/
+``clutch_overlap2`` (d_i [m]: > 0 the clutch is compressed, -backlash..0 inside
+its play), the cumulative ``motor_work``, ``friction_work`` (integral of
+F_r1 |v1| + F_r2 |v2|) and ``clutch_damper_work`` [J], ``kinetic``,
+``potential`` (from t = 0) and ``clutch_spring_energy`` [J], and the
+kinetostatic ``rod_force``, ``crank_pin_force``, ``motor_power``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Callable
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from .compliant_clutch import Clutch, CompliantModel, Regime
+from .cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from .errors import ParameterError, SimulationError
+from .kinematics import Geometry
+from .kinetostatics import add_kinetostatics
+from .params import RobotParams
+from .results import RunResult
+from .solver_support import check_finite, check_run_options, sample_times
+
+# DOP853 by measurement (paper's case, 1 s): 3-5x faster than Radau at k = 1e5..1e7 N/m, also with
+# near-critical damping; LSODA's event location let the stick/slip states chatter, so it is not offered
+METHODS = ("DOP853", "Radau")
+# more zero-length segments in a row than this is chatter, not motion
+_MAX_STALLED_SEGMENTS = 50
+_PROGRESS_EVERY = 0.1  # [s] of simulated time between progress calls
+_BUDGET_CHECK_EVERY = 2000  # right-hand-side calls between wall-clock checks
+
+
+def simulate_compliant(
+    params: RobotParams,
+    geometry: Geometry | str = Geometry.EXACT,
+    t_end: float = 1.0,
+    *,
+    dt_out: float = 1e-4,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    method: str = "DOP853",
+    max_switches: int = 1_000_000,
+    wall_budget_s: float | None = None,
+    until_steady: bool = False,
+    steady_tol: float = STEADY_TOL,
+    steady_cycles: int = STEADY_CYCLES,
+    progress: Callable[[float], None] | None = None,
+) -> RunResult:
+    """Simulate the robot with compliant one-way clutches (``params.clutch_stiffness`` finite).
+
+    ``dt_out`` [s]: output grid. ``rtol``/``atol``: ``solve_ivp`` tolerances on the state
+    (phi [rad], omega [rad/s], x1 [m], v1 [m/s], three cumulative works [J]); ``method``: its
+    integrator (DOP853 by default: the clutch springs' oscillations are undamped or lightly
+    damped, so they must be resolved, which an explicit method does cheapest). ``max_switches``:
+    most regime changes allowed; ``wall_budget_s`` [s]: most wall-clock time allowed (None: no
+    limit); both raise SimulationError when exceeded. ``until_steady``: stop at the end of the
+    revolution where the per-revolution mean speed has settled (``steady_tol``, ``steady_cycles``;
+    ``t_end`` is the cap). ``progress(t)`` is called about every 0.1 s of simulated time.
+    Initial module velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in
+    the other engines.
+    """
+    check_run_options(t_end, dt_out, rtol, atol)
+    if params.clutch_stiffness is None:
+        raise ParameterError("clutch_stiffness=rigid: the compliant clutch model needs a finite stiffness; "
+                             "allowed: 0 < clutch_stiffness <= 1e12 N/m")
+    if method not in METHODS:
+        raise ParameterError(f"method={method!r} is unknown; allowed: {', '.join(METHODS)}")
+    if isinstance(max_switches, bool) or not isinstance(max_switches, int) or max_switches < 1:
+        raise ParameterError(f"max_switches={max_switches!r} is out of range; allowed: a whole number >= 1")
+    if wall_budget_s is not None and not (isinstance(wall_budget_s, (int, float)) and wall_budget_s > 0
+                                          and math.isfinite(wall_budget_s)):
+        raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number > 0 "
+                             "or None")
+    try:
+        watch = SteadyWatch(params.phi0, steady_tol, steady_cycles)
+    except ValueError as exc:
+        raise ParameterError(str(exc)) from None
+    started = time.perf_counter()
+    model = CompliantModel(params, geometry)
+    budget = _Budget(started, wall_budget_s)
+    grid = np.linspace(0.0, t_end, max(1, math.ceil(t_end / dt_out - 1e-9)) + 1)
+
+    K0 = float(model.linkage.transfer(params.phi0).K)
+    v1_0 = max(-K0 * params.omega0, 0.0)
+    y = np.array([params.phi0, params.omega0, 0.0, v1_0, 0.0, 0.0, 0.0])
+    start = Regime(tuple(int(np.sign(v)) for v in (v1_0, v1_0 + K0 * params.omega0)),
+                   (Clutch.TRACKING, Clutch.TRACKING), (0.0, 0.0))
+    regime, y = model.decide(0.0, y, start, None)
+    t, pieces, switches, short_run, turns = 0.0, [], 0, 0, 0
+    next_report, reported, stall = _PROGRESS_EVERY, None, None
+    while True:
+        if regime.static:  # both stuck, crank at rest, every load constant: at rest for good
+            stall = (f"at rest for good from t={t:.6g} s: both modules held by friction and clutch springs, "
+                     f"crank at phi={y[0]:.6g} rad")
+            pieces.append(_piece(model, regime, sample_times(t, t_end, grid),
+                                 lambda ts: np.repeat(y[:, None], np.size(ts), axis=1)))
+            break
+        target = params.phi0 + 2 * math.pi * (turns + 1)
+        events = model.events(regime, target, t)
+        sol = solve_ivp(budget.wrap(model.rhs(regime)), (t, t_end), y, method=method, rtol=rtol, atol=atol,
+                        events=[e for e, _, _ in events], dense_output=True)
+        if sol.status < 0:
+            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s: {sol.message}")
+        t_stop = float(sol.t[-1])
+        missed = _missed_crossing(events, sol)
+        if missed is not None:
+            t_stop = missed[0]
+        piece = _piece(model, regime, sample_times(t, t_stop, grid), sol.sol)
+        pieces.append(piece)
+        if watch.update(piece["t"], piece["phi"], 0.5 * (piece["x1"] + piece["x2"])) and until_steady:
+            _cut(pieces, watch.steady_at)
+            break
+        if progress is not None and t_stop >= next_report:
+            progress(t_stop)
+            reported, next_report = t_stop, (math.floor(t_stop / _PROGRESS_EVERY) + 1) * _PROGRESS_EVERY
+        budget.check(t_stop)
+        if missed is None and sol.status != 1:
+            break
+        if missed is None:
+            hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
+            t_event, y_event = float(sol.t_events[hit][0]), np.array(sol.y_events[hit][0])
+        else:
+            t_event, hit, y_event = missed
+        fired = events[hit][2]
+        short_run = short_run + 1 if t_event - t <= 1e-12 * (1.0 + t) else 0
+        if short_run > _MAX_STALLED_SEGMENTS:
+            raise SimulationError(f"the clutch and friction states chatter at t={t:.6g} s (phi={y[0]:.6g} rad)")
+        t = t_event
+        if fired[0] == "revolution":  # only a sample: the regime goes on
+            turns += 1
+            y = y_event
+            y[0] = max(y[0], target)  # on the boundary, so the steady test sees the whole turn
+        else:
+            regime, y = model.decide(t, y_event, regime, fired)
+            switches += 1
+            if switches > max_switches:
+                raise SimulationError(f"more than max_switches={max_switches} clutch and friction switches by "
+                                      f"t={t:.6g} s")
+        if t >= t_end:
+            break
+    if progress is not None and reported != float(pieces[-1]["t"][-1]):
+        progress(float(pieces[-1]["t"][-1]))  # the end, unless just reported
+
+    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    add_kinetostatics(series, model.dyn)
+    del series["motor_torque"]  # folded into motor_power
+    check_finite(series)
+    return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
+                     t_end=t_end, series=series, energy=energy_audit(series),
+                     wall_time_s=time.perf_counter() - started, stall=stall,
+                     settings={"method": method, "rtol": rtol, "atol": atol, "dt_out": dt_out,
+                               "rod_modelled": model.dyn.include_rod, "clutch_model": "compliant",
+                               "steady_tol": steady_tol, "steady_cycles": steady_cycles,
+                               "switches": switches})
+
+
+def energy_audit(series: dict[str, np.ndarray]) -> dict[str, float]:
+    """Motor work = kinetic + potential energy gained + friction work + clutch spring energy gained
+    + clutch damper work + residual [J], from a run's cumulative columns."""
+    def gained(column):
+        return float(series[column][-1] - series[column][0])
+    parts = {"motor_work_j": gained("motor_work"), "kinetic_j": gained("kinetic"),
+             "potential_j": gained("potential"), "friction_j": gained("friction_work"),
+             "clutch_spring_j": gained("clutch_spring_energy"), "clutch_damper_j": gained("clutch_damper_work")}
+    parts["residual_j"] = parts["motor_work_j"] - sum(v for k, v in parts.items() if k != "motor_work_j")
+    return parts
+
+
+class _Budget:
+    """The wall-clock budget, checked between segments and every few thousand right-hand-side calls."""
+
+    def __init__(self, started: float, limit: float | None):
+        self.started, self.limit = started, limit
+
+    def check(self, t: float) -> None:
+        if self.limit is not None and time.perf_counter() - self.started > self.limit:
+            raise SimulationError(f"wall_budget_s={self.limit:g} s exceeded at t={t:.6g} s of simulated time")
+
+    def wrap(self, rhs):
+        if self.limit is None:
+            return rhs
+        calls = [0]
+
+        def f(t, y):
+            calls[0] += 1
+            if calls[0] % _BUDGET_CHECK_EVERY == 0:
+                self.check(t)
+            return rhs(t, y)
+        return f
+
+
+# interior points checked per accepted step for an event function that crossed and came back
+_GRAZE_POINTS = 8
+
+
+def _missed_crossing(events: list, sol):
+    """An event crossing that solve_ivp missed: (t, event index, state) of the first, or None.
+
+    solve_ivp sees an event only where its function has changed sign between step ends; a clutch
+    overlap or a module speed that crosses and comes back within one step (a module that passes its
+    anchor and turns, inside one long step) slips through. Each step is sampled at interior points
+    through the dense output; where a function went clearly past its threshold (by more than 1e-9 of
+    its size over the segment), its first crossing is located with brentq.
+    """
+    ends = sol.t
+    if ends.size < 2:
+        return None
+    fractions = np.arange(1, _GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)
+    times = (ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel()
+    states = sol.sol(times)
+    values = np.array([np.broadcast_to(raw(times, states), times.shape) for _, raw, _ in events], dtype=float)
+    direction = np.array([raw.direction for _, raw, _ in events])[:, None]
+    scale = np.maximum(np.abs(values).max(axis=1, keepdims=True), 1e-300)
+    past = direction * values > 1e-9 * scale
+    if not past.any():
+        return None
+    k, j = min(zip(*np.nonzero(past)), key=lambda kj: times[kj[1]])
+    guarded = events[k][0]
+    step = j // _GRAZE_POINTS
+    points = [ends[step], *times[step * _GRAZE_POINTS: j + 1]]  # the step's start up to the first clear crossing
+    signs = [direction[k, 0] * guarded(time, sol.sol(time)) for time in points]
+    if signs[0] > 0 or max(signs) <= 0:  # past at a step end already, or only at the segment's start (where
+        return None  # the functions report the safe side): solve_ivp's own event handling covers it
+    first = next(i for i, value in enumerate(signs) if value > 0)
+    t_root = brentq(lambda time: guarded(time, sol.sol(time)), points[first - 1], points[first], xtol=1e-15,
+                    rtol=4 * np.finfo(float).eps)
+    return t_root, k, sol.sol(t_root)
+
+
+def _cut(pieces: list, t_last: float) -> None:
+    """Drop the samples after the end of the steady revolution, ``t_last`` [s].
+
+    That end is a segment's last sample (a revolution event), which the steady test may place a
+    rounding error earlier (it interpolates where the crank angle reaches the whole turn, and the
+    event may land a hair past it): the first sample at or after t_last - 1e-9 s is the last kept.
+    """
+    last = pieces[-1]
+    keep = int(np.searchsorted(last["t"], t_last - 1e-9 * (1.0 + t_last), side="left")) + 1
+    pieces[-1] = {c: v[:keep] for c, v in last.items()}
+
+
+def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.ndarray]:
+    """The series columns of one segment at ``times`` (n,) from its dense output."""
+    p, dyn = model.params, model.dyn
+    y = dense(times)
+    phi, omega, x1, v1 = y[0], y[1], y[2], y[3]
+    m = model.motion(y, regime)
+    mt = m.mass
+    shape = phi.shape
+
+    def full(value):
+        return np.broadcast_to(np.asarray(value, dtype=float), shape).astype(float)
+
+    spring = sum(0.5 * model.k * np.maximum(d, 0.0) ** 2 for d in m.overlap)
+    # gravity's potential: -g_x times the mass-weighted displacement (the rod's centre moves with x1 and the linkage)
+    moment = p.m1 * x1 + p.m2 * m.x2
+    if dyn.include_rod:
+        moment = moment + p.rod_mass * (x1 + model.linkage.rod_com(phi)[0] - model.linkage.rod_com(p.phi0)[0])
+    return {
+        "t": times, "phi": phi, "omega": omega, "alpha": full(m.alpha), "x1": x1, "x2": full(m.x2),
+        "v1": v1, "v2": full(m.v2), "a1": full(m.a1), "a2": full(m.a2),
+        "S": full(mt.transfer.S), "S_dot": full(mt.transfer.K * omega),
+        # an engaged clutch's k d - c v is >= 0 by its regime; at the event that clips it, it is 0 to within
+        # the event's location error, which must not show as a pull
+        "lambda1": np.maximum(full(m.force[0]), 0.0), "lambda2": np.maximum(full(m.force[1]), 0.0),
+        "mode": np.full(shape, int(regime.mode)),
+        "resistance1": full(m.friction[0]), "resistance2": full(m.friction[1]),
+        "clutch_overlap1": full(m.overlap[0]), "clutch_overlap2": full(m.overlap[1]),
+        "motor_work": y[4], "friction_work": y[5], "clutch_damper_work": y[6],
+        "kinetic": full(0.5 * (mt.m11 * v1**2 + 2.0 * mt.m12 * v1 * omega + mt.m22 * omega**2)),
+        "potential": full(-model.g * moment), "clutch_spring_energy": full(spring),
+        "motor_torque": full(m.torque),
+    }
