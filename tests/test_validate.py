@@ -212,3 +212,33 @@ def test_validate_bad_parameter_exits_2_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "report"
     assert main(["validate", "--quick", "--out", str(out), "--set", "L=0.01"]) == 2
     assert "L=0.01" in capsys.readouterr().err and not out.exists()
+
+
+def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_validation, tmp_path):
+    """The registry the further studies (motor, incline, clutch compliance) plug into."""
+    import copy
+
+    from ipir_mujoco.report.document import Image, Paragraph
+    from ipir_mujoco.report.plots import new_figure
+    from ipir_mujoco.report.sections import Section
+    from ipir_mujoco.report.validation import write_report
+    from ipir_mujoco.studies.validate import run_sections
+
+    def render(result, figures_dir):
+        fig, (ax,) = new_figure(1)
+        ax.plot([0, 1], [0, result["twice_L_m"]])
+        fig.savefig(figures_dir / "toy.png")
+        return [Paragraph(f"twice L is {result['twice_L_m']:g} m"), Image("figures/toy.png", "toy figure")]
+
+    toy = Section("toy", "toy study", lambda params, quick, progress: {"twice_L_m": 2 * params.L}, render,
+                  lambda result: {"question": "Is L positive?", "answer": "Yes", "evidence": "sections.toy"})
+    metrics, rungs = copy.deepcopy(quick_validation)
+    seen = []
+    run_sections(metrics, RobotParams(L=0.3), True, seen.append, (toy,))
+    assert metrics["sections"]["toy"] == {"twice_L_m": 0.6} and metrics["verdicts"][-1]["question"] == "Is L positive?"
+    assert seen[0] == "toy study ..." and seen[-1].startswith("toy study: done")
+    write_report(tmp_path, metrics, rungs, (toy,))
+    markdown = (tmp_path / "report.md").read_text()
+    # the section sits after the core sections and before the numerical evidence
+    assert markdown.index("Energy audit") < markdown.index("twice L is 0.6 m") < markdown.index("Numerical convergence")
+    assert "](figures/toy.png)" in markdown and "**Is L positive?** Yes" in markdown

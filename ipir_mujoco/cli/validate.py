@@ -23,6 +23,7 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..report.sections import SECTIONS
     from ..report.validation import write_report
     from ..studies.validate import validate
 
@@ -32,11 +33,11 @@ def run(args: argparse.Namespace) -> int:
     def progress(message: str) -> None:
         print(f"validate: {message}", file=sys.stderr, flush=True)
 
-    metrics, rungs = validate(params, quick=args.quick, progress=progress)
+    metrics, rungs = validate(params, quick=args.quick, progress=progress, sections=SECTIONS)
     progress("writing report ...")
     with staged_output(args.out) as staging:
         write_json(staging / "metrics.json", metrics)
-        write_report(staging, metrics, rungs)
+        write_report(staging, metrics, rungs, SECTIONS)
     for verdict in metrics["verdicts"]:
         print(f"{verdict['question']}\n  {verdict['answer']}")
     print(f"report: {args.out}/index.html (also report.md, metrics.json, figures/)")

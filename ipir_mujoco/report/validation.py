@@ -10,10 +10,7 @@ place and is otherwise complete.
 
 from __future__ import annotations
 
-import base64
-import html
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
@@ -24,32 +21,10 @@ from ipir_mujoco.analytic.results import Mode
 
 from ..labels import summary_label
 from .diagram import write_mechanism_diagram
+from .document import Heading, Image, Paragraph, Table, fmt, pct, to_html, to_markdown
 from .plots import new_figure, write_paper_figures
 from ..studies.paper_reference import describe_differences
 from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
-
-
-@dataclass
-class Heading:
-    text: str
-    level: int = 2
-
-
-@dataclass
-class Paragraph:
-    text: str
-
-
-@dataclass
-class Table:
-    header: Sequence[str]
-    rows: Sequence[Sequence[str]]
-
-
-@dataclass
-class Image:
-    path: str  # relative to the report folder; .png or .gif
-    caption: str
 
 
 # The report's animation: the start of the MuJoCo ratchet run (t_end [s] simulated), ten times slower than
@@ -57,18 +32,6 @@ class Image:
 ANIMATION = {"t_end": 0.5, "width": 480, "height": 270, "fps": 12.5, "speed": 0.1}  # 80 ms a frame
 ANIMATION_QUICK = {"t_end": 0.2, "width": 320, "height": 180, "fps": 10.0, "speed": 0.1}
 ANIMATION_RUNG = "MuJoCo ratchet"
-
-
-def _fmt(value, digits: int = 4) -> str:
-    if value is None:
-        return "n/a"
-    if isinstance(value, float) and not math.isfinite(value):
-        return "n/a"
-    return f"{value:.{digits}g}"
-
-
-def _pct(value) -> str:
-    return "" if value is None else f"{100 * value:+.2f} %"
 
 
 def figure_clutch_reactions(rung: Rung, path: Path) -> None:
@@ -163,7 +126,7 @@ def _paper_section(metrics: dict, figures: dict[str, str]) -> list:
               "every other rung is compared with it."))
         first = metrics["ladder"][0]["summary"]
         blocks.append(Table(["figure", "paper's model at this design"],
-                            [[summary_label(k), _fmt(first[k], 6)] for k in LADDER_FIGURES]))
+                            [[summary_label(k), fmt(first[k], 6)] for k in LADDER_FIGURES]))
     blocks.append(Paragraph("Identities: the paper also states the range of the gap, which every slider-crank "
                             "has by construction; they hold for any run and are not counted as reproduced figures."))
     blocks.append(Table(["identity", "paper's words", "expected [m]", "paper's model [m]", "holds"],
@@ -200,7 +163,7 @@ def _mechanism_section(figures: dict[str, str], animation_note: str | None, sett
 
 
 def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | None = None,
-                 animation: dict | None = None) -> list:
+                 animation: dict | None = None, extra: Sequence = ()) -> list:
     case = metrics["paper_case"]
     where = ("at the paper's case" if case["is_paper_case"]
              else "at a design that is not the paper's case (" + describe_differences(case["differences"]) + ")")
@@ -222,8 +185,8 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     for rung in metrics["ladder"]:
         cells = [rung["name"], rung["isolates"]]
         for key in LADDER_FIGURES:
-            change = _pct(rung["change_vs_previous"][key])
-            cells.append(_fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
+            change = pct(rung["change_vs_previous"][key])
+            cells.append(fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
     blocks.append(Table(header, rows))
 
@@ -250,8 +213,8 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                          for key in LR_FIGURES + ("S_at_angle", "S_dot_at_angle")]))
     blocks.append(Table(["L/r [-]"] + [f"{label}: first order vs exact" for _, label in LR_CURVES]
                         + ["MuJoCo vs exact: crank revolutions"],
-                        [[f"{row['ratio']:.3g}"] + [_pct(row["divergence"][key]) for key, _ in LR_CURVES]
-                         + [_pct(row["mujoco_vs_exact"]["revolutions"])] for row in study["rows"]]))
+                        [[f"{row['ratio']:.3g}"] + [pct(row["divergence"][key]) for key, _ in LR_CURVES]
+                         + [pct(row["mujoco_vs_exact"]["revolutions"])] for row in study["rows"]]))
 
     pull = metrics["clutch_pull"]
     blocks.append(Heading("Clutch forces under the paper's rule"))
@@ -272,9 +235,11 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                             "the soft constraints and the time stepping took."))
     blocks.append(Table(["rung", "motor work [J]", "kinetic [J]", "friction [J]", "residual [J]",
                          "residual / motor work [-]"],
-                        [[r["name"], _fmt(e["motor_work_j"], 8), _fmt(e["kinetic_j"], 8), _fmt(e["friction_j"], 8),
+                        [[r["name"], fmt(e["motor_work_j"], 8), fmt(e["kinetic_j"], 8), fmt(e["friction_j"], 8),
                           f"{e['residual_j']:.2e}", f"{e['residual_j'] / e['motor_work_j']:.1e}"]
                          for r in metrics["ladder"] for e in [r["summary"]["energy"]]]))
+
+    blocks += list(extra)
 
     conv = metrics["convergence"]
     blocks.append(Heading("Numerical convergence"))
@@ -288,7 +253,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                          summary_label("x2_final"), "vs equations: revolutions", "energy residual / motor work [-]"],
                         [[f"{r['clutch']} ({r['rule']})", f"{r['timestep']:g}", f"{r['revolutions']:.6f}",
                           f"{r['x1_final']:.6f}", f"{r['x2_final']:.6f}",
-                          _pct(r["vs_analytic"]["revolutions"]) if "vs_analytic" in r else "",
+                          pct(r["vs_analytic"]["revolutions"]) if "vs_analytic" in r else "",
                           f"{r['residual_fraction']:.1e}"] for r in conv["mujoco"]]))
     blocks.append(Table(["equations rtol [-]", summary_label("revolutions"), summary_label("x1_final"),
                          summary_label("x2_final"), "energy residual / motor work [-]"],
@@ -312,56 +277,6 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     return blocks
 
 
-def to_markdown(blocks: list) -> str:
-    out = []
-    for block in blocks:
-        if isinstance(block, Heading):
-            out.append("#" * block.level + " " + block.text)
-        elif isinstance(block, Paragraph):
-            out.append(block.text)
-        elif isinstance(block, Table):
-            out.append("| " + " | ".join(block.header) + " |")
-            out.append("|" + "---|" * len(block.header))
-            out.extend("| " + " | ".join(str(c).replace("|", "\\|") for c in row) + " |" for row in block.rows)
-        elif isinstance(block, Image):
-            out.append(f"![{block.caption}]({block.path})\n\n*{block.caption}*")
-        out.append("")
-    return "\n".join(out)
-
-
-_CSS = """body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
-table{border-collapse:collapse;margin:1em 0;font-size:0.9em}th,td{border:1px solid #bbb;padding:4px 8px;
-vertical-align:top}th{background:#eee}img{max-width:100%}figure{margin:1.5em 0}figcaption{color:#555}"""
-
-
-def _inline(text: str) -> str:
-    escaped = html.escape(text)
-    parts = escaped.split("**")
-    return "".join(f"<strong>{p}</strong>" if i % 2 else p for i, p in enumerate(parts))
-
-
-def to_html(blocks: list, folder: Path) -> str:
-    body = []
-    for block in blocks:
-        if isinstance(block, Heading):
-            body.append(f"<h{block.level}>{html.escape(block.text)}</h{block.level}>")
-        elif isinstance(block, Paragraph):
-            body.append(f"<p>{_inline(block.text)}</p>")
-        elif isinstance(block, Table):
-            head = "".join(f"<th>{html.escape(h)}</th>" for h in block.header)
-            rows = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
-                           for row in block.rows)
-            body.append(f"<table><tr>{head}</tr>{rows}</table>")
-        elif isinstance(block, Image):
-            data = base64.b64encode((folder / block.path).read_bytes()).decode("ascii")
-            mime = "image/gif" if block.path.endswith(".gif") else "image/png"
-            body.append(f'<figure><img src="data:{mime};base64,{data}" alt="{html.escape(block.caption)}">'
-                        f"<figcaption>{html.escape(block.caption)}</figcaption></figure>")
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f"<title>ipir-mujoco validation report</title><style>{_CSS}</style></head><body>\n"
-            + "\n".join(body) + "\n</body></html>\n")
-
-
 def write_animation(rung: Rung, path: Path, quick: bool) -> tuple[str | None, dict]:
     """The report's animation of ``rung``'s run; (None, settings) if written, else (why not, settings)."""
     from ..video import RenderUnavailable, VideoSettings, write_video
@@ -375,8 +290,12 @@ def write_animation(rung: Rung, path: Path, quick: bool) -> tuple[str | None, di
     return None, settings
 
 
-def write_report(folder: Path, metrics: dict, rungs: list[Rung]) -> None:
-    """Write figures/, report.md and index.html into ``folder`` (metrics.json is the caller's)."""
+def write_report(folder: Path, metrics: dict, rungs: list[Rung], sections: Sequence = ()) -> None:
+    """Write figures/, report.md and index.html into ``folder`` (metrics.json is the caller's).
+
+    ``sections`` (:class:`ipir_mujoco.report.sections.Section`) draw their parts
+    from ``metrics["sections"]``, after the core and before the numerical evidence.
+    """
     figures_dir = folder / "figures"
     figures_dir.mkdir(parents=True, exist_ok=True)
     drawn = [r for r in rungs if r.name in FIGURE_RUNGS]
@@ -387,7 +306,10 @@ def write_report(folder: Path, metrics: dict, rungs: list[Rung]) -> None:
     figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
     physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
     note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
+    extra = []
+    for section in sections:
+        extra += section.render(metrics["sections"][section.key], figures_dir)
     figures = {p.name: f"figures/{p.name}" for p in figures_dir.iterdir()}
-    blocks = build_blocks(metrics, figures, note, animation)
+    blocks = build_blocks(metrics, figures, note, animation, extra)
     (folder / "report.md").write_text(to_markdown(blocks))
     (folder / "index.html").write_text(to_html(blocks, folder))

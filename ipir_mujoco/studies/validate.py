@@ -45,6 +45,8 @@ compares every rung with the paper's model at that design (the first rung).
                           mujoco_default_error, equations_default_error}: largest
                           relative change of revolutions/x1/x2 from the default setting
                           to the finest one tried
+    sections              {key: metrics} of each further study the report runs
+                          (see ipir_mujoco.report.sections)
     params                the parameter set used (SI units; rod_inertia resolved)
     parameter_table       list of {name, value, text, units, meaning}: text shows
                           'rigid' / 'uniform' where the value was left to its default rule
@@ -59,7 +61,7 @@ import platform
 import sys
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -312,11 +314,15 @@ def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict, study:
     }
 
 
-def validate(params: RobotParams, quick: bool = False, progress: Callable[[str], None] = lambda _m: None):
+def validate(params: RobotParams, quick: bool = False, progress: Callable[[str], None] = lambda _m: None,
+             sections: Sequence = ()):
     """Run everything the report needs and return (metrics, rungs).
 
     ``quick`` samples outputs 10x coarser and sweeps L/r, timesteps and
-    tolerances on coarser grids (for tests and CI).
+    tolerances on coarser grids (for tests and CI). ``sections``
+    (:class:`ipir_mujoco.report.sections.Section`) are further studies: each
+    one's metrics go to ``metrics["sections"][key]`` and its verdict, if it
+    gives one, joins the verdicts.
     """
     from .lr_study import RATIOS_FULL, RATIOS_QUICK, lr_study
 
@@ -325,7 +331,23 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
     rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
     study = lr_study(params, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
     convergence = convergence_evidence(params, quick, lambda m: progress(f"convergence: {m}"))
-    return build_metrics(params, rungs, settings, study, convergence), rungs
+    metrics = build_metrics(params, rungs, settings, study, convergence)
+    run_sections(metrics, params, quick, progress, sections)
+    return metrics, rungs
+
+
+def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Callable[[str], None],
+                 sections: Sequence) -> None:
+    """Compute each section into ``metrics["sections"]`` and add its verdict, if any (in place)."""
+    metrics.setdefault("sections", {})
+    for section in sections:
+        started = time.perf_counter()
+        progress(f"{section.title} ...")
+        result = section.compute(params, quick, lambda m, s=section: progress(f"{s.title}: {m}"))
+        metrics["sections"][section.key] = result
+        if section.verdict is not None and (verdict := section.verdict(result)) is not None:
+            metrics["verdicts"].append(verdict)
+        progress(f"{section.title}: done ({time.perf_counter() - started:.1f} s)")
 
 
 def pull_per_stroke(run: RunResult) -> list[dict]:

@@ -1,0 +1,33 @@
+"""Sections of the validation report beyond its core (the paper, the ladder, L/r, clutch forces).
+
+Each :class:`Section` is a study that ``validate`` runs and a part of the
+report it draws: ``compute`` returns a JSON-ready dict stored in
+``metrics.json`` under ``sections.<key>``; ``render`` writes the section's
+figures into the report's figures folder and returns its blocks
+(:mod:`ipir_mujoco.report.document`); ``verdict``, if given, adds a
+{question, answer, evidence} to the report's opening verdicts.
+:data:`SECTIONS` lists them in report order; ``ipir-mujoco validate`` runs
+them all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from ipir_mujoco.analytic.params import RobotParams
+
+Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class Section:
+    key: str  # metrics.json: sections.<key>
+    title: str
+    compute: Callable[[RobotParams, bool, Progress], dict]  # (params, quick, progress) -> metrics
+    render: Callable[[dict, Path], list]  # (metrics, figures folder) -> blocks; Image paths "figures/NAME"
+    verdict: Callable[[dict], dict | None] | None = None
+
+
+SECTIONS: tuple[Section, ...] = ()
