@@ -10,8 +10,9 @@ import pytest
 
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.engine import captured_warnings
-from ipir_mujoco.engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, SolverSettings,
-                               build_model, closed_loop_pose, default_mjcf, qpos_address)
+from ipir_mujoco.engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_END, ROD_HINGE,
+                                      SolverSettings, build_model, closed_loop_pose, default_mjcf, drive_control,
+                                      qpos_address, set_closed_loop_state)
 
 NAMED_KINDS = {  # object type -> count field of MjModel
     mujoco.mjtObj.mjOBJ_BODY: "nbody", mujoco.mjtObj.mjOBJ_JOINT: "njnt", mujoco.mjtObj.mjOBJ_GEOM: "ngeom",
@@ -72,7 +73,9 @@ def test_the_compiled_model_carries_the_parameters_and_nothing_hidden(params):
     for name, force in ((REAR_SLIDE, params.F_r1), (FRONT_SLIDE, params.F_r2)):
         assert m.dof_frictionloss[m.joint(name).dofadr[0]] == pytest.approx(force)
     assert np.all(m.dof_armature == 0) and np.all(m.dof_damping == 0) and np.all(m.jnt_stiffness == 0)
-    assert np.all(m.opt.gravity == 0) and m.opt.timestep == 5e-5
+    assert np.all(m.actuator_damping == 0) and np.all(m.actuator_armature == 0)
+    # a horizontal pipe: gravity is all across the pipe (-z), normal to the mechanism's plane
+    assert np.array_equal(m.opt.gravity, [0.0, 0.0, -params.g]) and m.opt.timestep == 5e-5
     assert m.eq_solref[m.equality(LOOP).id][0] == pytest.approx(2 * settings.timestep)
     assert m.eq_data[m.equality(LOOP).id][:3] == pytest.approx([params.L, 0, 0])
 
@@ -118,3 +121,56 @@ def test_solver_settings_are_validated():
         SolverSettings(timestep=1e-4, constraint_time_constant=1e-4)
     with pytest.raises(ParameterError, match="integrator"):
         SolverSettings(integrator="leapfrog")
+
+
+@pytest.mark.parametrize("incline,g", [(0.0, 9.81), (30.0, 9.81), (90.0, 9.81), (-20.0, 9.81), (45.0, 1.62)])
+def test_gravity_follows_the_pipe_incline(incline, g):
+    """Along the pipe axis x: -g sin(incline); the rest across the pipe, where it moves nothing."""
+    params = RobotParams(incline=incline, g=g)
+    m = build_model(params)
+    angle = math.radians(incline)
+    # the compiler stores the vector as given: equal to a few ulps of g
+    np.testing.assert_allclose(m.opt.gravity, [-g * math.sin(angle), 0.0, -g * math.cos(angle)], rtol=0,
+                               atol=4 * np.finfo(float).eps * g)
+    # the across-pipe part only loads bearings: with the component along x removed, gravity's
+    # generalized force (qfrc_bias at rest) is zero on every joint, at any pose
+    m.opt.gravity[0] = 0.0
+    d = mujoco.MjData(m)
+    for phi in (0.3, 1.9, 4.0):
+        for name, value in closed_loop_pose(params, phi).items():
+            d.qpos[qpos_address(m, name)] = value
+        mujoco.mj_forward(m, d)
+        assert np.all(np.abs(d.qfrc_bias) <= 1e-15 * g), phi
+
+
+def test_the_motor_is_mujocos_own_actuator_with_the_dc_motor_line():
+    """drive = motor: a general actuator whose gain and bias give M_stall (1 - omega / omega_noload).
+
+    The force MuJoCo computes, gainprm[0] ctrl + biasprm[2] omega (XML reference,
+    actuator/general), read from data.actuator_force at crank speeds below zero,
+    at rest, below, at and above the no-load speed; a handful of roundings: 1e-14 M_stall.
+    """
+    params = RobotParams(drive="motor", M_stall=0.8, omega_noload=25.0)
+    m = build_model(params)
+    motor = m.actuator(MOTOR).id
+    assert m.actuator_gaintype[motor] == mujoco.mjtGain.mjGAIN_FIXED
+    assert m.actuator_biastype[motor] == mujoco.mjtBias.mjBIAS_AFFINE
+    d = mujoco.MjData(m)
+    set_closed_loop_state(m, d, params)
+    d.ctrl[motor] = drive_control(params)
+    crank = m.joint(CRANK_HINGE).dofadr[0]
+    for omega in (-40.0, -3.0, 0.0, 12.5, 25.0, 37.0, 200.0):
+        d.qvel[:] = 0.0
+        d.qvel[crank] = omega
+        mujoco.mj_forward(m, d)
+        expected = params.M_stall * (1 - omega / params.omega_noload)
+        assert d.actuator_force[motor] == pytest.approx(expected, rel=0, abs=1e-14 * params.M_stall), omega
+    # the constant torque stays a constant torque, whatever the speed
+    params = RobotParams(M=0.3)
+    m = build_model(params)
+    d = mujoco.MjData(m)
+    d.ctrl[motor] = drive_control(params)
+    for omega in (-10.0, 0.0, 50.0):
+        d.qvel[m.joint(CRANK_HINGE).dofadr[0]] = omega
+        mujoco.mj_forward(m, d)
+        assert d.actuator_force[motor] == 0.3

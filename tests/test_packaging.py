@@ -49,11 +49,13 @@ def test_importing_the_analytic_package_does_not_load_mujoco():
 
 
 def test_the_mujoco_side_never_runs_the_analytic_equations():
-    """The MuJoCo engine may share the parameter set, the result container and the errors with the
+    """The MuJoCo engine may share the parameter set, the result container, the errors and the
+    per-revolution figures (cycles: it reads time series, e.g. the steady-state watch) with the
     analytic package, nothing that computes dynamics."""
     import ipir_mujoco.engine
 
-    allowed = ("ipir_mujoco.analytic.params", "ipir_mujoco.analytic.results", "ipir_mujoco.analytic.errors")
+    allowed = ("ipir_mujoco.analytic.params", "ipir_mujoco.analytic.results", "ipir_mujoco.analytic.errors",
+               "ipir_mujoco.analytic.cycles")
     folder = Path(ipir_mujoco.engine.__file__).parent
     files = sorted(folder.glob("*.py"))
     assert len(files) >= 4

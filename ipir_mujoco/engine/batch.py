@@ -1,35 +1,53 @@
 """Many ratcheted MuJoCo designs at once, stepped by ``mujoco.batch`` on C threads.
 
 Each design's model is compiled by the same builder as a single run
-(:func:`ipir_mujoco.engine.model.build_model`); the batch runs one model with
-per-simulation copies of every field in which the designs differ, so the
-builder stays the only place that turns parameters into a model. Between steps
-the ratchet raises each simulation's lower slide bounds to the running maximum
-of its positions, in one vectorized write (the same rule as
-:class:`ipir_mujoco.engine.clutches.Ratchet`).
+(:func:`ipir_mujoco.engine.model.build_model`), with the timestep chosen for
+that design (:func:`ipir_mujoco.engine.timestep.choose_settings`) unless
+settings are given; the batch runs one model with per-simulation copies of
+every field in which the designs differ (timestep, gravity, drive included),
+so the builder stays the only place that turns parameters into a model. All
+designs share the output times (multiples of ``dt_out``); a design with a
+smaller timestep takes more substeps between them. Between substeps the
+ratchet raises each simulation's lower slide bounds (the rule of
+:class:`ipir_mujoco.engine.clutches.Ratchet`), in one vectorized write.
 
-What a batch can measure is the state: positions and speeds, so speed,
-distance per revolution, efficiency (work against the resistances, F_r times
-distance, over motor work M dphi), stalls and acceleration jumps; constraint
+What a batch can measure is the state and MuJoCo's energies: positions and
+speeds, the drive's work (from MuJoCo's actuator force, as the serial engine),
+the work against the resistances (F_r |v| per step, which equals the
+frictionloss rows' work to 1e-9 of the motor work on the paper's case),
+kinetic and potential energy, the loop gap and the backward excursion, so the
+same accuracy monitor as a serial run, the steady state and stalls. Constraint
 forces (clutch reactions, rod force) are not exposed per simulation and are
-left empty. A simulation MuJoCo resets for instability (its clock falls
-behind) is reported as failed, with the time of its last good sample.
+left out. A design that fails the monitor (``accuracy='stop'``), becomes
+unstable (MuJoCo resets it: its clock falls behind) or non-finite is reported
+with the reason and stops stepping; so does a steady (with ``until_steady``)
+or stalled one.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Sequence
 
 import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
 
+from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 
-from .simulate import captured_warnings
-from .model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, dof_address,
-                    qpos_address, set_closed_loop_state)
+from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_END, SolverSettings, build_model,
+                    dof_address, drive_control, qpos_address, set_closed_loop_state)
+from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode
+from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_run_options, climb_energy, rest_since,
+                     stall_reason)
+from .timestep import DT_MIN, choose_settings
+
+OPTION_FIELDS = ("timestep", "gravity", "integrator")
+COLUMNS = ("t", "phi", "omega", "x1", "x2", "v1", "v2", "a1", "a2", "motor_work", "friction_work", "kinetic",
+           "potential", "loop_gap")
 
 
 def _differing_fields(models: Sequence[mujoco.MjModel]) -> list[str]:
@@ -44,84 +62,297 @@ def _differing_fields(models: Sequence[mujoco.MjModel]) -> list[str]:
             continue
         if any(not np.array_equal(getattr(m, name), value) for m in models[1:]):
             names.append(name)
+    for name in OPTION_FIELDS:
+        value = np.asarray(getattr(base.opt, name))
+        if any(not np.array_equal(np.asarray(getattr(m.opt, name)), value) for m in models[1:]):
+            names.append("opt." + name)
     return names
 
 
 def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: float = 1e-3,
-                      settings: SolverSettings = SolverSettings(), nthread: int = 0) -> list[dict]:
+                      settings: SolverSettings | None = None, nthread: int = 0, *, accuracy: str = "stop",
+                      until_steady: bool = False, steady_tol: float = STEADY_TOL,
+                      steady_cycles: int = STEADY_CYCLES) -> list[dict]:
     """Run every design with the joint-limit ratchet.
 
     One dict per design: ``{"series": {column: ndarray (n,)}, "motor_work_j": J,
-    "friction_work_j": J}`` with the columns t, phi, omega, x1, x2, v1, v2, a1, a2,
-    or ``{"error": message}``.
+    "friction_work_j": J, "energy": {...}, "accuracy": {...}, "stall": str | None,
+    "steady": bool, "settings": {...}}``. ``motor_work_j`` and ``friction_work_j``
+    are M (phi_end - phi_0) and F_r1 x1 + F_r2 x2 under a constant torque (exact
+    there, the ratchet letting modules move only forward), the cumulative
+    columns' last values under the motor; ``energy`` is the audit as a serial
+    run's. The columns are those of :data:`COLUMNS`
+    (t [s], phi [rad], omega [rad/s], x1, x2 [m], v1, v2 [m/s], a1, a2 [m/s^2],
+    cumulative motor_work and friction_work, kinetic and potential [J], loop_gap
+    [m]), or ``{"error": message}`` (with ``"accuracy"`` when the monitor
+    stopped it). ``settings`` None: each design's own automatic timestep, halved
+    (at most twice) for a design the monitor stops, as in a serial run; the
+    halvings are in the outcome's ``settings["refinements"]``.
     """
+    check_accuracy_mode(accuracy)
+    SteadyWatch(0.0, steady_tol, steady_cycles)  # validates both
     results: list[dict | None] = [None] * len(designs)
-    models, index = [], []
+    chosen: dict[int, SolverSettings] = {}
     for i, params in enumerate(designs):
         try:
-            models.append(build_model(params, settings, ratchet=True))
-            index.append(i)
+            check_run_options(params, t_end, dt_out)
+            chosen[i] = settings if settings is not None else choose_settings(params, t_end, dt_out)[0]
         except ValueError as exc:
             results[i] = {"error": str(exc)}
-    if not models:
-        return results
-    base = models[0]
-    steps_per_sample = max(1, round(dt_out / settings.timestep))
-    n_samples = max(1, math.ceil(t_end / (steps_per_sample * settings.timestep) - 1e-9))
-    n = len(models)
-
-    with captured_warnings():
-        batch = mjbatch.Batch(base, nsim=n, nthread=nthread)
-        for name in _differing_fields(models) + ["jnt_range"]:
-            per_sim = batch.expand(name)
-            for k, model in enumerate(models):
-                per_sim[k] = getattr(model, name)
-        qpos, qvel, ctrl, clock = batch.bind("qpos"), batch.bind("qvel"), batch.bind("ctrl"), batch.bind("time")
-        for k, (model, i) in enumerate(zip(models, index)):
-            data = mujoco.MjData(model)
-            set_closed_loop_state(model, data, designs[i])
-            qpos[k], qvel[k] = data.qpos, data.qvel
-            ctrl[k, base.actuator(MOTOR).id] = designs[i].M
-        batch.forward()
-
-        slides_q = np.array([qpos_address(base, n_) for n_ in (REAR_SLIDE, FRONT_SLIDE)])
-        slides_v = np.array([dof_address(base, n_) for n_ in (REAR_SLIDE, FRONT_SLIDE)])
-        slide_joints = np.array([base.joint(n_).id for n_ in (REAR_SLIDE, FRONT_SLIDE)])
-        crank_q, crank_v = qpos_address(base, CRANK_HINGE), dof_address(base, CRANK_HINGE)
-        jnt_range = batch.expand("jnt_range")
-        bounds = qpos[:, slides_q].copy()
-        jnt_range[:, slide_joints, 0] = bounds
-        x_start = qpos[:, slides_q].copy()
-
-        rows = n_samples + 1
-        record = {key: np.zeros((rows, n)) for key in ("t", "phi", "omega", "x1", "x2", "v1", "v2", "a1", "a2")}
-        record["t"][0], record["phi"][0], record["omega"][0] = 0.0, qpos[:, crank_q], qvel[:, crank_v]
-        failed_at = np.full(n, np.nan)
-        last_v = qvel[:, slides_v].copy()
-        for s in range(1, rows):
-            for _ in range(steps_per_sample):
-                last_v = qvel[:, slides_v].copy()
-                np.maximum(bounds, qpos[:, slides_q], out=bounds)
-                jnt_range[:, slide_joints, 0] = bounds
-                batch.step()
-            expected = s * steps_per_sample * settings.timestep
-            bad = (np.abs(clock - expected) > 0.5 * settings.timestep) | ~np.all(np.isfinite(qpos), axis=1)
-            newly = bad & np.isnan(failed_at)
-            failed_at[newly] = record["t"][s - 1][0]
-            v = qvel[:, slides_v]
-            record["t"][s] = expected
-            record["phi"][s], record["omega"][s] = qpos[:, crank_q], qvel[:, crank_v]
-            record["x1"][s], record["x2"][s] = (qpos[:, slides_q] - x_start).T
-            record["v1"][s], record["v2"][s] = v.T
-            record["a1"][s], record["a2"][s] = ((v - last_v) / settings.timestep).T
-
-    for k, i in enumerate(index):
-        if not np.isnan(failed_at[k]):
-            results[i] = {"error": f"MuJoCo became unstable after t={failed_at[k]:.6g} s"}
-            continue
-        p = designs[i]
-        series = {key: values[:, k] for key, values in record.items()}
-        motor = p.M * (series["phi"][-1] - series["phi"][0])
-        friction = p.F_r1 * series["x1"][-1] + p.F_r2 * series["x2"][-1]
-        results[i] = {"series": series, "motor_work_j": motor, "friction_work_j": friction}
+    halvings = {i: [] for i in chosen}
+    for attempt in range(REFINEMENTS + 1):
+        models, index = [], []
+        for i, own in chosen.items():
+            try:
+                if abs(round(dt_out / own.timestep) * own.timestep - dt_out) > 1e-9 * dt_out:
+                    raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the "
+                                         f"timestep ({own.timestep} s)")
+                models.append(build_model(designs[i], own, ratchet=True))
+                index.append(i)
+            except ValueError as exc:
+                results[i] = {"error": str(exc)}
+        if not models:
+            break
+        batch = _Batch(models, [designs[i] for i in index], [chosen[i] for i in index], t_end, dt_out, nthread,
+                       accuracy, until_steady, steady_tol, steady_cycles)
+        retry = {}
+        for i, outcome in zip(index, batch.run()):
+            outcome.setdefault("settings", {})["refinements"] = halvings[i]
+            results[i] = outcome
+            # as a serial run: an automatic step the monitor stops is halved (at most twice)
+            failed = outcome.get("error", "").startswith("MuJoCo accuracy check failed")
+            if failed and settings is None and attempt < REFINEMENTS and chosen[i].timestep / 2 >= DT_MIN:
+                halvings[i].append({"timestep": chosen[i].timestep, "reason": outcome["error"]})
+                retry[i] = replace(chosen[i], timestep=chosen[i].timestep / 2)
+        if not retry:
+            break
+        chosen = retry
     return results
+
+
+class _Batch:
+    def __init__(self, models, designs, settings, t_end, dt_out, nthread, accuracy, until_steady, steady_tol,
+                 steady_cycles):
+        self.models, self.designs, self.settings = models, designs, settings
+        self.t_end, self.dt_out, self.accuracy = t_end, dt_out, accuracy
+        self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
+        self.n = len(models)
+        self.nthread = nthread
+        self.dt = np.array([s.timestep for s in settings])
+        self.k = np.rint(dt_out / self.dt).astype(int)  # substeps per output interval
+        self.n_steps = np.floor(t_end / self.dt * (1 + 1e-12)).astype(int)  # never past t_end
+        self.n_samples = int(np.max(np.ceil(self.n_steps / self.k)))
+
+    def run(self) -> list[dict]:
+        with captured_warnings():
+            self._start()
+            self._loop()
+        return [self._outcome(k) for k in range(self.n)]
+
+    def _start(self) -> None:
+        base, n = self.models[0], self.n
+        batch = self.batch = mjbatch.Batch(base, nsim=n, nthread=self.nthread)
+        for name in _differing_fields(self.models) + ["jnt_range"]:
+            per_sim = batch.expand(name)
+            for k, model in enumerate(self.models):
+                per_sim[k] = getattr(model.opt, name[4:]) if name.startswith("opt.") else getattr(model, name)
+        self.qpos, self.qvel, ctrl, self.clock = (batch.bind(f) for f in ("qpos", "qvel", "ctrl", "time"))
+        self.energy, self.force = batch.bind("energy"), batch.bind("actuator_force")
+        qacc = batch.bind("qacc")
+        self.site_xpos, self.xpos = batch.bind("site_xpos"), batch.bind("xpos")
+        motor = base.actuator(MOTOR).id
+        self.motor = motor
+        kinetic0 = np.zeros(n)
+        for k, (model, params) in enumerate(zip(self.models, self.designs)):
+            data = mujoco.MjData(model)
+            set_closed_loop_state(model, data, params)
+            self.qpos[k], self.qvel[k] = data.qpos, data.qvel
+            ctrl[k, motor] = drive_control(params)
+        batch.forward()
+        self.slides_q = np.array([qpos_address(base, s) for s in (REAR_SLIDE, FRONT_SLIDE)])
+        self.slides_v = np.array([dof_address(base, s) for s in (REAR_SLIDE, FRONT_SLIDE)])
+        self.slide_joints = np.array([base.joint(s).id for s in (REAR_SLIDE, FRONT_SLIDE)])
+        self.crank_q, self.crank_v = qpos_address(base, CRANK_HINGE), dof_address(base, CRANK_HINGE)
+        self.margins = np.array([m.jnt_margin[self.slide_joints] for m in self.models])
+        self.friction = np.array([m.dof_frictionloss[self.slides_v] for m in self.models])
+        self.slope = np.array([m.actuator_gear[motor, 0] ** 2 * m.actuator_biasprm[motor, 2] for m in self.models])
+        self.gear = np.array([m.actuator_gear[motor, 0] for m in self.models])
+        self.jnt_range = batch.expand("jnt_range")
+        self.bounds = self.qpos[:, self.slides_q].copy()
+        self.jnt_range[:, self.slide_joints, 0] = self.bounds - self.margins
+        self.x_start = self.qpos[:, self.slides_q].copy()
+        self.site, self.front = base.site(ROD_END).id, base.body("front_module").id
+        loop = base.equality(LOOP).id
+        data = mujoco.MjData(base)
+        mujoco.mj_kinematics(base, data)
+        self.pin_offset = data.xmat[self.front].reshape(3, 3) @ base.eq_data[loop, 3:6]
+
+        self.record = {c: np.full((self.n_samples + 1, n), np.nan) for c in COLUMNS}
+        self.last_row = np.zeros(n, dtype=int)
+        self.failed: list[str | None] = [None] * n
+        self.stall: list[str | None] = [None] * n
+        self.running = np.ones(n, dtype=bool)
+        self.wm, self.wf = np.zeros(n), np.zeros(n)
+        self.excursion = np.zeros(n)
+        self.monitors = [AccuracyMonitor(Tolerances.for_params(p), self.accuracy, s.timestep)
+                         for p, s in zip(self.designs, self.settings)]
+        torque = self.gear * self.force[:, motor]
+        kinetic0[:] = self.energy[:, 1]
+        self.energy0 = self.energy.copy()
+        climb = [climb_energy(m, p) for m, p in zip(self.models, self.designs)]
+        self.floor = np.maximum.reduce([kinetic0, 2 * math.pi * np.abs(torque), climb])
+        self.watches = [SteadyWatch(float(self.qpos[k, self.crank_q]), self.steady_tol, self.steady_cycles)
+                        for k in range(n)] if self.until_steady else None
+        self.fed = 0
+        self._sample(0, self.qvel - self.dt[:, None] * qacc, np.zeros(n))  # first accelerations: MuJoCo's qacc
+
+    def _loop(self) -> None:
+        batch, n = self.batch, self.n
+        block = max(1, round(BLOCK_TIME / self.dt_out))
+        done = np.zeros(n, dtype=int)
+        vel_stage = int(mujoco.mjtStage.mjSTAGE_VEL)
+        slides_q, slides_v, joints, crank_v = self.slides_q, self.slides_v, self.slide_joints, self.crank_v
+        for s in range(1, self.n_samples + 1):
+            steps = np.where(self.running, np.minimum(self.k, self.n_steps - done), 0)
+            stepping = steps > 0
+            if not stepping.any():
+                break
+            substeps = int(steps.max())
+            # the common case: every simulation still running takes every substep
+            uniform = bool(np.all(steps[stepping] == substeps))
+            ids = None if stepping.all() else np.flatnonzero(stepping)
+            v_before = self.qvel.copy()
+            dt = np.where(stepping, self.dt, 0.0)
+            for j in range(substeps):
+                q = self.qpos[:, slides_q]
+                np.maximum(self.excursion, np.max(self.bounds - q, axis=1), out=self.excursion)
+                np.maximum(self.bounds, q, out=self.bounds)
+                self.jnt_range[:, joints, 0] = self.bounds - self.margins
+                omega_prev = self.qvel[:, crank_v].copy()
+                if uniform:
+                    if j == substeps - 1:
+                        v_before[:] = self.qvel
+                        batch.step(ids, stage=vel_stage)
+                    else:
+                        batch.step(ids)
+                else:
+                    active = steps > j
+                    dt = np.where(active, self.dt, 0.0)
+                    ending = np.flatnonzero(active & (steps == j + 1))
+                    going = np.flatnonzero(steps > j + 1)
+                    v_before[ending] = self.qvel[ending]
+                    if going.size:
+                        batch.step(going)
+                    if ending.size:
+                        batch.step(ending, stage=vel_stage)
+                omega = self.qvel[:, crank_v]
+                torque = self.gear * self.force[:, self.motor] + self.slope * (omega - omega_prev)
+                self.wm += torque * omega * dt
+                self.wf += (self.friction * np.abs(self.qvel[:, slides_v])).sum(axis=1) * dt
+            done += steps
+            self._sample(s, v_before, stepping.astype(float), torque)
+            self._check_health(s, stepping, done)
+            if s % block == 0 or s == self.n_samples:
+                self._block(s)
+
+    def _sample(self, s: int, v_before: np.ndarray, stepped: np.ndarray, torque: np.ndarray | None = None) -> None:
+        """Record row ``s`` for the simulations that stepped into it, and feed their monitors."""
+        rows = np.flatnonzero(stepped > 0) if s else np.arange(self.n)
+        r, q, v = self.record, self.qpos, self.qvel
+        dt = self.dt[rows]
+        r["t"][s, rows] = self.clock[rows]
+        r["phi"][s, rows], r["omega"][s, rows] = q[rows, self.crank_q], v[rows, self.crank_v]
+        x = q[rows][:, self.slides_q] - self.x_start[rows]
+        r["x1"][s, rows], r["x2"][s, rows] = x.T
+        vv = v[rows][:, self.slides_v]
+        r["v1"][s, rows], r["v2"][s, rows] = vv.T
+        a = (vv - v_before[rows][:, self.slides_v]) / dt[:, None]
+        r["a1"][s, rows], r["a2"][s, rows] = a.T
+        r["motor_work"][s, rows], r["friction_work"][s, rows] = self.wm[rows], self.wf[rows]
+        kinetic = self.energy[rows, 1]
+        potential = self.energy[rows, 0] - self.energy0[rows, 0]
+        r["kinetic"][s, rows], r["potential"][s, rows] = kinetic, potential
+        gap = np.linalg.norm(self.site_xpos[rows, self.site] - self.xpos[rows, self.front] - self.pin_offset, axis=1)
+        r["loop_gap"][s, rows] = gap
+        self.last_row[rows] = s
+        if torque is not None:
+            self.floor[rows] = np.maximum(self.floor[rows], 2 * math.pi * np.abs(torque[rows]))
+        residual = self.wm[rows] - self.wf[rows] - (kinetic - self.energy0[rows, 1]) - potential
+        scale = np.maximum.reduce([np.abs(self.wm[rows]), self.wf[rows], np.abs(potential), self.floor[rows]])
+        for k, t, res, sc, g, e in zip(rows, self.clock[rows], residual, scale, gap, self.excursion[rows]):
+            monitor = self.monitors[k]
+            try:
+                if sc > 0 and abs(res) > abs(monitor.worst["residual_ratio"]) * sc:
+                    monitor.residual(float(t), float(res), float(sc))
+                if g > monitor.worst["loop_gap_m"]:
+                    monitor.loop_gap(float(t), float(g))
+                if e > monitor.worst["excursion_m"]:
+                    monitor.excursion(float(t), float(e))
+            except AccuracyError as exc:
+                self._finish(k, error=str(exc))
+
+    def _check_health(self, s: int, stepped: np.ndarray, done: np.ndarray) -> None:
+        """MuJoCo resets a simulation it finds unstable (its clock falls behind): fail it."""
+        expected = done * self.dt
+        bad = stepped & self.running & ((np.abs(self.clock - expected) > 0.5 * self.dt)
+                                        | ~np.all(np.isfinite(self.qpos), axis=1))
+        for k in np.flatnonzero(bad):
+            t_good = float(self.record["t"][s - 1, k])
+            self._finish(k, error=f"MuJoCo became unstable after t={t_good:.6g} s (a smaller timestep may carry "
+                                  "the run further)")
+        self.running &= done < self.n_steps
+
+    def _block(self, s: int) -> None:
+        """Steady state and stalls of the running designs, from the rows since the last block."""
+        r = self.record
+        for k in np.flatnonzero(self.running):
+            last = int(self.last_row[k])
+            if self.watches is not None:
+                t = r["t"][self.fed:last + 1, k]
+                travel = 0.5 * (r["x1"][self.fed:last + 1, k] + r["x2"][self.fed:last + 1, k])
+                if self.watches[k].update(t, r["phi"][self.fed:last + 1, k], travel):
+                    end = int(np.searchsorted(r["t"][:last + 1, k], self.watches[k].steady_at - 1e-12))
+                    self._finish(k, last=end)
+                    continue
+            since = rest_since(r["t"][:last + 1, k], r["omega"][:last + 1, k], r["v1"][:last + 1, k],
+                               r["v2"][:last + 1, k], self.designs[k].r)
+            if since is not None:
+                self.stall[k] = stall_reason(since, float(r["t"][last, k]), float(r["phi"][last, k]))
+                self._finish(k)
+        self.fed = s + 1
+
+    def _finish(self, k: int, error: str | None = None, last: int | None = None) -> None:
+        if not self.running[k] and self.failed[k] is None and error is None:
+            return
+        self.running[k] = False
+        if error is not None and self.failed[k] is None:
+            self.failed[k] = error
+        if last is not None:
+            self.last_row[k] = last
+
+    def _outcome(self, k: int) -> dict:
+        monitor = self.monitors[k]
+        if self.failed[k] is not None:
+            return {"error": self.failed[k], "accuracy": monitor.record()}
+        n = int(self.last_row[k]) + 1
+        series = {c: values[:n, k].copy() for c, values in self.record.items()}
+        wm, wf = float(series["motor_work"][-1]), float(series["friction_work"][-1])
+        kinetic = float(series["kinetic"][-1] - series["kinetic"][0])
+        potential = float(series["potential"][-1])
+        residual = wm - wf - kinetic - potential
+        scale = max(abs(wm), wf, abs(potential), float(self.floor[k]))
+        steady = self.watches is not None and self.watches[k].steady_at is not None
+        p = self.designs[k]
+        if p.drive == "torque":  # the sweep's figures: exact for a constant torque and forward-only modules
+            motor = p.M * float(series["phi"][-1] - series["phi"][0])
+            against = p.F_r1 * float(series["x1"][-1]) + p.F_r2 * float(series["x2"][-1])
+        else:
+            motor, against = wm, wf
+        return {"series": series, "motor_work_j": motor, "friction_work_j": against,
+                "energy": {"motor_work_j": wm, "kinetic_j": kinetic, "friction_j": wf, "potential_j": potential,
+                           "residual_j": residual},
+                "accuracy": monitor.record(residual / scale if scale > 0 else 0.0),
+                "stall": self.stall[k], "steady": steady,
+                "settings": {"timestep": float(self.dt[k]), "dt_out": self.dt_out,
+                             "solimp": list(self.settings[k].solimp),
+                             "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles}}

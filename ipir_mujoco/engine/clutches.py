@@ -1,10 +1,12 @@
 """One-way clutches in MuJoCo: a joint-limit ratchet and velocity-triggered locks.
 
-A controller is called before every ``mj_step`` (:meth:`before_step`) and
-after it (:meth:`after_step`, with the step's :class:`StepForces`); it reports
-per module whether its clutch holds and the clutch's reaction force [N]
-(positive pushes the module forward), read from MuJoCo's constraint forces of
-the step just taken.
+A controller is called before every ``mj_step`` (:meth:`before_step`) and, if
+it needs the step's constraint forces, after it (:meth:`after_step`; None when
+it does not). At the output samples :meth:`reactions` reports per module
+whether its clutch holds and the clutch's reaction force [N] (positive pushes
+the module forward), read from MuJoCo's constraint rows of the step just taken.
+These run every step, so they work on Python floats and touch only the few
+entries they need.
 
 Nothing here uses the analytic model: the lock rules read MuJoCo's state.
 """
@@ -14,7 +16,6 @@ from __future__ import annotations
 import math
 
 import mujoco
-import numpy as np
 
 from .model import (CRANK_HINGE, FRONT_LOCK, FRONT_SLIDE, REAR_LOCK, REAR_SLIDE, ROD_HINGE, dof_address,
                     qpos_address)
@@ -22,67 +23,89 @@ from .model import (CRANK_HINGE, FRONT_LOCK, FRONT_SLIDE, REAR_LOCK, REAR_SLIDE,
 LIMIT_ROW = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 SLIDES = (REAR_SLIDE, FRONT_SLIDE)
+# constraint rows per equality type (connect: 3 translations, weld: 6, joint/tendon/distance: 1)
+_EQUALITY_ROWS = {int(mujoco.mjtEq.mjEQ_CONNECT): 3, int(mujoco.mjtEq.mjEQ_WELD): 6}
 
 
-class StepForces:
-    """The constraint forces of the step just taken, read from MuJoCo once per step.
-
-    ``by_row[(type, id)]``: the summed force of the rows of one constraint
-    element (mjtConstraint type, element id); ``loop``: the three rows of the
-    loop-closing ``connect`` (world-frame force on the rod at C). A plain
-    Python pass over the few rows (about seven) costs less than numpy masks.
-    """
-
-    __slots__ = ("by_row", "loop")
-
-    def __init__(self, data: mujoco.MjData, loop_id: int):
-        n = data.nefc
-        self.by_row: dict[tuple[int, int], float] = {}
-        self.loop: list[float] = []
-        for row_type, element, force in zip(data.efc_type[:n].tolist(), data.efc_id[:n].tolist(),
-                                            data.efc_force[:n].tolist()):
-            if row_type == EQUALITY_ROW and element == loop_id:
-                self.loop.append(force)
-            else:
-                key = (row_type, element)
-                self.by_row[key] = self.by_row.get(key, 0.0) + force
-
-    def force(self, row_type: int, element: int) -> float | None:
-        """Summed force of one element's rows, None if it has no active row."""
-        return self.by_row.get((row_type, element))
+def equality_row(model: mujoco.MjModel, data: mujoco.MjData, eq_id: int) -> int:
+    """Index of the first constraint row of equality ``eq_id`` (active): MuJoCo puts the rows of the
+    active equalities first, in id order."""
+    row = 0
+    for e in range(eq_id):
+        if data.eq_active[e]:
+            row += _EQUALITY_ROWS.get(int(model.eq_type[e]), 1)
+    return row
 
 
 class Ratchet:
-    """Each slide's lower limit follows the running maximum of its position.
+    """Each slide's lower limit follows the running maximum of its position, one margin below it.
 
-    A limit row exists only while the distance to the bound is below the
-    joint's margin (1e-9 m), so the bound is raised to max(bound, q) rather
-    than to q, which would leave the distance at exactly 0 and the clutch never
-    engaged (see shared/DESIGN.md). The limit force is the clutch reaction,
-    >= 0 by construction.
+    A limit row exists while the distance from the bound is below the joint's
+    margin (1e-9 m), and MuJoCo's soft limit pulls that distance toward the
+    margin itself. So the bound is kept at (running maximum - margin): a module
+    that has not moved back feels no clutch force, and one that has is pushed
+    back toward its running maximum, never beyond it. (A bound at the running
+    maximum itself would push every held module forward by up to a margin per
+    step: a creep of ~1e-5 m/s at 1e-4 s.) The limit force is the clutch
+    reaction, >= 0 by construction. ``excursion`` [m] is the largest backward
+    excursion of a module below its running maximum seen so far (checked
+    before every step).
     """
 
     name = "ratchet"
+    after_step = None
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
         self.model, self.data = model, data
-        self.joint_ids = np.array([model.joint(n).id for n in SLIDES])
-        self.qpos_adr = np.array([qpos_address(model, n) for n in SLIDES])
-        if not np.all(model.jnt_limited[self.joint_ids]):
-            raise ValueError("the ratchet needs limited slides: build the model with ratchet=True")
-        self.bounds = data.qpos[self.qpos_adr].copy()  # running maximum of each module's position
-        model.jnt_range[self.joint_ids, 0] = self.bounds
-        self.forces = [0.0, 0.0]
+        self.joint_ids = [model.joint(n).id for n in SLIDES]
+        self.qpos_adr = [qpos_address(model, n) for n in SLIDES]
+        limited = [j for j in range(model.njnt) if model.jnt_limited[j]]
+        if sorted(limited) != sorted(self.joint_ids):
+            raise ValueError("the ratchet needs the two slides, and only them, limited: build the model with "
+                             "ratchet=True")
+        self.bounds = [float(data.qpos[a]) for a in self.qpos_adr]  # running maximum of each module's position
+        self.margins = [float(model.jnt_margin[j]) for j in self.joint_ids]
+        self.range = model.jnt_range
+        for j, b, margin in zip(self.joint_ids, self.bounds, self.margins):
+            self.range[j, 0] = b - margin
+        self.excursion = 0.0
+        self._qpos = data.qpos
 
     def before_step(self) -> None:
-        np.maximum(self.bounds, self.data.qpos[self.qpos_adr], out=self.bounds)
-        self.model.jnt_range[self.joint_ids, 0] = self.bounds
+        # unrolled for the two slides: this runs before every step
+        q, bounds = self._qpos, self.bounds
+        (a0, a1), (j0, j1) = self.qpos_adr, self.joint_ids
+        x = float(q[a0])
+        if x > bounds[0]:
+            bounds[0] = x
+            self.range[j0, 0] = x - self.margins[0]
+        elif bounds[0] - x > self.excursion:
+            self.excursion = bounds[0] - x
+        x = float(q[a1])
+        if x > bounds[1]:
+            bounds[1] = x
+            self.range[j1, 0] = x - self.margins[1]
+        elif bounds[1] - x > self.excursion:
+            self.excursion = bounds[1] - x
 
-    def after_step(self, forces: StepForces) -> None:
-        self.forces = [forces.force(LIMIT_ROW, int(j)) or 0.0 for j in self.joint_ids]
+    def reactions(self) -> tuple[bool, bool, float, float]:
+        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
 
-    def reactions(self) -> tuple[list[bool], list[float]]:
-        return [f > 0.0 for f in self.forces], list(self.forces)
+        The limit rows follow the equality and friction rows, in joint order, and
+        only the two slides are limited (checked at construction).
+        """
+        d = self.data
+        start, nl = d.ne + d.nf, d.nl
+        if nl == 2:
+            rear, front = d.efc_force[start:start + 2].tolist()
+            if self.joint_ids[0] > self.joint_ids[1]:
+                rear, front = front, rear
+        elif nl == 1:
+            force = float(d.efc_force[start])
+            rear, front = (force, 0.0) if d.efc_id[start] == self.joint_ids[0] else (0.0, force)
+        else:
+            rear = front = 0.0
+        return rear > 0.0, front > 0.0, rear, front
 
 
 class Locks:
@@ -101,7 +124,8 @@ class Locks:
 
     A lock is anchored at the module's position when it engages
     (``eq_data[e, 0] = q``: a joint equality without joint2 holds q = q0 + a0,
-    and q0 = 0 for the slides).
+    and q0 = 0 for the slides). ``excursion`` [m]: the largest distance a held
+    module was found behind its anchor at the start of a step.
     """
 
     name = "lock"
@@ -117,12 +141,13 @@ class Locks:
         self.crank_v, self.rod_v = dof_address(model, CRANK_HINGE), dof_address(model, ROD_HINGE)
         self.held = [False, False]
         self.forces = [0.0, 0.0]
-        velocities = [data.qvel[a] for a in self.dof_adr]
+        self.excursion = 0.0
         if rule == "kinematic":
             s_dot = self.gap_rate()
             self._apply([s_dot >= 0, s_dot <= 0])
+            self.after_step = None  # the paper's rule needs no forces between samples
         else:
-            self._apply([v <= 0 for v in velocities])
+            self._apply([data.qvel[a] <= 0 for a in self.dof_adr])
 
     def gap_rate(self) -> float:
         """The linkage's S_dot [m/s] from the crank and rod joint states."""
@@ -135,10 +160,17 @@ class Locks:
         for i, (now, want) in enumerate(zip(self.held, wanted)):
             if want and not now:
                 self.model.eq_data[self.eq_ids[i], 0] = self.data.qpos[self.qpos_adr[i]]
-            self.data.eq_active[self.eq_ids[i]] = want
+            if want != now:
+                self.data.eq_active[self.eq_ids[i]] = want
         self.held = list(wanted)
 
     def before_step(self) -> None:
+        q = self.data.qpos
+        for i in (0, 1):
+            if self.held[i]:
+                back = self.model.eq_data[self.eq_ids[i], 0] - q[self.qpos_adr[i]]
+                if back > self.excursion:
+                    self.excursion = float(back)
         if self.rule == "kinematic":
             s_dot = self.gap_rate()
             if s_dot < 0:
@@ -146,26 +178,30 @@ class Locks:
             elif s_dot > 0:
                 self._apply([True, False])
         else:
-            wanted = []
-            for i in range(2):
-                if self.held[i]:
-                    wanted.append(self.forces[i] >= 0.0)
-                else:
-                    wanted.append(self.data.qvel[self.dof_adr[i]] < 0.0)
-            self._apply(wanted)
+            v = self.data.qvel
+            self._apply([self.forces[i] >= 0.0 if self.held[i] else v[self.dof_adr[i]] < 0.0 for i in (0, 1)])
 
-    def after_step(self, forces: StepForces) -> None:
-        self.forces = [(forces.force(EQUALITY_ROW, eq_id) or 0.0) if held else 0.0
-                       for eq_id, held in zip(self.eq_ids, self.held)]
+    def after_step(self) -> None:
+        self.forces = self._lock_forces()
 
-    def reactions(self) -> tuple[list[bool], list[float]]:
-        return list(self.held), list(self.forces)
+    def _lock_forces(self) -> list[float]:
+        forces = [0.0, 0.0]
+        for i in (0, 1):
+            if self.held[i]:
+                forces[i] = float(self.data.efc_force[equality_row(self.model, self.data, self.eq_ids[i])])
+        return forces
+
+    def reactions(self) -> tuple[bool, bool, float, float]:
+        forces = self._lock_forces()
+        return self.held[0], self.held[1], forces[0], forces[1]
 
 
 class NoClutch:
     """Both modules free (for checks such as momentum conservation)."""
 
     name = "none"
+    after_step = None
+    excursion = 0.0
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
         pass
@@ -173,8 +209,5 @@ class NoClutch:
     def before_step(self) -> None:
         pass
 
-    def after_step(self, forces: StepForces) -> None:
-        pass
-
-    def reactions(self) -> tuple[list[bool], list[float]]:
-        return [False, False], [0.0, 0.0]
+    def reactions(self) -> tuple[bool, bool, float, float]:
+        return False, False, 0.0, 0.0

@@ -2,10 +2,11 @@
 
 The shipped ``mjcf/inchworm.xml`` is the template: it names every element and
 sets the structure (slides, crank hinge, rod hinge, the loop-closing
-``connect``, clutch locks, motor). :func:`build_model` loads it with
+``connect``, clutch locks, drive). :func:`build_model` loads it with
 ``mujoco.MjSpec`` and writes every number of the parameter set into it (masses,
-inertias, lengths, resistances) and the solver settings, then compiles. No XML
-text is edited.
+inertias, lengths, resistances, the drive's gain and bias, gravity) and the
+solver settings, then compiles. No XML text is edited. Each physical effect is
+written by one small function (``_write_*``), so a new one adds a function.
 
 Element names used by the engine (read by name, never by index) are the
 constants below.
@@ -45,17 +46,22 @@ def default_mjcf() -> Path:
 
 @dataclass(frozen=True)
 class SolverSettings:
-    """MuJoCo settings; the defaults are the converged ones (see ``mjcf/README.md``).
+    """MuJoCo settings (see ``mjcf/README.md`` for the evidence).
 
+    ``timestep`` [s]: 1e-4 is the largest the engine chooses by itself; a run
+    given no settings has its step chosen from the motion
+    (:func:`ipir_mujoco.engine.timestep.choose_settings`).
     ``constraint_time_constant`` [s] (default: 2 timesteps) is the solref time
     constant of every constraint: the loop, clutch limits and locks, and the
-    resistances' friction rows. ``solimp`` is MuJoCo's impedance triple.
+    resistances' friction rows. ``solimp`` is MuJoCo's impedance triple, by
+    default its largest impedance 0.9999 (a soft row leaks 1 - d of the free
+    acceleration it resists).
     """
 
     timestep: float = 1e-4
     integrator: str = "implicitfast"
     constraint_time_constant: float | None = None
-    solimp: tuple[float, float, float] = (0.99, 0.999, 0.001)
+    solimp: tuple[float, float, float] = (0.9999, 0.9999, 0.001)
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.timestep) and 0 < self.timestep <= 1e-2):
@@ -78,7 +84,8 @@ class SolverSettings:
         return {**asdict(self), "constraint_time_constant": self.time_constant}
 
 
-def _check_params(params: RobotParams) -> None:
+def check_params(params: RobotParams) -> None:
+    """The parameters the MuJoCo model needs beyond the shared ranges (ParameterError, one line)."""
     if params.rod_mass <= 0:
         raise ParameterError(f"rod_mass={params.rod_mass} kg is out of range for the MuJoCo engine; allowed: "
                              "rod_mass > 0 (the rod is a body in the loop)")
@@ -113,13 +120,19 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
     ``ratchet`` makes both slides limited (the joint-limit ratchet clutch); the
     engine raises their lower bounds as the modules advance.
     """
-    _check_params(params)
+    check_params(params)
     spec = load_spec(mjcf)
     hint = str(mjcf or default_mjcf())
-    body = lambda name: _element(spec.body, name, hint)  # noqa: E731
-    joint = lambda name: _element(spec.joint, name, hint)  # noqa: E731
-    r, L = params.r, params.L
+    for write in (_write_mechanism, _write_drive, _write_gravity):
+        write(spec, params, hint)
+    _write_solver(spec, settings, hint, ratchet)
+    return spec
 
+
+def _write_mechanism(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
+    """Masses, inertias, lengths and resistances."""
+    body = lambda name: _element(spec.body, name, hint)  # noqa: E731
+    r, L = params.r, params.L
     rear, crank, rod, front = body("rear_module"), body("crank"), body("rod"), body("front_module")
     rear.mass = (1 - CRANK_MASS_SHARE) * params.m1
     crank.mass = CRANK_MASS_SHARE * params.m1
@@ -137,12 +150,60 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
 
     front.pos = [r + L, 0, 0]  # reference pose (all joints 0): crank points at C, S = r + L
     front.mass = params.m2
-    loop = _element(spec.equality, LOOP, hint)
-    loop.data[0:3] = [L, 0, 0]  # C in the rod's frame
+    _element(spec.equality, LOOP, hint).data[0:3] = [L, 0, 0]  # C in the rod's frame
 
-    joint(REAR_SLIDE).frictionloss = params.F_r1
-    joint(FRONT_SLIDE).frictionloss = params.F_r2
+    _element(spec.joint, REAR_SLIDE, hint).frictionloss = params.F_r1
+    _element(spec.joint, FRONT_SLIDE, hint).frictionloss = params.F_r2
 
+
+def _write_drive(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
+    """The crank actuator: torque = gainprm[0] ctrl + biasprm[0] + biasprm[1] phi + biasprm[2] omega (gear 1).
+
+    MuJoCo's general actuator with fixed gain and affine bias (XML reference,
+    actuator/general gaintype and biastype). ``drive='torque'``: gain 1, no bias,
+    ctrl = M. ``drive='motor'``: gain M_stall, bias -(M_stall / omega_noload) omega,
+    ctrl = 1 (full voltage), so the torque is M_stall (1 - omega / omega_noload) on
+    both sides of the no-load speed, computed by MuJoCo itself every step (and
+    integrated implicitly in omega by the implicit integrators). See
+    :func:`drive_control` for the ctrl value.
+    """
+    act = _element(spec.actuator, MOTOR, hint)
+    act.gear[0] = 1.0
+    act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+    act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+    act.dyntype = mujoco.mjtDyn.mjDYN_NONE
+    act.gainprm[:] = 0.0
+    act.biasprm[:] = 0.0
+    if params.drive == "motor":
+        act.gainprm[0] = params.M_stall
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.biasprm[2] = -params.M_stall / params.omega_noload
+    else:
+        act.gainprm[0] = 1.0
+        act.biastype = mujoco.mjtBias.mjBIAS_NONE
+
+
+def drive_control(params: RobotParams) -> float:
+    """The ctrl value of the crank actuator: M [N m] for a constant torque, 1 (full voltage) for the motor."""
+    return 1.0 if params.drive == "motor" else params.M
+
+
+def _write_gravity(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
+    """Gravity in the robot's frame: x along the pipe axis, the mechanism in the x-y plane.
+
+    The pipe axis rises ``incline`` degrees above the horizontal, so gravity has
+    -g sin(incline) along x and -g cos(incline) along z, across the pipe and
+    normal to the mechanism's plane: a z force has no component along a slide
+    (x) and no moment about a hinge (z), so it only loads bearings (the crank is
+    balanced, its centre of mass on the hinge axis).
+    """
+    angle = math.radians(params.incline)
+    spec.option.gravity = [-params.g * math.sin(angle), 0.0, -params.g * math.cos(angle)]
+
+
+def _write_solver(spec: mujoco.MjSpec, settings: SolverSettings, hint: str, ratchet: bool) -> None:
+    """Timestep, integrator and the soft-constraint parameters of every constraint row."""
+    joint = lambda name: _element(spec.joint, name, hint)  # noqa: E731
     spec.option.timestep = settings.timestep
     spec.option.integrator = INTEGRATORS[settings.integrator]
     solref = [settings.time_constant, 1.0]
@@ -157,7 +218,6 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
     for name in (LOOP, REAR_LOCK, FRONT_LOCK):
         eq = _element(spec.equality, name, hint)
         eq.solref, eq.solimp = solref, solimp
-    return spec
 
 
 def build_model(params: RobotParams, settings: SolverSettings = SolverSettings(),

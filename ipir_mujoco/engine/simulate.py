@@ -1,95 +1,53 @@
 """Simulate the robot in MuJoCo and fill the shared result container.
 
 The stepping loop: before each ``mj_step`` the clutch controller updates its
-limits or locks; after it, the loop accumulates the energy terms and, every
-output interval, records a sample. MuJoCo warnings are intercepted (nothing is
-written to ``MUJOCO_LOG.TXT``) and turn into a :class:`SimulationError` with the
-time and MuJoCo's message, as does a non-finite state.
+limits or locks (and tracks how far a module slid back); after it, the loop
+accumulates the drive's work and the work against the resistances; every
+output interval it records a sample (:mod:`.recorder`) and feeds the accuracy
+monitor (:mod:`.monitor`). Every ~0.05 s of simulated time it reports
+progress, checks the wall-time budget, the periodic steady state and a stall.
+MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
+turn into a :class:`SimulationError` with the time and MuJoCo's message, as
+does a non-finite state.
 
-Sampling: a sample at time t_{n+1} holds the state after step n, the module
-accelerations of that step ((v_{n+1} - v_n) / dt) and the constraint forces
-MuJoCo computed for it.
-
-Energy audit, per step with the velocities v_{n+1} that move the positions:
-motor work ctrl * (phi_{n+1} - phi_n) (exact for MuJoCo's update), friction work from
-the frictionloss rows, the work absorbed by the clutch rows (``clutch_j``),
-and the kinetic energy from ``mj_energyVel``. ``residual_j`` = motor - kinetic
-- friction is what the soft constraints (clutches and loop) and the time
-discretization took together. The loop's own share is not reported: its
-constraint power measured this way carries an O(dt) bookkeeping term (J(q_n)
-v_{n+1} != 0 on a curved constraint) that the discretization term cancels, so
-the split would be noise, not physics.
+Energy audit, per step with the velocities v_{n+1} that move the positions
+(q_{n+1} = q_n + dt v_{n+1}): drive work tau * (phi_{n+1} - phi_n) with the
+torque MuJoCo applied over the step (for the motor, whose velocity term the
+implicit integrator treats implicitly, tau(omega_{n+1})), work against the
+resistances from the frictionloss rows, kinetic and potential energy from
+MuJoCo's own ``energy``. ``residual_j`` = motor - friction - kinetic -
+potential is what the soft constraints (clutches and loop) and the time
+discretization took together; the monitor holds it to a tolerance.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 import time
-from dataclasses import dataclass
-from typing import Callable, Iterator
+from dataclasses import replace
+from typing import Callable
 
 import mujoco
 import numpy as np
 
+from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult
+from ipir_mujoco.analytic.params import RobotParams, require_params
+from ipir_mujoco.analytic.results import RunResult
 
-from .clutches import EQUALITY_ROW, LIMIT_ROW, Locks, NoClutch, Ratchet, StepForces
-from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_HINGE, SolverSettings, build_model,
-                    dof_address, qpos_address, set_closed_loop_state)
+from .clutches import Locks, NoClutch, Ratchet
+from .common import (BLOCK_TIME, REFINEMENTS, CrankServo, captured_warnings, check_run_options, climb_energy,
+                     rest_since, stall_reason)
+from .model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, dof_address,
+                    drive_control, qpos_address, set_closed_loop_state)
+from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode
+from .recorder import EXTRA_COLUMNS, Recorder
+from .timestep import DT_MIN, choose_settings
+
+__all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
 FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
-
-
-@dataclass(frozen=True)
-class CrankServo:
-    """A stiff PD servo that makes the crank follow phi_ref(t), omega_ref(t).
-
-    Motor torque = kp (phi_ref - phi) + kv (omega_ref - omega), recomputed every
-    step; no feedforward, so the torque MuJoCo reports is what its own physics
-    needs to follow the reference (inverse kinetostatics by simulation).
-    Defaults: natural frequency 1000 rad/s, critical damping, for J = 1e-3 kg m^2.
-    """
-
-    phi_ref: Callable[[float], float]
-    omega_ref: Callable[[float], float]
-    kp: float = 1000.0  # N m / rad
-    kv: float = 2.0  # N m s / rad
-
-    def torque(self, t: float, phi: float, omega: float) -> float:
-        return self.kp * (float(self.phi_ref(t)) - phi) + self.kv * (float(self.omega_ref(t)) - omega)
-# Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
-# along the rod), motor power [W], total momentum along x [kg m/s], motor torque [N m].
-EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque")
 IMPLEMENTATIONS = ("ratchet", "lock", "none")
-
-
-@contextlib.contextmanager
-def captured_warnings() -> Iterator[list[str]]:
-    """Route MuJoCo's warning text into a list instead of MUJOCO_LOG.TXT and stderr."""
-    messages: list[str] = []
-    previous = mujoco.get_mju_user_warning()
-    mujoco.set_mju_user_warning(messages.append)
-    try:
-        yield messages
-    finally:
-        mujoco.set_mju_user_warning(previous)
-
-
-def _warning_count(data: mujoco.MjData) -> int:
-    return sum(int(w.number) for w in data.warning)
-
-
-def _mode(rear_held: bool, front_held: bool) -> int:
-    if rear_held and front_held:
-        return int(Mode.BOTH_LOCKED)
-    if front_held:
-        return int(Mode.CONTRACTION)
-    if rear_held:
-        return int(Mode.EXPANSION)
-    return int(Mode.BOTH_MOVING)
 
 
 def simulate_mujoco(
@@ -99,10 +57,15 @@ def simulate_mujoco(
     t_end: float = 1.0,
     *,
     dt_out: float = 1e-4,
-    settings: SolverSettings = SolverSettings(),
+    settings: SolverSettings | None = None,
     mjcf=None,
     progress: Callable[[float], None] | None = None,
     servo: CrankServo | None = None,
+    accuracy: str = "stop",
+    until_steady: bool = False,
+    steady_tol: float = STEADY_TOL,
+    steady_cycles: int = STEADY_CYCLES,
+    wall_budget_s: float | None = None,
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -110,15 +73,18 @@ def simulate_mujoco(
     construction, so ``clutch`` must be 'unilateral'), 'lock' (velocity-
     triggered locks released by ``clutch`` = 'kinematic', the paper's rule, or
     'unilateral', a lock that would pull lets go), or 'none' (no clutches).
-    ``dt_out`` [s] must be a whole number of timesteps. ``progress`` is called
-    with the simulated time about every 0.1 s of it. ``servo`` replaces the
-    constant torque M by a crank servo (:class:`CrankServo`).
+    ``dt_out`` [s] (<= t_end) must be a whole number of timesteps. ``settings``:
+    None chooses the timestep from the motion (:func:`.timestep.choose_settings`)
+    and halves it (at most twice) if the accuracy monitor fails; given settings
+    are used as they are. ``accuracy``: 'stop' (a failed accuracy check is a
+    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``).
+    ``until_steady`` stops at the end of the revolution where the periodic
+    steady state is reached (``t_end`` caps it). ``progress`` is called with the
+    simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
+    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
     """
-    defaults = RobotParams()
-    for name in ("drive", "clutch_stiffness", "clutch_damping", "clutch_backlash", "incline"):
-        if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
-            raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the MuJoCo engine yet; "
-                                 f"allowed: {getattr(defaults, name)!r}")
+    params = require_params(params)
+    check_run_options(params, t_end, dt_out)
     if implementation not in IMPLEMENTATIONS:
         raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
     if clutch not in ("kinematic", "unilateral"):
@@ -126,175 +92,243 @@ def simulate_mujoco(
     if implementation == "ratchet" and clutch == "kinematic":
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
-    for name, value in (("t_end", t_end), ("dt_out", dt_out)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
-    steps_per_sample = round(dt_out / settings.timestep)
-    if steps_per_sample < 1 or abs(steps_per_sample * settings.timestep - dt_out) > 1e-9 * dt_out:
-        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
-                             f"({settings.timestep} s)")
-    n_samples = max(1, math.ceil(t_end / dt_out - 1e-9))
+    check_accuracy_mode(accuracy)
+    SteadyWatch(0.0, steady_tol, steady_cycles)  # validates both
+    if wall_budget_s is not None and not (math.isfinite(wall_budget_s) and wall_budget_s > 0):
+        raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number > 0")
 
+    options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
+                   progress=progress, servo=servo, accuracy=accuracy, until_steady=until_steady,
+                   steady_tol=steady_tol, steady_cycles=steady_cycles, wall_budget_s=wall_budget_s)
+    if settings is not None:
+        return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
-    model = build_model(params, settings, mjcf, ratchet=implementation == "ratchet")
-    data = mujoco.MjData(model)
-    with captured_warnings() as messages:
-        set_closed_loop_state(model, data, params)
-        if implementation == "ratchet":
-            controller = Ratchet(model, data)
-        elif implementation == "lock":
-            controller = Locks(model, data, clutch, params.r, params.L)
+    chosen, why = choose_settings(params, t_end, dt_out, servo, implementation)
+    failures = []
+    for attempt in range(REFINEMENTS + 1):
+        try:
+            run = _Run(params, chosen, started=started, **options)
+            return run.result({"timestep_source": "auto", "timestep_rule": why, "refinements": failures})
+        except AccuracyError as exc:
+            if attempt == REFINEMENTS or chosen.timestep / 2 < DT_MIN:
+                raise
+            failures.append({"timestep": chosen.timestep, "reason": str(exc)})
+            chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+class _Run:
+    """One MuJoCo run with fixed settings (the loop is in :meth:`_integrate`)."""
+
+    def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
+                 until_steady, steady_tol, steady_cycles, wall_budget_s, started=None):
+        self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
+        self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
+        self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
+        self.wall_budget_s = wall_budget_s
+        self.started = time.perf_counter() if started is None else started
+        dt = settings.timestep
+        self.steps_per_sample = round(dt_out / dt)
+        if self.steps_per_sample < 1 or abs(self.steps_per_sample * dt - dt_out) > 1e-9 * dt_out:
+            raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
+                                 f"({dt} s)")
+        self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
+        self.model = build_model(params, settings, mjcf, ratchet=implementation == "ratchet")
+        self.data = mujoco.MjData(self.model)
+        self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
+        self.stall: str | None = None
+
+    def result(self, extra_settings: dict) -> RunResult:
+        with captured_warnings() as messages:
+            last = self._integrate(messages)
+        rec = self.recorder
+        series = rec.series(last)
+        wm, wf = series["motor_work"][-1], series["friction_work"][-1]
+        kinetic = series["kinetic"][-1] - series["kinetic"][0]
+        potential = series["potential"][-1]
+        residual = wm - wf - kinetic - potential
+        energy = {"motor_work_j": float(wm), "kinetic_j": float(kinetic), "friction_j": float(wf),
+                  "potential_j": float(potential), "residual_j": float(residual)}
+        scale = max(abs(wm), wf, abs(potential), self.energy_floor)
+        label = {"ratchet": "unilateral", "lock": self.clutch, "none": "none"}[self.implementation]
+        return RunResult(
+            engine="mujoco", geometry="exact", clutch=label, params=self.params, t_end=float(series["t"][-1]),
+            series=series, energy=energy, wall_time_s=time.perf_counter() - self.started,
+            settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch, "dt_out": self.dt_out,
+                      "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
+                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles},
+            stall=self.stall,
+            accuracy=self.monitor.record(residual / scale if scale > 0 else 0.0),
+        )
+
+    def _setup(self):
+        m, d, p = self.model, self.data, self.params
+        set_closed_loop_state(m, d, p)
+        if self.implementation == "ratchet":
+            controller = Ratchet(m, d)
+        elif self.implementation == "lock":
+            controller = Locks(m, d, self.clutch, p.r, p.L)
         else:
-            controller = NoClutch(model, data)
-        recorder = _Recorder(model, data, params, n_samples + 1)
-        loop_id = model.equality(LOOP).id
-        motor = model.actuator(MOTOR).id
-        crank_q, crank_v = qpos_address(model, CRANK_HINGE), dof_address(model, CRANK_HINGE)
-        data.ctrl[motor] = params.M if servo is None else servo.torque(0.0, data.qpos[crank_q], data.qvel[crank_v])
-        mujoco.mj_forward(model, data)
-        _check(data, messages, 0.0)
-        recorder.start(controller)
-        next_report = 0.1
-        for _sample in range(n_samples):
-            for _step in range(steps_per_sample):
+            controller = NoClutch(m, d)
+        self.controller = controller
+        self.motor = m.actuator(MOTOR).id
+        self.crank_q, self.crank_v = qpos_address(m, CRANK_HINGE), dof_address(m, CRANK_HINGE)
+        d.ctrl[self.motor] = drive_control(p) if self.servo is None else self.servo.torque(
+            0.0, d.qpos[self.crank_q], d.qvel[self.crank_v])
+        mujoco.mj_forward(m, d)
+        # the frictionloss rows follow the equality rows, one per dof with friction, in dof order
+        self.friction_dofs = [int(i) for i in np.flatnonzero(m.dof_frictionloss > 0)]
+        rows = range(d.ne, d.ne + d.nf)
+        if d.nf != len(self.friction_dofs) or any(
+                d.efc_type[r] != FRICTION_ROW or d.efc_id[r] != dof for r, dof in zip(rows, self.friction_dofs)):
+            raise ParameterError("the MJCF model has friction rows the engine does not expect (only the slides' "
+                                 "frictionloss)")
+        gear = float(m.actuator_gear[self.motor, 0])
+        implicit = m.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+        self.torque_slope = gear * gear * float(m.actuator_biasprm[self.motor, 2]) if implicit else 0.0
+        self.gear = gear
+        self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2)
+
+    def _integrate(self, messages: list[str]) -> int:
+        """Step to t_end (or the steady state, or a stall); returns the last sample's row.
+
+        The inner loop runs every step: it works on Python floats (one
+        ``tolist`` per array read) and calls the monitor only when a figure
+        exceeds its worst so far.
+        """
+        self._setup()
+        m, d, rec, ctl = self.model, self.data, self.recorder, self.controller
+        dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
+        step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
+        motor, cq, cv, gear, slope = self.motor, self.crank_q, self.crank_v, self.gear, self.torque_slope
+        nfric = len(self.friction_dofs)
+        fa, fb = (self.friction_dofs + [0, 0])[:2]
+
+        torque = gear * d.actuator_force.item(motor)
+        rec.qvel_before[0] = qvel - dt * d.qacc  # so that the first sample's acceleration is MuJoCo's qacc
+        row = rec.sample(torque, 0.0, 0.0, ctl.reactions())
+        start = rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
+        self.energy0 = start[:2]
+        self.energy_floor = max(self.energy0[0], 2 * math.pi * abs(torque), climb_energy(m, self.params))
+        self._judge(row, *start)
+        self._check(messages, 0.0)
+
+        wm = wf = 0.0
+        omega_prev = qvel.item(cv)
+        pending = -1
+        sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
+        block = max(1, round(BLOCK_TIME / self.dt_out))
+        checks = _BlockChecks(self)
+        last = None
+        while done < n_steps:
+            k = min(sps, n_steps - done)
+            for j in range(k):
                 if servo is not None:
-                    data.ctrl[motor] = servo.torque(data.time, data.qpos[crank_q], data.qvel[crank_v])
-                controller.before_step()
-                recorder.before_step()
-                mujoco.mj_step(model, data)
-                forces = StepForces(data, loop_id)
-                controller.after_step(forces)
-                recorder.after_step(forces)
-            _check(data, messages, recorder.last_time)
-            recorder.sample(controller)
-            if progress is not None and data.time >= next_report:
-                progress(float(data.time))
-                next_report += 0.1
-        mujoco.mj_forward(model, data)  # energy terms at the final state
-        _check(data, messages, recorder.last_time, recorder.warnings_seen)
-        energy = recorder.energy()
+                    ctrl[motor] = servo.torque(d.time, qpos[cq], qvel[cv])
+                before()
+                if j == k - 1:
+                    rec.qvel_before[rec.count] = qvel
+                step(m, d)
+                if after is not None:
+                    after()
+                v = qvel.tolist()
+                omega = v[cv]
+                torque = gear * d.actuator_force.item(motor) + slope * (omega - omega_prev)
+                wm += torque * omega * dt
+                if nfric == 2:
+                    ne = d.ne
+                    f0, f1 = d.efc_force[ne:ne + 2].tolist()
+                    wf -= (f0 * v[fa] + f1 * v[fb]) * dt
+                elif nfric == 1:
+                    wf -= d.efc_force.item(d.ne) * v[fa] * dt
+                omega_prev = omega
+                if pending >= 0:
+                    self._judge(pending, *rec.fill_deferred(pending))
+                    pending = -1
+            done += k
+            if messages:
+                self._check(messages, float(rec.t[rec.count - 1]))
+            pending = rec.sample(torque, wm, wf, ctl.reactions())
+            if abs(torque) * 2 * math.pi > self.energy_floor:
+                self.energy_floor = 2 * math.pi * abs(torque)
+            if ctl.excursion > self.monitor.worst["excursion_m"]:
+                self.monitor.excursion(d.time, ctl.excursion)
+            samples += 1
+            if samples % block == 0 or done >= n_steps:
+                last = checks.check(pending, messages)
+                if last is not None:
+                    break
+        mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
+        if pending >= 0:
+            self._judge(pending, *rec.fill_deferred(pending))
+        self._check(messages, float(rec.t[rec.count - 1]))
+        return rec.count - 1 if last is None else last
 
-    label = {"ratchet": "unilateral", "lock": clutch, "none": "none"}[implementation]
-    return RunResult(
-        engine="mujoco",
-        geometry="exact",
-        clutch=label,
-        params=params,
-        t_end=float(data.time),
-        series=recorder.series(),
-        energy=energy,
-        wall_time_s=time.perf_counter() - started,
-        settings={"mujoco_clutch": implementation, "clutch_rule": clutch, "dt_out": dt_out,
-                  "mujoco_version": mujoco.__version__, **settings.as_dict()},
-    )
+    def _judge(self, row: int, kinetic: float, potential: float, gap: float) -> None:
+        """Feed sample ``row``'s residual ratio and loop gap to the monitor, when they beat its worst."""
+        mon, rec = self.monitor, self.recorder
+        wm, wf = rec.works(row)
+        dpot = potential - self.energy0[1]
+        residual = wm - wf - (kinetic - self.energy0[0]) - dpot
+        scale = max(abs(wm), wf, abs(dpot), self.energy_floor)
+        if scale > 0 and abs(residual) > abs(mon.worst["residual_ratio"]) * scale:
+            mon.residual(rec.t.item(row), residual, scale)
+        if gap > mon.worst["loop_gap_m"]:
+            mon.loop_gap(rec.t.item(row), gap)
+
+    def _check(self, messages: list[str], t_good: float) -> None:
+        """Raise on a MuJoCo warning or a non-finite state; ``t_good`` [s] is the last sample known good
+        (MuJoCo resets the state, clock included, when it detects a bad one)."""
+        if messages:
+            raise SimulationError(f"MuJoCo became unstable after t={t_good:.6g} s: {messages[0]} "
+                                  "(a smaller --timestep may carry the run further)")
+        if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+            raise SimulationError(f"non-finite state after t={t_good:.6g} s")
 
 
-def _check(data: mujoco.MjData, messages: list[str], t_good: float, seen: int | None = None) -> None:
-    """Raise on a MuJoCo warning or a non-finite state.
+class _BlockChecks:
+    """What the run checks every BLOCK_TIME of simulated time: progress, budget, steady state, stall."""
 
-    MuJoCo passes the first occurrence of each warning to the user handler, so
-    ``messages`` catches every warning of a fresh MjData; the counters
-    (``seen``: the count at the start) are read only when asked, as reading
-    them costs more than a step. ``t_good`` [s] is the last sample known good:
-    MuJoCo resets the state, clock included, when it detects a bad one.
-    """
-    if messages or (seen is not None and _warning_count(data) > seen):
-        reason = messages[0] if messages else "MuJoCo raised a warning"
-        raise SimulationError(f"MuJoCo became unstable after t={t_good:.6g} s: {reason} "
-                              "(a smaller --timestep may carry the run further)")
-    if not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))):
-        raise SimulationError(f"non-finite state after t={t_good:.6g} s")
+    def __init__(self, run: _Run):
+        self.run = run
+        self.next_report = 0.1
+        self.fed = 0  # samples given to the steady-state watch so far
+        rec = run.recorder
+        self.r1, self.f2 = rec.qa[REAR_SLIDE], rec.qa[FRONT_SLIDE]
+        self.v_adr = [rec.va[n] for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
+        self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
+            if run.until_steady else None
+        # a stall is final only under constant loads: not with a servo's time-varying torque
+        self.stall_watch = run.servo is None
 
+    def check(self, newest: int, messages: list[str]) -> int | None:
+        """Returns the row to end the run at (steady state or stall), or None to go on."""
+        run, rec = self.run, self.run.recorder
+        t = float(rec.t[newest])
+        run._check(messages, float(rec.t[max(newest - 1, 0)]))
+        if run.progress is not None and t >= self.next_report - 1e-12:
+            run.progress(t)
+            self.next_report = 0.1 * (math.floor(t / 0.1 + 1e-9) + 1)
+        if run.wall_budget_s is not None and time.perf_counter() - run.started > run.wall_budget_s:
+            raise SimulationError(f"the run exceeded its wall-time budget of {run.wall_budget_s:g} s at "
+                                  f"t={t:.6g} s (simulated)")
+        if self.watch is not None:
+            q = rec.qpos[self.fed:newest + 1]
+            travel = 0.5 * (q[:, self.r1] - rec.qpos[0, self.r1] + q[:, self.f2] - rec.qpos[0, self.f2])
+            steady = self.watch.update(rec.t[self.fed:newest + 1], q[:, rec.qa[CRANK_HINGE]], travel)
+            self.fed = newest + 1
+            if steady:
+                return int(np.searchsorted(rec.t[:newest + 1], self.watch.steady_at - 1e-12, side="left"))
+        if self.stall_watch:
+            return self._stall(newest, t)
+        return None
 
-class _Recorder:
-    """Samples, energy accumulators and constraint-force bookkeeping."""
-
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int):
-        self.model, self.data, self.params = model, data, params
-        self.q = [qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)]
-        self.v = [dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
-        self.loop_id = model.equality(LOOP).id
-        # the slide each clutch row acts on: limit rows by joint id, lock rows by equality id
-        self.limit_dof = {int(j): int(model.jnt_dofadr[j]) for j in range(model.njnt)}
-        self.lock_dof = {e: int(model.jnt_dofadr[model.eq_obj1id[e]]) for e in range(model.neq)
-                         if model.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT}
-        self.loop_force: list[float] = []  # the last step's connect rows
-        self.dt = model.opt.timestep
-        self.table = {c: np.empty(capacity) for c in COLUMNS + EXTRA_COLUMNS}
-        self.count = 0
-        self.v_before = np.zeros(model.nv)
-        self.work = {"friction": 0.0, "clutch": 0.0, "motor": 0.0}
-        self.motor_id = model.actuator(MOTOR).id
-        self.warnings_seen = 0
-
-    def start(self, controller) -> None:
-        self.phi0 = float(self.data.qpos[self.q[0]])
-        self.x0 = self.data.qpos[[self.q[1], self.q[2]]].copy()
-        self.kinetic0 = float(self.data.energy[1])
-        self.v_before[:] = self.data.qvel
-        self.warnings_seen = _warning_count(self.data)
-        self.sample(controller, initial=True)
-
-    def before_step(self) -> None:
-        self.v_before[:] = self.data.qvel
-
-    def after_step(self, forces: StepForces) -> None:
-        d = self.data
-        v = d.qvel
-        # constraint power with the velocities that moved the positions (rows act on one slide each)
-        friction = clutch = 0.0
-        for (row_type, element), force in forces.by_row.items():
-            if row_type == FRICTION_ROW:
-                friction += force * v[element]  # a dof-friction row's id is its dof
-            elif row_type == LIMIT_ROW:
-                clutch += force * v[self.limit_dof[element]]
-            elif row_type == EQUALITY_ROW:
-                clutch += force * v[self.lock_dof[element]]
-        self.work["friction"] -= friction * self.dt
-        self.work["clutch"] -= clutch * self.dt
-        self.work["motor"] += float(d.ctrl[self.motor_id]) * v[self.v[0]] * self.dt  # = ctrl * (phi change)
-        self.loop_force = forces.loop
-
-    def sample(self, controller, initial: bool = False) -> None:
-        d, p, i = self.data, self.params, self.count
-        q, v = d.qpos, d.qvel
-        phi, omega = q[self.q[0]], v[self.v[0]]
-        x1, x2 = q[self.q[1]] - self.x0[0], q[self.q[2]] - self.x0[1]
-        accel = np.zeros(3) if initial else (v[self.v] - self.v_before[self.v]) / self.dt
-        held, reactions = controller.reactions()
-        beta = phi + q[self.q[3]]
-        loop = [] if initial else self.loop_force
-        # the pin force on the rod at C along the rod's axis: tension > 0
-        rod_force = loop[0] * math.cos(beta) + loop[1] * math.sin(beta) if len(loop) == 3 else 0.0
-        row = {
-            "t": d.time, "phi": phi, "omega": omega, "alpha": accel[0], "x1": x1, "x2": x2,
-            "v1": v[self.v[1]], "v2": v[self.v[2]], "a1": accel[1], "a2": accel[2],
-            "S": q[self.q[2]] + p.r + p.L - q[self.q[1]], "S_dot": v[self.v[2]] - v[self.v[1]],
-            "lambda1": reactions[0], "lambda2": reactions[1], "mode": _mode(*held),
-            "rod_force": rod_force, "motor_power": d.ctrl[self.motor_id] * omega, "momentum": self._momentum_x(),
-            "motor_torque": d.ctrl[self.motor_id],
-        }
-        for name, value in row.items():
-            self.table[name][i] = value
-        self.count += 1
-        self.last_time = float(d.time)
-
-    def _momentum_x(self) -> float:
-        """Total linear momentum of the robot along the pipe [kg m/s]."""
-        mujoco.mj_subtreeVel(self.model, self.data)
-        return float(self.data.subtree_linvel[0, 0] * self.model.body_subtreemass[0])
-
-    def series(self) -> dict[str, np.ndarray]:
-        out = {name: values[: self.count].copy() for name, values in self.table.items()}
-        out["mode"] = out["mode"].astype(int)
-        return out
-
-    def energy(self) -> dict[str, float]:
-        motor = float(self.work["motor"])
-        kinetic = float(self.data.energy[1]) - self.kinetic0
-        friction = float(self.work["friction"])
-        residual = motor - kinetic - friction
-        return {
-            "motor_work_j": motor, "kinetic_j": kinetic, "friction_j": friction, "residual_j": residual,
-            "clutch_j": float(self.work["clutch"]),
-        }
+    def _stall(self, newest: int, t: float) -> int | None:
+        rec = self.run.recorder
+        v = rec.qvel[:newest + 1]
+        since = rest_since(rec.t[:newest + 1], v[:, self.v_adr[0]], v[:, self.v_adr[1]], v[:, self.v_adr[2]],
+                           self.run.params.r)
+        if since is None:
+            return None
+        self.run.stall = stall_reason(since, t, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
+        return newest

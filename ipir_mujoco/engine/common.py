@@ -1,0 +1,102 @@
+"""What serial and batched MuJoCo runs share: option checks, warnings, the crank servo, stalls.
+
+Stall: under a constant torque or the motor (loads that do not change with
+time), a robot whose crank pin and modules have all been slower than
+REST_SPEED for REST_TIME is in a static equilibrium it will not leave; the run
+ends there with a one-line reason (:func:`stall_reason`), not an error.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from dataclasses import dataclass
+from typing import Callable, Iterator
+
+import mujoco
+import numpy as np
+
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import RobotParams
+
+from .model import check_params
+
+UNMODELLED = ("clutch_stiffness", "clutch_damping", "clutch_backlash")  # refused until the engine models them
+REST_SPEED = 1e-6  # m/s: modules and crank pin slower are at rest (a held module creeps at 1e-9..1e-8 m/s)
+REST_TIME = 0.1  # s: at rest this long under constant loads is a stall
+BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
+REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often
+
+
+@dataclass(frozen=True)
+class CrankServo:
+    """A stiff PD servo that makes the crank follow phi_ref(t), omega_ref(t).
+
+    Motor torque = kp (phi_ref - phi) + kv (omega_ref - omega), recomputed every
+    step; no feedforward, so the torque MuJoCo reports is what its own physics
+    needs to follow the reference (inverse kinetostatics by simulation).
+    Defaults: natural frequency 1000 rad/s, critical damping, for J = 1e-3 kg m^2.
+    """
+
+    phi_ref: Callable[[float], float]
+    omega_ref: Callable[[float], float]
+    kp: float = 1000.0  # N m / rad
+    kv: float = 2.0  # N m s / rad
+
+    def torque(self, t: float, phi: float, omega: float) -> float:
+        return self.kp * (float(self.phi_ref(t)) - phi) + self.kv * (float(self.omega_ref(t)) - omega)
+
+
+@contextlib.contextmanager
+def captured_warnings() -> Iterator[list[str]]:
+    """Route MuJoCo's warning text into a list instead of MUJOCO_LOG.TXT and stderr."""
+    messages: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(messages.append)
+    try:
+        yield messages
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def check_run_options(params: RobotParams, t_end: float, dt_out: float) -> None:
+    """The checks every MuJoCo entry point shares (ParameterError, one line)."""
+    defaults = RobotParams()
+    for name in UNMODELLED:
+        if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
+            raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the MuJoCo engine yet; "
+                                 f"allowed: {getattr(defaults, name)!r}")
+    check_params(params)
+    for name, value in (("t_end", t_end), ("dt_out", dt_out)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
+    if dt_out > t_end:
+        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: dt_out <= t_end ({t_end} s)")
+
+
+def climb_energy(model: mujoco.MjModel, params: RobotParams) -> float:
+    """Potential energy of raising the whole robot by one stroke 2 r along the pipe [J]: with the drive's
+    2 pi |torque|, one revolution's energy scale, the floor of the monitor's energy scale."""
+    return float(model.body_subtreemass[0] * abs(model.opt.gravity[0]) * 2 * params.r)
+
+
+def rest_since(t: np.ndarray, omega: np.ndarray, v1: np.ndarray, v2: np.ndarray, r: float) -> float | None:
+    """When the robot came to rest, if it has been at rest for the last REST_TIME; else None.
+
+    Arrays of shape (n,), the samples so far: t [s], crank speed [rad/s], module
+    speeds [m/s]; ``r`` [m] the crank length. At rest: the crank pin (r |omega|)
+    and both modules slower than REST_SPEED.
+    """
+    if t[-1] - t[0] < REST_TIME:
+        return None
+    first = int(np.searchsorted(t, t[-1] - REST_TIME - 1e-12))
+    if max(r * np.abs(omega[first:]).max(), np.abs(v1[first:]).max(), np.abs(v2[first:]).max()) > REST_SPEED:
+        return None
+    moving = np.flatnonzero((r * np.abs(omega) > REST_SPEED) | (np.abs(v1) > REST_SPEED) | (np.abs(v2) > REST_SPEED))
+    return float(t[moving[-1] + 1]) if moving.size else float(t[0])
+
+
+def stall_reason(since: float, t_stop: float, phi: float) -> str:
+    """The one-line stall reason of RunResult.stall (times [s], crank angle [rad])."""
+    return (f"stalled: crank and modules at rest from t={since:.4g} s (crank at {math.degrees(phi) % 360:.1f} deg "
+            f"in its turn); the drive cannot turn the crank on against the load (run stopped at t={t_stop:.4g} s)")

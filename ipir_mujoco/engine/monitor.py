@@ -1,0 +1,143 @@
+"""The accuracy monitor of every MuJoCo run: three figures, each with a tolerance, never silent.
+
+MuJoCo's constraints are soft and its step is first order, so a run can drift
+from the mechanism it models without any warning from MuJoCo itself. Three
+figures show it while the run goes, each measured on the run's own state:
+
+``residual_ratio``
+    The energy audit's residual (motor work - work against the resistances -
+    kinetic and potential energy gained: what the soft constraints and the time
+    stepping created or lost) over the energy put through the robot so far:
+    the largest of the motor work, the work against the resistances, the
+    potential energy change and the initial kinetic energy, and at least one
+    revolution's energy: the drive's 2 pi |torque| and the potential energy of
+    a climb by one stroke 2 r (the rule near the start, where the motor work is
+    still tiny, and for a robot that gravity moves). Tolerance 1e-3: over the cases of the
+    convergence study the error in revolutions stayed below 0.8 x the residual
+    ratio (a light rod dissipates: -0.29 % revolutions at +3.8e-3; a fast
+    crank creates energy: +0.087 % at -3.1e-3), so 1e-3 keeps the revolutions
+    within 0.1 % of the converged mechanism.
+``loop_gap_m``
+    Distance between the rod's end C and module 2's pin [m]: how far the
+    loop-closing constraint gives. A gap g moves the linkage's angles by about
+    g / r, so the tolerance is 1e-5 r (1e-3 of what 0.1 % of a revolution
+    would need, as the gap does not accumulate); 5e-7 m for the paper's crank.
+``excursion_m``
+    How far a module slid back below its furthest position so far [m] (the
+    ratchet's give; 0 for an ideal one-way clutch). Each hold lets the module
+    lose at most that much of the stroke 2 r it gains per revolution, so an
+    excursion e costs at most e / (2 r) of the travel; the tolerance
+    2e-4 r keeps that at 1e-4, a tenth of the 0.1 % target; 1e-5 m for the
+    paper's crank.
+
+Crossing a tolerance stops the run with a :class:`SimulationError` that names
+the time, the figure, its value, the tolerance and the remedy
+(``accuracy='stop'``, the default), or is recorded in the run's accuracy
+record and the run goes on (``accuracy='warn'``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.analytic.params import RobotParams
+
+ACCURACY_MODES = ("stop", "warn")
+RESIDUAL_TOL = 1e-3  # of the energy put through the robot (see the module docstring)
+LOOP_GAP_PER_R = 1e-3  # loop gap tolerance over the crank length r
+EXCURSION_PER_R = 2e-4  # backward excursion tolerance over the crank length r
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """The monitor's tolerances: residual ratio [-], loop gap [m], backward excursion [m]."""
+
+    residual_ratio: float
+    loop_gap_m: float
+    excursion_m: float
+
+    @classmethod
+    def for_params(cls, params: RobotParams) -> "Tolerances":
+        return cls(RESIDUAL_TOL, LOOP_GAP_PER_R * params.r, EXCURSION_PER_R * params.r)
+
+
+class AccuracyError(SimulationError):
+    """A run stopped by the accuracy monitor (a SimulationError: exit status 1)."""
+
+
+def check_accuracy_mode(accuracy: str) -> str:
+    if accuracy not in ACCURACY_MODES:
+        raise ParameterError(f"accuracy={accuracy!r} is unknown; allowed: {', '.join(ACCURACY_MODES)}")
+    return accuracy
+
+
+_WHAT = {
+    "residual_ratio": "the energy residual (energy the stepping created or lost) reached {value:+.2e} of the "
+                      "energy put through the robot",
+    "loop_gap_m": "the loop-closure gap (rod end to module 2's pin) reached {value:.3g} m",
+    "excursion_m": "a module slid back {value:.3g} m below its furthest position (ratchet excursion)",
+}
+
+
+class AccuracyMonitor:
+    """Tracks the worst of each figure and acts when one crosses its tolerance.
+
+    ``timestep`` [s] is the run's, for the remedy in the message. Feed it with
+    :meth:`residual`, :meth:`loop_gap` and :meth:`excursion`; read
+    :meth:`record` at the end.
+    """
+
+    def __init__(self, tolerances: Tolerances, mode: str = "stop", timestep: float | None = None):
+        self.tolerances, self.mode, self.timestep = tolerances, check_accuracy_mode(mode), timestep
+        self.worst = {"residual_ratio": 0.0, "loop_gap_m": 0.0, "excursion_m": 0.0}
+        self.worst_t = dict.fromkeys(self.worst, 0.0)
+        self.violations: list[dict] = []
+        self._crossed: set[str] = set()
+
+    def residual(self, t: float, residual_j: float, scale_j: float) -> None:
+        """The audit's residual [J] at time ``t`` [s] against the energy put through the robot [J]."""
+        ratio = residual_j / scale_j if scale_j > 0 else 0.0
+        if abs(ratio) > abs(self.worst["residual_ratio"]):
+            self.worst["residual_ratio"], self.worst_t["residual_ratio"] = ratio, t
+            if abs(ratio) > self.tolerances.residual_ratio:
+                self._crossing("residual_ratio", t, ratio, self.tolerances.residual_ratio)
+
+    def loop_gap(self, t: float, gap_m: float) -> None:
+        if gap_m > self.worst["loop_gap_m"]:
+            self.worst["loop_gap_m"], self.worst_t["loop_gap_m"] = gap_m, t
+            if gap_m > self.tolerances.loop_gap_m:
+                self._crossing("loop_gap_m", t, gap_m, self.tolerances.loop_gap_m)
+
+    def excursion(self, t: float, excursion_m: float) -> None:
+        if excursion_m > self.worst["excursion_m"]:
+            self.worst["excursion_m"], self.worst_t["excursion_m"] = excursion_m, t
+            if excursion_m > self.tolerances.excursion_m:
+                self._crossing("excursion_m", t, excursion_m, self.tolerances.excursion_m)
+
+    def _crossing(self, figure: str, t: float, value: float, tolerance: float) -> None:
+        if self.mode == "stop":
+            raise AccuracyError(self.message(figure, t, value, tolerance))
+        if figure not in self._crossed:  # the first crossing of each figure; the worst is in record()
+            self._crossed.add(figure)
+            self.violations.append({"figure": figure, "t_s": float(t), "value": float(value),
+                                    "tolerance": float(tolerance)})
+
+    def message(self, figure: str, t: float, value: float, tolerance: float) -> str:
+        smaller = f" (e.g. --timestep {self.timestep / 2:.3g})" if self.timestep else ""
+        return (f"MuJoCo accuracy check failed at t={t:.6g} s: {_WHAT[figure].format(value=value)}, tolerance "
+                f"{tolerance:.3g}; use a smaller --timestep{smaller}, or --accuracy warn to finish the run and "
+                "record it")
+
+    def record(self, final_residual_ratio: float | None = None) -> dict:
+        """The run's accuracy record: worst figures, when they occurred, tolerances, violations."""
+        out = {k: float(v) for k, v in self.worst.items()}
+        out["worst_at_s"] = {k: float(v) for k, v in self.worst_t.items()}
+        if final_residual_ratio is not None and math.isfinite(final_residual_ratio):
+            out["residual_ratio_final"] = float(final_residual_ratio)
+        out["tolerances"] = asdict(self.tolerances)
+        out["mode"] = self.mode
+        out["ok"] = not self.violations
+        out["violations"] = list(self.violations)
+        return out

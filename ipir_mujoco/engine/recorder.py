@@ -1,0 +1,131 @@
+"""Output samples of a MuJoCo run: raw rows while it runs, the result's columns at the end.
+
+While the run goes, a sample stores whole rows (qpos, qvel, the velocities
+before the sample's step, a few scalars) into preallocated arrays, which costs
+a few row copies; the columns are computed from them, vectorized, once at the
+end (:meth:`Recorder.series`).
+
+Timing of what a sample holds: the sample at t_{n+1} holds the state after step
+n, the module accelerations of that step ((v_{n+1} - v_n) / dt), the
+constraint forces MuJoCo computed for it, and the torque the drive applied over
+it. The energies, the loop gap and the momentum at t_{n+1} are what MuJoCo
+computes at the start of the *next* step, so they are filled in then
+(:meth:`Recorder.fill_deferred`; the last sample after a final ``mj_forward``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import COLUMNS, Mode
+
+from .clutches import equality_row
+from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, dof_address, qpos_address
+
+# Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
+# along the rod), motor power [W], total momentum along x [kg m/s], motor torque [N m],
+# loop-closure gap [m]; and the cumulative energy columns every driving engine writes [J].
+EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
+ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential")
+# the per-sample scalars, in their order in Recorder.scalars
+_SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
+            "friction_work")
+_DEFERRED = ("kinetic", "potential", "loop_gap", "momentum")
+
+
+class Recorder:
+    """Preallocated sample rows for ``capacity`` samples (see the module docstring)."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int):
+        self.model, self.data, self.params = model, data, params
+        self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
+        self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
+        self.loop_id = model.equality(LOOP).id
+        self.site = model.site(ROD_END).id
+        self.front = model.body("front_module").id
+        self.t = np.empty(capacity)
+        self.qpos = np.empty((capacity, model.nq))
+        self.qvel = np.empty((capacity, model.nv))
+        self.qvel_before = np.empty((capacity, model.nv))
+        self.scalars: list[tuple] = []  # one tuple of _SCALARS per sample
+        self.deferred: list[tuple | None] = [None] * capacity  # one tuple of _DEFERRED per sample
+        self.count = 0
+        # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
+        mujoco.mj_kinematics(model, data)
+        anchor = model.eq_data[self.loop_id, 3:6]
+        self.pin_offset = (data.xmat[self.front].reshape(3, 3) @ anchor).tolist()
+        self.total_mass = float(model.body_subtreemass[0])
+
+    def sample(self, torque: float, motor_work: float, friction_work: float, reactions) -> int:
+        """Store the current state as a sample; returns its row (its deferred values come later).
+
+        ``torque`` [N m]: the drive's torque over the last step; ``motor_work``,
+        ``friction_work`` [J]: cumulative; ``reactions``: the clutch controller's
+        (rear held, front held, rear reaction [N], front reaction [N]).
+        """
+        d, i = self.data, self.count
+        self.t[i] = d.time
+        self.qpos[i] = d.qpos
+        self.qvel[i] = d.qvel
+        row = equality_row(self.model, d, self.loop_id) if self.loop_id else 0
+        fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
+        self.scalars.append((torque, fx, fy, *reactions, motor_work, friction_work))
+        self.count += 1
+        return i
+
+    def works(self, i: int) -> tuple[float, float]:
+        """Cumulative (motor work, friction work) [J] of sample ``i``."""
+        row = self.scalars[i]
+        return row[7], row[8]
+
+    def fill_deferred(self, i: int) -> tuple[float, float, float]:
+        """Energies, loop gap and momentum of sample ``i`` from MuJoCo's current (start of step) values.
+
+        Returns (kinetic [J], potential [J], loop gap [m]).
+        """
+        d = self.data
+        sx, sy, sz = d.site_xpos[self.site].tolist()
+        bx, by, bz = d.xpos[self.front].tolist()
+        ox, oy, oz = self.pin_offset
+        gap = math.sqrt((sx - bx - ox) ** 2 + (sy - by - oy) ** 2 + (sz - bz - oz) ** 2)
+        mujoco.mj_subtreeVel(self.model, d)
+        momentum = d.subtree_linvel.item(0) * self.total_mass
+        potential, kinetic = d.energy.tolist()
+        self.deferred[i] = (kinetic, potential, gap, momentum)
+        return kinetic, potential, gap
+
+    def series(self, last: int | None = None) -> dict[str, np.ndarray]:
+        """Every column, for the samples 0..``last`` (default: all)."""
+        n = self.count if last is None else last + 1
+        p, dt = self.params, self.model.opt.timestep
+        q, v, vb = self.qpos[:n], self.qvel[:n], self.qvel_before[:n]
+        sc = dict(zip(_SCALARS, np.array(self.scalars[:n], dtype=float).reshape(n, len(_SCALARS)).T))
+        de = dict(zip(_DEFERRED, np.array(self.deferred[:n], dtype=float).reshape(n, len(_DEFERRED)).T))
+        c, r1, f2, rod = (self.qa[k] for k in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE))
+        cv, r1v, f2v = (self.va[k] for k in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE))
+        accel = (v - vb) / dt
+        phi, omega = q[:, c], v[:, cv]
+        beta = phi + q[:, rod]
+        held1, held2 = sc["held1"] > 0.5, sc["held2"] > 0.5
+        mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
+                        np.where(held2, int(Mode.CONTRACTION),
+                                 np.where(held1, int(Mode.EXPANSION), int(Mode.BOTH_MOVING))))
+        out = {
+            "t": self.t[:n].copy(), "phi": phi.copy(), "omega": omega.copy(), "alpha": accel[:, cv],
+            "x1": q[:, r1] - q[0, r1], "x2": q[:, f2] - q[0, f2], "v1": v[:, r1v].copy(), "v2": v[:, f2v].copy(),
+            "a1": accel[:, r1v], "a2": accel[:, f2v], "S": q[:, f2] + p.r + p.L - q[:, r1],
+            "S_dot": v[:, f2v] - v[:, r1v], "lambda1": sc["lambda1"].copy(), "lambda2": sc["lambda2"].copy(),
+            "mode": mode.astype(int),
+            # the pin force on the rod at C along the rod's axis: tension > 0
+            "rod_force": sc["loop_fx"] * np.cos(beta) + sc["loop_fy"] * np.sin(beta),
+            "motor_power": sc["motor_torque"] * omega, "momentum": de["momentum"].copy(),
+            "motor_torque": sc["motor_torque"].copy(), "loop_gap": de["loop_gap"].copy(),
+            "motor_work": sc["motor_work"].copy(), "friction_work": sc["friction_work"].copy(),
+            "kinetic": de["kinetic"].copy(), "potential": de["potential"] - de["potential"][0],
+        }
+        assert set(COLUMNS) <= set(out)
+        return out

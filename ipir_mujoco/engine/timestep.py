@@ -1,0 +1,99 @@
+"""The timestep a MuJoCo run needs, chosen from the motion it will meet.
+
+MuJoCo's first-order step creates energy on the rotating linkage: over a run
+the audit's residual grows like (omega dt)^3 times the number of revolutions
+(measured at the paper's case from 1 to 5 s with the ratchet and the locks,
+``python -m ipir_mujoco.studies.convergence``). So the step is chosen from two
+bounds known before the run, the crank speed ``omega_b`` and the revolutions
+``N_b``, such that the predicted residual ratio
+
+    C (omega_b dt)^3 N_b
+
+is half the accuracy monitor's tolerance (1e-3), with C fitted to the measured
+residuals against these same bounds (largest of the fits: 0.36 for the
+ratchet, 2.4 for the locks, whose engagements add their own error). The step
+never exceeds 1e-4 s, the default proven at the paper's 1 s case (5e-5 s for
+the locks), and is a whole fraction of the output interval. Further limits:
+
+- a very light rod: MuJoCo's soft loop leaks (1 - d) of the rod end's free
+  acceleration, which grows as the module-to-rod mass ratio; with the
+  impedance d = 0.9999 a ratio of 1e4 (rod 1e-4 kg) costs 3e-5 of the
+  revolutions at 1e-4 s and the error falls as dt^2, so above the ratio 3e4
+  the step shrinks as sqrt(3e4 / ratio);
+- a crank servo: 0.2 / max(sqrt(kp / J_A), kv / J_A), a tenth of the explicit
+  stability limit of its stiffness and damping.
+
+Bounds on the crank: for a constant torque M, the energy the drive put in
+bounds the crank's kinetic energy, J_A omega^2 / 2 <= KE(0) + |M| (phi - phi0),
+which integrates to omega <= omega_start + |M| t / J_A and
+phi - phi0 <= omega_start t + |M| t^2 / (2 J_A), with omega_start =
+sqrt(2 KE(0) / J_A) and KE(0) bounded with every mass moving at the crank pin's
+largest slider speed. For the DC motor the crank cannot run faster than
+omega_noload on its own (above it the motor brakes): omega_b =
+max(omega_noload, omega_start). Gravity downhill is not in these bounds; the
+accuracy monitor catches what they miss and the engine then halves the step.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import RobotParams
+
+from .model import SolverSettings
+from .monitor import RESIDUAL_TOL
+
+DT_MAX = 1e-4  # s: the default proven at the paper's 1 s case (mjcf/README.md)
+# the locks with the paper's rule stop a module within a step at every engagement: at the paper's 1 s
+# case their residual is -1.45e-3 at 1e-4 s (over the tolerance) and +1.9e-4 at 5e-5 s
+DT_MAX_CLUTCH = {"ratchet": DT_MAX, "lock": 5e-5, "none": DT_MAX}
+DT_MIN = 1e-6  # s: a run needing less is refused (over a million steps per simulated second)
+TARGET = 0.5 * RESIDUAL_TOL  # predicted residual ratio to aim at: half the monitor's tolerance
+RESIDUAL_CONSTANT = {"ratchet": 0.36, "lock": 2.4, "none": 0.36}  # C of the law above, per clutch
+LEAK_RATIO = 3e4  # module-to-rod mass ratio from which a light rod shortens the step
+SERVO_SHARE = 0.2  # of 1 / (servo rate)
+
+
+def crank_bounds(params: RobotParams, t_end: float) -> tuple[float, float]:
+    """(omega_b [rad/s], revolutions bound N_b) over ``t_end`` [s] (see the module docstring)."""
+    p = params
+    lever = p.r * (1 + p.r / math.sqrt(p.L**2 - p.r**2))  # largest slider speed per crank speed [m/rad]
+    rod_turn = p.r / math.sqrt(p.L**2 - p.r**2)  # largest rod angular speed per crank speed
+    mass = p.m1 + p.m2 + p.rod_mass
+    j_start = p.J_A + mass * lever**2 + p.rod_inertia_value * rod_turn**2
+    omega_start = abs(p.omega0) * math.sqrt(j_start / p.J_A)
+    if p.drive == "motor":
+        omega_b = max(p.omega_noload, omega_start)
+        return omega_b, omega_b * t_end / (2 * math.pi)
+    omega_b = omega_start + abs(p.M) * t_end / p.J_A
+    return omega_b, (omega_start * t_end + abs(p.M) * t_end**2 / (2 * p.J_A)) / (2 * math.pi)
+
+
+def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None,
+                    clutch: str = "ratchet") -> tuple[SolverSettings, dict]:
+    """The settings for a run, and why: (SolverSettings, {the bounds and each limit [s]}).
+
+    ``clutch``: the MuJoCo clutch implementation ('ratchet', 'lock', 'none').
+    Raises ParameterError if the run would need a step below 1e-6 s.
+    """
+    omega_b, revolutions = crank_bounds(params, t_end)
+    limits = {"default_s": DT_MAX_CLUTCH[clutch]}
+    if omega_b > 0 and revolutions > 0:
+        constant = RESIDUAL_CONSTANT[clutch]
+        limits["speed_s"] = (TARGET / (constant * max(revolutions, 1.0))) ** (1 / 3) / omega_b
+    ratio = max(params.m1, params.m2) / params.rod_mass
+    if ratio > LEAK_RATIO:
+        limits["rod_mass_s"] = DT_MAX * math.sqrt(LEAK_RATIO / ratio)
+    if servo is not None:
+        rate = max(math.sqrt(servo.kp / params.J_A), servo.kv / params.J_A)
+        limits["servo_s"] = SERVO_SHARE / rate
+    needed = min(limits.values())
+    if needed < DT_MIN:
+        raise ParameterError(
+            f"t_end={t_end:g} s: the crank can reach {omega_b:.3g} rad/s and MuJoCo would need a timestep of "
+            f"{needed:.2g} s; allowed: runs needing a timestep >= {DT_MIN:g} s (shorten t_end, use the motor "
+            "drive, or give the timestep yourself)")
+    steps = math.ceil(dt_out / needed * (1 - 1e-12))
+    why = {"omega_bound_rad_s": omega_b, "revolutions_bound": revolutions, **limits}
+    return SolverSettings(timestep=dt_out / steps), why

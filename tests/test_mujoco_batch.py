@@ -1,0 +1,79 @@
+"""Batched MuJoCo runs: the serial engine's physics and its accuracy monitor, per design."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.engine import simulate_mujoco
+from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.engine.model import SolverSettings
+
+
+def test_batch_equals_the_serial_engine_with_motor_gravity_and_own_timesteps():
+    """Each design keeps its own automatic timestep in one batch: a fast crank (J_A = 1e-4) steps finer."""
+    designs = [RobotParams(drive="motor", incline=30.0), RobotParams(J_A=1e-4), RobotParams(incline=-20.0, M=0.1)]
+    t_end = 0.3
+    batched = run_ratchet_batch(designs, t_end, dt_out=1e-3, nthread=1)
+    timesteps = [outcome["settings"]["timestep"] for outcome in batched]
+    assert timesteps[1] < timesteps[0] / 1.5  # really different steps in one batch
+    for params, outcome in zip(designs, batched):
+        run = simulate_mujoco(params, "unilateral", "ratchet", t_end, dt_out=1e-3)
+        assert outcome["settings"]["timestep"] == run.settings["timestep"]
+        b, s = outcome["series"], run.series
+        # the same models from the same states, stepped alike: bit for bit
+        for column in ("t", "phi", "omega", "x1", "x2", "v1", "v2", "a1", "a2", "motor_work", "kinetic", "potential"):
+            np.testing.assert_array_equal(b[column], s[column], err_msg=column)
+        # the gap is summed in another order (a few ulps of ~1e-5 m); the batch's friction work is
+        # F_r |v| dt per step, the serial engine's the frictionloss rows' work: equal while a module
+        # slides at F_r, apart in the few steps where it starts or stops (below 1e-9 of the motor work)
+        np.testing.assert_allclose(b["loop_gap"], s["loop_gap"], rtol=1e-12, atol=1e-20)
+        np.testing.assert_allclose(b["friction_work"], s["friction_work"], rtol=0, atol=1e-8 * s["motor_work"][-1])
+        assert outcome["accuracy"]["ok"] and run.accuracy["ok"]
+        for figure in ("loop_gap_m", "excursion_m"):
+            assert outcome["accuracy"][figure] == pytest.approx(run.accuracy[figure], rel=1e-9, abs=1e-18), figure
+        # residuals differ by the friction bookkeeping only: 1e-8 of the energy scale
+        assert outcome["accuracy"]["residual_ratio"] == pytest.approx(run.accuracy["residual_ratio"], abs=1e-8)
+
+
+def test_a_design_failing_the_monitor_is_marked_and_the_others_kept():
+    """A coarse common step (4e-4 s): the paper's design fails the energy check, a gentle motor passes."""
+    designs = [RobotParams(), RobotParams(drive="motor", M_stall=0.3, omega_noload=8.0)]
+    coarse = SolverSettings(timestep=4e-4)
+    failed, kept = run_ratchet_batch(designs, 0.8, dt_out=4e-3, settings=coarse, nthread=1)
+    assert "accuracy check failed at t=" in failed["error"] and "energy residual" in failed["error"]
+    assert not failed["accuracy"]["ok"] or failed["accuracy"]["mode"] == "stop"
+    assert "error" not in kept and kept["accuracy"]["ok"] and kept["series"]["phi"][-1] > 1.0
+    # warn: the failing design is kept, with the crossing recorded
+    recorded, _ = run_ratchet_batch(designs, 0.8, dt_out=4e-3, settings=coarse, accuracy="warn", nthread=1)
+    assert "error" not in recorded and not recorded["accuracy"]["ok"]
+    assert recorded["accuracy"]["violations"][0]["figure"] == "residual_ratio"
+
+
+def test_batch_stops_steady_and_stalled_designs():
+    designs = [RobotParams(drive="motor"), RobotParams(drive="motor", M_stall=0.02)]
+    # one thread: two designs are too few to gain from more, and the suite shares the machine
+    steady, stalled = run_ratchet_batch(designs, 3.0, dt_out=1e-3, nthread=1, until_steady=True)
+    serial = simulate_mujoco(designs[0], "unilateral", "ratchet", 3.0, dt_out=1e-3, until_steady=True)
+    assert steady["steady"] and steady["stall"] is None
+    # the serial run stops at the same sample, at the end of the same steady revolution
+    np.testing.assert_array_equal(steady["series"]["t"], serial.series["t"])
+    assert stalled["stall"] is not None and stalled["stall"].startswith("stalled: crank and modules at rest")
+    assert not stalled["steady"] and stalled["series"]["t"][-1] < 1.0
+
+
+def test_batch_halves_an_automatic_step_that_fails(monkeypatch):
+    """As a serial run: an automatic step the monitor stops (4e-4 s, residual -7e-3 at the paper's
+    case) is halved for that design only, and the design comes back within the tolerance."""
+    from ipir_mujoco.engine import batch as batch_module
+
+    chosen = batch_module.choose_settings
+    def coarse(params, *args):
+        return (SolverSettings(timestep=4e-4), {}) if params.M > 0.2 else chosen(params, *args)
+
+    monkeypatch.setattr(batch_module, "choose_settings", coarse)
+    fast, gentle = run_ratchet_batch([RobotParams(), RobotParams(M=0.1)], 0.8, dt_out=4e-3, nthread=1)
+    assert [h["timestep"] for h in fast["settings"]["refinements"]][0] == 4e-4
+    assert fast["settings"]["timestep"] < 4e-4 and fast["accuracy"]["ok"] and "error" not in fast
+    assert gentle["settings"]["refinements"] == [] and gentle["accuracy"]["ok"]
