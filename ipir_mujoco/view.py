@@ -29,8 +29,9 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 
 from .cli.common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
-from .engine.clutches import Locks, Ratchet, StepForces
-from .engine.model import LOOP, MOTOR, SolverSettings, build_model, set_closed_loop_state
+from .engine.clutches import Locks, Ratchet
+from .engine.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
+from .engine.timestep import choose_settings
 from .video import FREE_RGBA, HELD_RGBA, HOUSINGS
 
 
@@ -38,15 +39,17 @@ class ViewedRobot:
     """The model, its data and the engine's clutch controller, stepped one MuJoCo step at a time."""
 
     def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,
-                 settings: SolverSettings = SolverSettings()):
+                 settings: SolverSettings | None = None, t_end: float = 4.0):
         self.params, self.clutch = params, clutch
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
         if self.implementation == "ratchet" and clutch == "kinematic":
             raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                                  "--mujoco-clutch lock for the paper's rule")
+        if settings is None:  # the step the engine would choose for a run of t_end [s]
+            settings, _ = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
+        self.settings = settings
         self.model = build_model(params, settings, ratchet=self.implementation == "ratchet")
         self.data = mujoco.MjData(self.model)
-        self.loop_id = self.model.equality(LOOP).id
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self.reset()
 
@@ -55,15 +58,16 @@ class ViewedRobot:
         set_closed_loop_state(self.model, self.data, self.params)
         self.controller = (Ratchet(self.model, self.data) if self.implementation == "ratchet"
                            else Locks(self.model, self.data, self.clutch, self.params.r, self.params.L))
-        self.data.ctrl[self.model.actuator(MOTOR).id] = self.params.M
+        self.data.ctrl[self.model.actuator(MOTOR).id] = drive_control(self.params)
         mujoco.mj_forward(self.model, self.data)
 
     def step(self) -> None:
         """One MuJoCo step with the clutch controller around it, as the engine's own loop does."""
         self.controller.before_step()
         mujoco.mj_step(self.model, self.data)
-        self.controller.after_step(StepForces(self.data, self.loop_id))
-        held, _ = self.controller.reactions()
+        if self.controller.after_step is not None:
+            self.controller.after_step()
+        held = self.controller.reactions()[:2]
         for geom, on in zip(self.housings, held):
             self.model.geom_rgba[geom] = HELD_RGBA if on else FREE_RGBA
 
@@ -92,7 +96,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ParameterError(f"--slow {args.slow} is out of range; allowed: 1 <= FACTOR <= 1000")
         if not (0.0 < args.t_end <= 60.0):
             raise ParameterError(f"--t-end {args.t_end} is out of range; allowed: 0 < SECONDS <= 60")
-        robot = ViewedRobot(model_params(args), args.clutch, args.mujoco_clutch)
+        robot = ViewedRobot(model_params(args), args.clutch, args.mujoco_clutch, t_end=args.t_end)
         if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
             raise ParameterError("the viewer needs a screen and none is set (no DISPLAY); "
                                  "write a video instead: ipir-mujoco render")
