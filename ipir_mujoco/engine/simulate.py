@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.params import RobotParams, check_run_options
 from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult
 
 from .clutches import EQUALITY_ROW, LIMIT_ROW, Locks, NoClutch, Ratchet, StepForces
@@ -126,9 +126,7 @@ def simulate_mujoco(
     if implementation == "ratchet" and clutch == "kinematic":
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
-    for name, value in (("t_end", t_end), ("dt_out", dt_out)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
+    t_end, dt_out = check_run_options(t_end, dt_out)  # the one check every engine and interface shares
     steps_per_sample = round(dt_out / settings.timestep)
     if steps_per_sample < 1 or abs(steps_per_sample * settings.timestep - dt_out) > 1e-9 * dt_out:
         raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
