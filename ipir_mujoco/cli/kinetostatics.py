@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.omega is not None:
         if not (math.isfinite(args.omega) and 0 < abs(args.omega) <= MAX_OMEGA):
-            raise ParameterError(f"--omega {args.omega:g} rad/s is out of range; allowed: 0 < |omega| <= "
+            raise ParameterError(f"omega={args.omega:g} rad/s is out of range; allowed: 0 < |omega| <= "
                                  f"{MAX_OMEGA:g} rad/s (the range of omega0)")
         check_real("--revolutions", args.revolutions, high=MAX_REVOLUTIONS)
     params = model_params(args)
