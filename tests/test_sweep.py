@@ -342,3 +342,17 @@ def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch):
         assert float(row["divergence:mujoco-lock:steady_speed_m_s"]) == pytest.approx(0.01, rel=1e-6)
     assert rows[0]["analytic-unilateral:stalled"] == "0" and rows[1]["analytic-unilateral:stalled"] == "1"
     assert "dead centre" in rows[1]["notes"]
+
+
+def test_the_batch_never_runs_a_motor_design_as_a_constant_torque(tmp_path):
+    """run_ratchet_batch drives the crank with the constant M; until it models the motor, a motor design
+    is a recorded failure with the way out, not a silently different robot."""
+    study = Study((parse_vary("L=0.1,0.2"),), base=RobotParams(drive="motor"), engines=("mujoco-ratchet",),
+                  t_end=0.1)
+    rows = rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=1))
+    from ipir_mujoco.engine import batch
+
+    if "motor" in getattr(batch, "MODELLED_DRIVES", ("torque",)):
+        pytest.skip("the batched engine models the motor")
+    assert all("drive='motor' is not modelled by the batched engine" in r["error"] and "--no-batch" in r["error"]
+               for r in rows)

@@ -191,24 +191,33 @@ def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out:
     Runs in a process of its own (the batch pool), so that Ctrl-C can end it at once and its per-step
     Python work does not compete with the main process.
     """
-    from ..engine.batch import run_ratchet_batch
+    from ..engine import batch
 
     params: list[RobotParams | None] = []
-    for design in values:
+    refused: dict[int, str] = {}
+    # the batch sets the actuator to the constant M: a design it does not model must not pass silently
+    # (batch.py declares MODELLED_DRIVES once it models more than the constant torque)
+    modelled = getattr(batch, "MODELLED_DRIVES", ("torque",))
+    for k, design in enumerate(values):
         try:
             params.append(base.replace(**design))
         except ValueError:
             params.append(None)
+            continue
+        if params[-1].drive not in modelled:
+            refused[k] = (f"{BATCHED}: drive={params[-1].drive!r} is not modelled by the batched engine; "
+                          f"allowed: {', '.join(modelled)} (or run MuJoCo one by one: --no-batch)")
+            params[-1] = None
     valid = [p for p in params if p is not None]
     steady = {"until_steady": True} if until_steady else {}
     try:
-        outcomes = iter(run_ratchet_batch(valid, t_end, dt_out, nthread=nthread, **steady) if valid else [])
+        outcomes = iter(batch.run_ratchet_batch(valid, t_end, dt_out, nthread=nthread, **steady) if valid else [])
     except Exception as exc:  # noqa: BLE001 (recorded per design; the analytic side goes on)
         outcomes = iter([{"error": f"batch failed: {type(exc).__name__}: {exc}"}] * len(valid))
     results = []
-    for p in params:
+    for k, p in enumerate(params):
         if p is None:
-            results.append({BATCHED: {"error": "invalid design"}})
+            results.append({BATCHED: {"error": refused.get(k, "invalid design")}})
             continue
         outcome = next(outcomes)
         results.append({BATCHED: {"error": f"{BATCHED}: {outcome['error']}"} if "error" in outcome
