@@ -33,6 +33,7 @@ def rows_of(path: Path) -> list[dict]:
 def test_vary_specifications():
     assert parse_vary("L=0.1:0.3:3").values == pytest.approx((0.1, 0.2, 0.3))
     assert parse_vary("L=0.1:1:3:log").values == pytest.approx((0.1, np.sqrt(0.1), 1.0))
+    assert parse_vary("L=0.1:1:3:log").log and not parse_vary("L=0.1:1:3").log  # drawn on a log axis
     assert parse_vary("m2=0.5,1,2").values == (0.5, 1.0, 2.0)
     axis = parse_vary("M=0.1:0.4")
     assert axis.is_range and (axis.low, axis.high) == (0.1, 0.4)

@@ -110,7 +110,7 @@ def parse_vary(text: str) -> Axis:
             raise ParameterError(f"--vary {text!r}: N={count:g} points would need {count * 8:.3g} bytes for the "
                                  f"axis alone; allowed: N <= {MAX_DESIGNS} (designs per sweep)")
         spaced = np.geomspace if log else np.linspace
-        return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))))
+        return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))), log=log)
     raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N[:log], NAME=A,B,C or NAME=LO:HI[:log]")
 
 
