@@ -327,6 +327,69 @@ def load_params(
     return RobotParams(**values)
 
 
+# ----------------------------------------------------------------------------------------------------
+# Run options: the one check every engine and interface calls (simulate, sweep, study files, Python API)
+
+MAX_T_END = 3600.0  # s: an hour of simulated motion; a motor reaches its steady state in seconds, and a
+# MuJoCo run at its 1e-4 s step already takes 3.6e7 steps for an hour
+MAX_SAMPLES = 10_000_000  # samples kept per run: ~20 float64 columns -> 1.6 GB in memory, ~4 GB as CSV
+SAMPLE_BYTES = 20 * 8  # bytes per kept sample (about 20 float64 columns)
+
+
+def check_real(name: str, value: Any, *, low: float = 0.0, high: float = math.inf, low_open: bool = True,
+               unit: str = "") -> float:
+    """``value`` as a float if it is a finite real number (any numeric type) inside the interval; else a
+    ParameterError naming ``name``, the value and the allowed range."""
+    unit_text = f" {unit}" if unit else ""
+    low_text = f"{low:g} {'<' if low_open else '<='} {name}"
+    allowed = low_text + (f" <= {high:g}{unit_text}" if math.isfinite(high) else unit_text)
+    number = as_real(value)
+    if number is None:
+        raise ParameterError(f"{name}={value!r} is not a number; allowed: {allowed}")
+    if not math.isfinite(number) or not (number > low if low_open else number >= low) or number > high:
+        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
+    return number
+
+
+def _shown(value: Any) -> str:
+    """A number as the message shows it: 1e+09 rather than 1000000000.0; -1.0 and 0.25 as written."""
+    if isinstance(value, float) and math.isfinite(value) and value != 0 and not 1e-4 <= abs(value) < 1e6:
+        return f"{value:g}"
+    return repr(value)
+
+
+def check_whole(name: str, value: Any, *, low: int = 0, high: int | None = None, why: str = "") -> int:
+    """``value`` as an int if it is a whole number (int, numpy integer, or an integral float) in
+    [low, high]; else a ParameterError naming it. ``why`` explains the upper limit."""
+    allowed = f"a whole number >= {low}" + (f" and <= {high}{why}" if high is not None else "")
+    number = as_real(value)
+    if number is None or not math.isfinite(number) or number != int(number):
+        raise ParameterError(f"{name}={value!r} is not a whole number; allowed: {allowed}")
+    whole = int(number)
+    if whole < low or (high is not None and whole > high):
+        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
+    return whole
+
+
+def check_run_options(t_end: Any, dt_out: Any) -> tuple[float, float]:
+    """(t_end [s], dt_out [s]) as floats, checked once for every engine and interface.
+
+    t_end: 0 < t_end <= MAX_T_END; dt_out: 0 < dt_out <= t_end; and the run keeps at most
+    MAX_SAMPLES samples (t_end / dt_out + 1), with the size it would need named in the message.
+    """
+    t_end = check_real("t_end", t_end, high=MAX_T_END, unit="s")
+    dt_out = check_real("dt_out", dt_out, unit="s")
+    if dt_out > t_end:
+        raise ParameterError(f"dt_out={dt_out:g} s is out of range; allowed: dt_out <= t_end ({t_end:g} s)")
+    samples = t_end / dt_out + 1
+    if samples > MAX_SAMPLES:
+        raise ParameterError(
+            f"t_end={t_end:g} s with dt_out={dt_out:g} s would keep {samples:.3g} samples "
+            f"(~{samples * SAMPLE_BYTES / 1e9:.3g} GB); allowed: at most {MAX_SAMPLES:.0e} samples "
+            f"(dt_out >= {t_end / (MAX_SAMPLES - 1):.3g} s for this t_end)")
+    return t_end, dt_out
+
+
 def require_params(params: Any) -> RobotParams:
     """``params`` if it is a :class:`RobotParams`, else a ParameterError (for the Python API's entry points)."""
     if not isinstance(params, RobotParams):

@@ -1,23 +1,46 @@
 """Command line: ``ipir-mujoco`` (``python -m ipir_mujoco``); the contract is in docs/cli.md.
 
 Exit status: 0 success, 2 bad input (one line on stderr naming the value and
-what is allowed), 1 a failure of the simulation itself (with the reason).
-Each subcommand lives in its own module with ``add_parser(commands)`` and
+what is allowed), 1 a failure of the simulation itself (with the reason), 130
+interrupted (Ctrl-C). Every failure is one line on stderr; ``--debug`` (before
+or after the subcommand) re-raises it with its traceback instead. Each
+subcommand lives in its own module with ``add_parser(commands)`` and
 ``run(args) -> int``.
 """
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
+import threading
 from typing import Sequence
 
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 
-from .. import __version__
-from . import compare, kinetostatics, params, render, simulate, sweep, validate
-from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "build_parser", "main"]
+def _interrupted_while_loading(signum, frame):  # pragma: no cover (timing)
+    # Ctrl-C while numpy, scipy, matplotlib or MuJoCo load: nothing is open yet, so leave at once,
+    # in one line (a KeyboardInterrupt here would print a traceback from inside an import)
+    os.write(2, b"ipir-mujoco: interrupted\n")
+    os._exit(EXIT_INTERRUPTED)
+
+
+_loading_guard = (threading.current_thread() is threading.main_thread()
+                  and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+if _loading_guard:
+    signal.signal(signal.SIGINT, _interrupted_while_loading)
+try:
+    from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+
+    from .. import __version__
+    from . import compare, kinetostatics, params, render, simulate, sweep, validate
+    from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
+finally:
+    if _loading_guard:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "main"]
 
 COMMANDS = (simulate, validate, compare, sweep, kinetostatics, params, render)
 
@@ -27,23 +50,51 @@ def build_parser() -> Parser:
                     description="Cross-check the analytic model of a two-module inchworm in-pipe robot "
                                 "against MuJoCo physics. 'ipir-mujoco params' lists every parameter.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    add_global_options(parser, top=True)
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for command in COMMANDS:
         command.add_parser(commands)
+    for subparser in set(commands.choices.values()):
+        add_global_options(subparser)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Run the command line; return the exit status (see the module docstring)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except KeyboardInterrupt:
+        print("ipir-mujoco: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    prefix = f"ipir-mujoco {args.command}"
     try:
         return args.handler(args)
-    except ParameterError as exc:
-        print(f"ipir-mujoco {args.command}: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except SimulationError as exc:
-        print(f"ipir-mujoco {args.command}: simulation failed: {exc}", file=sys.stderr)
-        return EXIT_FAILURE
+    except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
+        if args.debug or isinstance(exc, SystemExit):
+            raise
+        code, message = _describe_failure(exc)
+        print(f"{prefix}: {message}", file=sys.stderr)
+        return code
+
+
+def _describe_failure(exc: BaseException) -> tuple[int, str]:
+    """(exit status, one line) for an exception that reached the command line."""
+    def one_line(text: str) -> str:
+        return " ".join(str(text).split())
+
+    if isinstance(exc, ParameterError):
+        return EXIT_BAD_INPUT, f"error: {one_line(exc)}"
+    if isinstance(exc, SimulationError):
+        return EXIT_FAILURE, f"simulation failed: {one_line(exc)}"
+    if isinstance(exc, KeyboardInterrupt):
+        return EXIT_INTERRUPTED, "interrupted"
+    if isinstance(exc, MemoryError):
+        return EXIT_FAILURE, "out of memory (a smaller run: shorter --t-end, larger --dt-out, fewer designs)"
+    if isinstance(exc, OSError):
+        where = f" {exc.filename!r}" if exc.filename else ""
+        return EXIT_FAILURE, f"cannot read or write{where}: {one_line(exc.strerror or exc)}"
+    return EXIT_FAILURE, (f"internal error: {type(exc).__name__}: {one_line(exc)} "
+                          "(run again with --debug for the traceback, and please report it)")
 
 
 if __name__ == "__main__":  # pragma: no cover

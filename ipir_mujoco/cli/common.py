@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import DRIVES, RobotParams, load_params
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
@@ -15,6 +16,12 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str):  # noqa: D102 (argparse API)
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def add_global_options(parser: argparse.ArgumentParser, top: bool = False) -> None:
+    """--debug, accepted before and after the subcommand."""
+    parser.add_argument("--debug", action="store_true", default=False if top else argparse.SUPPRESS,
+                        help="on a failure, show the Python traceback instead of the one-line message")
 
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
@@ -36,6 +43,17 @@ def model_params(args: argparse.Namespace) -> RobotParams:
     if getattr(args, "drive", None) is not None:
         params = params.replace(drive=args.drive)
     return params
+
+
+def check_input_file(option: str, path: str) -> None:
+    """A file the user names exists and is a file (not a folder), or a one-line ParameterError."""
+    from pathlib import Path
+
+    target = Path(path)
+    if target.is_dir():
+        raise ParameterError(f"{option} {path!r} is a folder; give a file")
+    if not target.exists():
+        raise ParameterError(f"{option} {path!r} does not exist")
 
 
 def progress_printer(t_end: float):

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import check_real, check_run_options, read_text_file
 from ipir_mujoco.analytic.results import write_json
 
 from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
 
 def add_parser(commands) -> None:
@@ -18,7 +20,8 @@ def add_parser(commands) -> None:
                                           "or samples of phi(t)) and get the motor torque, clutch reactions and "
                                           "rod force it needs, as CSV and a plot against crank angle.")
     source = kin.add_mutually_exclusive_group(required=True)
-    source.add_argument("--omega", type=float, metavar="RAD_S", help="constant crank speed [rad/s]")
+    source.add_argument("--omega", type=float, metavar="RAD_S",
+                        help="constant crank speed [rad/s], 0 < |omega| <= 1e4 (the range of omega0)")
     source.add_argument("--samples", metavar="FILE.csv",
                         help="CSV with columns t (s, from 0, increasing) and phi (rad); a cubic spline goes through them")
     kin.add_argument("--revolutions", type=float, default=2.0, help="turns at constant speed (default 2)")
@@ -32,17 +35,38 @@ def add_parser(commands) -> None:
 
 
 def _read_crank_samples(path: str):
+    """(t [s], phi [rad]) from a CSV file with a header row naming t and phi; one-line errors otherwise."""
     import numpy as np
 
-    try:
-        table = np.genfromtxt(path, delimiter=",", names=True)
-    except OSError:
-        raise ParameterError(f"--samples {path!r} cannot be read (does it exist?)") from None
-    names = table.dtype.names or ()
-    if "t" not in names or "phi" not in names:
-        raise ParameterError(f"--samples {path!r} needs a header row with columns t and phi; found {list(names)}")
-    return np.atleast_1d(table["t"]), np.atleast_1d(table["phi"])
+    check_input_file("--samples", path)
+    lines = [ln for ln in read_text_file(path, "--samples").splitlines() if ln.strip()]
+    if not lines:
+        raise ParameterError(f"--samples {path!r} is empty; allowed: a CSV file with a header row t,phi "
+                             "and one row per sample")
+    header = [name.strip() for name in lines[0].split(",")]
+    if "t" not in header or "phi" not in header:
+        hint = " (columns are separated by commas, not ';')" if ";" in lines[0] else ""
+        raise ParameterError(f"--samples {path!r} needs a header row with columns t and phi{hint}; "
+                             f"found {header}")
+    rows = []
+    for number, line in enumerate(lines[1:], start=2):
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise ParameterError(f"--samples {path!r} line {number} has {len(cells)} values; the header "
+                                 f"has {len(header)}")
+        try:
+            rows.append([float(c) for c in cells])
+        except ValueError:
+            raise ParameterError(f"--samples {path!r} line {number}: {line.strip()!r} is not a row of "
+                                 "numbers") from None
+    table = np.array(rows, dtype=float).reshape(len(rows), len(header))
+    return table[:, header.index("t")], table[:, header.index("phi")]
 
+
+# |omega| at most this [rad/s] (~95,000 rpm): the same bound as the initial crank speed omega0; the
+# torque a prescribed motion needs grows as omega^2, and above it the figures are meaningless
+MAX_OMEGA = 1e4
+MAX_REVOLUTIONS = 1e4  # turns at constant speed: two mode switches each
 
 
 def run(args: argparse.Namespace) -> int:
@@ -50,12 +74,19 @@ def run(args: argparse.Namespace) -> int:
 
     from ..report.plots import figure_kinetostatics
 
-    check_output_dir(args.out)
-    params = model_params(args)
     if args.omega is not None:
+        if not (math.isfinite(args.omega) and 0 < abs(args.omega) <= MAX_OMEGA):
+            raise ParameterError(f"omega={args.omega:g} rad/s is out of range; allowed: 0 < |omega| <= "
+                                 f"{MAX_OMEGA:g} rad/s (the range of omega0)")
+        check_real("--revolutions", args.revolutions, high=MAX_REVOLUTIONS)
+    params = model_params(args)
+    samples = _read_crank_samples(args.samples) if args.samples is not None else None
+    check_output_dir(args.out)
+    if samples is None:
         motion = CrankMotion.constant_speed(args.omega, params.phi0, args.revolutions)
     else:
-        motion = CrankMotion.from_samples(*_read_crank_samples(args.samples))
+        motion = CrankMotion.from_samples(*samples)
+        check_run_options(motion.t_end, motion.t_end / 2000)  # its output grid: 2000 intervals
     run = inverse_kinetostatics(params, motion, args.geometry, args.clutch)
     s = run.series
     with staged_output(args.out) as staging:

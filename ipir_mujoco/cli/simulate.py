@@ -7,11 +7,12 @@ import json
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import check_run_options, check_whole
 from ipir_mujoco.analytic.results import RunResult, write_json, write_mode_changes
 
 from ..output import check_output_dir, staged_output
 from ..report.plots import write_paper_figures
-from .common import EXIT_OK, add_model_options, model_params, progress_printer
+from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
 
 
 def add_parser(commands) -> None:
@@ -43,6 +44,9 @@ def add_parser(commands) -> None:
                      help="stop at the periodic steady state (per-revolution mean speed settled); --t-end caps it")
     sim.add_argument("--dt-out", type=float, default=1e-4, metavar="SECONDS",
                      help="output sample interval (default 1e-4 s); mode switches are sampled exactly")
+    sim.add_argument("--max-switches", type=int, default=None, metavar="N",
+                     help="analytic engines: stop with an error after N mode switches (a work budget for designs "
+                          "that chatter; default: the engine's, 100000)")
     sim.add_argument("--out", metavar="DIR",
                      help="write DIR/timeseries.csv, DIR/mode_changes.csv (time and crank angle of each mode "
                           "change), DIR/summary.json and the paper's figures as PNG")
@@ -50,25 +54,21 @@ def add_parser(commands) -> None:
     sim.set_defaults(handler=run)
 
 
-def run_simulation(args: argparse.Namespace) -> RunResult:
-    """The run ``simulate`` asks for (raises ParameterError on bad input)."""
-    params = model_params(args)
-    extra = {"until_steady": True} if args.until_steady else {}
+def check_options(args: argparse.Namespace) -> None:
+    """Every option of ``simulate`` that the engines do not check themselves, before any work."""
+    check_run_options(args.t_end, args.dt_out)
+    if args.max_switches is not None:
+        check_whole("--max-switches", args.max_switches, low=1)
     if args.engine == "mujoco":
         if args.geometry == "approx":
             raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real "
                                  "linkage; allowed: --geometry exact (or leave it out)")
-        from ..engine import simulate_mujoco
-        from ..engine.model import SolverSettings
-
-        implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
-        if args.timestep is not None:  # otherwise the engine's own choice
-            extra["settings"] = SolverSettings(timestep=args.timestep)
-        if args.accuracy != "stop":
-            extra["accuracy"] = args.accuracy
-        progress = progress_printer(args.t_end) if not args.json else None
-        return simulate_mujoco(params, args.clutch, implementation, args.t_end, dt_out=args.dt_out,
-                               mjcf=args.mjcf, progress=progress, **extra)
+        if args.max_switches is not None:
+            raise ParameterError(f"--max-switches {args.max_switches} applies only to --engine analytic "
+                                 "(MuJoCo's cost is its step count, t_end / timestep)")
+        if args.mjcf is not None:
+            check_input_file("--mjcf", args.mjcf)
+        return
     for option, value in (("--mjcf", args.mjcf), ("--timestep", args.timestep)):
         if value is not None:
             raise ParameterError(f"{option} {value} applies only to --engine mujoco")
@@ -77,6 +77,29 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
     if args.accuracy != "stop":
         raise ParameterError(f"--accuracy {args.accuracy} applies only to --engine mujoco (the analytic "
                              "engines hold their solver tolerance)")
+
+
+def run_simulation(args: argparse.Namespace) -> RunResult:
+    """The run ``simulate`` asks for (raises ParameterError on bad input)."""
+    check_options(args)
+    params = model_params(args)
+    extra = {"until_steady": True} if args.until_steady else {}
+    progress = progress_printer(args.t_end) if not args.json else None
+    if progress is not None:
+        extra["progress"] = progress
+    if args.engine == "mujoco":
+        from ..engine import simulate_mujoco
+        from ..engine.model import SolverSettings
+
+        implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
+        if args.timestep is not None:  # otherwise the engine's own choice
+            extra["settings"] = SolverSettings(timestep=args.timestep)
+        if args.accuracy != "stop":
+            extra["accuracy"] = args.accuracy
+        return simulate_mujoco(params, args.clutch, implementation, args.t_end, dt_out=args.dt_out,
+                               mjcf=args.mjcf, **extra)
+    if args.max_switches is not None:
+        extra["max_switches"] = args.max_switches
     return analytic.simulate(params, args.geometry or "approx", args.clutch, args.t_end, dt_out=args.dt_out,
                              **extra)
 
@@ -104,6 +127,8 @@ def format_summary(run: RunResult) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_options(args)
+    model_params(args)  # bad parameters are reported before the output folder is looked at
     if args.out is not None:
         check_output_dir(args.out)
     result = run_simulation(args)

@@ -9,7 +9,9 @@ from pathlib import Path
 from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.results import write_json
 
-from .common import EXIT_OK, add_model_options, model_params
+from ..studies.sweep_metrics import METRICS
+from ..studies.sweep_space import ENGINES
+from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
 
 def add_parser(commands) -> None:
@@ -20,41 +22,66 @@ def add_parser(commands) -> None:
     swp.add_argument("--vary", action="append", default=[], metavar="NAME=SPEC",
                      help="NAME=START:STOP:N[:log] (grid), NAME=A,B,C (list) or NAME=LO:HI[:log] (with --sample)")
     swp.add_argument("--sample", type=int, default=None, metavar="N", help="N space-filling (Sobol) designs")
-    swp.add_argument("--seed", type=int, default=None, help="seed of the Sobol sample (default 0)")
+    swp.add_argument("--seed", type=int, default=None, help="seed of the Sobol sample, >= 0 (default 0)")
     swp.add_argument("--engines", default=None, metavar="LIST",
                      help="comma-separated, first one is the reference for divergence; from: analytic-approx, "
                           "analytic-exact, analytic-unilateral, mujoco-lock, mujoco-ratchet "
                           "(default: mujoco-ratchet,analytic-unilateral)")
-    swp.add_argument("--t-end", type=float, default=None, metavar="SECONDS", help="simulated time per design (default 1 s)")
+    swp.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+                     help="simulated time per design (default 1 s); with --until-steady, the cap")
+    swp.add_argument("--until-steady", action="store_true", default=None,
+                     help="run every design to its periodic steady state (--t-end caps it); rows then carry the "
+                          "steady speed, time to steady state and energy per metre (use with --drive motor)")
+    swp.add_argument("--timeout-per-design", type=float, default=None, metavar="SECONDS",
+                     help="wall-time budget per design (analytic engines and MuJoCo run one by one); a design past "
+                          "it is recorded as failed with the reason, never a hang")
     swp.add_argument("--study", metavar="FILE.toml", help="study file ([sweep] and [params] tables); options win over it")
     add_model_options(swp)
     swp.add_argument("--out", metavar="DIR", default="sweep", help="results folder (default ./sweep)")
     swp.add_argument("--resume", action="store_true", help="complete an interrupted sweep in DIR")
     swp.add_argument("--workers", type=int, default=None, help="processes/threads to use (default: all cores)")
     swp.add_argument("--no-batch", action="store_true", help="run MuJoCo designs one by one, not through mujoco.batch")
+    swp.add_argument("--batch-size", type=int, default=None, metavar="N",
+                     help="MuJoCo designs stepped together per chunk (default 64); rows reach results.csv as chunks "
+                          "finish")
+    swp.add_argument("--plot-metric", default=None, metavar="METRIC",
+                     help="metric the heatmap colours (default: steady_speed_m_s with --until-steady, else "
+                          "mean_speed_mps); any of: " + ", ".join(METRICS))
     swp.add_argument("--scheduler", metavar="ADDRESS",
                      help="run on a Dask distributed scheduler (needs the 'dask' extra), e.g. tcp://host:8786")
     swp.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..studies.sweep import SweepInterrupted, run_sweep
-    from ..report.sweep_plots import best_designs, plot_sweep, read_results
+def study_from_args(args: argparse.Namespace):
+    """The Study the options describe: defaults, the study file, then the command line (which wins)."""
     from ..studies.sweep_space import Study, parse_vary, read_study
 
     base = model_params(args)
     options = read_study(args.study, base) if args.study else {"base": base}
     if args.vary:
         options["axes"] = tuple(parse_vary(v) for v in args.vary)
-    if args.engines:
-        options["engines"] = tuple(e.strip() for e in args.engines.split(",") if e.strip())
-    for key in ("sample", "seed", "t_end"):  # options given on the command line win over the study file
+    if args.engines is not None:
+        names = tuple(e.strip() for e in args.engines.split(",") if e.strip())
+        if not names:
+            raise ParameterError(f"--engines {args.engines!r} names no engine; allowed: a comma-separated list "
+                                 f"from: {', '.join(ENGINES)}")
+        options["engines"] = names
+    for key in ("sample", "seed", "t_end", "until_steady"):  # options given on the command line win over the file
         if getattr(args, key) is not None:
             options[key] = getattr(args, key)
     options.setdefault("axes", ())
-    study = Study(**options)
-    if args.workers is not None and args.workers < 1:
-        raise ParameterError(f"--workers {args.workers} is out of range; allowed: >= 1")
+    return Study(**options)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..report.sweep_plots import best_designs, check_plot_metric, plot_sweep, rankings, read_results
+    from ..studies.sweep import SweepInterrupted, check_sweep_options, run_sweep
+
+    if args.study is not None:
+        check_input_file("--study", args.study)
+    study = study_from_args(args)
+    metric = check_plot_metric(args.plot_metric, study.until_steady)
+    check_sweep_options(args.out, args.resume, args.workers, args.timeout_per_design, args.batch_size)
     client = None
     if args.scheduler:
         try:
@@ -67,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(f"--scheduler {args.scheduler!r} cannot be reached: {exc}") from None
     try:
         results = run_sweep(study, args.out, executor=client.get_executor() if client else None,
-                            batch_mujoco=not args.no_batch, resume=args.resume, workers=args.workers)
+                            batch_mujoco=not args.no_batch, resume=args.resume, workers=args.workers,
+                            timeout_per_design=args.timeout_per_design, batch_size=args.batch_size)
     except SweepInterrupted as exc:
         print(f"ipir-mujoco sweep: {exc}", file=sys.stderr)
         return 130
@@ -75,12 +103,13 @@ def run(args: argparse.Namespace) -> int:
         if client is not None:
             client.close()
     axes = [a.name for a in study.axes]
-    figures = plot_sweep(results, axes, list(study.engines), args.out)
-    best = best_designs(read_results(results), axes, list(study.engines))
-    write_json(Path(args.out) / "best.json", {"best": best})
     columns = read_results(results)
+    figures = plot_sweep(results, study, args.out, metric=metric)
+    best = best_designs(columns, axes, list(study.engines))
+    write_json(Path(args.out) / "best.json", {"best": best, "ranking": rankings(columns, axes, list(study.engines))})
     failed = sum(bool(e) for e in columns["error"])
-    print(f"{len(columns['design_id'])} designs, {failed} failed; results in {results}")
+    stalled = sum(any(columns[f"{e}:stalled"][k] == 1 for e in study.engines) for k in range(len(columns["design_id"])))
+    print(f"{len(columns['design_id'])} designs, {failed} failed, {stalled} stalled; results in {results}")
     for item in best:
         where = ", ".join(f"{a}={item[a]:.4g}" for a in axes)
         print(f"  best {item['metric']:24s} {item['engine']:20s} {item['value']:.4g} at {where}")

@@ -18,6 +18,7 @@ import numpy as np
 
 from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.params import check_run_options as shared_run_options
 
 from .model import check_params
 
@@ -59,19 +60,15 @@ def captured_warnings() -> Iterator[list[str]]:
         mujoco.set_mju_user_warning(previous)
 
 
-def check_run_options(params: RobotParams, t_end: float, dt_out: float) -> None:
-    """The checks every MuJoCo entry point shares (ParameterError, one line)."""
+def check_run_options(params: RobotParams, t_end: float, dt_out: float) -> tuple[float, float]:
+    """The checks every MuJoCo entry point shares (ParameterError, one line); (t_end, dt_out) as floats."""
     defaults = RobotParams()
     for name in UNMODELLED:
         if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
             raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the MuJoCo engine yet; "
                                  f"allowed: {getattr(defaults, name)!r}")
     check_params(params)
-    for name, value in (("t_end", t_end), ("dt_out", dt_out)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ParameterError(f"{name}={value!r} is out of range; allowed: a finite number > 0")
-    if dt_out > t_end:
-        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: dt_out <= t_end ({t_end} s)")
+    return shared_run_options(t_end, dt_out)  # the one check of run options every engine and interface shares
 
 
 def climb_energy(model: mujoco.MjModel, params: RobotParams) -> float:

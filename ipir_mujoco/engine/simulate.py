@@ -84,7 +84,7 @@ def simulate_mujoco(
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
     """
     params = require_params(params)
-    check_run_options(params, t_end, dt_out)
+    t_end, dt_out = check_run_options(params, t_end, dt_out)
     if implementation not in IMPLEMENTATIONS:
         raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
     if clutch not in ("kinematic", "unilateral"):

@@ -1,47 +1,71 @@
 """Pictures of a sweep: lines for one varied parameter, heatmaps for two, best designs.
 
-The heatmap shows the first engine's mean forward speed over the two varied
-parameters, with the contours where the second engine diverges from it by 1 %
-and 5 % (in crank revolutions) drawn over it: where the simpler model can be
-trusted, and where not.
+The heatmap colours one metric of the first engine over the first two varied
+parameters (the steady speed for a sweep run to steady state, else the mean
+forward speed; ``--plot-metric`` chooses another) and draws over it the
+contours where the second engine diverges from the first by 1 % and 5 % in
+that metric (in revolutions for a metric without a divergence column): where
+the simpler model can be trusted, and where not. A second panel maps that
+divergence itself. Axes carry their units; an axis swept log-spaced (``:log``)
+is drawn on a log scale.
 """
 
 from __future__ import annotations
 
 import csv
+import textwrap
 from pathlib import Path
 
 import numpy as np
 
-from .plots import new_figure
-from ..studies.sweep_metrics import METRICS
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import parameter_units
 
-# metrics where larger is better; the rest (forces, jumps) are better small
-LARGER_IS_BETTER = ("mean_speed_mps", "distance_per_rev_m", "efficiency")
-UNITS = {"revolutions": "rev", "mean_speed_mps": "m/s", "distance_per_rev_m": "m", "efficiency": "-",
-         "peak_clutch_reaction_n": "N", "peak_rod_force_n": "N", "accel_jump_mps2": "m/s^2", "stalled": "0/1"}
+from ..studies.sweep_files import DIVERGENCE
+from ..studies.sweep_metrics import METRICS, UNITS
+from .plots import new_figure
+
+# metrics where larger is better; the rest (energy per metre, forces, jumps, time to settle) are better small
+LARGER_IS_BETTER = ("mean_speed_mps", "steady_speed_m_s", "distance_per_rev_m", "efficiency")
+NOT_RANKED = ("revolutions", "steady", "stalled", "residual_ratio", "loop_gap_m")
+RANKING = (("steady_speed_m_s", "highest first"), ("energy_per_metre_j_m", "lowest first"))
+RANKED = 10  # designs listed per ranking
+
+
+def check_plot_metric(metric: str | None, until_steady: bool) -> str:
+    """The heatmap's metric: ``metric`` if it is one, else the default for the kind of sweep."""
+    if metric is None:
+        return "steady_speed_m_s" if until_steady else "mean_speed_mps"
+    if metric not in METRICS:
+        raise ParameterError(f"--plot-metric {metric!r} is unknown; allowed: {', '.join(METRICS)}")
+    return metric
 
 
 def read_results(path: str | Path) -> dict[str, np.ndarray]:
-    """results.csv as columns (numbers as float, empty cells as NaN; 'error' as str)."""
-    with Path(path).open(newline="") as fh:
+    """results.csv as columns (numbers as float, empty cells as NaN; 'notes' and 'error' as str)."""
+    with Path(path).open(newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
     columns = {}
     for name in (rows[0].keys() if rows else []):
-        if name == "error":
+        if name in ("error", "notes"):
             columns[name] = np.array([r[name] for r in rows], dtype=object)
         else:
             columns[name] = np.array([float(r[name]) if r[name] != "" else np.nan for r in rows])
     return columns
 
 
+def _usable(columns: dict[str, np.ndarray], engine: str) -> np.ndarray:
+    """Designs where ``engine`` gave a result and the robot did not stall."""
+    return np.isfinite(columns[f"{engine}:revolutions"]) & (columns[f"{engine}:stalled"] != 1)
+
+
 def best_designs(columns: dict[str, np.ndarray], axes: list[str], engines: list[str]) -> list[dict]:
-    """The best design per engine and metric (ignoring failed and stalled designs)."""
+    """The best design per engine and metric (ignoring designs an engine failed on or stalled in)."""
     best = []
     for engine in engines:
-        ok = np.array([not e for e in columns["error"]]) & (columns[f"{engine}:stalled"] == 0)
+        ok = _usable(columns, engine)
         for metric in METRICS:
-            if metric in ("stalled", "revolutions"):
+            if metric in NOT_RANKED:
                 continue
             values = np.where(ok, columns[f"{engine}:{metric}"], np.nan)
             if np.all(np.isnan(values)):
@@ -52,65 +76,122 @@ def best_designs(columns: dict[str, np.ndarray], axes: list[str], engines: list[
     return best
 
 
-def plot_sweep(results: str | Path, axes: list[str], engines: list[str], out: str | Path) -> list[Path]:
+def rankings(columns: dict[str, np.ndarray], axes: list[str], engines: list[str]) -> dict:
+    """Per engine, the RANKED best designs by steady speed (highest first) and energy per metre (lowest)."""
+    out: dict = {}
+    for engine in engines:
+        ok = _usable(columns, engine)
+        for metric, order in RANKING:
+            values = np.where(ok, columns[f"{engine}:{metric}"], np.nan)
+            finite = np.flatnonzero(np.isfinite(values))
+            ranked = finite[np.argsort(-values[finite] if metric in LARGER_IS_BETTER else values[finite],
+                                       kind="stable")][:RANKED]
+            out.setdefault(engine, {})[metric] = {
+                "order": order, "units": UNITS[metric],
+                "designs": [{"design_id": int(columns["design_id"][i]), "value": float(values[i]),
+                             **{a: float(columns[a][i]) for a in axes}} for i in ranked]}
+    return out
+
+
+def _label(name: str) -> str:
+    return f"{name} [{parameter_units(name)}]"
+
+
+def plot_sweep(results: str | Path, study, out: str | Path, metric: str = "mean_speed_mps") -> list[Path]:
     """Write the sweep's figures into ``out``; return their paths."""
     columns = read_results(results)
+    axes, engines = list(study.axes), list(study.engines)
     out = Path(out)
-    written = []
+    if not len(columns.get("design_id", [])):
+        return []
     if len(axes) == 1:
-        x = columns[axes[0]]
-        order = np.argsort(x)
-        shown = ("mean_speed_mps", "efficiency", "distance_per_rev_m", "peak_clutch_reaction_n", "peak_rod_force_n",
-                 "accel_jump_mps2")
-        fig, panels = new_figure(len(shown), height=2.2)
-        for ax, metric in zip(panels, shown):
-            for engine in engines:
-                ax.plot(x[order], columns[f"{engine}:{metric}"][order], "o-", ms=3, label=engine)
-            ax.set(ylabel=f"{metric} [{UNITS[metric]}]")
-            ax.grid(alpha=0.3)
-        panels[0].legend(fontsize="small")
-        panels[-1].set_xlabel(axes[0])
-        path = out / "sweep_lines.png"
-        fig.savefig(path, dpi=110)
-        written.append(path)
-    elif len(axes) >= 2:
-        x, y = columns[axes[0]], columns[axes[1]]
-        speed = columns[f"{engines[0]}:mean_speed_mps"]
-        fig, (ax,) = new_figure(1, height=5.0)
-        grid = _as_grid(x, y, speed)
-        if grid is not None:
-            xs, ys, zs = grid
-            mesh = ax.pcolormesh(xs, ys, zs, shading="nearest", cmap="viridis")
+        return [_lines(columns, axes[0], engines, out)]
+    return [_heatmap(columns, axes[0], axes[1], engines, metric, out)]
+
+
+def _lines(columns, axis, engines, out: Path) -> Path:
+    x = columns[axis.name]
+    order = np.argsort(x)
+    shown = ("mean_speed_mps", "steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "distance_per_rev_m",
+             "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2")
+    shown = [m for m in shown if any(np.isfinite(columns[f"{e}:{m}"]).any() for e in engines)]
+    fig, panels = new_figure(len(shown), height=2.0)
+    for ax, metric in zip(panels, shown):
+        for engine in engines:
+            ax.plot(x[order], columns[f"{engine}:{metric}"][order], "o-", ms=3, label=engine)
+        ax.set(ylabel=f"{metric}\n[{UNITS[metric]}]")
+        ax.grid(alpha=0.3)
+        if axis.log:
+            ax.set_xscale("log")
+    panels[0].legend(fontsize="small")
+    panels[-1].set_xlabel(_label(axis.name))
+    path = out / "sweep_lines.png"
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
+    x, y = columns[ax_x.name], columns[ax_y.name]
+    values = columns[f"{engines[0]}:{metric}"]
+    panels_count = 2 if len(engines) > 1 else 1
+    fig, panels = new_figure(panels_count, height=4.2)
+    ax = panels[0]
+    _colour_map(fig, ax, x, y, values, f"{engines[0]}: {metric} [{UNITS[metric]}]")
+    if len(engines) > 1:
+        compared = metric if metric in DIVERGENCE else "revolutions"
+        divergence = np.abs(columns[f"divergence:{engines[1]}:{compared}"]) * 100
+        finite = divergence[np.isfinite(divergence)]
+        low, high = (finite.min(), finite.max()) if finite.size else (np.nan, np.nan)
+        levels = [level for level in (1, 5) if low < level < high]
+        if levels:
+            grid = _as_grid(x, y, divergence)
+            draw = ax.contour if grid is not None else ax.tricontour
+            contours = draw(*(grid if grid is not None else (x, y, divergence)), levels=levels,
+                            colors=["white", "red"][:len(levels)], linewidths=1.5)
+            ax.clabel(contours, fmt=lambda v: f"{v:g} %", fontsize="small")
+            title = (f"{metric} of {engines[0]}; contours: {engines[1]} differs by "
+                     f"{' / '.join(f'{v} %' for v in levels)} in {compared}")
+        elif finite.size:
+            title = (f"{metric} of {engines[0]}; {engines[1]} differs by {low:.2g} to {high:.2g} % in {compared} "
+                     "everywhere (no 1 % / 5 % contour inside the map)")
         else:
-            mesh = ax.tricontourf(x, y, speed, levels=20, cmap="viridis")
-        fig.colorbar(mesh, ax=ax, label=f"{engines[0]} mean forward speed [m/s]")
-        if len(engines) > 1:
-            divergence = np.abs(columns[f"divergence:{engines[1]}:revolutions"]) * 100
-            finite = divergence[np.isfinite(divergence)]
-            low, high = (finite.min(), finite.max()) if finite.size else (np.nan, np.nan)
-            levels = [level for level in (1, 5) if low < level < high]
-            if levels:
-                drawn = _as_grid(x, y, divergence)
-                draw = ax.contour if drawn is not None else ax.tricontour
-                contours = draw(*(drawn if drawn is not None else (x, y, divergence)), levels=levels,
-                                colors=["white", "red"][:len(levels)], linewidths=1.5)
-                ax.clabel(contours, fmt=lambda v: f"{v:g} %", fontsize="small")
-                title = (f"contours: {engines[1]} differs from {engines[0]} by "
-                         f"{' / '.join(f'{v} %' for v in levels)} in revolutions")
-            else:
-                title = (f"{engines[1]} differs from {engines[0]} by {low:.2g} to {high:.2g} % in revolutions "
-                         "everywhere: no 1 % / 5 % contour inside the map")
-        else:
-            title = "mean forward speed"
-        failed = np.array([bool(e) for e in columns["error"]])
-        if failed.any():
-            ax.plot(x[failed], y[failed], "kx", ms=5, label="failed design")
-            ax.legend(fontsize="small", loc="upper right")
-        ax.set(xlabel=axes[0], ylabel=axes[1], title=title)
-        path = out / "sweep_heatmap.png"
-        fig.savefig(path, dpi=110)
-        written.append(path)
-    return written
+            title = f"{metric} of {engines[0]}; no design where both engines give {compared}"
+        _colour_map(fig, panels[1], x, y, divergence, f"|{engines[1]} - {engines[0]}| / |{engines[0]}| "
+                                                         f"in {compared} [%]")
+        panels[1].set_title(f"divergence of {engines[1]} from {engines[0]} in {compared}", fontsize="medium")
+    else:
+        title = f"{metric} of {engines[0]}"
+    failed = np.array([bool(e) for e in columns["error"]])
+    stalled = np.zeros(len(x), dtype=bool)
+    for engine in engines:
+        stalled |= columns[f"{engine}:stalled"] == 1
+    for mask, marker, label in ((failed, "kx", "failed design"), (stalled & ~failed, "w+", "stalled design")):
+        if mask.any():
+            ax.plot(x[mask], y[mask], marker, ms=5, label=label)
+    if (failed | stalled).any():
+        ax.legend(fontsize="small", loc="upper right")
+    ax.set_title("\n".join(textwrap.wrap(title, 80)), fontsize="medium")
+    for panel in panels:
+        panel.set(xlabel=_label(ax_x.name), ylabel=_label(ax_y.name))
+        if ax_x.log:
+            panel.set_xscale("log")
+        if ax_y.log:
+            panel.set_yscale("log")
+    path = out / "sweep_heatmap.png"
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def _colour_map(fig, ax, x, y, z, label: str) -> None:
+    grid = _as_grid(x, y, z)
+    if grid is not None:
+        mesh = ax.pcolormesh(*grid, shading="nearest", cmap="viridis")
+    elif np.isfinite(z).sum() >= 3:
+        keep = np.isfinite(z)
+        mesh = ax.tricontourf(x[keep], y[keep], z[keep], levels=20, cmap="viridis")
+    else:
+        mesh = ax.scatter(x, y, c=z, cmap="viridis")
+    fig.colorbar(mesh, ax=ax, label="\n".join(textwrap.wrap(label, 40)))
 
 
 def _as_grid(x, y, z):

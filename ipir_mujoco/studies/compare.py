@@ -27,31 +27,74 @@ from pathlib import Path
 import numpy as np
 
 from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import RunResult, mode_changes, read_csv
+from ipir_mujoco.analytic.params import RobotParams, read_text_file
+from ipir_mujoco.analytic.results import COLUMNS, RunResult, mode_changes
 
 QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 
 
 def load_run(folder: str | Path) -> RunResult:
-    """A run written by ``simulate --out`` (timeseries.csv and summary.json)."""
+    """A run written by ``simulate --out`` (timeseries.csv and summary.json).
+
+    Anything that is not such a run is a one-line ParameterError naming the folder and what is
+    wrong: a missing or unreadable file, a time series with fewer than two samples, a row torn or
+    ragged, a value that is not a finite number, a summary that is not the one simulate writes.
+    """
     folder = Path(folder)
+    if not folder.is_dir():
+        raise ParameterError(f"{str(folder)!r} is not a run folder (it does not exist or is a file); "
+                             "write one with 'ipir-mujoco simulate --out DIR'")
     csv, summary = folder / "timeseries.csv", folder / "summary.json"
     for path in (csv, summary):
         if not path.is_file():
             raise ParameterError(f"{str(folder)!r} is not a run folder: {path.name} is missing "
                                  "(write one with 'ipir-mujoco simulate --out DIR')")
+    series = read_series(csv)
     try:
-        record = json.loads(summary.read_text())
-        series = read_csv(csv)
+        record = json.loads(read_text_file(summary, "summary"))
         params = RobotParams(**record["params"])
         return RunResult(record["engine"], record["geometry"], record["clutch"], params, float(record["t_end"]),
                          series, record["summary"]["energy"], record.get("wall_time_s", 0.0),
                          record.get("settings", {}), stall=record["summary"].get("stall_reason"),
                          accuracy=record["summary"].get("accuracy"))
-    except (ValueError, KeyError, TypeError) as exc:
-        raise ParameterError(f"run folder {str(folder)!r} cannot be read: {exc}") from None
+    except ParameterError as exc:
+        raise ParameterError(f"run folder {str(folder)!r}: summary.json: {exc}") from None
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        what = f"lacks {exc}" if isinstance(exc, KeyError) else f"cannot be read: {exc}"
+        raise ParameterError(f"run folder {str(folder)!r}: summary.json {what}") from None
+
+
+def read_series(path: str | Path) -> dict[str, np.ndarray]:
+    """A timeseries.csv as columns (shape (n,), n >= 2, every value finite), or a one-line ParameterError."""
+    path = Path(path)
+    lines = read_text_file(path, "time series").splitlines()
+    where = f"time series {str(path)!r}"
+    if not lines or not lines[0].strip():
+        raise ParameterError(f"{where} is empty; allowed: the file 'ipir-mujoco simulate --out' writes")
+    names = [name.strip() for name in lines[0].split(",")]
+    missing = [c for c in COLUMNS if c not in names]
+    if missing:
+        raise ParameterError(f"{where} lacks the columns {' '.join(missing)} in its header row")
+    rows = [line for line in lines[1:] if line.strip()]
+    if len(rows) < 2:
+        raise ParameterError(f"{where} has {len(rows)} sample row(s); a run needs at least 2")
+    try:
+        table = np.loadtxt(rows, delimiter=",", ndmin=2)
+    except ValueError as exc:  # a torn or ragged row: numpy says which, in its first line
+        raise ParameterError(f"{where}: {str(exc).splitlines()[0]}") from None
+    if table.shape[1] != len(names):
+        raise ParameterError(f"{where}: rows have {table.shape[1]} values, the header {len(names)}")
+    bad = np.argwhere(~np.isfinite(table))
+    if bad.size:
+        row, column = bad[0]
+        raise ParameterError(f"{where} line {row + 2}: {names[column]}={table[row, column]} is not a finite "
+                             "number (simulate never writes one: the file was changed)")
+    series = {name: table[:, k] for k, name in enumerate(names)}
+    if np.any(np.diff(series["t"]) < 0) or not series["t"][-1] > series["t"][0]:
+        raise ParameterError(f"{where}: the times t do not increase from the first row to the last")
+    series["mode"] = series["mode"].astype(int)
+    return series
 
 
 def _unique_times(t: np.ndarray, values: np.ndarray):

@@ -1,250 +1,382 @@
 """Run a what-if study: every design through every engine, results streamed to disk.
 
 ``run_sweep`` writes ``OUT/sweep.json`` (the study and its fingerprint) and
-``OUT/results.csv``, one row per design, appended and flushed as each design
-finishes, so a crash or Ctrl-C leaves a readable file; ``resume=True`` skips
-the designs already in it (and refuses a file written by another study). A
-design or engine that fails records its error in the row and the sweep goes on.
+``OUT/results.csv`` (columns: :mod:`ipir_mujoco.studies.sweep_files`), one row
+per design, appended and flushed as each design finishes, so a crash or Ctrl-C
+keeps every finished design; ``resume=True`` skips the designs already in it
+(and refuses a folder that holds another study, or no sweep at all). A design
+or engine that fails records its error in the row and the sweep goes on; a
+design that stalls is a result (``stalled`` = 1, the reason in ``notes``).
+When every design is done the file is rewritten in design order, so two runs
+of one study give byte-identical files.
 
 Where work runs:
 
-* default: analytic engines in a process pool over all cores; MuJoCo's
-  ratchet in batches through ``mujoco.batch`` (C threads) in the main process;
+* default: analytic engines (and MuJoCo's lock) in a process pool; MuJoCo's
+  ratchet through ``mujoco.batch`` (C threads) in a process of its own, in
+  chunks of ``batch_size`` designs so rows stream as chunks finish. Both sides
+  run at once and share the cores: while both have work, the batch gets half
+  of them (rounded up) and the pool the rest; whichever finishes first hands
+  its cores to the other. Ctrl-C ends both pools' processes at once; the rows
+  written are every design finished by then.
 * ``executor=``: any ``concurrent.futures.Executor`` (a Dask ``Client``'s
-  ``get_executor()`` for a cluster); every engine of a design runs as one
-  task on it, MuJoCo serially.
+  ``get_executor()`` for a cluster); every engine of a design runs as one task
+  on it, MuJoCo serially.
 
-Row columns: ``design_id``, the varied parameters, then ``ENGINE:METRIC`` for
-every engine and metric (:mod:`ipir_mujoco.studies.sweep_metrics`), then
-``divergence:ENGINE:revolutions`` and ``divergence:ENGINE:mean_speed_mps``,
-(ENGINE - first engine) / |first engine|, then ``error``.
+Work budget: ``timeout_per_design`` [s] of wall time per design, passed to the
+analytic engines as ``wall_budget_s`` and enforced in the pool's workers by an
+alarm (a design past it is a recorded failure naming the budget); a worker that
+stays stuck past twice the budget is abandoned and killed at the end. Batched
+MuJoCo runs cost a fixed number of steps and are not timed. Pool workers die
+with the main process (Linux: PR_SET_PDEATHSIG; elsewhere a watcher thread).
 """
 
 from __future__ import annotations
 
 import concurrent.futures as futures
-import csv
 import json
-import math
 import os
+import queue
 import signal
 import sys
+import threading
 import time
+from collections import deque
 from pathlib import Path
 from typing import Callable
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.analytic.params import RobotParams, check_real, check_whole
 
-from .sweep_metrics import METRICS, design_metrics
+from ..output import check_output_dir
+from .sweep_files import Progress, ResultsFile, header_for, make_row
+from .sweep_metrics import batch_metrics, run_metrics
 from .sweep_space import Study
 
-DT_OUT = 1e-3  # s: output interval of the sweep's runs; enough for the metrics, light on memory
-BATCH_SIZE = 64  # MuJoCo designs stepped together
-DIVERGENCE = ("revolutions", "mean_speed_mps")
+BATCH_SIZE = 64  # MuJoCo designs stepped together: ~2 s of work per chunk for 1 s runs on 2 cores
+BATCHED = "mujoco-ratchet"
 
 
 class SweepInterrupted(RuntimeError):
     """Ctrl-C (or SIGINT) stopped the sweep; the rows written so far are kept."""
 
 
-def _run_engine(engine: str, params: RobotParams, t_end: float):
-    if engine == "analytic-approx":
-        return analytic.simulate(params, "approx", "kinematic", t_end, dt_out=DT_OUT)
-    if engine == "analytic-exact":
-        return analytic.simulate(params, "exact", "kinematic", t_end, dt_out=DT_OUT)
-    if engine == "analytic-unilateral":
-        return analytic.simulate(params, "exact", "unilateral", t_end, dt_out=DT_OUT)
+class DesignTimeout(Exception):
+    """A design ran past the sweep's wall-time budget (raised by the worker's alarm)."""
+
+
+def _run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float, options: dict):
+    """One engine on one design; ``options``: until_steady, wall_budget_s (analytic engines only)."""
+    steady = {"until_steady": True} if options.get("until_steady") else {}
+    if engine.startswith("analytic-"):
+        budget = {"wall_budget_s": options["wall_budget_s"]} if options.get("wall_budget_s") else {}
+        geometry, clutch = {"analytic-approx": ("approx", "kinematic"), "analytic-exact": ("exact", "kinematic"),
+                            "analytic-unilateral": ("exact", "unilateral")}[engine]
+        return analytic.simulate(params, geometry, clutch, t_end, dt_out=dt_out, **steady, **budget)
     from ..engine import simulate_mujoco
 
     if engine == "mujoco-lock":
-        return simulate_mujoco(params, "kinematic", "lock", t_end, dt_out=DT_OUT)
-    return simulate_mujoco(params, "unilateral", "ratchet", t_end, dt_out=DT_OUT)
+        return simulate_mujoco(params, "kinematic", "lock", t_end, dt_out=dt_out, **steady)
+    return simulate_mujoco(params, "unilateral", "ratchet", t_end, dt_out=dt_out, **steady)
 
 
-def engine_metrics(engine: str, params: RobotParams, t_end: float) -> dict:
-    """Metrics of one engine on one design, or {"error": message}."""
+def engine_metrics(engine: str, params: RobotParams, t_end: float, dt_out: float, options: dict) -> dict:
+    """Metrics of one engine on one design, or {"error": message}; a stall adds {"note": reason}."""
     try:
-        run = _run_engine(engine, params, t_end)
-    except (ValueError, RuntimeError) as exc:
+        run = _run_engine(engine, params, t_end, dt_out, options)
+    except (ParameterError, SimulationError) as exc:
         return {"error": f"{engine}: {exc}"}
-    s = run.series
-    useful = params.F_r1 * s["x1"][-1] + params.F_r2 * s["x2"][-1]
-    return design_metrics(s, run.summary["energy"]["motor_work_j"], useful)
+    except DesignTimeout:
+        raise
+    except Exception as exc:  # noqa: BLE001 (one design's surprise must not end the sweep)
+        return {"error": f"{engine}: internal error: {type(exc).__name__}: {exc}"}
+    metrics = run_metrics(run)
+    if run.stall:
+        metrics["note"] = f"stalled: {run.stall}"
+    return metrics
 
 
-def _batch_metrics(outcome: dict) -> dict:
-    if "error" in outcome:
-        return {"error": f"mujoco-ratchet: {outcome['error']}"}
-    return design_metrics(outcome["series"], outcome["motor_work_j"], outcome["friction_work_j"])
+def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end: float, dt_out: float = 1e-3,
+               options: dict | None = None, alarm: bool = False) -> dict[str, dict]:
+    """Every engine of ``engines`` on the design ``base`` with ``values``: {engine: metrics}.
 
-
-def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end: float) -> dict[str, dict]:
-    """Every engine of ``engines`` on the design ``base`` with ``values``: {engine: metrics}."""
+    ``alarm``: enforce ``options['wall_budget_s']`` with SIGALRM (pool workers only: the main
+    thread of a process of our own).
+    """
+    options = options or {}
     try:
         params = base.replace(**values)
     except ValueError as exc:
         return {engine: {"error": f"invalid design: {exc}"} for engine in engines}
-    return {engine: engine_metrics(engine, params, t_end) for engine in engines}
+    budget = options.get("wall_budget_s")
+    results: dict[str, dict] = {}
+    armed = bool(alarm and budget and hasattr(signal, "setitimer")
+                 and threading.current_thread() is threading.main_thread())
+    if armed:
+        signal.signal(signal.SIGALRM, _raise_timeout)
+        signal.setitimer(signal.ITIMER_REAL, budget)
+    try:
+        for engine in engines:
+            results[engine] = engine_metrics(engine, params, t_end, dt_out, options)
+    except DesignTimeout:
+        for engine in engines:
+            if engine not in results:
+                results[engine] = {"error": f"{engine}: exceeded --timeout-per-design {budget:g} s of wall time"}
+    finally:
+        if armed:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+    return results
 
 
-def _ignore_sigint() -> None:  # pool workers leave Ctrl-C to the main process
+def _raise_timeout(signum, frame):
+    raise DesignTimeout()
+
+
+def _worker_init(parent: int) -> None:
+    """Pool workers: Ctrl-C is the main process's business; die with the main process."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            PR_SET_PDEATHSIG = 1
+            if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0:
+                if os.getppid() != parent:  # the parent died before the request took effect
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):
+            pass
+
+    def watch() -> None:  # elsewhere: notice the parent's death within a second
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="parent-watch").start()
 
 
-class _ResultsFile:
-    """results.csv: header once, one flushed row per finished design."""
-
-    def __init__(self, path: Path, header: list[str], resume: bool):
-        self.path, self.header = path, header
-        self.done: set[int] = set()
-        if path.exists():
-            if not resume:
-                raise ParameterError(f"{str(path)!r} exists; use --resume to complete it, or another --out")
-            with path.open(newline="") as fh:
-                lines = fh.read().splitlines(keepends=True)
-            complete = [ln for ln in lines if ln.endswith("\n")]  # a row cut by a crash is dropped
-            rows = list(csv.reader(complete))
-            if not rows or rows[0] != header:
-                raise ParameterError(f"{str(path)!r} was written for other engines or parameters; "
-                                     "resume needs the same study")
-            self.done = {int(r[0]) for r in rows[1:] if r}
-            path.write_text("".join(complete))
-        else:
-            with path.open("w", newline="") as fh:
-                csv.writer(fh).writerow(header)
-        self.handle = path.open("a", newline="")
-        self.writer = csv.writer(self.handle)
-
-    def write(self, row: dict) -> None:
-        self.writer.writerow([_cell(row.get(column)) for column in self.header])
-        self.handle.flush()
-        os.fsync(self.handle.fileno())
-
-    def close(self) -> None:
-        self.handle.close()
+def _kill_workers(pool: futures.ProcessPoolExecutor) -> None:
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if terminate is not None:
+        terminate()
+        return
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.kill()
 
 
-def _cell(value) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return ""
-    return f"{value:.10g}" if isinstance(value, float) else str(value)
+class _Cores:
+    """How the cores are shared between the batch thread and the pool while both have work."""
+
+    def __init__(self, total: int, batch: bool, pool: bool):
+        self.total = max(1, total)
+        self.batch_active, self.pool_active = batch, pool
+
+    def batch_threads(self) -> int:
+        if not self.pool_active:
+            return self.total
+        return max(1, (self.total + 1) // 2)
+
+    def pool_slots(self) -> int:
+        if not self.batch_active:
+            return self.total
+        return max(1, self.total - self.batch_threads())
 
 
-def _row(design_id: int, values: dict, results: dict[str, dict], engines: tuple[str, ...]) -> dict:
-    row = {"design_id": design_id, **values}
-    errors = [r["error"] for r in results.values() if "error" in r]
-    for engine in engines:
-        for metric in METRICS:
-            row[f"{engine}:{metric}"] = results[engine].get(metric)
-    reference = results[engines[0]]
-    for engine in engines[1:]:
-        for metric in DIVERGENCE:
-            a, b = reference.get(metric), results[engine].get(metric)
-            row[f"divergence:{engine}:{metric}"] = (b - a) / abs(a) if a and b is not None else None
-    row["error"] = " | ".join(errors)
-    return row
+def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out: float, nthread: int,
+                    until_steady: bool = False) -> list[dict]:
+    """The batched engine on one chunk of designs: [{BATCHED: metrics or {"error": ...}}] in their order.
+
+    Runs in a process of its own (the batch pool), so that Ctrl-C can end it at once and its per-step
+    Python work does not compete with the main process.
+    """
+    from ..engine import batch
+
+    params: list[RobotParams | None] = []
+    refused: dict[int, str] = {}
+    # the batch sets the actuator to the constant M: a design it does not model must not pass silently
+    # (batch.py declares MODELLED_DRIVES once it models more than the constant torque)
+    modelled = getattr(batch, "MODELLED_DRIVES", ("torque",))
+    for k, design in enumerate(values):
+        try:
+            params.append(base.replace(**design))
+        except ValueError:
+            params.append(None)
+            continue
+        if params[-1].drive not in modelled:
+            refused[k] = (f"{BATCHED}: drive={params[-1].drive!r} is not modelled by the batched engine; "
+                          f"allowed: {', '.join(modelled)} (or run MuJoCo one by one: --no-batch)")
+            params[-1] = None
+    valid = [p for p in params if p is not None]
+    steady = {"until_steady": True} if until_steady else {}
+    try:
+        outcomes = iter(batch.run_ratchet_batch(valid, t_end, dt_out, nthread=nthread, **steady) if valid else [])
+    except Exception as exc:  # noqa: BLE001 (recorded per design; the analytic side goes on)
+        outcomes = iter([{"error": f"batch failed: {type(exc).__name__}: {exc}"}] * len(valid))
+    results = []
+    for k, p in enumerate(params):
+        if p is None:
+            results.append({BATCHED: {"error": refused.get(k, "invalid design")}})
+            continue
+        outcome = next(outcomes)
+        results.append({BATCHED: {"error": f"{BATCHED}: {outcome['error']}"} if "error" in outcome
+                        else _batch_design_metrics(outcome)})
+    return results
 
 
-def header_for(study: Study) -> list[str]:
-    columns = ["design_id", *(a.name for a in study.axes)]
-    columns += [f"{engine}:{metric}" for engine in study.engines for metric in METRICS]
-    columns += [f"divergence:{engine}:{metric}" for engine in study.engines[1:] for metric in DIVERGENCE]
-    return columns + ["error"]
+def _batch_design_metrics(outcome: dict) -> dict:
+    metrics = batch_metrics(outcome)
+    if outcome.get("stall"):
+        metrics["note"] = f"stalled: {outcome['stall']}"
+    return metrics
 
 
-class Progress:
-    """Designs done, rate and time left, on stderr (a line per tenth when not a terminal)."""
-
-    def __init__(self, total: int, already: int, enabled: bool = True):
-        self.total, self.done, self.start, self.enabled = total, already, time.perf_counter(), enabled
-        self.first = already
-        self.tty = sys.stderr.isatty()
-        self.next_line = already + max(1, total // 10)
-
-    def advance(self, count: int = 1) -> None:
-        self.done += count
-        if not self.enabled:
-            return
-        elapsed = time.perf_counter() - self.start
-        rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else float("inf")
-        text = f"sweep {self.done}/{self.total} designs, {rate:.2f} designs/s, {left:.0f} s left"
-        if self.tty:
-            print("\r" + text, end="\n" if self.done >= self.total else "", file=sys.stderr, flush=True)
-        elif self.done >= self.next_line or self.done >= self.total:
-            print(text, file=sys.stderr, flush=True)
-            self.next_line = self.done + max(1, self.total // 10)
+def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_design, batch_size) -> Path:
+    """The options of a sweep beside the study, checked before anything is created."""
+    if workers is not None:
+        check_whole("workers", workers, low=1, high=1024)
+    if timeout_per_design is not None:
+        check_real("timeout_per_design", timeout_per_design, high=1e6, unit="s")
+    if batch_size is not None:
+        check_whole("batch_size", batch_size, low=1, high=100_000)
+    out = check_output_dir(out)
+    meta = out / "sweep.json"
+    if resume and out.is_dir() and any(out.iterdir()) and not meta.is_file():
+        raise ParameterError(f"--resume --out {str(out)!r}: the folder holds no sweep (no sweep.json); give the "
+                             "folder of the sweep to complete")
+    return out
 
 
 def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | None = None,
               batch_mujoco: bool = True, resume: bool = False, workers: int | None = None,
-              progress: bool = True, on_row: Callable[[dict], None] | None = None) -> Path:
+              progress: bool = True, on_row: Callable[[dict], None] | None = None,
+              timeout_per_design: float | None = None, batch_size: int | None = None) -> Path:
     """Run ``study``, writing OUT/results.csv; return its path (see the module docstring)."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ParameterError(f"--out {str(out)!r} exists and is not a folder")
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_sweep_options(out, resume, workers, timeout_per_design, batch_size)
     meta = out / "sweep.json"
     record = {"fingerprint": study.fingerprint(), "study": study.to_json()}
-    if resume and meta.exists() and json.loads(meta.read_text()).get("fingerprint") != record["fingerprint"]:
-        raise ParameterError(f"{str(out)!r} holds another study (its sweep.json differs); resume needs the same one")
+    if resume and meta.is_file():
+        try:
+            previous = json.loads(meta.read_text(encoding="utf-8")).get("fingerprint")
+        except (ValueError, UnicodeDecodeError, AttributeError):
+            previous = None
+        if previous != record["fingerprint"]:
+            raise ParameterError(f"{str(out)!r} holds another study (its sweep.json differs); resume needs the same one")
     designs = study.designs()
-    results_file = _ResultsFile(out / "results.csv", header_for(study), resume)
-    meta.write_text(json.dumps(record, indent=2) + "\n")
+    out.mkdir(parents=True, exist_ok=True)
+    results_file = ResultsFile(out / "results.csv", header_for(study), resume)
+    meta.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
     todo = [i for i in range(len(designs)) if i not in results_file.done]
     bar = Progress(len(designs), len(designs) - len(todo), progress)
     engines = study.engines
-    batched = ("mujoco-ratchet",) if batch_mujoco and executor is None and "mujoco-ratchet" in engines else ()
+    batched = (BATCHED,) if batch_mujoco and executor is None and BATCHED in engines else ()
     pooled = tuple(e for e in engines if e not in batched)
+    options = {"until_steady": study.until_steady, "wall_budget_s": timeout_per_design}
     partial: dict[int, dict[str, dict]] = {i: {} for i in todo}
+    cores = _Cores(workers or os.cpu_count() or 1, bool(batched and todo), bool(pooled and todo))
+    events: queue.Queue = queue.Queue()  # (kind, None, future) as futures finish: "pool" or "batch"
 
     def finish(i: int, results: dict[str, dict]) -> None:
+        if i not in partial:  # a late answer for a design already written (abandoned, then done)
+            return
         partial[i].update(results)
         if len(partial[i]) == len(engines):
-            row = _row(i, designs[i], partial.pop(i), engines)
+            row = make_row(i, designs[i], partial.pop(i), engines)
             results_file.write(row)
             if on_row is not None:
                 on_row(row)
             bar.advance()
 
-    own_pool = executor is None and bool(pooled)
-    pool = futures.ProcessPoolExecutor(max_workers=workers or os.cpu_count(), initializer=_ignore_sigint) \
-        if own_pool else executor
-    pending: dict[futures.Future, int] = {}
+    own_pool = executor is None and bool(pooled) and bool(todo)
+    pool = (futures.ProcessPoolExecutor(max_workers=cores.total, initializer=_worker_init, initargs=(os.getpid(),))
+            if own_pool else executor)
+    chunks = deque([todo[k:k + (batch_size or BATCH_SIZE)] for k in range(0, len(todo), batch_size or BATCH_SIZE)]
+                   if batched else [])
+    batch_pool = (futures.ProcessPoolExecutor(max_workers=1, initializer=_worker_init, initargs=(os.getpid(),))
+                  if chunks else None)
+    waiting = deque(todo if pooled else [])
+    running: dict[futures.Future, list] = {}  # pool future -> [design, first seen running (monotonic s) or None]
+    batch_running: dict[futures.Future, list[int]] = {}  # batch future -> its chunk
+    abandoned = False
     try:
-        if pooled:
-            for i in todo:
-                pending[pool.submit(run_design, designs[i], study.base, pooled, study.t_end)] = i
-        if batched:
-            from ..engine.batch import run_ratchet_batch
+        def submit_more() -> None:
+            if chunks and not batch_running:  # one chunk at a time, on the cores the pool leaves
+                chunk = chunks.popleft()
+                future = batch_pool.submit(run_batch_chunk, [designs[i] for i in chunk], study.base, study.t_end,
+                                           study.dt_out, cores.batch_threads(), study.until_steady)
+                batch_running[future] = chunk
+                future.add_done_callback(lambda f: events.put(("batch", None, f)))
+            # no task queued ahead: an idle worker would take it and overrun the cores the batch holds
+            slots = cores.pool_slots() if own_pool else len(waiting)
+            while waiting and len(running) < slots:
+                i = waiting.popleft()
+                try:
+                    future = pool.submit(run_design, designs[i], study.base, pooled, study.t_end, study.dt_out,
+                                         options, own_pool)
+                except futures.BrokenExecutor as exc:  # a worker was killed (out of memory?): no more pool work
+                    for j in (i, *waiting):
+                        finish(j, {e: {"error": f"{e}: the process pool broke: {exc}"} for e in pooled})
+                    waiting.clear()
+                    return
+                running[future] = [i, None]
+                future.add_done_callback(lambda f: events.put(("pool", None, f)))
 
-            for start in range(0, len(todo), BATCH_SIZE):
-                chunk = todo[start:start + BATCH_SIZE]
-                params = []
-                for i in chunk:
-                    try:
-                        params.append(study.base.replace(**designs[i]))
-                    except ValueError:
-                        params.append(None)
-                valid = [p for p in params if p is not None]
-                outcome = iter(run_ratchet_batch(valid, study.t_end, DT_OUT, nthread=workers or 0) if valid else [])
-                for i, p in zip(chunk, params):
-                    metrics = _batch_metrics(next(outcome)) if p is not None else {"error": "invalid design"}
-                    finish(i, {"mujoco-ratchet": metrics})
-                done_now, _ = futures.wait(list(pending), timeout=0)
-                for future in done_now:
-                    finish(pending.pop(future), future.result())
-        for future in futures.as_completed(list(pending)):
-            finish(pending.pop(future), future.result())
+        submit_more()
+        while partial:
+            try:
+                kind, _, future = events.get(timeout=0.25)
+            except queue.Empty:
+                kind = None
+            if kind == "batch" and future in batch_running:
+                chunk = batch_running.pop(future)
+                try:
+                    outcomes = future.result()
+                except Exception as exc:  # noqa: BLE001 (the batch's process died: recorded, the sweep goes on)
+                    outcomes = [{BATCHED: {"error": f"{BATCHED}: the batch process failed: {type(exc).__name__}: "
+                                                    f"{exc}"}}] * len(chunk)
+                for i, result in zip(chunk, outcomes):
+                    finish(i, result)
+            elif kind == "pool" and future in running:
+                i, _ = running.pop(future)
+                try:
+                    finish(i, future.result())
+                except Exception as exc:  # noqa: BLE001 (a worker that died: recorded, the sweep goes on)
+                    finish(i, {e: {"error": f"{e}: the worker failed: {type(exc).__name__}: {exc}"} for e in pooled})
+            abandoned |= _abandon_stuck(running, timeout_per_design, pooled, finish)
+            cores.batch_active = bool(chunks or batch_running)
+            cores.pool_active = bool(waiting or running)
+            submit_more()
     except KeyboardInterrupt:
-        for future in pending:
-            future.cancel()
         raise SweepInterrupted(f"interrupted after {bar.done} of {len(designs)} designs; the rows so far are in "
                                f"{out / 'results.csv'}; run again with --resume to complete it") from None
     finally:
-        if own_pool:
-            pool.shutdown(wait=True, cancel_futures=True)
+        interrupted = bool(partial)
+        for own, kill in ((pool if own_pool else None, interrupted or abandoned), (batch_pool, interrupted)):
+            if own is not None:
+                if kill:  # workers ignore Ctrl-C and may be deep in a long design: end them now
+                    _kill_workers(own)
+                own.shutdown(wait=not kill, cancel_futures=True)
+        if executor is not None:
+            for future in running:
+                future.cancel()
         results_file.close()
+    results_file.sort()
     return out / "results.csv"
+
+
+def _abandon_stuck(running: dict, budget: float | None, pooled, finish) -> bool:
+    """Record as failed the designs whose worker stayed busy past twice the budget (+5 s); True if any."""
+    if not budget:
+        return False
+    now, gave_up = time.monotonic(), False
+    for future, slot in list(running.items()):
+        if slot[1] is None:
+            if future.running():
+                slot[1] = now
+        elif now - slot[1] > 2 * budget + 5.0:
+            del running[future]
+            finish(slot[0], {e: {"error": f"{e}: exceeded --timeout-per-design {budget:g} s of wall time "
+                                          "(the worker did not stop; killed)"} for e in pooled})
+            gave_up = True
+    return gave_up

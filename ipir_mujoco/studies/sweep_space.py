@@ -30,22 +30,27 @@ a sample of the box). A TOML study file says the same::
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import json
 import math
-import tomllib
+import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import qmc
 
 from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import PARAMETER_NAMES, RobotParams
+from ipir_mujoco.analytic.params import (MAX_T_END, PARAMETER_NAMES, RobotParams, as_real, check_real,
+                                         check_run_options, check_whole, read_toml_file, require_params)
 
 ENGINES = ("analytic-approx", "analytic-exact", "analytic-unilateral", "mujoco-lock", "mujoco-ratchet")
 DEFAULT_ENGINES = ("mujoco-ratchet", "analytic-unilateral")
+# designs per sweep: about 3.5 h at the 8 designs/s measured for 1 s runs of the default engines on
+# 2 cores (runs to a steady state cost more), and the grid stays small in memory; split a larger study
+MAX_DESIGNS = 100_000
+DT_OUT = 1e-3  # s: output interval of the sweep's runs; enough for the metrics, light on memory
 
 
 @dataclass(frozen=True)
@@ -71,10 +76,17 @@ def parse_vary(text: str) -> Axis:
         raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N, NAME=A,B,C or NAME=LO:HI")
     if name not in PARAMETER_NAMES:
         raise ParameterError(f"--vary {text!r}: unknown parameter {name!r}; known parameters: {' '.join(PARAMETER_NAMES)}")
-    try:
-        if "," in spec:
+    if "," in spec:
+        try:
             values = tuple(float(v) for v in spec.split(","))
-            return Axis(name, values)
+        except ValueError:
+            raise ParameterError(f"--vary {text!r}: {spec!r} is not a list of numbers") from None
+        if not all(math.isfinite(v) for v in values):
+            raise ParameterError(f"--vary {text!r}: every value must be a finite number")
+        if len(values) > MAX_DESIGNS:
+            raise ParameterError(f"--vary {text!r} lists {len(values)} values; allowed: at most {MAX_DESIGNS}")
+        return Axis(name, values)
+    try:
         parts = spec.split(":")
         log = parts[-1].strip() == "log"
         if log:
@@ -94,14 +106,23 @@ def parse_vary(text: str) -> Axis:
         count = numbers[2]
         if count != int(count) or count < 1:
             raise ParameterError(f"--vary {text!r}: N={count:g} must be a whole number >= 1")
+        if count > MAX_DESIGNS:
+            raise ParameterError(f"--vary {text!r}: N={count:g} points would need {count * 8:.3g} bytes for the "
+                                 f"axis alone; allowed: N <= {MAX_DESIGNS} (designs per sweep)")
         spaced = np.geomspace if log else np.linspace
-        return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))))
+        return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))), log=log)
     raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N[:log], NAME=A,B,C or NAME=LO:HI[:log]")
 
 
 @dataclass(frozen=True)
 class Study:
-    """What a sweep runs: base parameters, axes, sampling, engines, simulated time [s]."""
+    """What a sweep runs: base parameters, axes, sampling, engines, simulated time [s].
+
+    ``until_steady``: every engine stops at the periodic steady state (``t_end`` is the cap).
+    Every field is checked here, the one place the command line, study files and the Python API
+    meet: numbers of any numeric type, strings where lists are wanted refused by name, the count
+    of designs bounded (:data:`MAX_DESIGNS`).
+    """
 
     axes: tuple[Axis, ...]
     base: RobotParams = field(default_factory=RobotParams)
@@ -109,30 +130,65 @@ class Study:
     t_end: float = 1.0
     sample: int | None = None
     seed: int = 0
+    until_steady: bool = False
 
     def __post_init__(self) -> None:
+        set_ = functools.partial(object.__setattr__, self)
+        if isinstance(self.axes, (str, Axis)) or not all(isinstance(a, Axis) for a in self.axes):
+            raise ParameterError(f"axes={self.axes!r} is not a list of axes; build them with parse_vary('NAME=SPEC')")
+        set_("axes", tuple(self.axes))
         if not self.axes:
             raise ParameterError("a sweep needs at least one --vary")
         names = [a.name for a in self.axes]
         if len(set(names)) != len(names):
             raise ParameterError(f"--vary names a parameter twice: {names}")
+        set_("base", require_params(self.base))
+        if isinstance(self.engines, str):
+            raise ParameterError(f"engines={self.engines!r} is a single string; allowed: a list of engine names, "
+                                 f"e.g. [{self.engines!r}], from: {', '.join(ENGINES)}")
+        set_("engines", tuple(self.engines))
+        if not self.engines:
+            raise ParameterError(f"engines=[] names no engine; allowed: one or more of {', '.join(ENGINES)}")
         unknown = [e for e in self.engines if e not in ENGINES]
-        if unknown or not self.engines:
-            raise ParameterError(f"engine {unknown[0] if unknown else None!r} is unknown; allowed: {', '.join(ENGINES)}")
-        if not (math.isfinite(self.t_end) and self.t_end > 0):
-            raise ParameterError(f"t_end={self.t_end} is out of range; allowed: a finite number > 0")
+        if unknown:
+            raise ParameterError(f"engine {unknown[0]!r} is unknown; allowed: {', '.join(ENGINES)}")
+        if len(set(self.engines)) != len(self.engines):
+            raise ParameterError(f"engines={list(self.engines)} names an engine twice")
+        set_("t_end", check_run_options(self.t_end, self.dt_out)[0])
+        if self.sample is not None:
+            set_("sample", check_whole("sample", self.sample, low=1, high=MAX_DESIGNS, why=" designs"))
+        set_("seed", check_whole("seed", self.seed, low=0))
+        if not isinstance(self.until_steady, bool):
+            raise ParameterError(f"until_steady={self.until_steady!r} is not true or false")
         ranges = [a for a in self.axes if a.is_range]
         if self.sample is None and ranges:
             raise ParameterError(f"--vary {ranges[0].name}=LO:HI is a range: give --sample N, or N points (LO:HI:N)")
-        if self.sample is not None and (self.sample < 1 or any(not a.is_range for a in self.axes)):
-            raise ParameterError("--sample N needs N >= 1 and every --vary given as a range LO:HI")
+        if self.sample is not None and any(not a.is_range for a in self.axes):
+            raise ParameterError("--sample N needs every --vary given as a range LO:HI")
+        if self.sample is None:
+            count = math.prod(len(a.values) for a in self.axes)
+            if count > MAX_DESIGNS:
+                raise ParameterError(f"the grid of {' x '.join(str(len(a.values)) for a in self.axes)} = {count:.3g} "
+                                     f"designs is too large; allowed: at most {MAX_DESIGNS} designs per sweep")
+
+    @property
+    def dt_out(self) -> float:
+        """Output interval of the sweep's runs [s]: enough for the metrics, light on memory."""
+        t_end = as_real(self.t_end)
+        return DT_OUT if t_end is None or not t_end > 0 else min(DT_OUT, t_end)
 
     def designs(self) -> list[dict[str, float]]:
         """Every design as {varied name: value}, in a fixed order (its index is the design id)."""
         names = [a.name for a in self.axes]
         if self.sample is None:
             return [dict(zip(names, combo)) for combo in itertools.product(*(a.values for a in self.axes))]
-        unit = qmc.Sobol(d=len(self.axes), scramble=True, seed=self.seed).random(self.sample)
+        from scipy.stats import qmc  # loaded when a sample is drawn: scipy.stats is slow to import
+
+        with warnings.catch_warnings():
+            # scipy warns unless N is a power of 2 (the sequence's balance is exact only then); the first
+            # N points of the scrambled sequence are still space-filling, and N is the user's choice
+            warnings.filterwarnings("ignore", message=".*balance properties of Sobol", category=UserWarning)
+            unit = qmc.Sobol(d=len(self.axes), scramble=True, seed=self.seed).random(self.sample)
         designs = []
         for point in unit:
             design = {}
@@ -146,7 +202,8 @@ class Study:
 
     def to_json(self) -> dict:
         return {"axes": [asdict(a) for a in self.axes], "base": self.base.as_dict(), "engines": list(self.engines),
-                "t_end": self.t_end, "sample": self.sample, "seed": self.seed}
+                "t_end": self.t_end, "sample": self.sample, "seed": self.seed,
+                **({"until_steady": True} if self.until_steady else {})}
 
     def fingerprint(self) -> str:
         """A hash that changes whenever the set of designs or what is run on them changes."""
@@ -154,33 +211,50 @@ class Study:
 
 
 def read_study(path: str | Path, base: RobotParams) -> dict:
-    """The [sweep] table of a TOML study file as Study keyword arguments; [params] updates ``base``."""
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise ParameterError(f"study file {str(path)!r} does not exist") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"study file {str(path)!r} is not valid TOML: {exc}") from None
+    """The [sweep] table of a TOML study file as Study keyword arguments; [params] updates ``base``.
+
+    Every value is checked here, with the file named in the one-line message: lists where lists
+    are wanted (a string is refused by name), numbers where numbers are wanted.
+    """
+    where = f"study file {str(path)!r}"
+    data = read_toml_file(path, "study file")
     unknown = set(data) - {"sweep", "params"}
     if unknown:
-        raise ParameterError(f"study file {str(path)!r}: unknown table {sorted(unknown)[0]!r}; allowed: sweep, params")
-    sweep = dict(data.get("sweep", {}))
-    allowed = {"vary", "engines", "t_end", "sample", "seed"}
+        raise ParameterError(f"{where}: unknown table {sorted(unknown)[0]!r}; allowed: sweep, params")
+    sweep, params = data.get("sweep", {}), data.get("params", {})
+    for table, value in (("sweep", sweep), ("params", params)):
+        if not isinstance(value, dict):
+            raise ParameterError(f"{where}: {table} = {value!r} must be a table [{table}]")
+    allowed = {"vary", "engines", "t_end", "sample", "seed", "until_steady"}
     if set(sweep) - allowed:
-        raise ParameterError(f"study file {str(path)!r}: unknown key {sorted(set(sweep) - allowed)[0]!r} in [sweep]; "
+        raise ParameterError(f"{where}: unknown key {sorted(set(sweep) - allowed)[0]!r} in [sweep]; "
                              f"allowed: {', '.join(sorted(allowed))}")
     kwargs: dict = {}
-    if "vary" in sweep:
-        kwargs["axes"] = tuple(parse_vary(v) for v in sweep["vary"])
-    if "engines" in sweep:
-        kwargs["engines"] = tuple(sweep["engines"])
-    for key in ("t_end", "sample", "seed"):
-        if key in sweep:
-            kwargs[key] = sweep[key]
-    params = data.get("params", {})
     try:
+        for key, example in (("vary", '"L=0.1,0.2"'), ("engines", '"analytic-approx"')):
+            if key not in sweep:
+                continue
+            items = sweep[key]
+            if not isinstance(items, list):
+                raise ParameterError(f"{key}={items!r} is not a list; allowed: a list of strings, e.g. "
+                                     f"{key} = [{example}]")
+            for k, item in enumerate(items):
+                if not isinstance(item, str):
+                    raise ParameterError(f"{key}[{k}]={item!r} is not a string; allowed: a list of strings, e.g. "
+                                         f"{key} = [{example}]")
+            kwargs["axes" if key == "vary" else key] = (tuple(parse_vary(v) for v in items) if key == "vary"
+                                                        else tuple(items))
+        if "t_end" in sweep:
+            kwargs["t_end"] = check_real("t_end", sweep["t_end"], high=MAX_T_END, unit="s")
+        if "sample" in sweep:
+            kwargs["sample"] = check_whole("sample", sweep["sample"], low=1, high=MAX_DESIGNS, why=" designs")
+        if "seed" in sweep:
+            kwargs["seed"] = check_whole("seed", sweep["seed"], low=0)
+        if "until_steady" in sweep:
+            if not isinstance(sweep["until_steady"], bool):
+                raise ParameterError(f"until_steady={sweep['until_steady']!r} is not true or false")
+            kwargs["until_steady"] = sweep["until_steady"]
         kwargs["base"] = base.replace(**params)
-    except TypeError as exc:
-        raise ParameterError(f"study file {str(path)!r}: [params] {exc}") from None
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: {exc}") from None
     return kwargs

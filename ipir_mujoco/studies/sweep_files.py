@@ -1,0 +1,121 @@
+"""A sweep's files and rows: results.csv streamed row by row, its header, progress on stderr.
+
+Row columns: ``design_id``, the varied parameters, then ``ENGINE:METRIC`` for every engine and
+metric (:mod:`ipir_mujoco.studies.sweep_metrics`), then ``divergence:ENGINE:METRIC``,
+(ENGINE - first engine) / |first engine| for the metrics in :data:`DIVERGENCE`, then ``notes``
+(stall reasons: a stalled design is a result) and ``error`` (why an engine gave no result).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+from ipir_mujoco.analytic.errors import ParameterError
+
+from .sweep_metrics import METRICS
+from .sweep_space import Study
+
+DIVERGENCE = ("revolutions", "mean_speed_mps", "steady_speed_m_s", "energy_per_metre_j_m", "accel_jump_mps2")
+
+
+def header_for(study: Study) -> list[str]:
+    columns = ["design_id", *(a.name for a in study.axes)]
+    columns += [f"{engine}:{metric}" for engine in study.engines for metric in METRICS]
+    columns += [f"divergence:{engine}:{metric}" for engine in study.engines[1:] for metric in DIVERGENCE]
+    return columns + ["notes", "error"]
+
+
+def make_row(design_id: int, values: dict, results: dict[str, dict], engines: tuple[str, ...]) -> dict:
+    """One row of results.csv from {engine: metrics or {"error": ...}} (metrics may carry a "note")."""
+    row = {"design_id": design_id, **values}
+    for engine in engines:
+        for metric in METRICS:
+            row[f"{engine}:{metric}"] = results[engine].get(metric)
+    reference = results[engines[0]]
+    for engine in engines[1:]:
+        for metric in DIVERGENCE:
+            a, b = reference.get(metric), results[engine].get(metric)
+            usable = a is not None and b is not None and math.isfinite(a) and math.isfinite(b) and a != 0
+            row[f"divergence:{engine}:{metric}"] = (b - a) / abs(a) if usable else None
+    row["notes"] = " | ".join(f"{e}: {results[e]['note']}" for e in engines if results[e].get("note"))
+    row["error"] = " | ".join(results[e]["error"] for e in engines if "error" in results[e])
+    return row
+
+
+def _cell(value) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    return f"{value:.10g}" if isinstance(value, float) else " ".join(str(value).split())
+
+
+class ResultsFile:
+    """results.csv: header once, one flushed row per finished design; sorted by design_id when complete."""
+
+    def __init__(self, path: Path, header: list[str], resume: bool):
+        self.path, self.header = path, header
+        self.done: set[int] = set()
+        if path.exists():
+            if not resume:
+                raise ParameterError(f"{str(path)!r} exists; use --resume to complete it, or another --out")
+            with path.open(newline="", encoding="utf-8") as fh:
+                lines = fh.read().splitlines(keepends=True)
+            complete = [ln for ln in lines if ln.endswith("\n")]  # a row cut by a crash is dropped
+            rows = list(csv.reader(complete))
+            if not rows or rows[0] != header:
+                raise ParameterError(f"{str(path)!r} was written for other engines, metrics or parameters; "
+                                     "resume needs the same study and version")
+            self.done = {int(r[0]) for r in rows[1:] if r}
+            path.write_text("".join(complete), encoding="utf-8")
+        else:
+            with path.open("w", newline="", encoding="utf-8") as fh:
+                csv.writer(fh).writerow(header)
+        self.handle = path.open("a", newline="", encoding="utf-8")
+        self.writer = csv.writer(self.handle)
+
+    def write(self, row: dict) -> None:
+        self.writer.writerow([_cell(row.get(column)) for column in self.header])
+        self.handle.flush()
+        os.fsync(self.handle.fileno())
+
+    def close(self) -> None:
+        self.handle.close()
+
+    def sort(self) -> None:
+        """Rewrite the file in design order (atomically): two runs of one study give the same bytes."""
+        with self.path.open(newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+        staged = self.path.with_name(f".{self.path.name}.sorting")
+        with staged.open("w", newline="", encoding="utf-8") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(rows[0])
+            writer.writerows(sorted(rows[1:], key=lambda r: int(r[0])))
+        staged.replace(self.path)
+
+
+class Progress:
+    """Designs done, rate and time left, on stderr (a line per tenth when not a terminal)."""
+
+    def __init__(self, total: int, already: int, enabled: bool = True):
+        self.total, self.done, self.start, self.enabled = total, already, time.perf_counter(), enabled
+        self.first = already
+        self.tty = sys.stderr.isatty()
+        self.next_line = already + max(1, total // 10)
+
+    def advance(self, count: int = 1) -> None:
+        self.done += count
+        if not self.enabled:
+            return
+        elapsed = time.perf_counter() - self.start
+        rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
+        left = (self.total - self.done) / rate if rate > 0 else float("inf")
+        text = f"sweep {self.done}/{self.total} designs, {rate:.2f} designs/s, {left:.0f} s left"
+        if self.tty:
+            print("\r" + text, end="\n" if self.done >= self.total else "", file=sys.stderr, flush=True)
+        elif self.done >= self.next_line or self.done >= self.total:
+            print(text, file=sys.stderr, flush=True)
+            self.next_line = self.done + max(1, self.total // 10)

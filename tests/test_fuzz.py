@@ -1,0 +1,286 @@
+"""Bad input from every side: the command line, study and config files, run folders, the Python API.
+
+Each case must end as exit 2 (the user's input) or 1 (the simulation) with ONE line on stderr
+that names the offending value, create nothing, and print no library warning. The table holds
+every case the hardening issue found (and their neighbours); hypothesis adds random text for the
+parsers. ``IPIR_FUZZ=long`` runs the property tests with many more examples (the CI profile is
+derandomized and short: see conftest.py).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from decimal import Decimal
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic import ParameterError, RobotParams
+from ipir_mujoco.analytic.params import MAX_SAMPLES, check_run_options
+from ipir_mujoco.cli import main
+from ipir_mujoco.studies.sweep_space import MAX_DESIGNS, Study, parse_vary
+
+LONG = os.environ.get("IPIR_FUZZ") == "long"
+EXAMPLES = 2000 if LONG else 60
+
+
+def run_cli(capsys, argv):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            code = main([str(a) for a in argv])
+        except SystemExit as exc:  # argparse's own errors
+            code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err, [str(w.message) for w in caught]
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """Bad files of every kind, and one good run folder to break (shared: no case may write into it)."""
+    f = tmp_path_factory.mktemp("fuzz")
+    (f / "latin1.toml").write_bytes(b"L = 0.3 # \xff\xfe\n")
+    (f / "latin1_study.toml").write_bytes(b'[sweep]\nvary = ["L=0.1,0.2"] # \xff\n')
+    for name, text in {"t_end_abc": '[sweep]\nvary=["L=0.1,0.2"]\nt_end="abc"\n',
+                       "sample_x": '[sweep]\nvary=["L=0.1:0.2"]\nsample="x"\n',
+                       "vary_numbers": "[sweep]\nvary=[1,2]\n",
+                       "vary_string": '[sweep]\nvary="L=0.1,0.2"\n',
+                       "engines_string": '[sweep]\nvary=["L=0.1,0.2"]\nengines="analytic-approx"\n',
+                       "sweep_not_table": 'sweep = 3\n',
+                       "params_bad": '[sweep]\nvary=["L=0.1,0.2"]\n[params]\nm1 = "heavy"\n'}.items():
+        (f / f"{name}.toml").write_text(text)
+    (f / "folder").mkdir()
+    (f / "afile").write_text("x")
+    run = f / "run"
+    assert main(["simulate", "--t-end", "0.05", "--dt-out", "1e-3", "--out", str(run)]) == 0
+    header = (run / "timeseries.csv").read_text().splitlines()[0]
+    for name, text in {"empty": "", "header_only": header + "\n", "torn": header + "\n0,0,0"}.items():
+        shutil.copytree(run, f / name)
+        (f / name / "timeseries.csv").write_text(text)
+    shutil.copytree(run, f / "nan")
+    lines = (f / "nan" / "timeseries.csv").read_text().splitlines()
+    cells = lines[5].split(",")
+    cells[4] = "nan"
+    lines[5] = ",".join(cells)
+    (f / "nan" / "timeseries.csv").write_text("\n".join(lines) + "\n")
+    (f / "k_empty.csv").write_text("")
+    (f / "k_semicolon.csv").write_text("t;phi\n0;0\n0.1;0.2\n0.2;0.5\n0.3;0.9\n")
+    (f / "k_ragged.csv").write_text("t,phi\n0,0\n0.1\n0.2,0.5\n0.3,0.9\n")
+    return f
+
+
+# (argv with {f} for the fixture folder, exit status, a fragment of the one line)
+CASES = [
+    (["simulate", "--set", "omega0=1e300"], 2, "omega0=1e+300 is out of range"),
+    (["simulate", "--geometry", "exact", "--set", "L=1e300"], 2, "L=1e+300 is out of range"),
+    (["simulate", "--set", "M=1e300"], 2, "M=1e+300 is out of range"),
+    (["simulate", "--config", "{f}/latin1.toml"], 2, "not UTF-8"),
+    (["simulate", "--config", "{f}/folder"], 2, "is a folder"),
+    (["simulate", "--t-end", "1e9"], 2, "t_end=1e+09 is out of range"),
+    (["simulate", "--t-end", "100", "--dt-out", "1e-12"], 2, "would keep 1e+14 samples"),
+    (["simulate", "--dt-out", "0"], 2, "dt_out=0.0 is out of range"),
+    (["simulate", "--engine", "mujoco", "--t-end", "0.1", "--dt-out", "0.2"], 2, "dt_out <= t_end"),
+    (["simulate", "--engine", "mujoco", "--mjcf", "{f}/folder"], 2, "is a folder"),
+    (["simulate", "--engine", "mujoco", "--max-switches", "10"], 2, "--max-switches 10 applies only"),
+    (["simulate", "--max-switches", "0"], 2, "--max-switches=0 is out of range"),
+    (["simulate", "--t-end", "0.1", "--out", "{f}/afile/sub"], 2, "is a file, not a folder"),
+    (["simulate", "--t-end", "0.1", "--out", "{f}/afile"], 2, "is not a folder"),
+    (["compare", "{f}/run", "{f}/empty"], 2, "is empty"),
+    (["compare", "{f}/run", "{f}/header_only"], 2, "0 sample row(s)"),
+    (["compare", "{f}/run", "{f}/torn"], 2, "1 sample row(s)"),
+    (["compare", "--json", "{f}/run", "{f}/nan"], 2, "x1=nan is not a finite number"),
+    (["compare", "{f}/run", "{f}/afile"], 2, "is not a run folder"),
+    (["compare", "{f}/run", "{f}/run", "--tolerance", "nan"], 2, "tolerance=nan"),
+    (["kinetostatics", "--samples", "{f}/k_empty.csv", "--out", "{f}/k"], 2, "is empty"),
+    (["kinetostatics", "--samples", "{f}/k_semicolon.csv", "--out", "{f}/k"], 2, "not ';'"),
+    (["kinetostatics", "--samples", "{f}/k_ragged.csv", "--out", "{f}/k"], 2, "line 3 has 1 values"),
+    (["kinetostatics", "--samples", "{f}/folder", "--out", "{f}/k"], 2, "is a folder"),
+    (["kinetostatics", "--omega", "1e12", "--out", "{f}/k"], 2, "omega=1e+12 rad/s is out of range"),
+    (["kinetostatics", "--omega", "nan", "--out", "{f}/k"], 2, "omega=nan"),
+    (["sweep", "--study", "{f}/latin1_study.toml", "--out", "{f}/s"], 2, "not UTF-8"),
+    (["sweep", "--study", "{f}/folder", "--out", "{f}/s"], 2, "is a folder"),
+    (["sweep", "--study", "{f}/t_end_abc.toml", "--out", "{f}/s"], 2, "t_end='abc' is not a number"),
+    (["sweep", "--study", "{f}/sample_x.toml", "--out", "{f}/s"], 2, "sample='x' is not a whole number"),
+    (["sweep", "--study", "{f}/vary_numbers.toml", "--out", "{f}/s"], 2, "vary[0]=1 is not a string"),
+    (["sweep", "--study", "{f}/vary_string.toml", "--out", "{f}/s"], 2, "vary='L=0.1,0.2' is not a list"),
+    (["sweep", "--study", "{f}/engines_string.toml", "--out", "{f}/s"], 2,
+     "engines='analytic-approx' is not a list"),
+    (["sweep", "--study", "{f}/sweep_not_table.toml", "--out", "{f}/s"], 2, "must be a table"),
+    (["sweep", "--study", "{f}/params_bad.toml", "--out", "{f}/s"], 2, "m1='heavy' is not a number"),
+    (["sweep", "--vary", "L=0.1,0.2", "--engines", ",", "--out", "{f}/s"], 2, "--engines ',' names no engine"),
+    (["sweep", "--vary", "L=0.08:0.3:1e12", "--out", "{f}/s"], 2, "allowed: N <= 100000"),
+    (["sweep", "--vary", "L=0.08:0.3:400", "--vary", "m2=0.1:1:400", "--out", "{f}/s"], 2, "400 x 400"),
+    (["sweep", "--vary", "L=0.1,nan", "--out", "{f}/s"], 2, "every value must be a finite number"),
+    (["sweep", "--vary", "L=0.1:0.2", "--sample", "2", "--seed", "-1", "--out", "{f}/s"], 2, "seed=-1"),
+    (["sweep", "--vary", "L=0.1:0.2", "--sample", "0", "--out", "{f}/s"], 2, "sample=0"),
+    (["sweep", "--vary", "L=0.1,0.2", "--t-end", "inf", "--out", "{f}/s"], 2, "t_end=inf"),
+    (["sweep", "--vary", "L=0.1,0.2", "--timeout-per-design", "-1", "--out", "{f}/s"], 2, "timeout_per_design"),
+    (["sweep", "--vary", "L=0.1,0.2", "--workers", "0", "--out", "{f}/s"], 2, "workers=0"),
+    (["sweep", "--vary", "L=0.1,0.2", "--plot-metric", "beauty", "--out", "{f}/s"], 2, "'beauty' is unknown"),
+    (["sweep", "--vary", "L=0.1,0.2", "--resume", "--out", "{f}/run"], 2, "holds no sweep"),
+    (["sweep", "--vary", "L=0.1,0.2", "--out", "{f}/afile/sub"], 2, "is a file, not a folder"),
+]
+
+
+@pytest.mark.parametrize("argv,code,fragment", CASES, ids=[" ".join(c[0])[:60] for c in CASES])
+def test_bad_input_is_one_line_with_the_right_exit_status_and_creates_nothing(capsys, files, argv, code, fragment):
+    before = sorted(p.name for p in files.iterdir())
+    got, _, err, caught = run_cli(capsys, [a.format(f=files) for a in argv])
+    assert got == code, err
+    assert err.count("\n") == 1 and fragment in err, err
+    assert caught == []  # no library warning on the way
+    assert sorted(p.name for p in files.iterdir()) == before  # no output folder left behind
+
+
+def test_an_unwritable_output_folder_is_refused_before_the_run(capsys, tmp_path):
+    if os.geteuid() == 0:  # root writes through permission bits; sysfs refuses new files even to root
+        if not Path("/sys/kernel").is_dir():
+            pytest.skip("no sysfs: no folder here that root cannot write")
+        target = Path("/sys/ipir-mujoco-test/out")
+    else:
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o555)
+        target = locked / "out"
+    code, out, err, _ = run_cli(capsys, ["simulate", "--t-end", "0.1", "--out", target])
+    assert code == 2 and err.count("\n") == 1 and "cannot write in" in err and out == ""
+
+
+def test_a_sample_of_any_size_draws_without_a_scipy_warning():
+    study = Study((parse_vary("L=0.06:0.5"), parse_vary("m2=0.2:3")), sample=5)  # not a power of 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(study.designs()) == 5
+
+
+def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(capsys, monkeypatch):
+    from ipir_mujoco.cli import simulate
+
+    def broken(args):
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setattr(simulate, "run_simulation", broken)
+    code, _, err, _ = run_cli(capsys, ["simulate"])
+    assert code == 1 and err.count("\n") == 1 and "internal error: ZeroDivisionError: a bug" in err
+    assert "--debug" in err
+    for argv in (["--debug", "simulate"], ["simulate", "--debug"]):
+        with pytest.raises(ZeroDivisionError):
+            main(argv)
+
+
+def test_ctrl_c_while_loading_prints_one_line_and_no_traceback(tmp_path):
+    """SIGINT at staggered moments of start-up (imports of numpy, scipy, matplotlib, MuJoCo):
+    whenever it lands, the command ends with status 130 (or, before Python's own handler is
+    installed, by the signal) and never prints a traceback."""
+    statuses = []
+    for delay in (0.05, 0.15, 0.3, 0.5):
+        process = subprocess.Popen([sys.executable, "-m", "ipir_mujoco", "simulate", "--t-end", "0.05"],
+                                   cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(delay)
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=60)
+        statuses.append(process.returncode)
+        assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+        assert process.returncode in (0, 130, -signal.SIGINT), err
+        assert process.returncode != 130 or err.strip().endswith("interrupted") and err.count("\n") == 1
+    assert 130 in statuses  # at least one landed while our code was loading or running
+
+
+def test_the_command_line_loads_no_numerics_before_it_can_catch_ctrl_c():
+    """The guard against a traceback on Ctrl-C is installed before the heavy imports start."""
+    code = ("import signal, sys; import ipir_mujoco.cli as c; "
+            "print(signal.getsignal(signal.SIGINT) is signal.default_int_handler, c._loading_guard)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == ["True", "True"]  # guarded while loading, Python's handler restored after
+
+
+# ---------------------------------------------------------------------------------------------
+# the Python API
+
+@pytest.mark.parametrize("value", [np.int64(2), np.float32(2.0), np.array(2.0), Fraction(2, 1), Decimal("2")])
+def test_numbers_of_every_numeric_type_are_numbers(value):
+    assert RobotParams(m1=value).m1 == 2.0 and type(RobotParams(m1=value).m1) is float
+    assert check_run_options(value, Fraction(1, 1000)) == (2.0, 0.001)
+
+
+@pytest.mark.parametrize("call,fragment", [
+    (lambda: RobotParams(mass=1), "unknown parameter 'mass'"),
+    (lambda: RobotParams(m1="1"), "m1='1' is not a number"),
+    (lambda: RobotParams(m1=True), "m1=True is not a number"),
+    (lambda: check_run_options(1e9, 1e-4), "t_end=1e+09 s"[:10]),
+    (lambda: check_run_options(100, 1e-6), "would keep 1e+08 samples"),
+    (lambda: check_run_options(1.0, float("nan")), "dt_out=nan"),
+    (lambda: analytic.simulate(RobotParams(), t_end=1e9), "t_end=1e+09"),
+    (lambda: analytic.simulate(RobotParams(), t_end=1.0, dt_out=1e-9), "samples"),
+    (lambda: Study((parse_vary("L=0.1,0.2"),), engines="analytic-approx"), "engines='analytic-approx' is a single"),
+    (lambda: Study("L=0.1,0.2"), "is not a list of axes"),
+    (lambda: Study((parse_vary("L=0.1,0.2"),), seed=-1), "seed=-1"),
+    (lambda: Study((parse_vary("L=0.1,0.2"),), t_end="abc"), "t_end='abc' is not a number"),
+    (lambda: Study((parse_vary("L=0.1,0.2"),), base=None), "params=None is not a RobotParams"),
+])
+def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment):
+    with pytest.raises(ParameterError) as info:
+        call()
+    assert fragment in str(info.value) and "\n" not in str(info.value)
+
+
+def test_mujoco_never_runs_past_t_end_by_a_sample_interval_it_was_not_given():
+    from ipir_mujoco.engine import simulate_mujoco
+
+    with pytest.raises(ParameterError, match="dt_out <= t_end"):
+        simulate_mujoco(RobotParams(), t_end=0.01, dt_out=0.1)
+
+
+# ---------------------------------------------------------------------------------------------
+# random text for the parsers: a ParameterError or a valid result, never anything else
+
+@settings(max_examples=EXAMPLES)
+@given(st.text(max_size=40))
+def test_vary_parser_accepts_or_refuses_cleanly(text):
+    try:
+        axis = parse_vary(text)
+    except ParameterError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert all(np.isfinite(axis.values)) and len(axis.values) <= MAX_DESIGNS
+
+
+@settings(max_examples=EXAMPLES)
+@given(st.one_of(st.floats(), st.integers(), st.text(max_size=5), st.none()),
+       st.one_of(st.floats(), st.integers(), st.text(max_size=5), st.none()))
+def test_run_options_accept_or_refuse_cleanly(t_end, dt_out):
+    try:
+        t, dt = check_run_options(t_end, dt_out)
+    except ParameterError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert 0 < dt <= t and t / dt + 1 <= MAX_SAMPLES
+
+
+@settings(max_examples=EXAMPLES)
+@given(st.dictionaries(st.sampled_from(["m1", "m2", "r", "L", "J_A", "M", "omega0", "phi0", "rod_mass"]),
+                       st.one_of(st.floats(), st.integers(min_value=-10**400, max_value=10**400),
+                                 st.text(max_size=4)), max_size=4))
+def test_parameter_sets_accept_or_refuse_cleanly(values):
+    try:
+        params = RobotParams(**values)
+    except ParameterError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert all(np.isfinite(v) for v in params.as_dict().values() if isinstance(v, float))
+
+
+def test_json_of_a_run_never_holds_nan(capsys):
+    code, out, _, _ = run_cli(capsys, ["simulate", "--json", "--t-end", "0.05"])
+    assert code == 0 and json.loads(out)["summary"]["revolutions"] > 0
