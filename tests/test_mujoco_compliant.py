@@ -54,7 +54,7 @@ def test_mujoco_applies_exactly_the_clutch_force_and_nothing_inside_the_play():
     model = build_model(params, settings)
     data = mujoco.MjData(model)
     set_closed_loop_state(model, data, params)
-    clutch = CompliantClutches(model, data, delta)
+    clutch = CompliantClutches(model, data, params)
     data.ctrl[model.actuator(MOTOR).id] = drive_control(params)
     mujoco.mj_forward(model, data)  # as the engine starts a run
     acts = [model.actuator(n).id for n in (REAR_CLUTCH, FRONT_CLUTCH)]

@@ -19,8 +19,9 @@ kinetic and potential energy, the loop gap and the backward excursion, so the
 same accuracy monitor as a serial run, the steady state and stalls. Constraint
 forces (clutch reactions, rod force) are not exposed per simulation and are
 left out. Compliant clutches (a finite ``clutch_stiffness``) are not batched:
-such a design is reported with a one-line error (run it serially). A design that fails the monitor (``accuracy='stop'``), becomes
-unstable (MuJoCo resets it: its clock falls behind) or non-finite is reported
+such a design is reported with a one-line error (run it serially). A design
+that fails the monitor (``accuracy='stop'``), becomes unstable (MuJoCo resets
+it: its clock falls behind) or non-finite is reported
 with the reason and stops stepping; so does a steady (with ``until_steady``)
 or stalled one.
 """

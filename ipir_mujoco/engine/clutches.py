@@ -228,7 +228,7 @@ def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotP
     """
     if implementation == "ratchet":
         if params.clutch_stiffness is not None:
-            return CompliantClutches(model, data, params.clutch_backlash)
+            return CompliantClutches(model, data, params)
         return Ratchet(model, data)
     if implementation == "lock":
         return Locks(model, data, rule, params.r, params.L)

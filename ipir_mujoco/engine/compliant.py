@@ -44,6 +44,8 @@ from __future__ import annotations
 
 import mujoco
 
+from ipir_mujoco.analytic.params import RobotParams
+
 from .model import FRONT_CLUTCH, FRONT_SLIDE, REAR_CLUTCH, REAR_SLIDE, dof_address, qpos_address
 
 SLIDES = (REAR_SLIDE, FRONT_SLIDE)
@@ -53,9 +55,11 @@ CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
 class CompliantClutches:
     """The controller of the compliant clutches: moves the anchors, switches the dampers, counts their work.
 
-    ``backlash`` [m]: the clutch's free play. The stiffness k [N/m] and damping
-    c [N s/m] are read from the compiled model's clutch actuators (what MuJoCo
-    applies), not from a parameter set. Called before every step
+    ``params``: the parameter set the model was built from; its
+    ``clutch_backlash`` [m] and ``clutch_damping`` c [N s/m] (the controller
+    switches the actuators' damping, so a model that has run holds 0 for a
+    clutch that was free) are used, and the stiffness k [N/m] is read from the
+    compiled model's clutch actuators and checked against it. Called before every step
     (:meth:`before_step`) and after it (:meth:`after_step`). ``overlap`` holds
     d_i = a_i - x_i [m] at the last step's start; ``damper_work`` [J] is the
     cumulative work the dampers dissipated; ``excursion`` is 0: a module's
@@ -65,7 +69,7 @@ class CompliantClutches:
     name = "compliant"
     excursion = 0.0
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, backlash: float):
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
         self.model, self.data = model, data
         self.act = [model.actuator(n).id for n in CLUTCHES]
         self.qpos_adr = [qpos_address(model, n) for n in SLIDES]
@@ -75,14 +79,14 @@ class CompliantClutches:
             if (model.actuator_trntype[u] != joint_trn or model.actuator_trnid[u, 0] != model.joint(slide).id
                     or model.actuator_gear[u, 0] != 1.0):
                 raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {slide!r} with gear 1")
-        k, c = float(model.actuator_gainprm[self.act[0], 0]), -float(model.actuator_biasprm[self.act[0], 2])
+        k, c = params.clutch_stiffness, params.clutch_damping
         for u in self.act:
-            if not (k > 0 and model.actuator_gainprm[u, 0] == k and model.actuator_biasprm[u, 1] == -k
-                    and model.actuator_biasprm[u, 2] == -c and model.actuator_forcelimited[u]
-                    and model.actuator_forcerange[u, 0] == 0.0):
-                raise ValueError("the clutch actuators need the same spring k > 0 and damper c, and force range "
-                                 "[0, ...]: build the model with a finite clutch_stiffness")
-        self.k, self.c, self.backlash, self.dt = k, c, float(backlash), float(model.opt.timestep)
+            if not (k is not None and model.actuator_gainprm[u, 0] == k and model.actuator_biasprm[u, 1] == -k
+                    and model.actuator_forcelimited[u] and model.actuator_forcerange[u, 0] == 0.0):
+                raise ValueError("the clutch actuators need the spring k = clutch_stiffness and the force range "
+                                 "[0, ...]: build the model from these parameters, with a finite clutch_stiffness")
+            model.actuator_biasprm[u, 2] = -c  # the damper as built (a model that has run may hold 0)
+        self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler and RK4 do not
         self.implicit = model.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT,
                                                  mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
