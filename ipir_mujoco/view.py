@@ -29,7 +29,7 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 
 from .cli.common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
-from .engine.clutches import Locks, Ratchet
+from .engine.clutches import clutch_controller
 from .engine.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
 from .engine.timestep import choose_settings
 from .video import FREE_RGBA, HELD_RGBA, HOUSINGS
@@ -56,8 +56,7 @@ class ViewedRobot:
     def reset(self) -> None:
         """Back to the start: the loop-consistent initial state, a fresh clutch controller."""
         set_closed_loop_state(self.model, self.data, self.params)
-        self.controller = (Ratchet(self.model, self.data) if self.implementation == "ratchet"
-                           else Locks(self.model, self.data, self.clutch, self.params.r, self.params.L))
+        self.controller = clutch_controller(self.model, self.data, self.params, self.implementation, self.clutch)
         self.data.ctrl[self.model.actuator(MOTOR).id] = drive_control(self.params)
         mujoco.mj_forward(self.model, self.data)
 

@@ -174,3 +174,23 @@ def test_the_motor_is_mujocos_own_actuator_with_the_dc_motor_line():
         d.qvel[m.joint(CRANK_HINGE).dofadr[0]] = omega
         mujoco.mj_forward(m, d)
         assert d.actuator_force[motor] == 0.3
+
+
+def test_the_clutch_actuators_carry_the_clutch_spring_and_damper_and_nothing_else():
+    """Compliant clutches: per slide a general actuator with force k ctrl - k x - c v, clamped to [0, ...]
+    (it never pulls), no mass, armature or damping of its own (the anchor it pulls from is its ctrl, so the
+    clutch adds no inertia to the robot); rigid clutches: all zero, no force at any state."""
+    from ipir_mujoco.engine.model import FRONT_CLUTCH, REAR_CLUTCH
+
+    params = RobotParams(clutch_stiffness=3e6, clutch_damping=40.0, clutch_backlash=1e-3)
+    for p, k, c in ((params, 3e6, 40.0), (RobotParams(), 0.0, 0.0)):
+        m = build_model(p)
+        assert m.nu == 3 and np.all(m.actuator_armature == 0) and np.all(m.actuator_damping == 0)
+        assert m.body_subtreemass[0] == build_model(RobotParams()).body_subtreemass[0]
+        for name, slide in ((REAR_CLUTCH, REAR_SLIDE), (FRONT_CLUTCH, FRONT_SLIDE)):
+            a = m.actuator(name).id
+            assert m.actuator_trnid[a, 0] == m.joint(slide).id and m.actuator_gear[a, 0] == 1.0
+            assert list(m.actuator_gainprm[a, :3]) == [k, 0, 0] and list(m.actuator_biasprm[a, :3]) == [0, -k, -c]
+            assert m.actuator_forcelimited[a] and m.actuator_forcerange[a, 0] == 0.0
+        # with compliant clutches the slides are not limited: the springs hold the modules, no limit row
+        assert not any(build_model(p, ratchet=True).jnt_limited) == (k > 0)

@@ -122,10 +122,8 @@ def test_until_steady_stops_at_the_end_of_the_steady_revolution():
     assert 0.9 < s["efficiency"] <= 1.0  # little kinetic energy is gained at cruise: most work goes to friction
 
 
-def test_the_engine_models_drive_and_incline_and_still_refuses_compliant_clutches():
-    for name, value in (("clutch_stiffness", 1e5), ("clutch_damping", 1.0), ("clutch_backlash", 1e-3)):
-        with pytest.raises(ParameterError, match=f"{name}=.* is not modelled by the MuJoCo engine yet"):
-            simulate_mujoco(RobotParams(**{name: value}), "unilateral", "ratchet", 0.01)
+def test_the_engine_models_drive_and_incline():
+    # (compliant clutches, and what stays refused with them: tests/test_mujoco_compliant.py)
     run = simulate_mujoco(RobotParams(drive="motor", incline=30.0), "unilateral", "ratchet", 0.3, dt_out=1e-3)
     # climbing 30 deg: the potential energy MuJoCo reports is g sin(30 deg) times the mass-weighted climb
     # of the modules and of the rod's centre (at L/2 along the rod from the crank pin)

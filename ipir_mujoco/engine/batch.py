@@ -18,8 +18,10 @@ frictionloss rows' work to 1e-9 of the motor work on the paper's case),
 kinetic and potential energy, the loop gap and the backward excursion, so the
 same accuracy monitor as a serial run, the steady state and stalls. Constraint
 forces (clutch reactions, rod force) are not exposed per simulation and are
-left out. A design that fails the monitor (``accuracy='stop'``), becomes
-unstable (MuJoCo resets it: its clock falls behind) or non-finite is reported
+left out. Compliant clutches (a finite ``clutch_stiffness``) are not batched:
+such a design is reported with a one-line error (run it serially). A design
+that fails the monitor (``accuracy='stop'``), becomes unstable (MuJoCo resets
+it: its clock falls behind) or non-finite is reported
 with the reason and stops stepping; so does a steady (with ``until_steady``)
 or stalled one.
 """
@@ -96,6 +98,10 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
     for i, params in enumerate(designs):
         try:
             check_run_options(params, t_end, dt_out)
+            if params.clutch_stiffness is not None:
+                raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m: batched runs have rigid "
+                                     "ratchets only; allowed: clutch_stiffness=rigid (run compliant clutches "
+                                     "serially, with simulate_mujoco)")
             chosen[i] = settings if settings is not None else choose_settings(params, t_end, dt_out)[0]
         except ValueError as exc:
             results[i] = {"error": str(exc)}

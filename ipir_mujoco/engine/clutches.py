@@ -9,6 +9,8 @@ These run every step, so they work on Python floats and touch only the few
 entries they need.
 
 Nothing here uses the analytic model: the lock rules read MuJoCo's state.
+:func:`clutch_controller` picks the controller for a run (the compliant
+clutches' is in :mod:`.compliant`).
 """
 
 from __future__ import annotations
@@ -17,6 +19,9 @@ import math
 
 import mujoco
 
+from ipir_mujoco.analytic.params import RobotParams
+
+from .compliant import CompliantClutches
 from .model import (CRANK_HINGE, FRONT_LOCK, FRONT_SLIDE, REAR_LOCK, REAR_SLIDE, ROD_HINGE, dof_address,
                     qpos_address)
 
@@ -211,3 +216,22 @@ class NoClutch:
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         return False, False, 0.0, 0.0
+
+
+def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, implementation: str,
+                      rule: str = "unilateral"):
+    """The clutch controller of a run, for a model built with ``ratchet=implementation == 'ratchet'``.
+
+    'ratchet': the joint-limit ratchet, or with a finite ``params.clutch_stiffness`` the compliant clutches
+    (:class:`.compliant.CompliantClutches`); 'lock': the locks with ``rule``; 'none': no clutches. Call it
+    after the initial state is set (the ratchet and the anchors start at the modules' positions).
+    """
+    if implementation == "ratchet":
+        if params.clutch_stiffness is not None:
+            return CompliantClutches(model, data, params)
+        return Ratchet(model, data)
+    if implementation == "lock":
+        return Locks(model, data, rule, params.r, params.L)
+    if implementation == "none":
+        return NoClutch(model, data)
+    raise ValueError(f"mujoco clutch {implementation!r} is unknown; allowed: ratchet, lock, none")

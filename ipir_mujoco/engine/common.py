@@ -22,7 +22,6 @@ from ipir_mujoco.analytic.params import check_run_options as shared_run_options
 
 from .model import check_params
 
-UNMODELLED = ("clutch_stiffness", "clutch_damping", "clutch_backlash")  # refused until the engine models them
 REST_SPEED = 1e-6  # m/s: modules and crank pin slower are at rest (a held module creeps at 1e-9..1e-8 m/s)
 REST_TIME = 0.1  # s: at rest this long under constant loads is a stall
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
@@ -62,11 +61,13 @@ def captured_warnings() -> Iterator[list[str]]:
 
 def check_run_options(params: RobotParams, t_end: float, dt_out: float) -> tuple[float, float]:
     """The checks every MuJoCo entry point shares (ParameterError, one line); (t_end, dt_out) as floats."""
-    defaults = RobotParams()
-    for name in UNMODELLED:
-        if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
-            raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the MuJoCo engine yet; "
-                                 f"allowed: {getattr(defaults, name)!r}")
+    if params.clutch_stiffness is None:
+        defaults = RobotParams()
+        for name in ("clutch_damping", "clutch_backlash"):
+            if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
+                raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid "
+                                     f"clutch has no spring for it to act with); allowed: {getattr(defaults, name)!r} "
+                                     "with clutch_stiffness=rigid")
     check_params(params)
     return shared_run_options(t_end, dt_out)  # the one check of run options every engine and interface shares
 

@@ -29,11 +29,15 @@ from ..resources import mjcf_dir
 REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "crank_hinge", "rod_hinge"
 REAR_LOCK, FRONT_LOCK, LOOP = "rear_lock", "front_lock", "rod_to_front"
 MOTOR, ROD_END = "crank_motor", "rod_end"
+REAR_CLUTCH, FRONT_CLUTCH = "rear_clutch", "front_clutch"  # the compliant clutches' spring-damper actuators
 # Share of m1 carried by the crank body; the rest is the module body. Both
 # translate with module 1, so the split changes nothing but must keep each > 0.
 CRANK_MASS_SHARE = 0.01
 # Slide range far beyond any run (1000 km): only the lower bound ever acts.
 RANGE_FAR = 1e6
+# A clutch actuator's force range is [0, this] N: it never pulls; the upper bound is MuJoCo's largest
+# state value (mjMAXVAL), far beyond any clutch force a run survives.
+CLUTCH_FORCE_MAX = 1e10
 
 INTEGRATORS = {"euler": mujoco.mjtIntegrator.mjINT_EULER, "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT, "rk4": mujoco.mjtIntegrator.mjINT_RK4}
@@ -118,14 +122,16 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
     """The template with ``params`` and ``settings`` written in (not compiled).
 
     ``ratchet`` makes both slides limited (the joint-limit ratchet clutch); the
-    engine raises their lower bounds as the modules advance.
+    engine raises their lower bounds as the modules advance. Only for rigid
+    clutches: a compliant ratchet (finite ``clutch_stiffness``) holds its
+    modules with its clutch actuators' springs, and its slides stay unlimited.
     """
     check_params(params)
     spec = load_spec(mjcf)
     hint = str(mjcf or default_mjcf())
-    for write in (_write_mechanism, _write_drive, _write_gravity):
+    for write in (_write_mechanism, _write_drive, _write_gravity, _write_clutches):
         write(spec, params, hint)
-    _write_solver(spec, settings, hint, ratchet)
+    _write_solver(spec, settings, hint, ratchet and params.clutch_stiffness is None)
     return spec
 
 
@@ -199,6 +205,37 @@ def _write_gravity(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
     """
     angle = math.radians(params.incline)
     spec.option.gravity = [-params.g * math.sin(angle), 0.0, -params.g * math.cos(angle)]
+
+
+def _write_clutches(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
+    """The compliant clutches: per module a spring k [N/m] and damper c [N s/m] from an anchor to the module.
+
+    Each is a general actuator on the module's slide, a position servo with the
+    anchor position [m] as its target ``ctrl``: force = k ctrl - k x - c v =
+    k (anchor - x) - c v (gainprm[0] = k, biasprm = [0, -k, -c]), clamped by
+    its force range to [0, 1e10] N, so it pushes and never pulls. Being an
+    actuator force, k is a physical stiffness in N/m whatever the configuration
+    (unlike a soft constraint's solref, which scales with the row's effective
+    mass). The engine's controller (:class:`.compliant.CompliantClutches`)
+    moves the anchor and switches the damper off inside the backlash. With
+    rigid clutches (``clutch_stiffness`` None) both stay at zero: no force.
+    """
+    k = params.clutch_stiffness
+    for name in (REAR_CLUTCH, FRONT_CLUTCH):
+        act = _element(spec.actuator, name, hint)
+        act.gear[0] = 1.0
+        act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.dyntype = mujoco.mjtDyn.mjDYN_NONE
+        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.forcerange = [0.0, CLUTCH_FORCE_MAX]
+        act.gainprm[:] = 0.0
+        act.biasprm[:] = 0.0
+        if k is not None:
+            act.gainprm[0] = k
+            act.biasprm[1] = -k
+            act.biasprm[2] = -params.clutch_damping
 
 
 def _write_solver(spec: mujoco.MjSpec, settings: SolverSettings, hint: str, ratchet: bool) -> None:

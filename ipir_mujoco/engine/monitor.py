@@ -6,13 +6,19 @@ figures show it while the run goes, each measured on the run's own state:
 
 ``residual_ratio``
     The energy audit's residual (motor work - work against the resistances -
-    kinetic and potential energy gained: what the soft constraints and the time
-    stepping created or lost) over the energy put through the robot so far:
+    kinetic and potential energy gained, and with compliant clutches - the
+    energy their springs hold - the work their dampers dissipated: what the
+    soft constraints (loop, rigid clutches, friction rows) and the time
+    stepping, the clutch springs' included, created or lost) over the energy
+    put through the robot so far:
     the largest of the motor work, the work against the resistances, the
     potential energy change and the initial kinetic energy, and at least one
     revolution's energy: the drive's 2 pi |torque| and the potential energy of
     a climb by one stroke 2 r (the rule near the start, where the motor work is
-    still tiny, and for a robot that gravity moves). Tolerance 1e-3: over the cases of the
+    still tiny, and for a robot that gravity moves). A compliant clutch's spring
+    is counted as the step conserves it (:meth:`.compliant.CompliantClutches.stepped_spring_energy`),
+    so an impact under way does not swing the figure by 1/2 omega dt of its
+    energy. Tolerance 1e-3: over the cases of the
     convergence study the error in revolutions stayed below 0.8 x the residual
     ratio (a light rod dissipates: -0.29 % revolutions at +3.8e-3; a fast
     crank creates energy: +0.087 % at -3.1e-3), so 1e-3 keeps the revolutions
@@ -28,7 +34,9 @@ figures show it while the run goes, each measured on the run's own state:
     lose at most that much of the stroke 2 r it gains per revolution, so an
     excursion e costs at most e / (2 r) of the travel; the tolerance
     2e-4 r keeps that at 1e-4, a tenth of the 0.1 % target; 1e-5 m for the
-    paper's crank.
+    paper's crank. Rigid clutches only: a compliant clutch's module moving back
+    is its physics (the series' ``clutch_overlap1``/``clutch_overlap2``), so
+    the figure stays 0 there.
 
 Crossing a tolerance stops the run with a :class:`SimulationError` that names
 the time, the figure, its value, the tolerance and the remedy

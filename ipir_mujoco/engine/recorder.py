@@ -11,6 +11,10 @@ constraint forces MuJoCo computed for it, and the torque the drive applied over
 it. The energies, the loop gap and the momentum at t_{n+1} are what MuJoCo
 computes at the start of the *next* step, so they are filled in then
 (:meth:`Recorder.fill_deferred`; the last sample after a final ``mj_forward``).
+So are a compliant clutch's force and overlap: MuJoCo computes the clutch
+force at the start of a step, from the anchor the controller has just set for
+that state, so a sample's ``lambda1``/``lambda2`` and ``clutch_overlap1``/
+``clutch_overlap2`` describe the sample's own state.
 """
 
 from __future__ import annotations
@@ -31,17 +35,23 @@ from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HING
 # loop-closure gap [m]; and the cumulative energy columns every driving engine writes [J].
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
 ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential")
+# with compliant clutches: overlaps d_i [m] (> 0: the spring is compressed), the springs' stored energy and the
+# dampers' cumulative dissipation [J]
+COMPLIANT_COLUMNS = ("clutch_overlap1", "clutch_overlap2", "clutch_spring_energy", "clutch_damper_work")
 # the per-sample scalars, in their order in Recorder.scalars
 _SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
-            "friction_work")
-_DEFERRED = ("kinetic", "potential", "loop_gap", "momentum")
+            "friction_work", "clutch_damper_work")
+_DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
+             "clutch_overlap2")
 
 
 class Recorder:
     """Preallocated sample rows for ``capacity`` samples (see the module docstring)."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int):
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int,
+                 clutch=None):
         self.model, self.data, self.params = model, data, params
+        self.clutch = clutch  # the compliant clutches' controller (.compliant.CompliantClutches), or None
         self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
@@ -60,12 +70,14 @@ class Recorder:
         self.pin_offset = (data.xmat[self.front].reshape(3, 3) @ anchor).tolist()
         self.total_mass = float(model.body_subtreemass[0])
 
-    def sample(self, torque: float, motor_work: float, friction_work: float, reactions) -> int:
+    def sample(self, torque: float, motor_work: float, friction_work: float, reactions,
+               damper_work: float = 0.0) -> int:
         """Store the current state as a sample; returns its row (its deferred values come later).
 
         ``torque`` [N m]: the drive's torque over the last step; ``motor_work``,
-        ``friction_work`` [J]: cumulative; ``reactions``: the clutch controller's
-        (rear held, front held, rear reaction [N], front reaction [N]).
+        ``friction_work``, ``damper_work`` (the compliant clutches' dampers) [J]:
+        cumulative; ``reactions``: the clutch controller's (rear held, front
+        held, rear reaction [N], front reaction [N]).
         """
         d, i = self.data, self.count
         self.t[i] = d.time
@@ -73,19 +85,21 @@ class Recorder:
         self.qvel[i] = d.qvel
         row = equality_row(self.model, d, self.loop_id) if self.loop_id else 0
         fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
-        self.scalars.append((torque, fx, fy, *reactions, motor_work, friction_work))
+        self.scalars.append((torque, fx, fy, *reactions, motor_work, friction_work, damper_work))
         self.count += 1
         return i
 
-    def works(self, i: int) -> tuple[float, float]:
-        """Cumulative (motor work, friction work) [J] of sample ``i``."""
+    def works(self, i: int) -> tuple[float, float, float]:
+        """Cumulative (motor work, friction work, clutch damper work) [J] of sample ``i``."""
         row = self.scalars[i]
-        return row[7], row[8]
+        return row[7], row[8], row[9]
 
-    def fill_deferred(self, i: int) -> tuple[float, float, float]:
-        """Energies, loop gap and momentum of sample ``i`` from MuJoCo's current (start of step) values.
+    def fill_deferred(self, i: int) -> tuple[float, float, float, float]:
+        """Energies, loop gap, momentum and compliant clutch forces and overlaps of sample ``i`` from MuJoCo's
+        current (start of step) values.
 
-        Returns (kinetic [J], potential [J], loop gap [m]).
+        Returns (kinetic [J], potential [J], loop gap [m], clutch spring energy [J] as the step conserves
+        it: :meth:`.compliant.CompliantClutches.stepped_spring_energy`).
         """
         d = self.data
         sx, sy, sz = d.site_xpos[self.site].tolist()
@@ -95,8 +109,14 @@ class Recorder:
         mujoco.mj_subtreeVel(self.model, d)
         momentum = d.subtree_linvel.item(0) * self.total_mass
         potential, kinetic = d.energy.tolist()
-        self.deferred[i] = (kinetic, potential, gap, momentum)
-        return kinetic, potential, gap
+        spring = 0.0
+        if self.clutch is None:
+            self.deferred[i] = (kinetic, potential, gap, momentum, 0.0, 0.0, 0.0, 0.0)
+        else:
+            (f1, f2), (d1, d2) = self.clutch.forces(), self.clutch.overlap
+            spring = self.clutch.stepped_spring_energy()
+            self.deferred[i] = (kinetic, potential, gap, momentum, f1, f2, d1, d2)
+        return kinetic, potential, gap, spring
 
     def series(self, last: int | None = None) -> dict[str, np.ndarray]:
         """Every column, for the samples 0..``last`` (default: all)."""
@@ -110,6 +130,9 @@ class Recorder:
         accel = (v - vb) / dt
         phi, omega = q[:, c], v[:, cv]
         beta = phi + q[:, rod]
+        if self.clutch is not None:  # a compliant clutch holds while it pushes, at the sample's own state
+            sc["lambda1"], sc["lambda2"] = de["clutch_force1"], de["clutch_force2"]
+            sc["held1"], sc["held2"] = (de["clutch_force1"] > 0).astype(float), (de["clutch_force2"] > 0).astype(float)
         held1, held2 = sc["held1"] > 0.5, sc["held2"] > 0.5
         mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
                         np.where(held2, int(Mode.CONTRACTION),
@@ -127,5 +150,11 @@ class Recorder:
             "motor_work": sc["motor_work"].copy(), "friction_work": sc["friction_work"].copy(),
             "kinetic": de["kinetic"].copy(), "potential": de["potential"] - de["potential"][0],
         }
+        if self.clutch is not None:
+            d1, d2 = de["clutch_overlap1"], de["clutch_overlap2"]
+            out.update({"clutch_overlap1": d1.copy(), "clutch_overlap2": d2.copy(),
+                        "clutch_spring_energy": 0.5 * self.clutch.k * (np.maximum(d1, 0.0) ** 2
+                                                                       + np.maximum(d2, 0.0) ** 2),
+                        "clutch_damper_work": sc["clutch_damper_work"].copy()})
         assert set(COLUMNS) <= set(out)
         return out

@@ -10,14 +10,22 @@ MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
 turn into a :class:`SimulationError` with the time and MuJoCo's message, as
 does a non-finite state.
 
+Clutches: rigid one-way clutches are the joint-limit ratchet or the locks
+(:mod:`.clutches`); with a finite ``clutch_stiffness`` the ratchet becomes the
+compliant clutch (:mod:`.compliant`): a ratcheting anchor per module and a
+spring and damper from it to the module, MuJoCo actuator forces.
+
 Energy audit, per step with the velocities v_{n+1} that move the positions
 (q_{n+1} = q_n + dt v_{n+1}): drive work tau * (phi_{n+1} - phi_n) with the
 torque MuJoCo applied over the step (for the motor, whose velocity term the
 implicit integrator treats implicitly, tau(omega_{n+1})), work against the
 resistances from the frictionloss rows, kinetic and potential energy from
-MuJoCo's own ``energy``. ``residual_j`` = motor - friction - kinetic -
-potential is what the soft constraints (clutches and loop) and the time
-discretization took together; the monitor holds it to a tolerance.
+MuJoCo's own ``energy``; with compliant clutches also the springs' stored
+energy and the dampers' dissipation (:mod:`.compliant`). ``residual_j`` =
+motor - friction - kinetic - potential (- clutch spring and damper) is what
+the soft constraints (rigid clutches, loop, friction rows) and the time
+discretization (the clutch springs' stepping included) took together; the
+monitor holds it to a tolerance.
 """
 
 from __future__ import annotations
@@ -35,7 +43,7 @@ from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams, require_params
 from ipir_mujoco.analytic.results import RunResult
 
-from .clutches import Locks, NoClutch, Ratchet
+from .clutches import clutch_controller
 from .common import (BLOCK_TIME, REFINEMENTS, CrankServo, captured_warnings, check_run_options, climb_energy,
                      rest_since, stall_reason)
 from .model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, dof_address,
@@ -70,9 +78,12 @@ def simulate_mujoco(
     """Run MuJoCo on the real linkage.
 
     ``implementation``: 'ratchet' (joint-limit ratchet; one-way by
-    construction, so ``clutch`` must be 'unilateral'), 'lock' (velocity-
-    triggered locks released by ``clutch`` = 'kinematic', the paper's rule, or
-    'unilateral', a lock that would pull lets go), or 'none' (no clutches).
+    construction, so ``clutch`` must be 'unilateral'; with a finite
+    ``params.clutch_stiffness`` the compliant clutch: a ratcheting anchor with
+    a spring and damper to the module, see :mod:`.compliant`), 'lock'
+    (velocity-triggered locks released by ``clutch`` = 'kinematic', the
+    paper's rule, or 'unilateral', a lock that would pull lets go; rigid
+    only), or 'none' (no clutches; rigid parameters only).
     ``dt_out`` [s] (<= t_end) must be a whole number of timesteps. ``settings``:
     None chooses the timestep from the motion (:func:`.timestep.choose_settings`)
     and halves it (at most twice) if the accuracy monitor fails; given settings
@@ -92,6 +103,10 @@ def simulate_mujoco(
     if implementation == "ratchet" and clutch == "kinematic":
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
+    if params.clutch_stiffness is not None and implementation != "ratchet":
+        raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with the MuJoCo {implementation!r} "
+                             "clutch: only the ratchet has a compliant form; allowed: --clutch unilateral "
+                             "--mujoco-clutch ratchet")
     check_accuracy_mode(accuracy)
     SteadyWatch(0.0, steady_tol, steady_cycles)  # validates both
     if wall_budget_s is not None and not (math.isfinite(wall_budget_s) and wall_budget_s > 0):
@@ -133,6 +148,7 @@ class _Run:
             raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
                                  f"({dt} s)")
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
+        self.compliant = params.clutch_stiffness is not None
         self.model = build_model(params, settings, mjcf, ratchet=implementation == "ratchet")
         self.data = mujoco.MjData(self.model)
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
@@ -146,15 +162,20 @@ class _Run:
         wm, wf = series["motor_work"][-1], series["friction_work"][-1]
         kinetic = series["kinetic"][-1] - series["kinetic"][0]
         potential = series["potential"][-1]
-        residual = wm - wf - kinetic - potential
         energy = {"motor_work_j": float(wm), "kinetic_j": float(kinetic), "friction_j": float(wf),
-                  "potential_j": float(potential), "residual_j": float(residual)}
+                  "potential_j": float(potential)}
+        if self.compliant:
+            energy["clutch_spring_j"] = float(series["clutch_spring_energy"][-1] - series["clutch_spring_energy"][0])
+            energy["clutch_damper_j"] = float(series["clutch_damper_work"][-1])
+        residual = wm - sum(v for k, v in energy.items() if k != "motor_work_j")
+        energy["residual_j"] = float(residual)
         scale = max(abs(wm), wf, abs(potential), self.energy_floor)
         label = {"ratchet": "unilateral", "lock": self.clutch, "none": "none"}[self.implementation]
         return RunResult(
             engine="mujoco", geometry="exact", clutch=label, params=self.params, t_end=float(series["t"][-1]),
             series=series, energy=energy, wall_time_s=time.perf_counter() - self.started,
-            settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch, "dt_out": self.dt_out,
+            settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch,
+                      "clutch_model": "compliant" if self.compliant else "rigid", "dt_out": self.dt_out,
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles},
             stall=self.stall,
@@ -164,13 +185,7 @@ class _Run:
     def _setup(self):
         m, d, p = self.model, self.data, self.params
         set_closed_loop_state(m, d, p)
-        if self.implementation == "ratchet":
-            controller = Ratchet(m, d)
-        elif self.implementation == "lock":
-            controller = Locks(m, d, self.clutch, p.r, p.L)
-        else:
-            controller = NoClutch(m, d)
-        self.controller = controller
+        self.controller = controller = clutch_controller(m, d, p, self.implementation, self.clutch)
         self.motor = m.actuator(MOTOR).id
         self.crank_q, self.crank_v = qpos_address(m, CRANK_HINGE), dof_address(m, CRANK_HINGE)
         d.ctrl[self.motor] = drive_control(p) if self.servo is None else self.servo.torque(
@@ -187,7 +202,8 @@ class _Run:
         implicit = m.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
         self.torque_slope = gear * gear * float(m.actuator_biasprm[self.motor, 2]) if implicit else 0.0
         self.gear = gear
-        self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2)
+        self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
+                                 controller if self.compliant else None)
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
@@ -208,7 +224,7 @@ class _Run:
         rec.qvel_before[0] = qvel - dt * d.qacc  # so that the first sample's acceleration is MuJoCo's qacc
         row = rec.sample(torque, 0.0, 0.0, ctl.reactions())
         start = rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
-        self.energy0 = start[:2]
+        self.energy0 = (start[0], start[1] + start[3])  # kinetic; potential with the clutch springs
         self.energy_floor = max(self.energy0[0], 2 * math.pi * abs(torque), climb_energy(m, self.params))
         self._judge(row, *start)
         self._check(messages, 0.0)
@@ -248,7 +264,7 @@ class _Run:
             done += k
             if messages:
                 self._check(messages, float(rec.t[rec.count - 1]))
-            pending = rec.sample(torque, wm, wf, ctl.reactions())
+            pending = rec.sample(torque, wm, wf, ctl.reactions(), ctl.damper_work if self.compliant else 0.0)
             if abs(torque) * 2 * math.pi > self.energy_floor:
                 self.energy_floor = 2 * math.pi * abs(torque)
             if ctl.excursion > self.monitor.worst["excursion_m"]:
@@ -258,19 +274,24 @@ class _Run:
                 last = checks.check(pending, messages)
                 if last is not None:
                     break
+        if self.compliant:
+            before()  # the anchors and dampers for the final state, whose clutch forces the last sample holds
         mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
         if pending >= 0:
             self._judge(pending, *rec.fill_deferred(pending))
         self._check(messages, float(rec.t[rec.count - 1]))
         return rec.count - 1 if last is None else last
 
-    def _judge(self, row: int, kinetic: float, potential: float, gap: float) -> None:
-        """Feed sample ``row``'s residual ratio and loop gap to the monitor, when they beat its worst."""
+    def _judge(self, row: int, kinetic: float, potential: float, gap: float, spring: float) -> None:
+        """Feed sample ``row``'s residual ratio and loop gap to the monitor, when they beat its worst.
+
+        ``spring`` [J]: the compliant clutch springs' stored energy, counted with the potential energy
+        (as the dampers' work is with the friction work)."""
         mon, rec = self.monitor, self.recorder
-        wm, wf = rec.works(row)
-        dpot = potential - self.energy0[1]
-        residual = wm - wf - (kinetic - self.energy0[0]) - dpot
-        scale = max(abs(wm), wf, abs(dpot), self.energy_floor)
+        wm, wf, wc = rec.works(row)
+        dpot = potential + spring - self.energy0[1]
+        residual = wm - wf - wc - (kinetic - self.energy0[0]) - dpot
+        scale = max(abs(wm), wf + wc, abs(dpot), self.energy_floor)
         if scale > 0 and abs(residual) > abs(mon.worst["residual_ratio"]) * scale:
             mon.residual(rec.t.item(row), residual, scale)
         if gap > mon.worst["loop_gap_m"]:

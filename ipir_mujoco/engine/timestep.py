@@ -21,7 +21,19 @@ the locks), and is a whole fraction of the output interval. Further limits:
   revolutions at 1e-4 s and the error falls as dt^2, so above the ratio 3e4
   the step shrinks as sqrt(3e4 / ratio);
 - a crank servo: 0.2 / max(sqrt(kp / J_A), kv / J_A), a tenth of the explicit
-  stability limit of its stiffness and damping.
+  stability limit of its stiffness and damping;
+- compliant clutches: MuJoCo steps a spring explicitly, so its period must be
+  resolved: dt <= CLUTCH_SHARE / omega_c with omega_c = sqrt(k / min(m1, m2)),
+  an upper bound of every clutch frequency (the robot's kinetic energy is at
+  least 1/2 m1 v1^2 + 1/2 m2 v2^2, so the Rayleigh quotient of the springs,
+  k (v1^2 + v2^2) / (v^T M v), is at most k / min(m1, m2)). CLUTCH_SHARE = 0.1
+  (63 steps per period 2 pi / omega_c): an impact's peak force then comes out
+  within (omega dt)^2 / 4 = 2.5e-3 of its converged value by the step's own
+  error bound (entering the spring between two steps and sampling its
+  turning point, each up to (omega dt)^2 / 8), measured within 1e-3 over the
+  impacts of the paper's start and the default motor's cruise at k = 1e6..1e8
+  N/m (tests/test_mujoco_compliant.py, mjcf/README.md), while revolutions and
+  travel are set by the speed rule above.
 
 Bounds on the crank: for a constant torque M, the energy the drive put in
 bounds the crank's kinetic energy, J_A omega^2 / 2 <= KE(0) + |M| (phi - phi0),
@@ -53,6 +65,14 @@ TARGET = 0.5 * RESIDUAL_TOL  # predicted residual ratio to aim at: half the moni
 RESIDUAL_CONSTANT = {"ratchet": 0.36, "lock": 2.4, "none": 0.36}  # C of the law above, per clutch
 LEAK_RATIO = 3e4  # module-to-rod mass ratio from which a light rod shortens the step
 SERVO_SHARE = 0.2  # of 1 / (servo rate)
+CLUTCH_SHARE = 0.1  # of 1 / omega_c, the fastest clutch spring's angular frequency (see the module docstring)
+
+
+def clutch_rate(params: RobotParams) -> float:
+    """omega_c = sqrt(k / min(m1, m2)) [rad/s]: no clutch spring oscillates faster (0 for rigid clutches)."""
+    if params.clutch_stiffness is None:
+        return 0.0
+    return math.sqrt(params.clutch_stiffness / min(params.m1, params.m2))
 
 
 def crank_bounds(params: RobotParams, t_end: float) -> tuple[float, float]:
@@ -88,7 +108,15 @@ def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None
     if servo is not None:
         rate = max(math.sqrt(servo.kp / params.J_A), servo.kv / params.J_A)
         limits["servo_s"] = SERVO_SHARE / rate
+    if params.clutch_stiffness is not None:
+        limits["clutch_s"] = CLUTCH_SHARE / clutch_rate(params)
     needed = min(limits.values())
+    if needed == limits.get("clutch_s") and needed < DT_MIN:
+        raise ParameterError(
+            f"clutch_stiffness={params.clutch_stiffness:g} N/m: MuJoCo would need a timestep of {needed:.2g} s to "
+            f"resolve the clutch spring ({CLUTCH_SHARE:g} sqrt(min(m1, m2) / k)); allowed: runs needing a timestep "
+            f">= {DT_MIN:g} s (a stiffness up to {min(params.m1, params.m2) * (CLUTCH_SHARE / DT_MIN) ** 2:.3g} N/m "
+            "here, or give the timestep yourself)")
     if needed < DT_MIN:
         raise ParameterError(
             f"t_end={t_end:g} s: the crank can reach {omega_b:.3g} rad/s and MuJoCo would need a timestep of "

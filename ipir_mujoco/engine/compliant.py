@@ -1,0 +1,159 @@
+"""Compliant one-way clutches in MuJoCo: a spring and a damper from a ratcheting anchor to each module.
+
+The mechanism. Each module i has an anchor on the pipe that ratchets forward
+with it and never back: a_i = (running maximum of x_i) - clutch_backlash.
+Between the anchor and the module act a spring k [N/m] and a damper c
+[N s/m]: the model's clutch actuators (:func:`.model._write_clutches`), each
+a position servo on the module's slide whose target (``ctrl``) is the anchor.
+So the force MuJoCo computes and applies is, by construction,
+
+    k (a_i - x_i) - c v_i,  clamped by the actuator's force range to >= 0,
+
+i.e. max(0, k d_i - c v_i) with the overlap d_i = a_i - x_i > 0 (the module
+behind its anchor), and nothing inside the play (d_i <= 0: the damper is
+switched off, below, and the clamp removes the spring's negative part).
+
+The anchor has no mass: it is the actuator's target, raised before every step
+to (x_i - backlash) when the module has gone further than ever (a rigid
+one-sided link to the module that nothing can push back). It is the running
+maximum of the positions at the steps' starts; between two steps a module can
+pass that by at most |a_i| dt^2 / 2 (near a turning point), 5e-7 m at
+100 m/s^2 and 1e-4 s.
+
+The damper. MuJoCo's affine bias -c v acts wherever the force is not clamped;
+the definition applies c only while the module is behind its anchor. So the
+controller writes biasprm[2] = -c while d_i > 0 at the step's start and 0
+otherwise (inside the play, where a module approaching its anchor fast would
+otherwise meet a force c |v| - k |d| before it touches). Where k d - c v <= 0
+the force range clamps the force to 0 (the damper would pull), and MuJoCo's
+implicit integrators then leave the damping out of the step
+(``mjd_actuator_vel`` skips an actuator clamped by its force range), so a
+clamped clutch applies exactly nothing.
+
+Energy, per step with the velocities v_{n+1} that move the positions: the
+force applied over the step is MuJoCo's ``actuator_force`` f_n plus, for the
+implicit integrators, the damping's implicit part -c (v_{n+1} - v_n) (while
+unclamped and damped). The clutch spring stores 1/2 k max(d, 0)^2; the damper
+dissipates (k max(d_n, 0) - f_applied) v_{n+1} dt per step (c v^2 dt while
+engaged, k d v dt while clamped, as the analytic definition). What the run's
+energy audit leaves after these is the time discretization (the spring's
+stepping included) and the soft constraints.
+"""
+
+from __future__ import annotations
+
+import mujoco
+
+from ipir_mujoco.analytic.params import RobotParams
+
+from .model import FRONT_CLUTCH, FRONT_SLIDE, REAR_CLUTCH, REAR_SLIDE, dof_address, qpos_address
+
+SLIDES = (REAR_SLIDE, FRONT_SLIDE)
+CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
+
+
+class CompliantClutches:
+    """The controller of the compliant clutches: moves the anchors, switches the dampers, counts their work.
+
+    ``params``: the parameter set the model was built from; its
+    ``clutch_backlash`` [m] and ``clutch_damping`` c [N s/m] (the controller
+    switches the actuators' damping, so a model that has run holds 0 for a
+    clutch that was free) are used, and the stiffness k [N/m] is read from the
+    compiled model's clutch actuators and checked against it. Called before every step
+    (:meth:`before_step`) and after it (:meth:`after_step`). ``overlap`` holds
+    d_i = a_i - x_i [m] at the last step's start; ``damper_work`` [J] is the
+    cumulative work the dampers dissipated; ``excursion`` is 0: a module's
+    backward motion is the clutch's physics here, not a constraint's give.
+    """
+
+    name = "compliant"
+    excursion = 0.0
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
+        self.model, self.data = model, data
+        self.act = [model.actuator(n).id for n in CLUTCHES]
+        self.qpos_adr = [qpos_address(model, n) for n in SLIDES]
+        self.dof_adr = [dof_address(model, n) for n in SLIDES]
+        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
+        for u, slide in zip(self.act, SLIDES):
+            if (model.actuator_trntype[u] != joint_trn or model.actuator_trnid[u, 0] != model.joint(slide).id
+                    or model.actuator_gear[u, 0] != 1.0):
+                raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {slide!r} with gear 1")
+        k, c = params.clutch_stiffness, params.clutch_damping
+        for u in self.act:
+            if not (k is not None and model.actuator_gainprm[u, 0] == k and model.actuator_biasprm[u, 1] == -k
+                    and model.actuator_forcelimited[u] and model.actuator_forcerange[u, 0] == 0.0):
+                raise ValueError("the clutch actuators need the spring k = clutch_stiffness and the force range "
+                                 "[0, ...]: build the model from these parameters, with a finite clutch_stiffness")
+            model.actuator_biasprm[u, 2] = -c  # the damper as built (a model that has run may hold 0)
+        self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
+        # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler and RK4 do not
+        self.implicit = model.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT,
+                                                 mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+        self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm
+        self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
+        self.anchor = [float(data.qpos[a]) - self.backlash for a in self.qpos_adr]  # running maximum - backlash
+        for u, a in zip(self.act, self.anchor):
+            data.ctrl[u] = a
+        self._per_module = tuple(zip((0, 1), self.qpos_adr, self.dof_adr, self.act))
+        self.damped = [True, True]  # as built: biasprm[2] = -c
+        self.overlap = [0.0, 0.0]
+        self.v_before = [0.0, 0.0]
+        self.damper_work = 0.0
+        self.before_step()
+
+    def before_step(self) -> None:
+        """Raise each anchor to (x - backlash) if the module went further; damper on while d > 0."""
+        q, v, backlash, anchor, overlap = self._qpos, self._qvel, self.backlash, self.anchor, self.overlap
+        for i, adr, dof, act in self._per_module:  # this runs before every step: plain floats only
+            x = q.item(adr)
+            if x - backlash > anchor[i]:
+                anchor[i] = x - backlash
+                self._ctrl[act] = anchor[i]
+            d = anchor[i] - x
+            overlap[i] = d
+            self.v_before[i] = v.item(dof)
+            if (d > 0.0) != self.damped[i]:
+                self.damped[i] = d > 0.0
+                self._biasprm[act, 2] = -self.c if d > 0.0 else 0.0
+
+    def after_step(self) -> None:
+        """Add the step's damper dissipation: (spring force - applied force) * v_{n+1} * dt, both modules."""
+        work = 0.0
+        for i, _, dof, act in self._per_module:
+            d, applied = self.overlap[i], self._force.item(act)
+            if d <= 0.0 and applied == 0.0:
+                continue  # inside the play: no force, nothing dissipated (the common case)
+            speed = self._qvel.item(dof)
+            if applied > 0.0 and self.damped[i] and self.implicit:
+                applied -= self.c * (speed - self.v_before[i])  # the implicit integrators' damping over the step
+            work += ((self.k * d if d > 0.0 else 0.0) - applied) * speed
+        self.damper_work += work * self.dt
+
+    def stepped_spring_energy(self) -> float:
+        """The springs' energy [J] at the last step's start as MuJoCo's step conserves it: sum of
+        1/2 k d^2 + 1/2 dt k d v over the compressed clutches (d > 0).
+
+        The semi-implicit step (v_{n+1} from the force at x_n, then x_{n+1} = x_n + dt v_{n+1}) keeps
+        1/2 m v_n^2 + 1/2 k d_n^2 + 1/2 dt k d_n v_n exactly constant on a linear spring, with v_n the
+        velocity that moved the module to x_n (substitute the two updates: the change of each side is
+        dt k d_n (v_n + v_{n+1}) / 2 with opposite signs). The physical 1/2 k d^2 alone swings by up to
+        1/2 omega dt of an impact's energy while the impact goes on and comes back when it ends; the
+        accuracy monitor counts the spring with this form so that it sees what the stepping really
+        creates or loses, not that swing. The series column is the physical 1/2 k d^2.
+        """
+        k, dt = self.k, self.dt
+        energy = 0.0
+        for d, v in zip(self.overlap, self.v_before):
+            if d > 0.0:
+                energy += 0.5 * k * d * (d + dt * v)
+        return energy
+
+    def forces(self) -> tuple[float, float]:
+        """The clutch forces [N] MuJoCo computed at the last step's start (or the last mj_forward)."""
+        return self._force.item(self.act[0]), self._force.item(self.act[1])
+
+    def reactions(self) -> tuple[bool, bool, float, float]:
+        """(rear held, front held, rear force [N], front force [N]): held while its clutch pushes."""
+        f1, f2 = self.forces()
+        return f1 > 0.0, f2 > 0.0, f1, f2
