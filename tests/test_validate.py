@@ -242,3 +242,16 @@ def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_valid
     # the section sits after the core sections and before the numerical evidence
     assert markdown.index("Energy audit") < markdown.index("twice L is 0.6 m") < markdown.index("Numerical convergence")
     assert "](figures/toy.png)" in markdown and "**Is L positive?** Yes" in markdown
+
+
+def test_convergence_evidence_covers_the_envelope_corners(quick_validation):
+    """--quick checks the lightest rod and the shortest L/r with the automatic settings: each within the
+    envelope's 0.1 % target of the analytic one-way model (the full validate runs every corner)."""
+    from ipir_mujoco.studies.validate import SMOKE_CASES
+
+    envelope = quick_validation[0]["convergence"]["envelope"]
+    assert [r["case"] for r in envelope["rows"]] == list(SMOKE_CASES)
+    for row in envelope["rows"]:
+        assert max(abs(row["error"]["revolutions"]), abs(row["error"]["travel"])) < envelope["tolerance"] == 1e-3
+    assert envelope["worst_error"] == max(max(abs(r["error"]["revolutions"]), abs(r["error"]["travel"]))
+                                          for r in envelope["rows"])

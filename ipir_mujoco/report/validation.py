@@ -162,6 +162,45 @@ def _mechanism_section(figures: dict[str, str], animation_note: str | None, sett
     return blocks
 
 
+def _mujoco_settings_text(settings: dict) -> str:
+    """How each MuJoCo rung was integrated (its timestep was chosen from the motion)."""
+    runs = settings.get("mujoco_runs") or {"every run": settings["mujoco"]}
+    any_run = next(iter(runs.values()))
+    steps = "; ".join(f"{name}: timestep {s['timestep']:.3g} s, constraint time constant "
+                      f"{s['constraint_time_constant']:.3g} s" for name, s in runs.items())
+    return (f"{any_run['integrator']}, solimp {tuple(any_run['solimp'])}; timesteps chosen from the motion "
+            f"(the crank speed the drive can reach, the rod's mass ratio, the clutch stiffness): {steps}")
+
+
+def _envelope_blocks(envelope: dict) -> list:
+    """The automatic MuJoCo settings over the envelope's corners, against the analytic model."""
+    done = [r for r in envelope["rows"] if "error" in r]
+    headline = (f"With default options (the timestep chosen from the motion, the accuracy monitor on) MuJoCo "
+                f"stays within {100 * envelope['worst_error']:.3f} % of the analytic model of the same mechanism "
+                f"in crank revolutions and travel over {len(done)} runs at the envelope's corners (worst: "
+                f"{envelope['worst_case']}; the target is {100 * envelope['tolerance']:g} %)"
+                + (f"; the accuracy monitor stopped {envelope['stopped']} run(s), listed below"
+                   if envelope["stopped"] else "; the accuracy monitor stopped none")
+                + f". MuJoCo took {envelope['mujoco_wall_s']:.1f} s for them, the analytic model "
+                  f"{envelope['analytic_wall_s']:.1f} s. The whole envelope (speed, rod mass, L/r and mass ratio, "
+                  "both clutches) is tabulated in the package's mjcf/README.md.")
+    rows = []
+    for r in envelope["rows"]:
+        if "error" not in r:
+            rows.append([r["case"], f"{r['clutch']} ({r['rule']})", f"{r['t_end']:g}", "stopped", "", "", "", "",
+                         r["stopped"]])
+            continue
+        a = r["accuracy"]
+        rows.append([r["case"], f"{r['clutch']} ({r['rule']})", f"{r['t_end']:g}",
+                     f"{r['timestep']:.3g}" + (f" ({r['refinements']} halvings)" if r["refinements"] else ""),
+                     pct(r["error"]["revolutions"]), pct(r["error"]["travel"]), f"{a['residual_ratio']:+.1e}",
+                     f"{a['loop_gap_m']:.1e}", f"{r['wall_s']:.2f}"])
+    return [Paragraph(headline),
+            Table(["case", "MuJoCo clutch (rule)", "t_end [s]", "automatic timestep [s]",
+                   "MuJoCo vs equations: revolutions", "MuJoCo vs equations: travel",
+                   "worst energy residual / energy [-]", "worst loop gap [m]", "MuJoCo wall [s]"], rows)]
+
+
 def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | None = None,
                  animation: dict | None = None, extra: Sequence = ()) -> list:
     case = metrics["paper_case"]
@@ -244,9 +283,9 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     conv = metrics["convergence"]
     blocks.append(Heading("Numerical convergence"))
     blocks.append(Paragraph(
-        f"MuJoCo at this design, halving the timestep (constraint time constant two steps): the default "
-        f"{metrics['settings']['mujoco']['timestep']:g} s is within {100 * conv['mujoco_default_error']:.3f} % of the "
-        f"finest step tried. The equations (one-way clutches) against solver tolerance: the default rtol 1e-10 is "
+        f"MuJoCo at this design, halving the timestep (constraint time constant two steps): the largest step "
+        f"the engine chooses by itself, {metrics['settings']['mujoco']['timestep']:g} s, is within "
+        f"{100 * conv['mujoco_default_error']:.3f} % of the finest step tried. The equations (one-way clutches) against solver tolerance: the default rtol 1e-10 is "
         f"within {100 * conv['equations_default_error']:.1e} % of the tightest. Both far below the modelling "
         "differences above. The full study over three designs is in the package's mjcf/README.md."))
     blocks.append(Table(["MuJoCo clutch", "timestep [s]", summary_label("revolutions"), summary_label("x1_final"),
@@ -255,6 +294,9 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                           f"{r['x1_final']:.6f}", f"{r['x2_final']:.6f}",
                           pct(r["vs_analytic"]["revolutions"]) if "vs_analytic" in r else "",
                           f"{r['residual_fraction']:.1e}"] for r in conv["mujoco"]]))
+    envelope = conv.get("envelope")
+    if envelope is not None:
+        blocks += _envelope_blocks(envelope)
     blocks.append(Table(["equations rtol [-]", summary_label("revolutions"), summary_label("x1_final"),
                          summary_label("x2_final"), "energy residual / motor work [-]"],
                         [[f"{r['rtol']:g}", f"{r['revolutions']:.10f}", f"{r['x1_final']:.10f}",
@@ -268,9 +310,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     blocks.append(Paragraph(f"Analytic solver: DOP853, rtol {settings['rtol']:g}, atol {settings['atol']:g}, "
                             f"output every {settings['dt_out_s']:g} s plus every mode switch"
                             + (" (quick run)." if settings["quick"] else ".")
-                            + f" MuJoCo: {settings['mujoco']['integrator']}, timestep {settings['mujoco']['timestep']:g} s, "
-                            f"constraint time constant {settings['mujoco']['constraint_time_constant']:g} s, "
-                            f"solimp {tuple(settings['mujoco']['solimp'])} (evidence: the package's mjcf/README.md)."))
+                            + " MuJoCo: " + _mujoco_settings_text(settings) + " (evidence: the package's mjcf/README.md)."))
     blocks.append(Table(["software", "version"], [[k, v] for k, v in metrics["versions"].items()]))
     blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/studies/validate.py); "
                             "the model and its conventions are in docs/model.md."))

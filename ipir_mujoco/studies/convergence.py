@@ -90,7 +90,8 @@ def envelope_cases(quick: bool = False) -> list[tuple[str, RobotParams, float]]:
 
 
 def envelope_study(quick: bool = False, progress: Callable[[str], None] = lambda _m: None,
-                   clutches: Sequence[tuple[str, str]] = (("ratchet", "unilateral"), ("lock", "kinematic"))) -> dict:
+                   clutches: Sequence[tuple[str, str]] = (("ratchet", "unilateral"), ("lock", "kinematic")),
+                   cases: Sequence[tuple[str, RobotParams, float]] | None = None) -> dict:
     """MuJoCo with default (automatic) settings against the analytic model over the envelope.
 
     Returns ``{"rows": [...], "worst_error": float, "worst_case": str,
@@ -100,10 +101,11 @@ def envelope_study(quick: bool = False, progress: Callable[[str], None] = lambda
     signed), the accuracy figures, and both wall times; or, for a run the
     accuracy monitor stopped, ``stopped`` (its message). The runs use the
     default options (accuracy 'stop', automatic timestep). ``quick`` runs the
-    corners only (about a minute on a quiet machine).
+    corners only (about a minute on a quiet machine). ``cases`` replaces the
+    envelope by other (label, parameters, t_end [s]) triples.
     """
     rows = []
-    for label, params, t_end in envelope_cases(quick):
+    for label, params, t_end in (envelope_cases(quick) if cases is None else cases):
         for implementation, rule in clutches:
             progress(f"{label}, {implementation}")
             started = time.perf_counter()

@@ -42,16 +42,19 @@ compares every rung with the paper's model at that design (the first rung).
                           S_at_angle / S_dot_at_angle as fractions of 2r / max|S_dot|
     convergence           {mujoco: [rows of ipir_mujoco.studies.convergence], equations: [{rtol,
                           revolutions, x1_final, x2_final, residual_fraction}],
-                          mujoco_default_error, equations_default_error}: largest
+                          mujoco_default_error, equations_default_error, envelope}: largest
                           relative change of revolutions/x1/x2 from the default setting
-                          to the finest one tried
+                          to the finest one tried; envelope: ipir_mujoco.studies.convergence.
+                          envelope_study over the envelope's corners (two of them with --quick)
     sections              {key: metrics} of each further study the report runs
                           (see ipir_mujoco.report.sections)
     params                the parameter set used (SI units; rod_inertia resolved)
     parameter_table       list of {name, value, text, units, meaning}: text shows
                           'rigid' / 'uniform' where the value was left to its default rule
     settings              {t_end_s, quick, dt_out_s, rtol, atol, mujoco: {timestep,
-                          integrator, constraint_time_constant, solimp}}
+                          integrator, constraint_time_constant, solimp} (the largest step the
+                          engine chooses by itself), mujoco_runs: {rung name: the same four, as
+                          chosen from the motion for that run}}
     versions              software versions
 """
 
@@ -73,6 +76,9 @@ from .. import __version__
 from ..engine import simulate_mujoco
 from ..engine.model import SolverSettings
 from .paper_reference import PAPER_CASE, check_identities, check_paper_figures, describe_differences, differences_from_paper
+
+# the envelope corners validate --quick still runs: the lightest rod and the shortest L/r
+SMOKE_CASES = ("rod mass 0.0001 kg", "L/r = 1.1")
 
 LADDER_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
                   "min_clutch_reaction_n")
@@ -329,6 +335,10 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
     settings = {"t_end_s": 1.0, "quick": quick, "dt_out_s": 1e-3 if quick else 1e-4, "rtol": 1e-10, "atol": 1e-12,
                 "mujoco": SolverSettings().as_dict()}
     rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
+    # MuJoCo's settings are chosen per run from the motion: record what each MuJoCo rung used
+    settings["mujoco_runs"] = {r.name: {k: r.run.settings[k] for k in ("timestep", "integrator",
+                                                                         "constraint_time_constant", "solimp")}
+                               for r in rungs if r.run.engine == "mujoco"}
     study = lr_study(params, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
     convergence = convergence_evidence(params, quick, lambda m: progress(f"convergence: {m}"))
     metrics = build_metrics(params, rungs, settings, study, convergence)
@@ -374,7 +384,7 @@ def pull_per_stroke(run: RunResult) -> list[dict]:
 
 def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[str], None]) -> dict:
     """MuJoCo's figures against its timestep, the equations' against their tolerance (paper's case)."""
-    from .convergence import timestep_study
+    from .convergence import envelope_cases, envelope_study, timestep_study
 
     timesteps = (1e-4, 5e-5) if quick else (4e-4, 2e-4, 1e-4, 5e-5)
     label = "paper's case" if not differences_from_paper(params) else "this design"
@@ -395,5 +405,11 @@ def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[s
     mj_error = max(spread(rows, lambda r, c=c: r["clutch"] == c and r["timestep"] <= default)
                    for c in ("lock", "ratchet"))
     eq_error = spread(equations, lambda r: r["rtol"] <= 1e-10)
+    # the automatic settings over the envelope of designs and speeds (the corners; the whole envelope is in
+    # the package's mjcf/README.md); --quick checks two of the corners with the ratchet only
+    corners = envelope_cases(quick=True)
+    envelope = (envelope_study(cases=[c for c in corners if c[0] in SMOKE_CASES], progress=progress,
+                               clutches=(("ratchet", "unilateral"),))
+                if quick else envelope_study(quick=True, progress=progress))
     return {"mujoco": rows, "equations": equations, "mujoco_default_error": mj_error,
-            "equations_default_error": eq_error}
+            "equations_default_error": eq_error, "envelope": envelope}
