@@ -42,8 +42,9 @@ def add_parser(commands) -> None:
                      help="simulated time (default 1 s); with --until-steady, the cap")
     sim.add_argument("--until-steady", action="store_true",
                      help="stop at the periodic steady state (per-revolution mean speed settled); --t-end caps it")
-    sim.add_argument("--dt-out", type=float, default=1e-4, metavar="SECONDS",
-                     help="output sample interval (default 1e-4 s); mode switches are sampled exactly")
+    sim.add_argument("--dt-out", type=float, default=None, metavar="SECONDS",
+                     help="output sample interval (default 1e-4 s, or the --timestep if that is longer); the "
+                          "analytic engines also sample every mode switch")
     sim.add_argument("--max-switches", type=int, default=None, metavar="N",
                      help="analytic engines: stop with an error after N mode switches (a work budget for designs "
                           "that chatter; default: the engine's, 100000)")
@@ -54,8 +55,21 @@ def add_parser(commands) -> None:
     sim.set_defaults(handler=run)
 
 
+DT_OUT = 1e-4  # s: the default output interval
+
+
+def output_interval(args: argparse.Namespace) -> float:
+    """--dt-out, or by default 1e-4 s, a whole number of MuJoCo timesteps when --timestep is given."""
+    if args.dt_out is not None:
+        return args.dt_out
+    if args.engine == "mujoco" and args.timestep is not None and args.timestep > 0:
+        return args.timestep * max(1, round(DT_OUT / args.timestep))
+    return DT_OUT
+
+
 def check_options(args: argparse.Namespace) -> None:
     """Every option of ``simulate`` that the engines do not check themselves, before any work."""
+    args.dt_out = output_interval(args)
     check_run_options(args.t_end, args.dt_out)
     if args.max_switches is not None:
         check_whole("--max-switches", args.max_switches, low=1)
@@ -104,8 +118,8 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
                              **extra)
 
 
-def format_summary(run: RunResult) -> str:
-    """The human-readable summary ``simulate`` prints."""
+def format_summary(run: RunResult, until_steady: bool = False) -> str:
+    """The human-readable summary ``simulate`` prints (``until_steady``: the run was asked to stop there)."""
     s = run.summary
     e = s["energy"]
     first = s["first_contraction_end_s"]
@@ -120,10 +134,34 @@ def format_summary(run: RunResult) -> str:
         f"  mode switches            {s['mode_switches']}",
         "  min clutch reaction      " + ("none (no clutch held)" if reaction is None else f"{reaction:.4g} N"
                                        + ("   (negative: the lock would have to pull)" if reaction < 0 else "")),
-        f"  energy [J]: motor {e['motor_work_j']:.6g} = kinetic {e['kinetic_j']:.6g} "
-        f"+ friction {e['friction_j']:.6g} + residual {e['residual_j']:.2e}",
+        "  energy [J]: " + _energy_line(e),
     ]
+    if s["steady"]:
+        lines.append(f"  steady state from {s['t_steady_s']:.3f} s: {s['steady_speed_m_s']:.4g} m/s, "
+                     f"{s['distance_per_rev_m']:.4g} m per revolution, {s['energy_per_metre_j_m']:.4g} J/m, "
+                     f"efficiency {s['efficiency']:.3g}")
+    elif until_steady:
+        lines.append(f"  steady state            not reached by {run.t_end:g} s")
+    if s["stalled"]:
+        lines.append(f"  stalled: {s['stall_reason']}")
+    accuracy = s.get("accuracy") or {}
+    if "loop_gap_m" in accuracy:
+        lines.append(f"  accuracy: energy residual {accuracy['residual_ratio']:.1e} of the energy, loop gap "
+                     f"{accuracy['loop_gap_m']:.1e} m" + ("" if accuracy.get("ok", True) else
+                                                          "   OUT OF TOLERANCE: " + "; ".join(
+                                                              f"{v['figure']} {v['value']:.3g} (tolerance {v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
+                                                              for v in accuracy.get("violations", []))))
     return "\n".join(lines)
+
+
+def _energy_line(e: dict) -> str:
+    """motor = kinetic + friction (+ potential, clutch springs and dampers where the run has them) + residual."""
+    terms = [f"kinetic {e['kinetic_j']:.6g}", f"friction {e['friction_j']:.6g}"]
+    for key, word in (("potential_j", "potential"), ("clutch_spring_j", "clutch springs"),
+                      ("clutch_damper_j", "clutch dampers")):
+        if key in e and e[key] != 0.0:
+            terms.append(f"{word} {e[key]:.6g}")
+    return f"motor {e['motor_work_j']:.6g} = " + " + ".join(terms) + f" + residual {e['residual_j']:.2e}"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -142,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(record, allow_nan=False))
     else:
-        print(format_summary(result))
+        print(format_summary(result, args.until_steady))
         if args.out is not None:
             print(f"  wrote {args.out}/timeseries.csv, mode_changes.csv, summary.json and fig2-4 PNG")
     return EXIT_OK
