@@ -127,8 +127,8 @@ def format_table(study: dict) -> str:
     lines = []
     for key, point in study["points"].items():
         columns = [c for c in shown if point["until_steady"] or c[0] not in ("steady_speed_m_s", "energy_per_metre_j_m")]
-        lines.append(f"\n{point['label']} (each cell: analytic / MuJoCo; last column: MuJoCo's relative "
-                     "divergence of the peak force)")
+        lines.append(f"\n{point['label']} (each cell: analytic / MuJoCo; lost/stroke against the same engine's "
+                     "rigid clutch, < 0: gained; last column: MuJoCo's relative divergence of the peak force)")
         header = ["k [N/m]", "backlash [mm]"] + [c[1] for c in columns] + ["force divergence"]
         rows = []
         for r in (r for r in study["rows"] if r["point"] == key):
@@ -141,13 +141,16 @@ def format_table(study: dict) -> str:
         widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
         for row in [header] + rows:
             lines.append("  ".join(str(x).rjust(w) for x, w in zip(row, widths)))
-        for ref_engine in ("analytic", "mujoco"):
-            if "error" in ref[ref_engine]:
-                lines.append(f"  rigid {ref_engine}: n/a ({ref[ref_engine]['error']})")
+        failed = [(f"k={r['clutch_stiffness_n_m']:.3g} N/m, backlash {1e3 * r['clutch_backlash_m']:g} mm", r)
+                  for r in study["rows"] if r["point"] == key] + [("rigid", ref)]
+        for what, record in failed:
+            for engine in ("analytic", "mujoco"):
+                if "error" in record[engine]:
+                    lines.append(f"  {what}, {engine}: n/a ({record[engine]['error']})")
+    slopes = [s for s in study["scaling"] if s["slope_stiff"] is not None]
     lines.append("\nlog-log slope of the peak force against k over the stiffest decade (1/2: an impact; -> 0: a "
-                 "finite limit):")
-    for s in study["scaling"]:
-        if s["slope_stiff"] is not None:
-            lines.append(f"  {s['point']:8s} backlash {1e3 * s['clutch_backlash_m']:g} mm, {s['engine']:8s}: "
-                         f"{s['slope_stiff']:+.3f} ({s['stiff_range_n_m'][0]:.3g}..{s['stiff_range_n_m'][1]:.3g} N/m)")
+                 "finite limit):" + ("" if slopes else " none (a backlash needs two stiffnesses or more)"))
+    for s in slopes:
+        lines.append(f"  {s['point']:8s} backlash {1e3 * s['clutch_backlash_m']:g} mm, {s['engine']:8s}: "
+                     f"{s['slope_stiff']:+.3f} ({s['stiff_range_n_m'][0]:.3g}..{s['stiff_range_n_m'][1]:.3g} N/m)")
     return "\n".join(lines)

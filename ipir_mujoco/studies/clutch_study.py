@@ -225,7 +225,7 @@ def run_metrics(run, point: OperatingPoint) -> dict:
         k = steady_index([c.mean_speed_m_s for c in found], run.settings.get("steady_tol", 1e-4), n)
         if k is None:
             why = run.stall or f"no periodic steady state by t_end = {point.t_end:g} s"
-            return {"error": f"{run.engine}: {why}"}
+            return {"error": why}
         window = found[k - n + 1:k + 1]
         inside = (s["t"] >= window[0].t_start) & (s["t"] <= window[-1].t_end)
         revolutions = float(n)
