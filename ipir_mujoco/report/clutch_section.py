@@ -20,6 +20,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams
 
 from .document import Heading, Image, Paragraph, Table, fmt
@@ -152,12 +153,16 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     base = params.replace(clutch_stiffness=None, clutch_backlash=0.0)
     study = run_study(base, designs=designs, progress=progress)
     # the ideal clutch's spikes: the paper's own model (first order, massless rod, ideal locks) at start-up
-    paper = analytic.simulate(base.replace(drive="torque", rod_mass=0.0, rod_inertia=0.0), "approx", "kinematic",
-                              1.0, dt_out=1e-4)
-    s = paper.series
-    return {"realistic": [dict(p) for p in REALISTIC], "quick": quick, "study": study,
-            "paper_model": {"peak_acceleration_m_s2": float(np.maximum(np.abs(s["a1"]), np.abs(s["a2"])).max()),
-                            "peak_clutch_force_n": paper.summary["peak_clutch_force_n"]}}
+    try:
+        paper = analytic.simulate(base.replace(drive="torque", rod_mass=0.0, rod_inertia=0.0), "approx", "kinematic",
+                                  1.0, dt_out=1e-4)
+    except (ParameterError, SimulationError) as exc:  # a design the paper's model does not cover: said, not fatal
+        ideal = {"error": " ".join(str(exc).split())}
+    else:
+        s = paper.series
+        ideal = {"peak_acceleration_m_s2": float(np.maximum(np.abs(s["a1"]), np.abs(s["a2"])).max()),
+                 "peak_clutch_force_n": paper.summary["peak_clutch_force_n"]}
+    return {"realistic": [dict(p) for p in REALISTIC], "quick": quick, "study": study, "paper_model": ideal}
 
 
 def _row(study: dict, point: str, pair: dict) -> dict | None:
@@ -204,7 +209,7 @@ def render(metrics: dict, figures_dir: Path) -> list:
             rows.append([key, pair["name"]] + cells(row["analytic"], row["mujoco"]))
         ref = study["rigid"][key]
         rows.append([key, "rigid (k -> infinity)"] + cells(ref["analytic"], ref["mujoco"]))
-        if not point["until_steady"]:
+        if not point["until_steady"] and "error" not in paper:
             rows.append([key, "the paper's ideal lock (paper's model, analytic only)",
                          fmt(paper["peak_clutch_force_n"], 4), fmt(paper["peak_acceleration_m_s2"], 4), "", "", ""])
     blocks.append(Table(header, rows))
@@ -273,10 +278,12 @@ def verdict(metrics: dict) -> dict:
         head = "at cruise" if point["until_steady"] else "at the paper's start-up"
         answers.append(f"{head}: " + "; ".join(cells) + (" (rigid clutches: " + "; ".join(rigid) + ")"
                                                           if rigid else ""))
-    answer = ("Peak clutch force and peak module acceleration, " + ". And ".join(answers)
-              + f". The paper's ideal lock instead carries up to {paper['peak_clutch_force_n']:.4g} N and jolts a "
-                f"module by {paper['peak_acceleration_m_s2']:.4g} m/s^2 at start-up: its spikes come from the lock "
-                "rule, not from real engagement. With real one-way clutches the accelerations stay those of the "
+    ideal = "" if "error" in paper else (
+        f". The paper's ideal lock instead carries up to {paper['peak_clutch_force_n']:.4g} N and jolts a module by "
+        f"{paper['peak_acceleration_m_s2']:.4g} m/s^2 at start-up: its spikes come from the lock rule, not from real "
+        "engagement")
+    answer = ("Peak clutch force and peak module acceleration, " + ". And ".join(answers) + ideal
+              + ". With real one-way clutches the accelerations stay those of the "
                 "linkage unless the play makes a stiff clutch an impact (F ~ sqrt(k)); the force is set by the "
                 "clutch's stiffness and play.")
     return {"question": "What engagement loads does a real one-way clutch give, instead of the ideal clutch's "
