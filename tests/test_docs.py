@@ -18,14 +18,16 @@ CLI = (DOCS / "cli.md").read_text()
 def _sections() -> dict[str, str]:
     """docs/cli.md's text under each '## `ipir-mujoco NAME`' heading."""
     parts = re.split(r"^## ", CLI, flags=re.MULTILINE)
-    return {m.group(1): part for part in parts if (m := re.match(r"`ipir-mujoco (\w+)`", part))}
+    return {m.group(1): part for part in parts if (m := re.match(r"`ipir-mujoco ([\w-]+)`", part))}
 
 
 def test_every_subcommand_and_option_is_documented():
     parser = build_parser()
     subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     sections = _sections()
-    assert set(subparsers.choices) == set(sections) == {c.__name__.rsplit(".", 1)[-1] for c in COMMANDS}
+    # one module per subcommand: cli/clutch_study.py is `clutch-study`
+    assert set(subparsers.choices) == set(sections) == {c.__name__.rsplit(".", 1)[-1].replace("_", "-")
+                                                         for c in COMMANDS}
     shared = CLI.split("## Options every model command shares")[1].split("\n## ")[0]
     for name, sub in subparsers.choices.items():
         for action in sub._actions:

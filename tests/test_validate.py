@@ -166,8 +166,8 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     assert "<script" not in page and "http://" not in page and "https://" not in page
     for text in (page, markdown, (out / "metrics.json").read_text()):
         assert not [ref for ref in OUTSIDE_REFERENCES if ref in text]
-    # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study
-    assert page.count('src="data:image/png;base64,') == 7
+    # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study; the sections' figures
+    assert page.count('src="data:image/png;base64,') == 7 + 1
     try:
         gl_backend()
         has_gl = True
@@ -186,6 +186,18 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
         assert html.escape(verdict["question"]) in page
     # parameters left to a rule are shown by the rule's word
     assert "| clutch_stiffness | rigid | N/m |" in markdown and "(uniform rod" in markdown
+    # the real-clutch section: its numbers, both engines at both operating points, its verdict and figure
+    section = metrics["sections"]["clutch_engagement"]
+    assert {(r["point"], r["clutch_stiffness_n_m"], r["clutch_backlash_m"]) for r in section["study"]["rows"]} == {
+        (point, p["clutch_stiffness"], p["clutch_backlash"]) for point in ("cruise", "startup")
+        for p in section["realistic"]}
+    assert all("error" not in r[e] for r in section["study"]["rows"] for e in ("analytic", "mujoco"))
+    assert metrics["verdicts"][-1]["evidence"] == "sections.clutch_engagement"
+    sprag = next(r for r in section["study"]["rows"] if r["point"] == "startup" and r["clutch_backlash_m"] == 0)
+    assert f"{sprag['analytic']['peak_clutch_force_n']:.3g} N" in metrics["verdicts"][-1]["answer"]
+    assert markdown.index("## Energy audit") < markdown.index("## Real clutches: engagement loads") < markdown.index(
+        "## Numerical convergence")
+    assert "](figures/clutch_engagement.png)" in markdown
 
 
 def test_report_is_complete_without_opengl(quick_validation, tmp_path, monkeypatch):

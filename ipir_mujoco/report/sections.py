@@ -18,6 +18,8 @@ from typing import Callable
 
 from ipir_mujoco.analytic.params import RobotParams
 
+from . import clutch_section
+
 Progress = Callable[[str], None]
 
 
@@ -30,4 +32,7 @@ class Section:
     verdict: Callable[[dict], dict | None] | None = None
 
 
-SECTIONS: tuple[Section, ...] = ()
+SECTIONS: tuple[Section, ...] = (
+    Section("clutch_engagement", "Real clutches: engagement loads", clutch_section.compute, clutch_section.render,
+            clutch_section.verdict),
+)
