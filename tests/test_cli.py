@@ -143,3 +143,12 @@ def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
 
 def test_drive_option_is_checked(capsys):
     assert exit_code(["simulate", "--drive", "servo"]) == 2
+
+
+def test_dt_out_defaults_to_whole_timesteps_of_a_given_timestep(capsys):
+    """--timestep alone must not make the default --dt-out (1e-4 s) invalid: it becomes 3 steps of 3e-5 s."""
+    code, out, _ = run_cli(capsys, "simulate", "--engine", "mujoco", "--clutch", "unilateral", "--json",
+                           "--t-end", "0.01", "--timestep", "3e-5")
+    record = json.loads(out)
+    assert code == 0 and record["settings"]["timestep"] == 3e-5
+    assert record["settings"]["dt_out"] == pytest.approx(9e-5, rel=1e-12)

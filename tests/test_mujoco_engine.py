@@ -188,7 +188,8 @@ def test_cli_mujoco_json_and_exit_statuses(capsys, tmp_path, monkeypatch):
     bad_mjcf.write_text("<mujoco><worldbody>")
     for argv, fragment in ((["--geometry", "approx"], "--geometry approx"), (["--set", "rod_mass=0"], "rod_mass=0"),
                            (["--set", "L=0.05"], "L=0.05"), (["--mjcf", str(tmp_path / "no.xml")], "no.xml"),
-                           (["--mjcf", str(bad_mjcf)], "bad.xml"), (["--timestep", "3e-5"], "dt_out")):
+                           (["--mjcf", str(bad_mjcf)], "bad.xml"),
+                           (["--timestep", "3e-5", "--dt-out", "1e-4"], "dt_out")):
         assert main(["simulate", "--engine", "mujoco", *argv]) == 2, argv
         err = capsys.readouterr().err
         assert fragment in err and err.count("\n") == 1, argv
