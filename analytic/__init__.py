@@ -24,6 +24,9 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     ``geometry``: 'approx' (the paper's first order) or 'exact'.
     ``clutch``: 'kinematic' (the paper's rule: lock by the sign of S_dot) or
     'unilateral' (one-way clutches that can only push).
+    ``options``: ``dt_out``, ``rtol``, ``atol``, ``until_steady``, ``steady_tol``,
+    ``steady_cycles``, ``progress``, ``max_switches``, ``wall_budget_s``, ``torque``
+    (see :func:`simulate_kinematic` and :func:`simulate_unilateral`).
     """
     try:
         geometry = Geometry(geometry).value
@@ -40,7 +43,7 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
 def _refuse_unmodelled(params: RobotParams) -> None:
     """Parameters this engine does not model yet are refused, never silently ignored."""
     defaults = RobotParams()
-    for name in ("drive", "clutch_stiffness", "clutch_damping", "clutch_backlash", "incline"):
+    for name in ("clutch_stiffness", "clutch_damping", "clutch_backlash"):
         if getattr(params, name) != getattr(defaults, name):
             raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the analytic engine yet; "
                                  f"allowed: {getattr(defaults, name)!r}")
