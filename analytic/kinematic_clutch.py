@@ -49,7 +49,7 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import RunMonitor, check_finite, check_run_options, stall_reason, truncate
+from .solver_support import RunMonitor, check_finite, check_run_options, restart_step, stall_reason, truncate
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -135,7 +135,7 @@ def simulate_kinematic(
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, 0.0])
     mode = choose_initial_mode(dyn, params.phi0, params.omega0, _torque_at(torque, 0.0, y))
     pieces: list[dict[str, np.ndarray]] = []
-    switches, stall = 0, None
+    switches, stall, h0 = 0, None, None
     while True:
         if mode is Mode.BOTH_LOCKED:
             if torque is not None:
@@ -145,8 +145,8 @@ def simulate_kinematic(
             stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g)
             pieces.append(_stalled_piece(dyn, monitor.samples(t, t_end, grid), y))
             break
-        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque)
-        t_stop = float(sol.t[-1])
+        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0)
+        t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         piece = _mode_piece(dyn, mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, torque)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
@@ -197,8 +197,8 @@ def mode_rhs(dyn: OneDofDynamics, mode: Mode, torque: Callable | None = None) ->
     return rhs
 
 
-def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None):
-    """Integrate one mode from t0 until its switch event or t_end."""
+def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_step=None):
+    """Integrate one mode from t0 until its switch event or t_end (``first_step`` [s]: see restart_step)."""
     linkage, rhs = dyn.linkage, mode_rhs(dyn, mode, torque)
 
     def gap_rate(_t, y):
@@ -209,7 +209,7 @@ def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None):
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
-                        events=gap_rate, dense_output=True)
+                        events=gap_rate, dense_output=True, first_step=first_step)
     if sol.status < 0:
         raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
     return sol

@@ -57,7 +57,8 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import (RunMonitor, check_finite, check_run_options, missed_crossing, stall_reason, truncate)
+from .solver_support import (RunMonitor, check_finite, check_run_options, missed_crossing, restart_step, stall_reason,
+                             truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -290,7 +291,7 @@ def simulate_unilateral(
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, v1_0, 0.0])
     mode = model.choose(0.0, y, (v1_0, v1_0 + S_dot0))
     y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
-    t, pieces, switches, short_run, stall = 0.0, [], 0, 0, None
+    t, pieces, switches, short_run, stall, h0 = 0.0, [], 0, 0, None, None
     while True:
         if mode is Mode.BOTH_LOCKED:
             if torque is not None:
@@ -302,12 +303,12 @@ def simulate_unilateral(
                 y[:, None], np.size(ts), axis=1)))
             break
         events = model.events(mode)
-        sol = _integrate(model, mode, events, t, t_end, y, rtol, atol)
+        sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
         spurious = _spurious_start(model, mode, sol)
         if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
             events = model.events(mode, quiet=dict([spurious]))
-            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol)
-        t_stop = float(sol.t[-1])
+            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
+        t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events])
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
@@ -344,12 +345,12 @@ def simulate_unilateral(
                                "rod_modelled": model.dyn.include_rod, **monitor.settings})
 
 
-def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol):
+def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step):
     """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end."""
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(model.rhs(mode), (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
-                        events=[e for e, _ in events], dense_output=True)
+                        events=[e for e, _ in events], dense_output=True, first_step=first_step)
     if sol.status < 0:
         raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
     return sol
