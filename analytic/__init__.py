@@ -12,7 +12,7 @@ from .compliant_run import simulate_compliant
 from .errors import ParameterError, SimulationError
 from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
-from .params import PARAMETER_NAMES, RobotParams, load_params
+from .params import PARAMETER_NAMES, RobotParams, load_params, require_params
 from .unilateral_clutch import simulate_unilateral
 from .results import COLUMNS, MODE_NAMES, Mode, RunResult
 
@@ -27,8 +27,13 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     ``clutch``: 'kinematic' (the paper's rule: lock by the sign of S_dot) or
     'unilateral' (one-way clutches that can only push; with a finite
     ``params.clutch_stiffness`` the compliant clutch model, which also models
-    clutch damping and backlash, the drive and gravity).
+    clutch damping and backlash).
+    ``options``: ``dt_out``, ``rtol``, ``atol``, ``until_steady``, ``steady_tol``,
+    ``steady_cycles``, ``progress``, ``max_switches``, ``wall_budget_s``, ``torque``
+    (see :func:`simulate_kinematic`, :func:`simulate_unilateral` and
+    :func:`simulate_compliant`).
     """
+    params = require_params(params)
     try:
         geometry = Geometry(geometry).value
     except ValueError:
@@ -47,17 +52,13 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
 
 
 def _refuse_unmodelled(params: RobotParams) -> None:
-    """Parameters this engine does not model yet are refused, never silently ignored."""
+    """Clutch damping and backlash need a clutch with a spring: refused with rigid clutches, never ignored."""
     defaults = RobotParams()
     for name in ("clutch_damping", "clutch_backlash"):
         if getattr(params, name) != getattr(defaults, name):
             raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid clutch "
                                  f"has no spring for it to act with); allowed: {getattr(defaults, name)!r} with "
                                  "clutch_stiffness=rigid")
-    for name in ("drive", "incline"):
-        if getattr(params, name) != getattr(defaults, name):
-            raise ParameterError(f"{name}={getattr(params, name)!r} is not modelled by the analytic engine yet; "
-                                 f"allowed: {getattr(defaults, name)!r}")
 
 
 __all__ = [

@@ -77,7 +77,7 @@ def simulate_compliant(
     Initial module velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in
     the other engines.
     """
-    check_run_options(t_end, dt_out, rtol, atol)
+    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
     if params.clutch_stiffness is None:
         raise ParameterError("clutch_stiffness=rigid: the compliant clutch model needs a finite stiffness; "
                              "allowed: 0 < clutch_stiffness <= 1e12 N/m")

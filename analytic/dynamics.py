@@ -5,20 +5,28 @@ With the front module locked (contraction, x2_dot = 0) or the rear one locked
 x1_dot = e(phi) * omega with e = -K in contraction and e = 0 in expansion, and
 x2_dot = (e + K) * omega. Lagrange's equation in phi then reads
 
-    J_eff(phi) * alpha + 1/2 * J_eff'(phi) * omega^2 = Q(phi)
+    J_eff(phi) * alpha + 1/2 * J_eff'(phi) * omega^2 = Q(phi, omega)
 
     J_eff = J_A + m1 e^2 + m2 (e + K)^2 + m_rod ((e + a)^2 + b^2) + I_rod g^2
-    Q     = M - F_r1 e - F_r2 (e + K)
+    Q     = M(omega) - F_r1 e - F_r2 (e + K) + a_g P
+
+with M(omega) the drive's torque (:func:`.forces.drive_torque`) and a_g the
+acceleration gravity gives every body along the pipe
+(:func:`.forces.gravity_along_pipe`). Gravity along x is a uniform field, so
+its generalized force is a_g times the first column of the mass matrix in
+(x1, phi): a_g [M11, M12]; with x1_dot = e omega that is a_g P (P below, the
+momentum coefficient). The crank is balanced: gravity loads only its bearing.
 
 where (a, b, g) are the rod's velocity coefficients (see
 :class:`ipir_mujoco.analytic.kinematics.RodMotion`). With the first-order geometry the rod
 is ignored, as in the paper, and this is exactly the paper's (20)-(22):
 J_eff = J_A + m K^2, and 1/2 J_eff' = m K K'.
 
-Kinetostatics: the only external forces along x are the resistance of the
-moving module and the reaction of the locked clutch, so that reaction is the
-rate of change of the total momentum p = P(phi) * omega plus the resistance:
-lambda_locked = P' omega^2 + P alpha + F_moving.
+Kinetostatics: the external forces along x are the resistance of the moving
+module, gravity on the whole robot (M11 a_g) and the reaction of the locked
+clutch, so that reaction is the rate of change of the total momentum
+p = P(phi) * omega plus the resistance, less gravity:
+lambda_locked = P' omega^2 + P alpha + F_moving - M11 a_g.
 
 All methods are vectorized: ``phi`` and ``omega`` may be floats or ndarrays of
 one shape; results have that shape. Units: rad, rad/s, m, kg, N, J.
@@ -30,6 +38,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .forces import drive_torque, gravity_along_pipe
 from .kinematics import Geometry, Linkage, Transfer
 from .params import RobotParams
 from .results import Mode
@@ -77,6 +86,11 @@ class OneDofDynamics:
         if include_rod and self.geometry is not Geometry.EXACT:
             raise ValueError("rod mass needs the exact geometry; the first-order model has no rigid rod")
         self.include_rod = include_rod and (params.rod_mass > 0 or params.rod_inertia_value > 0)
+        self.a_g = gravity_along_pipe(params)  # [m/s^2], + forward (downhill)
+
+    def torque(self, omega, M=None):
+        """The crank torque [N m]: ``M`` if given, else the drive's torque at crank speed ``omega``."""
+        return drive_torque(self.params, omega) if M is None else M
 
     def mass_terms(self, phi) -> MassTerms:
         """The 2x2 mass matrix in (x1, phi) and its derivatives in phi.
@@ -100,8 +114,8 @@ class OneDofDynamics:
             dm22 = dm22 + 2.0 * (m * (rod.a * rod.da + rod.b * rod.db) + inertia * rod.g * rod.dg)
         return MassTerms(m11, m12, m22, dm12, dm22, tr)
 
-    def _terms(self, phi, mode: Mode, M=None):
-        """J_eff, dJ_eff/dphi, Q, P, dP/dphi, e, de, f, df and the transfer.
+    def _terms(self, phi, omega, mode: Mode, M=None):
+        """J_eff, dJ_eff/dphi, Q, P, dP/dphi, e, de, f, df, M11 and the transfer.
 
         With x1_dot = e omega the locked-module system has J_eff = [e, 1] M [e, 1]^T
         and total momentum P omega with P = M11 e + M12.
@@ -120,36 +134,37 @@ class OneDofDynamics:
         dJ = 2.0 * mt.m11 * e * de + 2.0 * (mt.dm12 * e + mt.m12 * de) + mt.dm22
         P = mt.m11 * e + mt.m12
         dP = mt.m11 * de + mt.dm12
-        Q = (p.M if M is None else M) - p.F_r1 * e - p.F_r2 * f
-        return J, dJ, Q, P, dP, e, de, f, df, mt.transfer
+        Q = self.torque(omega, M) - p.F_r1 * e - p.F_r2 * f + self.a_g * P
+        return J, dJ, Q, P, dP, e, de, f, df, mt.m11, mt.transfer
 
     def both_moving(self, phi, omega, M=None):
         """(x1_ddot [m/s^2], alpha [rad/s^2]) with both modules sliding forward against F_r1, F_r2.
 
-        M [x1_ddot, alpha]^T + [M12' omega^2, 1/2 M22' omega^2]^T = [-F_r1 - F_r2, M - F_r2 K]^T.
+        M [x1_ddot, alpha]^T + [M12' omega^2, 1/2 M22' omega^2]^T
+            = [-F_r1 - F_r2 + M11 a_g, M - F_r2 K + M12 a_g]^T.
         """
         p = self.params
         mt = self.mass_terms(phi)
-        rhs1 = -p.F_r1 - p.F_r2 - mt.dm12 * omega**2
-        rhs2 = (p.M if M is None else M) - p.F_r2 * mt.transfer.K - 0.5 * mt.dm22 * omega**2
+        rhs1 = -p.F_r1 - p.F_r2 + mt.m11 * self.a_g - mt.dm12 * omega**2
+        rhs2 = self.torque(omega, M) - p.F_r2 * mt.transfer.K + mt.m12 * self.a_g - 0.5 * mt.dm22 * omega**2
         det = mt.m11 * mt.m22 - mt.m12**2
         return (mt.m22 * rhs1 - mt.m12 * rhs2) / det, (mt.m11 * rhs2 - mt.m12 * rhs1) / det
 
     def acceleration(self, phi, omega, mode: Mode, M=None):
-        """Crank angular acceleration alpha [rad/s^2] in ``mode``; ``M`` [N m] overrides params.M."""
-        J, dJ, Q, *_ = self._terms(phi, mode, M)
+        """Crank angular acceleration alpha [rad/s^2] in ``mode``; ``M`` [N m] overrides the drive's torque."""
+        J, dJ, Q, *_ = self._terms(phi, omega, mode, M)
         return (Q - 0.5 * dJ * omega**2) / J
 
     def state(self, phi, omega, mode: Mode, M=None) -> ModeState:
-        """Accelerations, module velocities, reactions and energy in ``mode`` (``M`` overrides params.M)."""
-        J, dJ, Q, P, dP, e, de, f, df, tr = self._terms(phi, mode, M)
+        """Accelerations, module velocities, reactions and energy in ``mode`` (``M`` overrides the drive)."""
+        J, dJ, Q, P, dP, e, de, f, df, m11, tr = self._terms(phi, omega, mode, M)
         alpha = (Q - 0.5 * dJ * omega**2) / J
-        momentum_rate = dP * omega**2 + P * alpha
+        hold = dP * omega**2 + P * alpha - m11 * self.a_g  # momentum rate less gravity on the robot
         zero = 0.0 * alpha
         if mode is Mode.CONTRACTION:
-            lambda1, lambda2 = zero, momentum_rate + self.params.F_r1
+            lambda1, lambda2 = zero, hold + self.params.F_r1
         else:
-            lambda1, lambda2 = momentum_rate + self.params.F_r2, zero
+            lambda1, lambda2 = hold + self.params.F_r2, zero
         return ModeState(
             alpha=alpha,
             S=tr.S,
@@ -168,46 +183,103 @@ class OneDofDynamics:
         mt = self.mass_terms(phi)
         return 0.5 * (mt.m11 * v1**2 + 2.0 * mt.m12 * v1 * omega + mt.m22 * omega**2)
 
-    def energy_audit(self, series: dict, motor_work: float) -> dict[str, float]:
-        """Motor work = kinetic energy gained + friction work + residual [J] over a run's series.
+    def potential_energy(self, phi, x1, x2):
+        """Gravitational potential energy [J], up to a constant: -a_g (m1 x1 + m2 x2 + m_rod G_x).
 
-        Modules only move forward (or, in the free mechanism, feel no resistance),
-        so the work against the constant resistances is F_r times the displacements.
+        G_x = x1 + (the rod centre's x relative to A); the rod counts only where it is
+        modelled. dV/dx1 = -a_g M11 and dV/dphi = -a_g M12: the generalized gravity forces
+        above. Zero in a horizontal pipe.
         """
         p = self.params
-        phi, v1, omega = series["phi"], series["v1"], series["omega"]
-        gained = float(self.kinetic_energy(phi[-1], v1[-1], omega[-1]) - self.kinetic_energy(phi[0], v1[0], omega[0]))
-        friction = float(p.F_r1 * series["x1"][-1] + p.F_r2 * series["x2"][-1])
-        return {"motor_work_j": float(motor_work), "kinetic_j": gained, "friction_j": friction,
-                "residual_j": float(motor_work - gained - friction)}
+        moment = p.m1 * x1 + p.m2 * x2
+        if self.include_rod:
+            moment = moment + p.rod_mass * (x1 + self.linkage.rod_com(phi)[0])
+        return -self.a_g * moment
+
+    def energy_columns(self, series: dict) -> dict[str, np.ndarray]:
+        """The cumulative energy columns [J] of a run's series: kinetic, potential, friction_work.
+
+        Needs phi, omega, v1, x1, x2 (x_i from 0 at t = 0). ``potential`` is relative to t = 0.
+        ``friction_work`` = F_r1 x1 + F_r2 x2 is exact, not an approximation of the integral of
+        F_r1 |v1| + F_r2 |v2|: with rigid clutches (the paper's locks or one-way clutches) a module
+        never moves backward, so |v_i| = v_i and the integral is F_ri times the displacement.
+        """
+        p = self.params
+        phi, x1, x2 = series["phi"], series["x1"], series["x2"]
+        potential = self.potential_energy(phi, x1, x2)
+        return {"kinetic": self.kinetic_energy(phi, series["v1"], series["omega"]),
+                "potential": potential - potential[0],
+                "friction_work": p.F_r1 * x1 + p.F_r2 * x2}
+
+    def energy_audit(self, series: dict, motor_work: float | None = None) -> dict[str, float]:
+        """Motor work = kinetic + potential energy gained + friction work + residual [J] over a run.
+
+        Reads the columns ``kinetic``, ``potential``, ``friction_work`` (computed with
+        :meth:`energy_columns` where absent) and ``motor_work`` unless ``motor_work`` is given.
+        """
+        columns = {c: series[c] for c in ("kinetic", "potential", "friction_work") if c in series}
+        if len(columns) < 3:
+            ends = {c: np.asarray(series[c])[[0, -1]] for c in ("phi", "omega", "v1", "x1", "x2")}
+            columns = self.energy_columns(ends)
+        motor = float(series["motor_work"][-1] - series["motor_work"][0]) if motor_work is None else float(motor_work)
+        gained, lifted = (float(columns[c][-1] - columns[c][0]) for c in ("kinetic", "potential"))
+        friction = float(columns["friction_work"][-1] - columns["friction_work"][0])
+        return {"motor_work_j": motor, "kinetic_j": gained, "potential_j": lifted, "friction_j": friction,
+                "residual_j": motor - gained - lifted - friction}
 
     def motor_torque(self, phi, omega, alpha, a1, front_external):
         """Torque [N m] the motor must apply for crank motion (omega, alpha) and module-1 acceleration a1.
 
-        The phi-row of the two-DOF equations: M = M12 a1 + M22 alpha + 1/2 M22' omega^2 - K H2,
-        with H2 [N] the external force on module 2 (its hold, or -F_r2 while it moves).
+        The phi-row of the two-DOF equations:
+        M = M12 a1 + M22 alpha + 1/2 M22' omega^2 - K H2 - M12 a_g,
+        with H2 [N] the external force on module 2 but gravity (its hold, or -F_r2 while it moves).
         """
         mt = self.mass_terms(phi)
-        return mt.m12 * a1 + mt.m22 * alpha + 0.5 * mt.dm22 * omega**2 - mt.transfer.K * front_external
+        return (mt.m12 * (a1 - self.a_g) + mt.m22 * alpha + 0.5 * mt.dm22 * omega**2
+                - mt.transfer.K * front_external)
 
     def static_push(self, phi, M=None):
         """Force [N] with which the linkage, crank at rest, pushes module 2 forward (and module 1 back).
 
-        Virtual work on the massless-at-rest linkage: M dphi = P dS, so P = M / K;
-        at a dead centre (K = 0) the torque loads neither module.
+        Virtual work on the linkage: M dphi = P dS, so P = M / K, with M the drive's
+        torque at rest unless given; at a dead centre (K = 0) the torque loads neither module.
         """
         K = self.linkage.transfer(phi).K
-        M = self.params.M if M is None else M
-        with np.errstate(divide="ignore", invalid="ignore"):
+        M = self.torque(0.0, M)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # K ~ 1e-308: inf, no hold
             return np.where(K != 0, M / np.where(K != 0, K, 1.0), 0.0)
 
-    def stalled_reactions(self, phi):
-        """Clutch reactions holding a robot at rest with both modules locked [N].
+    def static_holds(self, phi, M=None):
+        """(R1, R2) [N]: the forces that hold each module of a robot at rest, + forward.
 
-        The linkage pushes module 2 with P = M / K and pulls module 1 with -P
-        (:meth:`static_push`). The module pulled backward is held by its clutch
-        (reaction |P|); the one pushed forward by its static resistance (a stall
-        means |P| <= F_r), so its clutch carries nothing.
+        Each is its clutch's and its resistance's together. Statics in (x1, phi) with
+        omega = 0: x1-row R1 + R2 + M11 a_g = 0, phi-row M + K R2 + M12 a_g = 0, so
+        R2 = -M / K - a_g M12 / K and R1 = -M11 a_g - R2. M12 / K = m2 + m_rod dG_x/dS stays
+        finite at a dead centre (dG_x/dS = (1 + D / S) / 2 in the exact geometry, D the rod's
+        projection on x), where the rod's weight splits between the pins as in the limit.
         """
-        push = self.static_push(phi)
-        return np.maximum(push, 0.0), np.maximum(-push, 0.0)
+        p = self.params
+        push = self.static_push(phi, M)
+        on_front = np.full(np.shape(push), p.m2)  # mass whose weight module 2's hold carries at rest
+        if self.include_rod:
+            tr = self.linkage.transfer(phi)
+            projection = tr.S - p.r * np.cos(phi)  # D = sqrt(L^2 - r^2 sin^2 phi)
+            on_front = on_front + p.rod_mass * 0.5 * (1.0 + projection / tr.S)
+        total = self.mass_terms(phi).m11
+        R2 = -push - self.a_g * on_front
+        return -total * self.a_g - R2, R2
+
+    def stalled_reactions(self, phi):
+        """Clutch reactions and resistance forces holding a robot at rest (both locked) [N].
+
+        Returns (lambda1, lambda2, resistance1, resistance2). Each module's hold R_i
+        (:meth:`static_holds`) is split as in every clutch model: a clutch only
+        pushes, so a hold pulling backward (R_i < 0) is the static resistance's, up to
+        F_ri; beyond that (only possible under the paper's bilateral locks) the lock pulls.
+        """
+        holds = self.static_holds(phi)
+        out = []
+        for R, F in zip(holds, (self.params.F_r1, self.params.F_r2)):
+            resistance = np.maximum(np.minimum(R, 0.0), -F)
+            out.append((R - resistance, resistance))
+        return out[0][0], out[1][0], out[0][1], out[1][1]

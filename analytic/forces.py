@@ -23,9 +23,8 @@ def drive_torque(params: RobotParams, omega):
     both sides (it brakes above omega_noload and gives more than M_stall when
     driven backward).
     """
-    if params.drive == "motor":
-        return params.M_stall * (1.0 - np.asarray(omega, dtype=float) / params.omega_noload) \
-            if isinstance(omega, np.ndarray) else params.M_stall * (1.0 - omega / params.omega_noload)
+    if params.drive == "motor":  # one expression for floats and arrays, so both paths are the same law
+        return params.M_stall * (1.0 - omega / params.omega_noload)
     return params.M + 0.0 * omega if isinstance(omega, np.ndarray) else params.M
 
 

@@ -7,7 +7,9 @@ their own dynamics (both can slide at once), integrated event by event as in
 :mod:`ipir_mujoco.analytic.unilateral_clutch` but with the crank's motion given instead of
 the torque. At every instant the motor torque is the phi-row of the two-DOF
 equations (:meth:`OneDofDynamics.motor_torque`), and the clutch reactions,
-rod and pin forces follow as in the forward models.
+rod and pin forces follow as in the forward models. Gravity along the pipe
+(a_g) enters every equation as in the forward models; the drive parameters do
+not (the torque is what this computes).
 """
 
 from __future__ import annotations
@@ -80,20 +82,21 @@ class _Prescribed:
 
     def evaluate(self, t, y, mode: Mode) -> dict:
         """Velocities, accelerations, holding forces R (nan if moving) and motor torque."""
-        p = self.p
+        p, a_g = self.p, self.dyn.a_g
         phi, omega, alpha = self.crank(t)
         mt = self.dyn.mass_terms(phi)
         K, dK = mt.transfer.K, mt.transfer.dK
         nan = np.nan * np.asarray(phi, dtype=float)
         if mode is Mode.CONTRACTION:
             v1, a1 = -K * omega, -(dK * omega**2 + K * alpha)
-            R1, R2 = nan, mt.m11 * a1 + mt.m12 * alpha + mt.dm12 * omega**2 + p.F_r1
+            # total momentum rate = hold - F_r1 + M11 a_g (Newton along x for the whole robot)
+            R1, R2 = nan, mt.m11 * (a1 - a_g) + mt.m12 * alpha + mt.dm12 * omega**2 + p.F_r1
         elif mode is Mode.EXPANSION:
             v1, a1 = 0.0 * K, 0.0 * K
-            R1, R2 = mt.m12 * alpha + mt.dm12 * omega**2 + p.F_r2, nan
+            R1, R2 = mt.m12 * alpha + mt.dm12 * omega**2 + p.F_r2 - mt.m11 * a_g, nan
         else:
             v1 = y[2]
-            a1 = (-p.F_r1 - p.F_r2 - mt.m12 * alpha - mt.dm12 * omega**2) / mt.m11
+            a1 = (-p.F_r1 - p.F_r2 + mt.m11 * a_g - mt.m12 * alpha - mt.dm12 * omega**2) / mt.m11
             R1, R2 = nan, nan
         v2, a2 = v1 + K * omega, a1 + dK * omega**2 + K * alpha
         front_external = np.where(np.isnan(R2), -p.F_r2, R2)
@@ -144,7 +147,7 @@ class _Prescribed:
         v_scale = self.p.r * abs(omega) + sum(abs(v) for v in velocities)
         at_rest = [abs(v) <= 1e-8 * v_scale + 1e-14 for v in velocities]
         p = self.p
-        a_scale = p.r * (omega**2 + abs(alpha)) + (p.F_r1 + p.F_r2) / min(p.m1, p.m2) + 1e-300
+        a_scale = p.r * (omega**2 + abs(alpha)) + (p.F_r1 + p.F_r2) / min(p.m1, p.m2) + abs(self.dyn.a_g) + 1e-300
         f_scale = p.F_r1 + p.F_r2 + (p.m1 + p.m2) * a_scale
         margins = {}
         for mode, held in HELD.items():
@@ -180,7 +183,7 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: kinematic, unilateral")
     t_end = motion.t_end
     dt_out = dt_out or t_end / 2000
-    check_run_options(t_end, dt_out, rtol, atol)
+    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
     started = time.perf_counter()
     model = _Prescribed(params, geometry, motion, clutch)
     grid = np.linspace(0.0, t_end, max(1, math.ceil(t_end / dt_out - 1e-9)) + 1)
@@ -213,9 +216,9 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
         if t >= t_end:
             break
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
-    motor_work = float(series.pop("motor_work")[-1])
+    series.update(model.dyn.energy_columns(series))
     add_kinetostatics(series, model.dyn)
-    energy = model.dyn.energy_audit(series, motor_work)
+    energy = model.dyn.energy_audit(series)
     return RunResult(engine="analytic-inverse", geometry=model.dyn.geometry.value, clutch=clutch, params=params,
                      t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,
                      settings={"motion": motion.description, "rtol": rtol, "atol": atol, "dt_out": dt_out})

@@ -21,7 +21,15 @@ expansion). Its first non-vanishing time derivative decides:
   alpha = M / J_eff, and S - S0 = K' (phi - phi0)^2 / 2 + O(phi^3): the gap
   shrinks (contraction) where K' < 0, as at phi = 0, and grows where K' > 0.
 * If no mode is consistent the robot stalls: both clutches hold, the crank
-  stays at rest, and under constant loads it stays so (``BOTH_LOCKED``).
+  stays at rest, and under constant loads it stays so (``BOTH_LOCKED``): the
+  drive's torque at rest is constant (M, or the motor's M_stall), so the stall
+  is final and reported in ``RunResult.stall``.
+
+The drive's torque (:func:`.forces.drive_torque`) and gravity along the pipe
+enter every mode through :class:`.dynamics.OneDofDynamics`. With the crank at
+rest mid-stroke, both modes are consistent only if gravity alone could move
+either module (a_g M_total > F_r1 + F_r2, a steep downhill): the paper's rule
+cannot say which module then moves, and the run stops with a SimulationError.
 """
 
 from __future__ import annotations
@@ -33,13 +41,15 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
+from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import check_finite, check_run_options, sample_times
+from .solver_support import RunMonitor, check_finite, check_run_options, restart_step, stall_reason, truncate
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -50,7 +60,7 @@ _ZERO_SD = 1e-10
 
 
 def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float, M: float | None = None) -> Mode:
-    """Next mode at a state where S_dot = 0 (see the module docstring); ``M`` overrides params.M."""
+    """Next mode at a state where S_dot = 0 (see the module docstring); ``M`` overrides the drive's torque."""
     tr = dyn.linkage.transfer(phi)
     alpha_c = float(dyn.acceleration(phi, omega, Mode.CONTRACTION, M))
     alpha_e = float(dyn.acceleration(phi, omega, Mode.EXPANSION, M))
@@ -58,11 +68,13 @@ def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float, M: fl
     sdd_e = tr.dK * omega**2 + tr.K * alpha_e
     tol = _ZERO_SDD * dyn.linkage.r * (omega**2 + abs(alpha_c) + abs(alpha_e))
     contraction_ok, expansion_ok = sdd_c < -tol, sdd_e > tol
-    if contraction_ok and expansion_ok:
+    if contraction_ok and expansion_ok:  # only where gravity alone can move either module (docstring)
+        p = dyn.params
         raise SimulationError(
-            f"both modes consistent at phi={phi:.6g} rad, omega={omega:.6g} rad/s "
-            "(impossible for non-negative resistances)"
-        )
+            f"the paper's clutch rule cannot choose a module at phi={phi:.6g} rad, omega={omega:.6g} rad/s: "
+            f"gravity along the pipe ({dyn.a_g:.4g} m/s^2) can move either module on its own, more than the "
+            f"resistances hold ((F_r1 + F_r2) / total mass = {(p.F_r1 + p.F_r2) / dyn.mass_terms(phi).m11:.4g} "
+            "m/s^2); use the one-way clutches (clutch='unilateral')")
     if contraction_ok:
         return Mode.CONTRACTION
     if expansion_ok:
@@ -90,20 +102,31 @@ def simulate_kinematic(
     atol: float = 1e-12,
     max_switches: int = 100_000,
     torque: Callable | None = None,
+    until_steady: bool = False,
+    steady_tol: float = STEADY_TOL,
+    steady_cycles: int = STEADY_CYCLES,
+    progress: Callable[[float], None] | None = None,
+    wall_budget_s: float | None = None,
 ) -> RunResult:
     """Simulate the robot with the paper's clutch rule.
 
     ``geometry`` 'approx' is the paper's model (rod ignored); 'exact' uses the
     exact slider-crank with the rod's mass and inertia. ``dt_out`` [s] is the
-    output grid; mode-switch instants are added to it (twice: once per mode).
-    ``rtol``/``atol`` go to ``solve_ivp`` (DOP853) on the state
-    (phi [rad], omega [rad/s], x1 [m], x2 [m], motor work [J]).
-    ``torque(t, phi, omega)`` [N m], vectorized, replaces the constant M
+    output grid; mode-switch instants are added to it (twice: once per mode),
+    and so is each revolution's end. ``rtol``/``atol`` go to ``solve_ivp``
+    (DOP853) on the state (phi [rad], omega [rad/s], x1 [m], x2 [m], motor work [J]).
+    ``torque(t, phi, omega)`` [N m], vectorized, replaces the drive of ``params``
     (e.g. a torque from inverse kinetostatics); a stall under it is an error,
-    since a stall is only final under constant loads.
+    since a stall is only final where the torque at rest is constant. With
+    ``until_steady`` the run stops at the end of the revolution where the
+    periodic steady state is reached (``steady_tol``, ``steady_cycles``: see
+    :class:`.cycles.SteadyWatch`); ``t_end`` [s] is the cap. Work budget and
+    progress: see :class:`.solver_support.RunMonitor`.
     """
-    check_run_options(t_end, dt_out, rtol, atol)
-    started = time.perf_counter()
+    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
+    monitor = RunMonitor(t_end, params.phi0, max_switches=max_switches, wall_budget_s=wall_budget_s,
+                         progress=progress, until_steady=until_steady, steady_tol=steady_tol,
+                         steady_cycles=steady_cycles)
     dyn = OneDofDynamics(params, geometry)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)
@@ -112,33 +135,35 @@ def simulate_kinematic(
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, 0.0])
     mode = choose_initial_mode(dyn, params.phi0, params.omega0, _torque_at(torque, 0.0, y))
     pieces: list[dict[str, np.ndarray]] = []
-    switches = 0
+    switches, stall, h0 = 0, None, None
     while True:
         if mode is Mode.BOTH_LOCKED:
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
-                                      "restarting from a stall is modelled only for a constant torque")
-            # Everything at rest under constant loads: nothing changes any more.
-            pieces.append(_stalled_piece(dyn, sample_times(t, t_end, grid), y))
+                                      "restarting from a stall is modelled only for a constant torque at rest")
+            # Everything at rest under a torque that is constant at rest: nothing changes any more.
+            stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g)
+            pieces.append(_stalled_piece(dyn, monitor.samples(t, t_end, grid), y))
             break
-        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque)
-        t_stop = float(sol.t[-1])
-        pieces.append(_mode_piece(dyn, mode, sample_times(t, t_stop, grid), sol.sol, torque))
-        if sol.status != 1:
+        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0)
+        t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
+        piece = _mode_piece(dyn, mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, torque)
+        steady_at = monitor.observe(piece)
+        pieces.append(piece if steady_at is None else truncate(piece, steady_at))
+        if steady_at is not None or sol.status != 1:
             break
         t, y = float(sol.t_events[0][0]), sol.y_events[0][0].copy()
         switches += 1
-        if switches > max_switches:
-            raise SimulationError(f"more than {max_switches} mode switches by t={t:.6g} s: the clutch rule chatters")
+        monitor.after_switch(t, switches, float(y[0]))
         mode = choose_mode_at_rest_gap(dyn, float(y[0]), float(y[1]), _torque_at(torque, t, y))
         if t >= t_end:
             break
 
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
-    motor_work = float(series.pop("motor_work")[-1])
+    monitor.report(float(series["t"][-1]), final=True)
+    series.update(dyn.energy_columns(series))
     add_kinetostatics(series, dyn)
     del series["motor_torque"]  # folded into motor_power
-    energy = dyn.energy_audit(series, motor_work)
     check_finite(series)
     return RunResult(
         engine="analytic",
@@ -147,10 +172,11 @@ def simulate_kinematic(
         params=params,
         t_end=t_end,
         series=series,
-        energy=energy,
-        wall_time_s=time.perf_counter() - started,
+        energy=dyn.energy_audit(series),
+        wall_time_s=time.perf_counter() - monitor.started,
         settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
-                  "rod_modelled": dyn.include_rod},
+                  "rod_modelled": dyn.include_rod, **monitor.settings},
+        stall=stall,
     )
 
 
@@ -158,25 +184,32 @@ def _torque_at(torque, t, y):
     return None if torque is None else float(torque(t, y[0], y[1]))
 
 
-def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None):
-    """Integrate one mode from t0 until its switch event or t_end."""
-    linkage = dyn.linkage
-    constant = dyn.params.M
+def mode_rhs(dyn: OneDofDynamics, mode: Mode, torque: Callable | None = None) -> Callable:
+    """d/dt of y = [phi, omega, x1, x2, motor work] in ``mode``: the drive's torque, or ``torque(t, phi, omega)``."""
+    linkage, params = dyn.linkage, dyn.params
 
     def rhs(t, y):
         phi, omega = y[0], y[1]
         K = linkage.transfer(phi).K
         e = -K if mode is Mode.CONTRACTION else 0.0
-        M = constant if torque is None else torque(t, phi, omega)
+        M = drive_torque(params, omega) if torque is None else torque(t, phi, omega)
         return [omega, dyn.acceleration(phi, omega, mode, M), e * omega, (e + K) * omega, M * omega]
+    return rhs
+
+
+def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_step=None):
+    """Integrate one mode from t0 until its switch event or t_end (``first_step`` [s]: see restart_step)."""
+    linkage, rhs = dyn.linkage, mode_rhs(dyn, mode, torque)
 
     def gap_rate(_t, y):
         return linkage.transfer(y[0]).K * y[1]
 
     gap_rate.terminal = True
     gap_rate.direction = 1.0 if mode is Mode.CONTRACTION else -1.0
-    sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
-                    events=gap_rate, dense_output=True)
+    with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
+        # controller rejects them, and the output is checked finite
+        sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
+                        events=gap_rate, dense_output=True, first_step=first_step)
     if sol.status < 0:
         raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
     return sol
@@ -184,7 +217,8 @@ def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None):
 
 def _mode_piece(dyn, mode, times, dense, torque=None) -> dict[str, np.ndarray]:
     phi, omega, x1, x2, work = dense(times)
-    M = np.full(times.shape, dyn.params.M) if torque is None else torque(times, phi, omega)
+    M = drive_torque(dyn.params, omega) if torque is None else torque(times, phi, omega)
+    M = np.broadcast_to(M, times.shape).astype(float)
     st = dyn.state(phi, omega, mode, M)
     return {
         "t": times, "phi": phi, "omega": omega, "alpha": st.alpha, "x1": x1, "x2": x2,
@@ -200,7 +234,7 @@ def _mode_piece(dyn, mode, times, dense, torque=None) -> dict[str, np.ndarray]:
 
 def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
     n = times.shape
-    lam1, lam2 = dyn.stalled_reactions(y[0])
+    lam1, lam2, res1, res2 = dyn.stalled_reactions(y[0])
     zeros = np.zeros(n)
     return {
         "t": times, "phi": np.full(n, y[0]), "omega": zeros, "alpha": zeros,
@@ -208,7 +242,7 @@ def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
         "a1": zeros, "a2": zeros, "S": np.full(n, dyn.linkage.gap(y[0])), "S_dot": zeros,
         "lambda1": np.full(n, lam1), "lambda2": np.full(n, lam2),
         "mode": np.full(n, int(Mode.BOTH_LOCKED)),
-        # the module pushed forward is held by its resistance (see stalled_reactions)
-        "resistance1": np.full(n, -lam2), "resistance2": np.full(n, -lam1),
-        "motor_work": np.full(n, y[4]), "motor_torque": np.full(n, dyn.params.M),
+        # a hold pulling a module back is its resistance's (see stalled_reactions)
+        "resistance1": np.full(n, res1), "resistance2": np.full(n, res2),
+        "motor_work": np.full(n, y[4]), "motor_torque": np.full(n, float(drive_torque(dyn.params, 0.0))),
     }

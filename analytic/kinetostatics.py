@@ -14,7 +14,9 @@ motor_power        W      motor torque * omega (the ``motor_torque`` column if p
 
 Frame and symbols as in :mod:`ipir_mujoco.analytic.kinematics`: e = (C - B) / L is the
 rod's unit vector, beta its angle. In the first-order geometry the rod is
-massless and taken along x (L >> r), as in the paper.
+massless and taken along x (L >> r), as in the paper. Gravity along the pipe
+(a_g, :func:`.forces.gravity_along_pipe`) is a uniform field along x: in each
+body's Newton equation it enters as the x-acceleration a_x - a_g.
 """
 
 from __future__ import annotations
@@ -32,7 +34,8 @@ def add_kinetostatics(series: dict[str, np.ndarray], dyn: OneDofDynamics) -> Non
     p, link = dyn.params, dyn.linkage
     phi, omega, alpha = series["phi"], series["omega"], series["alpha"]
     held_force = series["lambda2"] + series["resistance2"]  # external x-force on module 2 but the rod's
-    on_rod_x = held_force - p.m2 * series["a2"]  # force on the rod at C, x: minus the rod's pull on module 2
+    a_g = dyn.a_g
+    on_rod_x = held_force - p.m2 * (series["a2"] - a_g)  # force on the rod at C, x: minus the rod's pull on module 2
     if link.geometry.value == "approx":
         series["rod_force"] = on_rod_x
         series["crank_pin_force"] = np.abs(on_rod_x)
@@ -42,17 +45,17 @@ def add_kinetostatics(series: dict[str, np.ndarray], dyn: OneDofDynamics) -> Non
         cb_x, cb_y = D, -r * s  # C - B
         if dyn.include_rod:
             rod = link.rod_motion(phi)
-            a_gx = series["a1"] + rod.da * omega**2 + rod.a * alpha
-            a_gy = rod.db * omega**2 + rod.b * alpha
+            acc_x = series["a1"] + rod.da * omega**2 + rod.a * alpha - a_g  # relative to free fall
+            acc_y = rod.db * omega**2 + rod.b * alpha
             beta_acc = rod.dg * omega**2 + rod.g * alpha
             # moment about B of the rod: I_G beta_ddot + m (G - B) x a_G = (C - B) x F_C, G - B = (C - B) / 2
-            moment = p.rod_inertia_value * beta_acc + p.rod_mass * 0.5 * (cb_x * a_gy - cb_y * a_gx)
+            moment = p.rod_inertia_value * beta_acc + p.rod_mass * 0.5 * (cb_x * acc_y - cb_y * acc_x)
             on_rod_y = (moment + cb_y * on_rod_x) / cb_x
-            pin_x, pin_y = p.rod_mass * a_gx - on_rod_x, p.rod_mass * a_gy - on_rod_y  # crank on rod at B
+            pin_x, pin_y = p.rod_mass * acc_x - on_rod_x, p.rod_mass * acc_y - on_rod_y  # crank on rod at B
         else:
             on_rod_y = cb_y * on_rod_x / cb_x  # massless rod: the pin force lies along it
             pin_x, pin_y = -on_rod_x, -on_rod_y
         series["rod_force"] = (on_rod_x * cb_x + on_rod_y * cb_y) / p.L
         series["crank_pin_force"] = np.hypot(pin_x, pin_y)
-    torque = series.get("motor_torque", p.M)  # a torque profile where the run has one, else the constant M
+    torque = series.get("motor_torque", p.M)  # every solver writes the torque it applied; else the constant M
     series["motor_power"] = torque * omega

@@ -1,12 +1,15 @@
-"""Helpers shared by the analytic solvers: option checks, output sampling, finiteness."""
+"""Helpers shared by the analytic solvers: option checks, output sampling, finiteness, and the
+run monitor (work budget, progress, revolution ends, steady state)."""
 
 from __future__ import annotations
 
-import contextlib
-from typing import Iterator
+import math
+import time
 
 import numpy as np
+from scipy.optimize import brentq
 
+from .cycles import SteadyWatch
 from .errors import ParameterError, SimulationError
 from .params import check_real
 from .params import check_run_options as check_time_options
@@ -22,20 +25,6 @@ def check_run_options(t_end: float, dt_out: float, rtol: float = 1e-10, atol: fl
     return t_end, dt_out
 
 
-@contextlib.contextmanager
-def quiet_trial_steps() -> Iterator[None]:
-    """Floating-point warnings off around ``solve_ivp``.
-
-    An explicit Runge-Kutta step evaluates the right-hand side at trial states; a step that is far too
-    long can overflow there (omega**2 at omega ~ 1e160), and scipy's error estimate then reads inf/nan
-    ("invalid value encountered in dot"), rejects the step and retries a shorter one. The result is
-    guarded by that rejection and by :func:`check_finite` on the output, so the warnings say nothing a
-    user can act on.
-    """
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        yield
-
-
 def sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
     """Segment [t0, t1]: its end points and the output grid strictly inside."""
     inside = grid[(grid > t0) & (grid < t1)]
@@ -48,3 +37,187 @@ def check_finite(series: dict[str, np.ndarray]) -> None:
         if bad.size:
             t_bad = series["t"][bad[0]]
             raise SimulationError(f"non-finite {name} at t={t_bad:.6g} s")
+
+
+def restart_step(sol, previous: float | None, t_end: float) -> float | None:
+    """First step [s] for the segment after ``sol``: the last full step it took (its very last
+    one is cut at the event), else ``previous``; capped by what is left to t_end [s].
+
+    scipy's own first-step guess, from a crude second-derivative estimate, can propose a step far
+    longer than the motion allows, and DOP853's error estimate has been seen to accept it (a
+    2.4 ms step where 0.65 ms steps were needed: 3e-6 of the run's energy lost in one step).
+    Starting each segment from the step size the previous one settled on avoids that guess.
+    """
+    steps = np.diff(sol.t)
+    h = float(steps[-2]) if steps.size >= 2 else previous
+    left = t_end - float(sol.t[-1])
+    return None if h is None or not h > 0 or not left > 0 else min(h, left)
+
+
+# interior points checked per accepted step for a guard that dipped below zero and came back
+_GRAZE_POINTS = 8
+
+
+def missed_crossing(sol, guards, events):
+    """A guard crossing that solve_ivp missed: (t, event index, state) of the first, or None.
+
+    ``sol``: a solve_ivp result with dense output; ``guards(t (n,), Y (d, n))``: every
+    event function at once, array (n_events, n); ``events``: the event functions,
+    each falling through zero where its mode ends.
+
+    solve_ivp reports a crossing only where an event function is >= 0 at one step
+    end and <= 0 at the next. Two kinds slip through: a guard that dips below zero
+    and recovers within one step (a graze, seen when a coasting crank takes long
+    steps), and a guard that starts its segment a roundoff below zero (the state is
+    projected onto the new mode, e.g. v1 = -K omega = -1e-17 at a dead centre),
+    rises, and is below zero again at the next step end: no step then starts at
+    >= 0, so solve_ivp sees no crossing at all. So every guard is sampled at the
+    step ends and at interior points through the dense output, all in time order;
+    where it is first clearly negative, its root after the last clearly positive
+    sample is located with brentq (at the segment's start if it never was clearly
+    positive). "Clearly": beyond 1e-9 of the guard's largest value in the segment.
+    """
+    ends = sol.t
+    if ends.size < 2:
+        return None
+    fractions = np.arange(_GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)  # each step's start and interior points
+    times = np.append((ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel(), ends[-1])
+    values = guards(times, sol.sol(times))
+    scale = np.maximum(np.abs(values).max(axis=1), 1e-300)
+    first = None
+    for k, row in enumerate(values):
+        negative = np.flatnonzero(row < -1e-9 * scale[k])
+        if negative.size == 0 or first is not None and times[negative[0]] >= first[0]:
+            continue
+        j = negative[0]
+        before = np.flatnonzero(row[:j] > 1e-9 * scale[k])  # clearly positive: out of the roundoff at the start
+        if before.size == 0:  # never clearly above zero since the segment's start: it left zero downward at once
+            first = (float(times[0]), k)
+            continue
+        event = events[k]
+        first = (brentq(lambda time: event(time, sol.sol(time)), times[before[-1]], times[j], xtol=1e-15,
+                        rtol=4 * np.finfo(float).eps), k)
+    return None if first is None else (first[0], first[1], sol.sol(first[0]))
+
+
+PROGRESS_EVERY_S = 0.1  # simulated seconds between two progress calls, at least
+
+
+class RunMonitor:
+    """What an event-driven solver's loop shares: the work budget, progress, revolutions, steady state.
+
+    The solver calls :meth:`samples` for each segment's output times (the output
+    grid plus a sample exactly where each crank revolution ends), :meth:`observe`
+    with each finished piece (it returns the time to stop at once the periodic
+    steady state is reached, with ``until_steady``), and :meth:`after_switch` at
+    each mode switch (budget checks and progress).
+
+    ``max_switches``: mode switches allowed; ``wall_budget_s``: wall-clock seconds
+    allowed (None: no limit), checked between segments; ``progress(t)``: called
+    with the simulated time [s] at most every :data:`PROGRESS_EVERY_S` of it.
+    """
+
+    def __init__(self, t_end: float, phi0: float, *, max_switches: int, wall_budget_s: float | None,
+                 progress, until_steady: bool, steady_tol: float, steady_cycles: int):
+        if isinstance(max_switches, bool) or not isinstance(max_switches, (int, np.integer)) or max_switches < 0:
+            raise ParameterError(f"max_switches={max_switches!r} is out of range; allowed: a whole number >= 0")
+        if wall_budget_s is not None and not (isinstance(wall_budget_s, (int, float)) and not isinstance(
+                wall_budget_s, bool) and math.isfinite(wall_budget_s) and wall_budget_s > 0):
+            raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number of "
+                                 "seconds > 0, or None (no limit)")
+        if progress is not None and not callable(progress):
+            raise ParameterError(f"progress={progress!r} is not callable; allowed: a function of the simulated "
+                                 "time [s], or None")
+        if not isinstance(until_steady, (bool, np.bool_)):
+            raise ParameterError(f"until_steady={until_steady!r} is not a bool; allowed: True or False")
+        try:
+            self.watch = SteadyWatch(phi0, steady_tol, steady_cycles)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(str(exc)) from None
+        self.t_end, self.phi0 = t_end, float(phi0)
+        self.max_switches, self.wall_budget_s, self.progress = int(max_switches), wall_budget_s, progress
+        self.until_steady = bool(until_steady)
+        self.started = time.perf_counter()
+        self.next_report = PROGRESS_EVERY_S
+        self.next_end = float(phi0) + 2 * math.pi  # crank angle at which the current revolution ends
+
+    @property
+    def settings(self) -> dict:
+        """What a run records so that its summary applies the same steady-state test."""
+        return {"until_steady": self.until_steady, "steady_tol": self.watch.tol, "steady_cycles": self.watch.n}
+
+    def revolution_ends(self, t0: float, step_ends: np.ndarray, dense) -> list[float]:
+        """Times in (t0, step_ends[-1]] where the running maximum of phi first reaches phi0 + 2 pi k.
+
+        ``step_ends``: the solver's accepted step ends (from t0); ``dense(t)``: its dense
+        output, phi first. Each end is located with brentq on the dense output and moved
+        to the first float at which phi >= the target, so the sample there counts it.
+        """
+        ends = []
+        phis = np.asarray(dense(step_ends))[0]
+        for i in range(1, len(step_ends)):
+            while phis[i] >= self.next_end:
+                target = self.next_end
+                lo, hi = step_ends[i - 1], step_ends[i]
+                if phis[i - 1] >= target:  # reached at the start of the step (or a segment's start)
+                    when = lo
+                else:
+                    when = brentq(lambda s: dense(s)[0] - target, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+                    while dense(when)[0] < target and when < hi:
+                        when = min(np.nextafter(when, hi), hi)
+                ends.append(float(when))
+                self.next_end += 2 * math.pi
+        return ends
+
+    def samples(self, t0: float, t1: float, grid: np.ndarray, step_ends: np.ndarray | None = None,
+                dense=None) -> np.ndarray:
+        """Output times of the segment [t0, t1]: its end points, the grid inside and each revolution's end."""
+        times = sample_times(t0, t1, grid)
+        if dense is None or step_ends is None or t1 <= t0:
+            return times
+        ends = [s for s in self.revolution_ends(t0, np.asarray(step_ends, dtype=float), dense) if t0 < s < t1]
+        return np.union1d(times, ends) if ends else times
+
+    def observe(self, piece: dict[str, np.ndarray]) -> float | None:
+        """Feed a finished piece; with ``until_steady``, the time [s] to stop at once steady, else None."""
+        position = 0.5 * (np.asarray(piece["x1"]) + np.asarray(piece["x2"]))
+        if not (self.watch.update(piece["t"], piece["phi"], position) and self.until_steady):
+            return None
+        # the watch interpolates the end of the revolution between samples; the sample there (the
+        # first at or after it: the exact revolution end, where phi >= its target) is the last kept
+        t = piece["t"]
+        return float(t[min(np.searchsorted(t, self.watch.steady_at), t.size - 1)])
+
+    def after_switch(self, t: float, switches: int, phi: float) -> None:
+        """Budget checks and progress at a mode switch at time t [s] (the ``switches``-th) at crank angle phi."""
+        if switches > self.max_switches:
+            raise SimulationError(
+                f"the work budget max_switches={self.max_switches} is spent at t={t:.6g} s of {self.t_end:g} s "
+                f"(crank at {(phi - self.phi0) / (2 * math.pi):.4g} revolutions): raise max_switches or shorten "
+                "t_end")
+        spent = time.perf_counter() - self.started
+        if self.wall_budget_s is not None and spent > self.wall_budget_s:
+            raise SimulationError(
+                f"the work budget wall_budget_s={self.wall_budget_s:g} s is spent at t={t:.6g} s of "
+                f"{self.t_end:g} s ({switches} mode switches, crank at "
+                f"{(phi - self.phi0) / (2 * math.pi):.4g} revolutions): raise wall_budget_s or shorten t_end")
+        self.report(t)
+
+    def report(self, t: float, final: bool = False) -> None:
+        """Call ``progress(t)`` if PROGRESS_EVERY_S of simulated time has passed since the last call (or at the end)."""
+        if self.progress is not None and (t >= self.next_report or final):
+            self.progress(t)
+            self.next_report = t + PROGRESS_EVERY_S
+
+
+def truncate(piece: dict[str, np.ndarray], t_stop: float) -> dict[str, np.ndarray]:
+    """The samples of ``piece`` at or before t_stop [s]."""
+    keep = piece["t"] <= t_stop
+    return {c: (v[keep] if np.ndim(v) else v) for c, v in piece.items()}
+
+
+def stall_reason(t: float, phi: float, torque: float, a_g: float) -> str:
+    """RunResult.stall for a robot at rest for good from time t [s] at crank angle phi [rad]."""
+    against = "the resistances and gravity" if a_g != 0 else "the resistances"
+    return (f"at rest from t={t:.6g} s at phi={phi:.6g} rad: the drive's torque at rest ({torque:.6g} N m) "
+            f"cannot move the linkage against {against}")

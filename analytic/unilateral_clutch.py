@@ -33,6 +33,12 @@ next order, never by an arbitrary choice:
 Reported clutch reaction: lambda_i = max(R_i, 0) while held (a clutch only
 pushes; a backward hold is the resistance's), 0 while moving; the resistance
 force is in ``resistance1/2`` (-F_ri moving, min(R_i, 0) held).
+
+The drive's torque (:func:`.forces.drive_torque`, constant or a motor line) and
+gravity along the pipe enter every mode through :class:`.dynamics.OneDofDynamics`.
+Uphill, a held module's R_i includes the share of the robot's weight its clutch
+carries; downhill, gravity can pull a module forward (R_i < -F_ri): it is then
+released and runs, since no one-way clutch can stop forward motion.
 """
 
 from __future__ import annotations
@@ -42,15 +48,17 @@ import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
+from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
-from .solver_support import check_finite, check_run_options, sample_times
+from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
-from .results import COLUMNS, Mode, RunResult
+from .results import Mode, RunResult
+from .solver_support import (RunMonitor, check_finite, check_run_options, missed_crossing, restart_step, stall_reason,
+                             truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -62,6 +70,7 @@ _MAX_STALLED_SEGMENTS = 50
 # a speed below this [m/s] (a nanometre in a quarter hour) counts as rest; without a floor a crank
 # started at 1e-12 rad/s with no torque is neither at rest nor able to move in any mode
 _REST_SPEED = 1e-12
+_TINY = np.finfo(float).tiny  # what a quiet guard reads at least (see events)
 
 
 class UnilateralModel:
@@ -71,12 +80,12 @@ class UnilateralModel:
         self.params = params
         self.dyn = OneDofDynamics(params, geometry)
         self.linkage = self.dyn.linkage
-        self.torque = torque  # (t, phi, omega) -> N m, or None for the constant params.M
+        self.torque = torque  # (t, phi, omega) -> N m, or None for the drive of params
 
     def motor(self, t, phi, omega):
         """Motor torque [N m] at time t (array-friendly)."""
         if self.torque is None:
-            return self.params.M + 0.0 * np.asarray(phi, dtype=float)
+            return drive_torque(self.params, omega) + 0.0 * np.asarray(phi, dtype=float)
         return self.torque(t, phi, omega)
 
     # --- the state in each mode: y = [phi, omega, x1, x2, v1] ---------------------------
@@ -93,8 +102,7 @@ class UnilateralModel:
 
     def motion(self, phi, omega, v1, mode: Mode, M=None) -> dict:
         """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``; M [N m] the torque."""
-        p = self.params
-        M = p.M if M is None else M
+        M = self.dyn.torque(omega, M)
         nan = np.nan * np.asarray(phi, dtype=float)
         if mode in (Mode.CONTRACTION, Mode.EXPANSION):
             st = self.dyn.state(phi, omega, mode, M)
@@ -105,18 +113,18 @@ class UnilateralModel:
             a1, alpha = self.dyn.both_moving(phi, omega, M)
             tr = self.linkage.transfer(phi)
             return {"alpha": alpha, "a1": a1, "a2": a1 + tr.dK * omega**2 + tr.K * alpha, "R1": nan, "R2": nan}
-        # static stall: the linkage pushes module 2 with M / K and module 1 with -M / K
-        push = self.dyn.static_push(phi, M)
+        # static stall: the holds balance the torque (through the linkage) and gravity
+        R1, R2 = self.dyn.static_holds(phi, M)
         zero = np.zeros_like(nan)
-        return {"alpha": zero, "a1": zero, "a2": zero, "R1": push, "R2": -push}
+        return {"alpha": zero, "a1": zero, "a2": zero, "R1": R1, "R2": R2}
 
     def rhs(self, mode: Mode):
         """d/dt of y = [phi, omega, x1, x2, v1, motor work]: only what integration needs (hot path)."""
-        dyn, linkage, constant = self.dyn, self.linkage, self.torque is None
+        dyn, linkage, constant, params = self.dyn, self.linkage, self.torque is None, self.params
 
         def f(t, y):
             phi, omega, _x1, _x2, v1, _work = y
-            M = self.params.M if constant else self.torque(t, phi, omega)
+            M = drive_torque(params, omega) if constant else self.torque(t, phi, omega)
             tr = linkage.transfer(phi)
             if mode is Mode.BOTH_MOVING:
                 a1, alpha = dyn.both_moving(phi, omega, M)
@@ -127,20 +135,28 @@ class UnilateralModel:
             return [omega, alpha, 0.0, tr.K * omega, 0.0, M * omega]  # expansion: rear held
         return f
 
-    def events(self, mode: Mode):
-        """Terminal events of ``mode`` and what each means: ('velocity'|'margin', module index)."""
+    def events(self, mode: Mode, quiet: dict[int, float] | None = None):
+        """Terminal events of ``mode`` and what each means: ('velocity'|'margin', module index).
+
+        ``quiet`` {event index: time [s]}: that event reads at least +tiny until that time
+        (see :func:`_spurious_start`).
+        """
         p = self.params
+        quiet = quiet or {}
         found = []
         for i in (0, 1):
+            until = quiet.get(len(found), -math.inf)
             if HELD[mode][i]:
-                def margin(t, y, i=i):
+                def margin(t, y, i=i, until=until):
                     m = self.motion(y[0], y[1], y[4], mode, self.motor(t, y[0], y[1]))
-                    return (m["R1"] if i == 0 else m["R2"]) + (p.F_r1 if i == 0 else p.F_r2)
+                    value = (m["R1"] if i == 0 else m["R2"]) + (p.F_r1 if i == 0 else p.F_r2)
+                    return value if t > until else max(value, _TINY)
                 margin.terminal, margin.direction = True, -1.0
                 found.append((margin, ("margin", i)))
             else:
-                def velocity(_t, y, i=i):
-                    return self.velocities(y, mode)[i]
+                def velocity(t, y, i=i, until=until):
+                    value = self.velocities(y, mode)[i]
+                    return value if t > until else max(value, _TINY)
                 velocity.terminal, velocity.direction = True, -1.0
                 found.append((velocity, ("velocity", i)))
         return found
@@ -174,7 +190,7 @@ class UnilateralModel:
             raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
         motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode}
         a_scale = r * (omega**2 + max(abs(m["alpha"]) for m in motions.values())) \
-            + (p.F_r1 + p.F_r2 + abs(M) / r) / min(p.m1, p.m2)
+            + (p.F_r1 + p.F_r2 + abs(M) / r) / min(p.m1, p.m2) + abs(self.dyn.a_g)
         a_scale = max(a_scale, 1e-300)  # nothing drives the robot at all: every test is 0 / tiny = 0
         f_scale = p.F_r1 + p.F_r2 + (p.m1 + p.m2) * a_scale
         F = (p.F_r1, p.F_r2)
@@ -243,16 +259,28 @@ def simulate_unilateral(
     atol: float = 1e-12,
     max_switches: int = 100_000,
     torque=None,
+    until_steady: bool = False,
+    steady_tol: float = STEADY_TOL,
+    steady_cycles: int = STEADY_CYCLES,
+    progress=None,
+    wall_budget_s: float | None = None,
 ) -> RunResult:
     """Simulate the robot with one-way clutches (see the module docstring).
 
     Initial module velocities from (phi0, omega0) follow the MuJoCo engine's
     start: module 1 at rest unless the gap shrinks. ``torque(t, phi, omega)``
-    [N m], vectorized, replaces the constant M; a stall under it is an error
-    (a stall is only final under constant loads).
+    [N m], vectorized, replaces the drive of ``params``; a stall under it is an
+    error (a stall is only final where the torque at rest is constant, as for the
+    constant torque and the motor). With ``until_steady`` the run stops at the
+    end of the revolution where the periodic steady state is reached
+    (:class:`.cycles.SteadyWatch` with ``steady_tol``, ``steady_cycles``);
+    ``t_end`` [s] is the cap. Work budget and progress: see
+    :class:`.solver_support.RunMonitor`. Each revolution's end is an exact sample.
     """
-    check_run_options(t_end, dt_out, rtol, atol)
-    started = time.perf_counter()
+    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
+    monitor = RunMonitor(t_end, params.phi0, max_switches=max_switches, wall_budget_s=wall_budget_s,
+                         progress=progress, until_steady=until_steady, steady_tol=steady_tol,
+                         steady_cycles=steady_cycles)
     model = UnilateralModel(params, geometry, torque)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)
@@ -263,26 +291,32 @@ def simulate_unilateral(
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, v1_0, 0.0])
     mode = model.choose(0.0, y, (v1_0, v1_0 + S_dot0))
     y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
-    t, pieces, switches, short_run = 0.0, [], 0, 0
+    t, pieces, switches, short_run, stall, h0 = 0.0, [], 0, 0, None, None
     while True:
         if mode is Mode.BOTH_LOCKED:
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
-                                      "restarting from a stall is modelled only for a constant torque")
-            pieces.append(_piece(model, Mode.BOTH_LOCKED, sample_times(t, t_end, grid), lambda ts: np.repeat(
+                                      "restarting from a stall is modelled only for a constant torque at rest")
+            # at rest, held by statics, under a torque that is constant at rest: final
+            stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g)
+            pieces.append(_piece(model, Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
                 y[:, None], np.size(ts), axis=1)))
             break
         events = model.events(mode)
-        sol = solve_ivp(model.rhs(mode), (t, t_end), y, method="DOP853", rtol=rtol, atol=atol,
-                        events=[e for e, _ in events], dense_output=True)
-        if sol.status < 0:
-            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
-        t_stop = float(sol.t[-1])
-        grazed = _grazing_crossing(model, mode, sol, events)
+        sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
+        spurious = _spurious_start(model, mode, sol)
+        if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
+            events = model.events(mode, quiet=dict([spurious]))
+            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
+        t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
+        grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events])
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
-        pieces.append(_piece(model, mode, sample_times(t, t_stop, grid), sol.sol))
-        if grazed is None and sol.status != 1:
+        step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
+        piece = _piece(model, mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol)
+        steady_at = monitor.observe(piece)
+        pieces.append(piece if steady_at is None else truncate(piece, steady_at))
+        if steady_at is not None or grazed is None and sol.status != 1:
             break
         if grazed is None:
             hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
@@ -294,57 +328,59 @@ def simulate_unilateral(
         mode = model.choose(t, y_event, velocities, events[hit][1], previous=mode)
         y = model.project(y_event, mode, velocities)
         switches += 1
-        if switches > max_switches:
-            raise SimulationError(f"more than {max_switches} mode switches by t={t:.6g} s")
+        monitor.after_switch(t, switches, float(y[0]))
         if t >= t_end:
             break
 
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
-    motor = float(series.pop("motor_work")[-1])
+    monitor.report(float(series["t"][-1]), final=True)
+    series.update(model.dyn.energy_columns(series))
     add_kinetostatics(series, model.dyn)
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
-    energy = model.dyn.energy_audit(series, motor)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
-                     t_end=t_end, series=series, energy=energy, wall_time_s=time.perf_counter() - started,
+                     t_end=t_end, series=series, energy=model.dyn.energy_audit(series),
+                     wall_time_s=time.perf_counter() - monitor.started, stall=stall,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
-                               "rod_modelled": model.dyn.include_rod})
+                               "rod_modelled": model.dyn.include_rod, **monitor.settings})
 
 
-# interior points checked per accepted step for a guard that dipped below zero and came back
-_GRAZE_POINTS = 8
+def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step):
+    """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end."""
+    with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
+        # controller rejects them, and the output is checked finite
+        sol = solve_ivp(model.rhs(mode), (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
+                        events=[e for e, _ in events], dense_output=True, first_step=first_step)
+    if sol.status < 0:
+        raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: {sol.message}")
+    return sol
 
 
-def _grazing_crossing(model: UnilateralModel, mode: Mode, sol, events):
-    """A guard crossing that solve_ivp missed: (t, event index, state) of the first, or None.
+def _spurious_start(model: UnilateralModel, mode: Mode, sol, points: int = 32):
+    """(event index, time [s]) if solve_ivp put a crossing at the segment's start that is not one, else None.
 
-    solve_ivp sees an event only where its function changes sign between step
-    ends; a module whose speed dips below zero and recovers within one step
-    (a graze, seen when a coasting crank takes long steps) slips through. Each
-    accepted step is sampled at interior points through the dense output; where
-    a guard went clearly negative, its first root is located with brentq.
+    A mode starts where its guards are zero and rising (that is why it was chosen), but the
+    value there is a projected zero, +-1e-17 by roundoff. A guard that rises only briefly
+    (e.g. a module starting from rest with a small acceleration and a large negative jerk,
+    back at zero microseconds later) gives solve_ivp a first step that starts at 0 and ends
+    below it; its root search then sticks in the roundoff next to the start, and the run would
+    restart there, forever. If the guard is clearly positive in that first step before it is
+    clearly negative, the crossing at the start is spurious: returned is where it has risen.
     """
-    ends = sol.t
-    if ends.size < 2:
+    if sol.status != 1:
         return None
-    fractions = np.arange(1, _GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)
-    times = (ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel()
-    values = model.guards(times, sol.sol(times), mode)
-    scale = np.maximum(np.abs(values).max(axis=1, keepdims=True), 1e-300)
-    negative = values < -1e-9 * scale
-    if not negative.any():
+    t0 = sol.t[0]
+    k = min((k for k in range(len(sol.t_events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
+    if sol.t_events[k][0] - t0 > 1e-12 * (1.0 + abs(t0)):
         return None
-    k, j = min(zip(*np.nonzero(negative)), key=lambda kj: times[kj[1]])
-    event = events[k][0]
-    step = j // _GRAZE_POINTS
-    points = [ends[step], *times[step * _GRAZE_POINTS: j + 1]]  # the step's start up to the first clear dip
-    signs = [event(time, sol.sol(time)) for time in points]
-    if signs[0] < 0:  # negative at a step end already: solve_ivp's own event handling covers it
+    step = sol.sol.interpolants[0]  # the whole first step's dense output, also past the event
+    times = step.t_old + (step.t - step.t_old) * np.arange(1, points + 1) / points
+    values = model.guards(times, step(times), mode)[k]
+    threshold = 1e-9 * max(np.abs(values).max(), 1e-300)
+    rising, falling = np.flatnonzero(values > threshold), np.flatnonzero(values < -threshold)
+    if rising.size == 0 or falling.size and falling[0] < rising[0]:
         return None
-    first = next(i for i, value in enumerate(signs) if value < 0)
-    lo, hi = points[first - 1], points[first]
-    t_root = brentq(lambda time: event(time, sol.sol(time)), lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
-    return t_root, k, sol.sol(t_root)
+    return k, float(times[rising[0]])
 
 
 def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.ndarray]:
@@ -371,5 +407,4 @@ def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.nda
         "mode": np.full(phi.shape, int(mode)), "resistance1": resistance[0], "resistance2": resistance[1],
         "motor_work": y[5], "motor_torque": M,
     }
-    assert set(COLUMNS) <= set(piece)
     return piece

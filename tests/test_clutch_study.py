@@ -182,11 +182,12 @@ def test_the_figure_draws_the_rows_of_both_engines_and_the_rigid_limit(first_eng
         assert marker.get_xdata()[0] > max(STIFFNESS)  # right of the axis break
         assert marker.get_ydata()[0] == first_engagements["rigid"]["first"][engine]["peak_clutch_force_n"]
     assert ax.get_xscale() == ax.get_yscale() == "log" and "[N/m]" in ax.get_xlabel() and "[N]" in ax.get_ylabel()
-    # at cruise the analytic rigid model has no motor yet: no marker, and the panel says so
+    # at cruise both rigid models run under the motor: both markers, at their own peak forces
     (ax,) = study_figure(cruise).axes
-    gids = {line.get_gid() for line in ax.get_lines()}
-    assert "rigid:mujoco" in gids and "rigid:analytic" not in gids
-    assert any("rigid analytic" in text.get_text() for text in ax.texts)
+    markers = {line.get_gid(): line for line in ax.get_lines() if line.get_gid()}
+    for engine in ("analytic", "mujoco"):
+        assert markers[f"rigid:{engine}"].get_ydata()[0] == cruise["rigid"]["cruise"][engine]["peak_clutch_force_n"]
+    assert not any("rigid analytic" in text.get_text() for text in ax.texts)
 
 
 def run_cli(capsys, *argv):

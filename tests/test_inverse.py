@@ -95,3 +95,20 @@ def test_kinetostatics_command(tmp_path, capsys):
         assert main(["kinetostatics", *argv, "--out", str(tmp_path / "never")]) == 2
         assert fragment in capsys.readouterr().err
     assert not (tmp_path / "never").exists()
+
+
+@pytest.mark.parametrize("clutch", ["kinematic", "unilateral"])
+def test_on_a_slope_the_inverse_torque_drives_the_forward_model_the_same_way(clutch):
+    """Gravity enters the inverse (torque, holds) and the forward models alike: uphill, one turn at 30 rad/s."""
+    params = PARAMS.replace(incline=25.0)
+    motion = CrankMotion.constant_speed(OMEGA, revolutions=1)
+    inverse = inverse_kinetostatics(params, motion, "exact", clutch, dt_out=1e-5)
+    e, s = inverse.summary["energy"], inverse.series
+    assert e["potential_j"] > 0  # it climbed
+    assert abs(e["residual_j"]) < 1e-8 * e["motor_work_j"]
+    torque = lambda t, phi, omega: np.interp(t, s["t"], s["motor_torque"])  # noqa: E731
+    forward = FORWARD[clutch](params.replace(omega0=OMEGA), inverse.t_end, torque).series
+    # the same interpolation bound as on the level (test above): a few switches, 1e-5 rad
+    assert np.max(np.abs(forward["phi"] - OMEGA * forward["t"])) < 1e-5
+    for column in ("x1", "x2"):
+        assert forward[column][-1] == pytest.approx(s[column][-1], rel=1e-4, abs=1e-9)

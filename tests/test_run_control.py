@@ -1,0 +1,55 @@
+"""The analytic solvers' work budget, progress reports and run options."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
+from ipir_mujoco.analytic.solver_support import PROGRESS_EVERY_S
+
+# Issue 11's slow design: a runaway crank (M / J_A ~ 1.2e5 rad/s^2) that turns ~3000 times in 1 s
+RUNAWAY = RobotParams(m1=1.198, m2=0.1986, r=0.00706, L=0.01799, J_A=2.76e-5, F_r1=1.95, F_r2=14.8, M=3.25,
+                      phi0=3.81, omega0=-46.6, rod_mass=0.215)
+SOLVERS = [("approx", "kinematic"), ("exact", "unilateral")]
+
+
+@pytest.mark.parametrize("geometry,clutch", SOLVERS)
+def test_the_switch_budget_stops_a_run_with_its_name_and_remedy(geometry, clutch):
+    with pytest.raises(SimulationError, match=r"max_switches=5 is spent at t=[0-9.e-]+ s of 1 s .*raise max_switches"):
+        analytic.simulate(RobotParams(), geometry, clutch, 1.0, max_switches=5)
+
+
+@pytest.mark.parametrize("geometry,clutch", [("exact", "kinematic"), ("exact", "unilateral")])
+def test_the_wall_clock_budget_stops_a_runaway_design(geometry, clutch):
+    # checked between segments, each a few ms here: the run stops soon after 0.2 s of wall time,
+    # far short of the ~1 min the whole second takes
+    with pytest.raises(SimulationError, match=r"wall_budget_s=0.2 s is spent at t=.* raise wall_budget_s"):
+        analytic.simulate(RUNAWAY, geometry, clutch, 1.0, wall_budget_s=0.2)
+
+
+@pytest.mark.parametrize("geometry,clutch", SOLVERS)
+def test_progress_comes_every_tenth_of_a_simulated_second_at_most(geometry, clutch):
+    calls = []
+    run = analytic.simulate(RobotParams(drive="motor"), geometry, clutch, 1.0, dt_out=1e-3, progress=calls.append)
+    assert calls[-1] == run.series["t"][-1] == 1.0  # the end is always reported
+    gaps = np.diff(calls[:-1])
+    assert np.all(gaps >= PROGRESS_EVERY_S - 1e-12)  # never more often than every 0.1 s simulated
+    # reported at the first mode switch past each tenth: with >= 2 switches per turn and turns
+    # of < 0.4 s here, no gap exceeds 0.3 s
+    assert np.all(np.diff(calls) <= 0.3) and len(calls) >= 1.0 / 0.3
+
+
+@pytest.mark.parametrize("option,value,fragment", [
+    ("max_switches", -1, "max_switches=-1"), ("max_switches", 2.5, "max_switches=2.5"),
+    ("wall_budget_s", 0.0, "wall_budget_s=0.0"), ("wall_budget_s", math.nan, "wall_budget_s=nan"),
+    ("progress", "stderr", "progress='stderr'"), ("until_steady", "yes", "until_steady='yes'"),
+    ("steady_cycles", 1, "steady_cycles=1"), ("steady_tol", 0.0, "steady_tol=0.0"),
+])
+@pytest.mark.parametrize("clutch", ["kinematic", "unilateral"])
+def test_bad_run_options_are_parameter_errors(clutch, option, value, fragment):
+    with pytest.raises(ParameterError, match=f"^{fragment.replace('.', '[.]')} .*allowed"):
+        analytic.simulate(RobotParams(), "exact", clutch, 0.1, **{option: value})
