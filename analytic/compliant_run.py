@@ -164,7 +164,7 @@ def simulate_compliant(
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
-                     t_end=t_end, series=series, energy=energy_audit(series),
+                     t_end=float(series["t"][-1]), series=series, energy=energy_audit(series),
                      wall_time_s=time.perf_counter() - started, stall=stall,
                      settings={"method": method, "rtol": rtol, "atol": atol, "dt_out": dt_out,
                                "rod_modelled": model.dyn.include_rod, "clutch_model": "compliant",

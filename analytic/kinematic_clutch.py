@@ -170,7 +170,7 @@ def simulate_kinematic(
         geometry=dyn.geometry.value,
         clutch="kinematic",
         params=params,
-        t_end=t_end,
+        t_end=float(series["t"][-1]),  # the end of the run: t_end, or where it reached steady state
         series=series,
         energy=dyn.energy_audit(series),
         wall_time_s=time.perf_counter() - monitor.started,

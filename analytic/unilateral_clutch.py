@@ -339,7 +339,7 @@ def simulate_unilateral(
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
-                     t_end=t_end, series=series, energy=model.dyn.energy_audit(series),
+                     t_end=float(series["t"][-1]), series=series, energy=model.dyn.energy_audit(series),
                      wall_time_s=time.perf_counter() - monitor.started, stall=stall,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
                                "rod_modelled": model.dyn.include_rod, **monitor.settings})

@@ -38,8 +38,8 @@ def add_parser(commands) -> None:
     sim.add_argument("--mjcf", metavar="FILE.xml", default=None,
                      help="MJCF template for --engine mujoco (default: the shipped inchworm.xml)")
     add_model_options(sim)
-    sim.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS",
-                     help="simulated time (default 1 s); with --until-steady, the cap")
+    sim.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+                     help="simulated time (default 1 s); with --until-steady, the cap (default 30 s)")
     sim.add_argument("--until-steady", action="store_true",
                      help="stop at the periodic steady state (per-revolution mean speed settled); --t-end caps it")
     sim.add_argument("--dt-out", type=float, default=None, metavar="SECONDS",
@@ -67,8 +67,13 @@ def output_interval(args: argparse.Namespace) -> float:
     return DT_OUT
 
 
+T_END, T_END_STEADY = 1.0, 30.0  # s: the default run, and the default cap of a run to steady state
+
+
 def check_options(args: argparse.Namespace) -> None:
     """Every option of ``simulate`` that the engines do not check themselves, before any work."""
+    if args.t_end is None:
+        args.t_end = T_END_STEADY if args.until_steady else T_END
     args.dt_out = output_interval(args)
     check_run_options(args.t_end, args.dt_out)
     if args.max_switches is not None:

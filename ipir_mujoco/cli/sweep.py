@@ -28,7 +28,7 @@ def add_parser(commands) -> None:
                           "analytic-exact, analytic-unilateral, mujoco-lock, mujoco-ratchet "
                           "(default: mujoco-ratchet,analytic-unilateral)")
     swp.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
-                     help="simulated time per design (default 1 s); with --until-steady, the cap")
+                     help="simulated time per design (default 1 s); with --until-steady, the cap (default 10 s)")
     swp.add_argument("--until-steady", action="store_true", default=None,
                      help="run every design to its periodic steady state (--t-end caps it); rows then carry the "
                           "steady speed, time to steady state and energy per metre (use with --drive motor)")
@@ -52,6 +52,9 @@ def add_parser(commands) -> None:
     swp.set_defaults(handler=run)
 
 
+T_END_STEADY = 10.0  # s: the default cap of a run to steady state in a sweep
+
+
 def study_from_args(args: argparse.Namespace):
     """The Study the options describe: defaults, the study file, then the command line (which wins)."""
     from ..studies.sweep_space import Study, parse_vary, read_study
@@ -70,6 +73,8 @@ def study_from_args(args: argparse.Namespace):
         if getattr(args, key) is not None:
             options[key] = getattr(args, key)
     options.setdefault("axes", ())
+    if options.get("until_steady") and "t_end" not in options:
+        options["t_end"] = T_END_STEADY  # a run to steady state needs more than the 1 s default
     return Study(**options)
 
 
