@@ -6,7 +6,8 @@ it does not). At the output samples :meth:`reactions` reports per module
 whether its clutch holds and the clutch's reaction force [N] (positive pushes
 the module forward), read from MuJoCo's constraint rows of the step just taken.
 These run every step, so they work on Python floats and touch only the few
-entries they need.
+entries they need; :mod:`.stepper` runs the same rules compiled (a change here
+is a change there: its test compares the two bit for bit).
 
 Nothing here uses the analytic model: the lock rules read MuJoCo's state.
 :func:`clutch_controller` picks the controller for a run (the compliant
@@ -29,7 +30,7 @@ LIMIT_ROW = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 SLIDES = (REAR_SLIDE, FRONT_SLIDE)
 # constraint rows per equality type (connect: 3 translations, weld: 6, joint/tendon/distance: 1)
-_EQUALITY_ROWS = {int(mujoco.mjtEq.mjEQ_CONNECT): 3, int(mujoco.mjtEq.mjEQ_WELD): 6}
+EQUALITY_ROWS = {int(mujoco.mjtEq.mjEQ_CONNECT): 3, int(mujoco.mjtEq.mjEQ_WELD): 6}
 
 
 def equality_row(model: mujoco.MjModel, data: mujoco.MjData, eq_id: int) -> int:
@@ -38,7 +39,7 @@ def equality_row(model: mujoco.MjModel, data: mujoco.MjData, eq_id: int) -> int:
     row = 0
     for e in range(eq_id):
         if data.eq_active[e]:
-            row += _EQUALITY_ROWS.get(int(model.eq_type[e]), 1)
+            row += EQUALITY_ROWS.get(int(model.eq_type[e]), 1)
     return row
 
 

@@ -60,7 +60,8 @@ class CompliantClutches:
     switches the actuators' damping, so a model that has run holds 0 for a
     clutch that was free) are used, and the stiffness k [N/m] is read from the
     compiled model's clutch actuators and checked against it. Called before every step
-    (:meth:`before_step`) and after it (:meth:`after_step`). ``overlap`` holds
+    (:meth:`before_step`) and after it (:meth:`after_step`), or the same rules compiled in
+    :mod:`.stepper` (held equal bit for bit by its test). ``overlap`` holds
     d_i = a_i - x_i [m] at the last step's start; ``damper_work`` [J] is the
     cumulative work the dampers dissipated; ``excursion`` is 0: a module's
     backward motion is the clutch's physics here, not a constraint's give.

@@ -69,6 +69,9 @@ class Recorder:
         anchor = model.eq_data[self.loop_id, 3:6]
         self.pin_offset = (data.xmat[self.front].reshape(3, 3) @ anchor).tolist()
         self.total_mass = float(model.body_subtreemass[0])
+        # views of the fields read at every sample (their memory is fixed for the life of the MjData)
+        self._rod_end, self._front_pos = data.site_xpos[self.site], data.xpos[self.front]
+        self._energy, self._subtree_linvel = data.energy, data.subtree_linvel
 
     def sample(self, torque: float, motor_work: float, friction_work: float, reactions,
                damper_work: float = 0.0) -> int:
@@ -101,14 +104,13 @@ class Recorder:
         Returns (kinetic [J], potential [J], loop gap [m], clutch spring energy [J] as the step conserves
         it: :meth:`.compliant.CompliantClutches.stepped_spring_energy`).
         """
-        d = self.data
-        sx, sy, sz = d.site_xpos[self.site].tolist()
-        bx, by, bz = d.xpos[self.front].tolist()
+        sx, sy, sz = self._rod_end.tolist()
+        bx, by, bz = self._front_pos.tolist()
         ox, oy, oz = self.pin_offset
         gap = math.sqrt((sx - bx - ox) ** 2 + (sy - by - oy) ** 2 + (sz - bz - oz) ** 2)
-        mujoco.mj_subtreeVel(self.model, d)
-        momentum = d.subtree_linvel.item(0) * self.total_mass
-        potential, kinetic = d.energy.tolist()
+        mujoco.mj_subtreeVel(self.model, self.data)
+        momentum = self._subtree_linvel.item(0) * self.total_mass
+        potential, kinetic = self._energy.tolist()
         spring = 0.0
         if self.clutch is None:
             self.deferred[i] = (kinetic, potential, gap, momentum, 0.0, 0.0, 0.0, 0.0)

@@ -2,10 +2,12 @@
 
 The stepping loop: before each ``mj_step`` the clutch controller updates its
 limits or locks (and tracks how far a module slid back); after it, the loop
-accumulates the drive's work and the work against the resistances; every
-output interval it records a sample (:mod:`.recorder`) and feeds the accuracy
-monitor (:mod:`.monitor`). Every ~0.05 s of simulated time it reports
-progress, checks the wall-time budget, the periodic steady state and a stall.
+accumulates the drive's work and the work against the resistances. Those
+steps run in :mod:`.stepper`, compiled where it can be (same numbers bit for
+bit as its pure-Python form). Every output interval the run records a sample
+(:mod:`.recorder`) and feeds the accuracy monitor (:mod:`.monitor`). Every
+~0.05 s of simulated time it reports progress, checks the wall-time budget,
+the periodic steady state and a stall.
 MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
 turn into a :class:`SimulationError` with the time and MuJoCo's message, as
 does a non-finite state.
@@ -50,6 +52,7 @@ from .model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings,
                     drive_control, qpos_address, set_closed_loop_state)
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode
 from .recorder import EXTRA_COLUMNS, Recorder
+from .stepper import make_steps
 from .timestep import DT_MIN, choose_settings
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
@@ -208,20 +211,16 @@ class _Run:
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
 
-        The inner loop runs every step: it works on Python floats (one
-        ``tolist`` per array read) and calls the monitor only when a figure
-        exceeds its worst so far.
+        The steps between two samples run in :mod:`.stepper` (compiled where it can be); a sample's
+        deferred values are MuJoCo's at the start of the next step, so each interval's first step is
+        taken on its own and the previous sample judged after it.
         """
         self._setup()
         m, d, rec, ctl = self.model, self.data, self.recorder, self.controller
-        dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
-        step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
-        motor, cq, cv, gear, slope = self.motor, self.crank_q, self.crank_v, self.gear, self.torque_slope
-        nfric = len(self.friction_dofs)
-        fa, fb = (self.friction_dofs + [0, 0])[:2]
 
-        torque = gear * d.actuator_force.item(motor)
-        rec.qvel_before[0] = qvel - dt * d.qacc  # so that the first sample's acceleration is MuJoCo's qacc
+        torque = self.gear * d.actuator_force.item(self.motor)
+        # so that the first sample's acceleration is MuJoCo's qacc
+        rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
         row = rec.sample(torque, 0.0, 0.0, ctl.reactions())
         start = rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
         self.energy0 = (start[0], start[1] + start[3])  # kinetic; potential with the clutch springs
@@ -229,8 +228,9 @@ class _Run:
         self._judge(row, *start)
         self._check(messages, 0.0)
 
-        wm = wf = 0.0
-        omega_prev = qvel.item(cv)
+        steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, motor=self.motor, crank_q=self.crank_q,
+                                        crank_v=self.crank_v, gear=self.gear, slope=self.torque_slope,
+                                        friction_dofs=self.friction_dofs, torque=torque, servo=self.servo)
         pending = -1
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
@@ -238,33 +238,19 @@ class _Run:
         last = None
         while done < n_steps:
             k = min(sps, n_steps - done)
-            for j in range(k):
-                if servo is not None:
-                    ctrl[motor] = servo.torque(d.time, qpos[cq], qvel[cv])
-                before()
-                if j == k - 1:
-                    rec.qvel_before[rec.count] = qvel
-                step(m, d)
-                if after is not None:
-                    after()
-                v = qvel.tolist()
-                omega = v[cv]
-                torque = gear * d.actuator_force.item(motor) + slope * (omega - omega_prev)
-                wm += torque * omega * dt
-                if nfric == 2:
-                    ne = d.ne
-                    f0, f1 = d.efc_force[ne:ne + 2].tolist()
-                    wf -= (f0 * v[fa] + f1 * v[fb]) * dt
-                elif nfric == 1:
-                    wf -= d.efc_force.item(d.ne) * v[fa] * dt
-                omega_prev = omega
-                if pending >= 0:
-                    self._judge(pending, *rec.fill_deferred(pending))
-                    pending = -1
+            if pending >= 0:
+                steps.run(1, rec.count if k == 1 else -1)
+                self._judge(pending, *rec.fill_deferred(pending))
+                if k > 1:
+                    steps.run(k - 1, rec.count)
+            else:
+                steps.run(k, rec.count)
             done += k
             if messages:
                 self._check(messages, float(rec.t[rec.count - 1]))
-            pending = rec.sample(torque, wm, wf, ctl.reactions(), ctl.damper_work if self.compliant else 0.0)
+            torque = steps.torque
+            pending = rec.sample(torque, steps.motor_work, steps.friction_work, ctl.reactions(),
+                                 ctl.damper_work if self.compliant else 0.0)
             if abs(torque) * 2 * math.pi > self.energy_floor:
                 self.energy_floor = 2 * math.pi * abs(torque)
             if ctl.excursion > self.monitor.worst["excursion_m"]:
@@ -275,7 +261,8 @@ class _Run:
                 if last is not None:
                     break
         if self.compliant:
-            before()  # the anchors and dampers for the final state, whose clutch forces the last sample holds
+            # the anchors and dampers for the final state, whose clutch forces the last sample holds
+            ctl.before_step()
         mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
         if pending >= 0:
             self._judge(pending, *rec.fill_deferred(pending))

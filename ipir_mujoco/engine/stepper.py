@@ -1,0 +1,369 @@
+"""The stepping loop of a serial MuJoCo run: compiled (C) where it can be, the same loop in Python otherwise.
+
+Between two output samples a run takes k steps, and each step the engine
+updates the clutches before ``mj_step`` (:mod:`.clutches`, :mod:`.compliant`),
+does the clutches' bookkeeping after it and adds the drive's work and the work
+against the resistances. :class:`PythonSteps` is that loop in Python;
+:class:`CompiledSteps` hands the k steps to ``_stepper.c`` (a C extension
+built at install time), which calls the library's own ``mj_step`` and does the
+same double arithmetic in the same order, so both give the same numbers bit
+for bit (``tests/test_mujoco_stepper.py``), and syncs the clutch controller's
+state back after each call. Between the calls (every sample) everything else
+stays in Python: samples, the accuracy monitor, progress, budgets, steady
+state and stalls.
+
+Why a loop in C rather than MuJoCo's control callback: ``mjcb_control`` runs
+after the constraint rows are assembled, so a ratchet bound written there acts
+a step late, and the friction rows' forces of a step are gone by the next
+callback; the loop keeps today's order exactly (``mjcf/README.md`` has the
+measurements).
+
+The C code includes no MuJoCo header, so it does not depend on the version it
+was built against: Python passes the address of ``mj_step`` (from the loaded
+libmujoco, checked to be the instance the bindings use), of every array the
+loop touches (fixed for the life of an MjModel/MjData), and of the two mjData
+fields that change between steps, the ``efc_force`` pointer and the count
+``ne``; their offsets come from the running mujoco's own description of its
+structs (``mujoco.introspect``) and are checked against the live MjData before
+every run (pointers and counts read there must equal what the bindings
+report). Anything that does not check out, a missing build, a crank servo (a
+Python function of time) or ``IPIR_MUJOCO_STEPPER=python`` in the
+environment selects :class:`PythonSteps`; :func:`compiled_status` says which
+and why.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import glob
+import os
+from operator import itemgetter
+
+import mujoco
+import numpy as np
+
+from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet
+from .compliant import CompliantClutches
+
+ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
+# the clutch kinds, in the order of _stepper.c's enum
+CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant")
+_DATA_FIELDS = ("time", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_force")
+
+
+class PythonSteps:
+    """k steps of the run's loop in Python (the reference: :class:`CompiledSteps` must equal it).
+
+    ``qvel_before`` (n_samples, nv): the recorder's array; before the last step of a call to
+    :meth:`run` the velocities are copied into the row it names. ``torque`` [N m]: the drive's torque
+    from the initial ``mj_forward``. After each call: ``torque`` (over the last step) [N m],
+    cumulative ``motor_work`` and ``friction_work`` [J].
+    """
+
+    compiled = False
+
+    def __init__(self, model, data, controller, qvel_before, *, motor, crank_q, crank_v, gear, slope,
+                 friction_dofs, torque, servo=None):
+        self.model, self.data, self.controller, self.qvel_before = model, data, controller, qvel_before
+        self.motor, self.crank_q, self.crank_v, self.gear, self.slope = motor, crank_q, crank_v, gear, slope
+        self.friction_dofs, self.servo = list(friction_dofs), servo
+        self.torque, self.motor_work, self.friction_work = torque, 0.0, 0.0
+        self.omega_prev = data.qvel.item(crank_v)
+
+    def run(self, nstep: int, row: int = -1) -> None:
+        """``nstep`` steps; the velocities before the last one go to ``qvel_before[row]`` (row >= 0).
+
+        The inner loop works on Python floats (one ``tolist`` per array read)."""
+        m, d, ctl = self.model, self.data, self.controller
+        dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
+        step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
+        motor, cq, cv, gear, slope = self.motor, self.crank_q, self.crank_v, self.gear, self.slope
+        nfric = len(self.friction_dofs)
+        fa, fb = (self.friction_dofs + [0, 0])[:2]
+        torque, wm, wf, omega_prev = self.torque, self.motor_work, self.friction_work, self.omega_prev
+        for j in range(nstep):
+            if servo is not None:
+                ctrl[motor] = servo.torque(d.time, qpos[cq], qvel[cv])
+            before()
+            if j == nstep - 1 and row >= 0:
+                self.qvel_before[row] = qvel
+            step(m, d)
+            if after is not None:
+                after()
+            v = qvel.tolist()
+            omega = v[cv]
+            torque = gear * d.actuator_force.item(motor) + slope * (omega - omega_prev)
+            wm += torque * omega * dt
+            if nfric == 2:
+                ne = d.ne
+                f0, f1 = d.efc_force[ne:ne + 2].tolist()
+                wf -= (f0 * v[fa] + f1 * v[fb]) * dt
+            elif nfric == 1:
+                wf -= d.efc_force.item(d.ne) * v[fa] * dt
+            omega_prev = omega
+        self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
+
+
+class CompiledSteps(PythonSteps):
+    """The same loop in C (``_stepper.c``); same constructor and attributes as :class:`PythonSteps`.
+
+    The controller's state is copied into the C state at construction and back after every
+    :meth:`run`, so the controller reports (``reactions``, ``excursion``, the compliant clutches'
+    overlaps and dissipation) as after the Python loop. Raises :class:`LayoutError` if what the C
+    code relies on does not check out for this model and data.
+    """
+
+    compiled = True
+
+    def __init__(self, model, data, controller, qvel_before, **options):
+        if options.get("servo") is not None:
+            raise LayoutError("a crank servo is a Python function of time")
+        super().__init__(model, data, controller, qvel_before, **options)
+        stepper, library = _compiled()
+        offsets = _check_layout(data)
+        self._module = stepper
+        self._cfg = np.zeros(len(stepper.CONFIG), dtype=np.int64)
+        self._st = np.zeros(len(stepper.STATE))
+        self.C = {name: i for i, name in enumerate(stepper.CONFIG)}
+        self.S = {name: i for i, name in enumerate(stepper.STATE)}
+        if not (qvel_before.flags.c_contiguous and qvel_before.dtype == np.float64
+                and qvel_before.shape[1:] == (model.nv,)):
+            raise LayoutError("qvel_before must be a C-contiguous float64 array of rows of nv")
+        if data.eq_active.itemsize != 1 or model.jnt_range.shape[1:] != (2,):
+            raise LayoutError("eq_active must hold one byte per equality and jnt_range two bounds per joint")
+        address = data._address
+        self._set_config(
+            model=model._address, data=address, step=library["mj_step"], user_error=library["mju_user_error"],
+            efc_force_field=address + offsets["efc_force"], ne_field=address + offsets["ne"],
+            qpos=_address(data.qpos), qvel=_address(data.qvel), ctrl=_address(data.ctrl),
+            actuator_force=_address(data.actuator_force), qvel_before=_address(qvel_before),
+            jnt_range=_address(model.jnt_range), eq_data=_address(model.eq_data),
+            eq_data_stride=model.eq_data.shape[1], eq_active=_address(data.eq_active),
+            biasprm=_address(model.actuator_biasprm), biasprm_stride=model.actuator_biasprm.shape[1],
+            nv=model.nv, motor=self.motor, crank_q=self.crank_q, crank_v=self.crank_v,
+            nfric=len(self.friction_dofs), fric_a=(self.friction_dofs + [0])[0],
+            fric_b=(self.friction_dofs + [0, 0])[1])
+        self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
+        self._cfg[self.C["eq_rows"]] = _address(self._eq_rows) if self._eq_rows.size else 0
+        self._set_state(dt=model.opt.timestep, gear=self.gear, slope=self.slope, torque=self.torque,
+                        motor_work=0.0, friction_work=0.0, omega_prev=self.omega_prev)
+        self._load_controller()
+        self._args = (_address(self._cfg), _address(self._st))
+        self._common = itemgetter(*(self.S[n] for n in ("torque", "motor_work", "friction_work", "omega_prev")))
+
+    def run(self, nstep: int, row: int = -1) -> None:
+        if row >= len(self.qvel_before):
+            raise IndexError(f"row {row} is out of bounds for qvel_before of {len(self.qvel_before)} rows")
+        try:
+            self._module.run(*self._args, nstep, row)
+        except RuntimeError as exc:  # MuJoCo's error, raised as the bindings raise it
+            raise mujoco.FatalError(str(exc)) from None
+        state = self._st.tolist()
+        self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
+        self._sync(state)
+
+    def _set_config(self, **values) -> None:
+        for name, value in values.items():
+            self._cfg[self.C[name]] = int(value)
+
+    def _set_state(self, **values) -> None:
+        for name, value in values.items():
+            self._st[self.S[name]] = float(value)
+
+    def _load_controller(self) -> None:
+        """The controller's state and indices into the C arrays; picks the sync after each run."""
+        ctl, set_config, set_state = self.controller, self._set_config, self._set_state
+        if isinstance(ctl, Ratchet):
+            kind = "ratchet"
+            set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], joint0=ctl.joint_ids[0],
+                       joint1=ctl.joint_ids[1])
+            set_state(bound0=ctl.bounds[0], bound1=ctl.bounds[1], margin0=ctl.margins[0], margin1=ctl.margins[1],
+                      excursion=ctl.excursion)
+            self._sync, self._get = self._sync_ratchet, self._getter("bound0", "bound1", "excursion")
+        elif isinstance(ctl, Locks):
+            kind = "lock_" + ctl.rule
+            set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], slide_v0=ctl.dof_adr[0],
+                       slide_v1=ctl.dof_adr[1], eq0=ctl.eq_ids[0], eq1=ctl.eq_ids[1], rod_q=ctl.rod_q,
+                       rod_v=ctl.rod_v)
+            if (ctl.crank_q, ctl.crank_v) != (self.crank_q, self.crank_v):
+                raise LayoutError("the locks' crank joint is not the run's")
+            set_state(held0=ctl.held[0], held1=ctl.held[1], force0=ctl.forces[0], force1=ctl.forces[1], r=ctl.r,
+                      L=ctl.L, excursion=ctl.excursion)
+            self._sync, self._get = self._sync_locks, self._getter("held0", "held1", "force0", "force1", "excursion")
+        elif isinstance(ctl, CompliantClutches):
+            kind = "compliant"
+            set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], slide_v0=ctl.dof_adr[0],
+                       slide_v1=ctl.dof_adr[1], act0=ctl.act[0], act1=ctl.act[1], implicit=ctl.implicit)
+            set_state(anchor0=ctl.anchor[0], anchor1=ctl.anchor[1], overlap0=ctl.overlap[0],
+                      overlap1=ctl.overlap[1], v_before0=ctl.v_before[0], v_before1=ctl.v_before[1],
+                      damped0=ctl.damped[0], damped1=ctl.damped[1], damper_work=ctl.damper_work, k=ctl.k, c=ctl.c,
+                      backlash=ctl.backlash)
+            if ctl.dt != self.model.opt.timestep:
+                raise LayoutError("the compliant clutches' timestep is not the model's")
+            self._sync = self._sync_compliant
+            self._get = self._getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
+                                     "damped1", "damper_work")
+        elif isinstance(ctl, NoClutch):
+            kind = "none"
+            self._sync = lambda state: None
+        else:
+            raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
+        self._set_config(clutch=CLUTCH_KINDS.index(kind))
+
+    def _getter(self, *names):
+        return itemgetter(*(self.S[n] for n in names))
+
+    def _sync_ratchet(self, state: list[float]) -> None:
+        ctl = self.controller
+        ctl.bounds[0], ctl.bounds[1], ctl.excursion = self._get(state)
+
+    def _sync_locks(self, state: list[float]) -> None:
+        ctl = self.controller
+        held0, held1, force0, force1, ctl.excursion = self._get(state)
+        ctl.held, ctl.forces = [held0 != 0.0, held1 != 0.0], [force0, force1]
+
+    def _sync_compliant(self, state: list[float]) -> None:
+        ctl = self.controller
+        a0, a1, d0, d1, v0, v1, damped0, damped1, ctl.damper_work = self._get(state)
+        ctl.anchor, ctl.overlap, ctl.v_before = [a0, a1], [d0, d1], [v0, v1]
+        ctl.damped = [damped0 != 0.0, damped1 != 0.0]
+
+
+class LayoutError(RuntimeError):
+    """What the compiled loop relies on does not hold here (the pure-Python loop is used instead)."""
+
+
+def make_steps(model, data, controller, qvel_before, **options) -> PythonSteps:
+    """The compiled loop if it is available and checks out for this run, else the Python loop."""
+    if os.environ.get(ENV, "").strip().lower() != "python":
+        try:
+            return CompiledSteps(model, data, controller, qvel_before, **options)
+        except LayoutError:
+            pass
+    return PythonSteps(model, data, controller, qvel_before, **options)
+
+
+def compiled_status() -> tuple[bool, str]:
+    """(whether serial runs step in C, why not if they do not); a run with a crank servo always steps in
+    Python."""
+    if os.environ.get(ENV, "").strip().lower() == "python":
+        return False, f"{ENV}=python is set"
+    try:
+        _compiled()
+    except LayoutError as exc:
+        return False, str(exc)
+    return True, "compiled"
+
+
+def _address(array: np.ndarray) -> int:
+    return int(array.ctypes.data)
+
+
+@functools.lru_cache(maxsize=None)
+def _compiled_cached():
+    try:
+        from . import _stepper
+    except ImportError as exc:
+        return None, f"the compiled stepper is not built ({exc}); reinstall with a C compiler"
+    try:
+        library = _library()
+        _mjdata_offsets()
+    except (LayoutError, ImportError, OSError, AttributeError, KeyError, TypeError, ValueError) as exc:
+        return None, f"the compiled stepper cannot be used with mujoco {mujoco.__version__}: {exc}"
+    return (_stepper, library), "compiled"
+
+
+def _compiled():
+    found, why = _compiled_cached()
+    if found is None:
+        raise LayoutError(why)
+    return found
+
+
+def _library() -> dict[str, int]:
+    """Addresses of ``mj_step`` and of the legacy error handler pointer in the libmujoco the bindings use."""
+    folder = os.path.dirname(mujoco.__file__)
+    paths = sorted(glob.glob(os.path.join(folder, "libmujoco.so*"))
+                   + glob.glob(os.path.join(folder, "libmujoco*.dylib")))
+    if not paths:
+        raise LayoutError(f"no libmujoco beside the bindings in {folder}")
+    lib = ctypes.CDLL(paths[0])
+    # the instance the bindings use: a warning handler set through them shows in this library's global
+    if mujoco.get_mju_user_warning() is not None:
+        same = ctypes.c_void_p.in_dll(lib, "mju_user_warning").value is not None
+    else:
+        try:
+            mujoco.set_mju_user_warning(lambda message: None)
+            same = ctypes.c_void_p.in_dll(lib, "mju_user_warning").value is not None
+        finally:
+            mujoco.set_mju_user_warning(None)
+    if not same:
+        raise LayoutError(f"{paths[0]} is not the library instance the bindings use")
+    try:
+        user_error = ctypes.addressof(ctypes.c_void_p.in_dll(lib, "mju_user_error"))
+    except ValueError:  # no legacy handler: a MuJoCo error inside the loop is then MuJoCo's default (exit)
+        user_error = 0
+    return {"mj_step": ctypes.cast(lib.mj_step, ctypes.c_void_p).value, "mju_user_error": user_error}
+
+
+_SCALARS = {"mjtNum": ctypes.c_double, "double": ctypes.c_double, "float": ctypes.c_float, "int": ctypes.c_int,
+            "unsigned int": ctypes.c_uint, "size_t": ctypes.c_size_t, "uintptr_t": ctypes.c_size_t,
+            "mjtSize": ctypes.c_int64, "mjtBool": ctypes.c_bool, "mjtByte": ctypes.c_ubyte}
+
+
+@functools.lru_cache(maxsize=None)
+def _mjdata_offsets() -> dict[str, int]:
+    """Byte offsets of :data:`_DATA_FIELDS` in mjData, from ``mujoco.introspect``'s declaration of the
+    struct laid out by ctypes (the platform's C rules); only the fields up to the last one needed."""
+    from mujoco.introspect import ast_nodes, enums, structs
+
+    def ctype(t):
+        if isinstance(t, ast_nodes.PointerType):
+            return ctypes.c_void_p
+        if isinstance(t, ast_nodes.ArrayType):
+            inner = ctype(t.inner_type)
+            for extent in reversed(t.extents):
+                inner = inner * extent
+            return inner
+        if isinstance(t, ast_nodes.ValueType):
+            if t.name in _SCALARS:
+                return _SCALARS[t.name]
+            if t.name in enums.ENUMS:
+                return ctypes.c_int
+            if t.name in structs.STRUCTS:
+                return struct(t.name, None)
+        raise LayoutError(f"mjData field type {t!r} is not understood")
+
+    def struct(name, last):
+        fields = []
+        for field in structs.STRUCTS[name].fields:
+            fields.append((field.name, ctype(field.type)))
+            if field.name == last:
+                break
+        return type(name, (ctypes.Structure,), {"_fields_": fields})
+
+    names = [f.name for f in structs.STRUCTS["mjData"].fields]
+    missing = [n for n in _DATA_FIELDS if n not in names]
+    if missing:
+        raise LayoutError(f"mjData has no field {missing[0]!r}")
+    layout = struct("mjData", max(_DATA_FIELDS, key=names.index))
+    return {n: getattr(layout, n).offset for n in _DATA_FIELDS}
+
+
+def _check_layout(data: mujoco.MjData) -> dict[str, int]:
+    """The offsets, checked on ``data`` (after ``mj_forward``): every field read at its offset must be what
+    the bindings report."""
+    offsets = _mjdata_offsets()
+    base = data._address
+    read = {n: ctypes.c_int.from_address(base + offsets[n]).value for n in ("ne", "nf", "nl", "nefc")}
+    read["time"] = ctypes.c_double.from_address(base + offsets["time"]).value
+    for n in ("qpos", "qvel", "efc_force"):
+        read[n] = ctypes.c_void_p.from_address(base + offsets[n]).value
+    expected = {n: int(getattr(data, n)) for n in ("ne", "nf", "nl", "nefc")}
+    expected["time"] = float(data.time)
+    for n in ("qpos", "qvel", "efc_force"):
+        expected[n] = _address(getattr(data, n)) if getattr(data, n).size else read[n]
+    if data.nefc == 0 or read != expected:
+        raise LayoutError(f"the mjData layout does not check out: read {read}, expected {expected}")
+    return offsets

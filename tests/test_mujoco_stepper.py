@@ -1,0 +1,212 @@
+"""The compiled stepping loop gives the pure-Python loop's numbers bit for bit, and steps aside safely.
+
+The pure-Python loop (``IPIR_MUJOCO_STEPPER=python``) is the engine as it was before the compiled loop
+(the same code, moved into ``stepper.PythonSteps``); the compiled loop must reproduce it exactly: the same
+double arithmetic in the same order, so every column, energy figure, accuracy record and stall is equal,
+not merely close.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from ipir_mujoco.analytic import RobotParams, SimulationError
+from ipir_mujoco.engine import CrankServo, simulate_mujoco, stepper
+from ipir_mujoco.engine.clutches import Ratchet
+from ipir_mujoco.engine.model import (CRANK_HINGE, MOTOR, SolverSettings, build_model, build_spec, dof_address,
+                                      drive_control, qpos_address, set_closed_loop_state)
+
+
+def built() -> tuple[bool, str]:
+    """Whether the compiled loop is built and checks out here (whatever IPIR_MUJOCO_STEPPER says: these
+    tests choose the loop themselves)."""
+    try:
+        stepper._compiled()
+    except stepper.LayoutError as exc:
+        return False, str(exc)
+    return True, ""
+
+
+COMPILED, WHY_NOT = built()
+needs_compiled = pytest.mark.skipif(not COMPILED, reason=f"no compiled loop here: {WHY_NOT}")
+
+
+@pytest.fixture(autouse=True)
+def default_loop(monkeypatch):
+    """Each test starts with the engine's default choice of loop."""
+    monkeypatch.delenv(stepper.ENV, raising=False)
+
+# every clutch, both lock rules, the motor, gravity both ways, compliant springs with damping and play,
+# a stall and a coarse run the monitor warns about (name: parameters, clutch rule, MuJoCo clutch, t_end [s], options)
+DESIGNS = {
+    "ratchet": (RobotParams(), "unilateral", "ratchet", 0.4, {}),
+    "locks, paper's rule": (RobotParams(), "kinematic", "lock", 0.3, {}),
+    "locks, unilateral": (RobotParams(), "unilateral", "lock", 0.3, {}),
+    "compliant, motor, climb": (RobotParams(drive="motor", incline=20.0, clutch_stiffness=1e6, clutch_damping=300.0,
+                                            clutch_backlash=5e-4), "unilateral", "ratchet", 0.3, {}),
+    "motor, 30 deg climb": (RobotParams(drive="motor", incline=30.0), "unilateral", "ratchet", 0.3, {}),
+    "no clutch, downhill": (RobotParams(F_r1=0.0, F_r2=0.5, incline=-10.0), "unilateral", "none", 0.2, {}),
+    "stall": (RobotParams(drive="motor", M_stall=0.02), "unilateral", "ratchet", 1.0, {}),
+    "coarse step, warned": (RobotParams(), "unilateral", "ratchet", 0.5,
+                            {"settings": SolverSettings(timestep=5e-4), "dt_out": 5e-4, "accuracy": "warn"}),
+}
+
+
+def both_paths(monkeypatch, *args, **options):
+    """The same run with the Python loop and with the compiled one (checked to have done the stepping)."""
+    monkeypatch.setenv(stepper.ENV, "python")
+    python = simulate_mujoco(*args, **options)
+    monkeypatch.delenv(stepper.ENV)
+    calls = []
+    run = stepper.CompiledSteps.run
+    monkeypatch.setattr(stepper.CompiledSteps, "run", lambda self, *a: calls.append(a) or run(self, *a))
+    compiled = simulate_mujoco(*args, **options)
+    assert calls, "the compiled loop did not run"
+    return python, compiled
+
+
+@needs_compiled
+@pytest.mark.parametrize("name", DESIGNS)
+def test_the_compiled_loop_equals_the_python_loop_bit_for_bit(monkeypatch, name):
+    params, rule, implementation, t_end, options = DESIGNS[name]
+    options = {"dt_out": 1e-3, **options}
+    python, compiled = both_paths(monkeypatch, params, rule, implementation, t_end, **options)
+    assert python.series.keys() == compiled.series.keys()
+    for column, values in python.series.items():
+        np.testing.assert_array_equal(compiled.series[column], values, err_msg=column)
+    assert compiled.energy == python.energy and compiled.accuracy == python.accuracy
+    assert compiled.stall == python.stall and compiled.settings == python.settings
+    assert compiled.t_end == python.t_end and len(python.series["t"]) > 100
+    if name == "stall":
+        assert compiled.stall is not None and compiled.t_end < 1.0
+    if name == "coarse step, warned":
+        assert not compiled.accuracy["ok"]  # the monitor's crossing, its time and value, alike
+
+
+@needs_compiled
+def test_the_steady_state_stop_and_the_monitors_stop_are_the_same(monkeypatch):
+    steady = both_paths(monkeypatch, RobotParams(drive="motor"), "unilateral", "ratchet", 4.0, dt_out=1e-3,
+                        until_steady=True)
+    assert steady[0].summary["steady"] and steady[0].t_end < 4.0
+    np.testing.assert_array_equal(steady[1].series["t"], steady[0].series["t"])
+    assert steady[1].summary["t_steady_s"] == steady[0].summary["t_steady_s"]
+    messages = []
+    for path in ("python", ""):
+        monkeypatch.setenv(stepper.ENV, path)
+        with pytest.raises(SimulationError) as failure:
+            simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.5, dt_out=5e-4,
+                            settings=SolverSettings(timestep=5e-4))
+        messages.append(str(failure.value))
+    assert messages[0] == messages[1] and "accuracy check failed at t=" in messages[0]
+
+
+@needs_compiled
+def test_mujocos_warning_inside_the_compiled_loop_fails_the_run_as_before(monkeypatch, tmp_path):
+    """MuJoCo detects the blow-up inside the C loop (which released the GIL); its warning reaches the
+    engine's handler as from the Python loop: the same one-line error, no MUJOCO_LOG.TXT."""
+    monkeypatch.chdir(tmp_path)
+    messages = []
+    for path in ("python", ""):
+        monkeypatch.setenv(stepper.ENV, path)
+        with pytest.raises(SimulationError, match=r"unstable after t=\d") as failure:
+            simulate_mujoco(RobotParams(M=50.0), "kinematic", "lock", 1.0, dt_out=5e-3,
+                            settings=SolverSettings(timestep=5e-3), accuracy="warn")
+        messages.append(str(failure.value))
+    assert messages[0] == messages[1]
+    assert list(tmp_path.iterdir()) == []
+
+
+def loops(model, data, controller):
+    """(the engine's choice of loop for this model, data and controller, the options it was given)."""
+    friction = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
+    motor = model.actuator(MOTOR).id
+    options = dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
+                   gear=1.0, slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
+    return stepper.make_steps(model, data, controller, np.zeros((2, model.nv)), **options), options
+
+
+def ratcheted(params, model):
+    data = mujoco.MjData(model)
+    set_closed_loop_state(model, data, params)
+    data.ctrl[model.actuator(MOTOR).id] = drive_control(params)
+    mujoco.mj_forward(model, data)
+    return data, Ratchet(model, data)
+
+
+def starved_model(params) -> mujoco.MjModel:
+    """The ratcheted model with an arena too small once the two limit rows join the loop and friction rows:
+    it compiles and starts (the forward passes fit) and fails within 200 ratcheted steps. The smallest such
+    size depends on MuJoCo's version, so it is searched for (2.5 kB with mujoco 4.0)."""
+    def compiled(memory):
+        spec = build_spec(params, SolverSettings(), ratchet=True)
+        spec.memory = memory
+        return spec.compile()
+
+    for memory in range(2000, 8000, 100):  # bytes
+        try:
+            model = compiled(memory)
+            data, ratchet = ratcheted(params, model)
+        except (ValueError, mujoco.FatalError):
+            continue  # too small even for the forward pass at the start
+        try:
+            for _ in range(200):
+                ratchet.before_step()
+                mujoco.mj_step(model, data)
+        except mujoco.FatalError:
+            return compiled(memory)  # afresh: the ratchet has raised this one's bounds
+    pytest.skip("no arena size starves only the ratcheted steps with this MuJoCo")
+
+
+@needs_compiled
+def test_a_mujoco_error_inside_the_compiled_loop_is_the_bindings_error():
+    """Too little arena memory for the ratchet's extra constraint rows: MuJoCo's fatal error inside mj_step
+    becomes mujoco.FatalError with MuJoCo's message, as the bindings raise it, and the legacy error handler
+    the loop borrowed is given back."""
+    params = RobotParams()
+    errors = []
+    for path in ("python", "compiled"):
+        model = starved_model(params)
+        data, ratchet = ratcheted(params, model)
+        steps, options = loops(model, data, ratchet)
+        if path == "python":
+            steps = stepper.PythonSteps(model, data, ratchet, steps.qvel_before, **options)
+        assert steps.compiled == (path == "compiled")
+        with pytest.raises(mujoco.FatalError, match="out of memory") as failure:
+            steps.run(200)
+        errors.append(str(failure.value))
+    assert errors[0] == errors[1] and errors[0].startswith("mj_stackAlloc")
+    handler = stepper._library()["mju_user_error"]
+    assert handler and stepper.ctypes.c_void_p.from_address(handler).value is None
+
+
+@needs_compiled
+def test_what_does_not_check_out_steps_in_python(monkeypatch):
+    """A wrong mjData offset, a crank servo or the environment variable: the Python loop."""
+    params = RobotParams()
+    model = build_model(params, SolverSettings(), ratchet=True)
+    data, ratchet = ratcheted(params, model)
+    assert loops(model, data, ratchet)[0].compiled
+    layout = stepper._mjdata_offsets
+    offsets = dict(layout())
+    offsets["efc_force"] += 8  # the next pointer field: not what the bindings report
+    monkeypatch.setattr(stepper, "_mjdata_offsets", lambda: offsets)
+    assert not loops(model, data, ratchet)[0].compiled
+    monkeypatch.setattr(stepper, "_mjdata_offsets", layout)
+    servo = CrankServo(lambda t: 10.0 * t, lambda t: 10.0)
+    assert type(stepper.make_steps(model, data, ratchet, np.zeros((2, model.nv)), servo=servo,
+                                   **loops(model, data, ratchet)[1])) is stepper.PythonSteps
+    monkeypatch.setenv(stepper.ENV, "python")
+    assert not loops(model, data, ratchet)[0].compiled
+    assert stepper.compiled_status() == (False, f"{stepper.ENV}=python is set")
+
+
+def test_a_built_stepper_is_used_with_this_mujoco():
+    """Where the extension was built (a C compiler at install), the running mujoco's mjData layout and
+    library check out and serial runs step in C: this fails when a new mujoco moves what the loop reads."""
+    try:
+        from ipir_mujoco.engine import _stepper  # noqa: F401
+    except ImportError:
+        pytest.skip("the compiled stepper is not built here (installed without a C compiler)")
+    assert stepper.compiled_status() == (True, "compiled")
