@@ -152,6 +152,8 @@ def _findings(metrics: dict) -> list[str]:
                 "cruise is not stated for this design."]
     p = metrics["params"]
     load = p["F_r1"] + p["F_r2"]
+    level = p["incline"] == 0
+    lift = (p["m1"] + p["m2"]) * p["g"] * math.sin(math.radians(p["incline"]))
     energies = [r["energy_per_metre_j_m"] for r in metrics["rungs"] if _ok(r)]
     spread = max(abs(e / load - 1) for e in energies)
     speed = _change(rungs, ONE_WAY, "steady_speed_m_s")
@@ -173,11 +175,17 @@ def _findings(metrics: dict) -> list[str]:
         f"({one_way['crank_speed_rad_s']:.4g} against {rod['crank_speed_rad_s']:.4g} rad/s). Altogether the "
         f"paper's model is {pct(-speed / (1 + speed) if speed is not None else None)} off the cruising speed of "
         "the robot with one-way clutches.",
-        f"**Energy per metre.** {min(energies):.4f} to {max(energies):.4f} J/m in every rung: F_r1 + F_r2 = "
-        f"{load:g} N to within {100 * spread:.2g} % (the kinetic energy still gained over the steady window). Rigid "
-        "clutches engage at zero relative speed and dissipate nothing, so at cruise all the work the motor does at "
-        "the crank goes into the resistances (efficiency ~1), whatever the model: the idealizations do not change "
-        "the energy per metre. They change the mean crank torque the motor must give, "
+        (f"**Energy per metre.** {min(energies):.4f} to {max(energies):.4f} J/m in every rung: F_r1 + F_r2 = "
+         f"{load:g} N to within {100 * spread:.2g} % (the kinetic energy still gained over the steady window). Rigid "
+         "clutches engage at zero relative speed and dissipate nothing, so at cruise all the work the motor does at "
+         "the crank goes into the resistances (efficiency ~1), whatever the model: the idealizations do not change "
+         "the energy per metre. " if level else
+         f"**Energy per metre.** {min(energies):.4f} to {max(energies):.4f} J/m in every rung: in this pipe, "
+         f"inclined {p['incline']:g} deg, the motor's work per metre goes into the resistances, F_r1 + F_r2 = "
+         f"{load:g} N, and into the climb, (m1 + m2) g sin(incline) = {lift:.4g} N and the rod's share where it has "
+         "mass. Rigid clutches engage at zero relative speed and dissipate nothing, so the idealizations change the "
+         "energy per metre only by the rod's weight. ")
+        + "They change the mean crank torque the motor must give, "
         f"{paper['crank_torque_n_m']:.3g} N m in the paper's model against {one_way['crank_torque_n_m']:.3g} N m "
         f"with one-way clutches ({pct(_change(rungs, ONE_WAY, 'crank_torque_n_m'))}: the same work per metre over a "
         "longer distance per revolution), and with it the motor's current.",
@@ -243,9 +251,10 @@ def verdict(metrics: dict) -> dict | None:
         f"{one_way['steady_speed_m_s']:.4g} m/s{mj}: "
         f"{pct((paper['steady_speed_m_s'] - one_way['steady_speed_m_s']) / one_way['steady_speed_m_s'])}, because its "
         f"locks stop each module instead of letting it coast ({paper['distance_per_rev_m']:.4g} against "
-        f"{one_way['distance_per_rev_m']:.4g} m per revolution). Energy per metre is the same in every model, "
-        f"{paper['energy_per_metre_j_m']:.4f} against {one_way['energy_per_metre_j_m']:.4f} J/m (= F_r1 + F_r2: rigid "
-        f"clutches dissipate nothing); the peak clutch reaction at cruise is {paper['peak_clutch_force_n']:.3g} N "
+        f"{one_way['distance_per_rev_m']:.4g} m per revolution). Energy per metre is set by the load, not by the model: "
+        f"{paper['energy_per_metre_j_m']:.4f} against {one_way['energy_per_metre_j_m']:.4f} J/m ("
+        + ("= F_r1 + F_r2" if metrics["params"]["incline"] == 0 else "the resistances and the climb")
+        + f": rigid clutches dissipate nothing); the peak clutch reaction at cruise is {paper['peak_clutch_force_n']:.3g} N "
         f"against {one_way['peak_clutch_force_n']:.3g} N.")
     return {"question": "What does the paper's model get wrong at cruise, under a real motor?", "answer": answer,
             "evidence": "sections.cruise"}
