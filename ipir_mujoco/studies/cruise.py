@@ -225,8 +225,8 @@ def cruise_study(params: RobotParams, quick: bool = False, progress: Progress = 
 
     ``quick`` leaves out the MuJoCo runs at half their timestep. ``workers``: processes for the rungs
     (default: the cores, at most one per rung; 1 runs them here). A pool pays even for these short runs:
-    on 2 busy cores the quick study took 1.29 s with 2 workers against 1.70 s with 1, the full one 2.15 s
-    against 2.95 s.
+    on 2 cores under a load of ~2 from other work, the quick study took 0.80 s with 2 workers against
+    1.15 s with 1, the full one 1.19 s against 2.07 s (medians of 3).
     """
     started = time.perf_counter()
     motor = motor_params(params)
