@@ -167,7 +167,7 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     for text in (page, markdown, (out / "metrics.json").read_text()):
         assert not [ref for ref in OUTSIDE_REFERENCES if ref in text]
     # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study; the sections' figures
-    assert page.count('src="data:image/png;base64,') == 7 + 1
+    assert page.count('src="data:image/png;base64,') == 7 + 2
     try:
         gl_backend()
         has_gl = True
@@ -192,12 +192,20 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
         (point, p["clutch_stiffness"], p["clutch_backlash"]) for point in ("cruise", "startup")
         for p in section["realistic"]}
     assert all("error" not in r[e] for r in section["study"]["rows"] for e in ("analytic", "mujoco"))
-    assert metrics["verdicts"][-1]["evidence"] == "sections.clutch_engagement"
+    clutch_verdict = next(v for v in metrics["verdicts"] if v["evidence"] == "sections.clutch_engagement")
     sprag = next(r for r in section["study"]["rows"] if r["point"] == "startup" and r["clutch_backlash_m"] == 0)
-    assert f"{sprag['analytic']['peak_clutch_force_n']:.3g} N" in metrics["verdicts"][-1]["answer"]
+    assert f"{sprag['analytic']['peak_clutch_force_n']:.3g} N" in clutch_verdict["answer"]
     assert markdown.index("## Energy audit") < markdown.index("## Real clutches: engagement loads") < markdown.index(
         "## Numerical convergence")
     assert "](figures/clutch_engagement.png)" in markdown
+    # under a real motor: every rung at its steady state, MuJoCo within the cross-check tolerance, a verdict
+    cruise = metrics["sections"]["cruise"]
+    assert len(cruise["rungs"]) == 6 and all(r["steady"] for r in cruise["rungs"])
+    assert all(c["within"] for c in cruise["cross_checks"])
+    assert any(v["evidence"] == "sections.cruise" for v in metrics["verdicts"])
+    assert markdown.index("## Energy audit") < markdown.index("## Under a real motor") < markdown.index(
+        "## Numerical convergence")
+    assert "](figures/cruise_histories.png)" in markdown
 
 
 def test_report_is_complete_without_opengl(quick_validation, tmp_path, monkeypatch):

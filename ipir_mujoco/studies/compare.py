@@ -11,7 +11,10 @@ crank angle removes the error a small phase lag inflates at matching time
                              |a - b| and the scale (largest |a|) they compare to;
                              angle_grid is null when a crank does not turn monotonically
     summary                  {figure: {a, b, relative}}: (b - a) / |a| for revolutions,
-                             x1_final, x2_final, v1_max, v2_max, first_contraction_end_s
+                             x1_final, x2_final, v1_max, v2_max, first_contraction_end_s and the
+                             periodic steady state's t_steady_s, steady_speed_m_s, distance_per_rev_m,
+                             energy_per_metre_j_m, efficiency, peak_clutch_force_n (null where a run
+                             has no such figure, e.g. a run that did not reach steady state)
     switches                 {matched, unmatched_a, unmatched_b, dt: [...], max_abs_dt}:
                              mode changes matched one by one (same from->to, in order)
     first_exceedance         {quantity: t or null}: first time |a - b| exceeds
@@ -32,6 +35,10 @@ from ipir_mujoco.analytic.results import COLUMNS, RunResult, mode_changes
 
 QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
+# the periodic steady state (analytic.cycles, through RunResult.summary): over the steady window when a
+# run reached it, else (distance, efficiency, peak force) over the whole run, or null
+STEADY_FIGURES = ("t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m", "efficiency",
+                  "peak_clutch_force_n")
 
 
 def load_run(folder: str | Path) -> RunResult:
@@ -156,8 +163,9 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
         angle_errors = {q: _errors(resampled[id(a)][q], resampled[id(b)][q]) for q in ("t",) + QUANTITIES[1:]}
 
     summary = {}
-    for key in SUMMARY_FIGURES:
-        va, vb = a.summary[key], b.summary[key]
+    summary_a, summary_b = a.summary, b.summary
+    for key in SUMMARY_FIGURES + STEADY_FIGURES:
+        va, vb = summary_a.get(key), summary_b.get(key)
         relative = None if va in (None, 0) or vb is None else (vb - va) / abs(va)
         summary[key] = {"a": va, "b": vb, "relative": relative}
 
@@ -184,6 +192,8 @@ def format_comparison(result: dict) -> str:
     lines = [f"b = {result['b']} against a = {result['a']}, over {result['t_compared_s']:.4g} s", ""]
     rows = [("summary figure", "unit", "a", "b", "(b - a) / |a|")]
     for key, v in result["summary"].items():
+        if key in STEADY_FIGURES and v["a"] is None and v["b"] is None:
+            continue  # neither run has it (neither reached its steady state): not a row of empty cells
         name, unit = unit_of(SUMMARY, key)
         rows.append((name, unit, "none" if v["a"] is None else f"{v['a']:.6g}",
                      "none" if v["b"] is None else f"{v['b']:.6g}",

@@ -1,0 +1,264 @@
+"""The robot at cruise under a real motor: every rung of the model ladder run to its periodic steady state.
+
+Each rung of the validation ladder (the paper's model; exact geometry; the rod's mass; MuJoCo with the
+paper's locks; the one-way-clutch equations; MuJoCo's ratchet) is driven by the same DC gearmotor,
+torque M_stall (1 - omega / omega_noload), from rest until its per-revolution mean speed settles
+(``until_steady``; :mod:`ipir_mujoco.analytic.cycles`), and its steady state is read from the run's
+summary: time to steady state, steady speed, distance per revolution, energy per metre (motor work at
+the crank per metre), efficiency (work against the resistances / motor work), peak clutch reaction;
+and from them the mean crank speed 2 pi v / d [rad/s] and the mean crank torque (motor work per
+revolution / 2 pi) [N m], what the motor sees.
+
+Cross-check: each MuJoCo rung against the equations of the same mechanism (locks by the paper's rule
+against the exact equations with the rod; the ratchet against the one-way-clutch equations), with
+:func:`ipir_mujoco.studies.compare.compare_runs`' summary comparison. Steady speed, distance per
+revolution and energy per metre must agree within :data:`CROSS_CHECK_TOL` (its derivation is at its
+definition). The peak clutch reaction is compared too but not held to it: see :data:`CHECKED`.
+
+:func:`cruise_study` returns a JSON-ready dict (``sections.cruise`` of metrics.json)::
+
+    params        the motor-driven parameter set (SI)
+    quick, t_cap_s, dt_out_s, cross_check_tol, wall_s, workers
+    rungs         [{name, isolates, engine, geometry, clutch, mujoco_clutch, timestep, wall_s, steady,
+                   stalled, stall_reason, revolutions, t_steady_s, steady_speed_m_s, distance_per_rev_m,
+                   energy_per_metre_j_m, efficiency, peak_clutch_force_n, crank_speed_rad_s,
+                   crank_torque_n_m, crank_speed_range_rad_s ([min, max] over the steady window),
+                   change_vs_paper: {figure: (rung - paper) / |paper|},
+                   history: {t, omega, speed} (every HISTORY_DT s: s, rad/s, m/s, robot = mean of the
+                   modules), revolutions_end: {t, speed} (per-revolution mean speed [m/s] at each
+                   revolution's end [s])} or {name, isolates, error}]
+    cross_checks  [{mujoco, equations, figures: {figure: {a, b, relative}} (a = equations, b = MuJoCo),
+                   worst_checked, within, halved_step: the same for MuJoCo at half its timestep (full
+                   run only)}]
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as futures
+import math
+import os
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ipir_mujoco import analytic
+from ipir_mujoco.analytic.cycles import STEADY_TOL, cycles, travel
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.analytic.results import RunResult
+
+from ..engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
+from .compare import STEADY_FIGURES, compare_runs
+
+T_CAP = 10.0  # s: cap of every run; the default motor settles in about 2 s
+DT_OUT = 1e-3  # s: output interval (each analytic revolution's end is an exact sample whatever it is)
+HISTORY_DT = 4e-3  # s: interval of the stored time histories (about 60 points per crank revolution at cruise)
+# Figures held to CROSS_CHECK_TOL. The peak clutch reaction is not: a rigid clutch's reaction jumps where
+# it engages, which MuJoCo's soft constraint resolves over a few steps with an overshoot that depends on
+# the step and on whether a sample falls on it; and a held module's static friction takes part of the hold
+# (up to F_r), a share the rigid equations give entirely to the clutch (statically indeterminate).
+CHECKED = ("steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m")
+# Relative tolerance of the MuJoCo-against-equations cross-check at steady state, from the tolerances that
+# hold each engine, not from the differences seen:
+# - MuJoCo's accuracy monitor holds the energy residual to RESIDUAL_TOL = 1e-3 of the energy put through
+#   the robot, which keeps revolutions and travel within 0.1 % of the converged mechanism (the monitor's
+#   calibration, engine/monitor.py); at steady state the cumulative residual ratio tends to the per-
+#   revolution one, so energy per metre is held to it too;
+# - the ratchet's backward excursion, at most EXCURSION_PER_R r, costs at most EXCURSION_PER_R / 2 of the
+#   travel 2 r per stroke;
+# - each engine stops once the last 3 per-revolution mean speeds agree within STEADY_TOL = 1e-4: its
+#   steady figures lie within ~STEADY_TOL of the limit cycle's, so two engines differ by up to 2 STEADY_TOL.
+# The equations' own error (rtol 1e-10) is negligible beside these.
+CROSS_CHECK_TOL = RESIDUAL_TOL + EXCURSION_PER_R / 2 + 2 * STEADY_TOL  # 1.3e-3
+
+Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class CruiseRung:
+    """One rung of the ladder under the motor: which engine, geometry, clutch rule, and with or without rod."""
+
+    name: str
+    isolates: str  # the assumption it removes, against the rung before
+    engine: str  # 'analytic' | 'mujoco'
+    clutch: str  # the rule: 'kinematic' (paper's) | 'unilateral'
+    geometry: str = "exact"  # analytic only
+    implementation: str | None = None  # MuJoCo: 'lock' | 'ratchet'
+    massless_rod: bool = False
+
+
+RUNGS = (
+    CruiseRung("paper model", "nothing: first-order kinematics, massless rod, ideal locks", "analytic", "kinematic",
+               "approx", massless_rod=True),
+    CruiseRung("exact geometry", "L >> r: the exact slider-crank", "analytic", "kinematic", massless_rod=True),
+    CruiseRung("with rod mass", "the massless rod", "analytic", "kinematic"),
+    CruiseRung("MuJoCo, paper's rule", "the equations: MuJoCo physics, locks by the paper's rule", "mujoco",
+               "kinematic", implementation="lock"),
+    CruiseRung("one-way clutches", "ideal locks: clutches that can only push (equations)", "analytic", "unilateral"),
+    CruiseRung("MuJoCo ratchet", "the equations again: MuJoCo physics with one-way clutches (ratchet)", "mujoco",
+               "unilateral", implementation="ratchet"),
+)
+CROSS_CHECKS = (("MuJoCo, paper's rule", "with rod mass"), ("MuJoCo ratchet", "one-way clutches"))
+
+
+def motor_params(params: RobotParams) -> RobotParams:
+    """``params`` driven by its motor (M_stall, omega_noload as given; defaults 0.5 N m, 30 rad/s)."""
+    return params.replace(drive="motor")
+
+
+def run_rung(params: RobotParams, rung: CruiseRung, t_cap: float = T_CAP, dt_out: float = DT_OUT,
+             settings=None) -> RunResult:
+    """One rung to its steady state (``t_cap`` [s] caps it); ``settings``: MuJoCo SolverSettings, else automatic."""
+    p = params.replace(rod_mass=0.0, rod_inertia=0.0) if rung.massless_rod else params
+    if rung.engine == "analytic":
+        return analytic.simulate(p, rung.geometry, rung.clutch, t_cap, dt_out=dt_out, until_steady=True)
+    from ..engine import simulate_mujoco
+
+    extra = {} if settings is None else {"settings": settings}
+    return simulate_mujoco(p, rung.clutch, rung.implementation, t_cap, dt_out=dt_out, until_steady=True, **extra)
+
+
+def _task(params: RobotParams, rung: CruiseRung, t_cap: float, dt_out: float, halve: bool):
+    """A pool task: the rung's run (or its one-line failure), and with ``halve`` MuJoCo at half its step."""
+    started = time.perf_counter()
+    try:
+        run = run_rung(params, rung, t_cap, dt_out)
+    except (ParameterError, SimulationError) as exc:
+        return {"error": " ".join(str(exc).split())}, None, time.perf_counter() - started
+    halved = None
+    if halve and rung.engine == "mujoco":
+        from ..engine.model import SolverSettings
+
+        s = run.settings
+        finer = SolverSettings(timestep=s["timestep"] / 2, integrator=s["integrator"], solimp=tuple(s["solimp"]))
+        try:
+            halved = run_rung(params, rung, t_cap, dt_out, finer)
+        except (ParameterError, SimulationError) as exc:
+            halved = {"error": " ".join(str(exc).split())}
+    return run, halved, time.perf_counter() - started
+
+
+def _run_all(params, t_cap, dt_out, halve, workers, progress) -> dict:
+    """{rung name: (run or {"error"}, halved, wall [s])}: in a process pool of ``workers`` (1: here)."""
+    done: dict = {}
+
+    def finished(rung: CruiseRung, outcome) -> None:
+        done[rung.name] = outcome
+        run = outcome[0]
+        status = run["error"] if isinstance(run, dict) else (
+            f"steady {run.summary['steady_speed_m_s']:.4g} m/s from {run.summary['t_steady_s']:.3g} s"
+            if run.summary["steady"] else (run.stall or f"not steady by {run.t_end:g} s"))
+        progress(f"[{len(done)}/{len(RUNGS)}] {rung.name}: {status} ({outcome[2]:.2f} s)")
+
+    if workers <= 1:
+        for rung in RUNGS:
+            finished(rung, _task(params, rung, t_cap, dt_out, halve))
+        return done
+    from .sweep import _kill_workers, _worker_init  # pool workers die with this process, ignore Ctrl-C
+
+    pool = futures.ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
+    complete = False
+    try:
+        # the MuJoCo rungs first: the longest tasks
+        order = sorted(RUNGS, key=lambda r: r.engine != "mujoco")
+        pending = {pool.submit(_task, params, r, t_cap, dt_out, halve): r for r in order}
+        for future in futures.as_completed(pending):
+            finished(pending[future], future.result())
+        complete = True
+    finally:
+        if not complete:
+            _kill_workers(pool)
+        pool.shutdown(wait=complete, cancel_futures=True)
+    return done
+
+
+def _rounded(values, digits: int = 6) -> list[float]:
+    return [float(f"{v:.{digits}g}") for v in np.asarray(values, dtype=float)]
+
+
+def rung_record(rung: CruiseRung, run: RunResult, wall_s: float) -> dict:
+    """The steady-state figures and the time histories of one rung's run (see the module docstring)."""
+    s = run.summary
+    record = {"name": rung.name, "isolates": rung.isolates, "engine": run.engine, "geometry": run.geometry,
+              "clutch": run.clutch, "mujoco_clutch": rung.implementation, "timestep": run.settings.get("timestep"),
+              "wall_s": wall_s, "steady": s["steady"], "stalled": s["stalled"], "stall_reason": s["stall_reason"],
+              "revolutions": s["revolutions"], **{k: s[k] for k in STEADY_FIGURES}}
+    v, d, e = s["steady_speed_m_s"], s["distance_per_rev_m"], s["energy_per_metre_j_m"]
+    steady = s["steady"] and v is not None and d and e is not None
+    record["crank_speed_rad_s"] = 2 * math.pi * v / d if steady else None
+    record["crank_torque_n_m"] = e * d / (2 * math.pi) if steady else None
+    series = run.series
+    t = np.asarray(series["t"], dtype=float)
+    found = cycles(series)
+    window = t >= (found[-run.settings["steady_cycles"]].t_start if steady else t[-1])
+    omega = np.asarray(series["omega"])[window]
+    record["crank_speed_range_rad_s"] = [float(omega.min()), float(omega.max())] if steady else None
+    keep = np.concatenate([np.diff(t) > 0, [True]])  # of a duplicated switch instant, the later sample
+    grid = np.arange(0.0, t[-1] + 1e-12, HISTORY_DT)
+    speed = 0.5 * (np.asarray(series["v1"]) + np.asarray(series["v2"]))
+    record["history"] = {"t": _rounded(grid), "omega": _rounded(np.interp(grid, t[keep], series["omega"][keep])),
+                         "speed": _rounded(np.interp(grid, t[keep], speed[keep]))}
+    record["revolutions_end"] = {"t": _rounded([c.t_end for c in found]),
+                                 "speed": _rounded([c.mean_speed_m_s for c in found])}
+    record["travel_m"] = float(travel(series)[-1] - travel(series)[0])
+    return record
+
+
+def cross_check(equations: RunResult, mujoco: RunResult) -> dict:
+    """compare_runs' summary comparison of the steady figures: a = equations, b = MuJoCo."""
+    summary = compare_runs(equations, mujoco)["summary"]
+    figures = {k: summary[k] for k in STEADY_FIGURES}
+    checked = [figures[k]["relative"] for k in CHECKED]
+    worst = None if None in checked else max(abs(x) for x in checked)
+    return {"figures": figures, "worst_checked": worst, "within": worst is not None and worst <= CROSS_CHECK_TOL}
+
+
+def _relative(new, old):
+    return None if new is None or old is None or old == 0 else (new - old) / abs(old)
+
+
+def cruise_study(params: RobotParams, quick: bool = False, progress: Progress = lambda _m: None,
+                 workers: int | None = None, t_cap: float = T_CAP, dt_out: float = DT_OUT) -> dict:
+    """Every rung to its steady state under ``params``' motor, and the cross-checks (module docstring).
+
+    ``quick`` leaves out the MuJoCo runs at half their timestep. ``workers``: processes for the rungs
+    (default: the cores, at most one per rung; 1 runs them here). A pool pays even for these short runs:
+    on 2 cores under a load of ~2 from other work, the quick study took 0.80 s with 2 workers against
+    1.15 s with 1, the full one 1.19 s against 2.07 s (medians of 3).
+    """
+    started = time.perf_counter()
+    motor = motor_params(params)
+    workers = min(os.cpu_count() or 1, len(RUNGS)) if workers is None else workers
+    outcomes = _run_all(motor, t_cap, dt_out, not quick, workers, progress)
+    rungs, runs = [], {}
+    for rung in RUNGS:
+        run, _, wall = outcomes[rung.name]
+        if isinstance(run, dict):
+            rungs.append({"name": rung.name, "isolates": rung.isolates, **run})
+            continue
+        runs[rung.name] = run
+        rungs.append(rung_record(rung, run, wall))
+    paper = rungs[0] if "error" not in rungs[0] else None
+    for record in rungs:
+        if "error" not in record:
+            record["change_vs_paper"] = {k: (None if paper is None else _relative(record[k], paper[k]))
+                                         for k in STEADY_FIGURES + ("crank_speed_rad_s", "crank_torque_n_m")}
+    checks = []
+    for mj_name, eq_name in CROSS_CHECKS:
+        entry = {"mujoco": mj_name, "equations": eq_name}
+        if mj_name in runs and eq_name in runs:
+            entry.update(cross_check(runs[eq_name], runs[mj_name]))
+            halved = outcomes[mj_name][1]
+            if isinstance(halved, RunResult):
+                entry["halved_step"] = {"timestep": halved.settings["timestep"],
+                                        **cross_check(runs[eq_name], halved)}
+            elif isinstance(halved, dict):
+                entry["halved_step"] = halved
+        else:
+            entry["error"] = "a run of the pair failed (see its rung)"
+        checks.append(entry)
+    return {"params": motor.as_dict(), "quick": quick, "t_cap_s": t_cap, "dt_out_s": dt_out,
+            "cross_check_tol": CROSS_CHECK_TOL, "checked": list(CHECKED), "rungs": rungs, "cross_checks": checks,
+            "workers": workers, "wall_s": time.perf_counter() - started}
