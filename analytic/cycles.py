@@ -34,6 +34,7 @@ import numpy as np
 
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
+_WHOLE_TOL = 1e-9  # revolutions: see cycle_boundaries
 ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential", "clutch_spring_energy",
                   "clutch_damper_work")
 
@@ -51,11 +52,13 @@ def cycle_boundaries(t: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.nda
     ``indices[j]`` the first sample at or after it.
     """
     reach = np.maximum.accumulate(np.asarray(phi, dtype=float)) - phi[0]
-    whole = int(math.floor(reach[-1] / (2 * math.pi) + 1e-12))
+    # a turn short by less than 1e-9 of a revolution is complete: a run stopped exactly on a revolution end
+    # and written to CSV with 12 significant digits reads back a few 1e-12 revolutions short of it
+    whole = int(math.floor(reach[-1] / (2 * math.pi) + _WHOLE_TOL))
     if whole < 1:
         return np.zeros(0), np.zeros(0, dtype=int)
     targets = 2 * math.pi * np.arange(1, whole + 1)
-    idx = np.searchsorted(reach, targets - 1e-12 * (1 + targets), side="left")
+    idx = np.searchsorted(reach, targets - 2 * math.pi * _WHOLE_TOL * (1 + targets), side="left")
     idx = np.minimum(idx, len(t) - 1)
     times = np.empty(whole)
     for j, i in enumerate(idx):

@@ -82,3 +82,15 @@ def test_steady_index_needs_positive_speed_and_a_full_window():
     assert steady_index([0.0, 0.0, 0.0]) is None
     assert steady_index([1.0, 1.0]) is None
     assert steady_index([0.5, 1.0, 1.00001, 1.00002], tol=1e-4, n=3) == 3
+
+
+def test_a_run_ending_on_a_revolution_keeps_it_after_a_csv_round_trip(tmp_path):
+    """12 significant digits move phi by a few 1e-12 revolutions: the last revolution must still count."""
+    from ipir_mujoco.analytic import RobotParams, simulate
+    from ipir_mujoco.analytic.results import read_csv
+
+    run = simulate(RobotParams(drive="motor"), "exact", "unilateral", 10.0, dt_out=1e-3, until_steady=True)
+    run.write_csv(tmp_path / "ts.csv")
+    back = read_csv(tmp_path / "ts.csv")
+    assert cycle_summary(back)["cycles"] == cycle_summary(run.series)["cycles"] >= 3
+    assert cycle_summary(back)["steady"]

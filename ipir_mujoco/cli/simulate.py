@@ -142,9 +142,9 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         "  energy [J]: " + _energy_line(e),
     ]
     if s["steady"]:
-        lines.append(f"  steady state from {s['t_steady_s']:.3f} s: {s['steady_speed_m_s']:.4g} m/s, "
-                     f"{s['distance_per_rev_m']:.4g} m per revolution, {s['energy_per_metre_j_m']:.4g} J/m, "
-                     f"efficiency {s['efficiency']:.3g}")
+        lines.append(f"  steady state from {s['t_steady_s']:.3f} s: {s['steady_speed_m_s']:.5g} m/s, "
+                     f"{s['distance_per_rev_m']:.5g} m per revolution, {s['energy_per_metre_j_m']:.5g} J/m, "
+                     f"efficiency {s['efficiency']:.5g}")
     elif until_steady:
         lines.append(f"  steady state            not reached by {run.t_end:g} s")
     if s["stalled"]:

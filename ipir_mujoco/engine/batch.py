@@ -48,6 +48,7 @@ from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_run_optio
 from .timestep import DT_MIN, choose_settings
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
+MODELLED_DRIVES = ("torque", "motor")  # each design's own actuator gain and bias (checked against the serial engine)
 COLUMNS = ("t", "phi", "omega", "x1", "x2", "v1", "v2", "a1", "a2", "motor_work", "friction_work", "kinetic",
            "potential", "loop_gap")
 

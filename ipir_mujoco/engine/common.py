@@ -96,5 +96,5 @@ def rest_since(t: np.ndarray, omega: np.ndarray, v1: np.ndarray, v2: np.ndarray,
 
 def stall_reason(since: float, t_stop: float, phi: float) -> str:
     """The one-line stall reason of RunResult.stall (times [s], crank angle [rad])."""
-    return (f"stalled: crank and modules at rest from t={since:.4g} s (crank at {math.degrees(phi) % 360:.1f} deg "
+    return (f"crank and modules at rest from t={since:.4g} s (crank at {math.degrees(phi) % 360:.1f} deg "
             f"in its turn); the drive cannot turn the crank on against the load (run stopped at t={t_stop:.4g} s)")

@@ -56,7 +56,6 @@ from .sweep_space import Study
 
 BATCH_SIZE = 64  # MuJoCo designs stepped together: ~2 s of work per chunk for 1 s runs on 2 cores
 BATCHED = "mujoco-ratchet"
-BATCH_DRIVES = ("torque", "motor")  # drives the batched engine models, unless batch.py says otherwise
 
 
 class SweepInterrupted(RuntimeError):
@@ -196,10 +195,8 @@ def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out:
 
     params: list[RobotParams | None] = []
     refused: dict[int, str] = {}
-    # a drive the batch does not model must not pass silently. It models the constant torque and the motor
-    # (each design's own actuator gain and bias: tests/test_mujoco_batch.py checks it against the serial
-    # engine); batch.MODELLED_DRIVES, where declared, says so itself
-    modelled = getattr(batch, "MODELLED_DRIVES", BATCH_DRIVES)
+    # a drive the batch does not model must not pass silently: batch.MODELLED_DRIVES says which it does
+    modelled = batch.MODELLED_DRIVES
     for k, design in enumerate(values):
         try:
             params.append(base.replace(**design))
