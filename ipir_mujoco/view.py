@@ -17,7 +17,6 @@ one, use ``ipir-mujoco render`` for a video.
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 import time

@@ -18,7 +18,7 @@ from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.batch import run_ratchet_batch
 from ipir_mujoco.engine.compliant import CompliantClutches
 from ipir_mujoco.engine.model import (FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE, SolverSettings,
-                                      build_model, dof_address, drive_control, qpos_address, set_closed_loop_state)
+                                      build_model, dof_address, drive_control, set_closed_loop_state)
 from ipir_mujoco.engine.monitor import RESIDUAL_TOL
 from ipir_mujoco.engine.timestep import CLUTCH_SHARE, choose_settings, clutch_rate
 

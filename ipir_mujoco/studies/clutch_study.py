@@ -42,7 +42,7 @@ Divergence: (MuJoCo - analytic) / |analytic| for every metric both have.
 
 from __future__ import annotations
 
-import concurrent.futures as futures
+import functools
 import math
 import os
 import time
@@ -57,6 +57,7 @@ from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams, check_whole
 
 from ..engine import SolverSettings, simulate_mujoco
+from .pool import map_unordered
 from ..engine.timestep import choose_settings, clutch_rate
 
 
@@ -302,24 +303,12 @@ def run_tasks(base: RobotParams, tasks: list[Task], points_table: dict[str, Oper
         status = result["error"] if "error" in result else f"{result['wall_s']:.2f} s"
         progress(f"[{len(results)}/{len(tasks)}] {task.point} {task.engine} {what}: {status}")
 
-    if workers <= 1 or len(tasks) == 1:
-        for task in order:
-            done(task, run_task(base, points_table[task.point], task))
-        return results
-    from .sweep import _kill_workers, _worker_init  # pool workers die with this process, ignore Ctrl-C
-
-    pool = futures.ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
-    finished = False
-    try:
-        pending = {pool.submit(run_task, base, points_table[t.point], t): t for t in order}
-        for future in futures.as_completed(pending):
-            done(pending[future], future.result())
-        finished = True
-    finally:
-        if not finished:
-            _kill_workers(pool)
-        pool.shutdown(wait=finished, cancel_futures=True)
+    map_unordered(functools.partial(_run_task_item, base, points_table), order, workers, done)
     return results
+
+
+def _run_task_item(base: RobotParams, points_table: dict[str, OperatingPoint], task: Task) -> dict:
+    return run_task(base, points_table[task.point], task)
 
 
 def run_study(base: RobotParams, stiffness: Sequence[float] = STIFFNESS, backlash: Sequence[float] = BACKLASH,

@@ -34,7 +34,7 @@ definition). The peak clutch reaction is compared too but not held to it: see :d
 
 from __future__ import annotations
 
-import concurrent.futures as futures
+import functools
 import math
 import os
 import time
@@ -51,6 +51,7 @@ from ipir_mujoco.analytic.results import RunResult
 
 from ..engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
 from .compare import STEADY_FIGURES, compare_runs
+from .pool import map_unordered
 
 T_CAP = 10.0  # s: cap of every run; the default motor settles in about 2 s
 DT_OUT = 1e-3  # s: output interval (each analytic revolution's end is an exact sample whatever it is)
@@ -152,26 +153,14 @@ def _run_all(params, t_cap, dt_out, halve, workers, progress) -> dict:
             if run.summary["steady"] else (run.stall or f"not steady by {run.t_end:g} s"))
         progress(f"[{len(done)}/{len(RUNGS)}] {rung.name}: {status} ({outcome[2]:.2f} s)")
 
-    if workers <= 1:
-        for rung in RUNGS:
-            finished(rung, _task(params, rung, t_cap, dt_out, halve))
-        return done
-    from .sweep import _kill_workers, _worker_init  # pool workers die with this process, ignore Ctrl-C
-
-    pool = futures.ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
-    complete = False
-    try:
-        # the MuJoCo rungs first: the longest tasks
-        order = sorted(RUNGS, key=lambda r: r.engine != "mujoco")
-        pending = {pool.submit(_task, params, r, t_cap, dt_out, halve): r for r in order}
-        for future in futures.as_completed(pending):
-            finished(pending[future], future.result())
-        complete = True
-    finally:
-        if not complete:
-            _kill_workers(pool)
-        pool.shutdown(wait=complete, cancel_futures=True)
+    # the MuJoCo rungs first: the longest tasks
+    order = sorted(RUNGS, key=lambda r: r.engine != "mujoco")
+    map_unordered(functools.partial(_rung_task, params, t_cap, dt_out, halve), order, workers, finished)
     return done
+
+
+def _rung_task(params, t_cap, dt_out, halve, rung):
+    return _task(params, rung, t_cap, dt_out, halve)
 
 
 def _rounded(values, digits: int = 6) -> list[float]:
