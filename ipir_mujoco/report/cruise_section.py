@@ -214,7 +214,7 @@ def _agreement(metrics: dict) -> str:
         if peak is not None:
             peaks.append(f"{pct(peak)} ({check['mujoco']})")
     text = ("**MuJoCo against the equations of the same mechanism**, in steady speed, distance per revolution and "
-            f"energy per metre: " + "; ".join(parts) + f". Tolerance {100 * metrics['cross_check_tol']:.2g} %: MuJoCo's "
+            "energy per metre: " + "; ".join(parts) + f". Tolerance {100 * metrics['cross_check_tol']:.2g} %: MuJoCo's "
             "accuracy monitor (energy residual 1e-3, which keeps revolutions and travel within 0.1 %; ratchet "
             "excursion 1e-4 of the travel) plus twice the steady-state test's 1e-4 (each engine stops within it of "
             "its limit cycle).")
