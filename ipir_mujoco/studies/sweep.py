@@ -195,9 +195,11 @@ def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out:
 
     params: list[RobotParams | None] = []
     refused: dict[int, str] = {}
-    # the batch sets the actuator to the constant M: a design it does not model must not pass silently
-    # (batch.py declares MODELLED_DRIVES once it models more than the constant torque)
-    modelled = getattr(batch, "MODELLED_DRIVES", ("torque",))
+    # a drive the batch does not model must not pass silently. It builds each design's actuator with the
+    # serial engine's builder (gain and bias of the motor line included) and reads the motor's work from
+    # MuJoCo's actuator force, so it models both drives: its motor runs equal serial ones to the last digit
+    # (tests/test_climbing.py); batch.py may declare MODELLED_DRIVES to say otherwise
+    modelled = getattr(batch, "MODELLED_DRIVES", ("torque", "motor"))
     for k, design in enumerate(values):
         try:
             params.append(base.replace(**design))
