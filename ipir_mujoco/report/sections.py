@@ -18,7 +18,7 @@ from typing import Callable
 
 from ipir_mujoco.analytic.params import RobotParams
 
-from . import clutch_section
+from . import clutch_section, riser_section
 
 Progress = Callable[[str], None]
 
@@ -35,4 +35,5 @@ class Section:
 SECTIONS: tuple[Section, ...] = (
     Section("clutch_engagement", "Real clutches: engagement loads", clutch_section.compute, clutch_section.render,
             clutch_section.verdict),
+    Section("vertical_riser", "Vertical riser", riser_section.compute, riser_section.render, riser_section.verdict),
 )
