@@ -356,3 +356,22 @@ def test_the_batch_never_runs_a_drive_it_does_not_model(monkeypatch):
     rows = run_batch_chunk([{"L": 0.1}, {"L": 0.2}], RobotParams(drive="motor"), 0.1, 1e-3, 1)
     assert all("drive='motor' is not modelled by the batched engine" in r["mujoco-ratchet"]["error"]
                and "--no-batch" in r["mujoco-ratchet"]["error"] for r in rows)
+
+
+def test_the_batch_runs_a_motor_design_as_the_motor(tmp_path):
+    """run_ratchet_batch builds each design's actuator with the serial engine's builder, the motor line
+    included: a batched motor design gives the serial MuJoCo run's figures (the same model, the same steps,
+    the same reads of MuJoCo's state), not a constant torque's."""
+    from ipir_mujoco.engine import simulate_mujoco
+    from ipir_mujoco.studies.sweep_metrics import run_metrics
+
+    study = Study((parse_vary("L=0.1,0.2"),), base=RobotParams(drive="motor"), engines=("mujoco-ratchet",),
+                  t_end=0.1)
+    rows = rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=1))
+    for row in rows:
+        assert row["error"] == ""
+        serial = run_metrics(simulate_mujoco(RobotParams(drive="motor", L=float(row["L"])), "unilateral", "ratchet",
+                                             0.1, dt_out=1e-3))
+        # results.csv keeps 10 significant digits
+        assert float(row["mujoco-ratchet:revolutions"]) == pytest.approx(serial["revolutions"], rel=1e-9)
+        assert float(row["mujoco-ratchet:efficiency"]) == pytest.approx(serial["efficiency"], rel=1e-6)

@@ -166,8 +166,10 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     assert "<script" not in page and "http://" not in page and "https://" not in page
     for text in (page, markdown, (out / "metrics.json").read_text()):
         assert not [ref for ref in OUTSIDE_REFERENCES if ref in text]
-    # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study; the sections' figures
-    assert page.count('src="data:image/png;base64,') == 7 + 2
+    # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study; one figure per section
+    from ipir_mujoco.report.sections import SECTIONS
+
+    assert page.count('src="data:image/png;base64,') == 7 + len(SECTIONS)
     try:
         gl_backend()
         has_gl = True
@@ -206,6 +208,21 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     assert markdown.index("## Energy audit") < markdown.index("## Under a real motor") < markdown.index(
         "## Numerical convergence")
     assert "](figures/cruise_histories.png)" in markdown
+    # the vertical riser: the default motor stalls in both exact models, the paper's model says it climbs; the
+    # smallest motor that restarts anywhere (the torque needed at rest, rounded up to 0.01 N m) climbs in both
+    riser = metrics["sections"]["vertical_riser"]
+    assert all(riser["default"][e]["stalled"] for e in ("analytic-unilateral", "mujoco-ratchet"))
+    assert riser["default"]["analytic-approx"]["steady"] and not riser["default"]["analytic-approx"]["stalled"]
+    assert riser["need"]["torque_n_m"] > riser["motor"]["M_stall_n_m"]
+    assert 0 <= riser["stronger_n_m"] - riser["need"]["torque_n_m"] < 0.01
+    speeds = [riser["strong"][e]["steady_speed_m_s"] for e in ("analytic-unilateral", "mujoco-ratchet")]
+    assert abs(speeds[1] / speeds[0] - 1) < 1e-3  # TARGET of tests/test_mujoco_accuracy.py
+    riser_verdict = next(v for v in metrics["verdicts"] if v["evidence"] == "sections.vertical_riser")
+    assert riser_verdict["answer"].startswith("No, not with the motor of M_stall 0.5 N m")
+    assert f"{riser['need']['torque_n_m']:.4g} N m" in riser_verdict["answer"]
+    assert markdown.index("## Real clutches: engagement loads") < markdown.index("## Vertical riser") < markdown.index(
+        "## Numerical convergence")
+    assert "](figures/climbing_ability.png)" in markdown and "**It stalls.**" in markdown
 
 
 def test_report_is_complete_without_opengl(quick_validation, tmp_path, monkeypatch):

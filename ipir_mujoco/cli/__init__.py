@@ -34,7 +34,7 @@ try:
     from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 
     from .. import __version__
-    from . import clutch_study, compare, kinetostatics, params, render, simulate, sweep, validate
+    from . import climb, clutch_study, compare, kinetostatics, params, render, simulate, sweep, validate
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
     if _loading_guard:
@@ -42,7 +42,7 @@ finally:
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "main"]
 
-COMMANDS = (simulate, validate, compare, sweep, kinetostatics, params, render, clutch_study)
+COMMANDS = (simulate, validate, compare, sweep, kinetostatics, params, render, clutch_study, climb)
 
 
 def build_parser() -> Parser:

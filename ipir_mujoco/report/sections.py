@@ -18,7 +18,7 @@ from typing import Callable
 
 from ipir_mujoco.analytic.params import RobotParams
 
-from . import clutch_section, cruise_section
+from . import clutch_section, cruise_section, riser_section
 
 Progress = Callable[[str], None]
 
@@ -36,4 +36,5 @@ SECTIONS: tuple[Section, ...] = (
     Section("clutch_engagement", "Real clutches: engagement loads", clutch_section.compute, clutch_section.render,
             clutch_section.verdict),
     Section("cruise", "Under a real motor", cruise_section.compute, cruise_section.render, cruise_section.verdict),
+    Section("vertical_riser", "Vertical riser", riser_section.compute, riser_section.render, riser_section.verdict),
 )

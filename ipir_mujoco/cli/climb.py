@@ -1,0 +1,171 @@
+"""``ipir-mujoco climb``: the steepest pipe a design climbs with its drive, and its speed against the incline."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+from pathlib import Path
+
+from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.analytic.params import check_real, check_run_options
+from ipir_mujoco.analytic.results import write_json
+
+from ..output import check_output_dir, staged_output
+from .common import EXIT_OK, add_model_options, model_params
+
+FILES = ("climb.csv", "climb.json", "climb.png")
+KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
+        "mean_clutch_force_n", "efficiency", "climbing_efficiency", "stalled", "stall_t_s", "stall_phi_rad", "t_end_s")
+
+
+def add_parser(commands) -> None:
+    cmd = commands.add_parser(
+        "climb", help="climbing ability: the steepest incline a design climbs, speed and clutch loads against it",
+        description="For the design and its drive: the steepest incline at which the drive restarts the robot from "
+                    "rest at every crank angle (quasi-static), for the motor the steepest it climbs to a steady "
+                    "state from rest (bisection on runs), the energy bound; and at each incline of --inclines each "
+                    "engine's steady speed (motor) or mean speed (constant torque), clutch reactions and climbing "
+                    "efficiency. Writes DIR/climb.csv, DIR/climb.json and the figure DIR/climb.png.")
+    cmd.add_argument("--inclines", metavar="LIST|START:STOP:N", default="0:90:10",
+                     help="pipe inclines above the horizontal [deg], -90..90: a comma-separated list or N evenly "
+                          "spaced values from START to STOP (default 0:90:10)")
+    cmd.add_argument("--engines", metavar="LIST", default=None,
+                     help="comma-separated, from: analytic-approx, analytic-exact, analytic-unilateral, mujoco-lock, "
+                          "mujoco-ratchet (default: analytic-unilateral,mujoco-ratchet)")
+    cmd.add_argument("--tolerance", type=float, default=None, metavar="DEG",
+                     help="width of the bracket at which the bisection for the motor's steady-climb limit stops "
+                          "(default 0.1 deg)")
+    cmd.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+                     help="cap of each run to steady state (motor; default 10 s), or the length of each run "
+                          "(constant torque; default 1 s)")
+    add_model_options(cmd)
+    cmd.add_argument("--out", metavar="DIR", default="climb", help="results folder (default ./climb)")
+    cmd.set_defaults(handler=run)
+
+
+def parse_inclines(text: str) -> tuple[float, ...]:
+    """``--inclines`` as sorted distinct floats in -90..90 deg, or a one-line ParameterError."""
+    from ..studies.clutch_study import parse_values
+
+    values = parse_values("--inclines", text, log=False)
+    for value in values:
+        if not (math.isfinite(value) and -90.0 <= value <= 90.0):
+            raise ParameterError(f"--inclines {text!r}: incline={value!r} deg is out of range; allowed: "
+                                 "-90 <= incline <= 90 deg")
+    return values
+
+
+def parse_engines(text: str | None) -> tuple[str, ...]:
+    from ..studies.climbing import ENGINES
+    from ..studies.sweep_space import ENGINES as RUNNABLE
+
+    if text is None:
+        return ENGINES
+    names = tuple(dict.fromkeys(e.strip() for e in text.split(",") if e.strip()))
+    unknown = [e for e in names if e not in RUNNABLE]
+    if not names or unknown:
+        raise ParameterError(f"--engines {text!r}: " + (f"unknown {', '.join(unknown)}" if unknown else "no engine")
+                             + f"; allowed: a comma-separated list from: {', '.join(RUNNABLE)}")
+    return names
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..report.climb_figure import write_climb_figure
+    from ..studies import climbing
+
+    params = model_params(args)
+    if params.incline != 0.0:
+        raise ParameterError(f"incline={params.incline!r} in --set or --config: the study sets it; allowed: --inclines")
+    inclines = parse_inclines(args.inclines)
+    engines = parse_engines(args.engines)
+    tolerance = climbing.TOLERANCE_DEG if args.tolerance is None else check_real(
+        "--tolerance", args.tolerance, high=90.0, unit="deg")
+    t_end = climbing.default_t_end(params) if args.t_end is None else args.t_end
+    check_run_options(t_end, climbing.DT_OUT)
+    check_output_dir(args.out)
+
+    def progress(message: str) -> None:
+        print(f"climb: {message}", file=sys.stderr, flush=True)
+
+    study = climbing.climb_study(params, inclines, engines, tolerance, t_end, progress)
+    with staged_output(args.out) as staging:
+        write_csv(staging / FILES[0], study)
+        write_json(staging / FILES[1], study)
+        write_climb_figure(study, params, staging / FILES[2])
+    print(format_study(study, params))
+    print(f"{len(inclines)} inclines x {len(engines)} engines in {study['wall_s']:.1f} s; results: "
+          + ", ".join(str(Path(args.out) / f) for f in FILES))
+    return EXIT_OK
+
+
+def write_csv(path: Path, study: dict) -> None:
+    """One row per incline: the torque needed at rest, then ENGINE:KEY for each engine, then the errors."""
+    columns = ["incline_deg", "torque_needed_n_m"] + [f"{e}:{k}" for e in study["engines"] for k in KEYS] + ["error"]
+    with open(path, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(columns)
+        for row in study["rows"]:
+            cells = {"incline_deg": row["incline_deg"], "torque_needed_n_m": row["torque_needed_n_m"],
+                     "error": "; ".join(f"{e}: {m['error']}" for e, m in row["engines"].items() if "error" in m)}
+            for engine, metrics in row["engines"].items():
+                cells.update({f"{engine}:{k}": metrics.get(k) for k in KEYS})
+            writer.writerow(["" if cells.get(c) is None else _cell(cells[c]) for c in columns])
+
+
+def _cell(value) -> str:
+    if isinstance(value, bool):
+        return str(int(value))
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def _limit(record: dict) -> str:
+    if record["incline_deg"] is None:
+        return "none: the drive cannot restart it even in a vertical drop"
+    if record["any_incline"]:
+        return "any incline (90 deg)"
+    text = f"up to {record['incline_deg']:.2f} deg (hardest crank angle {math.degrees(record['phi_rad']):.1f} deg, " \
+           f"{record['stroke']})"
+    return text + (" (it needs a downhill slope)" if record["incline_deg"] < 0 else "")
+
+
+def format_study(study: dict, params) -> str:
+    """The study as text: the limits, then one line per incline with each engine's figures."""
+    motor = study["drive"] == "motor"
+    drive = (f"motor, M_stall {params.M_stall:g} N m, omega_noload {params.omega_noload:g} rad/s" if motor
+             else f"constant torque M = {params.M:g} N m")
+    bound = study["energy_bound"]
+    lines = [f"climbing ability ({drive}; torque at rest {study['torque_at_rest_n_m']:g} N m)",
+             f"  restarts from rest at every crank angle (quasi-static): {_limit(study['restart'])}",
+             f"    the paper's model (first order, massless rod):         {_limit(study['restart_paper_model'])}",
+             "  energy bound (a steady climb, 2 pi M0 per revolution):   "
+             + ("any incline" if bound["sin"] >= 1 else "none" if bound["incline_deg"] is None
+                else f"up to {bound['incline_deg']:.2f} deg"),
+             f"  a vertical riser needs a torque at rest of {study['vertical']['torque_n_m']:.4g} N m (hardest crank "
+             f"angle {math.degrees(study['vertical']['phi_rad']):.1f} deg)"]
+    for engine, limit in study["steady_climb"].items():
+        low, high = limit["bracket"]
+        lines.append(f"  steady climb from rest at phi0, {engine}: " + (
+            "not even at the restart limit" if limit["incline_deg"] is None else
+            f"up to {high:.2f} deg (climbs at all inclines tried)" if low == high else
+            f"up to {low:.2f} deg (stalls at {high:.2f} deg)"))
+    speed = "steady speed" if motor else f"mean speed over the last 3 revolutions of {study['t_end_s']:g} s"
+    lines.append(f"\nincline [deg], torque needed at rest [N m]; per engine: {speed} [m/s], peak / mean clutch "
+                 "reaction [N], climbing efficiency [-]")
+    for row in study["rows"]:
+        cells = [f"{row['incline_deg']:7.2f}", f"{row['torque_needed_n_m']:.4f}"]
+        for engine, m in row["engines"].items():
+            if "error" in m:
+                cells.append(f"{engine}: failed ({m['error']})")
+            elif m["stalled"]:
+                cells.append(f"{engine}: stalled at {math.degrees(m['stall_phi_rad']) % 360:.1f} deg in the turn, "
+                             f"at rest from t={m['stall_t_s']:.4g} s")
+            else:
+                v = m["steady_speed_m_s"] if motor else m["mean_speed_m_s"]
+                cells.append(f"{engine}: " + ("no steady state" if v is None else f"{v:.4g}") + " m/s, "
+                             + " / ".join("n/a" if m[k] is None else f"{m[k]:.4g}"
+                                          for k in ("peak_clutch_force_n", "mean_clutch_force_n"))
+                             + " N, " + ("n/a" if m["climbing_efficiency"] is None else f"{m['climbing_efficiency']:.4f}"))
+        lines.append("  " + "  |  ".join(cells))
+    return "\n".join(lines)

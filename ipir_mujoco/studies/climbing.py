@@ -1,0 +1,318 @@
+"""Climbing ability: the steepest pipe a design climbs with its drive, and its speed against the incline.
+
+The pipe rises ``incline`` degrees; gravity pulls every body back along it with g sin(incline).
+Three limits, in s = sin(incline):
+
+* **Restart limit** (quasi-static, any drive): at rest at crank angle phi, the drive's torque at rest
+  M0 (the constant M, or the motor's M_stall) must move the module the linkage drives forward (module
+  1 while the gap shrinks, K(phi) < 0; module 2 while it grows, K > 0) against its resistance and the
+  weight it carries, the other module held by its clutch. Statics
+  (:meth:`~ipir_mujoco.analytic.dynamics.OneDofDynamics.static_holds`) gives that module's hold
+  R_i(M), affine in M; it moves once R_i + F_ri < 0, so the torque it needs is the M with
+  R_i(M) = -F_ri (zero on a dead centre, where no torque reaches a module). With first-order
+  kinematics and a massless rod that is r |sin phi| (F_ri + m_i g s). The required torque is
+  affine in s, M_req = A(phi) + s B(phi) with B >= 0, so the robot restarts at every crank angle as
+  long as s <= min over phi of (M0 - A) / B. Above it a robot stopped at the hardest angle stays there.
+* **Steady-climb limit** (the motor): from rest at phi0 the run reaches its periodic steady state with
+  a positive speed (runs with ``until_steady``). The crank's kinetic energy can carry it over the
+  hardest angle, so this can lie above the restart limit. Found by bisection on the incline, between
+  the restart limit and the energy bound, per engine.
+* **Energy bound**: over a steady revolution each module advances at least one stroke 2r (one-way
+  clutches), and the drive gives at most 2 pi M0 (the motor's torque never exceeds M_stall while the
+  crank turns forward), so steady climbing needs 2 pi M0 >= 2 r (F_r1 + F_r2 + m g s), m the robot's
+  mass: s <= (pi M0 / r - F_r1 - F_r2) / (m g).
+
+Climbing efficiency (per run, over the steady window, else the whole run): the work that goes where
+it is meant to, against the resistances and into height, over the energy put in, by the motor and
+by gravity where it pulls the robot forward (downhill):
+(W_resistance + max(dV, 0)) / (W_motor + max(-dV, 0)). In a horizontal pipe it is the summary's
+``efficiency``; uphill that figure counts the lifting as lost (0.17 at 30 deg under the default
+motor, where nothing is lost) and downhill it exceeds 1.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles, steady_index, travel
+from ipir_mujoco.analytic.dynamics import OneDofDynamics
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.analytic.forces import drive_torque
+from ipir_mujoco.analytic.params import RobotParams, check_real
+from ipir_mujoco.analytic.results import RunResult
+
+from .sweep_metrics import mean_speed
+from .sweep_space import ENGINES as RUNNABLE
+
+ENGINES = ("analytic-unilateral", "mujoco-ratchet")  # the exact models with one-way clutches: the default pair
+LABELS = {"analytic-approx": "paper's model", "analytic-exact": "analytic, paper's rule",
+          "analytic-unilateral": "analytic one-way clutches", "mujoco-lock": "MuJoCo, paper's rule",
+          "mujoco-ratchet": "MuJoCo ratchet"}
+GRID = 3600  # crank angles per revolution scanned before refining the hardest one
+T_END = 10.0  # s: cap of a run to steady state (the sweep's)
+T_END_TORQUE = 1.0  # s: length of a constant-torque run (the paper's); it accelerates, so a longer one costs more
+DT_OUT = 1e-3  # s: output interval of the study's runs (the sweep's)
+# m/s: crank pin and modules slower are at rest (MuJoCo's stall test; its held modules creep at 1e-9..1e-8 m/s)
+REST_SPEED = 1e-6
+TOLERANCE_DEG = 0.1  # width of the bracket the bisection stops at [deg]
+Progress = Callable[[str], None]
+
+
+# --- quasi-static: the torque needed at rest ------------------------------------------------------------------------
+
+def required_torque(params: RobotParams, phi, geometry: str = "exact") -> np.ndarray:
+    """Torque at rest [N m] that moves the robot on from crank angle(s) ``phi`` [rad] (module docstring).
+
+    ``params.incline`` sets the slope; the drive in ``params`` does not matter. Shape of ``phi``.
+    """
+    dyn = OneDofDynamics(params, geometry)
+    phi = np.asarray(phi, dtype=float)
+    K = dyn.linkage.transfer(phi).K
+    free, unit = dyn.static_holds(phi, M=0.0), dyn.static_holds(phi, M=1.0)
+    contraction = K < 0  # the gap shrinks: the linkage drives module 1 forward, module 2 is held
+    hold = np.where(contraction, free[0], free[1])
+    slope = np.where(contraction, unit[0] - free[0], unit[1] - free[1])  # dR_i/dM = -+1/K
+    resistance = np.where(contraction, params.F_r1, params.F_r2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        needed = -(hold + resistance) / slope
+    return np.where(slope != 0, needed, 0.0)  # a dead centre: no torque reaches a module, none is needed
+
+
+def _hardest(score: Callable[[np.ndarray], np.ndarray]) -> tuple[float, float]:
+    """(phi [rad] in [0, 2 pi), value) where ``score`` (vectorized in phi) is smallest over a revolution:
+    a scan of GRID angles, then a bounded refinement around the best one (to ~1e-12 rad)."""
+    grid = np.linspace(0.0, 2 * math.pi, GRID, endpoint=False)
+    values = score(grid)
+    k = int(np.nanargmin(values))
+    step = grid[1] - grid[0]
+    found = minimize_scalar(lambda x: float(score(np.array([x]))[0]), bounds=(grid[k] - step, grid[k] + step),
+                            method="bounded", options={"xatol": 1e-12})
+    phi, value = (float(found.x), float(found.fun)) if found.fun <= values[k] else (float(grid[k]), float(values[k]))
+    return phi % (2 * math.pi), value
+
+
+def torque_needed(params: RobotParams, geometry: str = "exact", stroke: str | None = None) -> dict:
+    """The largest torque at rest [N m] a revolution needs at ``params.incline``, and where.
+
+    {"torque_n_m", "phi_rad", "stroke": "contraction" | "expansion" (which module then moves: 1 | 2)};
+    ``stroke`` limits the search to one of them.
+    """
+    linkage = OneDofDynamics(params, geometry).linkage
+
+    def score(p):
+        K = linkage.transfer(p).K
+        inside = np.ones(np.shape(p), dtype=bool) if stroke is None else (K < 0) == (stroke == "contraction")
+        return np.where(inside, -required_torque(params, p, geometry), np.inf)
+
+    phi, value = _hardest(score)
+    K = float(OneDofDynamics(params, geometry).linkage.transfer(phi).K)
+    return {"torque_n_m": -value, "phi_rad": phi, "stroke": "contraction" if K < 0 else "expansion"}
+
+
+def restart_limit(params: RobotParams, geometry: str = "exact") -> dict:
+    """The steepest incline at which the drive restarts the robot from rest at every crank angle.
+
+    {"incline_deg": float | None (None: not even a vertical drop moves it on), "sin": s*, "phi_rad"
+    (the hardest crank angle), "stroke", "torque_at_rest_n_m": M0, "any_incline": s* >= 1}. With
+    s* < 0 the drive needs a downhill slope to restart everywhere.
+    """
+    M0 = float(drive_torque(params, 0.0))
+    flat, vertical = params.replace(incline=0.0), params.replace(incline=90.0)
+    A = lambda p: required_torque(flat, p, geometry)  # noqa: E731
+    B = lambda p: required_torque(vertical, p, geometry) - A(p)  # noqa: E731
+
+    def allowed(p):
+        a, b = A(p), B(p)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # where gravity adds nothing (b = 0: a dead centre, or g = 0) only the torque decides
+            return np.where(b > 0, (M0 - a) / b, np.where(a <= M0, np.inf, -np.inf))
+
+    phi, s = _hardest(allowed)
+    K = float(OneDofDynamics(params, geometry).linkage.transfer(phi).K)
+    out = {"sin": s, "phi_rad": phi, "stroke": "contraction" if K < 0 else "expansion",
+           "torque_at_rest_n_m": M0, "any_incline": bool(s >= 1.0)}
+    out["incline_deg"] = 90.0 if s >= 1.0 else (None if s < -1.0 else math.degrees(math.asin(s)))
+    return out
+
+
+def energy_bound(params: RobotParams) -> dict:
+    """{"sin", "incline_deg"}: the steepest incline a steady climb can hold, by energy (module docstring)."""
+    mass = params.m1 + params.m2 + params.rod_mass
+    M0 = float(drive_torque(params, 0.0))
+    s = (math.pi * M0 / params.r - params.F_r1 - params.F_r2) / (mass * params.g) if params.g > 0 else math.inf
+    return {"sin": s, "incline_deg": 90.0 if s >= 1.0 else (None if s < -1.0 else math.degrees(math.asin(s)))}
+
+
+# --- runs -----------------------------------------------------------------------------------------------------------
+
+def default_t_end(params: RobotParams) -> float:
+    """[s]: the cap of a run to steady state under the motor, the length of a run under a constant torque."""
+    return T_END if params.drive == "motor" else T_END_TORQUE
+
+
+def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = DT_OUT) -> RunResult:
+    """One run of ``engine`` (a sweep engine name): to the steady state under the motor (``t_end`` [s] the
+    cap), else for ``t_end``."""
+    from .sweep import _run_engine  # the sweep's mapping of engine names to runs: one place for it
+
+    return _run_engine(engine, params, t_end, dt_out, {"until_steady": params.drive == "motor"})
+
+
+def steady_window(run: RunResult) -> tuple[float, float, bool]:
+    """(t0, t1) [s] of the steady window (the revolutions the steady test used), else the whole run; steady?"""
+    found = cycles(run.series)
+    n = run.settings.get("steady_cycles", STEADY_CYCLES)
+    k = steady_index([c.mean_speed_m_s for c in found], run.settings.get("steady_tol", STEADY_TOL), n)
+    if k is None:
+        return float(run.series["t"][0]), float(run.series["t"][-1]), False
+    return found[k - n + 1].t_start, found[k].t_end, True
+
+
+def climbing_efficiency(run: RunResult) -> float | None:
+    """(W_resistance + max(dV, 0)) / (W_motor + max(-dV, 0)) over the steady window, else the whole run
+    (module docstring); None where nothing was put in."""
+    s = run.series
+    if not all(c in s for c in ("motor_work", "friction_work", "potential")):
+        return None
+    t0, t1, _ = steady_window(run)
+    keep = np.concatenate([np.diff(s["t"]) > 0, [True]])
+    at = lambda c: np.interp([t0, t1], s["t"][keep], s[c][keep])  # noqa: E731
+    motor, friction, lifted = (float(np.diff(at(c))[0]) for c in ("motor_work", "friction_work", "potential"))
+    put_in = motor + max(-lifted, 0.0)
+    return (friction + max(lifted, 0.0)) / put_in if put_in > 0 else None
+
+
+def locked_pull_share(run: RunResult) -> float | None:
+    """Share of the run's time in which a clutch the paper's rule locks would have to pull (reaction < 0)."""
+    if run.clutch != "kinematic":
+        return None
+    from .validate import clutch_pull
+
+    return clutch_pull(run)["fraction_of_time"]
+
+
+def run_metrics(run: RunResult) -> dict:
+    """What the study keeps of one run (SI units; None where a figure does not exist for the run)."""
+    s, summary = run.series, run.summary
+    t0, t1, steady = steady_window(run)
+    inside = (s["t"] >= t0) & (s["t"] <= t1)
+    hold = s["lambda1"] + s["lambda2"]
+    mean_hold = float(np.trapezoid(hold[inside], s["t"][inside]) / (t1 - t0)) if steady else None
+    moved = travel(s)
+    out = {"revolutions": summary["revolutions"], "travel_m": float(moved[-1] - moved[0]), "t_end_s": run.t_end,
+           "steady": steady, "steady_speed_m_s": summary["steady_speed_m_s"], "t_steady_s": summary["t_steady_s"],
+           "mean_speed_m_s": mean_speed(s),
+           "peak_clutch_force_n": summary["peak_clutch_force_n"], "mean_clutch_force_n": mean_hold,
+           "efficiency": summary["efficiency"], "climbing_efficiency": climbing_efficiency(run),
+           "pull_share": locked_pull_share(run), "stalled": run.stall is not None, "stall_reason": run.stall,
+           "timestep_s": run.settings.get("timestep"), "wall_s": run.wall_time_s}
+    if run.stall is not None:  # when and where it stopped, and what the clutches hold there
+        moving = np.flatnonzero((run.params.r * np.abs(s["omega"]) > REST_SPEED) | (np.abs(s["v1"]) > REST_SPEED)
+                                | (np.abs(s["v2"]) > REST_SPEED))
+        out.update({"stall_t_s": float(s["t"][moving[-1] + 1] if moving.size else s["t"][0]),
+                    "stall_phi_rad": float(s["phi"][-1]), "lambda1_at_rest_n": float(s["lambda1"][-1]),
+                    "lambda2_at_rest_n": float(s["lambda2"][-1])})
+    return out
+
+
+def climbs(metrics: dict, drive: str) -> bool:
+    """The motor climbs where it reaches a steady state with a positive speed; a constant torque (which
+    has no steady state while it climbs at all) where it has not stalled by the end of its run."""
+    if "error" in metrics or metrics["stalled"]:
+        return False
+    return bool(metrics["steady"] and metrics["steady_speed_m_s"] > 0) if drive == "motor" else True
+
+
+def measure(engine: str, params: RobotParams, t_end: float | None = None) -> dict:
+    """:func:`run_metrics` of one run, or {"error": one line} for a run that fails (a runaway the paper's rule
+    cannot follow, MuJoCo's accuracy monitor, ...): a result of the study, not its end."""
+    try:
+        return run_metrics(run_engine(engine, params, default_t_end(params) if t_end is None else t_end))
+    except (ParameterError, SimulationError) as exc:
+        return {"error": " ".join(str(exc).split())}
+
+
+def steady_climb_limit(params: RobotParams, engine: str, low: float, high: float, tolerance: float = TOLERANCE_DEG,
+                       t_end: float | None = None, progress: Progress = lambda _m: None) -> dict:
+    """Bisection on the incline [deg] for the steepest one the motor climbs from rest at phi0 (``engine``).
+
+    ``low`` should climb and ``high`` not; each end is run first. {"incline_deg": the steepest incline
+    seen to climb (None if even ``low`` does not), "bracket": [climbs, does not] [deg], "runs": [{incline_deg,
+    climbs, note}]}; a bracket of ``high`` twice means it climbs up to ``high``.
+    """
+    check_real("tolerance", tolerance, high=90.0, unit="deg")
+    runs = []
+
+    def verdict(incline: float) -> bool:
+        metrics = measure(engine, params.replace(incline=incline), t_end)
+        ok = climbs(metrics, params.drive)
+        note = metrics.get("error") or metrics.get("stall_reason") or (
+            "" if ok else f"no steady state by t={metrics['t_end_s']:.3g} s")
+        runs.append({"incline_deg": incline, "climbs": ok, "note": note,
+                     "steady_speed_m_s": metrics.get("steady_speed_m_s")})
+        progress(f"{engine} at {incline:.4g} deg: {'climbs' if ok else 'does not climb'}")
+        return ok
+
+    if not verdict(low):
+        return {"incline_deg": None, "bracket": [None, low], "runs": runs}
+    if verdict(high):
+        return {"incline_deg": high, "bracket": [high, high], "runs": runs}
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if verdict(middle) else (low, middle)
+    return {"incline_deg": low, "bracket": [low, high], "runs": runs}
+
+
+def incline_curve(params: RobotParams, inclines, engines=ENGINES, t_end: float | None = None,
+                  progress: Progress = lambda _m: None) -> list[dict]:
+    """Per incline [deg]: the torque a revolution needs at rest there, and each engine's :func:`measure`."""
+    rows = []
+    for incline in inclines:
+        design = params.replace(incline=float(incline))
+        row = {"incline_deg": float(incline), "torque_needed_n_m": torque_needed(design)["torque_n_m"],
+               "engines": {}}
+        for engine in engines:
+            row["engines"][engine] = measure(engine, design, t_end)
+            m = row["engines"][engine]
+            progress(f"{float(incline):g} deg, {engine}: " + (
+                m["error"] if "error" in m else "stalled" if m["stalled"] else
+                f"{m['steady_speed_m_s']:.4g} m/s" if m["steady"] else f"{m['revolutions']:.3g} rev"))
+        rows.append(row)
+    return rows
+
+
+def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float = TOLERANCE_DEG,
+                t_end: float | None = None, progress: Progress = lambda _m: None) -> dict:
+    """The climbing ability of ``params`` with its drive (JSON-ready).
+
+    {"drive", "torque_at_rest_n_m", "restart": :func:`restart_limit` (exact geometry, the rod included),
+    "restart_paper_model": the same for the paper's first-order, massless-rod model, "energy_bound",
+    "vertical": :func:`torque_needed` at 90 deg, "steady_climb": {engine: :func:`steady_climb_limit`}
+    (motor only; empty for a constant torque), "rows": :func:`incline_curve`, "engines", "wall_s"}.
+    """
+    started = time.perf_counter()
+    t_end = default_t_end(params) if t_end is None else t_end
+    for engine in engines:
+        if engine not in RUNNABLE:
+            raise ParameterError(f"engine {engine!r} is unknown; allowed: {', '.join(RUNNABLE)}")
+    inclines = [check_real("incline", float(i), low=-90.0, high=90.0, low_open=False, unit="deg") for i in inclines]
+    restart = restart_limit(params)
+    paper = restart_limit(params.replace(rod_mass=0.0, rod_inertia=0.0), "approx")
+    bound = energy_bound(params)
+    limits = {}
+    if params.drive == "motor":
+        low = min(max(restart["incline_deg"] if restart["incline_deg"] is not None else -90.0, 0.0), 90.0)
+        high = 90.0 if bound["incline_deg"] is None or bound["sin"] >= 1 else max(bound["incline_deg"], low)
+        for engine in engines:
+            limits[engine] = steady_climb_limit(params, engine, low, high, tolerance, t_end, progress)
+    rows = incline_curve(params, inclines, engines, t_end, progress)
+    return {"drive": params.drive, "torque_at_rest_n_m": restart["torque_at_rest_n_m"], "restart": restart,
+            "restart_paper_model": paper, "energy_bound": bound,
+            "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "rows": rows,
+            "engines": list(engines), "tolerance_deg": tolerance, "t_end_s": t_end,
+            "wall_s": time.perf_counter() - started}
