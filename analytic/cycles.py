@@ -195,12 +195,24 @@ class SteadyWatch:
         return self.steady_at is not None
 
 
+def efficiency(motor_j: float, resistance_j: float, lifted_j: float = 0.0) -> float | None:
+    """The share of the energy put in that goes where it is meant to: (resistance work + potential energy
+    gained) / (motor work + potential energy released); None where nothing was put in.
+
+    In a horizontal pipe: resistance work / motor work. On a climb the lifting is useful work, not a
+    loss (with rigid clutches nothing is lost: 1 at any incline); downhill, gravity's work is energy
+    put in, so the figure stays at most 1 when nothing dissipates more than it should.
+    """
+    put_in = motor_j + max(-lifted_j, 0.0)
+    return (resistance_j + max(lifted_j, 0.0)) / put_in if put_in > 0 else None
+
+
 def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> dict:
     """The summary's per-revolution keys.
 
     ``steady`` (bool), ``t_steady_s``, ``steady_speed_m_s`` and
     ``energy_per_metre_j_m`` (None unless steady); ``distance_per_rev_m``,
-    ``efficiency`` (work against the resistances / motor work) and
+    ``efficiency`` (:func:`efficiency`) and
     ``peak_clutch_force_n``: over the steady window when steady, else over the
     whole run (None where the run lacks the columns); ``cycles``: whole
     revolutions; ``cycle_energy_residual_j``: the largest |audit residual| of a
@@ -225,7 +237,8 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
             motor = sum(works)
             out["energy_per_metre_j_m"] = motor / distance if distance > 0 else None
             friction = [c.friction_work_j for c in window]
-            out["efficiency"] = sum(friction) / motor if None not in friction and motor > 0 else None
+            lifted = sum(c.potential_change_j or 0.0 for c in window)
+            out["efficiency"] = efficiency(motor, sum(friction), lifted) if None not in friction else None
         else:
             out["efficiency"] = None
         peaks = [c.peak_clutch_force_n for c in window if c.peak_clutch_force_n is not None]
@@ -237,7 +250,8 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     if "motor_work" in series and "friction_work" in series:
         motor = float(series["motor_work"][-1] - series["motor_work"][0])
         friction = float(series["friction_work"][-1] - series["friction_work"][0])
-        out["efficiency"] = friction / motor if motor > 0 else None
+        lifted = float(series["potential"][-1] - series["potential"][0]) if "potential" in series else 0.0
+        out["efficiency"] = efficiency(motor, friction, lifted)
     else:
         out["efficiency"] = None
     lambdas = [series[c] for c in ("lambda1", "lambda2") if c in series]

@@ -17,7 +17,7 @@ from .common import EXIT_OK, add_model_options, model_params
 
 FILES = ("climb.csv", "climb.json", "climb.png")
 KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
-        "mean_clutch_force_n", "efficiency", "climbing_efficiency", "stalled", "stall_t_s", "stall_phi_rad", "t_end_s")
+        "mean_clutch_force_n", "efficiency", "stalled", "stall_t_s", "stall_phi_rad", "t_end_s")
 
 
 def add_parser(commands) -> None:
@@ -166,6 +166,6 @@ def format_study(study: dict, params) -> str:
                 cells.append(f"{engine}: " + ("no steady state" if v is None else f"{v:.4g}") + " m/s, "
                              + " / ".join("n/a" if m[k] is None else f"{m[k]:.4g}"
                                           for k in ("peak_clutch_force_n", "mean_clutch_force_n"))
-                             + " N, " + ("n/a" if m["climbing_efficiency"] is None else f"{m['climbing_efficiency']:.4f}"))
+                             + " N, " + ("n/a" if m["efficiency"] is None else f"{m['efficiency']:.4f}"))
         lines.append("  " + "  |  ".join(cells))
     return "\n".join(lines)

@@ -125,7 +125,7 @@ def render(metrics: dict, figures_dir: Path) -> list:
             continue
         rows.append([climbing.LABELS[engine], fmt(m["steady_speed_m_s"], 5), _relative(reference, m["steady_speed_m_s"]),
                      fmt(m["peak_clutch_force_n"], 4), fmt(m["mean_clutch_force_n"], 4),
-                     fmt(m["climbing_efficiency"], 6),
+                     fmt(m["efficiency"], 6),
                      "" if m["pull_share"] is None else f"{100 * m['pull_share']:.1f}"])
     blocks.append(Table(header, rows))
     blocks.append(Paragraph(_paper_rule_text(metrics)))

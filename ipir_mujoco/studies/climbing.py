@@ -22,12 +22,9 @@ Three limits, in s = sin(incline):
   crank turns forward), so steady climbing needs 2 pi M0 >= 2 r (F_r1 + F_r2 + m g s), m the robot's
   mass: s <= (pi M0 / r - F_r1 - F_r2) / (m g).
 
-Climbing efficiency (per run, over the steady window, else the whole run): the work that goes where
-it is meant to, against the resistances and into height, over the energy put in, by the motor and
-by gravity where it pulls the robot forward (downhill):
-(W_resistance + max(dV, 0)) / (W_motor + max(-dV, 0)). In a horizontal pipe it is the summary's
-``efficiency``; uphill that figure counts the lifting as lost (0.17 at 30 deg under the default
-motor, where nothing is lost) and downhill it exceeds 1.
+Efficiency on a slope: the summary's ``efficiency`` (:func:`ipir_mujoco.analytic.cycles.efficiency`)
+counts the work against the resistances and into height as useful, over the energy put in by the
+motor and by gravity where it pulls the robot forward (downhill).
 """
 
 from __future__ import annotations
@@ -173,20 +170,6 @@ def steady_window(run: RunResult) -> tuple[float, float, bool]:
     return found[k - n + 1].t_start, found[k].t_end, True
 
 
-def climbing_efficiency(run: RunResult) -> float | None:
-    """(W_resistance + max(dV, 0)) / (W_motor + max(-dV, 0)) over the steady window, else the whole run
-    (module docstring); None where nothing was put in."""
-    s = run.series
-    if not all(c in s for c in ("motor_work", "friction_work", "potential")):
-        return None
-    t0, t1, _ = steady_window(run)
-    keep = np.concatenate([np.diff(s["t"]) > 0, [True]])
-    at = lambda c: np.interp([t0, t1], s["t"][keep], s[c][keep])  # noqa: E731
-    motor, friction, lifted = (float(np.diff(at(c))[0]) for c in ("motor_work", "friction_work", "potential"))
-    put_in = motor + max(-lifted, 0.0)
-    return (friction + max(lifted, 0.0)) / put_in if put_in > 0 else None
-
-
 def locked_pull_share(run: RunResult) -> float | None:
     """Share of the run's time in which a clutch the paper's rule locks would have to pull (reaction < 0)."""
     if run.clutch != "kinematic":
@@ -208,7 +191,7 @@ def run_metrics(run: RunResult) -> dict:
            "steady": steady, "steady_speed_m_s": summary["steady_speed_m_s"], "t_steady_s": summary["t_steady_s"],
            "mean_speed_m_s": mean_speed(s),
            "peak_clutch_force_n": summary["peak_clutch_force_n"], "mean_clutch_force_n": mean_hold,
-           "efficiency": summary["efficiency"], "climbing_efficiency": climbing_efficiency(run),
+           "efficiency": summary["efficiency"],
            "pull_share": locked_pull_share(run), "stalled": run.stall is not None, "stall_reason": run.stall,
            "timestep_s": run.settings.get("timestep"), "wall_s": run.wall_time_s}
     if run.stall is not None:  # when and where it stopped, and what the clutches hold there
