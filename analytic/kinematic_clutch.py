@@ -41,6 +41,7 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import dop853, kernels
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
@@ -128,6 +129,7 @@ def simulate_kinematic(
                          progress=progress, until_steady=until_steady, steady_tol=steady_tol,
                          steady_cycles=steady_cycles)
     dyn = OneDofDynamics(params, geometry)
+    constants = kernels.pack(dyn)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)
 
@@ -145,7 +147,7 @@ def simulate_kinematic(
             stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g)
             pieces.append(_stalled_piece(dyn, monitor.samples(t, t_end, grid), y))
             break
-        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0)
+        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0, constants)
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         piece = _mode_piece(dyn, mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, torque)
         steady_at = monitor.observe(piece)
@@ -197,15 +199,28 @@ def mode_rhs(dyn: OneDofDynamics, mode: Mode, torque: Callable | None = None) ->
     return rhs
 
 
-def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_step=None):
-    """Integrate one mode from t0 until its switch event or t_end (``first_step`` [s]: see restart_step)."""
+def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_step=None, constants=None):
+    """Integrate one mode from t0 until its switch event or t_end (``first_step`` [s]: see restart_step).
+
+    The drive of ``params`` runs on the scalar kernels (``constants``: :func:`.kernels.pack` of ``dyn``);
+    a ``torque`` profile, a Python function, on solve_ivp with :func:`mode_rhs`: the same method.
+    """
+    direction = 1.0 if mode is Mode.CONTRACTION else -1.0
+    if torque is None:
+        constants = kernels.pack(dyn) if constants is None else constants
+        sol = dop853.solve(kernels.KINEMATIC, int(mode), t0, t_end, y0, constants, rtol, atol, first_step,
+                           [direction])
+        if sol.status < 0:
+            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: "
+                                  f"{sol.message}")
+        return sol
     linkage, rhs = dyn.linkage, mode_rhs(dyn, mode, torque)
 
     def gap_rate(_t, y):
         return linkage.transfer(y[0]).K * y[1]
 
     gap_rate.terminal = True
-    gap_rate.direction = 1.0 if mode is Mode.CONTRACTION else -1.0
+    gap_rate.direction = direction
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,

@@ -49,6 +49,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import dop853, kernels
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
@@ -81,6 +82,7 @@ class UnilateralModel:
         self.dyn = OneDofDynamics(params, geometry)
         self.linkage = self.dyn.linkage
         self.torque = torque  # (t, phi, omega) -> N m, or None for the drive of params
+        self.constants = kernels.pack(self.dyn)  # the scalar kernels' copy of the constants
 
     def motor(self, t, phi, omega):
         """Motor torque [N m] at time t (array-friendly)."""
@@ -307,7 +309,7 @@ def simulate_unilateral(
         spurious = _spurious_start(model, mode, sol)
         if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
             events = model.events(mode, quiet=dict([spurious]))
-            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
+            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0, dict([spurious]))
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events])
         if grazed is not None:
@@ -345,8 +347,20 @@ def simulate_unilateral(
                                "rod_modelled": model.dyn.include_rod, **monitor.settings})
 
 
-def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step):
-    """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end."""
+def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
+    """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end.
+
+    The drive of ``params`` runs on the scalar kernels (:mod:`.kernels`: the same events, event k
+    quiet until ``quiet[k]`` [s]); a ``torque`` profile, a Python function, on solve_ivp: the same method.
+    """
+    if model.torque is None:
+        quiet = quiet or {}
+        sol = dop853.solve(kernels.UNILATERAL, int(mode), t0, t_end, y0, model.constants, rtol, atol, first_step,
+                           [e.direction for e, _ in events], [quiet.get(k, -math.inf) for k in range(len(events))])
+        if sol.status < 0:
+            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: "
+                                  f"{sol.message}")
+        return sol
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(model.rhs(mode), (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
