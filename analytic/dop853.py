@@ -18,6 +18,7 @@ no Python per sample). Units: those of the state; times in s.
 
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -312,26 +313,36 @@ class DenseSolution:
         self.ts, self.F, self.t_full = ts, F, t_full
         self.t_old, self.y_old = ts[:-1], ys[:-1]
         self.h = t_full - self.t_old
+        self._h_safe = np.where(self.h != 0, self.h, 1.0)  # a constant piece (h = 0) has F = 0: any x will do
+        self._by_power = np.ascontiguousarray(F.transpose(1, 0, 2))  # (7, m, n): row gathers per power
+        self._ends = ts.tolist()
 
     def __call__(self, t):
         times = np.asarray(t, dtype=float)
-        scalar = times.ndim == 0
-        times = np.atleast_1d(times)
-        step = np.clip(np.searchsorted(self.ts, times, side="left") - 1, 0, self.h.size - 1)
-        y = self.evaluate(step, times)
-        return y[0] if scalar else y.T
+        if times.ndim == 0:  # one time (root searches): no array machinery
+            step = min(max(bisect.bisect_left(self._ends, float(times)) - 1, 0), self.h.size - 1)
+            out = np.empty(self.y_old.shape[1])
+            if self.h[step] == 0:
+                out[:] = self.y_old[step]
+            else:
+                _dense(self.F[step], self.y_old[step], self.t_old[step], self.h[step], float(times), out)
+            return out
+        step = np.searchsorted(self.ts, times, side="left")
+        step -= 1
+        np.minimum(np.maximum(step, 0, out=step), self.h.size - 1, out=step)
+        return self.evaluate(step, times).T
 
     def evaluate(self, step: np.ndarray, times: np.ndarray) -> np.ndarray:
-        """Step ``step[i]``'s interpolant at ``times[i]``: array (k, n)."""
-        h = self.h[step]
-        with np.errstate(invalid="ignore", divide="ignore"):  # a constant piece has h = 0 and F = 0
-            x = np.where(h != 0, (times - self.t_old[step]) / np.where(h != 0, h, 1.0), 0.0)[:, None]
-        F = self.F[step]
-        y = np.zeros((times.size, F.shape[2]))
-        for i in range(7):
-            y += F[:, 6 - i]
-            y *= x if i % 2 == 0 else 1 - x
-        return y + self.y_old[step]
+        """Step ``step[i]``'s interpolant at ``times[i]``: array (k, n) (scipy's Horner order)."""
+        x = ((times - self.t_old[step]) / self._h_safe[step])[:, None]
+        rest = 1 - x
+        y = self._by_power[6][step]
+        y *= x
+        for i in range(1, 7):
+            y += self._by_power[6 - i][step]
+            y *= x if i % 2 == 0 else rest
+        y += self.y_old[step]
+        return y
 
     @property
     def interpolants(self):

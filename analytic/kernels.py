@@ -158,3 +158,12 @@ def guard(model, mode, k, t, y, p, quiet):
     if t > quiet[k]:
         return value
     return max(value, TINY)
+
+
+@jit
+def guard_table(model, mode, n_events, p, times, states, out):
+    """Every event function of ``mode`` (none quiet) at ``times`` (n,) and ``states`` (n, d), into out (n_events, n)."""
+    never = np.full(max(n_events, 1), -math.inf)
+    for i in range(times.size):
+        for k in range(n_events):
+            out[k, i] = guard(model, mode, k, times[i], states[i], p, never)

@@ -26,8 +26,11 @@ def check_run_options(t_end: float, dt_out: float, rtol: float = 1e-10, atol: fl
 
 
 def sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
-    """Segment [t0, t1]: its end points and the output grid strictly inside."""
-    inside = grid[(grid > t0) & (grid < t1)]
+    """Segment [t0, t1]: its end points and the output grid strictly inside (``grid`` ascending).
+
+    Located by bisection, not by a mask over the whole grid: a run's cost must not grow with
+    (segments x grid points)."""
+    inside = grid[np.searchsorted(grid, t0, side="right"):max(np.searchsorted(grid, t1, side="left"), 0)]
     return np.concatenate([[t0], inside, [t1]]) if t1 > t0 else np.array([t0])
 
 
@@ -208,6 +211,27 @@ class RunMonitor:
         if self.progress is not None and (t >= self.next_report or final):
             self.progress(t)
             self.next_report = t + PROGRESS_EVERY_S
+
+
+def assemble(pieces: list[dict[str, np.ndarray]], columns) -> dict[str, np.ndarray]:
+    """The run's series from its pieces of integrated states (each with a ``mode`` column).
+
+    ``columns(mode, rows)`` gives every column of the samples ``rows`` (the pieces' columns, all
+    of that mode), vectorized: called once per mode of the run rather than once per segment, so
+    that a run of many short segments pays numpy's per-call cost a few times, not per segment.
+    Columns keep the order ``columns`` gives them.
+    """
+    raw = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    modes = raw["mode"]
+    series: dict[str, np.ndarray] = {}
+    for mode in np.unique(modes):
+        rows = np.flatnonzero(modes == mode)
+        part = columns(int(mode), {c: v[rows] for c, v in raw.items()})
+        for c, v in part.items():
+            if c not in series:
+                series[c] = np.empty(modes.size, dtype=np.asarray(v).dtype)
+            series[c][rows] = v
+    return series
 
 
 def truncate(piece: dict[str, np.ndarray], t_stop: float) -> dict[str, np.ndarray]:

@@ -50,6 +50,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import dop853, kernels
+from .accel import ACCELERATED
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
@@ -58,8 +59,8 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import (RunMonitor, check_finite, check_run_options, missed_crossing, restart_step, stall_reason,
-                             truncate)
+from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, restart_step,
+                             stall_reason, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -105,6 +106,8 @@ class UnilateralModel:
     def motion(self, phi, omega, v1, mode: Mode, M=None) -> dict:
         """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``; M [N m] the torque."""
         M = self.dyn.torque(omega, M)
+        if np.ndim(phi) == 0 and np.ndim(M) == 0 and mode is not Mode.BOTH_LOCKED:  # one state: the scalar kernels
+            return self._scalar_motion(float(phi), float(omega), mode, float(M))
         nan = np.nan * np.asarray(phi, dtype=float)
         if mode in (Mode.CONTRACTION, Mode.EXPANSION):
             st = self.dyn.state(phi, omega, mode, M)
@@ -119,6 +122,19 @@ class UnilateralModel:
         R1, R2 = self.dyn.static_holds(phi, M)
         zero = np.zeros_like(nan)
         return {"alpha": zero, "a1": zero, "a2": zero, "R1": R1, "R2": R2}
+
+    def _scalar_motion(self, phi: float, omega: float, mode: Mode, M: float) -> dict:
+        """:meth:`motion` at one state in a moving mode, on the scalar kernels (the same equations)."""
+        p, w2 = self.constants, omega * omega
+        if mode is Mode.BOTH_MOVING:
+            a1, alpha, K, dK = kernels.both_moving(p, phi, omega, M)
+            return {"alpha": alpha, "a1": a1, "a2": a1 + dK * w2 + K * alpha, "R1": math.nan, "R2": math.nan}
+        alpha, hold, K, dK = kernels.one_dof(p, int(mode), phi, omega, M)
+        if mode is Mode.CONTRACTION:  # front held: e = -K, f = 0
+            return {"alpha": alpha, "a1": -dK * w2 + -K * alpha, "a2": 0.0 * w2 + 0.0 * alpha, "R1": math.nan,
+                    "R2": hold + self.params.F_r1}
+        return {"alpha": alpha, "a1": 0.0 * w2 + 0.0 * alpha, "a2": dK * w2 + K * alpha, "R1": hold + self.params.F_r2,
+                "R2": math.nan}
 
     def rhs(self, mode: Mode):
         """d/dt of y = [phi, omega, x1, x2, v1, motor work]: only what integration needs (hot path)."""
@@ -165,6 +181,12 @@ class UnilateralModel:
 
     def guards(self, t, Y, mode: Mode) -> np.ndarray:
         """Every event function of ``mode`` at times t (n,) and states Y (6, n): array (n_events, n)."""
+        if ACCELERATED and self.torque is None and np.ndim(t) == 1:  # compiled: no numpy calls per segment
+            t = np.asarray(t, dtype=float)
+            out = np.empty((2, t.size))
+            kernels.guard_table(kernels.UNILATERAL, int(mode), 2, self.constants, t,
+                                np.ascontiguousarray(np.asarray(Y, dtype=float).T), out)
+            return out
         p = self.params
         v1, v2 = self.velocities(Y, mode)
         m = None
@@ -301,7 +323,7 @@ def simulate_unilateral(
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # at rest, held by statics, under a torque that is constant at rest: final
             stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g)
-            pieces.append(_piece(model, Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
+            pieces.append(_raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
                 y[:, None], np.size(ts), axis=1)))
             break
         events = model.events(mode)
@@ -315,7 +337,7 @@ def simulate_unilateral(
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
         step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
-        piece = _piece(model, mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol)
+        piece = _raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or grazed is None and sol.status != 1:
@@ -334,7 +356,7 @@ def simulate_unilateral(
         if t >= t_end:
             break
 
-    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    series = assemble(pieces, lambda mode, rows: _columns(model, Mode(mode), rows))
     monitor.report(float(series["t"][-1]), final=True)
     series.update(model.dyn.energy_columns(series))
     add_kinetostatics(series, model.dyn)
@@ -397,9 +419,17 @@ def _spurious_start(model: UnilateralModel, mode: Mode, sol, points: int = 32):
     return k, float(times[rising[0]])
 
 
-def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.ndarray]:
+def _raw_piece(mode: Mode, times, dense) -> dict[str, np.ndarray]:
+    """The integrated states at ``times`` (n,) from the segment's dense output, and the mode."""
     y = dense(times)
-    phi, omega = y[0], y[1]
+    return {"t": times, "phi": y[0], "omega": y[1], "x1": y[2], "x2": y[3], "state_v1": y[4], "motor_work": y[5],
+            "mode": np.full(times.shape, int(mode))}
+
+
+def _columns(model: UnilateralModel, mode: Mode, rows: dict) -> dict[str, np.ndarray]:
+    """Every column of the samples ``rows`` (:func:`_raw_piece`'s columns) of one mode."""
+    times, phi, omega = rows["t"], rows["phi"], rows["omega"]
+    y = np.array([phi, omega, rows["x1"], rows["x2"], rows["state_v1"], rows["motor_work"]])
     v1, v2 = model.velocities(y, mode)
     v1 = np.broadcast_to(v1, phi.shape).astype(float)
     v2 = np.broadcast_to(v2, phi.shape).astype(float)
@@ -418,7 +448,7 @@ def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.nda
         "x1": y[2], "x2": y[3], "v1": v1, "v2": v2,
         "a1": np.broadcast_to(m["a1"], phi.shape).astype(float), "a2": np.broadcast_to(m["a2"], phi.shape).astype(float),
         "S": tr.S, "S_dot": tr.K * omega, "lambda1": clutch[0], "lambda2": clutch[1],
-        "mode": np.full(phi.shape, int(mode)), "resistance1": resistance[0], "resistance2": resistance[1],
+        "mode": rows["mode"], "resistance1": resistance[0], "resistance2": resistance[1],
         "motor_work": y[5], "motor_torque": M,
     }
     return piece
