@@ -150,11 +150,9 @@ def _first_step(model, mode, t0, y0, f0, t_bound, p, rtol, atol):
 @jit
 def _combine(K, stages, weights, row, y, h, out):
     """out = y + h * sum_{q < stages} weights[row, q] K[q] (one Runge-Kutta stage's argument)."""
-    for j in range(out.size):
-        acc = 0.0
-        for q in range(stages):
-            acc += K[q, j] * weights[row, q]
-        out[j] = y[j] + acc * h
+    np.dot(weights[row, :stages], K[:stages], out)
+    out *= h
+    out += y
 
 
 @jit
@@ -211,23 +209,13 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
             for s in range(1, 12):
                 _combine(K, s, _A, s, y, h, tmp)
                 rhs(model, mode, t + _C[s] * h, tmp, p, K[s])
-            for j in range(n):
-                acc = 0.0
-                for q in range(12):
-                    acc += K[q, j] * _B[q]
-                y_new[j] = y[j] + h * acc
+            y_new[:] = y + h * np.dot(_B, K[:12])
             rhs(model, mode, t + h, y_new, p, f_new)
             K[12, :] = f_new
             nfev += 12
-            e5, e3 = 0.0, 0.0
-            for j in range(n):
-                scale = atol + max(abs(y[j]), abs(y_new[j])) * rtol
-                a5, a3 = 0.0, 0.0
-                for q in range(13):
-                    a5 += K[q, j] * _E5[q]
-                    a3 += K[q, j] * _E3[q]
-                e5 += (a5 / scale) ** 2
-                e3 += (a3 / scale) ** 2
+            scale = atol + np.maximum(np.abs(y), np.abs(y_new)) * rtol
+            e5 = np.sum((np.dot(_E5, K[:13]) / scale) ** 2)
+            e3 = np.sum((np.dot(_E3, K[:13]) / scale) ** 2)
             if e5 == 0.0 and e3 == 0.0:
                 error = 0.0
             else:
@@ -260,16 +248,11 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
             ts2[:m + 1], ys2[:m + 1], Fs2[:m], tf2[:m] = ts[:m + 1], ys[:m + 1], Fs[:m], t_full[:m]
             ts, ys, Fs, t_full = ts2, ys2, Fs2, tf2
         F = Fs[m]
-        for j in range(n):
-            dy = y_new[j] - tmp[j]
-            F[0, j] = dy
-            F[1, j] = h * K[0, j] - dy
-            F[2, j] = 2 * dy - h * (f_new[j] + K[0, j])
-            for i in range(4):
-                acc = 0.0
-                for q in range(16):
-                    acc += _D[i, q] * K[q, j]
-                F[3 + i, j] = h * acc
+        dy = y_new - tmp
+        F[0] = dy
+        F[1] = h * K[0] - dy
+        F[2] = 2 * dy - h * (f_new + K[0])
+        F[3:] = h * np.dot(_D, K)
         t = t_new
         for j in range(n):
             y[j] = y_new[j]
