@@ -156,12 +156,15 @@ def _combine(K, stages, weights, row, y, h, out):
 
 
 @jit
-def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events, directions, quiet):
+def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events, directions, quiet, max_steps,
+              resumed):
     """DOP853 from (t0, y0) until t_bound or the first terminal event.
 
     ``first_step`` [s] > 0 is used as given (capped by the interval), else scipy's guess.
     ``directions`` (n_events,): +1 an event fires rising through zero, -1 falling, 0 either;
-    ``quiet`` (n_events,): see :func:`.kernels.guard`. Returns (ts (m+1,), ys (m+1, n),
+    ``quiet`` (n_events,): see :func:`.kernels.guard`. After ``max_steps`` steps (0: no limit) it
+    returns with status 2, to be called again from its last step end with the step size it proposes
+    (``resumed`` = 1: not the segment's first call); the steps are those of one call. Returns (ts (m+1,), ys (m+1, n),
     F (m, 7, n) the dense-output coefficients of each step, t_full (m,) each step's own end,
     status, event index, event time, event state (n,), right-hand-side calls).
     """
@@ -190,7 +193,7 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
     if t0 >= t_bound:  # nothing to integrate: one constant piece
         ts[1], ys[1, :], t_full[0] = t0, y, t0
         Fs[0, :, :] = 0.0
-        return ts[:2], ys[:2], Fs[:1], t_full[:1], 0, hit, t_hit, y_hit, nfev
+        return ts[:2], ys[:2], Fs[:1], t_full[:1], 0, hit, t_hit, y_hit, nfev, h_abs
     while True:
         min_step = 10.0 * _spacing(t)
         if h_abs < min_step:
@@ -273,7 +276,7 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
             status = 1
             t_stop = t_hit
             _dense(F, tmp, t_old, h, t_hit, y_hit)
-            if m >= 1 and ts[m] == t_hit:  # solve_ivp drops a step whose event is at its start
+            if (m >= 1 or resumed) and ts[m] == t_hit:  # solve_ivp drops a step whose event is at its start
                 break
         m += 1
         ts[m] = t_stop
@@ -281,7 +284,10 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
         ys[m, :] = y_hit if status == 1 else y
         if status == 1 or finished:
             break
-    return ts[:m + 1], ys[:m + 1], Fs[:m], t_full[:m], status, hit, t_hit, y_hit, nfev
+        if m == max_steps:
+            status = 2
+            break
+    return ts[:m + 1], ys[:m + 1], Fs[:m], t_full[:m], status, hit, t_hit, y_hit, nfev, h_abs
 
 
 class DenseSolution:
@@ -358,16 +364,30 @@ class Segment:
 
 
 def solve(model: int, mode: int, t0: float, t_end: float, y0, p: np.ndarray, rtol: float, atol: float,
-          first_step: float | None, directions, quiet=None) -> Segment:
+          first_step: float | None, directions, quiet=None, max_steps: int | None = None, pause=None) -> Segment:
     """Integrate ``mode`` of ``model`` (kernel numbers) from t0 to t_end [s] or its first event.
 
     ``directions``: one per event (see :func:`integrate`); ``quiet``: per event, the time [s] until
-    which it reads at least +tiny (None: never).
+    which it reads at least +tiny (None: never). ``pause(t)`` is called every ``max_steps`` steps
+    (e.g. a wall-clock budget that raises); the result is the same as without pauses.
     """
     directions = np.asarray(directions, dtype=float)
     n_events = directions.size
     quiet = np.full(n_events, -math.inf) if quiet is None else np.asarray(quiet, dtype=float)
-    out = integrate(int(model), int(mode), float(t0), float(t_end), np.array(y0, dtype=float), p, float(rtol),
-                    float(atol), float(first_step or 0.0), n_events, directions, quiet)
-    ts, ys, F, t_full, status, hit, t_hit, y_hit, nfev = out
+    y0, h = np.array(y0, dtype=float), float(first_step or 0.0)
+    parts, resumed = [], 0
+    while True:
+        out = integrate(int(model), int(mode), float(t0), float(t_end), y0, p, float(rtol), float(atol), h, n_events,
+                        directions, quiet, int(max_steps or 0), resumed)
+        ts, ys, F, t_full, status, hit, t_hit, y_hit, nfev, h = out
+        parts.append(out)
+        if status != 2:
+            break
+        t0, y0, resumed = float(ts[-1]), ys[-1].copy(), 1
+        pause(t0)
+    if len(parts) > 1:  # one segment: each part starts where the last one ended
+        ts = np.concatenate([parts[0][0]] + [part[0][1:] for part in parts[1:]])
+        ys = np.concatenate([parts[0][1]] + [part[1][1:] for part in parts[1:]])
+        F, t_full = (np.concatenate([part[i] for part in parts]) for i in (2, 3))
+        nfev = sum(part[8] for part in parts)
     return Segment(ts, ys, F, t_full, int(status), int(hit), float(t_hit), y_hit, n_events, int(nfev))

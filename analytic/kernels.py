@@ -119,6 +119,9 @@ def rhs(model, mode, t, y, p, out):
         for i in range(out.size):
             out[i] = math.nan
         return
+    if model == COMPLIANT:
+        compliant_rhs(y, p, out)
+        return
     M = drive_torque(p, omega)
     out[0] = omega
     if model == KINEMATIC:
@@ -145,6 +148,8 @@ def guard(model, mode, k, t, y, p, quiet):
     phi, omega = y[0], y[1]
     if not (abs(phi) < 1e300 and abs(omega) < 1e300):
         return math.nan
+    if model == COMPLIANT:
+        return compliant_guard(mode, k, t, y, p)
     if model == KINEMATIC:
         return mass_terms(p, phi)[5] * omega
     if mode == BOTH_MOVING:
@@ -167,3 +172,109 @@ def guard_table(model, mode, n_events, p, times, states, out):
     for i in range(times.size):
         for k in range(n_events):
             out[k, i] = guard(model, mode, k, times[i], states[i], p, never)
+
+
+# --- compliant one-way clutches (:mod:`.compliant_clutch`) -------------------------------------------
+# state [phi, omega, x1, v1, motor work, friction work, damper work]; the regime and the segment's events
+# travel in ``p`` after the robot's constants (:func:`.compliant_run.segment_constants`); the "mode" argument
+# of rhs/guard says whether an event reads its raw value (RAW) or what the root search sees (GUARDED).
+COMPLIANT = 2
+RAW, GUARDED = 0, 1
+TRACKING, FREE, ENGAGED, CLIPPED = 0, 1, 2, 3  # .compliant_clutch.Clutch
+P_K, P_C, P_DELTA, P_S0, P_S1, P_S2, P_C1, P_C2, P_PK1, P_PK2, P_T0 = range(16, 27)
+P_EVENTS = 27  # then four numbers per event: kind, module, direction, offset
+EV_MARGIN, EV_VELOCITY, EV_OVERLAP, EV_TRACK, EV_PUSH, EV_PHI = range(6)
+
+
+@jit
+def gap(p, phi):
+    """S(phi) [m] (:meth:`.Linkage.gap`)."""
+    r, L, s, c = p[P_R], p[P_L], math.sin(phi), math.cos(phi)
+    if p[P_EXACT] == 0.0:
+        return L + r * c
+    return r * c + math.sqrt(L * L - (r * s) * (r * s))
+
+
+@jit
+def compliant_motion(p, y):
+    """:meth:`.CompliantModel.motion` at one state: (alpha, a1, a2, x2, v2, f1, f2, d1, d2, friction1,
+    friction2, torque, M11, M12, M22, dM12, dM22, S, K, dK)."""
+    phi, omega, x1, v1 = y[0], y[1], y[2], y[3]
+    m11, m12, m22, dm12, dm22, K, dK = mass_terms(p, phi)
+    S = gap(p, phi)
+    x2, v2 = x1 + S - p[P_S0], v1 + K * omega
+    k, c, delta = p[P_K], p[P_C], p[P_DELTA]
+    d1 = -delta if p[P_C1] == TRACKING else p[P_PK1] - delta - x1
+    d2 = -delta if p[P_C2] == TRACKING else p[P_PK2] - delta - x2
+    f1 = k * d1 - c * v1 if p[P_C1] == ENGAGED else 0.0
+    f2 = k * d2 - c * v2 if p[P_C2] == ENGAGED else 0.0
+    s1, s2 = p[P_S1], p[P_S2]
+    sliding1, sliding2 = -s1 * p[P_FR1], -s2 * p[P_FR2]
+    torque = drive_torque(p, omega)
+    w2, g = omega * omega, p[P_AG]
+    F1, F2 = f1 + sliding1, f2 + sliding2
+    b1 = F1 + F2 + m11 * g - dm12 * w2
+    b2 = torque + K * F2 + m12 * g - 0.5 * dm22 * w2
+    if s1 != 0.0 and s2 != 0.0:
+        det = m11 * m22 - m12 * m12
+        a1, alpha = (m22 * b1 - m12 * b2) / det, (m11 * b2 - m12 * b1) / det
+        r1, r2 = sliding1, sliding2
+    elif s2 != 0.0:  # module 1 stuck
+        a1, alpha = 0.0, b2 / m22
+        r1, r2 = m12 * alpha - b1, sliding2
+    elif s1 != 0.0:  # module 2 stuck
+        jeff = m11 * (K * K) - 2.0 * m12 * K + m22
+        alpha = (b2 - K * b1 + (m12 - K * m11) * dK * w2) / jeff
+        a1 = -K * alpha - dK * w2
+        r1, r2 = sliding1, m11 * a1 + m12 * alpha - b1
+    else:  # both stuck: statics
+        a1, alpha = 0.0, 0.0
+        R2 = -b2 / K if K != 0 else 0.0
+        r1, r2 = -b1 - R2, R2
+    a2 = a1 + dK * w2 + K * alpha
+    return alpha, a1, a2, x2, v2, f1, f2, d1, d2, r1, r2, torque, m11, m12, m22, dm12, dm22, S, K, dK
+
+
+@jit
+def compliant_rhs(y, p, out):
+    """:meth:`.CompliantModel.rhs`: d/dt y into ``out``."""
+    m = compliant_motion(p, y)
+    v1, v2, k, c = y[3], m[4], p[P_K], p[P_C]
+    damper = 0.0
+    if p[P_C1] == ENGAGED:
+        damper += c * v1 * v1
+    elif p[P_C1] == CLIPPED:
+        damper += k * m[7] * v1
+    if p[P_C2] == ENGAGED:
+        damper += c * v2 * v2
+    elif p[P_C2] == CLIPPED:
+        damper += k * m[8] * v2
+    out[0], out[1], out[2], out[3], out[4] = y[1], m[0], v1, m[1], m[11] * y[1]
+    out[5], out[6] = p[P_S1] * p[P_FR1] * v1 + p[P_S2] * p[P_FR2] * v2, damper
+
+
+@jit
+def compliant_guard(guarded, k, t, y, p):
+    """Event k of the segment (:meth:`.CompliantModel.events`): its raw value, or (``guarded``) as solve_ivp sees it."""
+    base = P_EVENTS + 4 * k
+    kind, i, direction, offset = p[base], p[base + 1], p[base + 2], p[base + 3]
+    if kind == EV_PHI:
+        value = y[0] + offset
+    elif kind == EV_MARGIN:
+        value = offset - abs(compliant_motion(p, y)[9 if i == 0 else 10])
+    else:
+        K = mass_terms(p, y[0])[5] if i == 1 else 0.0
+        v = y[3] if i == 0 else y[3] + K * y[1]
+        position = y[2] if i == 0 else y[2] + gap(p, y[0]) - p[P_S0]
+        peak = p[P_PK1] if i == 0 else p[P_PK2]
+        if kind == EV_VELOCITY:
+            value = (p[P_S1] if i == 0 else p[P_S2]) * v + offset
+        elif kind == EV_TRACK:
+            value = position - peak + offset
+        elif kind == EV_OVERLAP:
+            value = peak - p[P_DELTA] - position + offset
+        else:  # EV_PUSH
+            value = p[P_K] * (peak - p[P_DELTA] - position) - p[P_C] * v + offset
+    if guarded != 0 and (value == 0 or (t == p[P_T0] and direction * value > 0)):
+        return -direction * 1e-300
+    return value
