@@ -112,6 +112,20 @@ def both_moving(p, phi, omega, M):
 
 
 @jit
+def mode_motion(p, mode, phi, omega, M):
+    """(alpha, a1, a2, R1, R2) in a moving mode of the one-way model (:meth:`.UnilateralModel.motion`:
+    accelerations and each held module's hold, nan where it moves)."""
+    w2 = omega * omega
+    if mode == BOTH_MOVING:
+        a1, alpha, K, dK = both_moving(p, phi, omega, M)
+        return alpha, a1, a1 + dK * w2 + K * alpha, math.nan, math.nan
+    alpha, hold, K, dK = one_dof(p, mode, phi, omega, M)
+    if mode == CONTRACTION:  # front held: e = -K, f = 0
+        return alpha, -dK * w2 + -K * alpha, 0.0 * w2 + 0.0 * alpha, math.nan, hold + p[P_FR1]
+    return alpha, 0.0 * w2 + 0.0 * alpha, dK * w2 + K * alpha, hold + p[P_FR2], math.nan
+
+
+@jit
 def rhs(model, mode, t, y, p, out):
     """d/dt y into ``out`` (see the module docstring for the states)."""
     phi, omega = y[0], y[1]

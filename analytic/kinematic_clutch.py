@@ -50,8 +50,8 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, restart_step, stall_reason,
-                             truncate)
+from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, raw_piece, restart_step,
+                             stall_reason, truncate)
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -59,6 +59,7 @@ from .solver_support import (RunMonitor, assemble, check_finite, check_run_optio
 _ZERO_SDD = 1e-9
 # |S_dot| below this fraction of r * |omega| at the start counts as a dead centre.
 _ZERO_SD = 1e-10
+_STATES = ("phi", "omega", "x1", "x2", "motor_work")  # y, as series columns
 
 
 def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float, M: float | None = None) -> Mode:
@@ -146,12 +147,12 @@ def simulate_kinematic(
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # Everything at rest under a torque that is constant at rest: nothing changes any more.
             stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g)
-            pieces.append(_raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
-                y[:, None], np.size(ts), axis=1)))
+            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
+                y[:, None], np.size(ts), axis=1), _STATES))
             break
         sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0, constants)
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
-        piece = _raw_piece(mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol)
+        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or sol.status != 1:
@@ -232,15 +233,8 @@ def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_ste
     return sol
 
 
-def _raw_piece(mode, times, dense) -> dict[str, np.ndarray]:
-    """The integrated states at ``times`` (n,) from the segment's dense output, and the mode."""
-    phi, omega, x1, x2, work = dense(times)
-    return {"t": times, "phi": phi, "omega": omega, "x1": x1, "x2": x2, "motor_work": work,
-            "mode": np.full(times.shape, int(mode))}
-
-
 def _mode_columns(dyn, mode, rows, torque=None) -> dict[str, np.ndarray]:
-    """Every column of the samples ``rows`` (:func:`_raw_piece`'s columns) of one mode."""
+    """Every column of the samples ``rows`` (:data:`_STATES` and ``mode``) of one mode."""
     times, phi, omega = rows["t"], rows["phi"], rows["omega"]
     if mode is Mode.BOTH_LOCKED:
         return _stalled_columns(dyn, rows)

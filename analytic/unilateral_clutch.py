@@ -59,8 +59,8 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, restart_step,
-                             stall_reason, truncate)
+from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, raw_piece,
+                             restart_step, spurious_start, stall_reason, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -73,6 +73,7 @@ _MAX_STALLED_SEGMENTS = 50
 # started at 1e-12 rad/s with no torque is neither at rest nor able to move in any mode
 _REST_SPEED = 1e-12
 _TINY = np.finfo(float).tiny  # what a quiet guard reads at least (see events)
+_STATES = ("phi", "omega", "x1", "x2", "state_v1", "motor_work")  # y, as series columns (v1: not in every mode)
 
 
 class UnilateralModel:
@@ -107,7 +108,8 @@ class UnilateralModel:
         """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``; M [N m] the torque."""
         M = self.dyn.torque(omega, M)
         if np.ndim(phi) == 0 and np.ndim(M) == 0 and mode is not Mode.BOTH_LOCKED:  # one state: the scalar kernels
-            return self._scalar_motion(float(phi), float(omega), mode, float(M))
+            alpha, a1, a2, R1, R2 = kernels.mode_motion(self.constants, int(mode), float(phi), float(omega), float(M))
+            return {"alpha": alpha, "a1": a1, "a2": a2, "R1": R1, "R2": R2}
         nan = np.nan * np.asarray(phi, dtype=float)
         if mode in (Mode.CONTRACTION, Mode.EXPANSION):
             st = self.dyn.state(phi, omega, mode, M)
@@ -122,19 +124,6 @@ class UnilateralModel:
         R1, R2 = self.dyn.static_holds(phi, M)
         zero = np.zeros_like(nan)
         return {"alpha": zero, "a1": zero, "a2": zero, "R1": R1, "R2": R2}
-
-    def _scalar_motion(self, phi: float, omega: float, mode: Mode, M: float) -> dict:
-        """:meth:`motion` at one state in a moving mode, on the scalar kernels (the same equations)."""
-        p, w2 = self.constants, omega * omega
-        if mode is Mode.BOTH_MOVING:
-            a1, alpha, K, dK = kernels.both_moving(p, phi, omega, M)
-            return {"alpha": alpha, "a1": a1, "a2": a1 + dK * w2 + K * alpha, "R1": math.nan, "R2": math.nan}
-        alpha, hold, K, dK = kernels.one_dof(p, int(mode), phi, omega, M)
-        if mode is Mode.CONTRACTION:  # front held: e = -K, f = 0
-            return {"alpha": alpha, "a1": -dK * w2 + -K * alpha, "a2": 0.0 * w2 + 0.0 * alpha, "R1": math.nan,
-                    "R2": hold + self.params.F_r1}
-        return {"alpha": alpha, "a1": 0.0 * w2 + 0.0 * alpha, "a2": dK * w2 + K * alpha, "R1": hold + self.params.F_r2,
-                "R2": math.nan}
 
     def rhs(self, mode: Mode):
         """d/dt of y = [phi, omega, x1, x2, v1, motor work]: only what integration needs (hot path)."""
@@ -157,7 +146,7 @@ class UnilateralModel:
         """Terminal events of ``mode`` and what each means: ('velocity'|'margin', module index).
 
         ``quiet`` {event index: time [s]}: that event reads at least +tiny until that time
-        (see :func:`_spurious_start`).
+        (see :func:`.solver_support.spurious_start`).
         """
         p = self.params
         quiet = quiet or {}
@@ -323,12 +312,12 @@ def simulate_unilateral(
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # at rest, held by statics, under a torque that is constant at rest: final
             stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g)
-            pieces.append(_raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
-                y[:, None], np.size(ts), axis=1)))
+            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
+                y[:, None], np.size(ts), axis=1), _STATES))
             break
         events = model.events(mode)
         sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
-        spurious = _spurious_start(model, mode, sol)
+        spurious = spurious_start(sol, lambda ts, ys: model.guards(ts, ys, mode))
         if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
             events = model.events(mode, quiet=dict([spurious]))
             sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0, dict([spurious]))
@@ -337,7 +326,7 @@ def simulate_unilateral(
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
         step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
-        piece = _raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol)
+        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol, _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or grazed is None and sol.status != 1:
@@ -392,42 +381,8 @@ def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, 
     return sol
 
 
-def _spurious_start(model: UnilateralModel, mode: Mode, sol, points: int = 32):
-    """(event index, time [s]) if solve_ivp put a crossing at the segment's start that is not one, else None.
-
-    A mode starts where its guards are zero and rising (that is why it was chosen), but the
-    value there is a projected zero, +-1e-17 by roundoff. A guard that rises only briefly
-    (e.g. a module starting from rest with a small acceleration and a large negative jerk,
-    back at zero microseconds later) gives solve_ivp a first step that starts at 0 and ends
-    below it; its root search then sticks in the roundoff next to the start, and the run would
-    restart there, forever. If the guard is clearly positive in that first step before it is
-    clearly negative, the crossing at the start is spurious: returned is where it has risen.
-    """
-    if sol.status != 1:
-        return None
-    t0 = sol.t[0]
-    k = min((k for k in range(len(sol.t_events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
-    if sol.t_events[k][0] - t0 > 1e-12 * (1.0 + abs(t0)):
-        return None
-    step = sol.sol.interpolants[0]  # the whole first step's dense output, also past the event
-    times = step.t_old + (step.t - step.t_old) * np.arange(1, points + 1) / points
-    values = model.guards(times, step(times), mode)[k]
-    threshold = 1e-9 * max(np.abs(values).max(), 1e-300)
-    rising, falling = np.flatnonzero(values > threshold), np.flatnonzero(values < -threshold)
-    if rising.size == 0 or falling.size and falling[0] < rising[0]:
-        return None
-    return k, float(times[rising[0]])
-
-
-def _raw_piece(mode: Mode, times, dense) -> dict[str, np.ndarray]:
-    """The integrated states at ``times`` (n,) from the segment's dense output, and the mode."""
-    y = dense(times)
-    return {"t": times, "phi": y[0], "omega": y[1], "x1": y[2], "x2": y[3], "state_v1": y[4], "motor_work": y[5],
-            "mode": np.full(times.shape, int(mode))}
-
-
 def _columns(model: UnilateralModel, mode: Mode, rows: dict) -> dict[str, np.ndarray]:
-    """Every column of the samples ``rows`` (:func:`_raw_piece`'s columns) of one mode."""
+    """Every column of the samples ``rows`` (:data:`_STATES` and ``mode``) of one mode."""
     times, phi, omega = rows["t"], rows["phi"], rows["omega"]
     y = np.array([phi, omega, rows["x1"], rows["x2"], rows["state_v1"], rows["motor_work"]])
     v1, v2 = model.velocities(y, mode)
