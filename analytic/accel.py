@@ -14,7 +14,9 @@ run the Python source even where numba is installed (a test compares the two).
 
 from __future__ import annotations
 
+import hashlib
 import os
+from pathlib import Path
 
 try:
     if os.environ.get("IPIR_MUJOCO_JIT", "1") == "0":
@@ -24,6 +26,36 @@ except ImportError:  # the fallback: the kernels run as Python
     numba = None
 
 ACCELERATED = numba is not None  # True: the kernels are compiled
+_COMPILED_MODULES = ("kernels", "dop853")  # the modules whose functions are compiled and call each other
+
+
+def _drop_stale_cache() -> None:
+    """Delete the package's cached machine code when any compiled module's source has changed.
+
+    numba invalidates a cached function when its own file changes, not when a function it calls
+    from another file does: after an edit of kernels.py alone, the stepper (dop853.py) would run
+    the old kernels compiled into it. A checksum of both files, kept beside the cache, decides.
+    Only the package's own cache folder is touched; where it cannot be written (an installed,
+    read-only package, whose files change together), nothing is done.
+    """
+    here = Path(__file__).parent
+    cache = here / "__pycache__"
+    try:
+        digest = hashlib.sha256(b"".join((here / f"{m}.py").read_bytes() for m in _COMPILED_MODULES)).hexdigest()
+        marker = cache / "numba-kernels.sha256"
+        if marker.is_file() and marker.read_text() == digest:
+            return
+        for module in _COMPILED_MODULES:
+            for path in [*cache.glob(f"{module}.*.nbi"), *cache.glob(f"{module}.*.nbc")]:
+                path.unlink()
+        cache.mkdir(exist_ok=True)
+        marker.write_text(digest)
+    except OSError:
+        pass
+
+
+if ACCELERATED:
+    _drop_stale_cache()
 
 
 def jit(function):

@@ -96,6 +96,24 @@ def test_the_stepper_is_scipys_dop853(geometry):
     assert np.all(np.abs(got.sol(float(times[100])) - ref.sol(times[100])) <= 10 * (RTOL * scale + ATOL))
 
 
+def test_pausing_for_the_wall_clock_budget_leaves_the_integration_unchanged():
+    """The stepper stops every few steps for a budget check and resumes with the step size it had
+    proposed: the same steps, bit for bit, as one uninterrupted call (one-way clutches, expansion)."""
+    params = RobotParams(drive="motor", incline=5.0)
+    model = UnilateralModel(params, "exact")
+    y0 = [math.pi + 0.3, 12.0, 0.1, 0.2, 0.0, 0.5]
+    whole = dop853.solve(kernels.UNILATERAL, int(Mode.EXPANSION), 0.0, 0.5, y0, model.constants, RTOL, ATOL, None,
+                         [-1.0, -1.0])
+    pauses = []
+    paused = dop853.solve(kernels.UNILATERAL, int(Mode.EXPANSION), 0.0, 0.5, y0, model.constants, RTOL, ATOL, None,
+                          [-1.0, -1.0], max_steps=3, pause=pauses.append)
+    assert whole.status == paused.status == 1 and len(pauses) == (whole.t.size - 2) // 3 > 3
+    assert np.array_equal(whole.t, paused.t) and np.array_equal(whole.y, paused.y)
+    assert all(np.array_equal(a, b) for a, b in zip(whole.t_events, paused.t_events))
+    times = np.linspace(np.pi / 100, whole.t[-1], 97)
+    assert np.array_equal(whole.sol(times), paused.sol(times))
+
+
 # each case: (params, geometry, clutch, t_end); kept short, the Python path integrates ~10x slower
 CASES = {
     "paper": (RobotParams(), "approx", "kinematic", 0.6),
