@@ -377,8 +377,10 @@ def solve(model: int, mode: int, t0: float, t_end: float, y0, p: np.ndarray, rto
     y0, h = np.array(y0, dtype=float), float(first_step or 0.0)
     parts, resumed = [], 0
     while True:
-        out = integrate(int(model), int(mode), float(t0), float(t_end), y0, p, float(rtol), float(atol), h, n_events,
-                        directions, quiet, int(max_steps or 0), resumed)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # as Python (no numba), trial steps
+            # of a fast crank can overflow; the step controller rejects them, and the output is checked finite
+            out = integrate(int(model), int(mode), float(t0), float(t_end), y0, p, float(rtol), float(atol), h,
+                            n_events, directions, quiet, int(max_steps or 0), resumed)
         ts, ys, F, t_full, status, hit, t_hit, y_hit, nfev, h = out
         parts.append(out)
         if status != 2:

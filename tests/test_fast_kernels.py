@@ -137,7 +137,7 @@ print(json.dumps(out))
 """
 
 
-@pytest.mark.skipif(not ACCELERATED, reason="numba is not installed: there is only the Python path")
+@pytest.mark.skipif(not ACCELERATED, reason="the kernels are not compiled (numba missing, or IPIR_MUJOCO_JIT=0): one path only")
 def test_compiled_and_python_paths_give_the_same_runs():
     """The same stepper source, compiled by numba here and run as Python in a child process
     (IPIR_MUJOCO_JIT=0): every series column agrees to 1e-12 of its largest value. Both paths do the
