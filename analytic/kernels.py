@@ -1,4 +1,4 @@
-"""Scalar right-hand sides and event functions of the rigid-clutch models, for the compiled stepper.
+"""Scalar right-hand sides and event functions of the analytic models, for the compiled stepper.
 
 The same equations as :mod:`.kinematics`, :mod:`.dynamics` and :mod:`.forces`
 (the reference, vectorized over samples, and what the output columns are
@@ -12,7 +12,8 @@ A model's constants travel as one float array ``p`` (:func:`pack`, the
 [phi, omega, x1, x2, motor work]; one event, S_dot = K omega) and
 :data:`UNILATERAL` (one-way clutches; state [phi, omega, x1, x2, v1, motor
 work]; event k of a mode watches module k: its velocity while it moves, its
-hold margin R_k + F_rk while held). Modes are :class:`.results.Mode` values.
+hold margin R_k + F_rk while held), both with :class:`.results.Mode` values as
+modes, and :data:`COMPLIANT` (compliant one-way clutches, see below).
 Units: rad, rad/s, m, m/s, kg, N, N m, J.
 """
 
@@ -190,7 +191,7 @@ def guard_table(model, mode, n_events, p, times, states, out):
 
 # --- compliant one-way clutches (:mod:`.compliant_clutch`) -------------------------------------------
 # state [phi, omega, x1, v1, motor work, friction work, damper work]; the regime and the segment's events
-# travel in ``p`` after the robot's constants (:func:`.compliant_run.segment_constants`); the "mode" argument
+# travel in ``p`` after the robot's constants (:meth:`.CompliantModel.constants`); the "mode" argument
 # of rhs/guard says whether an event reads its raw value (RAW) or what the root search sees (GUARDED).
 COMPLIANT = 2
 RAW, GUARDED = 0, 1

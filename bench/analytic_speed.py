@@ -9,7 +9,7 @@ branch left main, ``git merge-base HEAD main``), copied
 from git into a temporary folder and imported from there under another name
 (nothing is committed or installed); "after" is the installed one. Both run
 the same cases, interleaved in one process so machine load affects them alike;
-each time is the best of R runs (one run for the 10 s cases before). Printed:
+each time is the best of R runs (10 s cases: one run before, three after). Printed:
 absolute wall times, the ratio after/before, each engine's 10 s / 1 s ratio
 with the ratio of crank revolutions beside it (the work an event-driven solver
 must do grows with the revolutions, not with the time), and a Markdown table
@@ -133,7 +133,7 @@ def main() -> None:
         for name, case in CASES.items():
             long = name in LONG
             old = (None, None) if long and args.skip_long else best(before, case, 1 if long else args.repeats)
-            new = best(analytic, case, 2 if long else args.repeats)
+            new = best(analytic, case, 3 if long else args.repeats)
             rows[name] = (old, new)
             ratio = f"{new[0] / old[0]:7.3f}" if old[0] else "      -"
             print(f"{name:42s} before {old[0] or float('nan'):8.3f} s  after {new[0] * 1e3:8.1f} ms  "
