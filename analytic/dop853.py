@@ -79,6 +79,8 @@ def _root(model, mode, k, p, quiet, F, y_old, t_old, h, xa, xb, buf):
         return xpre
     if fcur == 0.0:
         return xcur
+    if (fpre < 0.0) == (fcur < 0.0):  # the step's end state and its interpolant there differ in the guard's sign
+        return xb  # by roundoff (scipy's brentq would raise): the crossing is at the step's end
     for _ in range(100):
         if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
             xblk, fblk = xpre, fpre
