@@ -4,8 +4,8 @@ Run on demand (not part of the test suite), from the repository root:
 
     python bench/analytic_speed.py [--before REV] [--repeats R] [--skip-long]
 
-"Before" is the analytic package at git revision REV (default: where this
-branch left main, ``git merge-base HEAD main``), copied
+"Before" is the analytic package at git revision REV (default: 5590109, the
+last main on solve_ivp, before the compiled stepper), copied
 from git into a temporary folder and imported from there under another name
 (nothing is committed or installed); "after" is the installed one. Both run
 the same cases, interleaved in one process so machine load affects them alike;
@@ -35,6 +35,7 @@ from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.analytic.accel import ACCELERATED
 
 ROOT = Path(__file__).resolve().parents[1]
+BEFORE = "5590109"  # the last main whose analytic models integrate with solve_ivp
 MOTOR = dict(drive="motor")
 # name: (params, geometry, clutch, t_end, options); "motor to steady state" caps at 30 s
 CASES = {
@@ -117,13 +118,10 @@ print(json.dumps(out))
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--before", default=None, help="git revision of the 'before' analytic package")
+    parser.add_argument("--before", default=BEFORE, help="git revision of the 'before' analytic package")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--skip-long", action="store_true", help="skip the 10 s cases before (about 40 s)")
     args = parser.parse_args()
-    if args.before is None:
-        args.before = subprocess.run(["git", "-C", str(ROOT), "merge-base", "HEAD", "main"], capture_output=True,
-                                     text=True, check=True).stdout.strip()[:10]
     print(f"numba compiled kernels: {ACCELERATED}; before = {args.before}; best of {args.repeats}; "
           f"machine load (1 min) {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as folder:
