@@ -201,8 +201,9 @@ class UnilateralModel:
         at_rest = [abs(v) <= _TOL_V * v_scale + _REST_SPEED for v in (v1, v2)]
         if not at_rest[0] and v1 < 0 or not at_rest[1] and v2 < 0:
             raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
-        motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode}
-        a_scale = r * (omega**2 + max(abs(m["alpha"]) for m in motions.values())) \
+        # the static hold (alpha = 0, the 0.0 below) is computed further down, only where it is a candidate
+        motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode if mode is not Mode.BOTH_LOCKED}
+        a_scale = r * (omega**2 + max(0.0, *(abs(m["alpha"]) for m in motions.values()))) \
             + (p.F_r1 + p.F_r2 + abs(M) / r) / min(p.m1, p.m2) + abs(self.dyn.a_g)
         a_scale = max(a_scale, 1e-300)  # nothing drives the robot at all: every test is 0 / tiny = 0
         f_scale = p.F_r1 + p.F_r2 + (p.m1 + p.m2) * a_scale
@@ -215,7 +216,7 @@ class UnilateralModel:
             if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + _REST_SPEED
                                              or (abs(tr.K) <= 1e-12 * r and M != 0)):
                 continue  # a static hold needs the crank at rest, and a torque the linkage can resist
-            m = motions[mode]
+            m = motions[mode] if mode in motions else self.motion(phi, omega, v1, mode, M)
             tests = []
             for i in (0, 1):
                 if held[i]:
