@@ -58,10 +58,11 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import kernels
 from .dynamics import MassTerms, OneDofDynamics
 from .errors import SimulationError
 from .forces import drive_torque, gravity_along_pipe
-from .kinematics import Geometry
+from .kinematics import Geometry, Transfer
 from .params import RobotParams
 from .results import Mode
 
@@ -139,6 +140,7 @@ class CompliantModel:
         self.delta = params.clutch_backlash
         self.g = gravity_along_pipe(params)
         self.F = (params.F_r1, params.F_r2)
+        self.base = kernels.pack(self.dyn)
 
     # --- dynamics in a regime ------------------------------------------------------------
     def overlaps(self, x, regime: Regime) -> tuple:
@@ -148,6 +150,9 @@ class CompliantModel:
 
     def motion(self, y, regime: Regime) -> Motion:
         """Accelerations and forces at state(s) ``y`` (7,) or (7, n) in ``regime`` (vectorized)."""
+        if np.ndim(y[0]) == 0:  # one state: the scalar kernels, the same equations
+            m = kernels.compliant_motion(self.constants(regime), np.asarray(y, dtype=float))
+            return Motion(*m[:5], m[5:7], m[7:9], m[9:11], m[11], MassTerms(*m[12:17], Transfer(*m[17:])))
         phi, omega, x1, v1 = y[0], y[1], y[2], y[3]
         mt = self.dyn.mass_terms(phi)
         K, dK = mt.transfer.K, mt.transfer.dK
@@ -200,6 +205,11 @@ class CompliantModel:
             return [y[1], m.alpha, y[3], m.a1, m.torque * y[1], s1 * F1 * v[0] + s2 * F2 * v[1], damper]
         return f
 
+    def constants(self, regime: Regime, events: list = (), t0: float = math.nan) -> np.ndarray:
+        """The kernels' constants (:data:`.kernels.P_K` on) for ``regime`` and ``events`` (:meth:`events`) from t0."""
+        head = [self.k, self.c, self.delta, self.S0, *regime.slip, *(int(c) for c in regime.clutch), *regime.peak, t0]
+        return np.concatenate([self.base, head, [x for _, raw, _ in events for x in raw.code]])
+
     # --- events --------------------------------------------------------------------------
     def events(self, regime: Regime, next_revolution: float, t0: float) -> list:
         """Terminal events of ``regime`` from time ``t0``: [(function for solve_ivp, raw function, (kind, module))].
@@ -223,35 +233,38 @@ class CompliantModel:
         found = []
         eps_d, eps_v = _HYSTERESIS_OVERLAP, _HYSTERESIS_SPEED
 
-        def add(kind, i, direction, fn):
+        def add(kind, i, direction, fn, code, offset=0.0):  # code, offset: the kernels' form (kernels.compliant_guard)
             def guarded(t, y):
                 value = fn(t, y)
                 return -direction * 1e-300 if value == 0 or (t == t0 and direction * value > 0) else value
             guarded.terminal, guarded.direction = True, direction
-            fn.direction = direction
+            fn.direction, fn.code = direction, (code, i, direction, offset)
             found.append((guarded, fn, (kind, i)))
 
         for i in (0, 1):
             s, c = regime.slip[i], regime.clutch[i]
             if s == 0:  # |R_i| exceeds F_ri
                 eps_f = _HYSTERESIS_FORCE * max(1.0, self.F[i])
-                add("margin", i, -1.0,
-                    lambda t, y, i=i, e=eps_f: self.F[i] + e - abs(self.motion(y, regime).friction[i]))
+                add("margin", i, -1.0, lambda t, y, i=i, e=eps_f: self.F[i] + e - abs(self.motion(y, regime).friction[i]),
+                    kernels.EV_MARGIN, self.F[i] + eps_f)
                 continue  # a stuck module's overlap and velocity are constant: no clutch event
             # s v falls below -eps_v: the module has stopped and turned
-            add("velocity", i, -1.0, lambda t, y, i=i, s=s: s * (y[3] if i == 0 else self.velocity2(y)) + eps_v)
+            add("velocity", i, -1.0, lambda t, y, i=i, s=s: s * (y[3] if i == 0 else self.velocity2(y)) + eps_v,
+                kernels.EV_VELOCITY, eps_v)
             if c is Clutch.FREE:
-                add("engage", i, 1.0, lambda t, y, i=i: self._overlap(y, regime, i) - eps_d)
+                add("engage", i, 1.0, lambda t, y, i=i: self._overlap(y, regime, i) - eps_d, kernels.EV_OVERLAP, -eps_d)
                 if self.delta > 0:
-                    add("track", i, 1.0, lambda t, y, i=i: self._position(y, i) - regime.peak[i] - eps_d)
+                    add("track", i, 1.0, lambda t, y, i=i: self._position(y, i) - regime.peak[i] - eps_d,
+                        kernels.EV_TRACK, -eps_d)
             elif c is Clutch.ENGAGED:
-                add("release", i, -1.0, lambda t, y, i=i: self._overlap(y, regime, i))
+                add("release", i, -1.0, lambda t, y, i=i: self._overlap(y, regime, i), kernels.EV_OVERLAP)
                 if self.c > 0:
-                    add("clip", i, -1.0, lambda t, y, i=i: self._push(y, regime, i))
+                    add("clip", i, -1.0, lambda t, y, i=i: self._push(y, regime, i), kernels.EV_PUSH)
             elif c is Clutch.CLIPPED:
-                add("engage", i, 1.0, lambda t, y, i=i: self._push(y, regime, i) - self.k * eps_d)
-                add("release", i, -1.0, lambda t, y, i=i: self._overlap(y, regime, i))
-        add("revolution", -1, 1.0, lambda t, y: y[0] - next_revolution)
+                add("engage", i, 1.0, lambda t, y, i=i: self._push(y, regime, i) - self.k * eps_d, kernels.EV_PUSH,
+                    -(self.k * eps_d))
+                add("release", i, -1.0, lambda t, y, i=i: self._overlap(y, regime, i), kernels.EV_OVERLAP)
+        add("revolution", -1, 1.0, lambda t, y: y[0] - next_revolution, kernels.EV_PHI, -next_revolution)
         return found
 
     def velocity2(self, y):

@@ -30,6 +30,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from . import dop853, kernels
+from .accel import ACCELERATED
 from .compliant_clutch import Clutch, CompliantModel, Regime
 from .cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
 from .errors import ParameterError, SimulationError
@@ -115,12 +117,18 @@ def simulate_compliant(
             break
         target = params.phi0 + 2 * math.pi * (turns + 1)
         events = model.events(regime, target, t)
-        sol = solve_ivp(budget.wrap(model.rhs(regime)), (t, t_end), y, method=method, rtol=rtol, atol=atol,
-                        events=[e for e, _, _ in events], dense_output=True)
+        if method == "DOP853":  # the compiled stepper on the scalar kernels: the same method
+            constants = model.constants(regime, events, t)
+            sol = dop853.solve(kernels.COMPLIANT, kernels.GUARDED, t, t_end, y, constants, rtol, atol, None,
+                               [raw.direction for _, raw, _ in events], max_steps=budget.steps, pause=budget.check)
+        else:
+            constants = None
+            sol = solve_ivp(budget.wrap(model.rhs(regime)), (t, t_end), y, method=method, rtol=rtol, atol=atol,
+                            events=[e for e, _, _ in events], dense_output=True)
         if sol.status < 0:
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s: {sol.message}")
         t_stop = float(sol.t[-1])
-        missed = _missed_crossing(events, sol)
+        missed = _missed_crossing(events, sol, constants)
         if missed is not None:
             t_stop = missed[0]
         piece = _piece(model, regime, sample_times(t, t_stop, grid), sol.sol)
@@ -189,6 +197,8 @@ class _Budget:
 
     def __init__(self, started: float, limit: float | None):
         self.started, self.limit = started, limit
+        # the compiled stepper pauses for a check after as many steps (15 right-hand sides each)
+        self.steps = None if limit is None else _BUDGET_CHECK_EVERY // 15
 
     def check(self, t: float) -> None:
         if self.limit is not None and time.perf_counter() - self.started > self.limit:
@@ -211,7 +221,7 @@ class _Budget:
 _GRAZE_POINTS = 8
 
 
-def _missed_crossing(events: list, sol):
+def _missed_crossing(events: list, sol, constants=None):
     """An event crossing that solve_ivp missed: (t, event index, state) of the first, or None.
 
     solve_ivp sees an event only where its function has changed sign between step ends; a clutch
@@ -226,7 +236,12 @@ def _missed_crossing(events: list, sol):
     fractions = np.arange(1, _GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)
     times = (ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel()
     states = sol.sol(times)
-    values = np.array([np.broadcast_to(raw(times, states), times.shape) for _, raw, _ in events], dtype=float)
+    if constants is not None and ACCELERATED:  # every raw value in one compiled call
+        values = np.empty((len(events), times.size))
+        kernels.guard_table(kernels.COMPLIANT, kernels.RAW, len(events), constants, times,
+                            np.ascontiguousarray(states.T), values)
+    else:
+        values = np.array([np.broadcast_to(raw(times, states), times.shape) for _, raw, _ in events], dtype=float)
     direction = np.array([raw.direction for _, raw, _ in events])[:, None]
     scale = np.maximum(np.abs(values).max(axis=1, keepdims=True), 1e-300)
     past = direction * values > 1e-9 * scale

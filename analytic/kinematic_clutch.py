@@ -41,6 +41,7 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import dop853, kernels
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
@@ -49,7 +50,8 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import RunMonitor, check_finite, check_run_options, restart_step, stall_reason, truncate
+from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, raw_piece, restart_step,
+                             stall_reason, truncate)
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -57,6 +59,7 @@ from .solver_support import RunMonitor, check_finite, check_run_options, restart
 _ZERO_SDD = 1e-9
 # |S_dot| below this fraction of r * |omega| at the start counts as a dead centre.
 _ZERO_SD = 1e-10
+_STATES = ("phi", "omega", "x1", "x2", "motor_work")  # y, as series columns
 
 
 def choose_mode_at_rest_gap(dyn: OneDofDynamics, phi: float, omega: float, M: float | None = None) -> Mode:
@@ -128,6 +131,7 @@ def simulate_kinematic(
                          progress=progress, until_steady=until_steady, steady_tol=steady_tol,
                          steady_cycles=steady_cycles)
     dyn = OneDofDynamics(params, geometry)
+    constants = kernels.pack(dyn)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)
 
@@ -143,11 +147,12 @@ def simulate_kinematic(
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # Everything at rest under a torque that is constant at rest: nothing changes any more.
             stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g)
-            pieces.append(_stalled_piece(dyn, monitor.samples(t, t_end, grid), y))
+            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
+                y[:, None], np.size(ts), axis=1), _STATES))
             break
-        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0)
+        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0, constants)
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
-        piece = _mode_piece(dyn, mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, torque)
+        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or sol.status != 1:
@@ -159,7 +164,7 @@ def simulate_kinematic(
         if t >= t_end:
             break
 
-    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    series = assemble(pieces, lambda mode, rows: _mode_columns(dyn, Mode(mode), rows, torque))
     monitor.report(float(series["t"][-1]), final=True)
     series.update(dyn.energy_columns(series))
     add_kinetostatics(series, dyn)
@@ -197,15 +202,28 @@ def mode_rhs(dyn: OneDofDynamics, mode: Mode, torque: Callable | None = None) ->
     return rhs
 
 
-def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_step=None):
-    """Integrate one mode from t0 until its switch event or t_end (``first_step`` [s]: see restart_step)."""
+def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_step=None, constants=None):
+    """Integrate one mode from t0 until its switch event or t_end (``first_step`` [s]: see restart_step).
+
+    The drive of ``params`` runs on the scalar kernels (``constants``: :func:`.kernels.pack` of ``dyn``);
+    a ``torque`` profile, a Python function, on solve_ivp with :func:`mode_rhs`: the same method.
+    """
+    direction = 1.0 if mode is Mode.CONTRACTION else -1.0
+    if torque is None:
+        constants = kernels.pack(dyn) if constants is None else constants
+        sol = dop853.solve(kernels.KINEMATIC, int(mode), t0, t_end, y0, constants, rtol, atol, first_step,
+                           [direction])
+        if sol.status < 0:
+            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: "
+                                  f"{sol.message}")
+        return sol
     linkage, rhs = dyn.linkage, mode_rhs(dyn, mode, torque)
 
     def gap_rate(_t, y):
         return linkage.transfer(y[0]).K * y[1]
 
     gap_rate.terminal = True
-    gap_rate.direction = 1.0 if mode is Mode.CONTRACTION else -1.0
+    gap_rate.direction = direction
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
@@ -215,34 +233,38 @@ def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_ste
     return sol
 
 
-def _mode_piece(dyn, mode, times, dense, torque=None) -> dict[str, np.ndarray]:
-    phi, omega, x1, x2, work = dense(times)
+def _mode_columns(dyn, mode, rows, torque=None) -> dict[str, np.ndarray]:
+    """Every column of the samples ``rows`` (:data:`_STATES` and ``mode``) of one mode."""
+    times, phi, omega = rows["t"], rows["phi"], rows["omega"]
+    if mode is Mode.BOTH_LOCKED:
+        return _stalled_columns(dyn, rows)
     M = drive_torque(dyn.params, omega) if torque is None else torque(times, phi, omega)
     M = np.broadcast_to(M, times.shape).astype(float)
     st = dyn.state(phi, omega, mode, M)
     return {
-        "t": times, "phi": phi, "omega": omega, "alpha": st.alpha, "x1": x1, "x2": x2,
+        "t": times, "phi": phi, "omega": omega, "alpha": st.alpha, "x1": rows["x1"], "x2": rows["x2"],
         "v1": st.v1, "v2": st.v2, "a1": st.a1, "a2": st.a2, "S": st.S, "S_dot": st.S_dot,
         "lambda1": st.lambda1, "lambda2": st.lambda2,
-        "mode": np.full(times.shape, int(mode)),
+        "mode": rows["mode"],
         # the paper's lock takes the whole holding force; a moving module feels -F_r
         "resistance1": np.zeros(times.shape) if mode is Mode.EXPANSION else np.full(times.shape, -dyn.params.F_r1),
         "resistance2": np.zeros(times.shape) if mode is Mode.CONTRACTION else np.full(times.shape, -dyn.params.F_r2),
-        "motor_work": work, "motor_torque": M,
+        "motor_work": rows["motor_work"], "motor_torque": M,
     }
 
 
-def _stalled_piece(dyn, times, y) -> dict[str, np.ndarray]:
-    n = times.shape
-    lam1, lam2, res1, res2 = dyn.stalled_reactions(y[0])
+def _stalled_columns(dyn, rows) -> dict[str, np.ndarray]:
+    n = rows["t"].shape
+    phi = float(rows["phi"][0])  # at rest: one crank angle
+    lam1, lam2, res1, res2 = dyn.stalled_reactions(phi)
     zeros = np.zeros(n)
     return {
-        "t": times, "phi": np.full(n, y[0]), "omega": zeros, "alpha": zeros,
-        "x1": np.full(n, y[2]), "x2": np.full(n, y[3]), "v1": zeros, "v2": zeros,
-        "a1": zeros, "a2": zeros, "S": np.full(n, dyn.linkage.gap(y[0])), "S_dot": zeros,
+        "t": rows["t"], "phi": np.full(n, phi), "omega": zeros, "alpha": zeros,
+        "x1": rows["x1"], "x2": rows["x2"], "v1": zeros, "v2": zeros,
+        "a1": zeros, "a2": zeros, "S": np.full(n, dyn.linkage.gap(phi)), "S_dot": zeros,
         "lambda1": np.full(n, lam1), "lambda2": np.full(n, lam2),
-        "mode": np.full(n, int(Mode.BOTH_LOCKED)),
+        "mode": rows["mode"],
         # a hold pulling a module back is its resistance's (see stalled_reactions)
         "resistance1": np.full(n, res1), "resistance2": np.full(n, res2),
-        "motor_work": np.full(n, y[4]), "motor_torque": np.full(n, float(drive_torque(dyn.params, 0.0))),
+        "motor_work": rows["motor_work"], "motor_torque": np.full(n, float(drive_torque(dyn.params, 0.0))),
     }

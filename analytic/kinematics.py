@@ -10,6 +10,7 @@ returns values of the same shape; lengths are in metres.
 
 from __future__ import annotations
 
+import math
 from enum import Enum
 from typing import NamedTuple
 
@@ -48,6 +49,12 @@ class RodMotion(NamedTuple):
     dg: np.ndarray
 
 
+def _functions(phi):
+    """(sin, cos, sqrt) for ``phi``: math's for one float (the event loop's single states: no numpy
+    call per evaluation), numpy's for arrays."""
+    return (math.sin, math.cos, math.sqrt) if isinstance(phi, float) else (np.sin, np.cos, np.sqrt)
+
+
 class Linkage:
     """The crank AB (length r) and rod BC (length L) in one geometry."""
 
@@ -60,11 +67,13 @@ class Linkage:
 
     def _root(self, phi):
         """sqrt(L^2 - r^2 sin^2 phi): the rod's projection on x [m] (exact geometry)."""
-        return np.sqrt(self.L**2 - (self.r * np.sin(phi)) ** 2)
+        sin, _, sqrt = _functions(phi)
+        return sqrt(self.L**2 - (self.r * sin(phi)) ** 2)
 
     def transfer(self, phi) -> Transfer:
         """S(phi), K = dS/dphi and dK/dphi."""
-        r, s, c = self.r, np.sin(phi), np.cos(phi)
+        sin, cos, _ = _functions(phi)
+        r, s, c = self.r, sin(phi), cos(phi)
         if self.geometry is Geometry.APPROX:
             return Transfer(self.L + r * c, -r * s, -r * c)
         D = self._root(phi)
@@ -90,7 +99,8 @@ class Linkage:
         """Velocity coefficients of the rod (exact geometry only; see :class:`RodMotion`)."""
         if self.geometry is not Geometry.EXACT:
             raise ValueError("the first-order geometry has no rigid rod; rod motion needs geometry 'exact'")
-        r, s, c = self.r, np.sin(phi), np.cos(phi)
+        sin, cos, _ = _functions(phi)
+        r, s, c = self.r, sin(phi), cos(phi)
         D = self._root(phi)
         _, K, dK = self.transfer(phi)
         # G = (B + C)/2 with B = (r c, r s), C = (S, 0).

@@ -26,8 +26,11 @@ def check_run_options(t_end: float, dt_out: float, rtol: float = 1e-10, atol: fl
 
 
 def sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
-    """Segment [t0, t1]: its end points and the output grid strictly inside."""
-    inside = grid[(grid > t0) & (grid < t1)]
+    """Segment [t0, t1]: its end points and the output grid strictly inside (``grid`` ascending).
+
+    Located by bisection, not by a mask over the whole grid: a run's cost must not grow with
+    (segments x grid points)."""
+    inside = grid[np.searchsorted(grid, t0, side="right"):max(np.searchsorted(grid, t1, side="left"), 0)]
     return np.concatenate([[t0], inside, [t1]]) if t1 > t0 else np.array([t0])
 
 
@@ -208,6 +211,60 @@ class RunMonitor:
         if self.progress is not None and (t >= self.next_report or final):
             self.progress(t)
             self.next_report = t + PROGRESS_EVERY_S
+
+
+def raw_piece(mode: int, times: np.ndarray, dense, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """A segment's integrated states at ``times`` (n,) from its dense output, as columns ``names``, and its mode."""
+    return {"t": times, **dict(zip(names, dense(times))), "mode": np.full(times.shape, int(mode))}
+
+
+def spurious_start(sol, guards, points: int = 32):
+    """(event index, time [s]) if the integrator put a crossing at the segment's start that is not one, else None.
+
+    ``guards(t (n,), Y (d, n))``: every event function at once, array (n_events, n). A mode
+    starts where its guards are zero and rising (that is why it was chosen), but the value there
+    is a projected zero, +-1e-17 by roundoff. A guard that rises only briefly (e.g. a module
+    starting from rest with a small acceleration and a large negative jerk, back at zero
+    microseconds later) gives a first step that starts at 0 and ends below it; the root search
+    then sticks in the roundoff next to the start, and the run would restart there, forever. If
+    the guard is clearly positive in that first step before it is clearly negative, the crossing
+    at the start is spurious: returned is where it has risen.
+    """
+    if sol.status != 1:
+        return None
+    t0 = sol.t[0]
+    k = min((k for k in range(len(sol.t_events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
+    if sol.t_events[k][0] - t0 > 1e-12 * (1.0 + abs(t0)):
+        return None
+    step = sol.sol.interpolants[0]  # the whole first step's dense output, also past the event
+    times = step.t_old + (step.t - step.t_old) * np.arange(1, points + 1) / points
+    values = guards(times, step(times))[k]
+    threshold = 1e-9 * max(np.abs(values).max(), 1e-300)
+    rising, falling = np.flatnonzero(values > threshold), np.flatnonzero(values < -threshold)
+    if rising.size == 0 or falling.size and falling[0] < rising[0]:
+        return None
+    return k, float(times[rising[0]])
+
+
+def assemble(pieces: list[dict[str, np.ndarray]], columns) -> dict[str, np.ndarray]:
+    """The run's series from its pieces of integrated states (each with a ``mode`` column).
+
+    ``columns(mode, rows)`` gives every column of the samples ``rows`` (the pieces' columns, all
+    of that mode), vectorized: called once per mode of the run rather than once per segment, so
+    that a run of many short segments pays numpy's per-call cost a few times, not per segment.
+    Columns keep the order ``columns`` gives them.
+    """
+    raw = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    modes = raw["mode"]
+    series: dict[str, np.ndarray] = {}
+    for mode in np.unique(modes):
+        rows = np.flatnonzero(modes == mode)
+        part = columns(int(mode), {c: v[rows] for c, v in raw.items()})
+        for c, v in part.items():
+            if c not in series:
+                series[c] = np.empty(modes.size, dtype=np.asarray(v).dtype)
+            series[c][rows] = v
+    return series
 
 
 def truncate(piece: dict[str, np.ndarray], t_stop: float) -> dict[str, np.ndarray]:

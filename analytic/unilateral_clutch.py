@@ -49,6 +49,8 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import dop853, kernels
+from .accel import ACCELERATED
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
 from .errors import SimulationError
@@ -57,8 +59,8 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
-from .solver_support import (RunMonitor, check_finite, check_run_options, missed_crossing, restart_step, stall_reason,
-                             truncate)
+from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, raw_piece,
+                             restart_step, spurious_start, stall_reason, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -71,6 +73,7 @@ _MAX_STALLED_SEGMENTS = 50
 # started at 1e-12 rad/s with no torque is neither at rest nor able to move in any mode
 _REST_SPEED = 1e-12
 _TINY = np.finfo(float).tiny  # what a quiet guard reads at least (see events)
+_STATES = ("phi", "omega", "x1", "x2", "state_v1", "motor_work")  # y, as series columns (v1: not in every mode)
 
 
 class UnilateralModel:
@@ -81,6 +84,7 @@ class UnilateralModel:
         self.dyn = OneDofDynamics(params, geometry)
         self.linkage = self.dyn.linkage
         self.torque = torque  # (t, phi, omega) -> N m, or None for the drive of params
+        self.constants = kernels.pack(self.dyn)  # the scalar kernels' copy of the constants
 
     def motor(self, t, phi, omega):
         """Motor torque [N m] at time t (array-friendly)."""
@@ -103,6 +107,9 @@ class UnilateralModel:
     def motion(self, phi, omega, v1, mode: Mode, M=None) -> dict:
         """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``; M [N m] the torque."""
         M = self.dyn.torque(omega, M)
+        if np.ndim(phi) == 0 and np.ndim(M) == 0 and mode is not Mode.BOTH_LOCKED:  # one state: the scalar kernels
+            alpha, a1, a2, R1, R2 = kernels.mode_motion(self.constants, int(mode), float(phi), float(omega), float(M))
+            return {"alpha": alpha, "a1": a1, "a2": a2, "R1": R1, "R2": R2}
         nan = np.nan * np.asarray(phi, dtype=float)
         if mode in (Mode.CONTRACTION, Mode.EXPANSION):
             st = self.dyn.state(phi, omega, mode, M)
@@ -139,7 +146,7 @@ class UnilateralModel:
         """Terminal events of ``mode`` and what each means: ('velocity'|'margin', module index).
 
         ``quiet`` {event index: time [s]}: that event reads at least +tiny until that time
-        (see :func:`_spurious_start`).
+        (see :func:`.solver_support.spurious_start`).
         """
         p = self.params
         quiet = quiet or {}
@@ -163,6 +170,12 @@ class UnilateralModel:
 
     def guards(self, t, Y, mode: Mode) -> np.ndarray:
         """Every event function of ``mode`` at times t (n,) and states Y (6, n): array (n_events, n)."""
+        if ACCELERATED and self.torque is None and np.ndim(t) == 1:  # compiled: no numpy calls per segment
+            t = np.asarray(t, dtype=float)
+            out = np.empty((2, t.size))
+            kernels.guard_table(kernels.UNILATERAL, int(mode), 2, self.constants, t,
+                                np.ascontiguousarray(np.asarray(Y, dtype=float).T), out)
+            return out
         p = self.params
         v1, v2 = self.velocities(Y, mode)
         m = None
@@ -188,8 +201,9 @@ class UnilateralModel:
         at_rest = [abs(v) <= _TOL_V * v_scale + _REST_SPEED for v in (v1, v2)]
         if not at_rest[0] and v1 < 0 or not at_rest[1] and v2 < 0:
             raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
-        motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode}
-        a_scale = r * (omega**2 + max(abs(m["alpha"]) for m in motions.values())) \
+        # the static hold (alpha = 0, the 0.0 below) is computed further down, only where it is a candidate
+        motions = {mode: self.motion(phi, omega, v1, mode, M) for mode in Mode if mode is not Mode.BOTH_LOCKED}
+        a_scale = r * (omega**2 + max(0.0, *(abs(m["alpha"]) for m in motions.values()))) \
             + (p.F_r1 + p.F_r2 + abs(M) / r) / min(p.m1, p.m2) + abs(self.dyn.a_g)
         a_scale = max(a_scale, 1e-300)  # nothing drives the robot at all: every test is 0 / tiny = 0
         f_scale = p.F_r1 + p.F_r2 + (p.m1 + p.m2) * a_scale
@@ -202,7 +216,7 @@ class UnilateralModel:
             if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + _REST_SPEED
                                              or (abs(tr.K) <= 1e-12 * r and M != 0)):
                 continue  # a static hold needs the crank at rest, and a torque the linkage can resist
-            m = motions[mode]
+            m = motions[mode] if mode in motions else self.motion(phi, omega, v1, mode, M)
             tests = []
             for i in (0, 1):
                 if held[i]:
@@ -299,21 +313,21 @@ def simulate_unilateral(
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # at rest, held by statics, under a torque that is constant at rest: final
             stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g)
-            pieces.append(_piece(model, Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
-                y[:, None], np.size(ts), axis=1)))
+            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
+                y[:, None], np.size(ts), axis=1), _STATES))
             break
         events = model.events(mode)
         sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
-        spurious = _spurious_start(model, mode, sol)
+        spurious = spurious_start(sol, lambda ts, ys: model.guards(ts, ys, mode))
         if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
             events = model.events(mode, quiet=dict([spurious]))
-            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
+            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0, dict([spurious]))
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events])
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
         step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
-        piece = _piece(model, mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol)
+        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol, _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or grazed is None and sol.status != 1:
@@ -332,7 +346,7 @@ def simulate_unilateral(
         if t >= t_end:
             break
 
-    series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    series = assemble(pieces, lambda mode, rows: _columns(model, Mode(mode), rows))
     monitor.report(float(series["t"][-1]), final=True)
     series.update(model.dyn.energy_columns(series))
     add_kinetostatics(series, model.dyn)
@@ -345,8 +359,20 @@ def simulate_unilateral(
                                "rod_modelled": model.dyn.include_rod, **monitor.settings})
 
 
-def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step):
-    """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end."""
+def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
+    """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end.
+
+    The drive of ``params`` runs on the scalar kernels (:mod:`.kernels`: the same events, event k
+    quiet until ``quiet[k]`` [s]); a ``torque`` profile, a Python function, on solve_ivp: the same method.
+    """
+    if model.torque is None:
+        quiet = quiet or {}
+        sol = dop853.solve(kernels.UNILATERAL, int(mode), t0, t_end, y0, model.constants, rtol, atol, first_step,
+                           [e.direction for e, _ in events], [quiet.get(k, -math.inf) for k in range(len(events))])
+        if sol.status < 0:
+            raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: "
+                                  f"{sol.message}")
+        return sol
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(model.rhs(mode), (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,
@@ -356,36 +382,10 @@ def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, 
     return sol
 
 
-def _spurious_start(model: UnilateralModel, mode: Mode, sol, points: int = 32):
-    """(event index, time [s]) if solve_ivp put a crossing at the segment's start that is not one, else None.
-
-    A mode starts where its guards are zero and rising (that is why it was chosen), but the
-    value there is a projected zero, +-1e-17 by roundoff. A guard that rises only briefly
-    (e.g. a module starting from rest with a small acceleration and a large negative jerk,
-    back at zero microseconds later) gives solve_ivp a first step that starts at 0 and ends
-    below it; its root search then sticks in the roundoff next to the start, and the run would
-    restart there, forever. If the guard is clearly positive in that first step before it is
-    clearly negative, the crossing at the start is spurious: returned is where it has risen.
-    """
-    if sol.status != 1:
-        return None
-    t0 = sol.t[0]
-    k = min((k for k in range(len(sol.t_events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
-    if sol.t_events[k][0] - t0 > 1e-12 * (1.0 + abs(t0)):
-        return None
-    step = sol.sol.interpolants[0]  # the whole first step's dense output, also past the event
-    times = step.t_old + (step.t - step.t_old) * np.arange(1, points + 1) / points
-    values = model.guards(times, step(times), mode)[k]
-    threshold = 1e-9 * max(np.abs(values).max(), 1e-300)
-    rising, falling = np.flatnonzero(values > threshold), np.flatnonzero(values < -threshold)
-    if rising.size == 0 or falling.size and falling[0] < rising[0]:
-        return None
-    return k, float(times[rising[0]])
-
-
-def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.ndarray]:
-    y = dense(times)
-    phi, omega = y[0], y[1]
+def _columns(model: UnilateralModel, mode: Mode, rows: dict) -> dict[str, np.ndarray]:
+    """Every column of the samples ``rows`` (:data:`_STATES` and ``mode``) of one mode."""
+    times, phi, omega = rows["t"], rows["phi"], rows["omega"]
+    y = np.array([phi, omega, rows["x1"], rows["x2"], rows["state_v1"], rows["motor_work"]])
     v1, v2 = model.velocities(y, mode)
     v1 = np.broadcast_to(v1, phi.shape).astype(float)
     v2 = np.broadcast_to(v2, phi.shape).astype(float)
@@ -404,7 +404,7 @@ def _piece(model: UnilateralModel, mode: Mode, times, dense) -> dict[str, np.nda
         "x1": y[2], "x2": y[3], "v1": v1, "v2": v2,
         "a1": np.broadcast_to(m["a1"], phi.shape).astype(float), "a2": np.broadcast_to(m["a2"], phi.shape).astype(float),
         "S": tr.S, "S_dot": tr.K * omega, "lambda1": clutch[0], "lambda2": clutch[1],
-        "mode": np.full(phi.shape, int(mode)), "resistance1": resistance[0], "resistance2": resistance[1],
+        "mode": rows["mode"], "resistance1": resistance[0], "resistance2": resistance[1],
         "motor_work": y[5], "motor_torque": M,
     }
     return piece
