@@ -63,3 +63,17 @@ def jit(function):
     if numba is None:
         return function
     return numba.njit(cache=True, nogil=True, error_model="numpy")(function)
+
+
+def compilation_pending() -> bool:
+    """True when the kernels will be compiled on their first call in this process (no cached machine
+    code where numba keeps it: NUMBA_CACHE_DIR if set, else beside the sources or, where those cannot
+    be written, the user's cache folder), so that a caller can say why the first run takes longer.
+    False without numba."""
+    if numba is None:
+        return False
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        places = [Path(os.environ["NUMBA_CACHE_DIR"])]
+    else:
+        places = [Path(__file__).parent / "__pycache__", Path.home() / ".cache" / "numba"]
+    return not any(any(place.rglob("dop853.*.nbi")) for place in places if place.is_dir())

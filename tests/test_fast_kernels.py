@@ -160,3 +160,23 @@ def test_compiled_and_python_paths_give_the_same_runs():
             scale = max(float(np.abs(values).max()), 1e-300)
             np.testing.assert_allclose(values, other, rtol=0, atol=1e-12 * scale, err_msg=f"{name}: {column}")
         assert math.isfinite(run.energy["residual_j"])
+
+
+def test_the_command_line_says_when_it_compiles_the_kernels_first(tmp_path, monkeypatch, capsys):
+    """A cold numba cache makes the first run slow: the command line says why, in one line on stderr;
+    a warm one (the cached index numba writes beside its machine code) says nothing."""
+    from ipir_mujoco.analytic import accel
+    from ipir_mujoco.cli import main
+
+    if not accel.ACCELERATED:
+        pytest.skip("numba is not installed: nothing is compiled")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert accel.compilation_pending()
+    assert main(["simulate", "--t-end", "0.05", "--json"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "compiling the analytic engines' kernels" in err
+    (tmp_path / "analytic_x").mkdir()
+    (tmp_path / "analytic_x" / "dop853.step-1.py311.nbi").write_bytes(b"")
+    assert not accel.compilation_pending()
+    assert main(["simulate", "--t-end", "0.05", "--json"]) == 0
+    assert capsys.readouterr().err == ""

@@ -67,6 +67,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("ipir-mujoco: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     prefix = f"ipir-mujoco {args.command}"
+    if args.command not in QUIET_COMMANDS:
+        _note_first_compilation(prefix)
     try:
         return args.handler(args)
     except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
@@ -75,6 +77,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         code, message = _describe_failure(exc)
         print(f"{prefix}: {message}", file=sys.stderr)
         return code
+
+
+QUIET_COMMANDS = ("params", "compare")  # they run no analytic engine
+
+
+def _note_first_compilation(prefix: str) -> None:
+    """Say why the first run on a machine takes longer: the analytic kernels compile once (numba)."""
+    from ipir_mujoco.analytic.accel import compilation_pending
+
+    if compilation_pending():
+        print(f"{prefix}: compiling the analytic engines' kernels for this machine, once (about 15 s; later runs "
+              "reuse them)", file=sys.stderr, flush=True)
 
 
 def _describe_failure(exc: BaseException) -> tuple[int, str]:
