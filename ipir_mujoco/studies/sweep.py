@@ -13,11 +13,11 @@ of one study give byte-identical files.
 Where work runs:
 
 * default: analytic engines (and MuJoCo's lock) in a process pool; MuJoCo's
-  ratchet through ``mujoco.batch`` (C threads) in a process of its own, in
-  chunks of ``batch_size`` designs so rows stream as chunks finish. Both sides
-  run at once and share the cores: while both have work, the batch gets half
-  of them (rounded up) and the pool the rest; whichever finishes first hands
-  its cores to the other. Ctrl-C ends both pools' processes at once; the rows
+  ratchet through ``mujoco.batch`` in chunks of ``batch_size`` designs, each
+  chunk in a process of its own on one thread, so rows stream as chunks
+  finish. Both sides run at once and share the cores: while both have work,
+  the batch gets half of them (rounded up) and the pool the rest; whichever
+  finishes first hands its cores to the other. Ctrl-C ends both pools' processes at once; the rows
   written are every design finished by then.
 * ``executor=``: any ``concurrent.futures.Executor`` (a Dask ``Client``'s
   ``get_executor()`` for a cluster); every engine of a design runs as one task
@@ -167,13 +167,18 @@ def _kill_workers(pool: futures.ProcessPoolExecutor) -> None:
 
 
 class _Cores:
-    """How the cores are shared between the batch thread and the pool while both have work."""
+    """How the cores are shared between the batch processes and the pool while both have work.
+
+    Each batch chunk runs in a process of its own on one thread: the batch's per-step Python work
+    (the ratchet's bounds) then runs in parallel too, where threads of one batch would wait for it
+    (measured on 2 cores, 400 designs, 1 s: two one-thread processes 11.4 s, one two-thread process 13.9 s).
+    """
 
     def __init__(self, total: int, batch: bool, pool: bool):
         self.total = max(1, total)
         self.batch_active, self.pool_active = batch, pool
 
-    def batch_threads(self) -> int:
+    def batch_slots(self) -> int:
         if not self.pool_active:
             return self.total
         return max(1, (self.total + 1) // 2)
@@ -181,7 +186,7 @@ class _Cores:
     def pool_slots(self) -> int:
         if not self.batch_active:
             return self.total
-        return max(1, self.total - self.batch_threads())
+        return max(1, self.total - self.batch_slots())
 
 
 def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out: float, nthread: int,
@@ -292,18 +297,18 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             if own_pool else executor)
     chunks = deque([todo[k:k + (batch_size or BATCH_SIZE)] for k in range(0, len(todo), batch_size or BATCH_SIZE)]
                    if batched else [])
-    batch_pool = (futures.ProcessPoolExecutor(max_workers=1, initializer=_worker_init, initargs=(os.getpid(),))
-                  if chunks else None)
+    batch_pool = (futures.ProcessPoolExecutor(max_workers=cores.total, initializer=_worker_init,
+                                              initargs=(os.getpid(),)) if chunks else None)
     waiting = deque(todo if pooled else [])
     running: dict[futures.Future, list] = {}  # pool future -> [design, first seen running (monotonic s) or None]
     batch_running: dict[futures.Future, list[int]] = {}  # batch future -> its chunk
     abandoned = False
     try:
         def submit_more() -> None:
-            if chunks and not batch_running:  # one chunk at a time, on the cores the pool leaves
+            while chunks and len(batch_running) < cores.batch_slots():  # on the cores the pool leaves
                 chunk = chunks.popleft()
                 future = batch_pool.submit(run_batch_chunk, [designs[i] for i in chunk], study.base, study.t_end,
-                                           study.dt_out, cores.batch_threads(), study.until_steady)
+                                           study.dt_out, 1, study.until_steady)
                 batch_running[future] = chunk
                 future.add_done_callback(lambda f: events.put(("batch", None, f)))
             # no task queued ahead: an idle worker would take it and overrun the cores the batch holds

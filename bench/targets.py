@@ -1,0 +1,129 @@
+"""Benchmark: every speed target of the package in one run, with its ratio, and the README's table.
+
+Run on demand (not part of the test suite), from the repository root:
+
+    python bench/targets.py [--repeats 3] [--before REV] [--skip-sweep]
+
+Targets (ratios measured in this one run; absolute times printed too):
+
+- the paper's model (approx, kinematic), 1 s: at most 0.1 of the analytic
+  package at ``--before`` (default 5590109, the last one on solve_ivp);
+- the one-way model (exact, unilateral), 1 s: at most 30 ms;
+- 10 s against 1 s: at most 11x, with the crank revolutions beside it (an
+  event-driven solver's work grows with the revolutions; under a constant
+  torque they grow like t^2, under the motor like t);
+- a serial MuJoCo ratchet run, 5 s, dt_out 1 ms: at most 1.5x a plain
+  ``mj_step`` over the same steps of the same compiled model (in a C loop);
+- a 20 x 20 sweep of L and m2 (MuJoCo ratchet + analytic one-way, 1 s each):
+  at most 1.5x the MuJoCo batched floor, the designs' steps x a plain
+  ``mj_step`` / the cores.
+
+The single-component benchmarks give more detail: ``bench/analytic_speed.py``
+(every analytic case, first-call and fallback costs), ``bench/ratchet_step.py``
+(every MuJoCo clutch, before and after), ``bench/sweep_throughput.py``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import analytic_speed  # noqa: E402  (bench/ siblings)
+import ratchet_step  # noqa: E402
+
+from ipir_mujoco.analytic import RobotParams  # noqa: E402
+from ipir_mujoco.engine.timestep import choose_settings  # noqa: E402
+from ipir_mujoco.studies.sweep import run_sweep  # noqa: E402
+from ipir_mujoco.studies.sweep_space import Study, parse_vary  # noqa: E402
+
+
+def analytic_rows(before_rev: str, repeats: int) -> list[tuple]:
+    with tempfile.TemporaryDirectory() as folder:
+        before = analytic_speed.load_before(before_rev, Path(folder))
+        from ipir_mujoco import analytic
+
+        cases = analytic_speed.CASES
+        timed = {}
+        for name in ("paper model (approx, kinematic), 1 s", "one-way model (exact, unilateral), 1 s",
+                     "paper model, 10 s", "one-way model, 10 s", "motor, one-way model, 1 s",
+                     "motor, one-way model, 10 s"):
+            timed[name] = analytic_speed.best(analytic, cases[name], repeats if "10 s" not in name else 1)
+        paper_before, _ = analytic_speed.best(before, cases["paper model (approx, kinematic), 1 s"], repeats)
+    paper, one_way = timed["paper model (approx, kinematic), 1 s"], timed["one-way model (exact, unilateral), 1 s"]
+    rows = [("paper model, 1 s", f"{paper[0] * 1e3:.1f} ms (before {paper_before * 1e3:.0f} ms)",
+             paper[0] / paper_before, "<= 0.1 of before"),
+            ("one-way model, 1 s", f"{one_way[0] * 1e3:.1f} ms", one_way[0] / 0.030, "<= 30 ms (ratio to 30 ms)")]
+    for short, long_ in analytic_speed.PAIRS:
+        (t1, run1), (t10, run10) = timed[short], timed[long_]
+        revs = run10.summary["revolutions"] / run1.summary["revolutions"]
+        rows.append((f"{long_} / 1 s", f"{t10:.3f} s against {t1 * 1e3:.1f} ms; revolutions x{revs:.1f}",
+                     t10 / t1, "<= 11 (cost per revolution: x" + f"{t10 / t1 / revs:.2f})"))
+    return rows
+
+
+def mujoco_row(repeats: int) -> tuple:
+    case = ratchet_step.CASES["ratchet"]
+    params, rule, implementation = case[:3]
+    t_end, dt_out = 5.0, 1e-3
+    timestep = choose_settings(params, t_end, dt_out, None, implementation)[0].timestep
+    overhead = ratchet_step.timer_cost()
+    plain = engine = math.inf
+    for _ in range(repeats):
+        plain = min(plain, ratchet_step.plain_step(case, t_end, timestep, overhead))
+        engine = min(engine, ratchet_step.engine_step(ratchet_step.simulate_mujoco, ratchet_step.SolverSettings, case,
+                                                      t_end, dt_out, timestep, given=False))
+    floor = plain - ratchet_step.call_overhead(case, timestep)
+    steps = int(t_end / timestep * (1 + 1e-12))
+    return ("MuJoCo ratchet, 5 s, dt_out 1 ms", f"{engine * steps:.2f} s for {steps} steps; plain mj_step "
+            f"{floor * 1e6:.2f} us", engine / floor, "<= 1.5 x plain mj_step")
+
+
+def sweep_row(plain_step_s: float) -> tuple:
+    study = Study((parse_vary("L=0.06:0.5:20"), parse_vary("m2=0.2:3:20")), t_end=1.0)
+    steps = 0
+    for design in study.designs():
+        params = study.base.replace(**design)
+        settings, _ = choose_settings(params, study.t_end, 1e-3, None, "ratchet")
+        steps += int(study.t_end / settings.timestep * (1 + 1e-12))
+    cores = os.cpu_count() or 1
+    floor = steps * plain_step_s / cores
+    with tempfile.TemporaryDirectory() as folder:
+        started = time.perf_counter()
+        run_sweep(study, Path(folder) / "s", progress=False)
+        wall = time.perf_counter() - started
+    return ("20 x 20 sweep (MuJoCo ratchet + analytic one-way, 1 s)",
+            f"{wall:.1f} s ({400 / wall:.1f} designs/s); floor {floor:.1f} s ({steps} steps x {plain_step_s * 1e6:.2f}"
+            f" us / {cores} cores)", wall / floor, "<= 1.5 x floor")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3, help="timings per case; the best is kept (default 3)")
+    parser.add_argument("--before", default=analytic_speed.BEFORE, help="git revision of the 'before' analytic code")
+    parser.add_argument("--skip-sweep", action="store_true", help="leave out the 20 x 20 sweep (about a minute)")
+    args = parser.parse_args()
+    load = os.getloadavg()
+    print(f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} on {os.cpu_count()} cores; best of {args.repeats}",
+          flush=True)
+    rows = analytic_rows(args.before, args.repeats)
+    rows.append(mujoco_row(args.repeats))
+    if not args.skip_sweep:
+        case = ratchet_step.CASES["ratchet"]
+        timestep = choose_settings(case[0], 1.0, 1e-3, None, "ratchet")[0].timestep
+        plain = ratchet_step.plain_step(case, 1.0, timestep, ratchet_step.timer_cost()) \
+            - ratchet_step.call_overhead(case, timestep)
+        rows.append(sweep_row(plain))
+    print("\n| target | measured | ratio | wanted |\n|---|---|---|---|")
+    for name, measured, ratio, wanted in rows:
+        print(f"| {name} | {measured} | {ratio:.3g} | {wanted} |")
+
+
+if __name__ == "__main__":
+    main()
