@@ -284,7 +284,7 @@ def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_valid
 def test_convergence_evidence_covers_the_envelope_corners(quick_validation):
     """--quick checks the lightest rod and the shortest L/r with the automatic settings: each within the
     envelope's 0.1 % target of the analytic one-way model (the full validate runs every corner)."""
-    from ipir_mujoco.studies.validate import SMOKE_CASES
+    from ipir_mujoco.studies.convergence import SMOKE_CASES
 
     envelope = quick_validation[0]["convergence"]["envelope"]
     assert [r["case"] for r in envelope["rows"]] == list(SMOKE_CASES)

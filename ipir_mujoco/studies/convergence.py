@@ -166,6 +166,42 @@ def envelope_table(study: dict) -> str:
     return "\n".join(lines)
 
 
+# the envelope corners validate --quick still runs: the lightest rod and the shortest L/r
+SMOKE_CASES = ("rod mass 0.0001 kg", "L/r = 1.1")
+
+def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[str], None]) -> dict:
+    """MuJoCo's figures against its timestep, the equations' against their tolerance (paper's case)."""
+    from .paper_reference import differences_from_paper
+
+    timesteps = (1e-4, 5e-5) if quick else (4e-4, 2e-4, 1e-4, 5e-5)
+    label = "paper's case" if not differences_from_paper(params) else "this design"
+    rows = timestep_study({label: params}, timesteps, progress=progress)
+    equations = []
+    for rtol in ((1e-10, 1e-12) if quick else (1e-6, 1e-8, 1e-10, 1e-12)):
+        run = analytic.simulate(params, "exact", "unilateral", 1.0, rtol=rtol, atol=rtol * 1e-2, dt_out=1e-3)
+        equations.append({"rtol": rtol, **{k: run.summary[k] for k in ("revolutions", "x1_final", "x2_final")},
+                          "residual_fraction": run.summary["energy"]["residual_j"] / run.summary["energy"]["motor_work_j"]})
+    default = SolverSettings().timestep
+
+    def spread(items, key_filter):
+        chosen = [r for r in items if key_filter(r)]
+        return max(abs(a[k] - b[k]) / abs(b[k]) for a in chosen for b in chosen
+                   for k in ("revolutions", "x1_final", "x2_final"))
+
+    # numerical error of the defaults: change from the default setting to the finest one tried
+    mj_error = max(spread(rows, lambda r, c=c: r["clutch"] == c and r["timestep"] <= default)
+                   for c in ("lock", "ratchet"))
+    eq_error = spread(equations, lambda r: r["rtol"] <= 1e-10)
+    # the automatic settings over the envelope of designs and speeds (the corners; the whole envelope is in
+    # the package's mjcf/README.md); --quick checks two of the corners with the ratchet only
+    corners = envelope_cases(quick=True)
+    envelope = (envelope_study(cases=[c for c in corners if c[0] in SMOKE_CASES], progress=progress,
+                               clutches=(("ratchet", "unilateral"),))
+                if quick else envelope_study(quick=True, progress=progress))
+    return {"mujoco": rows, "equations": equations, "mujoco_default_error": mj_error,
+            "equations_default_error": eq_error, "envelope": envelope}
+
+
 def main(argv: list[str] | None = None) -> int:  # pragma: no cover - a study run on demand
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the envelope's corners only")

@@ -75,10 +75,8 @@ from ipir_mujoco.analytic.results import MODE_NAMES, Mode, RunResult
 from .. import __version__
 from ..engine import simulate_mujoco
 from ..engine.model import SolverSettings
+from .convergence import convergence_evidence
 from .paper_reference import PAPER_CASE, check_identities, check_paper_figures, describe_differences, differences_from_paper
-
-# the envelope corners validate --quick still runs: the lightest rod and the shortest L/r
-SMOKE_CASES = ("rod mass 0.0001 kg", "L/r = 1.1")
 
 LADDER_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
                   "min_clutch_reaction_n")
@@ -380,36 +378,3 @@ def pull_per_stroke(run: RunResult) -> list[dict]:
                             "complete": bool(end < len(s["t"]))})
         start = end
     return strokes
-
-
-def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[str], None]) -> dict:
-    """MuJoCo's figures against its timestep, the equations' against their tolerance (paper's case)."""
-    from .convergence import envelope_cases, envelope_study, timestep_study
-
-    timesteps = (1e-4, 5e-5) if quick else (4e-4, 2e-4, 1e-4, 5e-5)
-    label = "paper's case" if not differences_from_paper(params) else "this design"
-    rows = timestep_study({label: params}, timesteps, progress=progress)
-    equations = []
-    for rtol in ((1e-10, 1e-12) if quick else (1e-6, 1e-8, 1e-10, 1e-12)):
-        run = analytic.simulate(params, "exact", "unilateral", 1.0, rtol=rtol, atol=rtol * 1e-2, dt_out=1e-3)
-        equations.append({"rtol": rtol, **{k: run.summary[k] for k in ("revolutions", "x1_final", "x2_final")},
-                          "residual_fraction": run.summary["energy"]["residual_j"] / run.summary["energy"]["motor_work_j"]})
-    default = SolverSettings().timestep
-
-    def spread(items, key_filter):
-        chosen = [r for r in items if key_filter(r)]
-        return max(abs(a[k] - b[k]) / abs(b[k]) for a in chosen for b in chosen
-                   for k in ("revolutions", "x1_final", "x2_final"))
-
-    # numerical error of the defaults: change from the default setting to the finest one tried
-    mj_error = max(spread(rows, lambda r, c=c: r["clutch"] == c and r["timestep"] <= default)
-                   for c in ("lock", "ratchet"))
-    eq_error = spread(equations, lambda r: r["rtol"] <= 1e-10)
-    # the automatic settings over the envelope of designs and speeds (the corners; the whole envelope is in
-    # the package's mjcf/README.md); --quick checks two of the corners with the ratchet only
-    corners = envelope_cases(quick=True)
-    envelope = (envelope_study(cases=[c for c in corners if c[0] in SMOKE_CASES], progress=progress,
-                               clutches=(("ratchet", "unilateral"),))
-                if quick else envelope_study(quick=True, progress=progress))
-    return {"mujoco": rows, "equations": equations, "mujoco_default_error": mj_error,
-            "equations_default_error": eq_error, "envelope": envelope}
