@@ -94,3 +94,61 @@ def test_a_run_ending_on_a_revolution_keeps_it_after_a_csv_round_trip(tmp_path):
     back = read_csv(tmp_path / "ts.csv")
     assert cycle_summary(back)["cycles"] == cycle_summary(run.series)["cycles"] >= 3
     assert cycle_summary(back)["steady"]
+
+
+def test_a_revolution_of_no_duration_does_not_hang_the_watch():
+    """Two turns ending at one instant (a crank angle that jumps at a repeated time, as a mode switch's twin
+    samples would if they disagreed): the second turn has no duration and so no speed, but it must end
+    (it used to be sought again and again, for ever)."""
+    watch = SteadyWatch(0.0)
+    watch.update([0.0, 1.0, 1.0], [0.0, 1.0, 20.0], [0.0, 0.1, 0.2])
+    assert watch.turns == math.floor(20.0 / (2 * math.pi)) == 3
+    assert len(watch.speeds) == 1  # only the first turn took time
+
+
+@pytest.mark.parametrize("geometry, clutch, extra", [("exact", "kinematic", {}), ("exact", "unilateral", {}),
+                                                     ("exact", "unilateral", {"clutch_stiffness": 1e5})])
+def test_efficiency_counts_kinetic_energy_released_as_put_in(geometry, clutch, extra):
+    """A crank started at 60 rad/s under a tiny torque: it coasts down, and the kinetic energy it releases,
+    not the motor, pays most of the resistance work. Counted as loss-free input (as potential energy released
+    downhill is) the figure is resistance work / (motor work + kinetic energy released) and at most 1, to the
+    audit's residual (solver error, far below 1e-6 of the energies); resistance work / motor work would read
+    3 to 7 here."""
+    from ipir_mujoco.analytic import RobotParams, simulate
+
+    run = simulate(RobotParams(omega0=60.0, M=0.01, **extra), geometry, clutch, 0.3, dt_out=1e-3)
+    e, s = run.energy, run.summary
+    assert e["kinetic_j"] < -0.2 and e["friction_j"] > 2 * e["motor_work_j"] > 0  # the case: coasting
+    assert not s["steady"]  # so the figure is over the whole run
+    expected = e["friction_j"] / (e["motor_work_j"] - e["kinetic_j"] - min(e.get("clutch_spring_j", 0.0), 0.0))
+    assert s["efficiency"] == pytest.approx(expected, rel=1e-9)
+    assert s["efficiency"] <= 1.0 + 1e-6
+
+
+def test_a_motor_driven_past_its_no_load_speed_absorbs_energy_it_does_not_put_in():
+    """A motor at twice its no-load speed brakes the crank: its work is negative (energy absorbed, a loss),
+    so the input is the kinetic energy released alone, and the figure stays at most 1 (it used to be None
+    here, and resistance work / (negative motor work + kinetic energy released) would exceed 1)."""
+    from ipir_mujoco.analytic import RobotParams, simulate
+    from ipir_mujoco.analytic.cycles import efficiency
+
+    assert efficiency(-1.0, 2.0, kinetic_j=-3.0) == pytest.approx(2.0 / 3.0)
+    assert efficiency(-1.0, 0.0) is None  # nothing put in
+    run = simulate(RobotParams(drive="motor", omega0=60.0), "exact", "unilateral", 0.1, dt_out=1e-3)
+    e = run.energy
+    assert e["motor_work_j"] < 0 < e["friction_j"] and e["kinetic_j"] < 0
+    assert run.summary["efficiency"] == pytest.approx(e["friction_j"] / -e["kinetic_j"], rel=1e-9)
+    assert run.summary["efficiency"] <= 1.0 + 1e-6
+
+
+def test_no_distance_per_revolution_below_one_revolution():
+    """The paper's robot in a vertical pipe under 0.25 N m stalls after about a tenth of a turn: it never
+    travels a "distance per revolution", so there is none (it used to extrapolate that tenth to 0.07 m)."""
+    from ipir_mujoco.analytic import RobotParams, simulate
+
+    run = simulate(RobotParams(incline=90.0), "exact", "unilateral", 0.5, dt_out=1e-3)
+    assert run.stall is not None and 0 < run.summary["revolutions"] < 1
+    assert run.summary["distance_per_rev_m"] is None
+    moving = simulate(RobotParams(), "approx", "kinematic", 0.5, dt_out=1e-3)
+    assert moving.summary["revolutions"] > 1 and moving.summary["distance_per_rev_m"] == pytest.approx(
+        (moving.summary["x1_final"] + moving.summary["x2_final"]) / 2 / moving.summary["revolutions"], rel=1e-12)
