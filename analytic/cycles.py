@@ -20,7 +20,11 @@ analytic ones) put a sample exactly on each boundary.
 
 Steady state: the run is at its periodic steady state at the end of cycle k
 when the mean speeds of the last ``cycles`` revolutions (k - cycles + 1 .. k)
-all lie within ``tol`` * |mean of them| of each other, and that mean is > 0.
+all lie within ``tol`` * |mean of them| of each other, that mean is > 0, and
+the speed's remaining drift, extrapolated from the last two changes, is within
+``tol`` * mean as well (see :func:`steady_at_end`): a heavy flywheel settles so
+slowly that three revolutions agree to 1e-4 while the speed is still 2e-3
+short of its final value.
 The steady *window* is those revolutions; the steady figures are averages over
 it (totals over the window divided by its time, distance or revolutions).
 """
@@ -138,13 +142,45 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
     return out
 
 
+_DRIFT_FLOOR = 1e-3  # of tol: a change per revolution this small counts as settled whatever its trend
+
+
+def remaining_drift(speeds: list[float] | np.ndarray) -> float:
+    """How far [m/s] the per-revolution mean speed still moves after its last value, extrapolated from its
+    last two changes d1, d2 as a geometric approach (ratio d2 / d1): |d2| rho / (1 - rho).
+
+    0 where the changes alternate in sign or one is zero (an oscillation the spread bounds); inf where they
+    do not shrink (a drift that does not die out, e.g. a constant torque accelerating for ever); inf with
+    fewer than three speeds.
+    """
+    if len(speeds) < 3:
+        return math.inf
+    d1, d2 = float(speeds[-2] - speeds[-3]), float(speeds[-1] - speeds[-2])
+    if d1 * d2 <= 0:
+        return 0.0
+    rho = d2 / d1
+    return abs(d2) * rho / (1.0 - rho) if rho < 1 else math.inf
+
+
+def steady_at_end(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> bool:
+    """Whether the last ``n`` per-revolution mean speeds [m/s] (of ``speeds``, in order) are the periodic
+    steady state: their mean > 0, their spread <= tol * mean, and the :func:`remaining_drift` <= tol * mean
+    (or the last change below _DRIFT_FLOOR * tol * mean, settled whatever its trend)."""
+    u = np.asarray(speeds, dtype=float)
+    if u.size < n:
+        return False
+    window = u[-n:]
+    mean = float(window.mean())
+    if not (mean > 0 and float(window.max() - window.min()) <= tol * mean):
+        return False
+    return abs(float(u[-1] - u[-2])) <= _DRIFT_FLOOR * tol * mean or remaining_drift(u) <= tol * mean
+
+
 def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> int | None:
-    """Index of the first revolution at whose end the last ``n`` mean speeds agree within ``tol``; or None."""
+    """Index of the first revolution at whose end the run is at steady state (:func:`steady_at_end`); or None."""
     u = np.asarray(speeds, dtype=float)
     for k in range(n - 1, u.size):
-        window = u[k - n + 1:k + 1]
-        mean = float(window.mean())
-        if mean > 0 and float(window.max() - window.min()) <= tol * mean:
+        if steady_at_end(u[:k + 1], tol, n):
             return k
     return None
 
@@ -154,7 +190,7 @@ class SteadyWatch:
 
     Feed it the samples as they come (:meth:`update` with arrays of t [s], phi
     [rad] and robot travel [m]); it returns True once the last ``n`` revolutions'
-    mean speeds agree within ``tol``. Cheap: work only where a revolution ends.
+    mean speeds are steady (:func:`steady_at_end`). Cheap: work only where a revolution ends.
     """
 
     def __init__(self, phi0: float, tol: float = STEADY_TOL, n: int = STEADY_CYCLES):
@@ -188,7 +224,7 @@ class SteadyWatch:
                 if tb > self.boundary[0]:
                     self.speeds.append((xb - self.boundary[1]) / (tb - self.boundary[0]))
                 self.boundary = (tb, xb)
-                if self.steady_at is None and steady_index(self.speeds[-self.n:], self.tol, self.n) is not None:
+                if self.steady_at is None and steady_at_end(self.speeds[-(self.n + 1):], self.tol, self.n):
                     self.steady_at = tb
                 self.turns += 1  # counted apart from the speeds, or a turn of no duration would loop forever
                 target = 2 * math.pi * (self.turns + 1)
@@ -263,9 +299,7 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
         return out
     revolutions = float((series["phi"][-1] - series["phi"][0]) / (2 * math.pi))
     moved = float(travel(series)[-1] - travel(series)[0])
-    # below one whole turn the figure would extrapolate a part of a stroke (a robot that stalls
-    # after a tenth of a turn never travels its "distance per revolution"): none
-    out["distance_per_rev_m"] = moved / revolutions if revolutions >= 1.0 - _WHOLE_TOL else None
+    out["distance_per_rev_m"] = moved / revolutions if revolutions > 1e-9 else None
     t = np.asarray(series["t"], dtype=float)
     out["efficiency"] = _stretch_efficiency(series, float(t[0]), float(t[-1]))
     lambdas = [series[c] for c in ("lambda1", "lambda2") if c in series]
