@@ -285,10 +285,8 @@ def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.
         return np.broadcast_to(np.asarray(value, dtype=float), shape).astype(float)
 
     spring = sum(0.5 * model.k * np.maximum(d, 0.0) ** 2 for d in m.overlap)
-    # gravity's potential: -g_x times the mass-weighted displacement (the rod's centre moves with x1 and the linkage)
-    moment = p.m1 * x1 + p.m2 * m.x2
-    if dyn.include_rod:
-        moment = moment + p.rod_mass * (x1 + model.linkage.rod_com(phi)[0] - model.linkage.rod_com(p.phi0)[0])
+    # from the start: x1 = x2 = 0 at phi0
+    potential = dyn.potential_energy(phi, x1, m.x2) - dyn.potential_energy(p.phi0, 0.0, 0.0)
     return {
         "t": times, "phi": phi, "omega": omega, "alpha": full(m.alpha), "x1": x1, "x2": full(m.x2),
         "v1": v1, "v2": full(m.v2), "a1": full(m.a1), "a2": full(m.a2),
@@ -300,7 +298,7 @@ def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.
         "resistance1": full(m.friction[0]), "resistance2": full(m.friction[1]),
         "clutch_overlap1": full(m.overlap[0]), "clutch_overlap2": full(m.overlap[1]),
         "motor_work": y[4], "friction_work": y[5], "clutch_damper_work": y[6],
-        "kinetic": full(0.5 * (mt.m11 * v1**2 + 2.0 * mt.m12 * v1 * omega + mt.m22 * omega**2)),
-        "potential": full(-model.g * moment), "clutch_spring_energy": full(spring),
+        "kinetic": full(dyn.kinetic_energy(phi, v1, omega)),
+        "potential": full(potential), "clutch_spring_energy": full(spring),
         "motor_torque": full(m.torque),
     }
