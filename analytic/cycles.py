@@ -20,7 +20,11 @@ analytic ones) put a sample exactly on each boundary.
 
 Steady state: the run is at its periodic steady state at the end of cycle k
 when the mean speeds of the last ``cycles`` revolutions (k - cycles + 1 .. k)
-all lie within ``tol`` * |mean of them| of each other, and that mean is > 0.
+all lie within ``tol`` * |mean of them| of each other, that mean is > 0, and
+the speed's remaining drift, extrapolated from the last two changes, is within
+``tol`` * mean as well (see :func:`steady_at_end`): a heavy flywheel settles so
+slowly that three revolutions agree to 1e-4 while the speed is still 2e-3
+short of its final value.
 The steady *window* is those revolutions; the steady figures are averages over
 it (totals over the window divided by its time, distance or revolutions).
 """
@@ -138,13 +142,45 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
     return out
 
 
+_DRIFT_FLOOR = 1e-3  # of tol: a change per revolution this small counts as settled whatever its trend
+
+
+def remaining_drift(speeds: list[float] | np.ndarray) -> float:
+    """How far [m/s] the per-revolution mean speed still moves after its last value, extrapolated from its
+    last two changes d1, d2 as a geometric approach (ratio d2 / d1): |d2| rho / (1 - rho).
+
+    0 where the changes alternate in sign or one is zero (an oscillation the spread bounds); inf where they
+    do not shrink (a drift that does not die out, e.g. a constant torque accelerating for ever); inf with
+    fewer than three speeds.
+    """
+    if len(speeds) < 3:
+        return math.inf
+    d1, d2 = float(speeds[-2] - speeds[-3]), float(speeds[-1] - speeds[-2])
+    if d1 * d2 <= 0:
+        return 0.0
+    rho = d2 / d1
+    return abs(d2) * rho / (1.0 - rho) if rho < 1 else math.inf
+
+
+def steady_at_end(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> bool:
+    """Whether the last ``n`` per-revolution mean speeds [m/s] (of ``speeds``, in order) are the periodic
+    steady state: their mean > 0, their spread <= tol * mean, and the :func:`remaining_drift` <= tol * mean
+    (or the last change below _DRIFT_FLOOR * tol * mean, settled whatever its trend)."""
+    u = np.asarray(speeds, dtype=float)
+    if u.size < n:
+        return False
+    window = u[-n:]
+    mean = float(window.mean())
+    if not (mean > 0 and float(window.max() - window.min()) <= tol * mean):
+        return False
+    return abs(float(u[-1] - u[-2])) <= _DRIFT_FLOOR * tol * mean or remaining_drift(u) <= tol * mean
+
+
 def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> int | None:
-    """Index of the first revolution at whose end the last ``n`` mean speeds agree within ``tol``; or None."""
+    """Index of the first revolution at whose end the run is at steady state (:func:`steady_at_end`); or None."""
     u = np.asarray(speeds, dtype=float)
     for k in range(n - 1, u.size):
-        window = u[k - n + 1:k + 1]
-        mean = float(window.mean())
-        if mean > 0 and float(window.max() - window.min()) <= tol * mean:
+        if steady_at_end(u[:k + 1], tol, n):
             return k
     return None
 
@@ -154,7 +190,7 @@ class SteadyWatch:
 
     Feed it the samples as they come (:meth:`update` with arrays of t [s], phi
     [rad] and robot travel [m]); it returns True once the last ``n`` revolutions'
-    mean speeds agree within ``tol``. Cheap: work only where a revolution ends.
+    mean speeds are steady (:func:`steady_at_end`). Cheap: work only where a revolution ends.
     """
 
     def __init__(self, phi0: float, tol: float = STEADY_TOL, n: int = STEADY_CYCLES):
@@ -167,6 +203,7 @@ class SteadyWatch:
         self.last = None  # (t, reach, travel) of the previous sample
         self.boundary = None  # (t, travel) where the current revolution began
         self.speeds: list[float] = []
+        self.turns = 0  # revolutions ended so far (a turn of no duration ends too, but has no speed)
         self.steady_at: float | None = None
 
     def update(self, t, phi, position) -> bool:
@@ -175,7 +212,7 @@ class SteadyWatch:
         if self.last is None:
             self.last = (t[0], reach[0], position[0])
             self.boundary = (t[0], position[0])
-        target = 2 * math.pi * (len(self.speeds) + 1)
+        target = 2 * math.pi * (self.turns + 1)
         if reach[-1] < target:  # no revolution ends in these samples: the common case
             self.reach, self.last = float(reach[-1]), (t[-1], reach[-1], position[-1])
             return self.steady_at is not None
@@ -187,24 +224,44 @@ class SteadyWatch:
                 if tb > self.boundary[0]:
                     self.speeds.append((xb - self.boundary[1]) / (tb - self.boundary[0]))
                 self.boundary = (tb, xb)
-                if self.steady_at is None and steady_index(self.speeds[-self.n:], self.tol, self.n) is not None:
+                if self.steady_at is None and steady_at_end(self.speeds[-(self.n + 1):], self.tol, self.n):
                     self.steady_at = tb
-                target = 2 * math.pi * (len(self.speeds) + 1)
+                self.turns += 1  # counted apart from the speeds, or a turn of no duration would loop forever
+                target = 2 * math.pi * (self.turns + 1)
             prev_t, prev_r, prev_x = ti, ri, xi
         self.reach, self.last = float(reach[-1]), (t[-1], reach[-1], position[-1])
         return self.steady_at is not None
 
 
-def efficiency(motor_j: float, resistance_j: float, lifted_j: float = 0.0) -> float | None:
-    """The share of the energy put in that goes where it is meant to: (resistance work + potential energy
-    gained) / (motor work + potential energy released); None where nothing was put in.
+def efficiency(motor_j: float, resistance_j: float, lifted_j: float = 0.0, kinetic_j: float = 0.0,
+               stored_j: float = 0.0) -> float | None:
+    """The share of the energy put in that goes where it is meant to, over a stretch of a run [-]; None where
+    nothing was put in.
 
-    In a horizontal pipe: resistance work / motor work. On a climb the lifting is useful work, not a
-    loss (with rigid clutches nothing is lost: 1 at any incline); downhill, gravity's work is energy
-    put in, so the figure stays at most 1 when nothing dissipates more than it should.
+    Arguments in J over the stretch: the drive's work ``motor_j``, the work against the resistances
+    ``resistance_j``, and the gains of potential (``lifted_j``), kinetic (``kinetic_j``) and clutch-spring
+    (``stored_j``) energy. Useful: resistance work + potential energy gained (on a climb the lifting is the
+    job, not a loss). Put in: motor work where positive (a motor driven past its no-load speed absorbs
+    energy: a loss, not negative input) + any potential, kinetic or spring energy released (downhill, or a
+    crank started fast and slowing down: that energy moves the robot as the motor's would). By the energy
+    balance the figure is then at most 1 (to the audit's residual) in every case; kinetic or spring energy
+    gained and damper work count as not useful. In a horizontal pipe at steady state: resistance work /
+    motor work.
     """
-    put_in = motor_j + max(-lifted_j, 0.0)
+    put_in = max(motor_j, 0.0) + max(-lifted_j, 0.0) + max(-kinetic_j, 0.0) + max(-stored_j, 0.0)
     return (resistance_j + max(lifted_j, 0.0)) / put_in if put_in > 0 else None
+
+
+def _stretch_efficiency(series: dict[str, np.ndarray], t0: float, t1: float) -> float | None:
+    """:func:`efficiency` over the times t0..t1 [s] of a run, from its cumulative energy columns (None
+    without motor and friction work)."""
+    if "motor_work" not in series or "friction_work" not in series:
+        return None
+    t = np.asarray(series["t"], dtype=float)
+    gained = {c: float(np.diff(_at(t, series[c], np.array([t0, t1])))[0]) if c in series else 0.0
+              for c in ("motor_work", "friction_work", "potential", "kinetic", "clutch_spring_energy")}
+    return efficiency(gained["motor_work"], gained["friction_work"], gained["potential"], gained["kinetic"],
+                      gained["clutch_spring_energy"])
 
 
 def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> dict:
@@ -236,24 +293,15 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
         if None not in works:
             motor = sum(works)
             out["energy_per_metre_j_m"] = motor / distance if distance > 0 else None
-            friction = [c.friction_work_j for c in window]
-            lifted = sum(c.potential_change_j or 0.0 for c in window)
-            out["efficiency"] = efficiency(motor, sum(friction), lifted) if None not in friction else None
-        else:
-            out["efficiency"] = None
+        out["efficiency"] = _stretch_efficiency(series, window[0].t_start, window[-1].t_end)
         peaks = [c.peak_clutch_force_n for c in window if c.peak_clutch_force_n is not None]
         out["peak_clutch_force_n"] = max(peaks) if peaks else None
         return out
     revolutions = float((series["phi"][-1] - series["phi"][0]) / (2 * math.pi))
     moved = float(travel(series)[-1] - travel(series)[0])
     out["distance_per_rev_m"] = moved / revolutions if revolutions > 1e-9 else None
-    if "motor_work" in series and "friction_work" in series:
-        motor = float(series["motor_work"][-1] - series["motor_work"][0])
-        friction = float(series["friction_work"][-1] - series["friction_work"][0])
-        lifted = float(series["potential"][-1] - series["potential"][0]) if "potential" in series else 0.0
-        out["efficiency"] = efficiency(motor, friction, lifted)
-    else:
-        out["efficiency"] = None
+    t = np.asarray(series["t"], dtype=float)
+    out["efficiency"] = _stretch_efficiency(series, float(t[0]), float(t[-1]))
     lambdas = [series[c] for c in ("lambda1", "lambda2") if c in series]
     out["peak_clutch_force_n"] = float(max(v.max() for v in lambdas)) if lambdas else None
     return out

@@ -116,9 +116,17 @@ class RunResult:
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall
         accuracy = dict(self.accuracy or {})
-        motor = self.energy.get("motor_work_j")
-        if "residual_ratio" not in accuracy and motor and "residual_j" in self.energy:
-            accuracy["residual_ratio"] = self.energy["residual_j"] / abs(motor)
+        if "residual_ratio" not in accuracy and "residual_j" in self.energy:
+            # against the energy put through the robot, as the MuJoCo engine's monitor measures it (its floor:
+            # the kinetic energy at the start, which the solver's rtol applies to as well): the motor's work
+            # alone is no scale where the robot coasts or runs downhill (0 with the drive off)
+            e = self.energy
+            start = float(self.series["kinetic"][0]) if "kinetic" in self.series else 0.0
+            scale = max(abs(e.get("motor_work_j", 0.0)), e.get("friction_j", 0.0) + e.get("clutch_damper_j", 0.0),
+                        abs(e.get("potential_j", 0.0) + e.get("clutch_spring_j", 0.0)), abs(e.get("kinetic_j", 0.0)),
+                        abs(start))
+            if scale > 0:
+                accuracy["residual_ratio"] = e["residual_j"] / scale
         summary["accuracy"] = accuracy
         return summary
 

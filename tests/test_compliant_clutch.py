@@ -161,6 +161,20 @@ def test_without_backlash_the_peak_force_tends_to_twice_the_rigid_jump():
     assert -0.6 < slope < -0.4, (slope, deficits)
 
 
+@pytest.mark.parametrize("damping, backlash", [(30.0, 0.0), (300.0, 0.0), (300.0, 1e-4)])
+def test_a_damped_clutchs_peak_force_does_not_depend_on_the_output_grid(damping, backlash):
+    """With damping the clutch force k d - c v peaks between the module's turning points, so between
+    samples: on the 1e-4 s grid it read 1.2e-3 low at 1e7 N/m and 300 N s/m ((omega_c dt_out)^2 / 8 with
+    omega_c = 3.2e3 rad/s), 1.3e-5 low at 30 N s/m. The run samples each maximum, located on the dense output
+    to sqrt(eps) of the time, so the peak is the same on a 1e-4 s and a 1e-6 s grid to roundoff."""
+    params = RobotParams(clutch_stiffness=1e7, clutch_damping=damping, clutch_backlash=backlash)
+    peaks = []
+    for dt_out in (1e-4, 1e-6):
+        s = compliant(params, 0.3, dt_out=dt_out).series
+        peaks.append(max(s["lambda1"].max(), s["lambda2"].max()))
+    assert peaks[0] == pytest.approx(peaks[1], rel=1e-9)
+
+
 def test_with_backlash_the_peak_force_is_an_impact_growing_as_sqrt_k():
     """With play the module crosses it and hits its clutch at a speed v0 that k does not change. A mass
     m_eff pressed by a load Q hitting a spring at v0 compresses it to k d_max = Q + sqrt(Q^2 + k m_eff v0^2):

@@ -71,3 +71,21 @@ def test_container_refuses_missing_or_ragged_columns():
 def test_json_refuses_nan(tmp_path):
     with pytest.raises(ValueError):
         write_json(tmp_path / "x.json", {"a": float("nan")})
+
+
+def test_the_residual_ratio_is_against_the_energy_put_through_the_robot():
+    """A crank coasting down from 60 rad/s with the drive off: the motor does no work, the kinetic energy
+    released pays the resistances. The audit's residual is still reported, over the energy put through the
+    robot (the largest of the works and energy changes, and the kinetic energy at the start, as MuJoCo's
+    monitor measures it; it used to be missing with the drive off, and over the motor's small work, 30x too
+    large, with a 1 mN m torque); the solver's error keeps it far below 1e-6."""
+    from ipir_mujoco.analytic import simulate
+
+    for M in (0.0, 0.001):
+        run = simulate(RobotParams(M=M, omega0=60.0), "exact", "unilateral", 0.3, dt_out=1e-3)
+        e = run.energy
+        assert abs(e["motor_work_j"]) < 0.05 * e["friction_j"]
+        ratio = run.summary["accuracy"]["residual_ratio"]
+        start = run.series["kinetic"][0]  # 1.8 J at 60 rad/s: the largest energy in play
+        assert ratio == pytest.approx(e["residual_j"] / max(e["friction_j"], -e["kinetic_j"], start), rel=1e-12)
+        assert abs(ratio) < 1e-6
