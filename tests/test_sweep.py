@@ -375,3 +375,31 @@ def test_the_batch_runs_a_motor_design_as_the_motor(tmp_path):
         # results.csv keeps 10 significant digits
         assert float(row["mujoco-ratchet:revolutions"]) == pytest.approx(serial["revolutions"], rel=1e-9)
         assert float(row["mujoco-ratchet:efficiency"]) == pytest.approx(serial["efficiency"], rel=1e-6)
+
+
+def test_mujoco_peak_forces_that_measure_the_numerics_are_left_empty():
+    """A rigid MuJoCo clutch takes up its load within a few steps: the peak reaction read from the sweep's
+    1 ms samples is whichever step a sample hits, and differs from the peak over every step of the same run
+    (the same trajectory: only the output interval changes). The sweep leaves it empty, and the lock's rod
+    force with it; a compliant clutch read at every step keeps its (physical) peak."""
+    from ipir_mujoco.engine import simulate_mujoco
+
+    params = RobotParams()
+    sampled = simulate_mujoco(params, "unilateral", "ratchet", 0.5, dt_out=1e-3)
+    every_step = simulate_mujoco(params, "unilateral", "ratchet", 0.5, dt_out=sampled.settings["timestep"])
+    assert sampled.settings["timestep"] < 1e-3
+    # the artefact: the same run's peak differs by far more than its accuracy monitor's 1e-3 with the sampling
+    assert abs(every_step.summary["peak_clutch_force_n"] / sampled.summary["peak_clutch_force_n"] - 1) > 1e-2
+    for run in (sampled, every_step):
+        metrics = run_metrics(run)
+        assert np.isnan(metrics["peak_clutch_force_n"])
+        assert np.isfinite(metrics["peak_rod_force_n"])  # the ratchet's rod force does not depend on the step
+    lock = run_metrics(simulate_mujoco(params, "kinematic", "lock", 0.3, dt_out=1e-3))
+    assert np.isnan(lock["peak_clutch_force_n"]) and np.isnan(lock["peak_rod_force_n"])
+    # the analytic engines keep theirs; MuJoCo with a compliant clutch read at every step keeps its peak
+    assert run_metrics(steady_run())["peak_clutch_force_n"] == 3.0
+    compliant = steady_run("mujoco")
+    compliant.settings = {"clutch_model": "compliant", "mujoco_clutch": "ratchet", "timestep": 1e-5, "dt_out": 1e-5}
+    assert run_metrics(compliant)["peak_clutch_force_n"] == 3.0
+    compliant.settings = {**compliant.settings, "dt_out": 1e-3}
+    assert np.isnan(run_metrics(compliant)["peak_clutch_force_n"])
