@@ -403,3 +403,19 @@ def test_mujoco_peak_forces_that_measure_the_numerics_are_left_empty():
     assert run_metrics(compliant)["peak_clutch_force_n"] == 3.0
     compliant.settings = {**compliant.settings, "dt_out": 1e-3}
     assert np.isnan(run_metrics(compliant)["peak_clutch_force_n"])
+
+
+def test_the_heatmap_colours_the_first_engine_that_gives_the_metric():
+    """--plot-metric peak_clutch_force_n with the default engines: the batched MuJoCo ratchet gives no peak
+    forces, and colouring its empty column drew a blank map with a meaningless colour bar."""
+    from ipir_mujoco.report.sweep_plots import coloured_engine
+
+    nan = np.full(4, np.nan)
+    columns = {"mujoco-ratchet:peak_clutch_force_n": nan, "analytic-unilateral:peak_clutch_force_n": np.arange(4.0),
+               "mujoco-ratchet:revolutions": np.ones(4), "analytic-unilateral:revolutions": np.ones(4)}
+    engines = ["mujoco-ratchet", "analytic-unilateral"]
+    engine, heading = coloured_engine(columns, engines, "peak_clutch_force_n")
+    assert engine == "analytic-unilateral" and "mujoco-ratchet gives no peak_clutch_force_n" in heading
+    assert coloured_engine(columns, engines, "revolutions") == ("mujoco-ratchet", "revolutions of mujoco-ratchet")
+    columns["analytic-unilateral:peak_clutch_force_n"] = nan
+    assert coloured_engine(columns, engines, "peak_clutch_force_n")[0] is None
