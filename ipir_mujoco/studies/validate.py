@@ -35,7 +35,7 @@ compares every rung with the paper's model at that design (the first rung).
                           t_end, mean_crank_speed, pull_fraction, complete}]}: how much of the
                           paper-model run (and of each stroke) has a locked clutch
                           that would have to pull
-    lr_study              {ratios, rows: [{ratio, L, first_order, exact, mujoco,
+    lr_study              {ratios, rows: [{ratio, L, first_order, exact, exact_with_rod, mujoco,
                           divergence, mujoco_vs_exact}], thresholds: {figure: {"1%"|"5%":
                           {between: [lo, hi]} | {below_sweep} | {whole_sweep}}}}: see
                           ipir_mujoco.studies.lr_study; divergence = (first order - exact) / |exact|,
