@@ -42,9 +42,10 @@ compares every rung with the paper's model at that design (the first rung).
                           S_at_angle / S_dot_at_angle as fractions of 2r / max|S_dot|
     convergence           {mujoco: [rows of ipir_mujoco.studies.convergence], equations: [{rtol,
                           revolutions, x1_final, x2_final, residual_fraction}],
-                          mujoco_default_error, equations_default_error, envelope}: largest
-                          relative change of revolutions/x1/x2 from the default setting
-                          to the finest one tried; envelope: ipir_mujoco.studies.convergence.
+                          mujoco_default_error, mujoco_auto_timestep: {clutch: s},
+                          equations_default_error, envelope}: largest relative change of
+                          revolutions/x1/x2 among the default setting (for MuJoCo, each
+                          clutch's automatic step) and the finer ones tried; envelope: ipir_mujoco.studies.convergence.
                           envelope_study over the envelope's corners (two of them with --quick)
     sections              {key: metrics} of each further study the report runs
                           (see ipir_mujoco.report.sections)
