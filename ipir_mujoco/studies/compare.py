@@ -11,7 +11,8 @@ crank angle removes the error a small phase lag inflates at matching time
                              |a - b| and the scale (largest |a|) they compare to;
                              angle_grid is null when a crank does not turn monotonically
     summary                  {figure: {a, b, relative}}: (b - a) / |a| for revolutions,
-                             x1_final, x2_final, v1_max, v2_max, first_contraction_end_s and the
+                             x1_final, x2_final, v1_max, v2_max (at, and up to, t_compared_s: the
+                             shorter run's end, e.g. of two runs to steady state), first_contraction_end_s and the
                              periodic steady state's t_steady_s, steady_speed_m_s, distance_per_rev_m,
                              energy_per_metre_j_m, efficiency, peak_clutch_force_n (null where a run
                              has no such figure, e.g. a run that did not reach steady state)
@@ -20,6 +21,7 @@ crank angle removes the error a small phase lag inflates at matching time
     first_exceedance         {quantity: t or null}: first time |a - b| exceeds
                              tolerance * scale on the time grid
     tolerance                the relative tolerance used there
+    t_end_a_s, t_end_b_s     where each run ends; t_compared_s, the shorter of them
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from ipir_mujoco.analytic.results import COLUMNS, RunResult, mode_changes
 
 QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
+AT_COMPARED_TIME = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max")  # depend on how long a run is
 # the periodic steady state (analytic.cycles, through RunResult.summary): over the steady window when a
 # run reached it, else (distance, efficiency, peak force) over the whole run, or null
 STEADY_FIGURES = ("t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m", "efficiency",
@@ -164,6 +167,10 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
 
     summary = {}
     summary_a, summary_b = a.summary, b.summary
+    if a.series["t"][-1] != b.series["t"][-1]:
+        # runs of different length (two runs to steady state stop at their own times): the figures that grow
+        # with the run are compared at the shorter run's end, not each at its own
+        summary_a, summary_b = (dict(run.summary, **_figures_until(run, t_end)) for run in (a, b))
     for key in SUMMARY_FIGURES + STEADY_FIGURES:
         va, vb = summary_a.get(key), summary_b.get(key)
         relative = None if va in (None, 0) or vb is None else (vb - va) / abs(va)
@@ -176,9 +183,20 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
         first[q] = float(grid[over[0]]) if over.size else None
 
     return {"a": f"{a.engine}/{a.geometry}/{a.clutch}", "b": f"{b.engine}/{b.geometry}/{b.clutch}",
-            "t_compared_s": float(t_end), "time_grid": time_errors, "angle_grid": angle_errors,
+            "t_compared_s": float(t_end), "t_end_a_s": float(a.series["t"][-1]), "t_end_b_s": float(b.series["t"][-1]), "time_grid": time_errors, "angle_grid": angle_errors,
             "summary": summary, "switches": match_switches(a, b), "first_exceedance": first,
             "tolerance": tolerance}
+
+
+def _figures_until(run: RunResult, t_end: float) -> dict:
+    """revolutions, travels [m] at ``t_end`` [s] and peak speeds [m/s] up to it (as RunResult.summary has them
+    at the run's end), from the series interpolated at ``t_end``."""
+    s = run.series
+    at = {q: float(np.interp(t_end, *_unique_times(s["t"], s[q]))) for q in ("phi", "x1", "x2", "v1", "v2")}
+    within = s["t"] <= t_end
+    return {"revolutions": (at["phi"] - s["phi"][0]) / (2 * np.pi), "x1_final": at["x1"] - s["x1"][0],
+            "x2_final": at["x2"] - s["x2"][0], "v1_max": max(float(np.max(s["v1"][within])), at["v1"]),
+            "v2_max": max(float(np.max(s["v2"][within])), at["v2"])}
 
 
 def format_comparison(result: dict) -> str:
@@ -190,6 +208,10 @@ def format_comparison(result: dict) -> str:
         return name, ("" if unit == "-" else unit)
 
     lines = [f"b = {result['b']} against a = {result['a']}, over {result['t_compared_s']:.4g} s", ""]
+    ends = result.get("t_end_a_s"), result.get("t_end_b_s")
+    if None not in ends and ends[0] != ends[1]:
+        lines[-1:-1] = [f"a ends at {ends[0]:.6g} s, b at {ends[1]:.6g} s: revolutions, travels and peak speeds "
+                        f"are compared at {result['t_compared_s']:.6g} s, the shorter run's end"]
     rows = [("summary figure", "unit", "a", "b", "(b - a) / |a|")]
     for key, v in result["summary"].items():
         if key in STEADY_FIGURES and v["a"] is None and v["b"] is None:
