@@ -152,3 +152,24 @@ def test_dt_out_defaults_to_whole_timesteps_of_a_given_timestep(capsys):
     record = json.loads(out)
     assert code == 0 and record["settings"]["timestep"] == 3e-5
     assert record["settings"]["dt_out"] == pytest.approx(9e-5, rel=1e-12)
+
+
+
+def test_a_reader_that_leaves_early_ends_the_command_quietly(monkeypatch, capsys):
+    """``ipir-mujoco compare A B | head``: stdout's reader closes the pipe and the next write raises
+    BrokenPipeError. Unix tools end quietly then (status 141, as a shell reports SIGPIPE); it printed
+    'ipir-mujoco compare: cannot read or write: Broken pipe' on stderr."""
+    from ipir_mujoco.cli import params as params_command
+
+    def closed_pipe(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    original = params_command.add_parser
+
+    def add_parser(commands):
+        original(commands)
+        commands.choices["params"].set_defaults(handler=closed_pipe)
+
+    monkeypatch.setattr(params_command, "add_parser", add_parser)
+    assert main(["params"]) == 141
+    assert capsys.readouterr().err == ""
