@@ -419,3 +419,24 @@ def test_the_heatmap_colours_the_first_engine_that_gives_the_metric():
     assert coloured_engine(columns, engines, "revolutions") == ("mujoco-ratchet", "revolutions of mujoco-ratchet")
     columns["analytic-unilateral:peak_clutch_force_n"] = nan
     assert coloured_engine(columns, engines, "peak_clutch_force_n")[0] is None
+
+
+def test_the_line_plot_does_not_draw_a_stalled_design_as_a_point_of_the_curve():
+    """A stalled design's figures are those of a robot at rest (the sizing sweep at M_stall 0.02 N m: speed 0,
+    0.06 m 'per revolution' of a partial turn, efficiency 1): a cross, not a point joined to the curve."""
+    from types import SimpleNamespace
+
+    from ipir_mujoco.report.sweep_plots import lines_figure
+
+    x = np.array([0.02, 0.04, 0.06, 0.08])
+    columns = {"M_stall": x, "a:stalled": np.array([1.0, 0.0, 0.0, 0.0])}
+    for metric in ("mean_speed_mps", "distance_per_rev_m"):
+        columns[f"a:{metric}"] = np.array([0.06, 0.11, 0.12, 0.125])
+    for metric in ("steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n",
+                   "peak_rod_force_n", "accel_jump_mps2"):
+        columns[f"a:{metric}"] = np.full(4, np.nan)
+    fig = lines_figure(columns, SimpleNamespace(name="M_stall", log=False), ["a"])
+    lines = {line.get_gid(): line for ax in fig.axes for line in ax.get_lines() if line.get_gid()}
+    curve = lines["a:distance_per_rev_m"].get_ydata()
+    assert np.isnan(curve[0]) and list(curve[1:]) == [0.11, 0.12, 0.125]
+    assert list(lines["stalled:a:distance_per_rev_m"].get_xdata()) == [0.02]

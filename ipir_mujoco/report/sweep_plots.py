@@ -110,6 +110,14 @@ def plot_sweep(results: str | Path, study, out: str | Path, metric: str = "mean_
 
 
 def _lines(columns, axis, engines, out: Path) -> Path:
+    path = out / "sweep_lines.png"
+    lines_figure(columns, axis, engines).savefig(path, dpi=110)
+    return path
+
+
+def lines_figure(columns, axis, engines):
+    """One panel per metric any engine gives, against the one varied parameter; lines carry gids
+    ``ENGINE:METRIC`` (stalled designs left out) and ``stalled:ENGINE:METRIC`` (their crosses)."""
     x = columns[axis.name]
     order = np.argsort(x)
     shown = ("mean_speed_mps", "steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "distance_per_rev_m",
@@ -117,17 +125,23 @@ def _lines(columns, axis, engines, out: Path) -> Path:
     shown = [m for m in shown if any(np.isfinite(columns[f"{e}:{m}"]).any() for e in engines)]
     fig, panels = new_figure(len(shown), height=2.0)
     for ax, metric in zip(panels, shown):
-        for engine in engines:
-            ax.plot(x[order], columns[f"{engine}:{metric}"][order], "o-", ms=3, label=engine)
+        for j, engine in enumerate(engines):
+            values = columns[f"{engine}:{metric}"][order]
+            # a stalled design's figures are those of a robot at rest (no speed, a partial revolution): a
+            # cross, not a point of the curve
+            stalled = columns[f"{engine}:stalled"][order] == 1
+            line, = ax.plot(x[order], np.where(stalled, np.nan, values), "o-", ms=3, label=engine,
+                            gid=f"{engine}:{metric}")
+            if stalled.any():
+                ax.plot(x[order][stalled], values[stalled], "x", ms=6, color=line.get_color(),
+                        label=f"{engine}: stalled" if metric == shown[0] else None, gid=f"stalled:{engine}:{metric}")
         ax.set(ylabel=f"{metric}\n[{UNITS[metric]}]")
         ax.grid(alpha=0.3)
         if axis.log:
             ax.set_xscale("log")
     panels[0].legend(fontsize="small")
     panels[-1].set_xlabel(_label(axis.name))
-    path = out / "sweep_lines.png"
-    fig.savefig(path, dpi=110)
-    return path
+    return fig
 
 
 def coloured_engine(columns: dict[str, np.ndarray], engines: list[str], metric: str) -> tuple[str | None, str]:
