@@ -131,3 +131,26 @@ def test_runs_of_different_length_are_compared_at_the_shorter_ones_end(capsys):
     from ipir_mujoco.studies.compare import format_comparison
 
     assert "compared at 0.6 s, the shorter run's end" in format_comparison(compare_runs(long, short))
+
+
+def test_a_quantity_held_at_zero_is_judged_against_the_mechanisms_scale():
+    """Module 2 held still in run a (a vertical pipe where the robot stalls): its largest |a| is 0, and b's
+    round-off (58 nm in MuJoCo's ratchet) was reported as first exceeding 1 % at t = 0.00025 s. The scale is at
+    least the stroke 2r for a position and r x the largest crank speed for a speed."""
+    from ipir_mujoco.studies.compare import format_comparison
+
+    a, b = synthetic(), synthetic()
+    for run in (a, b):
+        run.series["x2"] = np.zeros_like(run.series["t"])
+        run.series["v2"] = np.full_like(run.series["t"], -0.0)
+    b.series["x2"] = b.series["x2"] + 6e-8
+    b.series["v2"] = b.series["v2"] + 2e-4
+    result = compare_runs(a, b)
+    r = a.params.r
+    assert result["time_grid"]["x2"]["scale"] == pytest.approx(2 * r)
+    assert result["time_grid"]["v2"]["scale"] == pytest.approx(r * OMEGA)
+    assert result["first_exceedance"]["x2"] is None and result["first_exceedance"]["v2"] is None
+    # a real difference still shows: 2 mm is 2 % of the stroke
+    b.series["x2"] = b.series["x2"] + 2e-3
+    assert compare_runs(a, b)["first_exceedance"]["x2"] == 0.0
+    assert " -0 " not in format_comparison(result)

@@ -8,7 +8,10 @@ crank angle removes the error a small phase lag inflates at matching time
 :func:`compare_runs` returns a plain dict (JSON-ready)::
 
     time_grid / angle_grid   {quantity: {rms, max, scale}} for phi omega x1 x2 v1 v2 S S_dot: RMS and largest
-                             |a - b| and the scale (largest |a|) they compare to;
+                             |a - b| and the scale (largest |a|) they compare to; on the time grid
+                             at least the mechanism's own (a turn 2 pi for phi, the stroke 2r for
+                             x1 x2 S, r x the largest crank speed for v1 v2 S_dot), so that a module
+                             a holds still is not judged against a scale of 0;
                              angle_grid is null when a crank does not turn monotonically
     summary                  {figure: {a, b, relative}}: (b - a) / |a| for revolutions,
                              x1_final, x2_final, v1_max, v2_max (at, and up to, t_compared_s: the
@@ -151,6 +154,13 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
     for run in (a, b):
         on_time[id(run)] = {q: np.interp(grid, *_unique_times(run.series["t"], run.series[q])) for q in QUANTITIES}
     time_errors = {q: _errors(on_time[id(a)][q], on_time[id(b)][q]) for q in QUANTITIES}
+    # a quantity a holds at zero (a held module: x2 = 0, v2 = 0) has no scale of its own: every round-off of b
+    # then exceeded 'tolerance x 0' (58 nm of MuJoCo's ratchet in a vertical pipe read as over 1 %)
+    crank_speed = float(np.max(np.abs(a.series["omega"])))
+    floors = {"phi": 2 * np.pi, "x1": 2 * a.params.r, "x2": 2 * a.params.r, "S": 2 * a.params.r,
+              "v1": a.params.r * crank_speed, "v2": a.params.r * crank_speed, "S_dot": a.params.r * crank_speed}
+    for q, floor in floors.items():
+        time_errors[q]["scale"] = max(time_errors[q]["scale"], floor)
 
     angle_errors = None
     if _monotonic(a.series["phi"]) and _monotonic(b.series["phi"]):
@@ -180,7 +190,7 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
     for q in QUANTITIES:
         scale = time_errors[q]["scale"]
         over = np.flatnonzero(np.abs(on_time[id(b)][q] - on_time[id(a)][q]) > tolerance * scale)
-        first[q] = float(grid[over[0]]) if over.size else None
+        first[q] = float(grid[over[0]]) if over.size and scale > 0 else None
 
     return {"a": f"{a.engine}/{a.geometry}/{a.clutch}", "b": f"{b.engine}/{b.geometry}/{b.clutch}",
             "t_compared_s": float(t_end), "t_end_a_s": float(a.series["t"][-1]), "t_end_b_s": float(b.series["t"][-1]), "time_grid": time_errors, "angle_grid": angle_errors,
@@ -217,12 +227,13 @@ def format_comparison(result: dict) -> str:
         if key in STEADY_FIGURES and v["a"] is None and v["b"] is None:
             continue  # neither run has it (neither reached its steady state): not a row of empty cells
         name, unit = unit_of(SUMMARY, key)
-        rows.append((name, unit, "none" if v["a"] is None else f"{v['a']:.6g}",
-                     "none" if v["b"] is None else f"{v['b']:.6g}",
+        rows.append((name, unit, "none" if v["a"] is None else f"{v['a'] + 0.0:.6g}",  # + 0.0: no '-0'
+                     "none" if v["b"] is None else f"{v['b'] + 0.0:.6g}",
                      "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"))
     lines += _aligned(rows)
     tolerance = result["tolerance"]
-    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a|;",
+    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a| (at least a turn, the "
+              "stroke 2r or r x the largest crank speed);",
               f"first over = first time |b - a| > tolerance x scale (tolerance {tolerance:g} = {100 * tolerance:g} %)"]
     rows = [("quantity", "unit", "at same time", "at same crank angle", "scale", "first over [s]")]
     for q in QUANTITIES:
