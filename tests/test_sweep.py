@@ -440,3 +440,19 @@ def test_the_line_plot_does_not_draw_a_stalled_design_as_a_point_of_the_curve():
     curve = lines["a:distance_per_rev_m"].get_ydata()
     assert np.isnan(curve[0]) and list(curve[1:]) == [0.11, 0.12, 0.125]
     assert list(lines["stalled:a:distance_per_rev_m"].get_xdata()) == [0.02]
+
+
+def test_a_metric_equal_in_every_design_names_no_best_design():
+    """Runs too short for a whole crank revolution have mean speed 0 in every design: the sweep printed
+    'best mean_speed_mps ... 0 at L=0.1, m2=0.5', the first design, as if it had been found best."""
+    from ipir_mujoco.report.sweep_plots import best_designs
+
+    columns = {"design_id": np.arange(3.0), "L": np.array([0.1, 0.2, 0.3]), "a:revolutions": np.ones(3),
+               "a:stalled": np.zeros(3)}
+    for metric in ("mean_speed_mps", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m",
+                   "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2"):
+        columns[f"a:{metric}"] = np.full(3, np.nan)
+    columns["a:mean_speed_mps"] = np.zeros(3)
+    columns["a:efficiency"] = np.array([0.1, 0.3, 0.2])
+    best = best_designs(columns, ["L"], ["a"])
+    assert [(b["metric"], b["L"]) for b in best] == [("efficiency", 0.2)]

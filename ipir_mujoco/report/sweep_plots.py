@@ -68,8 +68,8 @@ def best_designs(columns: dict[str, np.ndarray], axes: list[str], engines: list[
             if metric in NOT_RANKED:
                 continue
             values = np.where(ok, columns[f"{engine}:{metric}"], np.nan)
-            if np.all(np.isnan(values)):
-                continue
+            if np.all(np.isnan(values)) or np.nanmin(values) == np.nanmax(values):
+                continue  # nothing to rank (e.g. mean speed 0 in every design of runs too short for a revolution)
             i = int(np.nanargmax(values) if metric in LARGER_IS_BETTER else np.nanargmin(values))
             best.append({"engine": engine, "metric": metric, "value": float(values[i]),
                          "design_id": int(columns["design_id"][i]), **{a: float(columns[a][i]) for a in axes}})
