@@ -152,3 +152,43 @@ def test_dt_out_defaults_to_whole_timesteps_of_a_given_timestep(capsys):
     record = json.loads(out)
     assert code == 0 and record["settings"]["timestep"] == 3e-5
     assert record["settings"]["dt_out"] == pytest.approx(9e-5, rel=1e-12)
+
+
+
+def test_a_reader_that_leaves_early_ends_the_command_quietly(monkeypatch, capsys):
+    """``ipir-mujoco compare A B | head``: stdout's reader closes the pipe and the next write raises
+    BrokenPipeError. Unix tools end quietly then (status 141, as a shell reports SIGPIPE); it printed
+    'ipir-mujoco compare: cannot read or write: Broken pipe' on stderr."""
+    from ipir_mujoco.cli import params as params_command
+
+    def closed_pipe(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    original = params_command.add_parser
+
+    def add_parser(commands):
+        original(commands)
+        commands.choices["params"].set_defaults(handler=closed_pipe)
+
+    monkeypatch.setattr(params_command, "add_parser", add_parser)
+    assert main(["params"]) == 141
+    assert capsys.readouterr().err == ""
+
+
+def test_the_text_summary_prints_no_negative_zero_and_no_round_off_terms():
+    """A held module's round-off below zero printed 'peak speed -0.000 m/s'; MuJoCo's compliant clutch with
+    no damping printed 'clutch dampers -5.99456e-16' in the energy balance."""
+    from ipir_mujoco.analytic import RobotParams
+    from ipir_mujoco.analytic.results import COLUMNS, RunResult
+    from ipir_mujoco.cli.simulate import format_summary
+
+    t = np.linspace(0.0, 1.0, 11)
+    series = {c: np.zeros_like(t) for c in COLUMNS}
+    series["t"] = t
+    series["v2"] = np.full_like(t, -3e-12)  # held, within round-off
+    series["x2"] = np.full_like(t, -1e-13)
+    energy = {"motor_work_j": 3.0, "kinetic_j": 1.0, "friction_j": 2.0, "residual_j": 0.0, "clutch_damper_j": -6e-16,
+              "clutch_spring_j": 0.25}
+    text = format_summary(RunResult("mujoco", "exact", "unilateral", RobotParams(), 1.0, series, energy))
+    assert "-0.0" not in text and "module 2 (front) moved   0.0000 m   peak speed 0.000 m/s" in text
+    assert "clutch dampers" not in text and "clutch springs 0.25" in text

@@ -186,6 +186,20 @@ def test_analytic_and_mujoco_agree_on_a_slope_as_in_a_horizontal_pipe(side_by_si
     assert mj.accuracy["ok"]
 
 
+def test_the_study_gives_no_peak_reaction_for_mujocos_rigid_clutches(side_by_side):
+    """A rigid MuJoCo clutch engages through a soft constraint that overshoots by an amount set by the step, and
+    read every DT_OUT its peak is whichever step a sample hits: the same run read at every step gives another
+    peak. The study leaves MuJoCo's out (the equations give the rigid clutch's) and keeps its mean reaction."""
+    an, mj = side_by_side["90 deg, M_stall 0.57 N m"]
+    every_step = simulate_mujoco(CASES["90 deg, M_stall 0.57 N m"], "unilateral", "ratchet", 10.0,
+                                 dt_out=mj.settings["timestep"], until_steady=True)
+    assert mj.settings["timestep"] < DT_OUT
+    assert abs(every_step.summary["peak_clutch_force_n"] / mj.summary["peak_clutch_force_n"] - 1) > 0.1
+    kept = climbing.run_metrics(mj)
+    assert kept["peak_clutch_force_n"] is None and kept["mean_clutch_force_n"] > 0
+    assert climbing.run_metrics(an)["peak_clutch_force_n"] == an.summary["peak_clutch_force_n"]
+
+
 def test_efficiency_counts_the_lift_as_useful(side_by_side):
     """Rigid clutches lose nothing: over the steady window (resistance work + potential energy) / motor work is 1
     less the kinetic energy the window gains (its ends settled to 1e-4 in speed, not equal), to the energy audit's

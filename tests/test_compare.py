@@ -111,3 +111,46 @@ def test_format_comparison_names_units_tolerance_and_aligns_columns():
             block.append(lines[j])
             j += 1
         assert len(block) > 2 and {len(line) for line in block[1:]} == {len(lines[i])}, block
+
+
+def test_runs_of_different_length_are_compared_at_the_shorter_ones_end(capsys):
+    """Two runs to steady state stop at their own times; their revolutions and travels, each at its own end,
+    differed by the extra time (the paper's model, 1.75 s, against one-way clutches, 2.22 s: +28.6 % in
+    revolutions), not by the models. The same robot run for 1 s and for 0.6 s compares as identical."""
+    long = synthetic()
+    short = synthetic()
+    keep = long.series["t"] <= 0.6
+    short.series = {k: v[keep] for k, v in long.series.items()}
+    for a, b in ((long, short), (short, long)):
+        result = compare_runs(a, b)
+        assert result["t_compared_s"] == pytest.approx(0.6) and {result["t_end_a_s"], result["t_end_b_s"]} == {0.6, 1.0}
+        for key in ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max"):
+            assert result["summary"][key]["relative"] == pytest.approx(0.0, abs=1e-12), key
+        # and the figures are those of the shorter run (its summary, at its end)
+        assert result["summary"]["revolutions"]["a"] == pytest.approx(short.summary["revolutions"], rel=1e-12)
+    from ipir_mujoco.studies.compare import format_comparison
+
+    assert "compared at 0.6 s, the shorter run's end" in format_comparison(compare_runs(long, short))
+
+
+def test_a_quantity_held_at_zero_is_judged_against_the_mechanisms_scale():
+    """Module 2 held still in run a (a vertical pipe where the robot stalls): its largest |a| is 0, and b's
+    round-off (58 nm in MuJoCo's ratchet) was reported as first exceeding 1 % at t = 0.00025 s. The scale is at
+    least the stroke 2r for a position and r x the largest crank speed for a speed."""
+    from ipir_mujoco.studies.compare import format_comparison
+
+    a, b = synthetic(), synthetic()
+    for run in (a, b):
+        run.series["x2"] = np.zeros_like(run.series["t"])
+        run.series["v2"] = np.full_like(run.series["t"], -0.0)
+    b.series["x2"] = b.series["x2"] + 6e-8
+    b.series["v2"] = b.series["v2"] + 2e-4
+    result = compare_runs(a, b)
+    r = a.params.r
+    assert result["time_grid"]["x2"]["scale"] == pytest.approx(2 * r)
+    assert result["time_grid"]["v2"]["scale"] == pytest.approx(r * OMEGA)
+    assert result["first_exceedance"]["x2"] is None and result["first_exceedance"]["v2"] is None
+    # a real difference still shows: 2 mm is 2 % of the stroke
+    b.series["x2"] = b.series["x2"] + 2e-3
+    assert compare_runs(a, b)["first_exceedance"]["x2"] == 0.0
+    assert " -0 " not in format_comparison(result)

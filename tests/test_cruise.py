@@ -225,13 +225,34 @@ def test_every_rung_reaches_its_steady_state_and_the_study_records_the_runs(stud
         assert r["crank_speed_rad_s"] == pytest.approx(2 * math.pi * r["steady_speed_m_s"] / r["distance_per_rev_m"])
         low, high = r["crank_speed_range_rad_s"]
         assert low < r["crank_speed_rad_s"] < high
-    # the same runs as the engines give (same inputs, deterministic engines)
-    for name, run in (("with rod mass", runs["paper's rule"][0]), ("MuJoCo, paper's rule", runs["paper's rule"][1]),
-                      ("one-way clutches", runs["one-way"][0]), ("MuJoCo ratchet", runs["one-way"][1])):
+    # the same runs as the engines give (same inputs, deterministic engines); MuJoCo's read at every step
+    # of the step it chooses for the study's output interval
+    stepwise = {pair: simulate_mujoco(MOTOR, rule, implementation, 10.0, until_steady=True,
+                                      dt_out=runs[pair][1].settings["timestep"])
+                for pair, rule, implementation in (("paper's rule", "kinematic", "lock"),
+                                                   ("one-way", "unilateral", "ratchet"))}
+    for name, run in (("with rod mass", runs["paper's rule"][0]), ("MuJoCo, paper's rule", stepwise["paper's rule"]),
+                      ("one-way clutches", runs["one-way"][0]), ("MuJoCo ratchet", stepwise["one-way"])):
         for key in cruise.STEADY_FIGURES:
             assert records[name][key] == pytest.approx(run.summary[key], rel=1e-12), (name, key)
     for check in study["cross_checks"]:
         assert check["within"] and check["worst_checked"] <= TOL and "halved_step" not in check  # quick
+
+
+@pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
+def test_the_study_reads_mujocos_peak_clutch_reaction_at_every_step(study, runs, pair):
+    """A rigid MuJoCo clutch engages within a few steps; read every 1 ms its peak reaction is whichever step a
+    sample hits (at the default cruise 11.96 N for the ratchet and 95.0 N for the lock, both below the
+    equations' 12.13 N and 97.5 N, where at every step they overshoot them: 17.3 N and 140 N). The study's
+    MuJoCo runs are sampled at every step, so their peak is the largest over all steps: at least the sampled
+    one of the same trajectory (same step, so the same steps)."""
+    name = {"paper's rule": "MuJoCo, paper's rule", "one-way": "MuJoCo ratchet"}[pair]
+    record = {r["name"]: r for r in study["rungs"]}[name]
+    sampled = runs[pair][1]
+    assert record["timestep"] == sampled.settings["timestep"]
+    assert record["peak_clutch_force_n"] > sampled.summary["peak_clutch_force_n"]
+    # and MuJoCo's soft engagement overshoots the rigid equations' reaction (the step's effect, not hidden)
+    assert record["peak_clutch_force_n"] > runs[pair][0].summary["peak_clutch_force_n"]
 
 
 def test_the_report_section_says_what_the_paper_gets_wrong_at_cruise(study, tmp_path):

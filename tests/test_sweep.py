@@ -375,3 +375,84 @@ def test_the_batch_runs_a_motor_design_as_the_motor(tmp_path):
         # results.csv keeps 10 significant digits
         assert float(row["mujoco-ratchet:revolutions"]) == pytest.approx(serial["revolutions"], rel=1e-9)
         assert float(row["mujoco-ratchet:efficiency"]) == pytest.approx(serial["efficiency"], rel=1e-6)
+
+
+def test_mujoco_peak_forces_that_measure_the_numerics_are_left_empty():
+    """A rigid MuJoCo clutch takes up its load within a few steps: the peak reaction read from the sweep's
+    1 ms samples is whichever step a sample hits, and differs from the peak over every step of the same run
+    (the same trajectory: only the output interval changes). The sweep leaves it empty, and the lock's rod
+    force with it; a compliant clutch read at every step keeps its (physical) peak."""
+    from ipir_mujoco.engine import simulate_mujoco
+
+    params = RobotParams()
+    sampled = simulate_mujoco(params, "unilateral", "ratchet", 0.5, dt_out=1e-3)
+    every_step = simulate_mujoco(params, "unilateral", "ratchet", 0.5, dt_out=sampled.settings["timestep"])
+    assert sampled.settings["timestep"] < 1e-3
+    # the artefact: the same run's peak differs by far more than its accuracy monitor's 1e-3 with the sampling
+    assert abs(every_step.summary["peak_clutch_force_n"] / sampled.summary["peak_clutch_force_n"] - 1) > 1e-2
+    for run in (sampled, every_step):
+        metrics = run_metrics(run)
+        assert np.isnan(metrics["peak_clutch_force_n"])
+        assert np.isfinite(metrics["peak_rod_force_n"])  # the ratchet's rod force does not depend on the step
+    lock = run_metrics(simulate_mujoco(params, "kinematic", "lock", 0.3, dt_out=1e-3))
+    assert np.isnan(lock["peak_clutch_force_n"]) and np.isnan(lock["peak_rod_force_n"])
+    # the analytic engines keep theirs; MuJoCo with a compliant clutch read at every step keeps its peak
+    assert run_metrics(steady_run())["peak_clutch_force_n"] == 3.0
+    compliant = steady_run("mujoco")
+    compliant.settings = {"clutch_model": "compliant", "mujoco_clutch": "ratchet", "timestep": 1e-5, "dt_out": 1e-5}
+    assert run_metrics(compliant)["peak_clutch_force_n"] == 3.0
+    compliant.settings = {**compliant.settings, "dt_out": 1e-3}
+    assert np.isnan(run_metrics(compliant)["peak_clutch_force_n"])
+
+
+def test_the_heatmap_colours_the_first_engine_that_gives_the_metric():
+    """--plot-metric peak_clutch_force_n with the default engines: the batched MuJoCo ratchet gives no peak
+    forces, and colouring its empty column drew a blank map with a meaningless colour bar."""
+    from ipir_mujoco.report.sweep_plots import coloured_engine
+
+    nan = np.full(4, np.nan)
+    columns = {"mujoco-ratchet:peak_clutch_force_n": nan, "analytic-unilateral:peak_clutch_force_n": np.arange(4.0),
+               "mujoco-ratchet:revolutions": np.ones(4), "analytic-unilateral:revolutions": np.ones(4)}
+    engines = ["mujoco-ratchet", "analytic-unilateral"]
+    engine, heading = coloured_engine(columns, engines, "peak_clutch_force_n")
+    assert engine == "analytic-unilateral" and "mujoco-ratchet gives no peak_clutch_force_n" in heading
+    assert coloured_engine(columns, engines, "revolutions") == ("mujoco-ratchet", "revolutions of mujoco-ratchet")
+    columns["analytic-unilateral:peak_clutch_force_n"] = nan
+    assert coloured_engine(columns, engines, "peak_clutch_force_n")[0] is None
+
+
+def test_the_line_plot_does_not_draw_a_stalled_design_as_a_point_of_the_curve():
+    """A stalled design's figures are those of a robot at rest (the sizing sweep at M_stall 0.02 N m: speed 0,
+    0.06 m 'per revolution' of a partial turn, efficiency 1): a cross, not a point joined to the curve."""
+    from types import SimpleNamespace
+
+    from ipir_mujoco.report.sweep_plots import lines_figure
+
+    x = np.array([0.02, 0.04, 0.06, 0.08])
+    columns = {"M_stall": x, "a:stalled": np.array([1.0, 0.0, 0.0, 0.0])}
+    for metric in ("mean_speed_mps", "distance_per_rev_m"):
+        columns[f"a:{metric}"] = np.array([0.06, 0.11, 0.12, 0.125])
+    for metric in ("steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n",
+                   "peak_rod_force_n", "accel_jump_mps2"):
+        columns[f"a:{metric}"] = np.full(4, np.nan)
+    fig = lines_figure(columns, SimpleNamespace(name="M_stall", log=False), ["a"])
+    lines = {line.get_gid(): line for ax in fig.axes for line in ax.get_lines() if line.get_gid()}
+    curve = lines["a:distance_per_rev_m"].get_ydata()
+    assert np.isnan(curve[0]) and list(curve[1:]) == [0.11, 0.12, 0.125]
+    assert list(lines["stalled:a:distance_per_rev_m"].get_xdata()) == [0.02]
+
+
+def test_a_metric_equal_in_every_design_names_no_best_design():
+    """Runs too short for a whole crank revolution have mean speed 0 in every design: the sweep printed
+    'best mean_speed_mps ... 0 at L=0.1, m2=0.5', the first design, as if it had been found best."""
+    from ipir_mujoco.report.sweep_plots import best_designs
+
+    columns = {"design_id": np.arange(3.0), "L": np.array([0.1, 0.2, 0.3]), "a:revolutions": np.ones(3),
+               "a:stalled": np.zeros(3)}
+    for metric in ("mean_speed_mps", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m",
+                   "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2"):
+        columns[f"a:{metric}"] = np.full(3, np.nan)
+    columns["a:mean_speed_mps"] = np.zeros(3)
+    columns["a:efficiency"] = np.array([0.1, 0.3, 0.2])
+    best = best_designs(columns, ["L"], ["a"])
+    assert [(b["metric"], b["L"]) for b in best] == [("efficiency", 0.2)]

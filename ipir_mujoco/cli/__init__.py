@@ -74,12 +74,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
         if args.debug or isinstance(exc, SystemExit):
             raise
+        if isinstance(exc, BrokenPipeError):
+            return _reader_gone()
         code, message = _describe_failure(exc)
         print(f"{prefix}: {message}", file=sys.stderr)
         return code
 
 
 QUIET_COMMANDS = ("params", "compare")  # they run no analytic engine
+EXIT_PIPE_CLOSED = 141  # 128 + SIGPIPE, as shells report a writer whose reader left
+
+
+def _reader_gone() -> int:
+    """stdout's reader left (``ipir-mujoco ... | head``): end quietly, as Unix tools do, with no message, and
+    point stdout at /dev/null so that the interpreter's last flush does not complain either."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # stdout is not a file (tests capture it)
+        pass
+    return EXIT_PIPE_CLOSED
 
 
 def _note_first_compilation(prefix: str) -> None:

@@ -133,8 +133,8 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
         f"({run.wall_time_s:.2f} s wall)",
         f"  crank revolutions        {s['revolutions']:.4f}",
-        f"  module 1 (rear) moved    {s['x1_final']:.4f} m   peak speed {s['v1_max']:.3f} m/s",
-        f"  module 2 (front) moved   {s['x2_final']:.4f} m   peak speed {s['v2_max']:.3f} m/s",
+        f"  module 1 (rear) moved    {_fixed(s['x1_final'], 4)} m   peak speed {_fixed(s['v1_max'], 3)} m/s",
+        f"  module 2 (front) moved   {_fixed(s['x2_final'], 4)} m   peak speed {_fixed(s['v2_max'], 3)} m/s",
         "  first minimum of S       " + ("none" if first is None else f"{first:.4f} s"),
         f"  mode switches            {s['mode_switches']}",
         "  min clutch reaction      " + ("none (no clutch held)" if reaction is None else f"{reaction:.4g} N"
@@ -159,12 +159,20 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
     return "\n".join(lines)
 
 
+def _fixed(value: float, decimals: int) -> str:
+    """``value`` to ``decimals`` places, without the '-0.000' of a round-off below zero (a held module)."""
+    text = f"{value:.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
+
+
 def _energy_line(e: dict) -> str:
-    """motor = kinetic + friction (+ potential, clutch springs and dampers where the run has them) + residual."""
+    """motor = kinetic + friction (+ potential, clutch springs and dampers where the run has them) + residual;
+    a term within round-off of zero (1e-12 of the motor's work: a clutch damper of zero damping) is left out."""
     terms = [f"kinetic {e['kinetic_j']:.6g}", f"friction {e['friction_j']:.6g}"]
+    negligible = 1e-12 * abs(e["motor_work_j"])
     for key, word in (("potential_j", "potential"), ("clutch_spring_j", "clutch springs"),
                       ("clutch_damper_j", "clutch dampers")):
-        if key in e and e[key] != 0.0:
+        if key in e and abs(e[key]) > negligible:
             terms.append(f"{word} {e[key]:.6g}")
     return f"motor {e['motor_work_j']:.6g} = " + " + ".join(terms) + f" + residual {e['residual_j']:.2e}"
 

@@ -5,8 +5,8 @@ the mean speed over the last three revolutions of the run), one line per engine 
 solid, the others as open markers over it), the inclines where an engine stalled as crosses at zero
 speed, and the limits of :mod:`ipir_mujoco.studies.climbing` as vertical lines: the restart limit
 (dashed) and each engine's steady-climb limit (dotted). Bottom panel: the peak clutch reaction
-(over the steady window, or the whole run) and the mean total clutch reaction over the steady
-window, with the weight along the pipe, (m1 + m2 + m_rod) g sin(incline), that the clutches hold
+(over the steady window, or the whole run; none for MuJoCo's rigid clutches, whose peak is set by its
+step) and the mean total clutch reaction over the steady window, with the weight along the pipe, (m1 + m2 + m_rod) g sin(incline), that the clutches hold
 on average beside the moving module's resistance. Lines and markers carry gids (``speed:ENGINE``,
 ``stalled:ENGINE``, ``peak:ENGINE``, ``stalled-peak:ENGINE``, ``mean:ENGINE``, ``restart``,
 ``steady-limit:ENGINE``, ``weight``): the data a test can read back.
@@ -62,7 +62,8 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
             speed_ax.plot(x[stalled], np.zeros(stalled.sum()), gid=f"stalled:{engine}", **cross)
             force_ax.plot(x[stalled], peak[stalled], gid=f"stalled-peak:{engine}", **cross)
         speed_handles.append(Line2D([], [], color=colour, label=label, **style))
-        force_handles.append(Line2D([], [], color=colour, label=f"peak, {label}", **style))
+        if np.isfinite(peak).any():  # MuJoCo's rigid clutches give none (module docstring)
+            force_handles.append(Line2D([], [], color=colour, label=f"peak, {label}", **style))
         limit = study["steady_climb"].get(engine, {}).get("incline_deg")
         if limit is not None:
             # dashes offset per engine: lines at one incline show both colours in turn

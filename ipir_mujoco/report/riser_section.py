@@ -194,8 +194,9 @@ def _paper_rule_text(metrics: dict) -> str:
     weight = metrics["weight_n"]
     text += (f"On average over a steady revolution the clutches carry the weight ({weight:.4g} N) and the moving "
              "module's resistance (the mean reactions above); the peaks come where a module is stopped. MuJoCo's "
-             "rigid ratchet engages through a soft constraint and overshoots the rigid model's peak by up to "
-             "twice the load it takes up, by the step (see the real-clutch section).")
+             "peak is not shown (n/a): its rigid ratchet engages through a soft constraint that overshoots the "
+             "rigid model's peak by an amount set by the step, up to twice the load it takes up (see the "
+             "real-clutch section); its mean reaction is the robot's.")
     return text
 
 

@@ -1,7 +1,7 @@
 """Pictures of a sweep: lines for one varied parameter, heatmaps for two, best designs.
 
-The heatmap colours one metric of the first engine over the first two varied
-parameters (the steady speed for a sweep run to steady state, else the mean
+The heatmap colours one metric of the first engine that gives it (a batched
+MuJoCo run gives no peak forces) over the first two varied parameters (the steady speed for a sweep run to steady state, else the mean
 forward speed; ``--plot-metric`` chooses another) and draws over it the
 contours where the second engine diverges from the first by 1 % and 5 % in
 that metric (in revolutions for a metric without a divergence column): where
@@ -68,8 +68,8 @@ def best_designs(columns: dict[str, np.ndarray], axes: list[str], engines: list[
             if metric in NOT_RANKED:
                 continue
             values = np.where(ok, columns[f"{engine}:{metric}"], np.nan)
-            if np.all(np.isnan(values)):
-                continue
+            if np.all(np.isnan(values)) or np.nanmin(values) == np.nanmax(values):
+                continue  # nothing to rank (e.g. mean speed 0 in every design of runs too short for a revolution)
             i = int(np.nanargmax(values) if metric in LARGER_IS_BETTER else np.nanargmin(values))
             best.append({"engine": engine, "metric": metric, "value": float(values[i]),
                          "design_id": int(columns["design_id"][i]), **{a: float(columns[a][i]) for a in axes}})
@@ -110,6 +110,14 @@ def plot_sweep(results: str | Path, study, out: str | Path, metric: str = "mean_
 
 
 def _lines(columns, axis, engines, out: Path) -> Path:
+    path = out / "sweep_lines.png"
+    lines_figure(columns, axis, engines).savefig(path, dpi=110)
+    return path
+
+
+def lines_figure(columns, axis, engines):
+    """One panel per metric any engine gives, against the one varied parameter; lines carry gids
+    ``ENGINE:METRIC`` (stalled designs left out) and ``stalled:ENGINE:METRIC`` (their crosses)."""
     x = columns[axis.name]
     order = np.argsort(x)
     shown = ("mean_speed_mps", "steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "distance_per_rev_m",
@@ -117,26 +125,47 @@ def _lines(columns, axis, engines, out: Path) -> Path:
     shown = [m for m in shown if any(np.isfinite(columns[f"{e}:{m}"]).any() for e in engines)]
     fig, panels = new_figure(len(shown), height=2.0)
     for ax, metric in zip(panels, shown):
-        for engine in engines:
-            ax.plot(x[order], columns[f"{engine}:{metric}"][order], "o-", ms=3, label=engine)
+        for j, engine in enumerate(engines):
+            values = columns[f"{engine}:{metric}"][order]
+            # a stalled design's figures are those of a robot at rest (no speed, a partial revolution): a
+            # cross, not a point of the curve
+            stalled = columns[f"{engine}:stalled"][order] == 1
+            line, = ax.plot(x[order], np.where(stalled, np.nan, values), "o-", ms=3, label=engine,
+                            gid=f"{engine}:{metric}")
+            if stalled.any():
+                ax.plot(x[order][stalled], values[stalled], "x", ms=6, color=line.get_color(),
+                        label=f"{engine}: stalled" if metric == shown[0] else None, gid=f"stalled:{engine}:{metric}")
         ax.set(ylabel=f"{metric}\n[{UNITS[metric]}]")
         ax.grid(alpha=0.3)
         if axis.log:
             ax.set_xscale("log")
     panels[0].legend(fontsize="small")
     panels[-1].set_xlabel(_label(axis.name))
-    path = out / "sweep_lines.png"
-    fig.savefig(path, dpi=110)
-    return path
+    return fig
+
+
+def coloured_engine(columns: dict[str, np.ndarray], engines: list[str], metric: str) -> tuple[str | None, str]:
+    """The engine whose ``metric`` the heatmap colours: the first that gives it for some design (a batched
+    MuJoCo run gives no peak forces, for one), and the title's words for it; (None, words) if none does."""
+    for engine in engines:
+        if np.isfinite(columns[f"{engine}:{metric}"]).any():
+            skipped = engines[:engines.index(engine)]
+            return engine, f"{metric} of {engine}" + (
+                f" ({', '.join(skipped)} gives no {metric})" if skipped else "")
+    return None, f"no engine gives {metric} for these designs"
 
 
 def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
     x, y = columns[ax_x.name], columns[ax_y.name]
-    values = columns[f"{engines[0]}:{metric}"]
+    shown, heading = coloured_engine(columns, engines, metric)
     panels_count = 2 if len(engines) > 1 else 1
     fig, panels = new_figure(panels_count, height=4.2)
     ax = panels[0]
-    _colour_map(fig, ax, x, y, values, f"{engines[0]}: {metric} [{UNITS[metric]}]")
+    if shown is None:
+        ax.text(0.5, 0.5, heading, transform=ax.transAxes, ha="center", va="center")
+        ax.set(xlim=(np.nanmin(x), np.nanmax(x)), ylim=(np.nanmin(y), np.nanmax(y)))
+    else:
+        _colour_map(fig, ax, x, y, columns[f"{shown}:{metric}"], f"{shown}: {metric} [{UNITS[metric]}]")
     if len(engines) > 1:
         compared = metric if metric in DIVERGENCE else "revolutions"
         divergence = np.abs(columns[f"divergence:{engines[1]}:{compared}"]) * 100
@@ -149,18 +178,18 @@ def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
             contours = draw(*(grid if grid is not None else (x, y, divergence)), levels=levels,
                             colors=["white", "red"][:len(levels)], linewidths=1.5)
             ax.clabel(contours, fmt=lambda v: f"{v:g} %", fontsize="small")
-            title = (f"{metric} of {engines[0]}; contours: {engines[1]} differs by "
+            title = (f"{heading}; contours: {engines[1]} differs from {engines[0]} by "
                      f"{' / '.join(f'{v} %' for v in levels)} in {compared}")
         elif finite.size:
-            title = (f"{metric} of {engines[0]}; {engines[1]} differs by {low:.2g} to {high:.2g} % in {compared} "
+            title = (f"{heading}; {engines[1]} differs from {engines[0]} by {low:.2g} to {high:.2g} % in {compared} "
                      "everywhere (no 1 % / 5 % contour inside the map)")
         else:
-            title = f"{metric} of {engines[0]}; no design where both engines give {compared}"
+            title = f"{heading}; no design where both engines give {compared}"
         _colour_map(fig, panels[1], x, y, divergence, f"|{engines[1]} - {engines[0]}| / |{engines[0]}| "
                                                          f"in {compared} [%]")
         panels[1].set_title(f"divergence of {engines[1]} from {engines[0]} in {compared}", fontsize="medium")
     else:
-        title = f"{metric} of {engines[0]}"
+        title = heading
     failed = np.array([bool(e) for e in columns["error"]])
     stalled = np.zeros(len(x), dtype=bool)
     for engine in engines:

@@ -8,10 +8,14 @@ crank angle removes the error a small phase lag inflates at matching time
 :func:`compare_runs` returns a plain dict (JSON-ready)::
 
     time_grid / angle_grid   {quantity: {rms, max, scale}} for phi omega x1 x2 v1 v2 S S_dot: RMS and largest
-                             |a - b| and the scale (largest |a|) they compare to;
+                             |a - b| and the scale (largest |a|) they compare to; on the time grid
+                             at least the mechanism's own (a turn 2 pi for phi, the stroke 2r for
+                             x1 x2 S, r x the largest crank speed for v1 v2 S_dot), so that a module
+                             a holds still is not judged against a scale of 0;
                              angle_grid is null when a crank does not turn monotonically
     summary                  {figure: {a, b, relative}}: (b - a) / |a| for revolutions,
-                             x1_final, x2_final, v1_max, v2_max, first_contraction_end_s and the
+                             x1_final, x2_final, v1_max, v2_max (at, and up to, t_compared_s: the
+                             shorter run's end, e.g. of two runs to steady state), first_contraction_end_s and the
                              periodic steady state's t_steady_s, steady_speed_m_s, distance_per_rev_m,
                              energy_per_metre_j_m, efficiency, peak_clutch_force_n (null where a run
                              has no such figure, e.g. a run that did not reach steady state)
@@ -20,6 +24,7 @@ crank angle removes the error a small phase lag inflates at matching time
     first_exceedance         {quantity: t or null}: first time |a - b| exceeds
                              tolerance * scale on the time grid
     tolerance                the relative tolerance used there
+    t_end_a_s, t_end_b_s     where each run ends; t_compared_s, the shorter of them
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from ipir_mujoco.analytic.results import COLUMNS, RunResult, mode_changes
 
 QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
+AT_COMPARED_TIME = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max")  # depend on how long a run is
 # the periodic steady state (analytic.cycles, through RunResult.summary): over the steady window when a
 # run reached it, else (distance, efficiency, peak force) over the whole run, or null
 STEADY_FIGURES = ("t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m", "efficiency",
@@ -148,6 +154,13 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
     for run in (a, b):
         on_time[id(run)] = {q: np.interp(grid, *_unique_times(run.series["t"], run.series[q])) for q in QUANTITIES}
     time_errors = {q: _errors(on_time[id(a)][q], on_time[id(b)][q]) for q in QUANTITIES}
+    # a quantity a holds at zero (a held module: x2 = 0, v2 = 0) has no scale of its own: every round-off of b
+    # then exceeded 'tolerance x 0' (58 nm of MuJoCo's ratchet in a vertical pipe read as over 1 %)
+    crank_speed = float(np.max(np.abs(a.series["omega"])))
+    floors = {"phi": 2 * np.pi, "x1": 2 * a.params.r, "x2": 2 * a.params.r, "S": 2 * a.params.r,
+              "v1": a.params.r * crank_speed, "v2": a.params.r * crank_speed, "S_dot": a.params.r * crank_speed}
+    for q, floor in floors.items():
+        time_errors[q]["scale"] = max(time_errors[q]["scale"], floor)
 
     angle_errors = None
     if _monotonic(a.series["phi"]) and _monotonic(b.series["phi"]):
@@ -164,6 +177,10 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
 
     summary = {}
     summary_a, summary_b = a.summary, b.summary
+    if a.series["t"][-1] != b.series["t"][-1]:
+        # runs of different length (two runs to steady state stop at their own times): the figures that grow
+        # with the run are compared at the shorter run's end, not each at its own
+        summary_a, summary_b = (dict(run.summary, **_figures_until(run, t_end)) for run in (a, b))
     for key in SUMMARY_FIGURES + STEADY_FIGURES:
         va, vb = summary_a.get(key), summary_b.get(key)
         relative = None if va in (None, 0) or vb is None else (vb - va) / abs(va)
@@ -173,12 +190,23 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
     for q in QUANTITIES:
         scale = time_errors[q]["scale"]
         over = np.flatnonzero(np.abs(on_time[id(b)][q] - on_time[id(a)][q]) > tolerance * scale)
-        first[q] = float(grid[over[0]]) if over.size else None
+        first[q] = float(grid[over[0]]) if over.size and scale > 0 else None
 
     return {"a": f"{a.engine}/{a.geometry}/{a.clutch}", "b": f"{b.engine}/{b.geometry}/{b.clutch}",
-            "t_compared_s": float(t_end), "time_grid": time_errors, "angle_grid": angle_errors,
+            "t_compared_s": float(t_end), "t_end_a_s": float(a.series["t"][-1]), "t_end_b_s": float(b.series["t"][-1]), "time_grid": time_errors, "angle_grid": angle_errors,
             "summary": summary, "switches": match_switches(a, b), "first_exceedance": first,
             "tolerance": tolerance}
+
+
+def _figures_until(run: RunResult, t_end: float) -> dict:
+    """revolutions, travels [m] at ``t_end`` [s] and peak speeds [m/s] up to it (as RunResult.summary has them
+    at the run's end), from the series interpolated at ``t_end``."""
+    s = run.series
+    at = {q: float(np.interp(t_end, *_unique_times(s["t"], s[q]))) for q in ("phi", "x1", "x2", "v1", "v2")}
+    within = s["t"] <= t_end
+    return {"revolutions": (at["phi"] - s["phi"][0]) / (2 * np.pi), "x1_final": at["x1"] - s["x1"][0],
+            "x2_final": at["x2"] - s["x2"][0], "v1_max": max(float(np.max(s["v1"][within])), at["v1"]),
+            "v2_max": max(float(np.max(s["v2"][within])), at["v2"])}
 
 
 def format_comparison(result: dict) -> str:
@@ -190,17 +218,22 @@ def format_comparison(result: dict) -> str:
         return name, ("" if unit == "-" else unit)
 
     lines = [f"b = {result['b']} against a = {result['a']}, over {result['t_compared_s']:.4g} s", ""]
+    ends = result.get("t_end_a_s"), result.get("t_end_b_s")
+    if None not in ends and ends[0] != ends[1]:
+        lines[-1:-1] = [f"a ends at {ends[0]:.6g} s, b at {ends[1]:.6g} s: revolutions, travels and peak speeds "
+                        f"are compared at {result['t_compared_s']:.6g} s, the shorter run's end"]
     rows = [("summary figure", "unit", "a", "b", "(b - a) / |a|")]
     for key, v in result["summary"].items():
         if key in STEADY_FIGURES and v["a"] is None and v["b"] is None:
             continue  # neither run has it (neither reached its steady state): not a row of empty cells
         name, unit = unit_of(SUMMARY, key)
-        rows.append((name, unit, "none" if v["a"] is None else f"{v['a']:.6g}",
-                     "none" if v["b"] is None else f"{v['b']:.6g}",
+        rows.append((name, unit, "none" if v["a"] is None else f"{v['a'] + 0.0:.6g}",  # + 0.0: no '-0'
+                     "none" if v["b"] is None else f"{v['b'] + 0.0:.6g}",
                      "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"))
     lines += _aligned(rows)
     tolerance = result["tolerance"]
-    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a|;",
+    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a| (at least a turn, the "
+              "stroke 2r or r x the largest crank speed);",
               f"first over = first time |b - a| > tolerance x scale (tolerance {tolerance:g} = {100 * tolerance:g} %)"]
     rows = [("quantity", "unit", "at same time", "at same crank angle", "scale", "first over [s]")]
     for q in QUANTITIES:

@@ -35,16 +35,17 @@ compares every rung with the paper's model at that design (the first rung).
                           t_end, mean_crank_speed, pull_fraction, complete}]}: how much of the
                           paper-model run (and of each stroke) has a locked clutch
                           that would have to pull
-    lr_study              {ratios, rows: [{ratio, L, first_order, exact, mujoco,
+    lr_study              {ratios, rows: [{ratio, L, first_order, exact, exact_with_rod, mujoco,
                           divergence, mujoco_vs_exact}], thresholds: {figure: {"1%"|"5%":
                           {between: [lo, hi]} | {below_sweep} | {whole_sweep}}}}: see
                           ipir_mujoco.studies.lr_study; divergence = (first order - exact) / |exact|,
                           S_at_angle / S_dot_at_angle as fractions of 2r / max|S_dot|
     convergence           {mujoco: [rows of ipir_mujoco.studies.convergence], equations: [{rtol,
                           revolutions, x1_final, x2_final, residual_fraction}],
-                          mujoco_default_error, equations_default_error, envelope}: largest
-                          relative change of revolutions/x1/x2 from the default setting
-                          to the finest one tried; envelope: ipir_mujoco.studies.convergence.
+                          mujoco_default_error, mujoco_auto_timestep: {clutch: s},
+                          equations_default_error, envelope}: largest relative change of
+                          revolutions/x1/x2 among the default setting (for MuJoCo, each
+                          clutch's automatic step) and the finer ones tried; envelope: ipir_mujoco.studies.convergence.
                           envelope_study over the envelope's corners (two of them with --quick)
     sections              {key: metrics} of each further study the report runs
                           (see ipir_mujoco.report.sections)
