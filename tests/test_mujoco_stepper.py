@@ -123,7 +123,7 @@ def loops(model, data, controller):
     friction = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
     motor = model.actuator(MOTOR).id
     options = dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                   gear=1.0, slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
+                   slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
     return stepper.make_steps(model, data, controller, np.zeros((2, model.nv)), **options), options
 
 
