@@ -15,8 +15,8 @@ import pytest
 from ipir_mujoco.analytic import RobotParams, SimulationError
 from ipir_mujoco.engine import CrankServo, simulate_mujoco, stepper
 from ipir_mujoco.engine.clutches import Ratchet
-from ipir_mujoco.engine.model import (CRANK_HINGE, MOTOR, SolverSettings, build_model, build_spec, drive_control,
-                                      default_mjcf, set_closed_loop_state)
+from ipir_mujoco.engine.model import (MOTOR, SolverSettings, build_model, build_spec, default_mjcf, drive_control,
+                                      set_closed_loop_state)
 
 
 def built() -> tuple[bool, str]:

@@ -57,20 +57,16 @@ FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
 
 
 def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
-    """The keyword arguments of :func:`make_steps` for a model built by :func:`.model.build_model`, after
-    ``mj_forward`` on its initial state: the crank actuator and joint, the drive's implicit torque slope
-    (:func:`.model.drive_torque_slope`), the dofs with friction and the initial torque [N m].
-
-    The loop counts the work against the resistances from the frictionloss rows of the two slides only: a
-    model with friction on any other dof, or rows that are not those, is a ParameterError.
-    """
-    slide_dofs = {dof_address(model, n) for n in SLIDES}
+    """:func:`make_steps`' keyword arguments for a built model after ``mj_forward`` on its initial state: the
+    crank actuator and joint, the drive's implicit torque slope (:func:`.model.drive_torque_slope`), the
+    dofs with friction and the initial torque [N m]. The loop counts the work against the resistances from
+    the two slides' frictionloss rows only: friction on another dof, or other rows, is a ParameterError."""
+    slides = {dof_address(model, n) for n in SLIDES}
     friction_dofs = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
-    if not set(friction_dofs) <= slide_dofs:
-        names = [model.joint(model.dof_jntid[i]).name for i in friction_dofs if i not in slide_dofs]
-        raise ParameterError(f"frictionloss on {', '.join(map(repr, names))} in the MJCF model: the engine counts "
-                             "resistances on the two slides only; allowed: frictionloss on rear_slide and "
-                             "front_slide (F_r1, F_r2)")
+    if not set(friction_dofs) <= slides:
+        names = ", ".join(repr(model.joint(model.dof_jntid[i]).name) for i in friction_dofs if i not in slides)
+        raise ParameterError(f"frictionloss on {names} in the MJCF model: the engine counts resistances on the "
+                             "two slides only; allowed: frictionloss on rear_slide and front_slide (F_r1, F_r2)")
     # the frictionloss rows follow the equality rows, one per dof with friction, in dof order
     rows = range(data.ne, data.ne + data.nf)
     if data.nf != len(friction_dofs) or any(data.efc_type[r] != FRICTION_ROW or data.efc_id[r] != dof
@@ -79,8 +75,7 @@ def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
                              "frictionloss)")
     motor = model.actuator(MOTOR).id
     return dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                slope=drive_torque_slope(model), friction_dofs=friction_dofs,
-                torque=data.actuator_force.item(motor))
+                slope=drive_torque_slope(model), friction_dofs=friction_dofs, torque=data.actuator_force.item(motor))
 
 
 class PythonSteps:
