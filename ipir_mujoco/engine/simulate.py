@@ -143,13 +143,15 @@ class _Run:
         self.data = mujoco.MjData(self.model)
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
+        self.recorder: Recorder | None = None  # made by _setup
 
     def result(self, extra_settings: dict) -> RunResult:
         with captured_warnings() as messages:
             try:
                 last = self._integrate(messages)
             except mujoco.FatalError as exc:  # MuJoCo's error inside mj_step or mj_forward: one line, no traceback
-                t = float(self.recorder.t[self.recorder.count - 1]) if hasattr(self, "recorder") else 0.0
+                rec = self.recorder  # None or empty if MuJoCo failed before the first sample
+                t = float(rec.t[rec.count - 1]) if rec is not None and rec.count else 0.0
                 reason = " ".join(str(exc).split())
                 raise SimulationError(f"MuJoCo failed after t={t:.6g} s: {reason}") from None
         rec = self.recorder
