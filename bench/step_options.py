@@ -181,7 +181,7 @@ def run_compiled(params, timestep, steps, chunk):
     motor = model.actuator(MOTOR).id
     loop = stepper.CompiledSteps(model, data, ratchet, np.zeros((1, model.nv)), motor=motor,
                                  crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                                 gear=1.0, slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
+                                 slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
     tracker = Tracker(model, data)
     started = time.perf_counter()
     for _ in range(steps // chunk):

@@ -66,7 +66,7 @@ def _open_context(width: int, height: int):
         context.make_current()
     except Exception as exc:  # a library present but unusable: report it in one line, not a traceback
         message = " ".join(str(exc).split()) or type(exc).__name__
-        raise RenderUnavailable(f"MuJoCo_GL={backend}: the OpenGL context cannot be created ({message[:200]})") \
+        raise RenderUnavailable(f"MUJOCO_GL={backend}: the OpenGL context cannot be created ({message[:200]})") \
             from None
     return context
 

@@ -4,7 +4,8 @@ The shipped MJCF alone does not crawl: its one-way clutches are not MJCF
 elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.clutches`),
 which move a joint limit or switch a lock before every step. This command
 builds the model from a parameter set exactly as ``simulate --engine mujoco``
-does and steps it in a passive viewer loop that runs the same controller, in
+does and steps it in a passive viewer loop with the engine's own stepping loop
+(:mod:`ipir_mujoco.engine.stepper`: the same controller, compiled where it can be), in
 real time (or slower with ``--slow``), and starts the run again every
 ``--t-end`` seconds of simulated time (a constant torque accelerates the robot
 without bound). A module's housing turns green while its clutch holds it; the
@@ -23,51 +24,64 @@ import time
 from typing import Sequence
 
 import mujoco
+import numpy as np
 
 from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 
 from .cli.common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 from .engine.clutches import clutch_controller
+from .engine.common import check_clutch_options
 from .engine.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
+from .engine.stepper import loop_options, make_steps
 from .engine.timestep import choose_settings
 from .video import FREE_RGBA, HELD_RGBA, HOUSINGS
 
 
 class ViewedRobot:
-    """The model, its data and the engine's clutch controller, stepped one MuJoCo step at a time."""
+    """The model, its data and the engine's clutch controller, stepped by the engine's stepping loop.
+
+    Refuses (ParameterError, one line) exactly the parameters and clutch choices ``simulate_mujoco``
+    refuses (:func:`ipir_mujoco.engine.common.check_clutch_options`).
+    """
 
     def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,
                  settings: SolverSettings | None = None, t_end: float = 4.0):
         self.params, self.clutch = params, clutch
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
-        if self.implementation == "ratchet" and clutch == "kinematic":
-            raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
-                                 "--mujoco-clutch lock for the paper's rule")
+        check_clutch_options(params, clutch, self.implementation)
         if settings is None:  # the step the engine would choose for a run of t_end [s]
             settings, _ = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
         self.settings = settings
         self.model = build_model(params, settings, ratchet=self.implementation == "ratchet")
         self.data = mujoco.MjData(self.model)
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
+        self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)
         self.reset()
 
     def reset(self) -> None:
         """Back to the start: the loop-consistent initial state, a fresh clutch controller."""
-        set_closed_loop_state(self.model, self.data, self.params)
-        self.controller = clutch_controller(self.model, self.data, self.params, self.implementation, self.clutch)
-        self.data.ctrl[self.model.actuator(MOTOR).id] = drive_control(self.params)
-        mujoco.mj_forward(self.model, self.data)
+        m, d = self.model, self.data
+        set_closed_loop_state(m, d, self.params)
+        self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
+        d.ctrl[m.actuator(MOTOR).id] = drive_control(self.params)
+        mujoco.mj_forward(m, d)
+        self.steps = make_steps(m, d, self.controller, self._qvel_before, **loop_options(m, d))
+        self.held: tuple[bool, bool] | None = None
+        self._colour()
 
-    def step(self) -> None:
-        """One MuJoCo step with the clutch controller around it, as the engine's own loop does."""
-        self.controller.before_step()
-        mujoco.mj_step(self.model, self.data)
-        if self.controller.after_step is not None:
-            self.controller.after_step()
-        held = self.controller.reactions()[:2]
-        for geom, on in zip(self.housings, held):
-            self.model.geom_rgba[geom] = HELD_RGBA if on else FREE_RGBA
+    def step(self, n: int = 1) -> None:
+        """``n`` MuJoCo steps with the clutch controller around each, by the engine's own loop; then the
+        housings take the clutches' colours (rewritten only when a clutch's state changed)."""
+        self.steps.run(n)
+        self._colour()
+
+    def _colour(self) -> None:
+        held = tuple(self.controller.reactions()[:2])
+        if held != self.held:
+            self.held = held
+            for geom, on in zip(self.housings, held):
+                self.model.geom_rgba[geom] = HELD_RGBA if on else FREE_RGBA
 
 
 def build_parser() -> Parser:
@@ -114,9 +128,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         while viewer.is_running():
             started = time.perf_counter()
             with viewer.lock():
-                target = robot.data.time + frame / args.slow
-                while robot.data.time < target:  # as fast as real time allows, slower if the machine cannot
-                    robot.step()
+                # a frame's steps at once: as fast as real time allows, slower if the machine cannot
+                robot.step(max(1, round(frame / args.slow / robot.settings.timestep)))
                 if robot.data.time >= args.t_end:
                     robot.reset()
             viewer.sync()

@@ -176,3 +176,42 @@ def test_progress_every_tenth_of_a_second_and_the_wall_budget():
     assert all(b - a > 0.05 for a, b in zip(seen, seen[1:]))
     with pytest.raises(SimulationError, match=r"wall-time budget of 1e-09 s at t=0.05 s"):
         simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.5, dt_out=1e-3, wall_budget_s=1e-9)
+
+
+def test_progress_never_goes_back_across_a_halved_step(monkeypatch):
+    """The first attempt at 4e-4 s reports progress until the monitor stops it; the repeat at half the
+    step reports again only past that point, so a user's progress is increasing, and still reaches the end."""
+    chosen = engine_simulate.choose_settings
+    monkeypatch.setattr(engine_simulate, "choose_settings",
+                        lambda *args: (SolverSettings(timestep=4e-4), chosen(*args)[1]))
+    attempts, seen = [], []
+    real = engine_simulate._Run
+
+    class Counted(real):  # counts the attempts, to prove the retry happened after progress was reported
+        def __init__(self, *args, **kwargs):
+            attempts.append(len(seen))
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(engine_simulate, "_Run", Counted)
+    run = simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.8, dt_out=4e-4, progress=seen.append)
+    assert run.settings["refinements"] and len(attempts) >= 2 and attempts[1] >= 2  # reported, then repeated
+    assert all(b > a for a, b in zip(seen, seen[1:])), seen
+    assert seen[-1] == pytest.approx(0.8, abs=4e-4)
+
+
+@pytest.mark.parametrize("params, servo, t_end, named", [
+    (RobotParams(rod_mass=1e-10), None, 0.1, r"^rod_mass=1e-10 kg: the module-to-rod mass ratio 1e\+10 "),
+    (RobotParams(), engine_simulate.CrankServo(lambda t: 0.0, lambda t: 0.0, kp=1e12), 0.1,
+     r"^crank servo kp=1e\+12 N m/rad"),
+    (RobotParams(J_A=1e-6, M=10.0), None, 60.0, r"^t_end=60 s: the crank can reach"),
+])
+def test_a_timestep_below_the_floor_names_the_limit_that_set_it(params, servo, t_end, named):
+    """The refusal names what demanded the step (a light rod, a stiff servo, the crank speed), not always
+    the crank speed, and the timestep it would need, in one line."""
+    from ipir_mujoco.engine.timestep import DT_MIN, choose_settings
+
+    with pytest.raises(ParameterError, match=named) as refused:
+        choose_settings(params, t_end, 1e-3, servo)
+    message = str(refused.value)
+    assert "MuJoCo would need a timestep of" in message and f">= {DT_MIN:g} s" in message and "\n" not in message
+    assert ("crank can reach" in message) == named.startswith("^t_end")

@@ -15,8 +15,8 @@ import pytest
 from ipir_mujoco.analytic import RobotParams, SimulationError
 from ipir_mujoco.engine import CrankServo, simulate_mujoco, stepper
 from ipir_mujoco.engine.clutches import Ratchet
-from ipir_mujoco.engine.model import (CRANK_HINGE, MOTOR, SolverSettings, build_model, build_spec, dof_address,
-                                      drive_control, qpos_address, set_closed_loop_state)
+from ipir_mujoco.engine.model import (MOTOR, SolverSettings, build_model, build_spec, default_mjcf, drive_control,
+                                      set_closed_loop_state)
 
 
 def built() -> tuple[bool, str]:
@@ -120,10 +120,7 @@ def test_mujocos_warning_inside_the_compiled_loop_fails_the_run_as_before(monkey
 
 def loops(model, data, controller):
     """(the engine's choice of loop for this model, data and controller, the options it was given)."""
-    friction = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
-    motor = model.actuator(MOTOR).id
-    options = dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                   gear=1.0, slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
+    options = stepper.loop_options(model, data)
     return stepper.make_steps(model, data, controller, np.zeros((2, model.nv)), **options), options
 
 
@@ -135,10 +132,11 @@ def ratcheted(params, model):
     return data, Ratchet(model, data)
 
 
-def starved_model(params) -> mujoco.MjModel:
+def starved_model(params, memory_out: list | None = None) -> mujoco.MjModel:
     """The ratcheted model with an arena too small once the two limit rows join the loop and friction rows:
     it compiles and starts (the forward passes fit) and fails within 200 ratcheted steps. The smallest such
-    size depends on MuJoCo's version, so it is searched for (2.5 kB with mujoco 4.0)."""
+    size depends on MuJoCo's version, so it is searched for (2.5 kB with mujoco 4.0). ``memory_out``
+    receives that size [bytes]."""
     def compiled(memory):
         spec = build_spec(params, SolverSettings(), ratchet=True)
         spec.memory = memory
@@ -155,6 +153,8 @@ def starved_model(params) -> mujoco.MjModel:
                 ratchet.before_step()
                 mujoco.mj_step(model, data)
         except mujoco.FatalError:
+            if memory_out is not None:
+                memory_out.append(memory)
             return compiled(memory)  # afresh: the ratchet has raised this one's bounds
     pytest.skip("no arena size starves only the ratcheted steps with this MuJoCo")
 
@@ -210,3 +210,70 @@ def test_a_built_stepper_is_used_with_this_mujoco():
     except ImportError:
         pytest.skip("the compiled stepper is not built here (installed without a C compiler)")
     assert stepper.compiled_status() == (True, "compiled")
+
+
+def edited_template(old: str, new: str) -> str:
+    """The shipped MJCF's text with its one ``old`` replaced by ``new``."""
+    text = default_mjcf().read_text()
+    assert text.count(old) == 1
+    return text.replace(old, new)
+
+
+def test_a_mujoco_error_ends_the_run_with_one_line(monkeypatch, tmp_path):
+    """MuJoCo's fatal error inside a step (the arena too small for the ratchet's rows) ends simulate_mujoco
+    with a SimulationError naming the last good time and MuJoCo's reason, from either loop: no traceback."""
+    memory = []
+    starved_model(RobotParams(), memory)
+    path = tmp_path / "starved.xml"
+    path.write_text(edited_template('<compiler ', f'<size memory="{memory[0]}"/>\n  <compiler '))
+    messages = []
+    for loop in ("python", ""):
+        monkeypatch.setenv(stepper.ENV, loop)
+        with pytest.raises(SimulationError, match=r"^MuJoCo failed after t=[0-9.e-]+ s: mj_stackAlloc.*memory") as e:
+            simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.1, dt_out=1e-3, settings=SolverSettings(),
+                            mjcf=path)
+        messages.append(str(e.value))
+    assert messages[0] == messages[1] and "\n" not in messages[0]
+
+
+@pytest.mark.parametrize("flag, controller", [("mjDSBL_FRICTIONLOSS", "ratchet"), ("mjDSBL_EQUALITY", "lock")])
+def test_rows_the_loop_reads_are_checked_after_every_step(flag, controller):
+    """A step after which the rows the loop reads are absent (the friction rows, a held lock's equality row;
+    here disabled in the model's options between two calls) is a one-line SimulationError from both loops,
+    never a read of another row or past the end."""
+    from ipir_mujoco.engine.clutches import Locks
+
+    params, messages = RobotParams(), []
+    for path in ("python", "compiled"):
+        if controller == "ratchet":
+            model = build_model(params, SolverSettings(), ratchet=True)
+            data, ctl = ratcheted(params, model)
+        else:
+            model = build_model(params, SolverSettings())
+            data = mujoco.MjData(model)
+            set_closed_loop_state(model, data, params)
+            data.ctrl[model.actuator(MOTOR).id] = drive_control(params)
+            ctl = Locks(model, data, "unilateral", params.r, params.L)
+            mujoco.mj_forward(model, data)
+        steps, options = loops(model, data, ctl)
+        if path == "python":
+            steps = stepper.PythonSteps(model, data, ctl, steps.qvel_before, **options)
+        assert steps.compiled == (path == "compiled" and COMPILED)
+        steps.run(10)
+        model.opt.disableflags |= int(getattr(mujoco.mjtDisableBit, flag))
+        with pytest.raises(SimulationError, match=r"^MuJoCo's step to t=0.0011 s produced no") as failure:
+            steps.run(5)
+        messages.append(str(failure.value))
+    assert messages[0] == messages[1]
+
+
+def test_friction_off_the_slides_is_refused(tmp_path):
+    """The loop counts the work against the resistances on the two slides only: frictionloss on another
+    joint of a given MJCF is refused up front, not silently left out of the energy audit."""
+    from ipir_mujoco.analytic import ParameterError
+
+    path = tmp_path / "crank_friction.xml"
+    path.write_text(edited_template('<joint name="crank_hinge" class="linkage"/>',
+                                    '<joint name="crank_hinge" class="linkage" frictionloss="0.01"/>'))
+    with pytest.raises(ParameterError, match=r"^frictionloss on 'crank_hinge' in the MJCF model: .* allowed: "):
+        simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.01, mjcf=path)

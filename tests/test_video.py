@@ -155,3 +155,59 @@ def test_mechanism_diagram_is_drawn_to_the_parameters(tmp_path):
         rod = [line for line in fig.axes[0].get_lines() if line.get_color() == "tab:blue"][0]
         (bx, cx), (by, cy) = rod.get_xdata(), rod.get_ydata()
         assert math.hypot(cx - bx, cy - by) == pytest.approx(L, rel=1e-12) and cy == 0.0
+
+
+@pytest.mark.parametrize("params, clutch, implementation", [
+    (RobotParams(clutch_stiffness=1e6), "kinematic", "lock"),
+    (RobotParams(clutch_stiffness=1e6), "unilateral", "lock"),
+    (RobotParams(clutch_damping=50.0), "unilateral", "ratchet"),
+    (RobotParams(clutch_backlash=1e-3), "unilateral", "ratchet"),
+    (RobotParams(), "kinematic", "ratchet"),
+    (RobotParams(rod_mass=0.0), "unilateral", "ratchet"),
+])
+def test_the_viewer_refuses_what_the_engine_refuses(params, clutch, implementation):
+    """One check for both: the same ParameterError, word for word, before anything is built."""
+    from ipir_mujoco.analytic import ParameterError
+    from ipir_mujoco.view import ViewedRobot
+
+    with pytest.raises(ParameterError) as engine:
+        simulate_mujoco(params, clutch, implementation, 0.01)
+    with pytest.raises(ParameterError) as viewer:
+        ViewedRobot(params, clutch, implementation)
+    assert str(viewer.value) == str(engine.value) and "\n" not in str(engine.value)
+
+
+def test_the_lock_controller_refuses_a_compliant_clutch():
+    """The locks are rigid: given a finite stiffness the controller itself refuses, whoever calls it."""
+    import mujoco
+
+    from ipir_mujoco.analytic import ParameterError
+    from ipir_mujoco.engine.clutches import clutch_controller
+    from ipir_mujoco.engine.model import build_model
+
+    params = RobotParams(clutch_stiffness=1e6)
+    model = build_model(params)
+    for implementation in ("lock", "none"):
+        with pytest.raises(ParameterError, match=r"clutch_stiffness=1000000.0 N/m with the MuJoCo '(lock|none)'"):
+            clutch_controller(model, mujoco.MjData(model), params, implementation, "unilateral")
+
+
+def test_the_viewer_colours_the_housings_by_the_clutches():
+    """The viewer steps with the engine's loop (bit for bit the run's state) and writes the housings'
+    colours when a clutch's state changes: after each frame they show the clutches' held state."""
+    from ipir_mujoco.video import FREE_RGBA, HELD_RGBA
+    from ipir_mujoco.view import ViewedRobot
+
+    robot = ViewedRobot(RobotParams(), "unilateral")
+    seen = set()
+    for _ in range(160):  # 0.4 s in frames of 2.5 ms: the first contraction and the expansion after it
+        robot.step(round(2.5e-3 / robot.settings.timestep))
+        held = robot.controller.reactions()[:2]
+        for geom, on in zip(robot.housings, held):
+            expected = np.float32(HELD_RGBA if on else FREE_RGBA)  # MuJoCo stores colours in float32
+            np.testing.assert_array_equal(robot.model.geom_rgba[geom], expected)
+        seen.add(tuple(held))
+    assert len(seen) >= 2  # the clutches did change state (contraction and expansion)
+    run = simulate_mujoco(RobotParams(), "unilateral", "ratchet", robot.data.time, dt_out=2.5e-3,
+                          settings=robot.settings)
+    assert robot.data.qpos[robot.model.joint("crank_hinge").qposadr[0]] == run.series["phi"][-1]

@@ -6,7 +6,7 @@
  * (built with -ffp-contract=off, so no fused multiply-add changes a rounding), so the two paths agree bit for
  * bit. It includes no MuJoCo header: Python passes the address of mj_step (from the loaded libmujoco), of
  * every array it touches, and of the two mjData fields that move between steps (the efc_force pointer and
- * the count ne), whose offsets it reads from the running mujoco's own struct description and checks on the
+ * the counts ne and nf), whose offsets it reads from the running mujoco's own struct description and checks on the
  * live MjData before every run.
  *
  * Layout: two arrays owned by Python, one int64 per CONFIG field (addresses, indices, flags) and one double
@@ -24,7 +24,7 @@
 #include <string.h>
 
 #define CONFIG_FIELDS(X)                                                                         \
-  X(model) X(data) X(step) X(user_error) X(efc_force_field) X(ne_field)                          \
+  X(model) X(data) X(step) X(user_error) X(efc_force_field) X(ne_field) X(nf_field)              \
   X(qpos) X(qvel) X(ctrl) X(actuator_force) X(qvel_before)                                       \
   X(jnt_range) X(eq_data) X(eq_data_stride) X(eq_active) X(eq_rows) X(biasprm) X(biasprm_stride) \
   X(nv) X(clutch) X(motor) X(crank_q) X(crank_v) X(nfric) X(fric_a) X(fric_b)                    \
@@ -32,7 +32,7 @@
   X(eq0) X(eq1) X(rod_q) X(rod_v) X(act0) X(act1) X(implicit)
 
 #define STATE_FIELDS(X)                                                                          \
-  X(dt) X(gear) X(slope) X(torque) X(motor_work) X(friction_work) X(omega_prev) X(excursion)     \
+  X(dt) X(slope) X(torque) X(motor_work) X(friction_work) X(omega_prev) X(excursion)     \
   X(bound0) X(bound1) X(margin0) X(margin1)                                                      \
   X(held0) X(held1) X(force0) X(force1) X(r) X(L)                                                \
   X(anchor0) X(anchor1) X(overlap0) X(overlap1) X(v_before0) X(v_before1) X(damped0) X(damped1) \
@@ -47,6 +47,10 @@ enum { STATE_FIELDS(AS_ENUM) N_STATE };
 
 /* the clutch kinds (stepper.CLUTCH_KINDS holds the same order) */
 enum { NO_CLUTCH = 0, RATCHET = 1, LOCK_KINEMATIC = 2, LOCK_UNILATERAL = 3, COMPLIANT = 4 };
+
+/* what steps() returns: done, or which constraint rows it was to read are absent after a step (the
+ * Python loop raises for the same two: clutches.MISSING_ROWS holds the same order) */
+enum { STEPS_DONE = 0, MISSING_LOCK_ROW = 1, MISSING_FRICTION_ROWS = 2 };
 
 typedef void (*step_fn)(const void *m, void *d);
 typedef void (*error_fn)(const char *msg);
@@ -167,11 +171,18 @@ static void before_step(const int64_t *cfg, double *st) {
   }
 }
 
-/* the clutch bookkeeping after a step: Locks (unilateral rule), CompliantClutches.after_step */
-static void after_step(const int64_t *cfg, double *st, const double *efc_force) {
+/* the clutch bookkeeping after a step: Locks (unilateral rule), CompliantClutches.after_step; returns
+ * MISSING_LOCK_ROW (nothing read) if a held lock's row is not among the ne equality rows */
+static int after_step(const int64_t *cfg, double *st, const double *efc_force, int ne) {
   if (cfg[C_clutch] == LOCK_UNILATERAL) {
     for (int i = 0; i < 2; i++) {
-      st[S_force0 + i] = st[S_held0 + i] != 0.0 ? efc_force[equality_row(cfg, cfg[C_eq0 + i])] : 0.0;
+      if (st[S_held0 + i] != 0.0) {
+        int64_t row = equality_row(cfg, cfg[C_eq0 + i]);
+        if (row >= ne) return MISSING_LOCK_ROW;
+        st[S_force0 + i] = efc_force[row];
+      } else {
+        st[S_force0 + i] = 0.0;
+      }
     }
   } else if (cfg[C_clutch] == COMPLIANT) {
     const double *force = PTR(const double *, actuator_force), *qvel = PTR(const double *, qvel);
@@ -187,35 +198,39 @@ static void after_step(const int64_t *cfg, double *st, const double *efc_force) 
     }
     st[S_damper_work] += work * st[S_dt];
   }
+  return STEPS_DONE;
 }
 
-/* nstep steps; before the last one the velocities are copied into ``dest`` (if not NULL) */
-static void steps(const int64_t *cfg, double *st, long long nstep, double *dest) {
+/* nstep steps; before the last one the velocities are copied into ``dest`` (if not NULL). Returns
+ * STEPS_DONE, or the MISSING_* code of the rows a step did not produce (the state is then not written back) */
+static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) {
   const void *m = PTR(const void *, model);
   void *d = PTR(void *, data);
   step_fn step = PTR(step_fn, step);
   double *const *efc_field = PTR(double *const *, efc_force_field);
-  const int *ne_field = PTR(const int *, ne_field);
+  const int *ne_field = PTR(const int *, ne_field), *nf_field = PTR(const int *, nf_field);
   const double *qvel = PTR(const double *, qvel), *force = PTR(const double *, actuator_force);
   const int64_t motor = cfg[C_motor], crank_v = cfg[C_crank_v], nfric = cfg[C_nfric];
   const int64_t fa = cfg[C_fric_a], fb = cfg[C_fric_b];
-  const double dt = st[S_dt], gear = st[S_gear], slope = st[S_slope];
+  const double dt = st[S_dt], slope = st[S_slope];
   double torque = st[S_torque], wm = st[S_motor_work], wf = st[S_friction_work], omega_prev = st[S_omega_prev];
   for (long long n = 0; n < nstep; n++) {
     before_step(cfg, st);
     if (n == nstep - 1 && dest != NULL) memcpy(dest, qvel, (size_t)cfg[C_nv] * sizeof(double));
     step(m, d);
     const double *efc_force = *efc_field;
-    after_step(cfg, st, efc_force);
+    const int ne = *ne_field;
+    if (after_step(cfg, st, efc_force, ne) != STEPS_DONE) return MISSING_LOCK_ROW;
     double omega = qvel[crank_v];
-    torque = gear * force[motor] + slope * (omega - omega_prev);
+    torque = force[motor] + slope * (omega - omega_prev);
     wm += torque * omega * dt;
+    /* the frictionloss rows follow the ne equality rows, one per dof with friction: read only if there */
+    if (nfric > 0 && *nf_field != nfric) return MISSING_FRICTION_ROWS;
     if (nfric == 2) {
-      int ne = *ne_field;
       double f0 = efc_force[ne], f1 = efc_force[ne + 1];
       wf -= (f0 * qvel[fa] + f1 * qvel[fb]) * dt;
     } else if (nfric == 1) {
-      wf -= efc_force[*ne_field] * qvel[fa] * dt;
+      wf -= efc_force[ne] * qvel[fa] * dt;
     }
     omega_prev = omega;
   }
@@ -223,11 +238,13 @@ static void steps(const int64_t *cfg, double *st, long long nstep, double *dest)
   st[S_motor_work] = wm;
   st[S_friction_work] = wf;
   st[S_omega_prev] = omega_prev;
+  return STEPS_DONE;
 }
 
-/* run(config address, state address, nstep, qvel_before row or -1): see steps(). Returns None, or raises
+/* run(config address, state address, nstep, qvel_before row or -1): see steps(). Returns None; raises
  * RuntimeError with MuJoCo's message if MuJoCo reported an error (the run's data is then as the bindings
- * leave it after such an error: not to be stepped on). */
+ * leave it after such an error: not to be stepped on), or LookupError with the MISSING_* code as its
+ * argument if a step did not produce the rows the loop reads. */
 static PyObject *run(PyObject *self, PyObject *args) {
   (void)self;
   unsigned long long cfg_adr, st_adr;
@@ -238,6 +255,7 @@ static PyObject *run(PyObject *self, PyObject *args) {
   error_fn *user_error = PTR(error_fn *, user_error);
   double *dest = row >= 0 ? PTR(double *, qvel_before) + row * cfg[C_nv] : NULL;
   int failed = 0;
+  volatile int status = STEPS_DONE; /* set between setjmp and a possible longjmp */
   jmp_buf jump;
   if (user_error != NULL && loops_running++ == 0) {
     previous_error = *user_error;
@@ -246,7 +264,7 @@ static PyObject *run(PyObject *self, PyObject *args) {
   Py_BEGIN_ALLOW_THREADS
   error_jump = &jump;
   if (setjmp(jump) == 0) {
-    steps(cfg, st, nstep, dest);
+    status = steps(cfg, st, nstep, dest);
   } else {
     failed = 1;
   }
@@ -255,6 +273,14 @@ static PyObject *run(PyObject *self, PyObject *args) {
   if (user_error != NULL && --loops_running == 0) *user_error = previous_error;
   if (failed) {
     PyErr_SetString(PyExc_RuntimeError, error_text);
+    return NULL;
+  }
+  if (status != STEPS_DONE) {
+    PyObject *code = PyLong_FromLong(status);
+    if (code != NULL) {
+      PyErr_SetObject(PyExc_LookupError, code);
+      Py_DECREF(code);
+    }
     return NULL;
   }
   Py_RETURN_NONE;

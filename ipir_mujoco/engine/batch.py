@@ -40,11 +40,11 @@ from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
 from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 
-from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_END, SolverSettings, build_model,
-                    dof_address, drive_control, qpos_address, set_closed_loop_state)
-from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode
+from .model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
+                    drive_torque_slope, pin_offset, qpos_address, set_closed_loop_state)
+from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
 from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_run_options, climb_energy, rest_since,
-                     stall_reason)
+                     stall_reason, steps_per_output)
 from .timestep import DT_MIN, choose_settings
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
@@ -111,9 +111,7 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
         models, index = [], []
         for i, own in chosen.items():
             try:
-                if abs(round(dt_out / own.timestep) * own.timestep - dt_out) > 1e-9 * dt_out:
-                    raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the "
-                                         f"timestep ({own.timestep} s)")
+                steps_per_output(dt_out, own.timestep)
                 models.append(build_model(designs[i], own, ratchet=True))
                 index.append(i)
             except ValueError as exc:
@@ -123,11 +121,10 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
         batch = _Batch(models, [designs[i] for i in index], [chosen[i] for i in index], t_end, dt_out, nthread,
                        accuracy, until_steady, steady_tol, steady_cycles)
         retry = {}
-        for i, outcome in zip(index, batch.run()):
+        for i, outcome, failed in zip(index, batch.run(), batch.inaccurate):
             outcome.setdefault("settings", {})["refinements"] = halvings[i]
             results[i] = outcome
             # as a serial run: an automatic step the monitor stops is halved (at most twice)
-            failed = outcome.get("error", "").startswith("MuJoCo accuracy check failed")
             if failed and settings is None and attempt < REFINEMENTS and chosen[i].timestep / 2 >= DT_MIN:
                 halvings[i].append({"timestep": chosen[i].timestep, "reason": outcome["error"]})
                 retry[i] = replace(chosen[i], timestep=chosen[i].timestep / 2)
@@ -146,7 +143,7 @@ class _Batch:
         self.n = len(models)
         self.nthread = nthread
         self.dt = np.array([s.timestep for s in settings])
-        self.k = np.rint(dt_out / self.dt).astype(int)  # substeps per output interval
+        self.k = np.array([steps_per_output(dt_out, dt) for dt in self.dt])  # substeps per output interval
         self.n_steps = np.floor(t_end / self.dt * (1 + 1e-12)).astype(int)  # never past t_end
         self.n_samples = int(np.max(np.ceil(self.n_steps / self.k)))
 
@@ -159,8 +156,10 @@ class _Batch:
     def _start(self) -> None:
         base, n = self.models[0], self.n
         batch = self.batch = mjbatch.Batch(base, nsim=n, nthread=self.nthread)
-        for name in _differing_fields(self.models) + ["jnt_range"]:
-            per_sim = batch.expand(name)
+        fields = _differing_fields(self.models)
+        # the ratchet's bounds are per simulation: expanded whether or not the designs' ranges differ
+        for name in fields + (["jnt_range"] if "jnt_range" not in fields else []):
+            per_sim = batch.expand(name)  # the same live array on every call
             for k, model in enumerate(self.models):
                 per_sim[k] = getattr(model.opt, name[4:]) if name.startswith("opt.") else getattr(model, name)
         self.qpos, self.qvel, ctrl, self.clock = (batch.bind(f) for f in ("qpos", "qvel", "ctrl", "time"))
@@ -169,45 +168,39 @@ class _Batch:
         self.site_xpos, self.xpos = batch.bind("site_xpos"), batch.bind("xpos")
         motor = base.actuator(MOTOR).id
         self.motor = motor
-        kinetic0 = np.zeros(n)
         for k, (model, params) in enumerate(zip(self.models, self.designs)):
             data = mujoco.MjData(model)
             set_closed_loop_state(model, data, params)
             self.qpos[k], self.qvel[k] = data.qpos, data.qvel
             ctrl[k, motor] = drive_control(params)
         batch.forward()
-        self.slides_q = np.array([qpos_address(base, s) for s in (REAR_SLIDE, FRONT_SLIDE)])
-        self.slides_v = np.array([dof_address(base, s) for s in (REAR_SLIDE, FRONT_SLIDE)])
-        self.slide_joints = np.array([base.joint(s).id for s in (REAR_SLIDE, FRONT_SLIDE)])
+        self.slides_q = np.array([qpos_address(base, s) for s in SLIDES])
+        self.slides_v = np.array([dof_address(base, s) for s in SLIDES])
+        self.slide_joints = np.array([base.joint(s).id for s in SLIDES])
         self.crank_q, self.crank_v = qpos_address(base, CRANK_HINGE), dof_address(base, CRANK_HINGE)
         self.margins = np.array([m.jnt_margin[self.slide_joints] for m in self.models])
         self.friction = np.array([m.dof_frictionloss[self.slides_v] for m in self.models])
-        self.slope = np.array([m.actuator_gear[motor, 0] ** 2 * m.actuator_biasprm[motor, 2] for m in self.models])
-        self.gear = np.array([m.actuator_gear[motor, 0] for m in self.models])
+        self.slope = np.array([drive_torque_slope(m) for m in self.models])  # as the serial engine, per integrator
         self.jnt_range = batch.expand("jnt_range")
         self.bounds = self.qpos[:, self.slides_q].copy()
         self.jnt_range[:, self.slide_joints, 0] = self.bounds - self.margins
         self.x_start = self.qpos[:, self.slides_q].copy()
-        self.site, self.front = base.site(ROD_END).id, base.body("front_module").id
-        loop = base.equality(LOOP).id
-        data = mujoco.MjData(base)
-        mujoco.mj_kinematics(base, data)
-        self.pin_offset = data.xmat[self.front].reshape(3, 3) @ base.eq_data[loop, 3:6]
+        self.site, self.front, self.pin_offset = pin_offset(base)
 
         self.record = {c: np.full((self.n_samples + 1, n), np.nan) for c in COLUMNS}
         self.last_row = np.zeros(n, dtype=int)
         self.failed: list[str | None] = [None] * n
+        self.inaccurate = [False] * n  # stopped by the accuracy monitor (a halved timestep may pass)
         self.stall: list[str | None] = [None] * n
         self.running = np.ones(n, dtype=bool)
         self.wm, self.wf = np.zeros(n), np.zeros(n)
         self.excursion = np.zeros(n)
         self.monitors = [AccuracyMonitor(Tolerances.for_params(p), self.accuracy, s.timestep)
                          for p, s in zip(self.designs, self.settings)]
-        torque = self.gear * self.force[:, motor]
-        kinetic0[:] = self.energy[:, 1]
-        self.energy0 = self.energy.copy()
+        torque = self.force[:, motor]
+        self.energy0 = self.energy.copy()  # (potential, kinetic) [J] at t = 0
         climb = [climb_energy(m, p) for m, p in zip(self.models, self.designs)]
-        self.floor = np.maximum.reduce([kinetic0, 2 * math.pi * np.abs(torque), climb])
+        self.floor = np.maximum.reduce([self.energy0[:, 1], 2 * math.pi * np.abs(torque), climb])
         self.watches = [SteadyWatch(float(self.qpos[k, self.crank_q]), self.steady_tol, self.steady_cycles)
                         for k in range(n)] if self.until_steady else None
         self.fed = 0
@@ -253,7 +246,7 @@ class _Batch:
                     if ending.size:
                         batch.step(ending, stage=vel_stage)
                 omega = self.qvel[:, crank_v]
-                torque = self.gear * self.force[:, self.motor] + self.slope * (omega - omega_prev)
+                torque = self.force[:, self.motor] + self.slope * (omega - omega_prev)
                 self.wm += torque * omega * dt
                 self.wf += (self.friction * np.abs(self.qvel[:, slides_v])).sum(axis=1) * dt
             done += steps
@@ -284,8 +277,8 @@ class _Batch:
         self.last_row[rows] = s
         if torque is not None:
             self.floor[rows] = np.maximum(self.floor[rows], 2 * math.pi * np.abs(torque[rows]))
-        residual = self.wm[rows] - self.wf[rows] - (kinetic - self.energy0[rows, 1]) - potential
-        scale = np.maximum.reduce([np.abs(self.wm[rows]), self.wf[rows], np.abs(potential), self.floor[rows]])
+        residual, scale = energy_audit(self.wm[rows], self.wf[rows], kinetic - self.energy0[rows, 1], potential,
+                                       self.floor[rows])
         for k, t, res, sc, g, e in zip(rows, self.clock[rows], residual, scale, gap, self.excursion[rows]):
             monitor = self.monitors[k]
             try:
@@ -296,13 +289,15 @@ class _Batch:
                 if e > monitor.worst["excursion_m"]:
                     monitor.excursion(float(t), float(e))
             except AccuracyError as exc:
+                self.inaccurate[k] = self.failed[k] is None
                 self._finish(k, error=str(exc))
 
     def _check_health(self, s: int, stepped: np.ndarray, done: np.ndarray) -> None:
         """MuJoCo resets a simulation it finds unstable (its clock falls behind): fail it."""
         expected = done * self.dt
         bad = stepped & self.running & ((np.abs(self.clock - expected) > 0.5 * self.dt)
-                                        | ~np.all(np.isfinite(self.qpos), axis=1))
+                                        | ~np.all(np.isfinite(self.qpos), axis=1)
+                                        | ~np.all(np.isfinite(self.qvel), axis=1))
         for k in np.flatnonzero(bad):
             t_good = float(self.record["t"][s - 1, k])
             self._finish(k, error=f"MuJoCo became unstable after t={t_good:.6g} s (a smaller timestep may carry "
@@ -346,8 +341,7 @@ class _Batch:
         wm, wf = float(series["motor_work"][-1]), float(series["friction_work"][-1])
         kinetic = float(series["kinetic"][-1] - series["kinetic"][0])
         potential = float(series["potential"][-1])
-        residual = wm - wf - kinetic - potential
-        scale = max(abs(wm), wf, abs(potential), float(self.floor[k]))
+        residual, scale = energy_audit(wm, wf, kinetic, potential, float(self.floor[k]))
         steady = self.watches is not None and self.watches[k].steady_at is not None
         p = self.designs[k]
         if p.drive == "torque":  # the sweep's figures: exact for a constant torque and forward-only modules
@@ -357,8 +351,8 @@ class _Batch:
             motor, against = wm, wf
         return {"series": series, "motor_work_j": motor, "friction_work_j": against,
                 "energy": {"motor_work_j": wm, "kinetic_j": kinetic, "friction_j": wf, "potential_j": potential,
-                           "residual_j": residual},
-                "accuracy": monitor.record(residual / scale if scale > 0 else 0.0),
+                           "residual_j": float(residual)},
+                "accuracy": monitor.record(residual_ratio(residual, scale)),
                 "stall": self.stall[k], "steady": steady,
                 "settings": {"timestep": float(self.dt[k]), "dt_out": self.dt_out,
                              "solimp": list(self.settings[k].solimp),

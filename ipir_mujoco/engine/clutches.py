@@ -20,17 +20,24 @@ import math
 
 import mujoco
 
+from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams
 
 from .compliant import CompliantClutches
-from .model import (CRANK_HINGE, FRONT_LOCK, FRONT_SLIDE, REAR_LOCK, REAR_SLIDE, ROD_HINGE, dof_address,
-                    qpos_address)
+from .model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
 
-LIMIT_ROW = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
-EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-SLIDES = (REAR_SLIDE, FRONT_SLIDE)
 # constraint rows per equality type (connect: 3 translations, weld: 6, joint/tendon/distance: 1)
 EQUALITY_ROWS = {int(mujoco.mjtEq.mjEQ_CONNECT): 3, int(mujoco.mjtEq.mjEQ_WELD): 6}
+# the constraint rows the stepping loop reads after a step, by the code _stepper.c returns when one is absent
+MISSING_ROWS = {1: "a held lock's equality row", 2: "the resistances' frictionloss rows"}
+
+
+def missing_rows(code: int, t: float) -> SimulationError:
+    """The one-line error of a step after which constraint rows the loop reads are absent (``code``: a key
+    of MISSING_ROWS; ``t`` [s] the simulated time after the step)."""
+    return SimulationError(f"MuJoCo's step to t={t:.6g} s produced no {MISSING_ROWS[code]} (a constraint "
+                           "disabled in the model's options?): the run cannot measure the clutch and the "
+                           "resistances")
 
 
 def equality_row(model: mujoco.MjModel, data: mujoco.MjData, eq_id: int) -> int:
@@ -194,7 +201,10 @@ class Locks:
         forces = [0.0, 0.0]
         for i in (0, 1):
             if self.held[i]:
-                forces[i] = float(self.data.efc_force[equality_row(self.model, self.data, self.eq_ids[i])])
+                row = equality_row(self.model, self.data, self.eq_ids[i])
+                if row >= self.data.ne:  # as _stepper.c: never a row that is not this lock's
+                    raise missing_rows(1, self.data.time)
+                forces[i] = float(self.data.efc_force[row])
         return forces
 
     def reactions(self) -> tuple[bool, bool, float, float]:
@@ -219,14 +229,24 @@ class NoClutch:
         return False, False, 0.0, 0.0
 
 
+def refuse_compliant(params: RobotParams, implementation: str) -> None:
+    """ParameterError (one line) for a finite ``clutch_stiffness`` with a clutch that is rigid only."""
+    if params.clutch_stiffness is not None and implementation != "ratchet":
+        raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with the MuJoCo {implementation!r} "
+                             "clutch: only the ratchet has a compliant form; allowed: --clutch unilateral "
+                             "--mujoco-clutch ratchet")
+
+
 def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, implementation: str,
                       rule: str = "unilateral"):
     """The clutch controller of a run, for a model built with ``ratchet=implementation == 'ratchet'``.
 
     'ratchet': the joint-limit ratchet, or with a finite ``params.clutch_stiffness`` the compliant clutches
     (:class:`.compliant.CompliantClutches`); 'lock': the locks with ``rule``; 'none': no clutches. Call it
-    after the initial state is set (the ratchet and the anchors start at the modules' positions).
+    after the initial state is set (the ratchet and the anchors start at the modules' positions). A finite
+    ``clutch_stiffness`` with the locks or no clutch is a ParameterError: they are rigid only.
     """
+    refuse_compliant(params, implementation)
     if implementation == "ratchet":
         if params.clutch_stiffness is not None:
             return CompliantClutches(model, data, params)

@@ -1,4 +1,4 @@
-"""What serial and batched MuJoCo runs share: option checks, warnings, the crank servo, stalls.
+"""What serial and batched MuJoCo runs (and the viewer) share: option checks, warnings, the crank servo, stalls.
 
 Stall: under a constant torque or the motor (loads that do not change with
 time), a robot whose crank pin and modules have all been slower than
@@ -20,12 +20,15 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 from ipir_mujoco.analytic.params import check_run_options as shared_run_options
 
+from .clutches import refuse_compliant
 from .model import check_params
 
 REST_SPEED = 1e-6  # m/s: modules and crank pin slower are at rest (a held module creeps at 1e-9..1e-8 m/s)
 REST_TIME = 0.1  # s: at rest this long under constant loads is a stall
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often
+IMPLEMENTATIONS = ("ratchet", "lock", "none")  # the MuJoCo clutches
+RULES = ("kinematic", "unilateral")  # the clutch rules
 
 
 @dataclass(frozen=True)
@@ -59,8 +62,18 @@ def captured_warnings() -> Iterator[list[str]]:
         mujoco.set_mju_user_warning(previous)
 
 
-def check_run_options(params: RobotParams, t_end: float, dt_out: float) -> tuple[float, float]:
-    """The checks every MuJoCo entry point shares (ParameterError, one line); (t_end, dt_out) as floats."""
+def check_clutch_options(params: RobotParams, clutch: str = "unilateral", implementation: str = "ratchet") -> None:
+    """What every MuJoCo entry point (serial and batched runs, the viewer) refuses in the parameters and the
+    clutch choice (ParameterError, one line): ``clutch`` a rule of RULES, ``implementation`` one of
+    IMPLEMENTATIONS."""
+    if implementation not in IMPLEMENTATIONS:
+        raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
+    if clutch not in RULES:
+        raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(RULES)}")
+    if implementation == "ratchet" and clutch == "kinematic":
+        raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
+                             "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
+    refuse_compliant(params, implementation)
     if params.clutch_stiffness is None:
         defaults = RobotParams()
         for name in ("clutch_damping", "clutch_backlash"):
@@ -69,7 +82,37 @@ def check_run_options(params: RobotParams, t_end: float, dt_out: float) -> tuple
                                      f"clutch has no spring for it to act with); allowed: {getattr(defaults, name)!r} "
                                      "with clutch_stiffness=rigid")
     check_params(params)
+
+
+def check_run_options(params: RobotParams, t_end: float, dt_out: float, clutch: str = "unilateral",
+                      implementation: str = "ratchet") -> tuple[float, float]:
+    """The checks every MuJoCo run shares (ParameterError, one line): :func:`check_clutch_options` and the
+    run options; returns (t_end, dt_out) [s] as floats."""
+    check_clutch_options(params, clutch, implementation)
     return shared_run_options(t_end, dt_out)  # the one check of run options every engine and interface shares
+
+
+def steps_per_output(dt_out: float, timestep: float) -> int:
+    """How many timesteps make one output interval ``dt_out`` [s]; ParameterError unless a whole number."""
+    steps = round(dt_out / timestep)
+    if steps < 1 or abs(steps * timestep - dt_out) > 1e-9 * dt_out:
+        raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
+                             f"({timestep} s)")
+    return steps
+
+
+def monotone(progress: Callable[[float], None] | None) -> Callable[[float], None] | None:
+    """``progress`` called only with times beyond every time it was given before: a run repeated at a
+    smaller timestep (after a failed accuracy check) reports again only once it passes the first attempt."""
+    if progress is None:
+        return None
+    reached = [-math.inf]
+
+    def report(t: float) -> None:
+        if t > reached[0]:
+            reached[0] = t
+            progress(t)
+    return report
 
 
 def climb_energy(model: mujoco.MjModel, params: RobotParams) -> float:

@@ -46,9 +46,8 @@ import mujoco
 
 from ipir_mujoco.analytic.params import RobotParams
 
-from .model import FRONT_CLUTCH, FRONT_SLIDE, REAR_CLUTCH, REAR_SLIDE, dof_address, qpos_address
+from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 
-SLIDES = (REAR_SLIDE, FRONT_SLIDE)
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
 
 
@@ -89,8 +88,7 @@ class CompliantClutches:
             model.actuator_biasprm[u, 2] = -c  # the damper as built (a model that has run may hold 0)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler and RK4 do not
-        self.implicit = model.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT,
-                                                 mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+        self.implicit = implicit_damping(model)
         self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm
         self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
         self.anchor = [float(data.qpos[a]) - self.backlash for a in self.qpos_adr]  # running maximum - backlash

@@ -30,6 +30,7 @@ REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "
 REAR_LOCK, FRONT_LOCK, LOOP = "rear_lock", "front_lock", "rod_to_front"
 MOTOR, ROD_END = "crank_motor", "rod_end"
 REAR_CLUTCH, FRONT_CLUTCH = "rear_clutch", "front_clutch"  # the compliant clutches' spring-damper actuators
+SLIDES = (REAR_SLIDE, FRONT_SLIDE)  # the modules' slides, rear first
 # Share of m1 carried by the crank body; the rest is the module body. Both
 # translate with module 1, so the split changes nothing but must keep each > 0.
 CRANK_MASS_SHARE = 0.01
@@ -41,6 +42,9 @@ CLUTCH_FORCE_MAX = 1e10
 
 INTEGRATORS = {"euler": mujoco.mjtIntegrator.mjINT_EULER, "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT, "rk4": mujoco.mjtIntegrator.mjINT_RK4}
+# the integrators that treat an actuator's velocity term (its damping) implicitly, through MuJoCo's D matrix;
+# Euler and RK4 apply it explicitly, at the step's starting velocity
+IMPLICIT_INTEGRATORS = (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
 
 
 def default_mjcf() -> Path:
@@ -189,6 +193,26 @@ def _write_drive(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
         act.biastype = mujoco.mjtBias.mjBIAS_NONE
 
 
+def implicit_damping(model: mujoco.MjModel) -> bool:
+    """Whether the model's integrator applies actuator damping implicitly (with the step's final velocity)."""
+    return model.opt.integrator in IMPLICIT_INTEGRATORS
+
+
+def drive_torque_slope(model: mujoco.MjModel) -> float:
+    """d(torque)/d(omega) [N m s/rad] of the crank actuator that the step integrates implicitly.
+
+    MuJoCo's ``actuator_force`` is the drive's torque at the step's starting speed omega_n; the implicit
+    integrators apply the velocity term at the final speed, so the torque applied over the step is
+    actuator_force + slope (omega_{n+1} - omega_n) with slope = biasprm[2] (the motor's -M_stall /
+    omega_noload; 0 for a constant torque). Euler and RK4 apply actuator_force itself: slope 0. The
+    builder writes gear 1, so the actuator's force is the crank torque. Serial and batched runs both
+    count the drive's work with this slope.
+    """
+    if not implicit_damping(model):
+        return 0.0
+    return float(model.actuator_biasprm[model.actuator(MOTOR).id, 2])
+
+
 def drive_control(params: RobotParams) -> float:
     """The ctrl value of the crank actuator: M [N m] for a constant torque, 1 (full voltage) for the motor."""
     return 1.0 if params.drive == "motor" else params.M
@@ -313,6 +337,19 @@ def set_closed_loop_state(model: mujoco.MjModel, data: mujoco.MjData, params: Ro
         # freeing module 1 at -gap_rate carries A forward and leaves C (module 2) at rest
         data.qvel[dof_address(model, target)] = abs(gap_rate)
     mujoco.mj_forward(model, data)
+
+
+def pin_offset(model: mujoco.MjModel) -> tuple[int, int, np.ndarray]:
+    """(rod-end site id, front module body id, module 2's pin relative to that body in the world [m], (3,)).
+
+    The loop gap is |site_xpos[site] - xpos[front] - offset|: the pin is fixed in module 2's frame and that
+    body only slides, so its world offset is the same in every state (computed at qpos0).
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    front = model.body("front_module").id
+    offset = data.xmat[front].reshape(3, 3) @ model.eq_data[model.equality(LOOP).id, 3:6]
+    return model.site(ROD_END).id, front, offset
 
 
 def site_velocity_x(model: mujoco.MjModel, data: mujoco.MjData, site: str) -> float:

@@ -51,6 +51,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+import numpy as np
+
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams
 
@@ -71,6 +73,26 @@ class Tolerances:
     @classmethod
     def for_params(cls, params: RobotParams) -> "Tolerances":
         return cls(RESIDUAL_TOL, LOOP_GAP_PER_R * params.r, EXCURSION_PER_R * params.r)
+
+
+def energy_audit(motor_j, dissipated_j, kinetic_gain_j, stored_gain_j, floor_j):
+    """The energy audit's (residual [J], scale [J]) of the ``residual_ratio`` figure (module docstring).
+
+    ``motor_j``: the drive's cumulative work; ``dissipated_j``: the work against the resistances (and the
+    compliant clutches' dampers); ``kinetic_gain_j``: the kinetic energy gained since t = 0;
+    ``stored_gain_j``: the potential energy gained (and the clutch springs' change); ``floor_j``: the
+    smallest scale (the initial kinetic energy, one revolution's energy). Floats or arrays of one shape
+    (a batch's designs). residual = motor - dissipated - kinetic - stored; scale = the largest of |motor|,
+    dissipated, |stored| and the floor. Every run's monitor and energy record use this one audit.
+    """
+    residual = motor_j - dissipated_j - kinetic_gain_j - stored_gain_j
+    scale = np.maximum(np.maximum(np.abs(motor_j), dissipated_j), np.maximum(np.abs(stored_gain_j), floor_j))
+    return residual, scale
+
+
+def residual_ratio(residual_j: float, scale_j: float) -> float:
+    """residual / scale, 0 for a zero scale (nothing put through the robot yet)."""
+    return float(residual_j / scale_j) if scale_j > 0 else 0.0
 
 
 class AccuracyError(SimulationError):
@@ -108,7 +130,7 @@ class AccuracyMonitor:
 
     def residual(self, t: float, residual_j: float, scale_j: float) -> None:
         """The audit's residual [J] at time ``t`` [s] against the energy put through the robot [J]."""
-        ratio = residual_j / scale_j if scale_j > 0 else 0.0
+        ratio = residual_ratio(residual_j, scale_j)
         if abs(ratio) > abs(self.worst["residual_ratio"]):
             self.worst["residual_ratio"], self.worst_t["residual_ratio"] = ratio, t
             if abs(ratio) > self.tolerances.residual_ratio:

@@ -28,16 +28,14 @@ from ipir_mujoco.analytic.params import RobotParams
 from ipir_mujoco.analytic.results import COLUMNS, Mode
 
 from .clutches import equality_row
-from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, dof_address, qpos_address
+from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
 
 # Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
 # along the rod), motor power [W], total momentum along x [kg m/s], motor torque [N m],
 # loop-closure gap [m]; and the cumulative energy columns every driving engine writes [J].
+# With compliant clutches also: overlaps clutch_overlap1/2 d_i [m] (> 0: the spring is compressed), the springs'
+# stored energy clutch_spring_energy and the dampers' cumulative dissipation clutch_damper_work [J].
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
-ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential")
-# with compliant clutches: overlaps d_i [m] (> 0: the spring is compressed), the springs' stored energy and the
-# dampers' cumulative dissipation [J]
-COMPLIANT_COLUMNS = ("clutch_overlap1", "clutch_overlap2", "clutch_spring_energy", "clutch_damper_work")
 # the per-sample scalars, in their order in Recorder.scalars
 _SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
             "friction_work", "clutch_damper_work")
@@ -55,8 +53,9 @@ class Recorder:
         self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
-        self.site = model.site(ROD_END).id
-        self.front = model.body("front_module").id
+        # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
+        self.site, self.front, offset = pin_offset(model)
+        self.pin_offset = offset.tolist()
         self.t = np.empty(capacity)
         self.qpos = np.empty((capacity, model.nq))
         self.qvel = np.empty((capacity, model.nv))
@@ -64,10 +63,6 @@ class Recorder:
         self.scalars: list[tuple] = []  # one tuple of _SCALARS per sample
         self.deferred: list[tuple | None] = [None] * capacity  # one tuple of _DEFERRED per sample
         self.count = 0
-        # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
-        mujoco.mj_kinematics(model, data)
-        anchor = model.eq_data[self.loop_id, 3:6]
-        self.pin_offset = (data.xmat[self.front].reshape(3, 3) @ anchor).tolist()
         self.total_mass = float(model.body_subtreemass[0])
         # views of the fields read at every sample (their memory is fixed for the life of the MjData)
         self._rod_end, self._front_pos = data.site_xpos[self.site], data.xpos[self.front]

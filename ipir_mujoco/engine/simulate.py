@@ -6,11 +6,13 @@ accumulates the drive's work and the work against the resistances. Those
 steps run in :mod:`.stepper`, compiled where it can be (same numbers bit for
 bit as its pure-Python form). Every output interval the run records a sample
 (:mod:`.recorder`) and feeds the accuracy monitor (:mod:`.monitor`). Every
-~0.05 s of simulated time it reports progress, checks the wall-time budget,
-the periodic steady state and a stall.
+0.05 s of simulated time it checks the wall-time budget, the periodic steady
+state and a stall, and reports progress about every 0.1 s of it (never going
+back: a run repeated at a halved timestep reports again only past the first
+attempt's last report).
 MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
 turn into a :class:`SimulationError` with the time and MuJoCo's message, as
-does a non-finite state.
+do a non-finite state and a MuJoCo error (``mujoco.FatalError``).
 
 Clutches: rigid one-way clutches are the joint-limit ratchet or the locks
 (:mod:`.clutches`); with a finite ``clutch_stiffness`` the ratchet becomes the
@@ -46,19 +48,18 @@ from ipir_mujoco.analytic.params import RobotParams, require_params
 from ipir_mujoco.analytic.results import RunResult
 
 from .clutches import clutch_controller
-from .common import (BLOCK_TIME, REFINEMENTS, CrankServo, captured_warnings, check_run_options, climb_energy,
-                     rest_since, stall_reason)
-from .model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, dof_address,
-                    drive_control, qpos_address, set_closed_loop_state)
-from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode
+from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_run_options,
+                     climb_energy, monotone, rest_since, stall_reason, steps_per_output)
+from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
+from .model import set_closed_loop_state
+from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
 from .recorder import EXTRA_COLUMNS, Recorder
-from .stepper import make_steps
+from .stepper import loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
-FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
-IMPLEMENTATIONS = ("ratchet", "lock", "none")
+NO_REACTIONS = (False, False, 0.0, 0.0)  # a compliant run's samples take the clutch forces from the recorder
 
 
 def simulate_mujoco(
@@ -98,25 +99,14 @@ def simulate_mujoco(
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
     """
     params = require_params(params)
-    t_end, dt_out = check_run_options(params, t_end, dt_out)
-    if implementation not in IMPLEMENTATIONS:
-        raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
-    if clutch not in ("kinematic", "unilateral"):
-        raise ParameterError(f"clutch={clutch!r} is unknown; allowed: kinematic, unilateral")
-    if implementation == "ratchet" and clutch == "kinematic":
-        raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
-                             "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
-    if params.clutch_stiffness is not None and implementation != "ratchet":
-        raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with the MuJoCo {implementation!r} "
-                             "clutch: only the ratchet has a compliant form; allowed: --clutch unilateral "
-                             "--mujoco-clutch ratchet")
+    t_end, dt_out = check_run_options(params, t_end, dt_out, clutch, implementation)
     check_accuracy_mode(accuracy)
     SteadyWatch(0.0, steady_tol, steady_cycles)  # validates both
     if wall_budget_s is not None and not (math.isfinite(wall_budget_s) and wall_budget_s > 0):
         raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number > 0")
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
-                   progress=progress, servo=servo, accuracy=accuracy, until_steady=until_steady,
+                   progress=monotone(progress), servo=servo, accuracy=accuracy, until_steady=until_steady,
                    steady_tol=steady_tol, steady_cycles=steady_cycles, wall_budget_s=wall_budget_s)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
@@ -146,20 +136,24 @@ class _Run:
         self.wall_budget_s = wall_budget_s
         self.started = time.perf_counter() if started is None else started
         dt = settings.timestep
-        self.steps_per_sample = round(dt_out / dt)
-        if self.steps_per_sample < 1 or abs(self.steps_per_sample * dt - dt_out) > 1e-9 * dt_out:
-            raise ParameterError(f"dt_out={dt_out} s is out of range; allowed: a whole multiple of the timestep "
-                                 f"({dt} s)")
+        self.steps_per_sample = steps_per_output(dt_out, dt)
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
         self.compliant = params.clutch_stiffness is not None
         self.model = build_model(params, settings, mjcf, ratchet=implementation == "ratchet")
         self.data = mujoco.MjData(self.model)
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
+        self.recorder: Recorder | None = None  # made by _setup
 
     def result(self, extra_settings: dict) -> RunResult:
         with captured_warnings() as messages:
-            last = self._integrate(messages)
+            try:
+                last = self._integrate(messages)
+            except mujoco.FatalError as exc:  # MuJoCo's error inside mj_step or mj_forward: one line, no traceback
+                rec = self.recorder  # None or empty if MuJoCo failed before the first sample
+                t = float(rec.t[rec.count - 1]) if rec is not None and rec.count else 0.0
+                reason = " ".join(str(exc).split())
+                raise SimulationError(f"MuJoCo failed after t={t:.6g} s: {reason}") from None
         rec = self.recorder
         series = rec.series(last)
         wm, wf = series["motor_work"][-1], series["friction_work"][-1]
@@ -167,12 +161,13 @@ class _Run:
         potential = series["potential"][-1]
         energy = {"motor_work_j": float(wm), "kinetic_j": float(kinetic), "friction_j": float(wf),
                   "potential_j": float(potential)}
+        damper = spring = 0.0
         if self.compliant:
-            energy["clutch_spring_j"] = float(series["clutch_spring_energy"][-1] - series["clutch_spring_energy"][0])
-            energy["clutch_damper_j"] = float(series["clutch_damper_work"][-1])
-        residual = wm - sum(v for k, v in energy.items() if k != "motor_work_j")
+            spring = series["clutch_spring_energy"][-1] - series["clutch_spring_energy"][0]
+            damper = series["clutch_damper_work"][-1]
+            energy["clutch_spring_j"], energy["clutch_damper_j"] = float(spring), float(damper)
+        residual, scale = energy_audit(wm, wf + damper, kinetic, potential + spring, self.energy_floor)
         energy["residual_j"] = float(residual)
-        scale = max(abs(wm), wf, abs(potential), self.energy_floor)
         label = {"ratchet": "unilateral", "lock": self.clutch, "none": "none"}[self.implementation]
         return RunResult(
             engine="mujoco", geometry="exact", clutch=label, params=self.params, t_end=float(series["t"][-1]),
@@ -182,29 +177,18 @@ class _Run:
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles},
             stall=self.stall,
-            accuracy=self.monitor.record(residual / scale if scale > 0 else 0.0),
+            accuracy=self.monitor.record(residual_ratio(residual, scale)),
         )
 
     def _setup(self):
         m, d, p = self.model, self.data, self.params
         set_closed_loop_state(m, d, p)
         self.controller = controller = clutch_controller(m, d, p, self.implementation, self.clutch)
-        self.motor = m.actuator(MOTOR).id
-        self.crank_q, self.crank_v = qpos_address(m, CRANK_HINGE), dof_address(m, CRANK_HINGE)
-        d.ctrl[self.motor] = drive_control(p) if self.servo is None else self.servo.torque(
-            0.0, d.qpos[self.crank_q], d.qvel[self.crank_v])
+        motor, crank = m.actuator(MOTOR).id, m.joint(CRANK_HINGE)
+        d.ctrl[motor] = drive_control(p) if self.servo is None else self.servo.torque(
+            0.0, d.qpos[crank.qposadr[0]], d.qvel[crank.dofadr[0]])
         mujoco.mj_forward(m, d)
-        # the frictionloss rows follow the equality rows, one per dof with friction, in dof order
-        self.friction_dofs = [int(i) for i in np.flatnonzero(m.dof_frictionloss > 0)]
-        rows = range(d.ne, d.ne + d.nf)
-        if d.nf != len(self.friction_dofs) or any(
-                d.efc_type[r] != FRICTION_ROW or d.efc_id[r] != dof for r, dof in zip(rows, self.friction_dofs)):
-            raise ParameterError("the MJCF model has friction rows the engine does not expect (only the slides' "
-                                 "frictionloss)")
-        gear = float(m.actuator_gear[self.motor, 0])
-        implicit = m.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
-        self.torque_slope = gear * gear * float(m.actuator_biasprm[self.motor, 2]) if implicit else 0.0
-        self.gear = gear
+        self.loop = loop_options(m, d)
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
                                  controller if self.compliant else None)
 
@@ -218,7 +202,7 @@ class _Run:
         self._setup()
         m, d, rec, ctl = self.model, self.data, self.recorder, self.controller
 
-        torque = self.gear * d.actuator_force.item(self.motor)
+        torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
         row = rec.sample(torque, 0.0, 0.0, ctl.reactions())
@@ -228,9 +212,7 @@ class _Run:
         self._judge(row, *start)
         self._check(messages, 0.0)
 
-        steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, motor=self.motor, crank_q=self.crank_q,
-                                        crank_v=self.crank_v, gear=self.gear, slope=self.torque_slope,
-                                        friction_dofs=self.friction_dofs, torque=torque, servo=self.servo)
+        steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, servo=self.servo, **self.loop)
         pending = -1
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
@@ -249,8 +231,10 @@ class _Run:
             if messages:
                 self._check(messages, float(rec.t[rec.count - 1]))
             torque = steps.torque
-            pending = rec.sample(torque, steps.motor_work, steps.friction_work, ctl.reactions(),
-                                 ctl.damper_work if self.compliant else 0.0)
+            if self.compliant:
+                pending = rec.sample(torque, steps.motor_work, steps.friction_work, NO_REACTIONS, ctl.damper_work)
+            else:
+                pending = rec.sample(torque, steps.motor_work, steps.friction_work, ctl.reactions())
             if abs(torque) * 2 * math.pi > self.energy_floor:
                 self.energy_floor = 2 * math.pi * abs(torque)
             if ctl.excursion > self.monitor.worst["excursion_m"]:
@@ -276,9 +260,8 @@ class _Run:
         (as the dampers' work is with the friction work)."""
         mon, rec = self.monitor, self.recorder
         wm, wf, wc = rec.works(row)
-        dpot = potential + spring - self.energy0[1]
-        residual = wm - wf - wc - (kinetic - self.energy0[0]) - dpot
-        scale = max(abs(wm), wf + wc, abs(dpot), self.energy_floor)
+        residual, scale = energy_audit(wm, wf + wc, kinetic - self.energy0[0], potential + spring - self.energy0[1],
+                                       self.energy_floor)
         if scale > 0 and abs(residual) > abs(mon.worst["residual_ratio"]) * scale:
             mon.residual(rec.t.item(row), residual, scale)
         if gap > mon.worst["loop_gap_m"]:

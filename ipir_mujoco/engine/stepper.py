@@ -22,8 +22,8 @@ The C code includes no MuJoCo header, so it does not depend on the version it
 was built against: Python passes the address of ``mj_step`` (from the loaded
 libmujoco, checked to be the instance the bindings use), of every array the
 loop touches (fixed for the life of an MjModel/MjData), and of the two mjData
-fields that change between steps, the ``efc_force`` pointer and the count
-``ne``; their offsets come from the running mujoco's own description of its
+fields that change between steps, the ``efc_force`` pointer and the counts
+``ne`` and ``nf``; their offsets come from the running mujoco's own description of its
 structs (``mujoco.introspect``) and are checked against the live MjData before
 every run (pointers and counts read there must equal what the bindings
 report). Anything that does not check out, a missing build, a crank servo (a
@@ -43,13 +43,39 @@ from operator import itemgetter
 import mujoco
 import numpy as np
 
-from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet
+from ipir_mujoco.analytic.errors import ParameterError
+
+from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
 from .compliant import CompliantClutches
+from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
 CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant")
 _DATA_FIELDS = ("time", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_force")
+FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+
+
+def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
+    """:func:`make_steps`' keyword arguments for a built model after ``mj_forward`` on its initial state: the
+    crank actuator and joint, the drive's implicit torque slope (:func:`.model.drive_torque_slope`), the
+    dofs with friction and the initial torque [N m]. The loop counts the work against the resistances from
+    the two slides' frictionloss rows only: friction on another dof, or other rows, is a ParameterError."""
+    slides = {dof_address(model, n) for n in SLIDES}
+    friction_dofs = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
+    if not set(friction_dofs) <= slides:
+        names = ", ".join(repr(model.joint(model.dof_jntid[i]).name) for i in friction_dofs if i not in slides)
+        raise ParameterError(f"frictionloss on {names} in the MJCF model: the engine counts resistances on the "
+                             "two slides only; allowed: frictionloss on rear_slide and front_slide (F_r1, F_r2)")
+    # the frictionloss rows follow the equality rows, one per dof with friction, in dof order
+    rows = range(data.ne, data.ne + data.nf)
+    if data.nf != len(friction_dofs) or any(data.efc_type[r] != FRICTION_ROW or data.efc_id[r] != dof
+                                            for r, dof in zip(rows, friction_dofs)):
+        raise ParameterError("the MJCF model has friction rows the engine does not expect (only the slides' "
+                             "frictionloss)")
+    motor = model.actuator(MOTOR).id
+    return dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
+                slope=drive_torque_slope(model), friction_dofs=friction_dofs, torque=data.actuator_force.item(motor))
 
 
 class PythonSteps:
@@ -63,10 +89,10 @@ class PythonSteps:
 
     compiled = False
 
-    def __init__(self, model, data, controller, qvel_before, *, motor, crank_q, crank_v, gear, slope,
-                 friction_dofs, torque, servo=None):
+    def __init__(self, model, data, controller, qvel_before, *, motor, crank_q, crank_v, slope, friction_dofs,
+                 torque, servo=None):
         self.model, self.data, self.controller, self.qvel_before = model, data, controller, qvel_before
-        self.motor, self.crank_q, self.crank_v, self.gear, self.slope = motor, crank_q, crank_v, gear, slope
+        self.motor, self.crank_q, self.crank_v, self.slope = motor, crank_q, crank_v, slope
         self.friction_dofs, self.servo = list(friction_dofs), servo
         self.torque, self.motor_work, self.friction_work = torque, 0.0, 0.0
         self.omega_prev = data.qvel.item(crank_v)
@@ -78,7 +104,7 @@ class PythonSteps:
         m, d, ctl = self.model, self.data, self.controller
         dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
         step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
-        motor, cq, cv, gear, slope = self.motor, self.crank_q, self.crank_v, self.gear, self.slope
+        motor, cq, cv, slope = self.motor, self.crank_q, self.crank_v, self.slope
         nfric = len(self.friction_dofs)
         fa, fb = (self.friction_dofs + [0, 0])[:2]
         torque, wm, wf, omega_prev = self.torque, self.motor_work, self.friction_work, self.omega_prev
@@ -93,8 +119,11 @@ class PythonSteps:
                 after()
             v = qvel.tolist()
             omega = v[cv]
-            torque = gear * d.actuator_force.item(motor) + slope * (omega - omega_prev)
+            torque = d.actuator_force.item(motor) + slope * (omega - omega_prev)
             wm += torque * omega * dt
+            # the frictionloss rows follow the ne equality rows: read only if there (as _stepper.c)
+            if nfric and d.nf != nfric:
+                raise missing_rows(2, d.time)
             if nfric == 2:
                 ne = d.ne
                 f0, f1 = d.efc_force[ne:ne + 2].tolist()
@@ -136,6 +165,7 @@ class CompiledSteps(PythonSteps):
         self._set_config(
             model=model._address, data=address, step=library["mj_step"], user_error=library["mju_user_error"],
             efc_force_field=address + offsets["efc_force"], ne_field=address + offsets["ne"],
+            nf_field=address + offsets["nf"],
             qpos=_address(data.qpos), qvel=_address(data.qvel), ctrl=_address(data.ctrl),
             actuator_force=_address(data.actuator_force), qvel_before=_address(qvel_before),
             jnt_range=_address(model.jnt_range), eq_data=_address(model.eq_data),
@@ -146,7 +176,7 @@ class CompiledSteps(PythonSteps):
             fric_b=(self.friction_dofs + [0, 0])[1])
         self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
         self._cfg[self.C["eq_rows"]] = _address(self._eq_rows) if self._eq_rows.size else 0
-        self._set_state(dt=model.opt.timestep, gear=self.gear, slope=self.slope, torque=self.torque,
+        self._set_state(dt=model.opt.timestep, slope=self.slope, torque=self.torque,
                         motor_work=0.0, friction_work=0.0, omega_prev=self.omega_prev)
         self._load_controller()
         self._args = (_address(self._cfg), _address(self._st))
@@ -159,6 +189,8 @@ class CompiledSteps(PythonSteps):
             self._module.run(*self._args, nstep, row)
         except RuntimeError as exc:  # MuJoCo's error, raised as the bindings raise it
             raise mujoco.FatalError(str(exc)) from None
+        except LookupError as exc:  # rows the loop reads are absent: the Python loop's error
+            raise missing_rows(exc.args[0], self.data.time) from None
         state = self._st.tolist()
         self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
         self._sync(state)

@@ -90,6 +90,29 @@ def crank_bounds(params: RobotParams, t_end: float) -> tuple[float, float]:
     return omega_b, (omega_start * t_end + abs(p.M) * t_end**2 / (2 * p.J_A)) / (2 * math.pi)
 
 
+def _too_small(limit: str, needed: float, params: RobotParams, t_end: float, omega_b: float, servo) -> str:
+    """The one-line refusal of a run whose ``limit`` (a key of choose_settings' limits) needs a timestep
+    ``needed`` [s] below DT_MIN: it names that limit, its value and what to change."""
+    below = f"MuJoCo would need a timestep of {needed:.2g} s"
+    allowed = f"allowed: runs needing a timestep >= {DT_MIN:g} s"
+    if limit == "clutch_s":
+        return (f"clutch_stiffness={params.clutch_stiffness:g} N/m: {below} to resolve the clutch spring "
+                f"({CLUTCH_SHARE:g} sqrt(min(m1, m2) / k)); {allowed} (a stiffness up to "
+                f"{min(params.m1, params.m2) * (CLUTCH_SHARE / DT_MIN) ** 2:.3g} N/m here, or give the timestep "
+                "yourself)")
+    if limit == "rod_mass_s":
+        ratio = max(params.m1, params.m2) / params.rod_mass
+        return (f"rod_mass={params.rod_mass:g} kg: the module-to-rod mass ratio {ratio:.3g} makes MuJoCo's soft "
+                f"loop leak; {below}; {allowed} (a rod_mass of at least "
+                f"{max(params.m1, params.m2) / (LEAK_RATIO * (DT_MAX / DT_MIN) ** 2):.3g} kg here, or give the "
+                "timestep yourself)")
+    if limit == "servo_s":
+        return (f"crank servo kp={servo.kp:g} N m/rad, kv={servo.kv:g} N m s/rad on J_A={params.J_A:g} kg m^2: "
+                f"{below} to follow it stably; {allowed} (a softer servo, or give the timestep yourself)")
+    return (f"t_end={t_end:g} s: the crank can reach {omega_b:.3g} rad/s and {below}; {allowed} (shorten "
+            "t_end, use the motor drive, or give the timestep yourself)")
+
+
 def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None,
                     clutch: str = "ratchet") -> tuple[SolverSettings, dict]:
     """The settings for a run, and why: (SolverSettings, {the bounds and each limit [s]}).
@@ -111,17 +134,8 @@ def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None
     if params.clutch_stiffness is not None:
         limits["clutch_s"] = CLUTCH_SHARE / clutch_rate(params)
     needed = min(limits.values())
-    if needed == limits.get("clutch_s") and needed < DT_MIN:
-        raise ParameterError(
-            f"clutch_stiffness={params.clutch_stiffness:g} N/m: MuJoCo would need a timestep of {needed:.2g} s to "
-            f"resolve the clutch spring ({CLUTCH_SHARE:g} sqrt(min(m1, m2) / k)); allowed: runs needing a timestep "
-            f">= {DT_MIN:g} s (a stiffness up to {min(params.m1, params.m2) * (CLUTCH_SHARE / DT_MIN) ** 2:.3g} N/m "
-            "here, or give the timestep yourself)")
     if needed < DT_MIN:
-        raise ParameterError(
-            f"t_end={t_end:g} s: the crank can reach {omega_b:.3g} rad/s and MuJoCo would need a timestep of "
-            f"{needed:.2g} s; allowed: runs needing a timestep >= {DT_MIN:g} s (shorten t_end, use the motor "
-            "drive, or give the timestep yourself)")
+        raise ParameterError(_too_small(min(limits, key=limits.get), needed, params, t_end, omega_b, servo))
     steps = math.ceil(dt_out / needed * (1 - 1e-12))
     why = {"omega_bound_rad_s": omega_b, "revolutions_bound": revolutions, **limits}
     return SolverSettings(timestep=dt_out / steps), why
