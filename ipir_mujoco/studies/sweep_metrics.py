@@ -85,24 +85,33 @@ JUMP_GUARD_S = 2e-3  # s: gap between an event and each window, longer than a so
 JUMP_POINTS = 7  # velocities read per window (interpolated between samples)
 
 
+def _slope_weights(x: np.ndarray) -> np.ndarray:
+    """Weights w (len(x),) such that w @ y is the slope at 0 of the least-squares parabola through (x, y)."""
+    return np.linalg.pinv(np.vander(x, 3))[1]
+
+
+_OFFSETS = np.linspace(JUMP_GUARD_S, JUMP_GUARD_S + JUMP_WINDOW_S, JUMP_POINTS)  # s, after an event
+_BEFORE, _AFTER = _slope_weights(-_OFFSETS), _slope_weights(_OFFSETS)
+
+
 def accel_jump(series: dict[str, np.ndarray]) -> float:
     """Largest acceleration jump [m/s^2] of either module at a clutch event (module docstring); 0 if none."""
     t = np.asarray(series["t"], dtype=float)
     keep = np.concatenate([np.diff(t) > 0, [True]])  # of a duplicated instant, the later sample
     t_unique = t[keep]
     reach = JUMP_GUARD_S + JUMP_WINDOW_S
-    offsets = np.linspace(JUMP_GUARD_S, reach, JUMP_POINTS)
     largest = 0.0
     for column in ("v1", "v2"):
         v = np.asarray(series[column], dtype=float)
         held = v <= HELD_SPEED
         events = t[1:][held[1:] != held[:-1]]
         events = events[(events - reach >= t[0]) & (events + reach <= t[-1])]
-        for event in events:
-            # slope at the event of a parabola through v over each window: exact for a linear a(t)
-            before = np.polyfit(-offsets, np.interp(event - offsets, t_unique, v[keep]), 2)[1]
-            after = np.polyfit(offsets, np.interp(event + offsets, t_unique, v[keep]), 2)[1]
-            largest = max(largest, abs(float(after - before)))
+        if events.size == 0:
+            continue
+        # slope at the event of a parabola through v over each window: exact for a linear a(t)
+        before = np.interp(events[:, None] - _OFFSETS, t_unique, v[keep]) @ _BEFORE
+        after = np.interp(events[:, None] + _OFFSETS, t_unique, v[keep]) @ _AFTER
+        largest = max(largest, float(np.abs(after - before).max()))
     return largest
 
 
