@@ -31,7 +31,8 @@ def add_parser(commands) -> None:
                      help="MuJoCo clutch implementation: joint-limit ratchet (default with --clutch unilateral) "
                           "or velocity-triggered lock (default with --clutch kinematic)")
     sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
-                     help="MuJoCo timestep (default: chosen from the motion; see the docs)")
+                     help="MuJoCo timestep [s] (default: chosen from the motion, by the rule in mjcf/README.md, "
+                          "installed with the package: see 'ipir-mujoco --help')")
     sim.add_argument("--accuracy", choices=("stop", "warn"), default="stop",
                      help="MuJoCo accuracy monitor: stop the run when the energy residual or the loop gap "
                           "exceeds its tolerance (default), or warn, record it in the summary and go on")
