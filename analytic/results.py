@@ -44,6 +44,12 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .params import RobotParams
 
+# [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
+# far above the creep of MuJoCo's soft constraints (a held module creeps at 1e-9..1e-8 m/s), so every engine's
+# series reads rest alike (the analytic engines' rest is an exact 0). The summary's first minimum of S and
+# MuJoCo's stall test use it.
+REST_SPEED = 1e-6
+
 COLUMNS: tuple[str, ...] = (
     "t", "phi", "omega", "alpha", "x1", "x2", "v1", "v2", "a1", "a2",
     "S", "S_dot", "lambda1", "lambda2", "mode",
@@ -182,18 +188,21 @@ def write_mode_changes(path: str | Path, series: dict[str, np.ndarray]) -> None:
 
 
 def first_gap_minimum(t: np.ndarray, S_dot: np.ndarray) -> float | None:
-    """Time of the first minimum of S [s]: where S_dot first turns from < 0 to >= 0.
+    """Time of the first minimum of S [s]: where S first stops falling, S_dot turning from below -REST_SPEED
+    to -REST_SPEED or above (rising, or at rest: a robot that stalls while contracting has its minimum where
+    it comes to rest, whether its series holds an exact 0 there or the soft constraints' creep).
 
-    Linear interpolation between samples; None if S never reaches a minimum.
+    Arrays of shape (n,): t [s], S_dot [m/s]. The time where S_dot reaches 0, linearly interpolated between
+    the two samples (the later one if S_dot stays below 0, at rest); None if S never stops falling.
     """
-    falling = S_dot[:-1] < 0
-    rising = S_dot[1:] >= 0
-    hits = np.flatnonzero(falling & rising)
+    falling = S_dot[:-1] < -REST_SPEED
+    stopped = S_dot[1:] >= -REST_SPEED
+    hits = np.flatnonzero(falling & stopped)
     if hits.size == 0:
         return None
     i = hits[0]
     s0, s1 = S_dot[i], S_dot[i + 1]
-    return float(t[i] + (t[i + 1] - t[i]) * (-s0) / (s1 - s0))
+    return float(t[i] + (t[i + 1] - t[i]) * min(1.0, -s0 / (s1 - s0)))
 
 
 def min_locked_reaction(series: dict[str, np.ndarray]) -> float | None:

@@ -1,4 +1,4 @@
-"""Readable names and units of the summary figures and time-series quantities.
+"""Readable names and units of the summary figures and time-series quantities, and how a figure is written.
 
 Tables, reports and text output show these instead of the code names
 (``x1_final``, ``first_contraction_end_s``); the code names stay the keys of
@@ -6,6 +6,8 @@ summary.json and metrics.json.
 """
 
 from __future__ import annotations
+
+import numbers
 
 # summary key -> (name, unit)
 SUMMARY: dict[str, tuple[str, str]] = {
@@ -49,3 +51,14 @@ def series_label(key: str) -> str:
     """'gap S [m]' for 'S'; the key itself if it has no entry."""
     name, unit = SERIES.get(key, (key, ""))
     return f"{name} [{unit}]" if unit else name
+
+
+def significant(value: float, digits: int) -> str:
+    """``value`` to ``digits`` significant digits, trailing zeros kept so that a figure shows its precision
+    beside its neighbours ('0.1000', not '0.1', next to '0.1108'); an integer (a count) as it is, and no
+    '-0' for a round-off below zero."""
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    text = f"{float(value) + 0.0:#.{digits}g}"
+    mantissa, e, exponent = text.partition("e")
+    return mantissa.rstrip(".") + e + exponent

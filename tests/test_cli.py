@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -173,6 +174,30 @@ def test_a_reader_that_leaves_early_ends_the_command_quietly(monkeypatch, capsys
     monkeypatch.setattr(params_command, "add_parser", add_parser)
     assert main(["params"]) == 141
     assert capsys.readouterr().err == ""
+
+
+def _digits(number: str) -> int:
+    """Significant digits a printed number shows ('0.10000' -> 5, '2.0009' -> 5)."""
+    mantissa = number.split("e")[0].lstrip("-").replace(".", "").lstrip("0")
+    return len(mantissa)
+
+
+def test_the_steady_state_line_shows_every_figure_to_its_precision():
+    """The paper's model advances exactly 2 r = 0.1 m per revolution: printed '0.1' beside '0.42702 m/s' and
+    '2.0009 J/m', it hid its five digits; every figure of the line now shows them."""
+    from ipir_mujoco import analytic
+    from ipir_mujoco.analytic import RobotParams
+    from ipir_mujoco.cli.simulate import format_summary
+    from ipir_mujoco.labels import significant
+
+    assert [significant(v, 4) for v in (0.1, 0.11083, 1234.0, 1.5e-5, -1e-17 * 0, 16)] == \
+        ["0.1000", "0.1108", "1234", "1.500e-05", "0.000", "16"]
+    run = analytic.simulate(RobotParams(drive="motor"), "approx", "kinematic", 3.0, until_steady=True)
+    line = next(s for s in format_summary(run, until_steady=True).splitlines() if "steady state from" in s)
+    figures = re.findall(r"(\S+) (?:m/s|m per revolution|J/m)|efficiency (\S+)$", line)
+    numbers = [a or b for a, b in figures]
+    assert len(numbers) == 4 and "0.10000 m per revolution" in line, line
+    assert all(_digits(n) == 5 for n in numbers), line
 
 
 def test_the_text_summary_prints_no_negative_zero_and_no_round_off_terms():

@@ -71,6 +71,24 @@ def test_rows_agree_between_the_engines(first_engagements, cruise):
         assert row[engine]["energy_per_metre_j_m"] > 0 and row[engine]["steady_speed_m_s"] > 0
 
 
+def test_a_damped_analytic_peak_does_not_depend_on_the_output_grid():
+    """With clutch damping the analytic run locates each force maximum on its dense output (a bounded Brent
+    search to sqrt(eps) t), so the study's bound is (omega_c sqrt(eps) t_end)^2, not the grid's
+    (omega_c dt_out)^2 / 8 (2e-5 on the study's grid here); a grid 2.5 x coarser, which would read a sampled
+    peak up to 1.25e-4 low, reads the same peak within that bound."""
+    from ipir_mujoco.studies.clutch_study import Task, design, run_task
+
+    base, point = RobotParams(clutch_damping=30.0), FIRST["first"]
+    metrics = run_task(base, point, Task("first", "analytic", 1e5, 0.0))
+    params = design(base, point, 1e5, 0.0)
+    bound = (clutch_rate(params) * math.sqrt(np.finfo(float).eps) * point.t_end) ** 2
+    assert metrics["peak_sampling_bound"] == pytest.approx(bound) and bound < 1e-11
+    coarse = analytic.simulate(params, "exact", "unilateral", point.t_end, dt_out=1e-4).series
+    peak = max(coarse["lambda1"].max(), coarse["lambda2"].max())
+    assert metrics["dt_out_s"] < 1e-4 / 2.5 * (1 + 1e-12)
+    assert peak == pytest.approx(metrics["peak_clutch_force_n"], rel=bound, abs=0)
+
+
 def test_the_rigid_limit_is_approached_at_rate_one_over_k(first_engagements):
     """No play: each engine's revolutions differ from its own rigid clutch's (MuJoCo: its ratchet at the same
     step, so the stepping errors cancel) as C/k, the regular perturbation tests/test_compliant_clutch.py and

@@ -133,6 +133,21 @@ def test_runs_of_different_length_are_compared_at_the_shorter_ones_end(capsys):
     assert "compared at 0.6 s, the shorter run's end" in format_comparison(compare_runs(long, short))
 
 
+def test_the_summary_rows_show_each_figure_to_six_digits():
+    """The paper's model's 2 r = 0.1 m per revolution printed as '0.1' where its neighbours show six digits: every
+    figure of the summary table shows six significant digits, counts stay whole numbers."""
+    from ipir_mujoco import analytic
+    from ipir_mujoco.studies.compare import format_comparison
+
+    paper = analytic.simulate(RobotParams(drive="motor"), "approx", "kinematic", 3.0, until_steady=True)
+    exact = analytic.simulate(RobotParams(drive="motor"), "exact", "kinematic", 3.0, until_steady=True)
+    lines = format_comparison(compare_runs(paper, exact)).splitlines()
+    row = next(line for line in lines if line.strip().startswith("distance per revolution"))
+    assert row.split()[4] == "0.100000", row
+    switches = next(line for line in lines if line.strip().startswith("mode switches"))
+    assert "." not in switches.split()[2], switches
+
+
 def test_a_quantity_held_at_zero_is_judged_against_the_mechanisms_scale():
     """Module 2 held still in run a (a vertical pipe where the robot stalls): its largest |a| is 0, and b's
     round-off (58 nm in MuJoCo's ratchet) was reported as first exceeding 1 % at t = 0.00025 s. The scale is at

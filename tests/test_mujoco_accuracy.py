@@ -108,6 +108,21 @@ def test_a_motor_too_weak_for_the_load_is_a_stall_not_an_error():
     assert np.abs(run.series["v1"][last]).max() < 1e-6 and np.abs(run.series["v2"][last]).max() < 1e-6
 
 
+def test_both_engines_put_the_first_minimum_of_s_of_a_stall_where_the_robot_comes_to_rest():
+    """The default motor up a vertical pipe stalls while contracting (at rest from t = 0.3602 s in the
+    equations). The equations' S_dot rests at an exact 0, MuJoCo's held module creeps (S_dot about
+    -1.4e-9 m/s, never >= 0; this summary said 'none'): one summary function reads both as the minimum of S.
+    Within one output interval (1e-3 s): MuJoCo's rest is known to its samples, and the first at rest is its
+    minimum; the engines' motions agree far closer (the stall times differ by < 1e-3 s)."""
+    params, dt_out = RobotParams(drive="motor", incline=90.0), 1e-3
+    equations = analytic.simulate(params, "exact", "unilateral", 0.6, dt_out=dt_out)
+    mujoco = simulate_mujoco(params, "unilateral", "ratchet", 0.6, dt_out=dt_out)
+    assert equations.stall is not None and mujoco.stall is not None
+    first = equations.summary["first_contraction_end_s"]
+    assert first == pytest.approx(0.3602, abs=1e-4)
+    assert mujoco.summary["first_contraction_end_s"] == pytest.approx(first, abs=dt_out)
+
+
 def test_until_steady_stops_at_the_end_of_the_steady_revolution():
     """The default motor reaches its periodic steady state in about 2 s."""
     run = simulate_mujoco(RobotParams(drive="motor"), "unilateral", "ratchet", 10.0, dt_out=1e-3, until_steady=True)

@@ -14,6 +14,7 @@ import pytest
 
 from ipir_mujoco.analytic import RobotParams, SimulationError
 from ipir_mujoco.engine import CrankServo, simulate_mujoco, stepper
+from ipir_mujoco.engine.batch import run_ratchet_batch
 from ipir_mujoco.engine.clutches import Ratchet
 from ipir_mujoco.engine.model import (MOTOR, SolverSettings, build_model, build_spec, default_mjcf, drive_control,
                                       set_closed_loop_state)
@@ -234,6 +235,29 @@ def test_a_mujoco_error_ends_the_run_with_one_line(monkeypatch, tmp_path):
                             mjcf=path)
         messages.append(str(e.value))
     assert messages[0] == messages[1] and "\n" not in messages[0]
+
+
+def test_a_mujoco_error_fails_only_that_batched_design(monkeypatch, tmp_path):
+    """The same starved arena in a batch: mujoco.batch raises for the designs whose ratchet rows do not fit,
+    and each of those ends as the serial engine's one-line error for the same model, word for word; a design
+    that needs no ratchet rows (no drive torque: it never moves) runs to the end in the same batch."""
+    from ipir_mujoco.engine import batch as batch_module
+
+    memory = []
+    starved_model(RobotParams(), memory)
+    path = tmp_path / "starved.xml"
+    path.write_text(edited_template('<compiler ', f'<size memory="{memory[0]}"/>\n  <compiler '))
+    build = batch_module.build_model
+    monkeypatch.setattr(batch_module, "build_model",
+                        lambda params, settings, mjcf=None, ratchet=False: build(params, settings, path, ratchet))
+    designs = [RobotParams(), RobotParams(M=0.1), RobotParams(M=0.0)]
+    outcomes = run_ratchet_batch(designs, 0.1, dt_out=1e-3, settings=SolverSettings(), nthread=1)
+    for params, outcome in zip(designs[:2], outcomes):
+        with pytest.raises(SimulationError) as serial:
+            simulate_mujoco(params, "unilateral", "ratchet", 0.1, dt_out=1e-3, settings=SolverSettings(), mjcf=path)
+        assert outcome["error"] == str(serial.value) and "\n" not in outcome["error"]
+        assert outcome["error"].startswith("MuJoCo failed after t=") and "memory" in outcome["error"]
+    assert "error" not in outcomes[2] and outcomes[2]["series"]["t"][-1] == pytest.approx(0.1)
 
 
 @pytest.mark.parametrize("flag, controller", [("mjDSBL_FRICTIONLOSS", "ratchet"), ("mjDSBL_EQUALITY", "lock")])

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import ast
+import re
+import shutil
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 from ipir_mujoco import analytic
-from ipir_mujoco.resources import mjcf_dir
-
+from ipir_mujoco.resources import docs_dir, mjcf_dir, shipped
 
 
 def _imports(path: Path, package: str) -> list[str]:
@@ -32,6 +34,8 @@ def _imports(path: Path, package: str) -> list[str]:
 
 def test_mjcf_folder_is_reachable():
     assert (mjcf_dir() / "README.md").is_file()
+    assert (docs_dir() / "model.md").is_file()
+    assert Path(shipped("docs/model.md")) == docs_dir() / "model.md"
 
 
 def test_analytic_never_imports_mujoco_or_the_physics_side():
@@ -117,3 +121,56 @@ def test_package_metadata():
     # the Dask scheduler is its own extra; the test extra pulls it in only for the Dask test of sweep
     assert any(r.startswith("dask[distributed]") for r in extras["dask"])
     assert "ipir-mujoco[dask]" in extras["test"] and not any(r.startswith("dask") for r in extras["test"])
+
+
+def _printed_text(path: Path) -> list[str]:
+    """The string literals of a module that are not docstrings (f-strings' literal parts included): what its
+    messages, help and reports can print."""
+    tree = ast.parse(path.read_text())
+    docstrings = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and node.body:
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+                docstrings.add(id(first.value))
+    return [node.value for node in ast.walk(tree)
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings]
+
+
+# repository files a user with only the wheel lacks (README.md at the top, not mjcf/README.md)
+REPOSITORY_ONLY = re.compile(r"(?<![\w/])(README\.md|bench/|tests/|setup\.py|pyproject\.toml)")
+DOCUMENT = re.compile(r"(?<![\w/])((?:docs|mjcf)/[\w.-]+\.\w+)")  # a shipped folder's file, as named
+
+
+def test_the_wheel_ships_every_document_the_output_names(tmp_path):
+    """Built from a clean copy of the checkout, the wheel holds the user docs (ipir_mujoco/docs) and the MJCF
+    folder; every docs/ or mjcf/ file the program's messages, help or report name is in it, their relative
+    links resolve inside it, and no printed text sends a user to a file only the repository has."""
+    source = tmp_path / "src"
+    shutil.copytree(REPOSITORY, source, ignore=shutil.ignore_patterns(
+        ".git", "build", "dist", "*.egg-info", "__pycache__", "*.so", ".pytest_cache", ".hypothesis"))
+    done = subprocess.run([sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "-q", "-w",
+                           str(tmp_path / "wheel")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    (wheel,) = (tmp_path / "wheel").glob("ipir_mujoco-*.whl")
+    names = set(zipfile.ZipFile(wheel).namelist())
+    for doc in ("docs/cli.md", "docs/model.md", "docs/citing.md", "docs/mechanism.png", "mjcf/README.md",
+                "mjcf/inchworm.xml"):
+        assert f"ipir_mujoco/{doc}" in names, doc
+    named, misdirected = set(), []
+    for path in sorted((REPOSITORY / "ipir_mujoco").rglob("*.py")) + sorted((REPOSITORY / "analytic").rglob("*.py")):
+        for text in _printed_text(path):
+            named.update(DOCUMENT.findall(text))
+            misdirected += [f"{path.name}: {hit}" for hit in REPOSITORY_ONLY.findall(text)]
+    assert {"docs/model.md", "mjcf/README.md"} <= named  # the validation report's, at least
+    assert not [n for n in named if f"ipir_mujoco/{n}" not in names]
+    assert not misdirected
+    for page in [n for n in names if n.startswith("ipir_mujoco/docs/") and n.endswith(".md")]:
+        text = zipfile.ZipFile(wheel).read(page).decode()
+        for target in re.findall(r"\]\(([^)#]+)\)", text):
+            if not target.startswith("http"):
+                resolved = (Path(page).parent / target).as_posix().split("/")
+                while ".." in resolved:  # fold "a/../" away
+                    i = resolved.index("..")
+                    del resolved[i - 1:i + 1]
+                assert "/".join(resolved) in names, f"{page} links to {target}"

@@ -31,6 +31,22 @@ def test_first_gap_minimum_interpolates_the_sign_change():
     assert first_gap_minimum(series["t"], -np.abs(series["S_dot"]) - 1) is None
 
 
+def test_the_first_gap_minimum_of_a_stall_is_where_the_robot_comes_to_rest():
+    """A robot that stalls while contracting: S_dot falls to rest at t = 0.36 s and stays there, as an exact
+    0 (the analytic engines) or as MuJoCo's creep of a held module (-1.4e-9 m/s, which never turns >= 0): both
+    series give the same minimum, the first sample at rest (S_dot reaching 0 between the samples is past it)."""
+    from ipir_mujoco.analytic.results import REST_SPEED
+
+    t = np.linspace(0.3, 0.4, 101)  # 1e-3 s apart
+    falling = np.where(t < 0.36 - 1e-12, -0.05 * (0.36 - t), 0.0)
+    for at_rest in (-0.0, -1.4e-9, 1e-12):
+        S_dot = np.where(t < 0.36 - 1e-12, falling, at_rest)
+        # a positive round-off moves the interpolated zero by 1e-3 s x 1e-12 / 5e-5 = 2e-11 s
+        assert first_gap_minimum(t, S_dot) == pytest.approx(0.36, abs=1e-10), at_rest
+    # a gap still falling at twice the rest speed has no minimum yet
+    assert first_gap_minimum(t, np.where(t < 0.36, falling, -2 * REST_SPEED)) is None
+
+
 def test_min_locked_reaction_ignores_clutches_that_are_not_locked():
     series = synthetic_series()
     # contraction lasts to t = 1 (lambda2 = 5 - t >= 4), expansion after (lambda1 = 3 + t >= 4)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import html
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -179,6 +180,11 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     assert "<script" not in page and "http://" not in page and "https://" not in page
     for text in (page, markdown, (out / "metrics.json").read_text()):
         assert not [ref for ref in OUTSIDE_REFERENCES if ref in text]
+    # the documents it names are where the report says they are on this machine (installed with the package)
+    from ipir_mujoco.resources import shipped
+
+    for doc in ("docs/model.md", "mjcf/README.md"):
+        assert f"{doc} as {shipped(doc)}" in markdown and Path(shipped(doc)).is_file()
     # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study; one figure per section
     from ipir_mujoco.report.sections import SECTIONS
 

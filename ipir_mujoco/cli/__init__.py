@@ -34,6 +34,7 @@ try:
     from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 
     from .. import __version__
+    from ..resources import shipped
     from . import climb, clutch_study, compare, kinetostatics, params, render, simulate, sweep, validate
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
@@ -48,7 +49,10 @@ COMMANDS = (simulate, validate, compare, sweep, kinetostatics, params, render, c
 def build_parser() -> Parser:
     parser = Parser(prog="ipir-mujoco",
                     description="Cross-check the analytic model of a two-module inchworm in-pipe robot "
-                                "against MuJoCo physics. 'ipir-mujoco params' lists every parameter.")
+                                "against MuJoCo physics. 'ipir-mujoco params' lists every parameter.",
+                    epilog=f"Documentation, installed with the package: {shipped('docs/cli.md')} (every command "
+                           f"and option), {shipped('docs/model.md')} (the model and its conventions), "
+                           f"{shipped('mjcf/README.md')} (the MuJoCo model and the evidence for its settings).")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     add_global_options(parser, top=True)
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)

@@ -10,6 +10,7 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import check_run_options, check_whole
 from ipir_mujoco.analytic.results import RunResult, write_json, write_mode_changes
 
+from ..labels import significant
 from ..output import check_output_dir, staged_output
 from ..report.plots import write_paper_figures
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
@@ -31,7 +32,8 @@ def add_parser(commands) -> None:
                      help="MuJoCo clutch implementation: joint-limit ratchet (default with --clutch unilateral) "
                           "or velocity-triggered lock (default with --clutch kinematic)")
     sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
-                     help="MuJoCo timestep (default: chosen from the motion; see the docs)")
+                     help="MuJoCo timestep [s] (default: chosen from the motion, by the rule in mjcf/README.md, "
+                          "installed with the package: see 'ipir-mujoco --help')")
     sim.add_argument("--accuracy", choices=("stop", "warn"), default="stop",
                      help="MuJoCo accuracy monitor: stop the run when the energy residual or the loop gap "
                           "exceeds its tolerance (default), or warn, record it in the summary and go on")
@@ -142,9 +144,9 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         "  energy [J]: " + _energy_line(e),
     ]
     if s["steady"]:
-        lines.append(f"  steady state from {s['t_steady_s']:.3f} s: {s['steady_speed_m_s']:.5g} m/s, "
-                     f"{s['distance_per_rev_m']:.5g} m per revolution, {s['energy_per_metre_j_m']:.5g} J/m, "
-                     f"efficiency {s['efficiency']:.5g}")
+        lines.append(f"  steady state from {s['t_steady_s']:.3f} s: {significant(s['steady_speed_m_s'], 5)} m/s, "
+                     f"{significant(s['distance_per_rev_m'], 5)} m per revolution, "
+                     f"{significant(s['energy_per_metre_j_m'], 5)} J/m, efficiency {significant(s['efficiency'], 5)}")
     elif until_steady:
         lines.append(f"  steady state            not reached by {run.t_end:g} s")
     if s["stalled"]:

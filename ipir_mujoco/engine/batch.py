@@ -21,9 +21,11 @@ forces (clutch reactions, rod force) are not exposed per simulation and are
 left out. Compliant clutches (a finite ``clutch_stiffness``) are not batched:
 such a design is reported with a one-line error (run it serially). A design
 that fails the monitor (``accuracy='stop'``), becomes unstable (MuJoCo resets
-it: its clock falls behind) or non-finite is reported
-with the reason and stops stepping; so does a steady (with ``until_steady``)
-or stalled one.
+it: its clock falls behind) or non-finite, or in which MuJoCo raises an error
+(``mujoco.batch.SimulationError``, e.g. its memory arena is too small: the
+serial engine's one-line "MuJoCo failed after t=... s: <reason>") is reported
+with the reason and stops stepping, the others going on; so does a steady
+(with ``until_steady``) or stalled one.
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ from .timestep import DT_MIN, choose_settings
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
 MODELLED_DRIVES = ("torque", "motor")  # each design's own actuator gain and bias (checked against the serial engine)
+_NONE = np.zeros(0, dtype=int)  # no simulation
 COLUMNS = ("t", "phi", "omega", "x1", "x2", "v1", "v2", "a1", "a2", "motor_work", "friction_work", "kinetic",
            "potential", "loop_gap")
 
@@ -173,7 +176,13 @@ class _Batch:
             set_closed_loop_state(model, data, params)
             self.qpos[k], self.qvel[k] = data.qpos, data.qvel
             ctrl[k, motor] = drive_control(params)
-        batch.forward()
+        self.record = {c: np.full((self.n_samples + 1, n), np.nan) for c in COLUMNS}
+        self.last_row = np.zeros(n, dtype=int)
+        self.failed: list[str | None] = [None] * n
+        self.inaccurate = [False] * n  # stopped by the accuracy monitor (a halved timestep may pass)
+        self.stall: list[str | None] = [None] * n
+        self.running = np.ones(n, dtype=bool)
+        self._call(batch.forward)
         self.slides_q = np.array([qpos_address(base, s) for s in SLIDES])
         self.slides_v = np.array([dof_address(base, s) for s in SLIDES])
         self.slide_joints = np.array([base.joint(s).id for s in SLIDES])
@@ -187,12 +196,6 @@ class _Batch:
         self.x_start = self.qpos[:, self.slides_q].copy()
         self.site, self.front, self.pin_offset = pin_offset(base)
 
-        self.record = {c: np.full((self.n_samples + 1, n), np.nan) for c in COLUMNS}
-        self.last_row = np.zeros(n, dtype=int)
-        self.failed: list[str | None] = [None] * n
-        self.inaccurate = [False] * n  # stopped by the accuracy monitor (a halved timestep may pass)
-        self.stall: list[str | None] = [None] * n
-        self.running = np.ones(n, dtype=bool)
         self.wm, self.wf = np.zeros(n), np.zeros(n)
         self.excursion = np.zeros(n)
         self.monitors = [AccuracyMonitor(Tolerances.for_params(p), self.accuracy, s.timestep)
@@ -223,6 +226,7 @@ class _Batch:
             ids = None if stepping.all() else np.flatnonzero(stepping)
             v_before = self.qvel.copy()
             dt = np.where(stepping, self.dt, 0.0)
+            torque = None  # stays None if MuJoCo fails every simulation in the first substep
             for j in range(substeps):
                 q = self.qpos[:, slides_q]
                 np.maximum(self.excursion, np.max(self.bounds - q, axis=1), out=self.excursion)
@@ -232,19 +236,24 @@ class _Batch:
                 if uniform:
                     if j == substeps - 1:
                         v_before[:] = self.qvel
-                        batch.step(ids, stage=vel_stage)
+                        failed = self._call(batch.step, ids, stage=vel_stage)
                     else:
-                        batch.step(ids)
+                        failed = self._call(batch.step, ids)
                 else:
                     active = steps > j
                     dt = np.where(active, self.dt, 0.0)
                     ending = np.flatnonzero(active & (steps == j + 1))
                     going = np.flatnonzero(steps > j + 1)
                     v_before[ending] = self.qvel[ending]
-                    if going.size:
-                        batch.step(going)
+                    failed = self._call(batch.step, going) if going.size else _NONE
                     if ending.size:
-                        batch.step(ending, stage=vel_stage)
+                        failed = np.concatenate([failed, self._call(batch.step, ending, stage=vel_stage)])
+                if failed.size:  # those kept their state before the step and take no more
+                    steps[failed] = 0
+                    stepping = steps > 0
+                    ids = np.flatnonzero(stepping)
+                    if not ids.size:
+                        break
                 omega = self.qvel[:, crank_v]
                 torque = self.force[:, self.motor] + self.slope * (omega - omega_prev)
                 self.wm += torque * omega * dt
@@ -254,6 +263,22 @@ class _Batch:
             self._check_health(s, stepping, done)
             if s % block == 0 or s == self.n_samples:
                 self._block(s)
+
+    def _call(self, method, ids: np.ndarray | None = None, **options) -> np.ndarray:
+        """``method(ids, **options)`` (the batch's step or forward); the simulations in which MuJoCo raised
+        (they keep their state from before the call, the others complete it) fail with the serial
+        engine's one-line message. Returns their ids."""
+        try:
+            method(ids, **options)
+        except mjbatch.SimulationError as exc:
+            for k in exc.ids:
+                k = int(k)
+                row = int(self.last_row[k])
+                t_good = float(self.record["t"][row, k]) if np.isfinite(self.record["t"][row, k]) else 0.0
+                reason = " ".join(self.batch.error(k).split())
+                self._finish(k, error=f"MuJoCo failed after t={t_good:.6g} s: {reason}")
+            return np.asarray(exc.ids, dtype=int)
+        return _NONE
 
     def _sample(self, s: int, v_before: np.ndarray, stepped: np.ndarray, torque: np.ndarray | None = None) -> None:
         """Record row ``s`` for the simulations that stepped into it, and feed their monitors."""

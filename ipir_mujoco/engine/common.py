@@ -19,11 +19,11 @@ import numpy as np
 from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 from ipir_mujoco.analytic.params import check_run_options as shared_run_options
+from ipir_mujoco.analytic.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
 
 from .clutches import refuse_compliant
 from .model import check_params
 
-REST_SPEED = 1e-6  # m/s: modules and crank pin slower are at rest (a held module creeps at 1e-9..1e-8 m/s)
 REST_TIME = 0.1  # s: at rest this long under constant loads is a stall
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often

@@ -87,7 +87,7 @@ class CompliantClutches:
                                  "[0, ...]: build the model from these parameters, with a finite clutch_stiffness")
             model.actuator_biasprm[u, 2] = -c  # the damper as built (a model that has run may hold 0)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
-        # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler and RK4 do not
+        # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler does not
         self.implicit = implicit_damping(model)
         self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm
         self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force

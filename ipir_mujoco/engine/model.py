@@ -40,10 +40,13 @@ RANGE_FAR = 1e6
 # state value (mjMAXVAL), far beyond any clutch force a run survives.
 CLUTCH_FORCE_MAX = 1e10
 
+# The integrators the engines allow. Not RK4: the engines read a step's energies, drive torque and
+# frictionloss forces from mjData after mj_step, which under RK4 are its last stage's, not the step's (the
+# serial engine's kinetic energy at t = 1 ms of the motor case read 1.47e-4 J against 1.22e-4 J).
 INTEGRATORS = {"euler": mujoco.mjtIntegrator.mjINT_EULER, "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-               "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT, "rk4": mujoco.mjtIntegrator.mjINT_RK4}
+               "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT}
 # the integrators that treat an actuator's velocity term (its damping) implicitly, through MuJoCo's D matrix;
-# Euler and RK4 apply it explicitly, at the step's starting velocity
+# Euler applies it explicitly, at the step's starting velocity
 IMPLICIT_INTEGRATORS = (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
 
 
@@ -63,7 +66,10 @@ class SolverSettings:
     constant of every constraint: the loop, clutch limits and locks, and the
     resistances' friction rows. ``solimp`` is MuJoCo's impedance triple, by
     default its largest impedance 0.9999 (a soft row leaks 1 - d of the free
-    acceleration it resists).
+    acceleration it resists). ``integrator``: 'implicitfast' (default),
+    'implicit' or 'euler' (:data:`INTEGRATORS`); MuJoCo's 'rk4' is refused, as
+    the engines' energy and work bookkeeping reads a step's values after it,
+    which under RK4 are its last stage's.
     """
 
     timestep: float = 1e-4
@@ -204,7 +210,7 @@ def drive_torque_slope(model: mujoco.MjModel) -> float:
     MuJoCo's ``actuator_force`` is the drive's torque at the step's starting speed omega_n; the implicit
     integrators apply the velocity term at the final speed, so the torque applied over the step is
     actuator_force + slope (omega_{n+1} - omega_n) with slope = biasprm[2] (the motor's -M_stall /
-    omega_noload; 0 for a constant torque). Euler and RK4 apply actuator_force itself: slope 0. The
+    omega_noload; 0 for a constant torque). Euler applies actuator_force itself: slope 0. The
     builder writes gear 1, so the actuator's force is the crank torque. Serial and batched runs both
     count the drive's work with this slope.
     """

@@ -170,8 +170,8 @@ def _findings(metrics: dict) -> list[str]:
         f"clutches change it by {pct(_change(rungs, ONE_WAY, 'steady_speed_m_s', ROD))} against the same mechanism "
         f"with the paper's locks, to {one_way['steady_speed_m_s']:.4g} m/s (reached after "
         f"{one_way['t_steady_s']:.3g} s): a module that is no longer pushed coasts on against its resistance instead "
-        f"of being stopped by its lock, so each revolution carries the robot {one_way['distance_per_rev_m']:.4g} m "
-        f"instead of {rod['distance_per_rev_m']:.4g} m, while the crank turns at nearly the same mean speed "
+        f"of being stopped by its lock, so each revolution carries the robot {fmt(one_way['distance_per_rev_m'])} m "
+        f"instead of {fmt(rod['distance_per_rev_m'])} m, while the crank turns at nearly the same mean speed "
         f"({one_way['crank_speed_rad_s']:.4g} against {rod['crank_speed_rad_s']:.4g} rad/s). Altogether the "
         f"paper's model is {pct(-speed / (1 + speed) if speed is not None else None)} off the cruising speed of "
         "the robot with one-way clutches.",
@@ -251,8 +251,8 @@ def verdict(metrics: dict) -> dict | None:
         f"{paper['steady_speed_m_s']:.4g} m/s where the robot with one-way clutches cruises at "
         f"{one_way['steady_speed_m_s']:.4g} m/s{mj}: "
         f"{pct((paper['steady_speed_m_s'] - one_way['steady_speed_m_s']) / one_way['steady_speed_m_s'])}, because its "
-        f"locks stop each module instead of letting it coast ({paper['distance_per_rev_m']:.4g} against "
-        f"{one_way['distance_per_rev_m']:.4g} m per revolution). Energy per metre is set by the load, not by the model: "
+        f"locks stop each module instead of letting it coast ({fmt(paper['distance_per_rev_m'])} against "
+        f"{fmt(one_way['distance_per_rev_m'])} m per revolution). Energy per metre is set by the load, not by the model: "
         f"{paper['energy_per_metre_j_m']:.4f} against {one_way['energy_per_metre_j_m']:.4f} J/m ("
         + ("= F_r1 + F_r2" if metrics["params"]["incline"] == 0 else "the resistances and the climb")
         + f": rigid clutches dissipate nothing); the peak clutch reaction at cruise is {paper['peak_clutch_force_n']:.3g} N "

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
+from ..labels import significant
+
 
 @dataclass
 class Heading:
@@ -40,12 +42,13 @@ class Image:
 
 
 def fmt(value, digits: int = 4) -> str:
-    """A number to ``digits`` significant digits; 'n/a' for None or a non-finite value."""
+    """A number to ``digits`` significant digits, trailing zeros kept (:func:`..labels.significant`); 'n/a'
+    for None or a non-finite value."""
     if value is None:
         return "n/a"
     if isinstance(value, float) and not math.isfinite(value):
         return "n/a"
-    return f"{value:.{digits}g}"
+    return significant(value, digits)
 
 
 def pct(value) -> str:

@@ -20,6 +20,7 @@ import numpy as np
 from ipir_mujoco.analytic.results import Mode
 
 from ..labels import summary_label
+from ..resources import shipped
 from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Paragraph, Table, fmt, pct, to_html, to_markdown
 from .plots import new_figure, write_paper_figures
@@ -316,7 +317,9 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                             + " MuJoCo: " + _mujoco_settings_text(settings) + " (evidence: the package's mjcf/README.md)."))
     blocks.append(Table(["software", "version"], [[k, v] for k, v in metrics["versions"].items()]))
     blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/studies/validate.py); "
-                            "the model and its conventions are in docs/model.md."))
+                            "the model and its conventions are in docs/model.md. The documents this report names "
+                            f"are installed with the package: docs/model.md as {shipped('docs/model.md')}, "
+                            f"mjcf/README.md as {shipped('mjcf/README.md')}."))
     return blocks
 
 

@@ -41,7 +41,7 @@ from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.params import RobotParams, check_real
-from ipir_mujoco.analytic.results import RunResult
+from ipir_mujoco.analytic.results import REST_SPEED, RunResult  # REST_SPEED: m/s, at rest below it
 
 from .sweep_metrics import mean_speed
 from .sweep_space import ENGINES as RUNNABLE
@@ -54,8 +54,6 @@ GRID = 3600  # crank angles per revolution scanned before refining the hardest o
 T_END = 10.0  # s: cap of a run to steady state (the sweep's)
 T_END_TORQUE = 1.0  # s: length of a constant-torque run (the paper's); it accelerates, so a longer one costs more
 DT_OUT = 1e-3  # s: output interval of the study's runs (the sweep's)
-# m/s: crank pin and modules slower are at rest (MuJoCo's stall test; its held modules creep at 1e-9..1e-8 m/s)
-REST_SPEED = 1e-6
 TOLERANCE_DEG = 0.1  # width of the bracket the bisection stops at [deg]
 Progress = Callable[[str], None]
 

@@ -211,7 +211,7 @@ def _figures_until(run: RunResult, t_end: float) -> dict:
 
 def format_comparison(result: dict) -> str:
     """A readable table of :func:`compare_runs`' result: names with units, aligned columns, the tolerance."""
-    from ..labels import SERIES, SUMMARY
+    from ..labels import SERIES, SUMMARY, significant
 
     def unit_of(table, key):
         name, unit = table.get(key, (key, ""))
@@ -227,8 +227,8 @@ def format_comparison(result: dict) -> str:
         if key in STEADY_FIGURES and v["a"] is None and v["b"] is None:
             continue  # neither run has it (neither reached its steady state): not a row of empty cells
         name, unit = unit_of(SUMMARY, key)
-        rows.append((name, unit, "none" if v["a"] is None else f"{v['a'] + 0.0:.6g}",  # + 0.0: no '-0'
-                     "none" if v["b"] is None else f"{v['b'] + 0.0:.6g}",
+        rows.append((name, unit, "none" if v["a"] is None else significant(v["a"], 6),
+                     "none" if v["b"] is None else significant(v["b"], 6),
                      "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"))
     lines += _aligned(rows)
     tolerance = result["tolerance"]
