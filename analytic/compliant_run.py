@@ -273,7 +273,8 @@ def _force_peaks(model: CompliantModel, regime: Regime, t0: float, t1: float, so
     With damping it peaks between samples, where the output grid alone reads it low by up to
     (omega_c dt_out)^2 / 8 (measured: 1.2e-3 at 1e7 N/m, 300 N s/m, dt_out 1e-4 s). Scanned at the
     solver's step ends and points between, each local maximum is located with a bounded Brent search on
-    the dense output (to sqrt(eps) of the time: a force error of (omega_c 1.5e-8 t)^2, far below 1e-8).
+    the dense output (to sqrt(eps) of the time: a relative force error of (omega_c 1.5e-8 t)^2, 2.2e-9
+    at 1e7 N/m over 1 s, growing as t^2).
     """
     engaged = [i for i in (0, 1) if regime.clutch[i] is Clutch.ENGAGED]
     if model.c == 0 or not engaged or not t1 > t0:
