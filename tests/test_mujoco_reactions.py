@@ -20,7 +20,7 @@ from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.analytic.cycles import cycles
 from ipir_mujoco.analytic.results import Mode, mode_changes
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.studies.compare import match_switches
+from ipir_mujoco.studies.compare import compare_runs, format_comparison, match_switches
 
 # a module starts or stops sliding 4 times a revolution at the default motor's cruise: one-way clutches
 # switch contraction, both moving, expansion, both moving; the paper's rule switches at the two dead centres,
@@ -127,3 +127,15 @@ def test_lock_reactions_at_cruise_agree_with_the_equations(rule):
     tau = mj.settings["constraint_time_constant"]
     bound = TRANSITIONS_PER_REV * max(params.F_r1, params.F_r2) * 2 * tau * revolutions / T
     assert mean_hold(mj) == pytest.approx(mean_hold(eq), abs=bound)
+
+
+def test_compare_says_what_mujocos_peak_and_first_switch_are(cruise):
+    """compare flags the two figures of a rigid MuJoCo clutch that are not the physics: the peak force (the
+    soft engagement's overshoot) and the extra mode change of its start from rest; not for the equations."""
+    eq, mj = cruise
+    notes = compare_runs(eq, mj)["notes"]
+    assert len(notes) == 2 and all(note.count(" of b ") == 1 for note in notes)
+    first = mode_changes(mj.series)[0]
+    assert "peak clutch force" in notes[0] and f"t={first['t']:.3g} s, both_locked -> {first['to']}" in notes[1]
+    assert compare_runs(eq, eq)["notes"] == []
+    assert "note: first mode change of b" in format_comparison(compare_runs(eq, mj))
