@@ -116,7 +116,8 @@ def test_held_modes_match_on_the_papers_case():
 def test_lock_reactions_at_cruise_agree_with_the_equations(rule):
     """MuJoCo's locks, by the same convention (the paper's rule: the lock carries a held module's whole hold,
     as the paper's model, which gives it no resistance). Old readings (the lock row alone): +21 % (paper's
-    rule) and +4.4 % (one-way rule) in the mean clutch force at cruise."""
+    rule) and +4.4 % (one-way rule) in the mean clutch force at cruise; and under the one-way rule the
+    same held modes as the ratchet's."""
     params = RobotParams(drive="motor")
     eq = analytic.simulate(params, "exact", rule, 4.0, dt_out=1e-4, until_steady=True)
     mj = mujoco_at_every_step(params, rule, "lock", 4.0, until_steady=True)
@@ -127,6 +128,10 @@ def test_lock_reactions_at_cruise_agree_with_the_equations(rule):
     tau = mj.settings["constraint_time_constant"]
     bound = TRANSITIONS_PER_REV * max(params.F_r1, params.F_r2) * 2 * tau * revolutions / T
     assert mean_hold(mj) == pytest.approx(mean_hold(eq), abs=bound)
+    if rule == "unilateral":
+        # held while it stands, locked or on static friction: a lock lets go as soon as its row would pull,
+        # and read as the lock's state the releases came 5 ms before the equations'
+        assert_switches_match(eq, mj)
 
 
 def test_compare_says_what_mujocos_peak_and_first_switch_are(cruise):

@@ -254,22 +254,27 @@ class Locks:
         return forces
 
     def reactions(self) -> tuple[bool, bool, float, float]:
-        """(rear locked, front locked, rear reaction [N], front reaction [N]) of the last step.
+        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
 
         A locked module's total hold is its lock row plus its friction row (see the module docstring).
-        Under the paper's rule the lock carries all of it while the other module moves, as the paper's
-        model has it (a held module there has no resistance, and a lock that pulls is what the rule
-        reveals); with both locked, and under the one-way rule, the resistance takes a forward push up to
-        F_r (:func:`clutch_share`), as the analytic models do.
+        Under the paper's rule a module is held while it is locked, and the lock carries the whole hold
+        while the other module moves, as the paper's model has it (a held module there has no resistance,
+        and a lock that pulls is what the rule reveals). Under the one-way rule a module is held while it
+        stands, locked or on its static friction (its row above -F_r: a lock lets go as soon as its row
+        would pull, up to ~5 ms before the push on the module exceeds F_r), as the ratchet's; there, and
+        with both locked under the paper's rule, the resistance takes a forward push up to F_r
+        (:func:`clutch_share`), as the analytic models do.
         """
         forces = self._lock_forces()
         friction = friction_forces(self.data, self.dof_adr)
-        whole = self.rule == "kinematic" and not all(self.held)
-        out = []
+        kinematic = self.rule == "kinematic"
+        whole = kinematic and not all(self.held)
+        held, out = [], []
         for i in (0, 1):
+            held.append(self.held[i] or (not kinematic and friction[i] > -self.resistance[i]))
             hold = forces[i] + friction[i]
-            out.append(0.0 if not self.held[i] else hold if whole else clutch_share(hold, self.resistance[i]))
-        return self.held[0], self.held[1], out[0], out[1]
+            out.append(0.0 if not held[i] else hold if whole else clutch_share(hold, self.resistance[i]))
+        return held[0], held[1], out[0], out[1]
 
 
 class NoClutch:
