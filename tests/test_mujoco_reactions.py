@@ -17,7 +17,7 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.cycles import cycles
+from ipir_mujoco.analytic.cycles import STEADY_CYCLES, cycles
 from ipir_mujoco.analytic.results import Mode, mode_changes
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.studies.compare import compare_runs, format_comparison, match_switches
@@ -144,3 +144,24 @@ def test_compare_says_what_mujocos_peak_and_first_switch_are(cruise):
     assert "peak clutch force" in notes[0] and f"t={first['t']:.3g} s, both_locked -> {first['to']}" in notes[1]
     assert compare_runs(eq, eq)["notes"] == []
     assert "note: first mode change of b" in format_comparison(compare_runs(eq, mj))
+
+
+def test_climbs_mean_clutch_force_is_mujocos_impulse():
+    """climb's table reads MuJoCo at every step: read every 1 ms, the one-step engagement peaks of the paper's
+    rule's locks aliased its mean clutch force at the default motor's cruise to 0.765 N.
+
+    Under the paper's rule exactly one module slides at any time, so over whole revolutions of the periodic
+    state the momentum balance makes the mean clutch force F_r (F_r1 = F_r2 here), with no sampling error."""
+    from ipir_mujoco.engine.timestep import choose_settings
+    from ipir_mujoco.studies import climbing
+
+    params = RobotParams(drive="motor")
+    assert params.F_r1 == params.F_r2
+    lock = climbing.incline_curve(params, [0.0], engines=("mujoco-lock",))[0]["engines"]["mujoco-lock"]
+    assert lock["steady"]
+    tau = 2 * choose_settings(params, climbing.T_END, climbing.DT_OUT, clutch="lock")[0].timestep
+    # the steady window: STEADY_CYCLES revolutions, each at least 2 pi / omega_noload long (the motor's bound)
+    n = STEADY_CYCLES
+    shortest = n * 2 * np.pi / params.omega_noload
+    bound = TRANSITIONS_PER_REV * params.F_r1 * 2 * tau * n / shortest
+    assert lock["mean_clutch_force_n"] == pytest.approx(params.F_r1, abs=bound)

@@ -132,8 +132,9 @@ def _limit(record: dict) -> str:
 
 # what the MuJoCo columns are, measured at the default motor (mjcf/README.md, "Reactions and held modules")
 MUJOCO_NOTE = ("MuJoCo's rigid clutch: no peak (its soft engagement overshoots by an amount the timestep sets: "
-               "16.3 N at every 0.1 ms step against the equations' 12.1 N at cruise); its mean, read every 1 ms, "
-               "is within 0.3 % of the equations' (0.05 % read at every step; default motor, 0-60 deg)")
+               "16.3 N at every 0.1 ms step against the equations' 12.1 N at cruise); its mean, read at every step, "
+               "is within 0.05 % of the equations' with one-way clutches, 0.35 % under the paper's rule (default "
+               "motor, 0-70 deg)")
 
 
 def format_study(study: dict, params) -> str:
