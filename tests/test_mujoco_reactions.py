@@ -18,7 +18,7 @@ import pytest
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.analytic.cycles import STEADY_CYCLES, cycles
-from ipir_mujoco.analytic.results import Mode, mode_changes
+from ipir_mujoco.analytic.results import Mode
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.studies.compare import compare_runs, format_comparison, match_switches
 
@@ -86,17 +86,16 @@ def test_mean_clutch_force_at_cruise_agrees_between_engines(cruise):
 
 
 def assert_switches_match(eq, mj):
-    """Every switch of the equations has MuJoCo's counterpart within two constraint time constants, and
-    MuJoCo has one more: at the start from rest, where its soft friction rows take 1.5 time constants to
-    reach F_r (the modules are then both held at rest) while the equations' rear module slides at once."""
+    """Every switch of the equations has MuJoCo's counterpart within two constraint time constants (the soft
+    rows' response), and MuJoCo has no other: not at the start from rest, where its soft friction rows take
+    1.5 time constants to reach F_r while the equations' rear module slides at once (both modules stand,
+    the crank turns: a dead-centre passage, given to the mode it leads to)."""
     tau = mj.settings["constraint_time_constant"]
     matched = match_switches(eq, mj)
-    assert matched["unmatched_a"] == 0 and matched["unmatched_b"] == 1
+    assert matched["unmatched_a"] == 0 and matched["unmatched_b"] == 0
     assert matched["max_abs_dt"] <= 2 * tau
-    assert mj.summary["mode_switches"] == eq.summary["mode_switches"] + 1
-    first = mode_changes(mj.series)[0]
-    assert first["from"] == "both_locked" and first["t"] <= 3 * tau
-    assert mj.series["mode"][0] == Mode.BOTH_LOCKED and mode_changes(eq.series)[0]["t"] > 0.1
+    assert mj.summary["mode_switches"] == eq.summary["mode_switches"]
+    assert mj.series["mode"][0] == eq.series["mode"][0] != Mode.BOTH_LOCKED
 
 
 def test_held_modes_do_not_chatter_at_cruise(cruise):
@@ -105,11 +104,16 @@ def test_held_modes_do_not_chatter_at_cruise(cruise):
     assert_switches_match(*cruise)
 
 
-def test_held_modes_match_on_the_papers_case():
-    """The paper's case (constant torque, 1 s): old reading 30 switches against 29, releases 3.4 ms early."""
-    params = RobotParams()
-    assert_switches_match(analytic.simulate(params, "exact", "unilateral", 1.0),
-                          mujoco_at_every_step(params, "unilateral", "ratchet", 1.0))
+@pytest.mark.parametrize("params, t_end", [(RobotParams(), 1.0), (RobotParams(drive="motor", incline=60.0), 2.5)],
+                         ids=["paper's case", "60 deg"])
+def test_held_modes_match_on_the_papers_case_and_a_steep_climb(params, t_end):
+    """The paper's case (constant torque, 1 s): old reading 30 switches against 29, releases 3.4 ms early.
+    The default motor up a 60 deg pipe, where every switch is a hand-over at a dead centre (one module
+    stops as the other starts): MuJoCo's step may order the two a step apart, both modules held for that
+    step while the crank turns, a dead-centre passage that belongs to the mode it leads to (read as a mode
+    of its own: 13 switches against 9 over 3 s)."""
+    assert_switches_match(analytic.simulate(params, "exact", "unilateral", t_end),
+                          mujoco_at_every_step(params, "unilateral", "ratchet", t_end))
 
 
 @pytest.mark.parametrize("rule", ["kinematic", "unilateral"])
@@ -134,16 +138,14 @@ def test_lock_reactions_at_cruise_agree_with_the_equations(rule):
         assert_switches_match(eq, mj)
 
 
-def test_compare_says_what_mujocos_peak_and_first_switch_are(cruise):
-    """compare flags the two figures of a rigid MuJoCo clutch that are not the physics: the peak force (the
-    soft engagement's overshoot) and the extra mode change of its start from rest; not for the equations."""
+def test_compare_says_what_mujocos_peak_is(cruise):
+    """compare flags the figure of a rigid MuJoCo clutch that is not the physics, its peak force (the soft
+    engagement's overshoot); not for the equations."""
     eq, mj = cruise
     notes = compare_runs(eq, mj)["notes"]
-    assert len(notes) == 2 and all(note.count(" of b ") == 1 for note in notes)
-    first = mode_changes(mj.series)[0]
-    assert "peak clutch force" in notes[0] and f"t={first['t']:.3g} s, both_locked -> {first['to']}" in notes[1]
+    assert len(notes) == 1 and "peak clutch force of b (MuJoCo, rigid clutch)" in notes[0]
     assert compare_runs(eq, eq)["notes"] == []
-    assert "note: first mode change of b" in format_comparison(compare_runs(eq, mj))
+    assert "note: peak clutch force of b" in format_comparison(compare_runs(eq, mj))
 
 
 def test_climbs_mean_clutch_force_is_mujocos_impulse():

@@ -24,8 +24,8 @@ crank angle removes the error a small phase lag inflates at matching time
     first_exceedance         {quantity: t or null}: first time |a - b| exceeds
                              tolerance * scale on the time grid
     tolerance                the relative tolerance used there
-    notes                    [str]: what a figure above does not mean (MuJoCo's rigid clutch's peak force,
-                             its start from rest), one line each
+    notes                    [str]: what a figure above does not mean (MuJoCo's rigid clutch's peak force),
+                             one line each
     t_end_a_s, t_end_b_s     where each run ends; t_compared_s, the shorter of them
 """
 
@@ -202,21 +202,12 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
 
 def _notes(label: str, run: RunResult) -> list[str]:
     """What a MuJoCo run's figures do not mean (measured at the default motor: mjcf/README.md, "Reactions and
-    held modules"): a rigid clutch's peak force, and the first mode change of a start from rest."""
+    held modules"): a rigid clutch's peak force."""
     if run.engine != "mujoco" or run.clutch == "none" or run.settings.get("clutch_model") == "compliant":
         return []
-    notes = [f"peak clutch force of {label} (MuJoCo, rigid clutch): the overshoot of its soft engagement, set by "
-             "the timestep and by the step a sample falls on (16.3 N at every 0.1 ms step, 11.8 N read every "
-             "1 ms, against the equations' 12.1 N at the default motor's cruise), not a physical figure"]
-    changes = mode_changes(run.series)
-    tau, dt_out = run.settings.get("constraint_time_constant"), run.settings.get("dt_out", 0.0)
-    first = changes[0] if changes else None
-    if (first and tau and first["from"] == "both_locked" and first["t"] <= 3 * tau + dt_out
-            and run.series["v1"][0] == 0 and run.series["v2"][0] == 0):
-        notes.append(f"first mode change of {label} (t={first['t']:.3g} s, both_locked -> {first['to']}): MuJoCo's "
-                     "soft friction rows take about 3 steps from rest to reach F_r, and a module counts as held "
-                     "until its row slides; the equations' module slides at once")
-    return notes
+    return [f"peak clutch force of {label} (MuJoCo, rigid clutch): the overshoot of its soft engagement, set by "
+            "the timestep and by the step a sample falls on (16.3 N at every 0.1 ms step, 11.8 N read every 1 ms, "
+            "against the equations' 12.1 N at the default motor's cruise), not a physical figure"]
 
 
 def _figures_until(run: RunResult, t_end: float) -> dict:
