@@ -105,12 +105,13 @@ def _held_after_engagement(run, start: float) -> np.ndarray:
 
 
 @pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
-def test_mujocos_held_reaction_is_the_equations_within_the_resistance_share(runs, pair):
+def test_mujocos_held_reaction_is_the_equations_after_engagement(runs, pair):
     """The peak clutch reaction is not held to TOL: MuJoCo's soft clutch overshoots for a step or two where
-    it engages (left out here: the first sample of each hold), and a held module's static friction takes up
-    to F_r of the hold the rigid equations give entirely to the clutch. So after its engagement MuJoCo's
-    reaction lies within F_r of the equations' peak, less what the equations' reaction falls in the two
-    output intervals by which MuJoCo's second held sample can follow the engagement."""
+    it engages (left out here: the first sample of each hold). Both engines split a held module's hold
+    between clutch and static friction by one convention (engine/clutches.py), so after its engagement
+    MuJoCo's reaction reaches the equations' peak within the cross-check tolerance TOL, less what the
+    equations' reaction falls in the two output intervals by which MuJoCo's second held sample can follow
+    the engagement. (Read from the clutch row alone, it lay up to F_r above: 1 N more was allowed then.)"""
     equations, mujoco = runs[pair]
     start = cycles(mujoco.series)[-STEADY_CYCLES].t_start
     peak, settled = equations.summary["peak_clutch_force_n"], _held_after_engagement(mujoco, start)
@@ -123,8 +124,7 @@ def test_mujocos_held_reaction_is_the_equations_within_the_resistance_share(runs
         for i in np.flatnonzero(held & ~np.concatenate([[False], held[:-1]])):
             if t[i] >= start:
                 fall = max(fall, s[column][i] - np.interp(t[i] + dt, t[keep], s[column][keep]))
-    share = max(MOTOR.F_r1, MOTOR.F_r2)
-    assert peak - share - fall <= settled <= peak + share
+    assert peak - fall <= settled <= peak * (1 + TOL)
 
 
 def test_simulate_reaches_steady_state_in_both_engines_and_they_agree(capsys):

@@ -105,7 +105,9 @@ def test_stalled_robot_holds_with_the_statics_of_the_linkage():
     # soft constraints settle to their static load within a few time constants (2e-4 s)
     assert s["rod_force"][-1] == pytest.approx(params.M / (params.r * e_x), rel=1e-5)
     assert s["lambda2"][-1] == pytest.approx(params.M / params.r, rel=1e-5)
-    assert s["lambda1"][-1] == 0.0 and s["mode"][-1] == Mode.CONTRACTION
+    # module 1 stands on its static friction, its lock open: held, as in the equations' stall (both held)
+    assert s["lambda1"][-1] == 0.0 and s["mode"][-1] == Mode.BOTH_LOCKED
+    assert analytic.simulate(params, "exact", "unilateral", 0.3).series["mode"][-1] == Mode.BOTH_LOCKED
     # constraint compliance under 0.2 N: displacements far below a micrometre
     assert np.max(np.abs(s["x1"])) < 1e-6 and np.max(np.abs(s["x2"])) < 1e-6
     assert np.max(np.abs(s["phi"] - params.phi0)) < 1e-5

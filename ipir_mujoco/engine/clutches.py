@@ -3,8 +3,23 @@
 A controller is called before every ``mj_step`` (:meth:`before_step`) and, if
 it needs the step's constraint forces, after it (:meth:`after_step`; None when
 it does not). At the output samples :meth:`reactions` reports per module
-whether its clutch holds and the clutch's reaction force [N] (positive pushes
+whether it is held and the clutch's reaction force [N] (positive pushes
 the module forward), read from MuJoCo's constraint rows of the step just taken.
+
+A held module stands on two supports at once, its clutch row and its
+resistance's frictionloss row, and a rigid model leaves the split between them
+undetermined; only their sum, the module's total hold R_i, is. MuJoCo's soft
+solution splits it its own way: while the soft ratchet limit relaxes, the held
+module creeps forward at ~1e-9 m/s and its friction row pulls back with the
+whole F_r, which the limit row then carries on top of the load (+0.135 N of the
+mean clutch force at the default motor's cruise, 8 %); where neither saturates
+the two rows share the load about equally. So the reported reaction follows the
+package's one convention (:func:`clutch_share`, the analytic models' too): of
+the total hold, the resistance takes a forward push (R_i < 0, up to F_ri), the
+clutch everything else. And a module is held while it stands, i.e. while its
+clutch row pushes or its friction row sticks (below F_ri): not only while the
+clutch row pushes, which flickers on and off for ~1 ms before each release as
+the friction row takes over the last of the load.
 These run every step, so they work on Python floats and touch only the few
 entries they need; :mod:`.stepper` runs the same rules compiled (a change here
 is a change there: its test compares the two bit for bit).
@@ -38,6 +53,26 @@ def missing_rows(code: int, t: float) -> SimulationError:
     return SimulationError(f"MuJoCo's step to t={t:.6g} s produced no {MISSING_ROWS[code]} (a constraint "
                            "disabled in the model's options?): the run cannot measure the clutch and the "
                            "resistances")
+
+
+def friction_forces(data: mujoco.MjData, dofs: list[int]) -> list[float]:
+    """The frictionloss rows' forces [N] of the last step on the dofs ``dofs`` (0.0 for a dof without a
+    row): MuJoCo puts them after the equality rows, one per dof with friction, in dof order."""
+    out = [0.0] * len(dofs)
+    ids, forces = data.efc_id, data.efc_force
+    for row in range(data.ne, data.ne + data.nf):
+        dof = int(ids[row])
+        if dof in dofs:
+            out[dofs.index(dof)] = float(forces[row])
+    return out
+
+
+def clutch_share(hold: float, resistance: float) -> float:
+    """The clutch's part [N] of a held module's total hold ``hold`` [N] (clutch plus static resistance, > 0
+    forward), with ``resistance`` [N] the module's F_r: the resistance takes a forward push (hold < 0) up to
+    F_r, the clutch the rest (a lock may pull beyond it). The analytic models' convention: a one-way clutch
+    reports max(hold, 0)."""
+    return hold - min(max(hold, -resistance), 0.0)
 
 
 def equality_row(model: mujoco.MjModel, data: mujoco.MjData, eq_id: int) -> int:
@@ -83,6 +118,8 @@ class Ratchet:
             self.range[j, 0] = b - margin
         self.excursion = 0.0
         self._qpos = data.qpos
+        self.dof_adr = [dof_address(model, n) for n in SLIDES]
+        self.resistance = [float(model.dof_frictionloss[a]) for a in self.dof_adr]  # F_r1, F_r2 [N]
 
     def before_step(self) -> None:
         # unrolled for the two slides: this runs before every step
@@ -104,8 +141,11 @@ class Ratchet:
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
 
-        The limit rows follow the equality and friction rows, in joint order, and
-        only the two slides are limited (checked at construction).
+        A module is held while its limit row pushes or its friction row sticks (a force above -F_r: a
+        sliding module's row sits at exactly -F_r, MuJoCo's bound); its reaction is the clutch's share
+        (:func:`clutch_share`) of limit plus friction row, 0 while it slides (see the module docstring).
+        The limit rows follow the equality and friction rows, in joint order, and only the two slides
+        are limited (checked at construction).
         """
         d = self.data
         start, nl = d.ne + d.nf, d.nl
@@ -118,7 +158,12 @@ class Ratchet:
             rear, front = (force, 0.0) if d.efc_id[start] == self.joint_ids[0] else (0.0, force)
         else:
             rear = front = 0.0
-        return rear > 0.0, front > 0.0, rear, front
+        out = []
+        for limit, friction, resistance in zip((rear, front), friction_forces(d, self.dof_adr), self.resistance):
+            held = limit > 0.0 or friction > -resistance
+            out.append((held, clutch_share(limit + friction, resistance) if held else 0.0))
+        (held1, lambda1), (held2, lambda2) = out
+        return held1, held2, lambda1, lambda2
 
 
 class Locks:
@@ -152,6 +197,7 @@ class Locks:
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
         self.crank_q, self.rod_q = qpos_address(model, CRANK_HINGE), qpos_address(model, ROD_HINGE)
         self.crank_v, self.rod_v = dof_address(model, CRANK_HINGE), dof_address(model, ROD_HINGE)
+        self.resistance = [float(model.dof_frictionloss[a]) for a in self.dof_adr]  # F_r1, F_r2 [N]
         self.held = [False, False]
         self.forces = [0.0, 0.0]
         self.excursion = 0.0
@@ -208,8 +254,27 @@ class Locks:
         return forces
 
     def reactions(self) -> tuple[bool, bool, float, float]:
+        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
+
+        A locked module's total hold is its lock row plus its friction row (see the module docstring).
+        Under the paper's rule a module is held while it is locked, and the lock carries the whole hold
+        while the other module moves, as the paper's model has it (a held module there has no resistance,
+        and a lock that pulls is what the rule reveals). Under the one-way rule a module is held while it
+        stands, locked or on its static friction (its row above -F_r: a lock lets go as soon as its row
+        would pull, up to ~5 ms before the push on the module exceeds F_r), as the ratchet's; there, and
+        with both locked under the paper's rule, the resistance takes a forward push up to F_r
+        (:func:`clutch_share`), as the analytic models do.
+        """
         forces = self._lock_forces()
-        return self.held[0], self.held[1], forces[0], forces[1]
+        friction = friction_forces(self.data, self.dof_adr)
+        kinematic = self.rule == "kinematic"
+        whole = kinematic and not all(self.held)
+        held, out = [], []
+        for i in (0, 1):
+            held.append(self.held[i] or (not kinematic and friction[i] > -self.resistance[i]))
+            hold = forces[i] + friction[i]
+            out.append(0.0 if not held[i] else hold if whole else clutch_share(hold, self.resistance[i]))
+        return held[0], held[1], out[0], out[1]
 
 
 class NoClutch:

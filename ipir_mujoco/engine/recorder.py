@@ -15,6 +15,10 @@ So are a compliant clutch's force and overlap: MuJoCo computes the clutch
 force at the start of a step, from the anchor the controller has just set for
 that state, so a sample's ``lambda1``/``lambda2`` and ``clutch_overlap1``/
 ``clutch_overlap2`` describe the sample's own state.
+
+``mode`` comes from the clutch controller's held flags (a module stands); with
+rigid clutches a sample where both stand while the crank turns is a passage
+through a dead centre and takes the mode it leads to (:func:`_dead_centre_passages`).
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ from ipir_mujoco.analytic.params import RobotParams
 from ipir_mujoco.analytic.results import COLUMNS, Mode
 
 from .clutches import equality_row
+from .common import REST_SPEED
 from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
 
 # Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
@@ -41,6 +46,30 @@ _SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "
             "friction_work", "clutch_damper_work")
 _DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
              "clutch_overlap2")
+
+
+def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarray) -> np.ndarray:
+    """``mode`` with each sample where both modules are held while the crank turns (at it or at the next
+    sample) given the mode of the next sample that is not such (arrays of shape (n,); both, turning: bool).
+
+    With rigid clutches both modules stand still only where the crank is at rest, or for an instant as it
+    passes a dead centre (dS/dphi = 0): where one module stops just as the other starts, the equations
+    switch at once, and MuJoCo's step may order the two events a step apart, with both modules held for
+    that step. Such a passage belongs to the mode it leads to; so does the last sample at rest before the
+    crank turns (a start from rest, where the equations' module slides at once). A run that ends so keeps
+    its samples.
+    """
+    turning = turning | np.concatenate([turning[1:], turning[-1:]])
+    passing = both & turning
+    if not passing.any():
+        return mode
+    n = mode.size
+    # index of the first sample at or after each that is not a passage (n where none is)
+    following = np.minimum.accumulate(np.where(passing, n, np.arange(n))[::-1])[::-1]
+    relabel = passing & (following < n)
+    out = mode.copy()
+    out[relabel] = mode[following[relabel]]
+    return out
 
 
 class Recorder:
@@ -134,6 +163,8 @@ class Recorder:
         mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
                         np.where(held2, int(Mode.CONTRACTION),
                                  np.where(held1, int(Mode.EXPANSION), int(Mode.BOTH_MOVING))))
+        if self.clutch is None:
+            mode = _dead_centre_passages(mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED)
         out = {
             "t": self.t[:n].copy(), "phi": phi.copy(), "omega": omega.copy(), "alpha": accel[:, cv],
             "x1": q[:, r1] - q[0, r1], "x2": q[:, f2] - q[0, f2], "v1": v[:, r1v].copy(), "v2": v[:, f2v].copy(),

@@ -222,8 +222,7 @@ def _agreement(metrics: dict) -> str:
         text += (" The peak clutch reaction is not held to it (" + ", ".join(peaks) + "): a rigid clutch's reaction "
                  "jumps where it engages, which MuJoCo's soft constraint resolves over a few steps, overshooting for a "
                  "step or two by an amount set by the step (MuJoCo is read at every step here; see the column at half "
-                 "its step), and a held module's static friction takes up to F_r of the hold that the equations "
-                 "give entirely to the clutch. A real clutch's engagement load is set by its stiffness and play (the "
+                 "its step). A real clutch's engagement load is set by its stiffness and play (the "
                  "section on real clutches).")
     return text
 

@@ -56,7 +56,7 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     strong_riser = riser.replace(M_stall=stronger)
     strong = {}
     for engine in EXACT + PAPER_RULE:
-        strong[engine] = climbing.measure(engine, strong_riser)
+        strong[engine] = climbing.measure(engine, strong_riser, every_step=True)  # its mean clutch force is shown
         progress(f"M_stall {stronger:g} N m, vertical, {engine}: " + _state(strong[engine]))
     flat = climbing.measure("analytic-approx", strong_riser.replace(incline=0.0))
     study = climbing.climb_study(motor, INCLINES[quick], EXACT, TOLERANCE[quick], progress=progress)

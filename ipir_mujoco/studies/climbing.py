@@ -150,11 +150,20 @@ def default_t_end(params: RobotParams) -> float:
     return T_END if params.drive == "motor" else T_END_TORQUE
 
 
-def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = DT_OUT) -> RunResult:
+def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = DT_OUT,
+               every_step: bool = False) -> RunResult:
     """One run of ``engine`` (a sweep engine name): to the steady state under the motor (``t_end`` [s] the
-    cap), else for ``t_end``."""
+    cap), else for ``t_end``. ``every_step``: MuJoCo sampled at each of its steps (the timestep it chooses
+    for ``dt_out``), so that a mean over a window is its impulse: a sample holds its step's force, and
+    read every 1 ms a rigid clutch's one-step engagement peaks alias it (the paper's rule's locks at the
+    default motor's cruise: 0.765 N against 0.998 N at every step and the equations' 1.000 N)."""
     from .sweep import _run_engine  # the sweep's mapping of engine names to runs: one place for it
 
+    if every_step and engine.startswith("mujoco"):
+        from ..engine.timestep import choose_settings
+
+        clutch = "lock" if engine == "mujoco-lock" else "ratchet"
+        dt_out = choose_settings(params, t_end, dt_out, clutch=clutch)[0].timestep
     return _run_engine(engine, params, t_end, dt_out, {"until_steady": params.drive == "motor"})
 
 
@@ -183,13 +192,18 @@ def run_metrics(run: RunResult) -> dict:
     t0, t1, steady = steady_window(run)
     inside = (s["t"] >= t0) & (s["t"] <= t1)
     hold = s["lambda1"] + s["lambda2"]
-    mean_hold = float(np.trapezoid(hold[inside], s["t"][inside]) / (t1 - t0)) if steady else None
+    if run.engine == "mujoco":  # a sample holds the force of the step (the output interval) before it
+        after = (s["t"] > t0 + 1e-12) & (s["t"] <= t1 + 1e-12)
+        impulse = np.sum(hold[1:][after[1:]] * np.diff(s["t"])[after[1:]])
+    else:
+        impulse = np.trapezoid(hold[inside], s["t"][inside])
+    mean_hold = float(impulse / (t1 - t0)) if steady else None
     moved = travel(s)
     peak = summary["peak_clutch_force_n"]
     if run.engine == "mujoco" and run.settings.get("clutch_model") != "compliant":
         # a rigid MuJoCo clutch is a soft constraint whose engagement overshoot is set by the step, and read
-        # every DT_OUT it is whichever step a sample hits: at 90 deg under a 0.57 N m motor 42.3 N every 1 ms,
-        # 79.2 N at every 0.1 ms step, against the equations' 41.4 N (sweep_metrics' docstring has more)
+        # every DT_OUT it is whichever step a sample hits: at 90 deg under a 0.57 N m motor 41.37 N every 1 ms,
+        # 78.2 N at every 0.1 ms step, against the equations' 41.39 N (sweep_metrics' docstring has more)
         peak = None
     out = {"revolutions": summary["revolutions"], "travel_m": float(moved[-1] - moved[0]), "t_end_s": run.t_end,
            "steady": steady, "steady_speed_m_s": summary["steady_speed_m_s"], "t_steady_s": summary["t_steady_s"],
@@ -215,11 +229,14 @@ def climbs(metrics: dict, drive: str) -> bool:
     return bool(metrics["steady"] and metrics["steady_speed_m_s"] > 0) if drive == "motor" else True
 
 
-def measure(engine: str, params: RobotParams, t_end: float | None = None) -> dict:
+def measure(engine: str, params: RobotParams, t_end: float | None = None, every_step: bool = False) -> dict:
     """:func:`run_metrics` of one run, or {"error": one line} for a run that fails (a runaway the paper's rule
-    cannot follow, MuJoCo's accuracy monitor, ...): a result of the study, not its end."""
+    cannot follow, MuJoCo's accuracy monitor, ...): a result of the study, not its end. ``every_step``: as
+    :func:`run_engine` (the curve's runs, whose mean clutch force is shown; the bisection only asks whether
+    a run climbs)."""
     try:
-        return run_metrics(run_engine(engine, params, default_t_end(params) if t_end is None else t_end))
+        return run_metrics(run_engine(engine, params, default_t_end(params) if t_end is None else t_end,
+                                      every_step=every_step))
     except (ParameterError, SimulationError) as exc:
         return {"error": " ".join(str(exc).split())}
 
@@ -264,7 +281,7 @@ def incline_curve(params: RobotParams, inclines, engines=ENGINES, t_end: float |
         row = {"incline_deg": float(incline), "torque_needed_n_m": torque_needed(design)["torque_n_m"],
                "engines": {}}
         for engine in engines:
-            row["engines"][engine] = measure(engine, design, t_end)
+            row["engines"][engine] = measure(engine, design, t_end, every_step=True)
             m = row["engines"][engine]
             progress(f"{float(incline):g} deg, {engine}: " + (
                 m["error"] if "error" in m else "stalled" if m["stalled"] else

@@ -24,6 +24,8 @@ crank angle removes the error a small phase lag inflates at matching time
     first_exceedance         {quantity: t or null}: first time |a - b| exceeds
                              tolerance * scale on the time grid
     tolerance                the relative tolerance used there
+    notes                    [str]: what a figure above does not mean (MuJoCo's rigid clutch's peak force),
+                             one line each
     t_end_a_s, t_end_b_s     where each run ends; t_compared_s, the shorter of them
 """
 
@@ -195,7 +197,17 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
     return {"a": f"{a.engine}/{a.geometry}/{a.clutch}", "b": f"{b.engine}/{b.geometry}/{b.clutch}",
             "t_compared_s": float(t_end), "t_end_a_s": float(a.series["t"][-1]), "t_end_b_s": float(b.series["t"][-1]), "time_grid": time_errors, "angle_grid": angle_errors,
             "summary": summary, "switches": match_switches(a, b), "first_exceedance": first,
-            "tolerance": tolerance}
+            "tolerance": tolerance, "notes": [n for label, run in (("a", a), ("b", b)) for n in _notes(label, run)]}
+
+
+def _notes(label: str, run: RunResult) -> list[str]:
+    """What a MuJoCo run's figures do not mean (measured at the default motor: mjcf/README.md, "Reactions and
+    held modules"): a rigid clutch's peak force."""
+    if run.engine != "mujoco" or run.clutch == "none" or run.settings.get("clutch_model") == "compliant":
+        return []
+    return [f"peak clutch force of {label} (MuJoCo, rigid clutch): the overshoot of its soft engagement, set by "
+            "the timestep and by the step a sample falls on (16.3 N at every 0.1 ms step, 11.8 N read every 1 ms, "
+            "against the equations' 12.1 N at the default motor's cruise), not a physical figure"]
 
 
 def _figures_until(run: RunResult, t_end: float) -> dict:
@@ -251,6 +263,7 @@ def format_comparison(result: dict) -> str:
     lines += ["", f"mode switches: {sw['matched']} matched, largest time difference "
               + ("n/a" if sw["max_abs_dt"] is None else f"{sw['max_abs_dt']:.3g} s")
               + f"; unmatched: {sw['unmatched_a']} in a, {sw['unmatched_b']} in b"]
+    lines += [f"note: {note}" for note in result.get("notes", [])]
     return "\n".join(lines)
 
 

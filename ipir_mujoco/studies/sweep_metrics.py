@@ -51,8 +51,8 @@ sweep's rows shows it for every design. Output sampled at most every 1 ms (the s
 Peak forces from MuJoCo, left empty where they would measure the numerics. A rigid MuJoCo clutch is a
 soft constraint that takes up its load within a few steps and overshoots for a step or two, by an
 amount set by the step; read every 1 ms (the sweep's output), the peak is whichever step a sample
-hits. At the default motor's cruise the ratchet's peak reaction reads 11.96 N every 1 ms, 17.34 N at
-its 0.1 ms steps and 12.49 N at 0.05 ms (the equations: 12.13 N); the lock's 95.0, 140.3 and 109.9 N
+hits. At the default motor's cruise the ratchet's peak reaction reads 11.84 N every 1 ms, 16.34 N at
+its 0.1 ms steps and 12.09 N at 0.05 ms (the equations: 12.13 N); the lock's 96.0, 141.3 and 110.9 N
 (equations 97.5 N), and the lock's jolt reaches the rod (peak rod force 96.0, 119.4 and 139.7 N at
 0.05 ms read every 1 ms, at every step, and at 0.025 ms), while the ratchet's rod force holds
 (36.67-36.68 N). A compliant clutch's spring force is physical, but its peak falls between 1 ms
