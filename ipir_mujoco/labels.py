@@ -62,3 +62,12 @@ def significant(value: float, digits: int) -> str:
     text = f"{float(value) + 0.0:#.{digits}g}"
     mantissa, e, exponent = text.partition("e")
     return mantissa.rstrip(".") + e + exponent
+
+
+def signed_percent(fraction: float, decimals: int) -> str:
+    """A fraction as a signed percentage to ``decimals`` places ('+0.013 %'); a difference that rounds to
+    zero shows as '0.000 %', not '-0.000 %' (its sign would be round-off's)."""
+    text = f"{100 * float(fraction):+.{decimals}f}"
+    if float(text) == 0:
+        text = text.lstrip("+-")
+    return text + " %"

@@ -332,3 +332,14 @@ def test_the_timestep_halving_starts_from_each_clutchs_own_automatic_step(quick_
         worst = max([worst] + [abs(a[k] - b[k]) / abs(b[k]) for a in kept for b in kept
                                for k in ("revolutions", "x1_final", "x2_final")])
     assert conv["mujoco_default_error"] == pytest.approx(worst, rel=1e-12)
+
+
+def test_a_relative_difference_that_rounds_to_zero_is_printed_without_a_sign():
+    """The riser section printed the paper's rule on the exact linkage as '(-0.000 %)': a sign that is
+    round-off's, not the robot's. Differences that do not round to zero keep theirs."""
+    from ipir_mujoco.labels import signed_percent
+    from ipir_mujoco.report.riser_section import _relative
+
+    assert signed_percent(-1e-9, 3) == "0.000 %" and signed_percent(1e-9, 2) == "0.00 %"
+    assert signed_percent(1.3e-4, 3) == "+0.013 %" and signed_percent(-0.05, 2) == "-5.00 %"
+    assert _relative(0.16341, 0.16341 * (1 - 1e-9)) == "0.000 %"

@@ -23,6 +23,7 @@ from matplotlib.lines import Line2D
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams
 
+from ..labels import signed_percent
 from .document import Heading, Image, Paragraph, Table, fmt
 
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
@@ -271,7 +272,7 @@ def verdict(metrics: dict) -> dict:
                 continue
             an, div = row["analytic"], row["divergence"]["peak_clutch_force_n"]
             cells.append(f"{pair['name']} {an['peak_clutch_force_n']:.3g} N, {an['peak_acceleration_m_s2']:.3g} m/s^2"
-                         + ("" if div is None else f" (MuJoCo {100 * div:+.2f} %)"))
+                         + ("" if div is None else f" (MuJoCo {signed_percent(div, 2)})"))
         rigid = [f"{name} {ref['peak_clutch_force_n']:.3g} N, {ref['peak_acceleration_m_s2']:.3g} m/s^2"
                  for name, ref in (("analytic", study["rigid"][key]["analytic"]),
                                    ("MuJoCo", study["rigid"][key]["mujoco"])) if "error" not in ref]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ipir_mujoco.analytic.params import RobotParams
 
-from ..labels import summary_label
+from ..labels import signed_percent, summary_label
 from .document import Heading, Image, Paragraph, Table, fmt, pct
 from .plots import new_figure
 
@@ -35,7 +35,7 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
 
 def fine_pct(value) -> str:
     """A fraction as a signed percentage to 4 decimals (engine agreement is ~1e-5); 'n/a' for None."""
-    return "n/a" if value is None else f"{100 * value:+.4f} %"
+    return "n/a" if value is None else signed_percent(value, 4)
 
 
 def _rungs(metrics: dict) -> dict[str, dict]:

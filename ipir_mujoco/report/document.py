@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
-from ..labels import significant
+from ..labels import significant, signed_percent
 
 
 @dataclass
@@ -53,7 +53,7 @@ def fmt(value, digits: int = 4) -> str:
 
 def pct(value) -> str:
     """A fraction as a signed percentage with two decimals; '' for None."""
-    return "" if value is None else f"{100 * value:+.2f} %"
+    return "" if value is None else signed_percent(value, 2)
 
 
 def to_markdown(blocks: list) -> str:

@@ -19,6 +19,7 @@ import numpy as np
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.params import RobotParams
 
+from ..labels import signed_percent
 from ..studies import climbing
 from .climb_figure import write_climb_figure
 from .document import Heading, Image, Paragraph, Table, fmt
@@ -82,7 +83,7 @@ def _deg(phi: float | None) -> str:
 
 
 def _relative(a, b) -> str:
-    return "n/a" if a is None or b is None or a == 0 else f"{100 * (b - a) / abs(a):+.3f} %"
+    return "n/a" if a is None or b is None or a == 0 else signed_percent((b - a) / abs(a), 3)
 
 
 def render(metrics: dict, figures_dir: Path) -> list:
