@@ -38,7 +38,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import analytic_speed  # noqa: E402  (bench/ siblings)
 import ratchet_step  # noqa: E402
 
-from ipir_mujoco.analytic import RobotParams  # noqa: E402
 from ipir_mujoco.engine.timestep import choose_settings  # noqa: E402
 from ipir_mujoco.studies.sweep import run_sweep  # noqa: E402
 from ipir_mujoco.studies.sweep_space import Study, parse_vary  # noqa: E402

@@ -89,7 +89,7 @@ def _relative(a, b) -> str:
 def render(metrics: dict, figures_dir: Path) -> list:
     params = RobotParams(**{k: v for k, v in metrics["params"].items()})
     motor = params.replace(drive="motor")
-    study, need, default, strong = metrics["study"], metrics["need"], metrics["default"], metrics["strong"]
+    study, default, strong = metrics["study"], metrics["default"], metrics["strong"]
     write_climb_figure(study, motor, figures_dir / "climbing_ability.png")
     m_stall = metrics["motor"]["M_stall_n_m"]
     blocks: list = [Heading("Vertical riser"), Paragraph(
