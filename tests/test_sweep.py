@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import os
 import signal
 import subprocess
@@ -151,7 +152,11 @@ def test_sweep_command_writes_results_heatmap_and_best_designs(tmp_path, capsys)
     out = tmp_path / "s"
     assert main(["sweep", "--vary", "L=0.08:0.3:3", "--vary", "m2=0.5,1.5", "--engines",
                  "analytic-unilateral,analytic-approx", "--t-end", "0.5", "--out", str(out)]) == 0
-    assert "best mean_speed_mps" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "best mean_speed_mps" in printed
+    # each best value keeps its 4 significant digits ('2.000 J/m' for the rigid clutches' F_r1 + F_r2, not '2')
+    values = re.findall(r"^  best \S+ +\S+ +(\S+) at ", printed, flags=re.M)
+    assert values and all(len(re.sub(r"[^0-9]", "", v.split("e")[0]).lstrip("0")) == 4 for v in values), printed
     ranking = json.loads((out / "best.json").read_text())["ranking"]
     assert set(ranking["analytic-unilateral"]) == {"steady_speed_m_s", "energy_per_metre_j_m"}
     assert (out / "sweep_heatmap.png").read_bytes()[:4] == b"\x89PNG"

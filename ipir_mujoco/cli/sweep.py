@@ -9,6 +9,7 @@ from pathlib import Path
 from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.results import write_json
 
+from ..labels import significant
 from ..studies.sweep_metrics import METRICS
 from ..studies.sweep_space import ENGINES
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
@@ -117,6 +118,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"{len(columns['design_id'])} designs, {failed} failed, {stalled} stalled; results in {results}")
     for item in best:
         where = ", ".join(f"{a}={item[a]:.4g}" for a in axes)
-        print(f"  best {item['metric']:24s} {item['engine']:20s} {item['value']:.4g} at {where}")
+        print(f"  best {item['metric']:24s} {item['engine']:20s} {significant(item['value'], 4)} at {where}")
     print(f"  figures: {', '.join(str(f) for f in figures)}; best designs: {args.out}/best.json")
     return EXIT_OK
