@@ -350,17 +350,24 @@ def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch):
     assert "dead centre" in rows[1]["notes"]
 
 
-def test_the_batch_never_runs_a_drive_it_does_not_model(monkeypatch):
-    """A design whose drive the batched engine does not declare is a recorded failure with the way out,
-    not a silently different robot (the batch models the constant torque and the motor: a batch that
-    declared only the torque must refuse a motor design)."""
+def test_the_batch_hands_what_it_does_not_model_to_the_serial_engine(monkeypatch):
+    """A design whose drive the batched engine does not declare, or with compliant clutches (the batch has
+    rigid ratchets only), is neither a silently different robot nor a failure: it runs in the serial engine
+    and its row is the serial run's (the batch models the constant torque and the motor: a batch that
+    declared only the torque must hand a motor design over). Before, both were failed rows."""
     from ipir_mujoco.engine import batch
-    from ipir_mujoco.studies.sweep import run_batch_chunk
+    from ipir_mujoco.studies.sweep import engine_metrics, run_batch_chunk
 
     monkeypatch.setattr(batch, "MODELLED_DRIVES", ("torque",), raising=False)
-    rows = run_batch_chunk([{"L": 0.1}, {"L": 0.2}], RobotParams(drive="motor"), 0.1, 1e-3, 1)
-    assert all("drive='motor' is not modelled by the batched engine" in r["mujoco-ratchet"]["error"]
-               and "--no-batch" in r["mujoco-ratchet"]["error"] for r in rows)
+    base = RobotParams(drive="motor")
+    rows = run_batch_chunk([{"L": 0.1}, {"L": 0.2}], base, 0.1, 1e-3, 1)
+    for row, L in zip(rows, (0.1, 0.2)):
+        assert row["mujoco-ratchet"] == engine_metrics("mujoco-ratchet", base.replace(L=L), 0.1, 1e-3, {})
+    compliant = RobotParams(clutch_stiffness=1e6)
+    rows = run_batch_chunk([{"L": 0.1}, {"L": 0.2}], compliant, 0.1, 1e-3, 1)
+    for row, L in zip(rows, (0.1, 0.2)):
+        assert "error" not in row["mujoco-ratchet"], row
+        assert row["mujoco-ratchet"] == engine_metrics("mujoco-ratchet", compliant.replace(L=L), 0.1, 1e-3, {})
 
 
 def test_the_batch_runs_a_motor_design_as_the_motor(tmp_path):

@@ -15,7 +15,9 @@ Where work runs:
 * default: analytic engines (and MuJoCo's lock) in a process pool; MuJoCo's
   ratchet through ``mujoco.batch`` in chunks of ``batch_size`` designs, each
   chunk in a process of its own on one thread, so rows stream as chunks
-  finish. Both sides run at once and share the cores: while both have work,
+  finish; a design the batch does not model (compliant clutches, a drive
+  outside ``batch.MODELLED_DRIVES``) runs in that process with the serial
+  engine instead. Both sides run at once and share the cores: while both have work,
   the batch gets half of them (rounded up) and the pool the rest; whichever
   finishes first hands its cores to the other. Ctrl-C ends both pools' processes at once; the rows
   written are every design finished by then.
@@ -199,18 +201,18 @@ def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out:
     from ..engine import batch
 
     params: list[RobotParams | None] = []
-    refused: dict[int, str] = {}
-    # a drive the batch does not model must not pass silently: batch.MODELLED_DRIVES says which it does
-    modelled = batch.MODELLED_DRIVES
+    serial: dict[int, dict] = {}
+    # what the batch does not model (a drive it does not declare in batch.MODELLED_DRIVES, compliant clutches)
+    # runs here one by one in the serial engine, never as a silently different robot
     for k, design in enumerate(values):
         try:
             params.append(base.replace(**design))
         except ValueError:
             params.append(None)
             continue
-        if params[-1].drive not in modelled:
-            refused[k] = (f"{BATCHED}: drive={params[-1].drive!r} is not modelled by the batched engine; "
-                          f"allowed: {', '.join(modelled)} (or run MuJoCo one by one: --no-batch)")
+        p = params[-1]
+        if p.drive not in batch.MODELLED_DRIVES or p.clutch_stiffness is not None:
+            serial[k] = engine_metrics(BATCHED, p, t_end, dt_out, {"until_steady": until_steady})
             params[-1] = None
     valid = [p for p in params if p is not None]
     steady = {"until_steady": True} if until_steady else {}
@@ -221,7 +223,7 @@ def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out:
     results = []
     for k, p in enumerate(params):
         if p is None:
-            results.append({BATCHED: {"error": refused.get(k, "invalid design")}})
+            results.append({BATCHED: serial.get(k, {"error": "invalid design"})})
             continue
         outcome = next(outcomes)
         results.append({BATCHED: {"error": f"{BATCHED}: {outcome['error']}"} if "error" in outcome
