@@ -64,6 +64,13 @@ def significant(value: float, digits: int) -> str:
     return mantissa.rstrip(".") + e + exponent
 
 
+def fixed(value: float, decimals: int) -> str:
+    """``value`` to ``decimals`` places; a value that rounds to zero shows as '0.00', not '-0.00' (a held
+    module's round-off speed would otherwise read as moving back)."""
+    text = f"{float(value):.{decimals}f}"
+    return text.lstrip("-") if float(text) == 0 else text
+
+
 def signed_percent(fraction: float, decimals: int) -> str:
     """A fraction as a signed percentage to ``decimals`` places ('+0.013 %'); a difference that rounds to
     zero shows as '0.000 %', not '-0.000 %' (its sign would be round-off's)."""

@@ -30,6 +30,8 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import RobotParams
 from ipir_mujoco.analytic.results import Mode, RunResult
 
+from .labels import fixed
+
 HELD_RGBA = (0.15, 0.7, 0.3, 1.0)  # the clutch holds the module to the pipe
 FREE_RGBA = (0.6, 0.68, 0.85, 1.0)  # the module slides forward (grey-blue)
 HOUSINGS = ("rear_housing", "front_housing")
@@ -179,9 +181,10 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
             words = ("holds (green)", "slides")
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport,
                                f"{title}\nt = {when:.3f} s", f"\n{settings.speed:g}x real time", renderer)
-            state = (f"{np.interp(when, t, s['omega']):.1f} rad/s, {(phi - s['phi'][0]) / (2 * math.pi):.2f} rev\n"
-                     f"{np.interp(when, t, s['v1']):.2f} m/s, clutch {words[0] if held[0] else words[1]}\n"
-                     f"{np.interp(when, t, s['v2']):.2f} m/s, clutch {words[0] if held[1] else words[1]}")
+            state = (f"{fixed(np.interp(when, t, s['omega']), 1)} rad/s, "
+                     f"{fixed((phi - s['phi'][0]) / (2 * math.pi), 2)} rev\n"
+                     f"{fixed(np.interp(when, t, s['v1']), 2)} m/s, clutch {words[0] if held[0] else words[1]}\n"
+                     f"{fixed(np.interp(when, t, s['v2']), 2)} m/s, clutch {words[0] if held[1] else words[1]}")
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport,
                                "crank\nmodule 1 (rear)\nmodule 2 (front)", state, renderer)
             yield _read_frame(settings, viewport, renderer)

@@ -343,3 +343,7 @@ def test_a_relative_difference_that_rounds_to_zero_is_printed_without_a_sign():
     assert signed_percent(-1e-9, 3) == "0.000 %" and signed_percent(1e-9, 2) == "0.00 %"
     assert signed_percent(1.3e-4, 3) == "+0.013 %" and signed_percent(-0.05, 2) == "-5.00 %"
     assert _relative(0.16341, 0.16341 * (1 - 1e-9)) == "0.000 %"
+    # the animation's overlay printed a held module's round-off speed as '-0.00 m/s'
+    from ipir_mujoco.labels import fixed
+
+    assert fixed(-1e-4, 2) == "0.00" and fixed(-0.006, 2) == "-0.01" and fixed(3.14159, 1) == "3.1"
