@@ -12,6 +12,7 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import check_real, check_run_options
 from ipir_mujoco.analytic.results import write_json
 
+from ..labels import significant
 from ..output import check_output_dir, staged_output
 from .common import EXIT_OK, add_model_options, model_params
 
@@ -170,8 +171,8 @@ def format_study(study: dict, params) -> str:
                              f"at rest from t={m['stall_t_s']:.4g} s")
             else:
                 v = m["steady_speed_m_s"] if motor else m["mean_speed_m_s"]
-                cells.append(f"{engine}: " + ("no steady state" if v is None else f"{v:.4g}") + " m/s, "
-                             + " / ".join("n/a" if m[k] is None else f"{m[k]:.4g}"
+                cells.append(f"{engine}: " + ("no steady state" if v is None else significant(v, 4)) + " m/s, "
+                             + " / ".join("n/a" if m[k] is None else significant(m[k], 4)
                                           for k in ("peak_clutch_force_n", "mean_clutch_force_n"))
                              + " N, " + ("n/a" if m["efficiency"] is None else f"{m['efficiency']:.4f}"))
         lines.append("  " + "  |  ".join(cells))

@@ -12,6 +12,7 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import check_whole
 from ipir_mujoco.analytic.results import write_json
 
+from ..labels import significant
 from ..output import check_output_dir, staged_output
 from .common import EXIT_OK, model_params
 
@@ -116,7 +117,7 @@ def _cell(value) -> str:
 def _pair(an: dict, mj: dict, key: str, scale: float = 1.0, digits: int = 4) -> str:
     def one(m):
         value = None if "error" in m else m.get(key)
-        return "n/a" if value is None else f"{value * scale:.{digits}g}"
+        return "n/a" if value is None else significant(value * scale, digits)
     return f"{one(an)} / {one(mj)}"
 
 

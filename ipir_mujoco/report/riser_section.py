@@ -157,7 +157,7 @@ def _stall_text(metrics: dict) -> str:
                  f"{metrics['weight_n']:.4g} N).")
     if "error" not in paper and not paper["stalled"] and paper["steady"]:
         head += (f" The paper's own model (first-order kinematics, massless rod) climbs instead, at "
-                 f"{paper['steady_speed_m_s']:.3g} m/s: its requirement, r sin(phi) (F_r + m g), peaks at only "
+                 f"{fmt(paper['steady_speed_m_s'], 3)} m/s: its requirement, r sin(phi) (F_r + m g), peaks at only "
                  f"{metrics['need_paper']['torque_n_m']:.4g} N m, and its crank carries over it. It gets the answer wrong.")
     return head
 
@@ -237,7 +237,7 @@ def verdict(metrics: dict) -> dict:
                   f"{climbing.LABELS[e]} at {_deg(default[e]['stall_phi_rad'])}" for e in EXACT)
                  + f"), since lifting a module needs up to {need['torque_n_m']:.4g} N m at rest"
                  if stalls else "both exact models climb")
-              + ((f"; the paper's model wrongly says it climbs, at {paper['steady_speed_m_s']:.3g} m/s")
+              + ((f"; the paper's model wrongly says it climbs, at {fmt(paper['steady_speed_m_s'], 3)} m/s")
                  if "error" not in paper and paper["steady"] and stalls else "")
               + f". A motor of {metrics['stronger_n_m']:g} N m (the torque needed at rest, rounded up) climbs at "
               + " and ".join(f"{fmt(s, 4)} m/s" for s in speeds) + " (analytic, MuJoCo" + (
