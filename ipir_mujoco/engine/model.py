@@ -80,6 +80,10 @@ class SolverSettings:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.timestep) and 0 < self.timestep <= 1e-2):
             raise ParameterError(f"timestep={self.timestep} s is out of range; allowed: 0 < timestep <= 0.01 s")
+        if self.integrator == "rk4":
+            raise ParameterError("integrator='rk4' is not supported: the engine's energy and work bookkeeping reads "
+                                 "a step's values after it, which under RK4 are its last stage's; allowed: "
+                                 + ", ".join(INTEGRATORS))
         if self.integrator not in INTEGRATORS:
             raise ParameterError(f"integrator={self.integrator!r} is unknown; allowed: {', '.join(INTEGRATORS)}")
         tc = self.time_constant
