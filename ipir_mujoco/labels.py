@@ -64,6 +64,12 @@ def significant(value: float, digits: int) -> str:
     return mantissa.rstrip(".") + e + exponent
 
 
+def signed(value: float, digits: int) -> str:
+    """:func:`significant` with a sign ('+26.02', '-16.00', '0.000'): for ranges that cross zero."""
+    text = significant(value, digits)
+    return text if text.startswith("-") or float(text) == 0 else "+" + text
+
+
 def fixed(value: float, decimals: int) -> str:
     """``value`` to ``decimals`` places; a value that rounds to zero shows as '0.00', not '-0.00' (a held
     module's round-off speed would otherwise read as moving back)."""

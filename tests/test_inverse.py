@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -81,7 +83,14 @@ def test_prescribed_motion_is_validated():
 def test_kinetostatics_command(tmp_path, capsys):
     out = tmp_path / "k"
     assert main(["kinetostatics", "--omega", "30", "--clutch", "unilateral", "--out", str(out)]) == 0
-    assert "motor torque" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "motor torque" in printed
+    # every bound keeps 4 significant digits and its sign ('-16.00 .. +26.02 N', not '-16 .. +26.02')
+    bounds = re.findall(r"([-+]?[0-9.]+) \.\. ([-+]?[0-9.]+)", printed)
+    assert len(bounds) == 4, printed
+    for value in (v for pair in bounds for v in pair):
+        assert len(value.lstrip("+-").replace(".", "").lstrip("0")) == 4 or float(value) == 0, printed
+        assert value[0] in "+-" or float(value) == 0, printed
     assert (out / "kinetostatics.png").read_bytes()[:4] == b"\x89PNG"
     header = (out / "kinetostatics.csv").read_text().splitlines()[0].split(",")
     assert {"motor_torque", "lambda1", "lambda2", "rod_force", "phi"} <= set(header)

@@ -10,6 +10,7 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import check_real, check_run_options, read_text_file
 from ipir_mujoco.analytic.results import write_json
 
+from ..labels import signed
 from ..output import check_output_dir, staged_output
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
@@ -94,10 +95,10 @@ def run(args: argparse.Namespace) -> int:
         write_json(staging / "summary.json", run.to_json_dict())
         figure_kinetostatics(run).savefig(staging / "kinetostatics.png", dpi=120)
     print(f"{motion.description}, {args.clutch} clutches, {args.geometry} geometry, {run.t_end:.4g} s")
-    print(f"  motor torque     {s['motor_torque'].min():+.4g} .. {s['motor_torque'].max():+.4g} N m "
+    print(f"  motor torque     {signed(s['motor_torque'].min(), 4)} .. {signed(s['motor_torque'].max(), 4)} N m "
           f"(mean power {run.summary['energy']['motor_work_j'] / run.t_end:.4g} W)")
-    print(f"  clutch reactions rear {s['lambda1'].min():+.4g} .. {s['lambda1'].max():+.4g} N, "
-          f"front {s['lambda2'].min():+.4g} .. {s['lambda2'].max():+.4g} N")
-    print(f"  rod force        {s['rod_force'].min():+.4g} .. {s['rod_force'].max():+.4g} N (tension > 0)")
+    print(f"  clutch reactions rear {signed(s['lambda1'].min(), 4)} .. {signed(s['lambda1'].max(), 4)} N, "
+          f"front {signed(s['lambda2'].min(), 4)} .. {signed(s['lambda2'].max(), 4)} N")
+    print(f"  rod force        {signed(s['rod_force'].min(), 4)} .. {signed(s['rod_force'].max(), 4)} N (tension > 0)")
     print(f"  wrote {args.out}/kinetostatics.csv, kinetostatics.png, summary.json")
     return EXIT_OK
