@@ -55,16 +55,25 @@ def missing_rows(code: int, t: float) -> SimulationError:
                            "resistances")
 
 
-def friction_forces(data: mujoco.MjData, dofs: list[int]) -> list[float]:
-    """The frictionloss rows' forces [N] of the last step on the dofs ``dofs`` (0.0 for a dof without a
-    row): MuJoCo puts them after the equality rows, one per dof with friction, in dof order."""
-    out = [0.0] * len(dofs)
-    ids, forces = data.efc_id, data.efc_force
-    for row in range(data.ne, data.ne + data.nf):
-        dof = int(ids[row])
-        if dof in dofs:
-            out[dofs.index(dof)] = float(forces[row])
-    return out
+class FrictionRows:
+    """Where the frictionloss rows of ``dofs`` sit: MuJoCo puts them after the equality rows, one per dof
+    with friction, in dof order, so each dof's offset among them is fixed by the model. Read once per
+    sample, an element at a time at the known rows."""
+
+    def __init__(self, model: mujoco.MjModel, dofs: list[int]):
+        with_friction = [i for i in range(model.nv) if model.dof_frictionloss[i] > 0]
+        self.dofs = list(dofs)
+        self.offsets = [with_friction.index(dof) if dof in with_friction else -1 for dof in dofs]
+        self.count = len(with_friction)
+
+    def forces(self, data: mujoco.MjData) -> list[float]:
+        """The rows' forces [N] of the last step on ``dofs`` (0.0 for a dof without a row)."""
+        ne, force = data.ne, data.efc_force
+        if data.nf != self.count:  # rows disabled or not as the model says: find them by their ids
+            nf = data.nf
+            found = dict(zip(data.efc_id[ne:ne + nf].tolist(), force[ne:ne + nf].tolist()))
+            return [float(found.get(dof, 0.0)) for dof in self.dofs]
+        return [force.item(ne + k) if k >= 0 else 0.0 for k in self.offsets]
 
 
 def clutch_share(hold: float, resistance: float) -> float:
@@ -120,6 +129,7 @@ class Ratchet:
         self._qpos = data.qpos
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
         self.resistance = [float(model.dof_frictionloss[a]) for a in self.dof_adr]  # F_r1, F_r2 [N]
+        self.friction = FrictionRows(model, self.dof_adr)
 
     def before_step(self) -> None:
         # unrolled for the two slides: this runs before every step
@@ -158,12 +168,11 @@ class Ratchet:
             rear, front = (force, 0.0) if d.efc_id[start] == self.joint_ids[0] else (0.0, force)
         else:
             rear = front = 0.0
-        out = []
-        for limit, friction, resistance in zip((rear, front), friction_forces(d, self.dof_adr), self.resistance):
-            held = limit > 0.0 or friction > -resistance
-            out.append((held, clutch_share(limit + friction, resistance) if held else 0.0))
-        (held1, lambda1), (held2, lambda2) = out
-        return held1, held2, lambda1, lambda2
+        f1, f2 = self.friction.forces(d)
+        r1, r2 = self.resistance
+        held1, held2 = rear > 0.0 or f1 > -r1, front > 0.0 or f2 > -r2
+        return (held1, held2, clutch_share(rear + f1, r1) if held1 else 0.0,
+                clutch_share(front + f2, r2) if held2 else 0.0)
 
 
 class Locks:
@@ -198,6 +207,7 @@ class Locks:
         self.crank_q, self.rod_q = qpos_address(model, CRANK_HINGE), qpos_address(model, ROD_HINGE)
         self.crank_v, self.rod_v = dof_address(model, CRANK_HINGE), dof_address(model, ROD_HINGE)
         self.resistance = [float(model.dof_frictionloss[a]) for a in self.dof_adr]  # F_r1, F_r2 [N]
+        self.friction = FrictionRows(model, self.dof_adr)
         self.held = [False, False]
         self.forces = [0.0, 0.0]
         self.excursion = 0.0
@@ -266,7 +276,7 @@ class Locks:
         (:func:`clutch_share`), as the analytic models do.
         """
         forces = self._lock_forces()
-        friction = friction_forces(self.data, self.dof_adr)
+        friction = self.friction.forces(self.data)
         kinematic = self.rule == "kinematic"
         whole = kinematic and not all(self.held)
         held, out = [], []
