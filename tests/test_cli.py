@@ -15,23 +15,11 @@ import pytest
 from ipir_mujoco.analytic.results import COLUMNS, read_csv
 from ipir_mujoco.cli import main
 
+from cli_run import exit_code, run_cli
+
 SUMMARY_KEYS = {"revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
                 "mode_switches", "min_clutch_reaction_n", "energy"}
 ENERGY_KEYS = {"motor_work_j", "kinetic_j", "friction_j", "residual_j"}
-
-
-def exit_code(argv) -> int:
-    """main()'s exit status, whether it returns it or argparse exits with it."""
-    try:
-        return main(list(argv))
-    except SystemExit as exc:
-        return exc.code
-
-
-def run_cli(capsys, *argv):
-    code = exit_code(argv)
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_simulate_json_follows_the_contract(capsys):

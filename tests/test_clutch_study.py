@@ -15,10 +15,11 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.results import Mode
-from ipir_mujoco.cli import main
 from ipir_mujoco.engine.timestep import clutch_rate
 from ipir_mujoco.report.clutch_section import study_figure
 from ipir_mujoco.studies.clutch_study import OperatingPoint, run_study
+
+from cli_run import run_cli
 
 # the paper's start-up up to the first engagement of each clutch (the rear one at 0.245 s, with 1 mm of play
 # at 0.257 s): the same case the analytic tests derive the engagement laws on
@@ -208,14 +209,6 @@ def test_the_figure_draws_the_rows_of_both_engines_and_the_rigid_limit(first_eng
         assert markers[f"rigid:{engine}"].get_ydata()[0] == cruise["rigid"]["cruise"][engine]["peak_clutch_force_n"]
     assert not any("rigid analytic" in text.get_text() for text in ax.texts)
 
-
-def run_cli(capsys, *argv):
-    try:
-        code = main(list(argv))
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_the_command_writes_its_files_and_prints_the_table(capsys, tmp_path):

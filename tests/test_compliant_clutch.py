@@ -16,7 +16,8 @@ from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
 from ipir_mujoco.analytic.cycles import cycles
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.results import Mode
-from ipir_mujoco.cli import main
+
+from cli_run import run_cli
 
 
 def compliant(params, t_end, **options):
@@ -267,14 +268,6 @@ def test_unmodelled_combinations_are_refused():
         with pytest.raises(ParameterError, match=f"{name}=0.001 needs a finite clutch_stiffness"):
             analytic.simulate(RobotParams(**{name: 1e-3}), "exact", "unilateral")
 
-
-def run_cli(capsys, *argv):
-    try:
-        code = main(list(argv))
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.mark.parametrize("settings,fragment", [

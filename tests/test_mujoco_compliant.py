@@ -13,7 +13,6 @@ import pytest
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.analytic.cycles import cycles, travel
-from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.batch import run_ratchet_batch
 from ipir_mujoco.engine.compliant import CompliantClutches
@@ -29,6 +28,8 @@ def mujoco_run(params, t_end, timestep, **options):
     """A MuJoCo run at a given timestep, sampled at every step (a clutch force peaks between coarser samples)."""
     return simulate_mujoco(params, "unilateral", "ratchet", t_end, dt_out=timestep,
                            settings=SolverSettings(timestep=timestep), **options)
+
+from cli_run import run_cli
 
 
 def analytic_run(params, t_end):
@@ -256,11 +257,6 @@ def test_the_timestep_resolves_the_clutch_spring():
                                              r"3.2e-07 s .*\(a stiffness up to 1e\+10 N/m here"):
         choose_settings(RobotParams(clutch_stiffness=1e11), 0.5, 1e-4)
 
-
-def run_cli(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_cli_runs_the_compliant_clutch_in_mujoco(capsys, tmp_path, monkeypatch):
