@@ -11,7 +11,7 @@ from ipir_mujoco.analytic.results import write_json
 
 from ..labels import significant
 from ..studies.sweep_metrics import METRICS
-from ..studies.sweep_space import ENGINES
+from ..studies.sweep_space import DEFAULT_ENGINES, ENGINES
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
 
@@ -25,9 +25,8 @@ def add_parser(commands) -> None:
     swp.add_argument("--sample", type=int, default=None, metavar="N", help="N space-filling (Sobol) designs")
     swp.add_argument("--seed", type=int, default=None, help="seed of the Sobol sample, >= 0 (default 0)")
     swp.add_argument("--engines", default=None, metavar="LIST",
-                     help="comma-separated, first one is the reference for divergence; from: analytic-approx, "
-                          "analytic-exact, analytic-unilateral, mujoco-lock, mujoco-ratchet "
-                          "(default: mujoco-ratchet,analytic-unilateral)")
+                     help=f"comma-separated, first one is the reference for divergence; from: {', '.join(ENGINES)} "
+                          f"(default: {','.join(DEFAULT_ENGINES)})")
     swp.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
                      help="simulated time per design (default 1 s); with --until-steady, the cap (default 10 s)")
     swp.add_argument("--until-steady", action="store_true", default=None,
