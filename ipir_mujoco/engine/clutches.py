@@ -56,23 +56,21 @@ def missing_rows(code: int, t: float) -> SimulationError:
 
 
 class FrictionRows:
-    """Where the frictionloss rows of ``dofs`` sit: MuJoCo puts them after the equality rows, one per dof
-    with friction, in dof order, so each dof's offset among them is fixed by the model. Read once per
-    sample, an element at a time at the known rows."""
+    """The resistances of the modules on ``dofs``: ``resistance`` [N] (F_r1, F_r2) and where their
+    frictionloss rows sit. MuJoCo puts the rows after the equality rows, one per dof with friction, in dof
+    order, so each dof's offset among them is fixed by the model; read once per sample at those rows."""
 
     def __init__(self, model: mujoco.MjModel, dofs: list[int]):
         with_friction = [i for i in range(model.nv) if model.dof_frictionloss[i] > 0]
-        self.dofs = list(dofs)
+        self.resistance = [float(model.dof_frictionloss[dof]) for dof in dofs]
         self.offsets = [with_friction.index(dof) if dof in with_friction else -1 for dof in dofs]
         self.count = len(with_friction)
 
     def forces(self, data: mujoco.MjData) -> list[float]:
         """The rows' forces [N] of the last step on ``dofs`` (0.0 for a dof without a row)."""
+        if data.nf != self.count:  # as the stepping loops: never a row that is not this dof's
+            raise missing_rows(2, data.time)
         ne, force = data.ne, data.efc_force
-        if data.nf != self.count:  # rows disabled or not as the model says: find them by their ids
-            nf = data.nf
-            found = dict(zip(data.efc_id[ne:ne + nf].tolist(), force[ne:ne + nf].tolist()))
-            return [float(found.get(dof, 0.0)) for dof in self.dofs]
         return [force.item(ne + k) if k >= 0 else 0.0 for k in self.offsets]
 
 
@@ -128,8 +126,7 @@ class Ratchet:
         self.excursion = 0.0
         self._qpos = data.qpos
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
-        self.resistance = [float(model.dof_frictionloss[a]) for a in self.dof_adr]  # F_r1, F_r2 [N]
-        self.friction = FrictionRows(model, self.dof_adr)
+        self.friction = FrictionRows(model, self.dof_adr)  # and F_r1, F_r2 [N]
 
     def before_step(self) -> None:
         # unrolled for the two slides: this runs before every step
@@ -169,7 +166,7 @@ class Ratchet:
         else:
             rear = front = 0.0
         f1, f2 = self.friction.forces(d)
-        r1, r2 = self.resistance
+        r1, r2 = self.friction.resistance
         held1, held2 = rear > 0.0 or f1 > -r1, front > 0.0 or f2 > -r2
         return (held1, held2, clutch_share(rear + f1, r1) if held1 else 0.0,
                 clutch_share(front + f2, r2) if held2 else 0.0)
@@ -206,8 +203,7 @@ class Locks:
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
         self.crank_q, self.rod_q = qpos_address(model, CRANK_HINGE), qpos_address(model, ROD_HINGE)
         self.crank_v, self.rod_v = dof_address(model, CRANK_HINGE), dof_address(model, ROD_HINGE)
-        self.resistance = [float(model.dof_frictionloss[a]) for a in self.dof_adr]  # F_r1, F_r2 [N]
-        self.friction = FrictionRows(model, self.dof_adr)
+        self.friction = FrictionRows(model, self.dof_adr)  # and F_r1, F_r2 [N]
         self.held = [False, False]
         self.forces = [0.0, 0.0]
         self.excursion = 0.0
@@ -276,14 +272,14 @@ class Locks:
         (:func:`clutch_share`), as the analytic models do.
         """
         forces = self._lock_forces()
-        friction = self.friction.forces(self.data)
+        friction, resistance = self.friction.forces(self.data), self.friction.resistance
         kinematic = self.rule == "kinematic"
         whole = kinematic and not all(self.held)
         held, out = [], []
         for i in (0, 1):
-            held.append(self.held[i] or (not kinematic and friction[i] > -self.resistance[i]))
+            held.append(self.held[i] or (not kinematic and friction[i] > -resistance[i]))
             hold = forces[i] + friction[i]
-            out.append(0.0 if not held[i] else hold if whole else clutch_share(hold, self.resistance[i]))
+            out.append(0.0 if not held[i] else hold if whole else clutch_share(hold, resistance[i]))
         return held[0], held[1], out[0], out[1]
 
 

@@ -94,6 +94,7 @@ class PythonSteps:
         self.model, self.data, self.controller, self.qvel_before = model, data, controller, qvel_before
         self.motor, self.crank_q, self.crank_v, self.slope = motor, crank_q, crank_v, slope
         self.friction_dofs, self.servo = list(friction_dofs), servo
+        self.fric_a, self.fric_b = (self.friction_dofs + [0, 0])[:2]  # the slides' dofs (0: no row)
         self.torque, self.motor_work, self.friction_work = torque, 0.0, 0.0
         self.omega_prev = data.qvel.item(crank_v)
 
@@ -106,7 +107,7 @@ class PythonSteps:
         step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
         motor, cq, cv, slope = self.motor, self.crank_q, self.crank_v, self.slope
         nfric = len(self.friction_dofs)
-        fa, fb = (self.friction_dofs + [0, 0])[:2]
+        fa, fb = self.fric_a, self.fric_b
         torque, wm, wf, omega_prev = self.torque, self.motor_work, self.friction_work, self.omega_prev
         for j in range(nstep):
             if servo is not None:
@@ -172,8 +173,7 @@ class CompiledSteps(PythonSteps):
             eq_data_stride=model.eq_data.shape[1], eq_active=_address(data.eq_active),
             biasprm=_address(model.actuator_biasprm), biasprm_stride=model.actuator_biasprm.shape[1],
             nv=model.nv, motor=self.motor, crank_q=self.crank_q, crank_v=self.crank_v,
-            nfric=len(self.friction_dofs), fric_a=(self.friction_dofs + [0])[0],
-            fric_b=(self.friction_dofs + [0, 0])[1])
+            nfric=len(self.friction_dofs), fric_a=self.fric_a, fric_b=self.fric_b)
         self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
         self._cfg[self.C["eq_rows"]] = _address(self._eq_rows) if self._eq_rows.size else 0
         self._set_state(dt=model.opt.timestep, slope=self.slope, torque=self.torque,
