@@ -57,5 +57,5 @@ def add_kinetostatics(series: dict[str, np.ndarray], dyn: OneDofDynamics) -> Non
             pin_x, pin_y = -on_rod_x, -on_rod_y
         series["rod_force"] = (on_rod_x * cb_x + on_rod_y * cb_y) / p.L
         series["crank_pin_force"] = np.hypot(pin_x, pin_y)
-    torque = series.get("motor_torque", p.M)  # every solver writes the torque it applied; else the constant M
+    torque = series["motor_torque"]  # every solver writes the torque it applied (a motor's varies)
     series["motor_power"] = torque * omega

@@ -10,7 +10,7 @@ from ipir_mujoco.analytic.errors import ParameterError
 from ipir_mujoco.analytic.params import check_run_options, check_whole
 from ipir_mujoco.analytic.results import RunResult, write_json, write_mode_changes
 
-from ..labels import significant
+from ..labels import fixed, significant
 from ..output import check_output_dir, staged_output
 from ..report.plots import write_paper_figures
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
@@ -135,8 +135,8 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
         f"({run.wall_time_s:.2f} s wall)",
         f"  crank revolutions        {s['revolutions']:.4f}",
-        f"  module 1 (rear) moved    {_fixed(s['x1_final'], 4)} m   peak speed {_fixed(s['v1_max'], 3)} m/s",
-        f"  module 2 (front) moved   {_fixed(s['x2_final'], 4)} m   peak speed {_fixed(s['v2_max'], 3)} m/s",
+        f"  module 1 (rear) moved    {fixed(s['x1_final'], 4)} m   peak speed {fixed(s['v1_max'], 3)} m/s",
+        f"  module 2 (front) moved   {fixed(s['x2_final'], 4)} m   peak speed {fixed(s['v2_max'], 3)} m/s",
         "  first minimum of S       " + ("none" if first is None else f"{first:.4f} s"),
         f"  mode switches            {s['mode_switches']}",
         "  min clutch reaction      " + ("none (no clutch held)" if reaction is None else f"{reaction:.4g} N"
@@ -159,12 +159,6 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                                                               f"{v['figure']} {v['value']:.3g} (tolerance {v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
                                                               for v in accuracy.get("violations", []))))
     return "\n".join(lines)
-
-
-def _fixed(value: float, decimals: int) -> str:
-    """``value`` to ``decimals`` places, without the '-0.000' of a round-off below zero (a held module)."""
-    text = f"{value:.{decimals}f}"
-    return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
 def _energy_line(e: dict) -> str:

@@ -53,6 +53,7 @@ from ipir_mujoco.analytic.results import RunResult
 from ..engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
 from .compare import STEADY_FIGURES, compare_runs
 from .pool import map_unordered
+from .validate import relative_change
 
 T_CAP = 10.0  # s: cap of every run; the default motor settles in about 2 s
 DT_OUT = 1e-3  # s: the equations' output interval (each revolution's end is an exact sample whatever it is);
@@ -216,10 +217,6 @@ def cross_check(equations: RunResult, mujoco: RunResult) -> dict:
     return {"figures": figures, "worst_checked": worst, "within": worst is not None and worst <= CROSS_CHECK_TOL}
 
 
-def _relative(new, old):
-    return None if new is None or old is None or old == 0 else (new - old) / abs(old)
-
-
 def cruise_study(params: RobotParams, quick: bool = False, progress: Progress = lambda _m: None,
                  workers: int | None = None, t_cap: float = T_CAP, dt_out: float = DT_OUT) -> dict:
     """Every rung to its steady state under ``params``' motor, and the cross-checks (module docstring).
@@ -244,7 +241,7 @@ def cruise_study(params: RobotParams, quick: bool = False, progress: Progress = 
     paper = rungs[0] if "error" not in rungs[0] else None
     for record in rungs:
         if "error" not in record:
-            record["change_vs_paper"] = {k: (None if paper is None else _relative(record[k], paper[k]))
+            record["change_vs_paper"] = {k: (None if paper is None else relative_change(record[k], paper[k]))
                                          for k in STEADY_FIGURES + ("crank_speed_rad_s", "crank_torque_n_m")}
     checks = []
     for mj_name, eq_name in CROSS_CHECKS:
