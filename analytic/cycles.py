@@ -185,6 +185,13 @@ def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: i
     return None
 
 
+def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> list | None:
+    """The ``n`` whole revolutions (of :func:`cycles`) at whose end the run first is at steady state
+    (:func:`steady_index`), or None: the window every steady-state figure is taken over."""
+    k = steady_index([c.mean_speed_m_s for c in found], tol, n)
+    return None if k is None else found[k - n + 1:k + 1]
+
+
 class SteadyWatch:
     """Tells an engine, sample by sample, when its run has reached the periodic steady state.
 
@@ -276,14 +283,12 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     revolution (None without energy columns).
     """
     found = cycles(series)
-    speeds = [c.mean_speed_m_s for c in found]
-    k = steady_index(speeds, tol, n)
-    out = {"steady": k is not None, "t_steady_s": None, "steady_speed_m_s": None, "energy_per_metre_j_m": None,
+    window = steady_window(found, tol, n)
+    out = {"steady": window is not None, "t_steady_s": None, "steady_speed_m_s": None, "energy_per_metre_j_m": None,
            "cycles": len(found)}
     residuals = [abs(c.residual_j) for c in found if c.residual_j is not None]
     out["cycle_energy_residual_j"] = max(residuals) if residuals else None
-    if k is not None:
-        window = found[k - n + 1:k + 1]
+    if window is not None:
         time = sum(c.period_s for c in window)
         distance = sum(c.distance_m for c in window)
         out["t_steady_s"] = window[-1].t_end

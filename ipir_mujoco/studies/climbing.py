@@ -36,7 +36,8 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles, steady_index, travel
+from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles, travel
+from ipir_mujoco.analytic.cycles import steady_window as settled_cycles  # its own steady_window takes a run
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.forces import drive_torque
@@ -169,12 +170,11 @@ def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = D
 
 def steady_window(run: RunResult) -> tuple[float, float, bool]:
     """(t0, t1) [s] of the steady window (the revolutions the steady test used), else the whole run; steady?"""
-    found = cycles(run.series)
-    n = run.settings.get("steady_cycles", STEADY_CYCLES)
-    k = steady_index([c.mean_speed_m_s for c in found], run.settings.get("steady_tol", STEADY_TOL), n)
-    if k is None:
+    window = settled_cycles(cycles(run.series), run.settings.get("steady_tol", STEADY_TOL),
+                           run.settings.get("steady_cycles", STEADY_CYCLES))
+    if window is None:
         return float(run.series["t"][0]), float(run.series["t"][-1]), False
-    return found[k - n + 1].t_start, found[k].t_end, True
+    return window[0].t_start, window[-1].t_end, True
 
 
 def locked_pull_share(run: RunResult) -> float | None:

@@ -55,7 +55,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.cycles import cycles, steady_index
+from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles, steady_window
 from ipir_mujoco.analytic.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.params import RobotParams, check_whole
 
@@ -228,14 +228,13 @@ def run_metrics(run, point: OperatingPoint) -> dict:
     s, summary = run.series, run.summary
     found = cycles(s)
     if point.until_steady:
-        n = run.settings.get("steady_cycles", 3)
-        k = steady_index([c.mean_speed_m_s for c in found], run.settings.get("steady_tol", 1e-4), n)
-        if k is None:
+        window = steady_window(found, run.settings.get("steady_tol", STEADY_TOL),
+                               run.settings.get("steady_cycles", STEADY_CYCLES))
+        if window is None:
             why = run.stall or f"no periodic steady state by t_end = {point.t_end:g} s"
             return {"error": why}
-        window = found[k - n + 1:k + 1]
         inside = (s["t"] >= window[0].t_start) & (s["t"] <= window[-1].t_end)
-        revolutions = float(n)
+        revolutions = float(len(window))
     else:
         inside = np.ones(s["t"].shape, dtype=bool)
         revolutions = float(summary["revolutions"])
