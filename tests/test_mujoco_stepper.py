@@ -61,8 +61,11 @@ def both_paths(monkeypatch, *args, **options):
     python = simulate_mujoco(*args, **options)
     monkeypatch.delenv(stepper.ENV)
     calls = []
-    run = stepper.CompiledSteps.run
-    monkeypatch.setattr(stepper.CompiledSteps, "run", lambda self, *a: calls.append(a) or run(self, *a))
+    # rigid clutches record whole blocks in C; compliant ones step in C and record in Python
+    for method in ("run", "record"):
+        original = getattr(stepper.CompiledSteps, method)
+        monkeypatch.setattr(stepper.CompiledSteps, method,
+                            lambda self, *a, _original=original: calls.append(a) or _original(self, *a))
     compiled = simulate_mujoco(*args, **options)
     assert calls, "the compiled loop did not run"
     return python, compiled

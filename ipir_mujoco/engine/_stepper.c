@@ -29,20 +29,38 @@
   X(jnt_range) X(eq_data) X(eq_data_stride) X(eq_active) X(eq_rows) X(biasprm) X(biasprm_stride) \
   X(nv) X(clutch) X(motor) X(crank_q) X(crank_v) X(nfric) X(fric_a) X(fric_b)                    \
   X(slide_q0) X(slide_q1) X(slide_v0) X(slide_v1) X(joint0) X(joint1)                            \
-  X(eq0) X(eq1) X(rod_q) X(rod_v) X(act0) X(act1) X(implicit)
+  X(eq0) X(eq1) X(rod_q) X(rod_v) X(act0) X(act1) X(implicit)                                   \
+  X(nq) X(nl_field) X(time_field) X(warning_field) X(n_warning) X(efc_id_field) X(subtree_vel) X(energy)       \
+  X(rod_end) X(front_pos) X(subtree_linvel) X(loop_eq) X(fric_off0) X(fric_off1)                 \
+  X(rec_t) X(rec_qpos) X(rec_qvel) X(rec_scalars) X(rec_deferred) X(rec_excursion)
 
 #define STATE_FIELDS(X)                                                                          \
   X(dt) X(slope) X(torque) X(motor_work) X(friction_work) X(omega_prev) X(excursion)     \
   X(bound0) X(bound1) X(margin0) X(margin1)                                                      \
   X(held0) X(held1) X(force0) X(force1) X(r) X(L)                                                \
   X(anchor0) X(anchor1) X(overlap0) X(overlap1) X(v_before0) X(v_before1) X(damped0) X(damped1) \
-  X(damper_work) X(k) X(c) X(backlash)
+  X(damper_work) X(k) X(c) X(backlash)                                                          \
+  X(resist0) X(resist1) X(pin_x) X(pin_y) X(pin_z) X(total_mass) X(count) X(steps_done)
+
+/* what record() writes per sample: one row of each (Recorder's scalars and deferred arrays, in this order) */
+#define SCALAR_FIELDS(X)                                                                          \
+  X(motor_torque) X(loop_fx) X(loop_fy) X(held1) X(held2) X(lambda1) X(lambda2) X(motor_work)     \
+  X(friction_work) X(clutch_damper_work)
+#define DEFERRED_FIELDS(X)                                                                        \
+  X(kinetic) X(potential) X(loop_gap) X(momentum) X(clutch_force1) X(clutch_force2)               \
+  X(clutch_overlap1) X(clutch_overlap2) X(clutch_spring)
 
 #define AS_ENUM(name) C_##name,
 enum { CONFIG_FIELDS(AS_ENUM) N_CONFIG };
 #undef AS_ENUM
 #define AS_ENUM(name) S_##name,
 enum { STATE_FIELDS(AS_ENUM) N_STATE };
+#undef AS_ENUM
+#define AS_ENUM(name) R_##name,
+enum { SCALAR_FIELDS(AS_ENUM) N_SCALARS };
+#undef AS_ENUM
+#define AS_ENUM(name) D_##name,
+enum { DEFERRED_FIELDS(AS_ENUM) N_DEFERRED };
 #undef AS_ENUM
 
 /* the clutch kinds (stepper.CLUTCH_KINDS holds the same order) */
@@ -51,8 +69,11 @@ enum { NO_CLUTCH = 0, RATCHET = 1, LOCK_KINEMATIC = 2, LOCK_UNILATERAL = 3, COMP
 /* what steps() returns: done, or which constraint rows it was to read are absent after a step (the
  * Python loop raises for the same two: clutches.MISSING_ROWS holds the same order) */
 enum { STEPS_DONE = 0, MISSING_LOCK_ROW = 1, MISSING_FRICTION_ROWS = 2 };
+/* what record() returns besides STEPS_DONE: MuJoCo raised a warning in the last sample's interval */
+enum { RECORD_WARNED = 3 };
 
 typedef void (*step_fn)(const void *m, void *d);
+typedef void (*subtree_vel_fn)(const void *m, void *d);
 typedef void (*error_fn)(const char *msg);
 
 #define PTR(type, field) ((type)(intptr_t)cfg[C_##field])
@@ -241,19 +262,178 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
   return STEPS_DONE;
 }
 
-/* run(config address, state address, nstep, qvel_before row or -1): see steps(). Returns None; raises
- * RuntimeError with MuJoCo's message if MuJoCo reported an error (the run's data is then as the bindings
- * leave it after such an error: not to be stepped on), or LookupError with the MISSING_* code as its
- * argument if a step did not produce the rows the loop reads. */
-static PyObject *run(PyObject *self, PyObject *args) {
-  (void)self;
-  unsigned long long cfg_adr, st_adr;
-  long long nstep, row;
-  if (!PyArg_ParseTuple(args, "KKLL", &cfg_adr, &st_adr, &nstep, &row)) return NULL;
-  const int64_t *cfg = (const int64_t *)(intptr_t)cfg_adr;
-  double *st = (double *)(intptr_t)st_adr;
+/* clutches.clutch_share: the clutch's part of a held module's total hold (Python's max and min, in order) */
+static double clutch_share(double hold, double resistance) {
+  double bounded = -resistance > hold ? -resistance : hold;
+  double pushed = 0.0 < bounded ? 0.0 : bounded;
+  return hold - pushed;
+}
+
+/* clutches.FrictionRows.forces: the slides' frictionloss rows (0.0 for a slide without one); the step just
+ * taken has checked that the rows are there */
+static void friction_forces(const int64_t *cfg, const double *efc_force, int ne, double out[2]) {
+  for (int i = 0; i < 2; i++) {
+    int64_t offset = cfg[C_fric_off0 + i];
+    out[i] = offset >= 0 ? efc_force[ne + offset] : 0.0;
+  }
+}
+
+/* the clutch controller's reactions() after the last step: (rear held, front held, rear [N], front [N]) */
+static int reactions(const int64_t *cfg, const double *st, double out[4]) {
+  const double *efc_force = *PTR(double *const *, efc_force_field);
+  const int ne = *PTR(const int *, ne_field), nf = *PTR(const int *, nf_field), nl = *PTR(const int *, nl_field);
+  const double r[2] = {st[S_resist0], st[S_resist1]};
+  double f[2], hold[2];
+  /* as FrictionRows.forces: never a row that is not a slide's */
+  if (cfg[C_clutch] != NO_CLUTCH && nf != cfg[C_nfric]) return MISSING_FRICTION_ROWS;
+  switch (cfg[C_clutch]) {
+    case RATCHET: {
+      /* Ratchet.reactions: the limit rows follow the equality and friction rows, in joint order */
+      const int start = ne + nf;
+      double rear = 0.0, front = 0.0;
+      if (nl == 2) {
+        rear = efc_force[start];
+        front = efc_force[start + 1];
+        if (cfg[C_joint0] > cfg[C_joint1]) {
+          double swap = rear;
+          rear = front;
+          front = swap;
+        }
+      } else if (nl == 1) {
+        const int *efc_id = *PTR(int *const *, efc_id_field);
+        if (efc_id[start] == cfg[C_joint0]) {
+          rear = efc_force[start];
+        } else {
+          front = efc_force[start];
+        }
+      }
+      friction_forces(cfg, efc_force, ne, f);
+      hold[0] = rear;
+      hold[1] = front;
+      for (int i = 0; i < 2; i++) {
+        int held = hold[i] > 0.0 || f[i] > -r[i];
+        out[i] = held ? 1.0 : 0.0;
+        out[2 + i] = held ? clutch_share(hold[i] + f[i], r[i]) : 0.0;
+      }
+      return STEPS_DONE;
+    }
+    case LOCK_KINEMATIC:
+    case LOCK_UNILATERAL: {
+      /* Locks.reactions */
+      const int kinematic = cfg[C_clutch] == LOCK_KINEMATIC;
+      const int locked[2] = {st[S_held0] != 0.0, st[S_held1] != 0.0};
+      const int whole = kinematic && !(locked[0] && locked[1]);
+      friction_forces(cfg, efc_force, ne, f);
+      for (int i = 0; i < 2; i++) {
+        double lock = 0.0;
+        if (locked[i]) {
+          int64_t row = equality_row(cfg, cfg[C_eq0 + i]);
+          if (row >= ne) return MISSING_LOCK_ROW;
+          lock = efc_force[row];
+        }
+        int held = locked[i] || (!kinematic && f[i] > -r[i]);
+        double total = lock + f[i];
+        out[i] = held ? 1.0 : 0.0;
+        out[2 + i] = !held ? 0.0 : whole ? total : clutch_share(total, r[i]);
+      }
+      return STEPS_DONE;
+    }
+    default: /* NoClutch (the compliant clutches are recorded by Python) */
+      out[0] = out[1] = out[2] = out[3] = 0.0;
+      return STEPS_DONE;
+  }
+}
+
+/* Recorder.sample: the state after the last step as row ``row`` */
+static int sample(const int64_t *cfg, const double *st, int64_t row) {
+  const int64_t nq = cfg[C_nq], nv = cfg[C_nv];
+  const double *efc_force = *PTR(double *const *, efc_force_field);
+  const int ne = *PTR(const int *, ne_field);
+  double held[4];
+  int status = reactions(cfg, st, held);
+  if (status != STEPS_DONE) return status;
+  PTR(double *, rec_t)[row] = *PTR(const double *, time_field);
+  memcpy(PTR(double *, rec_qpos) + row * nq, PTR(const double *, qpos), (size_t)nq * sizeof(double));
+  memcpy(PTR(double *, rec_qvel) + row * nv, PTR(const double *, qvel), (size_t)nv * sizeof(double));
+  double *out = PTR(double *, rec_scalars) + row * N_SCALARS;
+  int64_t loop = equality_row(cfg, cfg[C_loop_eq]);
+  out[R_motor_torque] = st[S_torque];
+  out[R_loop_fx] = ne >= loop + 3 ? efc_force[loop] : 0.0;
+  out[R_loop_fy] = ne >= loop + 3 ? efc_force[loop + 1] : 0.0;
+  out[R_held1] = held[0];
+  out[R_held2] = held[1];
+  out[R_lambda1] = held[2];
+  out[R_lambda2] = held[3];
+  out[R_motor_work] = st[S_motor_work];
+  out[R_friction_work] = st[S_friction_work];
+  out[R_clutch_damper_work] = 0.0;
+  PTR(double *, rec_excursion)[row] = st[S_excursion];
+  return STEPS_DONE;
+}
+
+/* Recorder.fill_deferred (rigid clutches): MuJoCo's values at the start of the step just taken */
+static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
+  const double *energy = PTR(const double *, energy), *rod = PTR(const double *, rod_end);
+  const double *front = PTR(const double *, front_pos);
+  double *out = PTR(double *, rec_deferred) + row * N_DEFERRED;
+  double sx = rod[0], sy = rod[1], sz = rod[2], bx = front[0], by = front[1], bz = front[2];
+  double ox = st[S_pin_x], oy = st[S_pin_y], oz = st[S_pin_z];
+  double dx = sx - bx - ox, dy = sy - by - oy, dz = sz - bz - oz;
+  out[D_loop_gap] = sqrt(dx * dx + dy * dy + dz * dz);
+  PTR(subtree_vel_fn, subtree_vel)(PTR(const void *, model), PTR(void *, data));
+  out[D_momentum] = PTR(const double *, subtree_linvel)[0] * st[S_total_mass];
+  out[D_potential] = energy[0];
+  out[D_kinetic] = energy[1];
+  out[D_clutch_force1] = out[D_clutch_force2] = out[D_clutch_overlap1] = out[D_clutch_overlap2] = 0.0;
+  out[D_clutch_spring] = 0.0;
+}
+
+/* how many warnings MuJoCo has raised on this mjData so far (each mjWarningStat: lastinfo, number) */
+static long long warnings(const int64_t *cfg) {
+  const int *stat = PTR(const int *, warning_field);
+  long long total = 0;
+  for (int64_t w = 0; w < cfg[C_n_warning]; w++) total += stat[2 * w + 1];
+  return total;
+}
+
+/* simulate._integrate's sampling loop for rigid clutches: up to nsamples output intervals of sps steps
+ * (the last one cut at ``remaining`` steps), each recorded as a row; the first step of an interval fills the
+ * deferred values of the row before it (``pending``, -1: none). Rows go from st[count] on; st[count] and
+ * st[steps_done] count them. Returns STEPS_DONE, RECORD_WARNED (MuJoCo warned in the last interval, not recorded) or a
+ * MISSING_* code. */
+static int record(const int64_t *cfg, double *st, long long nsamples, long long sps, long long remaining,
+                  long long pending) {
+  const int64_t nv = cfg[C_nv];
+  double *before = PTR(double *, qvel_before);
+  for (long long s = 0; s < nsamples && remaining > 0; s++) {
+    const long long k = sps < remaining ? sps : remaining;
+    const int64_t row = (int64_t)st[S_count];
+    const long long warned = warnings(cfg);
+    int status;
+    if (pending >= 0) {
+      status = steps(cfg, st, 1, k == 1 ? before + row * nv : NULL);
+      if (status != STEPS_DONE) return status;
+      fill_deferred(cfg, pending, st);
+      if (k > 1 && (status = steps(cfg, st, k - 1, before + row * nv)) != STEPS_DONE) return status;
+    } else if ((status = steps(cfg, st, k, before + row * nv)) != STEPS_DONE) {
+      return status;
+    }
+    remaining -= k;
+    st[S_steps_done] += (double)k;
+    if (warnings(cfg) != warned) return RECORD_WARNED; /* as the Python loop: the interval is not recorded */
+    if ((status = sample(cfg, st, row)) != STEPS_DONE) return status;
+    st[S_count] = (double)(row + 1);
+    pending = row;
+  }
+  return STEPS_DONE;
+}
+
+/* Calls record(cfg, st, arguments...) (what = 'r') or steps(cfg, st, nstep, dest) (what = 's') without the GIL,
+ * with MuJoCo's errors caught. Returns the status, or -1 with RuntimeError (MuJoCo's message: the run's data is
+ * then as the bindings leave it after such an error, not to be stepped on) or LookupError (the MISSING_* code
+ * as its argument: a step did not produce the rows the loop reads) set. */
+static int guarded(const int64_t *cfg, double *st, char what, const long long *a, double *dest) {
   error_fn *user_error = PTR(error_fn *, user_error);
-  double *dest = row >= 0 ? PTR(double *, qvel_before) + row * cfg[C_nv] : NULL;
   int failed = 0;
   volatile int status = STEPS_DONE; /* set between setjmp and a possible longjmp */
   jmp_buf jump;
@@ -264,7 +444,7 @@ static PyObject *run(PyObject *self, PyObject *args) {
   Py_BEGIN_ALLOW_THREADS
   error_jump = &jump;
   if (setjmp(jump) == 0) {
-    status = steps(cfg, st, nstep, dest);
+    status = what == 'r' ? record(cfg, st, a[0], a[1], a[2], a[3]) : steps(cfg, st, a[0], dest);
   } else {
     failed = 1;
   }
@@ -273,21 +453,46 @@ static PyObject *run(PyObject *self, PyObject *args) {
   if (user_error != NULL && --loops_running == 0) *user_error = previous_error;
   if (failed) {
     PyErr_SetString(PyExc_RuntimeError, error_text);
-    return NULL;
+    return -1;
   }
-  if (status != STEPS_DONE) {
+  if (status == MISSING_LOCK_ROW || status == MISSING_FRICTION_ROWS) {
     PyObject *code = PyLong_FromLong(status);
     if (code != NULL) {
       PyErr_SetObject(PyExc_LookupError, code);
       Py_DECREF(code);
     }
-    return NULL;
+    return -1;
   }
+  return status;
+}
+
+/* run(config address, state address, nstep, qvel_before row or -1): see steps(). Returns None. */
+static PyObject *run(PyObject *self, PyObject *args) {
+  (void)self;
+  unsigned long long cfg_adr, st_adr;
+  long long nstep, row;
+  if (!PyArg_ParseTuple(args, "KKLL", &cfg_adr, &st_adr, &nstep, &row)) return NULL;
+  const int64_t *cfg = (const int64_t *)(intptr_t)cfg_adr;
+  double *dest = row >= 0 ? PTR(double *, qvel_before) + row * cfg[C_nv] : NULL;
+  if (guarded(cfg, (double *)(intptr_t)st_adr, 's', &nstep, dest) < 0) return NULL;
   Py_RETURN_NONE;
+}
+
+/* record(config address, state address, nsamples, steps per sample, steps remaining, pending row or -1): see
+ * record(). Returns its status (an int). */
+static PyObject *record_samples(PyObject *self, PyObject *args) {
+  (void)self;
+  unsigned long long cfg_adr, st_adr;
+  long long a[4];
+  if (!PyArg_ParseTuple(args, "KKLLLL", &cfg_adr, &st_adr, &a[0], &a[1], &a[2], &a[3])) return NULL;
+  int status = guarded((const int64_t *)(intptr_t)cfg_adr, (double *)(intptr_t)st_adr, 'r', a, NULL);
+  return status < 0 ? NULL : PyLong_FromLong(status);
 }
 
 static PyMethodDef methods[] = {
     {"run", run, METH_VARARGS, "run(config, state, nstep, row): nstep steps of a serial run (see stepper.py)"},
+    {"record", record_samples, METH_VARARGS,
+     "record(config, state, nsamples, sps, remaining, pending): recorded output intervals (see stepper.py)"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -296,6 +501,8 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_stepper", NULL, -1,
 #define AS_NAME(name) #name,
 static const char *const config_names[] = {CONFIG_FIELDS(AS_NAME)};
 static const char *const state_names[] = {STATE_FIELDS(AS_NAME)};
+static const char *const scalar_names[] = {SCALAR_FIELDS(AS_NAME)};
+static const char *const deferred_names[] = {DEFERRED_FIELDS(AS_NAME)};
 #undef AS_NAME
 
 static PyObject *names(const char *const *list, int n) {
@@ -316,7 +523,10 @@ PyMODINIT_FUNC PyInit__stepper(void) {
   PyObject *mod = PyModule_Create(&module);
   if (mod == NULL) return NULL;
   if (PyModule_AddObject(mod, "CONFIG", names(config_names, N_CONFIG)) < 0 ||
-      PyModule_AddObject(mod, "STATE", names(state_names, N_STATE)) < 0) {
+      PyModule_AddObject(mod, "STATE", names(state_names, N_STATE)) < 0 ||
+      PyModule_AddObject(mod, "SCALARS", names(scalar_names, N_SCALARS)) < 0 ||
+      PyModule_AddObject(mod, "DEFERRED", names(deferred_names, N_DEFERRED)) < 0 ||
+      PyModule_AddIntConstant(mod, "WARNED", RECORD_WARNED) < 0) {
     Py_DECREF(mod);
     return NULL;
   }

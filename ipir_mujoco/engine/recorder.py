@@ -41,11 +41,15 @@ from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_ad
 # With compliant clutches also: overlaps clutch_overlap1/2 d_i [m] (> 0: the spring is compressed), the springs'
 # stored energy clutch_spring_energy and the dampers' cumulative dissipation clutch_damper_work [J].
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
-# the per-sample scalars, in their order in Recorder.scalars
-_SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
-            "friction_work", "clutch_damper_work")
-_DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
-             "clutch_overlap2")
+# the per-sample scalars, in their order in Recorder.scalars (the compiled loop writes them too: stepper.py checks
+# the order against _stepper.c's)
+SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
+           "friction_work", "clutch_damper_work")
+# MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
+DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
+            "clutch_overlap2", "clutch_spring")
+_S = {name: i for i, name in enumerate(SCALARS)}
+_D = {name: i for i, name in enumerate(DEFERRED)}
 
 
 def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarray) -> np.ndarray:
@@ -89,8 +93,9 @@ class Recorder:
         self.qpos = np.empty((capacity, model.nq))
         self.qvel = np.empty((capacity, model.nv))
         self.qvel_before = np.empty((capacity, model.nv))
-        self.scalars: list[tuple] = []  # one tuple of _SCALARS per sample
-        self.deferred: list[tuple | None] = [None] * capacity  # one tuple of _DEFERRED per sample
+        self.scalars = np.zeros((capacity, len(SCALARS)))  # one row of SCALARS per sample
+        self.deferred = np.full((capacity, len(DEFERRED)), np.nan)  # one row of DEFERRED per sample
+        self.excursion = np.zeros(capacity)  # the clutch controller's backward excursion so far [m]
         self.count = 0
         self.total_mass = float(model.body_subtreemass[0])
         # views of the fields read at every sample (their memory is fixed for the life of the MjData)
@@ -98,13 +103,14 @@ class Recorder:
         self._energy, self._subtree_linvel = data.energy, data.subtree_linvel
 
     def sample(self, torque: float, motor_work: float, friction_work: float, reactions,
-               damper_work: float = 0.0) -> int:
+               damper_work: float = 0.0, excursion: float = 0.0) -> int:
         """Store the current state as a sample; returns its row (its deferred values come later).
 
         ``torque`` [N m]: the drive's torque over the last step; ``motor_work``,
         ``friction_work``, ``damper_work`` (the compliant clutches' dampers) [J]:
         cumulative; ``reactions``: the clutch controller's (rear held, front
-        held, rear reaction [N], front reaction [N]).
+        held, rear reaction [N], front reaction [N]); ``excursion`` [m]: its
+        backward excursion so far.
         """
         d, i = self.data, self.count
         self.t[i] = d.time
@@ -112,45 +118,37 @@ class Recorder:
         self.qvel[i] = d.qvel
         row = equality_row(self.model, d, self.loop_id) if self.loop_id else 0
         fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
-        self.scalars.append((torque, fx, fy, *reactions, motor_work, friction_work, damper_work))
+        self.scalars[i] = (torque, fx, fy, *reactions, motor_work, friction_work, damper_work)
+        self.excursion[i] = excursion
         self.count += 1
         return i
 
-    def works(self, i: int) -> tuple[float, float, float]:
-        """Cumulative (motor work, friction work, clutch damper work) [J] of sample ``i``."""
-        row = self.scalars[i]
-        return row[7], row[8], row[9]
-
-    def fill_deferred(self, i: int) -> tuple[float, float, float, float]:
-        """Energies, loop gap, momentum and compliant clutch forces and overlaps of sample ``i`` from MuJoCo's
-        current (start of step) values.
-
-        Returns (kinetic [J], potential [J], loop gap [m], clutch spring energy [J] as the step conserves
-        it: :meth:`.compliant.CompliantClutches.stepped_spring_energy`).
-        """
+    def fill_deferred(self, i: int) -> None:
+        """Energies, loop gap, momentum, compliant clutch forces and overlaps and the springs' energy as the step
+        conserves it (:meth:`.compliant.CompliantClutches.stepped_spring_energy`) of sample ``i`` from MuJoCo's
+        current (start of step) values."""
         sx, sy, sz = self._rod_end.tolist()
         bx, by, bz = self._front_pos.tolist()
         ox, oy, oz = self.pin_offset
-        gap = math.sqrt((sx - bx - ox) ** 2 + (sy - by - oy) ** 2 + (sz - bz - oz) ** 2)
+        dx, dy, dz = sx - bx - ox, sy - by - oy, sz - bz - oz
+        gap = math.sqrt(dx * dx + dy * dy + dz * dz)
         mujoco.mj_subtreeVel(self.model, self.data)
         momentum = self._subtree_linvel.item(0) * self.total_mass
         potential, kinetic = self._energy.tolist()
-        spring = 0.0
         if self.clutch is None:
-            self.deferred[i] = (kinetic, potential, gap, momentum, 0.0, 0.0, 0.0, 0.0)
+            self.deferred[i] = (kinetic, potential, gap, momentum, 0.0, 0.0, 0.0, 0.0, 0.0)
         else:
             (f1, f2), (d1, d2) = self.clutch.forces(), self.clutch.overlap
-            spring = self.clutch.stepped_spring_energy()
-            self.deferred[i] = (kinetic, potential, gap, momentum, f1, f2, d1, d2)
-        return kinetic, potential, gap, spring
+            self.deferred[i] = (kinetic, potential, gap, momentum, f1, f2, d1, d2,
+                                self.clutch.stepped_spring_energy())
 
     def series(self, last: int | None = None) -> dict[str, np.ndarray]:
         """Every column, for the samples 0..``last`` (default: all)."""
         n = self.count if last is None else last + 1
         p, dt = self.params, self.model.opt.timestep
         q, v, vb = self.qpos[:n], self.qvel[:n], self.qvel_before[:n]
-        sc = dict(zip(_SCALARS, np.array(self.scalars[:n], dtype=float).reshape(n, len(_SCALARS)).T))
-        de = dict(zip(_DEFERRED, np.array(self.deferred[:n], dtype=float).reshape(n, len(_DEFERRED)).T))
+        sc = dict(zip(SCALARS, self.scalars[:n].T))
+        de = dict(zip(DEFERRED, self.deferred[:n].T))
         c, r1, f2, rod = (self.qa[k] for k in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE))
         cv, r1v, f2v = (self.va[k] for k in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE))
         accel = (v - vb) / dt

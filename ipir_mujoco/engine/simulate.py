@@ -53,13 +53,12 @@ from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captu
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from .recorder import EXTRA_COLUMNS, Recorder
-from .stepper import loop_options, make_steps
+from .recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
+from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
-NO_REACTIONS = (False, False, 0.0, 0.0)  # a compliant run's samples take the clutch forces from the recorder
 
 
 def simulate_mujoco(
@@ -195,9 +194,9 @@ class _Run:
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
 
-        The steps between two samples run in :mod:`.stepper` (compiled where it can be); a sample's
-        deferred values are MuJoCo's at the start of the next step, so each interval's first step is
-        taken on its own and the previous sample judged after it.
+        The steps run and the samples are recorded in :mod:`.stepper` (compiled where it can be), a block of
+        BLOCK_TIME at a time; a sample's deferred values are MuJoCo's at the start of the next step, so each
+        sample is judged by the monitor in the next interval (:meth:`_replay`).
         """
         self._setup()
         m, d, rec, ctl = self.model, self.data, self.recorder, self.controller
@@ -205,41 +204,30 @@ class _Run:
         torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
-        row = rec.sample(torque, 0.0, 0.0, ctl.reactions())
-        start = rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
-        self.energy0 = (start[0], start[1] + start[3])  # kinetic; potential with the clutch springs
+        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion)
+        rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
+        kinetic, potential, spring = (rec.deferred[row, DEFERRED.index(n)] for n in
+                                      ("kinetic", "potential", "clutch_spring"))
+        self.energy0 = (kinetic, potential + spring)  # kinetic; potential with the clutch springs
         self.energy_floor = max(self.energy0[0], 2 * math.pi * abs(torque), climb_energy(m, self.params))
-        self._judge(row, *start)
+        self._replay((0, 1), (0, 1))
         self._check(messages, 0.0)
 
         steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, servo=self.servo, **self.loop)
-        pending = -1
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
         checks = _BlockChecks(self)
-        last = None
+        pending, last = -1, None  # the first interval has no sample before it to fill in
         while done < n_steps:
-            k = min(sps, n_steps - done)
-            if pending >= 0:
-                steps.run(1, rec.count if k == 1 else -1)
-                self._judge(pending, *rec.fill_deferred(pending))
-                if k > 1:
-                    steps.run(k - 1, rec.count)
-            else:
-                steps.run(k, rec.count)
-            done += k
-            if messages:
-                self._check(messages, float(rec.t[rec.count - 1]))
-            torque = steps.torque
-            if self.compliant:
-                pending = rec.sample(torque, steps.motor_work, steps.friction_work, NO_REACTIONS, ctl.damper_work)
-            else:
-                pending = rec.sample(torque, steps.motor_work, steps.friction_work, ctl.reactions())
-            if abs(torque) * 2 * math.pi > self.energy_floor:
-                self.energy_floor = 2 * math.pi * abs(torque)
-            if ctl.excursion > self.monitor.worst["excursion_m"]:
-                self.monitor.excursion(d.time, ctl.excursion)
-            samples += 1
+            first = rec.count
+            status, taken = steps.record(rec, block - samples % block, sps, n_steps - done, pending, messages)
+            done += taken
+            samples += rec.count - first
+            pending = rec.count - 1
+            # each interval judged the sample before it, from its first step on (none before the first interval);
+            # an interval in which MuJoCo warned is not recorded, but it judged the last sample first
+            warned = status == WARNED
+            self._replay((max(first - 1, 1), rec.count - (0 if warned else 1)), (first, rec.count), warned, messages)
             if samples % block == 0 or done >= n_steps:
                 last = checks.check(pending, messages)
                 if last is not None:
@@ -248,24 +236,59 @@ class _Run:
             # the anchors and dampers for the final state, whose clutch forces the last sample holds
             ctl.before_step()
         mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
-        if pending >= 0:
-            self._judge(pending, *rec.fill_deferred(pending))
+        if pending >= 1:
+            rec.fill_deferred(pending)
+            self._replay((pending, pending + 1), (rec.count, rec.count))
         self._check(messages, float(rec.t[rec.count - 1]))
         return rec.count - 1 if last is None else last
 
-    def _judge(self, row: int, kinetic: float, potential: float, gap: float, spring: float) -> None:
-        """Feed sample ``row``'s residual ratio and loop gap to the monitor, when they beat its worst.
+    def _replay(self, judged: tuple[int, int], new: tuple[int, int], warned: bool = False, messages=()) -> None:
+        """Feed the monitor what rows ``judged`` (a, b: rows a..b-1, whose deferred values are filled) and the
+        new samples ``new`` (first, end) show, in the order the samples were taken: sample i's interval first
+        judged row i - 1 (residual ratio, then loop gap), then raised the energy floor to sample i's torque and
+        reported its excursion; if MuJoCo warned in the interval after the last new sample (``warned``: it was
+        not recorded, but it judged that sample), the run fails with the last good time. Only the values that beat the monitor's worst so far are fed (the others cannot
+        change it), so a block costs a few array operations."""
+        rec, mon = self.recorder, self.monitor
+        (a, b), (first, end) = judged, new
+        rows = np.arange(a, b)
+        events = []  # (position in the sampling order, kind, row)
+        if rows.size:
+            # the floor each judged row saw: raised by every sample's torque up to it (2 pi |torque|)
+            torque = rec.scalars[a:b, SCALARS.index("motor_torque")]
+            floors = np.fmax.accumulate(np.concatenate([[self.energy_floor], 2 * math.pi * np.abs(torque)]))[1:]
+            residual, scale = self._audit(rows, floors)
+            ratio = np.divide(residual, scale, out=np.zeros_like(residual), where=scale > 0)
+            events += [(2 * j + 2, 0, j) for j in rows[_rising(ratio, mon.worst["residual_ratio"])].tolist()]
+            gap = rec.deferred[a:b, DEFERRED.index("loop_gap")]
+            events += [(2 * j + 2, 1, j) for j in rows[_rising(gap, mon.worst["loop_gap_m"])].tolist()]
+        if warned and messages:  # in the interval after the last new sample, once it had judged the one before
+            events.append((2 * end, 2, end - 1))
+        news = np.arange(first, end)
+        events += [(2 * i + 1, 3, i) for i in news[_rising(rec.excursion[first:end], mon.worst["excursion_m"])].tolist()]
+        for _, kind, j in sorted(events):
+            t = rec.t.item(j)
+            if kind == 0:
+                mon.residual(t, residual.item(j - a), scale.item(j - a))
+            elif kind == 1:
+                mon.loop_gap(t, rec.deferred.item(j, DEFERRED.index("loop_gap")))
+            elif kind == 2:
+                self._check(messages, t)
+            else:
+                mon.excursion(t, rec.excursion.item(j))
+        if end > first:
+            torque = rec.scalars[first:end, SCALARS.index("motor_torque")]
+            self.energy_floor = max(self.energy_floor, float(np.max(2 * math.pi * np.abs(torque))))
 
-        ``spring`` [J]: the compliant clutch springs' stored energy, counted with the potential energy
-        (as the dampers' work is with the friction work)."""
-        mon, rec = self.monitor, self.recorder
-        wm, wf, wc = rec.works(row)
-        residual, scale = energy_audit(wm, wf + wc, kinetic - self.energy0[0], potential + spring - self.energy0[1],
-                                       self.energy_floor)
-        if scale > 0 and abs(residual) > abs(mon.worst["residual_ratio"]) * scale:
-            mon.residual(rec.t.item(row), residual, scale)
-        if gap > mon.worst["loop_gap_m"]:
-            mon.loop_gap(rec.t.item(row), gap)
+    def _audit(self, rows: np.ndarray, floors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The energy audit's (residual [J], scale [J]) of samples ``rows`` with energy floors ``floors`` [J]:
+        the clutch springs count with the potential energy, their dampers with the friction work."""
+        rec = self.recorder
+        sc, de = rec.scalars[rows], rec.deferred[rows]
+        S, D = SCALARS.index, DEFERRED.index
+        return energy_audit(sc[:, S("motor_work")], sc[:, S("friction_work")] + sc[:, S("clutch_damper_work")],
+                            de[:, D("kinetic")] - self.energy0[0],
+                            de[:, D("potential")] + de[:, D("clutch_spring")] - self.energy0[1], floors)
 
     def _check(self, messages: list[str], t_good: float) -> None:
         """Raise on a MuJoCo warning or a non-finite state; ``t_good`` [s] is the last sample known good
@@ -275,6 +298,13 @@ class _Run:
                                   "(a smaller --timestep may carry the run further)")
         if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
+
+
+def _rising(values: np.ndarray, worst: float) -> np.ndarray:
+    """Indices of ``values`` whose magnitude beats every one before it and ``worst`` (NaN never does)."""
+    size = np.abs(values)
+    before = np.fmax.accumulate(np.concatenate([[abs(worst)], size[:-1]]))
+    return np.flatnonzero(size > before)
 
 
 class _BlockChecks:

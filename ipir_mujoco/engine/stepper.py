@@ -48,12 +48,15 @@ from ipir_mujoco.analytic.errors import ParameterError
 from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
 from .compliant import CompliantClutches
 from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
+from .recorder import DEFERRED, SCALARS, Recorder
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
 CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant")
-_DATA_FIELDS = ("time", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_force")
+_DATA_FIELDS = ("warning", "time", "energy", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_id", "efc_force")
 FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+DONE, WARNED = 0, 3  # what record() returns: all intervals taken, or MuJoCo warned in the last one (_stepper.c's)
+NO_REACTIONS = (False, False, 0.0, 0.0)
 
 
 def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
@@ -134,6 +137,38 @@ class PythonSteps:
             omega_prev = omega
         self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
 
+    def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
+               messages: list[str]) -> tuple[int, int]:
+        """Up to ``nsamples`` output intervals of ``sps`` steps each (the last one cut at ``remaining``
+        steps), each recorded as a sample of ``rec``; an interval's first step is where MuJoCo computes the
+        previous sample's deferred values (``pending``: its row, -1 for none), so they are filled after it.
+        Stops, without recording it, after an interval in which MuJoCo warned (``messages`` grew). Returns
+        (DONE or WARNED, steps taken)."""
+        ctl, warned, taken = self.controller, len(messages), 0
+        compliant = isinstance(ctl, CompliantClutches)
+        for _ in range(nsamples):
+            if remaining <= 0:
+                break
+            k = min(sps, remaining)
+            if pending >= 0:
+                self.run(1, rec.count if k == 1 else -1)
+                rec.fill_deferred(pending)
+                if k > 1:
+                    self.run(k - 1, rec.count)
+            else:
+                self.run(k, rec.count)
+            remaining -= k
+            taken += k
+            if len(messages) != warned:  # the state may be MuJoCo's reset: nothing to record
+                return WARNED, taken
+            if compliant:  # its samples take the clutch forces from the deferred values
+                pending = rec.sample(self.torque, self.motor_work, self.friction_work, NO_REACTIONS,
+                                     ctl.damper_work, ctl.excursion)
+            else:
+                pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(),
+                                     0.0, ctl.excursion)
+        return DONE, taken
+
 
 class CompiledSteps(PythonSteps):
     """The same loop in C (``_stepper.c``); same constructor and attributes as :class:`PythonSteps`.
@@ -195,6 +230,50 @@ class CompiledSteps(PythonSteps):
         self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
         self._sync(state)
 
+    def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
+               messages: list[str]) -> tuple[int, int]:
+        if self._kind == "compliant":  # its deferred values and reactions are the controller's (Python)
+            return super().record(rec, nsamples, sps, remaining, pending, messages)
+        if rec is not self._rec:
+            self._bind(rec)
+        st, S = self._st, self.S
+        st[S["count"]], st[S["steps_done"]] = rec.count, 0.0
+        try:
+            status = self._module.record(*self._args, nsamples, sps, remaining, pending)
+        except RuntimeError as exc:
+            raise mujoco.FatalError(str(exc)) from None
+        except LookupError as exc:
+            raise missing_rows(exc.args[0], self.data.time) from None
+        finally:
+            rec.count = int(st[S["count"]])
+        state = st.tolist()
+        self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
+        self._sync(state)
+        return status, int(state[S["steps_done"]])
+
+    def _bind(self, rec: Recorder) -> None:
+        """Where the C loop writes ``rec``'s samples and reads what they hold."""
+        arrays = (rec.t, rec.qpos, rec.qvel, rec.scalars, rec.deferred, rec.excursion)
+        if rec.qvel_before is not self.qvel_before or not all(
+                a.flags.c_contiguous and a.dtype == np.float64 for a in arrays):
+            raise LayoutError("the recorder's arrays are not the loop's C-contiguous float64 buffers")
+        ctl, offsets, address = self.controller, _mjdata_offsets(), self.data._address
+        friction = getattr(ctl, "friction", None)
+        fric_off, resist = (friction.offsets, friction.resistance) if friction is not None else ([-1, -1], [0, 0])
+        self._set_config(
+            nq=self.model.nq, nl_field=address + offsets["nl"], time_field=address + offsets["time"],
+            warning_field=address + offsets["warning"], n_warning=len(self.data.warning),
+            efc_id_field=address + offsets["efc_id"], subtree_vel=_compiled()[1]["mj_subtreeVel"],
+            energy=address + offsets["energy"], rod_end=_address(rec._rod_end), front_pos=_address(rec._front_pos),
+            subtree_linvel=_address(rec._subtree_linvel), loop_eq=rec.loop_id, fric_off0=fric_off[0],
+            fric_off1=fric_off[1], rec_t=_address(rec.t), rec_qpos=_address(rec.qpos), rec_qvel=_address(rec.qvel),
+            rec_scalars=_address(rec.scalars), rec_deferred=_address(rec.deferred),
+            rec_excursion=_address(rec.excursion))
+        ox, oy, oz = rec.pin_offset
+        self._set_state(resist0=resist[0], resist1=resist[1], pin_x=ox, pin_y=oy, pin_z=oz,
+                        total_mass=rec.total_mass)
+        self._rec = rec
+
     def _set_config(self, **values) -> None:
         for name, value in values.items():
             self._cfg[self.C[name]] = int(value)
@@ -242,6 +321,7 @@ class CompiledSteps(PythonSteps):
         else:
             raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
         self._set_config(clutch=CLUTCH_KINDS.index(kind))
+        self._kind, self._rec = kind, None
 
     def _getter(self, *names):
         return itemgetter(*(self.S[n] for n in names))
@@ -298,6 +378,8 @@ def _compiled_cached():
         from . import _stepper
     except ImportError as exc:
         return None, f"the compiled stepper is not built ({exc}); reinstall with a C compiler"
+    if (tuple(_stepper.SCALARS), tuple(_stepper.DEFERRED)) != (SCALARS, DEFERRED):
+        return None, "the compiled stepper was built from other sources than this package's; reinstall it"
     try:
         library = _library()
         _mjdata_offsets()
@@ -336,7 +418,8 @@ def _library() -> dict[str, int]:
         user_error = ctypes.addressof(ctypes.c_void_p.in_dll(lib, "mju_user_error"))
     except ValueError:  # no legacy handler: a MuJoCo error inside the loop is then MuJoCo's default (exit)
         user_error = 0
-    return {"mj_step": ctypes.cast(lib.mj_step, ctypes.c_void_p).value, "mju_user_error": user_error}
+    return {"mj_step": ctypes.cast(lib.mj_step, ctypes.c_void_p).value,
+            "mj_subtreeVel": ctypes.cast(lib.mj_subtreeVel, ctypes.c_void_p).value, "mju_user_error": user_error}
 
 
 _SCALARS = {"mjtNum": ctypes.c_double, "double": ctypes.c_double, "float": ctypes.c_float, "int": ctypes.c_int,
@@ -375,6 +458,9 @@ def _mjdata_offsets() -> dict[str, int]:
                 break
         return type(name, (ctypes.Structure,), {"_fields_": fields})
 
+    stat = [(f.name, getattr(f.type, "name", None)) for f in structs.STRUCTS["mjWarningStat"].fields]
+    if stat != [("lastinfo", "int"), ("number", "int")]:  # _stepper.c counts warnings on this layout
+        raise LayoutError(f"mjWarningStat is {stat}, not (int lastinfo, int number)")
     names = [f.name for f in structs.STRUCTS["mjData"].fields]
     missing = [n for n in _DATA_FIELDS if n not in names]
     if missing:
@@ -390,12 +476,18 @@ def _check_layout(data: mujoco.MjData) -> dict[str, int]:
     base = data._address
     read = {n: ctypes.c_int.from_address(base + offsets[n]).value for n in ("ne", "nf", "nl", "nefc")}
     read["time"] = ctypes.c_double.from_address(base + offsets["time"]).value
-    for n in ("qpos", "qvel", "efc_force"):
+    for n in ("qpos", "qvel", "efc_id", "efc_force"):
         read[n] = ctypes.c_void_p.from_address(base + offsets[n]).value
+    # each mjWarningStat is (lastinfo, number), two ints
+    read["warning"] = [ctypes.c_int.from_address(base + offsets["warning"] + 8 * w + 4).value
+                       for w in range(len(data.warning))]
+    read["energy"] = base + offsets["energy"]
     expected = {n: int(getattr(data, n)) for n in ("ne", "nf", "nl", "nefc")}
     expected["time"] = float(data.time)
-    for n in ("qpos", "qvel", "efc_force"):
+    for n in ("qpos", "qvel", "efc_id", "efc_force"):
         expected[n] = _address(getattr(data, n)) if getattr(data, n).size else read[n]
+    expected["warning"] = [int(stat.number) for stat in data.warning]
+    expected["energy"] = _address(data.energy)
     if data.nefc == 0 or read != expected:
         raise LayoutError(f"the mjData layout does not check out: read {read}, expected {expected}")
     return offsets
