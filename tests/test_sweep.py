@@ -302,7 +302,8 @@ def test_steady_state_metrics_come_from_the_run_summary():
     assert np.isnan(metrics["residual_ratio"])  # the analytic engines have no accuracy monitor
 
 
-def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch):
+@pytest.mark.parametrize("batch_mujoco", [True, False])
+def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch, batch_mujoco):
     """The engines' until_steady keyword (and the analytic wall_budget_s) are passed; the batched
     MuJoCo series is read through analytic.cycles; a stalled design is marked, not failed. The fakes
     raise unless they get the keywords: pool and batch processes fork with them in place."""
@@ -338,14 +339,19 @@ def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch):
     monkeypatch.setattr(batch_module, "run_ratchet_batch", fake_batch)
     study = Study((parse_vary("L=0.1,0.2"),), engines=("mujoco-ratchet", "analytic-unilateral", "mujoco-lock"),
                   t_end=2.0, until_steady=True)
-    rows = rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=1, timeout_per_design=30))
+    rows = rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=1, timeout_per_design=30,
+                             batch_mujoco=batch_mujoco))
     assert all(r["error"] == "" for r in rows)
     for row in rows:
-        assert float(row["mujoco-ratchet:steady"]) == 1 and float(row["mujoco-ratchet:residual_ratio"]) == 1e-4
+        # each fake's own residual: the ratchet went where it was sent
+        assert float(row["mujoco-ratchet:steady"]) == 1
+        assert float(row["mujoco-ratchet:residual_ratio"]) == (1e-4 if batch_mujoco else 2e-4)
         assert float(row["mujoco-lock:loop_gap_m"]) == 3e-7
         assert float(row["analytic-unilateral:steady_speed_m_s"]) == pytest.approx(0.2, rel=1e-9)
-        # 0.0101 against 0.01 m per radian: the steady speed diverges by exactly 1 %
-        assert float(row["divergence:mujoco-lock:steady_speed_m_s"]) == pytest.approx(0.01, rel=1e-6)
+        # 0.0101 against the batch fake's 0.01 m per radian: the steady speed diverges by exactly 1 %; none
+        # against the serial fake's own 0.0101
+        assert float(row["divergence:mujoco-lock:steady_speed_m_s"]) == pytest.approx(0.01 if batch_mujoco else 0.0,
+                                                                                     rel=1e-6, abs=1e-12)
     assert rows[0]["analytic-unilateral:stalled"] == "0" and rows[1]["analytic-unilateral:stalled"] == "1"
     assert "dead centre" in rows[1]["notes"]
 
@@ -468,3 +474,31 @@ def test_a_metric_equal_in_every_design_names_no_best_design():
     columns["a:efficiency"] = np.array([0.1, 0.3, 0.2])
     best = best_designs(columns, ["L"], ["a"])
     assert [(b["metric"], b["L"]) for b in best] == [("efficiency", 0.2)]
+
+
+def test_the_default_sweep_runs_mujoco_serially_where_its_loop_is_compiled(tmp_path):
+    """Where the serial engine steps in C, the default sweep runs the ratchet designs through it: each row
+    is the serial run's metrics (rod force included, which the batch cannot measure), not the batch's."""
+    from ipir_mujoco.engine.stepper import compiled_status
+    from ipir_mujoco.studies.sweep import engine_metrics
+    from ipir_mujoco.studies.sweep_files import _cell, make_row
+
+    compiled, why = compiled_status()
+    if not compiled:
+        pytest.skip(f"no compiled loop here: {why}")
+    study = Study((parse_vary("L=0.1,0.2"),), engines=("mujoco-ratchet",), t_end=0.2)
+    rows = rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=1))
+    for i, row in enumerate(rows):
+        design = {"L": (0.1, 0.2)[i]}
+        serial = engine_metrics("mujoco-ratchet", study.base.replace(**design), study.t_end, study.dt_out, {})
+        expected = make_row(i, design, {"mujoco-ratchet": serial}, study.engines)
+        assert row == {k: _cell(v) for k, v in expected.items()}
+        assert float(row["mujoco-ratchet:peak_rod_force_n"]) > 0
+
+
+def test_no_batch_with_a_batch_size_is_refused(tmp_path, capsys):
+    code = main(["sweep", "--vary", "L=0.1,0.2", "--t-end", "0.1", "--out", str(tmp_path / "s"), "--no-batch",
+                 "--batch-size", "4"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--batch-size 4 with --no-batch" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "s").exists()

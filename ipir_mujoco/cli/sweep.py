@@ -40,10 +40,12 @@ def add_parser(commands) -> None:
     swp.add_argument("--out", metavar="DIR", default="sweep", help="results folder (default ./sweep)")
     swp.add_argument("--resume", action="store_true", help="complete an interrupted sweep in DIR")
     swp.add_argument("--workers", type=int, default=None, help="processes/threads to use (default: all cores)")
-    swp.add_argument("--no-batch", action="store_true", help="run MuJoCo designs one by one, not through mujoco.batch")
+    swp.add_argument("--no-batch", action="store_true",
+                     help="run MuJoCo designs one by one in the serial engine, never through mujoco.batch (the "
+                          "default wherever the serial engine's compiled loop is built)")
     swp.add_argument("--batch-size", type=int, default=None, metavar="N",
-                     help="MuJoCo designs stepped together per chunk (default 64); rows reach results.csv as chunks "
-                          "finish")
+                     help="step the MuJoCo ratchet designs through mujoco.batch, N per chunk (64 where the batch "
+                          "is used without this option); rows reach results.csv as chunks finish")
     swp.add_argument("--plot-metric", default=None, metavar="METRIC",
                      help="metric the heatmap colours (default: steady_speed_m_s with --until-steady, else "
                           "mean_speed_mps); any of: " + ", ".join(METRICS))
@@ -87,6 +89,9 @@ def run(args: argparse.Namespace) -> int:
     study = study_from_args(args)
     metric = check_plot_metric(args.plot_metric, study.until_steady)
     check_sweep_options(args.out, args.resume, args.workers, args.timeout_per_design, args.batch_size)
+    if args.no_batch and args.batch_size is not None:
+        raise ParameterError(f"--batch-size {args.batch_size} with --no-batch: the batch size is for mujoco.batch; "
+                             "allowed: one of the two")
     client = None
     if args.scheduler:
         try:
@@ -99,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(f"--scheduler {args.scheduler!r} cannot be reached: {exc}") from None
     try:
         results = run_sweep(study, args.out, executor=client.get_executor() if client else None,
-                            batch_mujoco=not args.no_batch, resume=args.resume, workers=args.workers,
+                            batch_mujoco=False if args.no_batch else None, resume=args.resume, workers=args.workers,
                             timeout_per_design=args.timeout_per_design, batch_size=args.batch_size)
     except SweepInterrupted as exc:
         print(f"ipir-mujoco sweep: {exc}", file=sys.stderr)

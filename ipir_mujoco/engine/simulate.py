@@ -57,6 +57,12 @@ from .recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 
+# columns of the recorder's arrays the monitor reads
+_TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK = (SCALARS.index(n) for n in (
+    "motor_torque", "motor_work", "friction_work", "clutch_damper_work"))
+_KINETIC, _POTENTIAL, _SPRING, _GAP = (DEFERRED.index(n) for n in ("kinetic", "potential", "clutch_spring",
+                                                                    "loop_gap"))
+
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
 
@@ -251,44 +257,40 @@ class _Run:
         change it), so a block costs a few array operations."""
         rec, mon = self.recorder, self.monitor
         (a, b), (first, end) = judged, new
-        rows = np.arange(a, b)
         events = []  # (position in the sampling order, kind, row)
-        if rows.size:
+        if b > a:
             # the floor each judged row saw: raised by every sample's torque up to it (2 pi |torque|)
-            torque = rec.scalars[a:b, SCALARS.index("motor_torque")]
-            floors = np.fmax.accumulate(np.concatenate([[self.energy_floor], 2 * math.pi * np.abs(torque)]))[1:]
-            residual, scale = self._audit(rows, floors)
+            revolution = 2 * math.pi * np.abs(rec.scalars[a:b, _TORQUE])
+            floors = np.fmax.accumulate(np.append(self.energy_floor, revolution))[1:]
+            residual, scale = self._audit(a, b, floors)
             ratio = np.divide(residual, scale, out=np.zeros_like(residual), where=scale > 0)
-            events += [(2 * j + 2, 0, j) for j in rows[_rising(ratio, mon.worst["residual_ratio"])].tolist()]
-            gap = rec.deferred[a:b, DEFERRED.index("loop_gap")]
-            events += [(2 * j + 2, 1, j) for j in rows[_rising(gap, mon.worst["loop_gap_m"])].tolist()]
+            events += [(2 * j + 2, 0, j) for j in _rising(ratio, mon.worst["residual_ratio"], a)]
+            events += [(2 * j + 2, 1, j) for j in _rising(rec.deferred[a:b, _GAP], mon.worst["loop_gap_m"], a)]
         if warned and messages:  # in the interval after the last new sample, once it had judged the one before
             events.append((2 * end, 2, end - 1))
-        news = np.arange(first, end)
-        events += [(2 * i + 1, 3, i) for i in news[_rising(rec.excursion[first:end], mon.worst["excursion_m"])].tolist()]
+        if end > first:
+            events += [(2 * i + 1, 3, i) for i in _rising(rec.excursion[first:end], mon.worst["excursion_m"], first)]
         for _, kind, j in sorted(events):
             t = rec.t.item(j)
             if kind == 0:
                 mon.residual(t, residual.item(j - a), scale.item(j - a))
             elif kind == 1:
-                mon.loop_gap(t, rec.deferred.item(j, DEFERRED.index("loop_gap")))
+                mon.loop_gap(t, rec.deferred.item(j, _GAP))
             elif kind == 2:
                 self._check(messages, t)
             else:
                 mon.excursion(t, rec.excursion.item(j))
         if end > first:
-            torque = rec.scalars[first:end, SCALARS.index("motor_torque")]
-            self.energy_floor = max(self.energy_floor, float(np.max(2 * math.pi * np.abs(torque))))
+            largest = float(np.max(np.abs(rec.scalars[first:end, _TORQUE])))
+            self.energy_floor = max(self.energy_floor, 2 * math.pi * largest)
 
-    def _audit(self, rows: np.ndarray, floors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The energy audit's (residual [J], scale [J]) of samples ``rows`` with energy floors ``floors`` [J]:
+    def _audit(self, a: int, b: int, floors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The energy audit's (residual [J], scale [J]) of samples a..b-1 with energy floors ``floors`` [J]:
         the clutch springs count with the potential energy, their dampers with the friction work."""
-        rec = self.recorder
-        sc, de = rec.scalars[rows], rec.deferred[rows]
-        S, D = SCALARS.index, DEFERRED.index
-        return energy_audit(sc[:, S("motor_work")], sc[:, S("friction_work")] + sc[:, S("clutch_damper_work")],
-                            de[:, D("kinetic")] - self.energy0[0],
-                            de[:, D("potential")] + de[:, D("clutch_spring")] - self.energy0[1], floors)
+        sc, de = self.recorder.scalars[a:b], self.recorder.deferred[a:b]
+        return energy_audit(sc[:, _MOTOR_WORK], sc[:, _FRICTION_WORK] + sc[:, _DAMPER_WORK],
+                            de[:, _KINETIC] - self.energy0[0], de[:, _POTENTIAL] + de[:, _SPRING] - self.energy0[1],
+                            floors)
 
     def _check(self, messages: list[str], t_good: float) -> None:
         """Raise on a MuJoCo warning or a non-finite state; ``t_good`` [s] is the last sample known good
@@ -300,11 +302,14 @@ class _Run:
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
 
 
-def _rising(values: np.ndarray, worst: float) -> np.ndarray:
-    """Indices of ``values`` whose magnitude beats every one before it and ``worst`` (NaN never does)."""
+def _rising(values: np.ndarray, worst: float, offset: int) -> list[int]:
+    """Rows (index + ``offset``) of ``values`` whose magnitude beats every one before it and ``worst`` (NaN
+    never does): the values the monitor would take."""
     size = np.abs(values)
-    before = np.fmax.accumulate(np.concatenate([[abs(worst)], size[:-1]]))
-    return np.flatnonzero(size > before)
+    if not np.fmax.reduce(size) > abs(worst):  # the common case once a run is under way: nothing to feed
+        return []
+    before = np.fmax.accumulate(np.append(abs(worst), size[:-1]))
+    return (np.flatnonzero(size > before) + offset).tolist()
 
 
 class _BlockChecks:

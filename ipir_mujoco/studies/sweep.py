@@ -12,15 +12,20 @@ of one study give byte-identical files.
 
 Where work runs:
 
-* default: analytic engines (and MuJoCo's lock) in a process pool; MuJoCo's
+* default: every engine of a design, one after the other, as one task of a
+  process pool (the serial MuJoCo engine steps and records in C, within ~1.2x
+  of MuJoCo's own step cost for a 1-s run, so the analytic and MuJoCo work of
+  the designs fills every core).
+* with ``batch_size`` (``batch_mujoco=True``), or where the serial engine's
+  compiled loop is not built (``engine.stepper.compiled_status``): MuJoCo's
   ratchet through ``mujoco.batch`` in chunks of ``batch_size`` designs, each
   chunk in a process of its own on one thread, so rows stream as chunks
   finish; a design the batch does not model (compliant clutches, a drive
   outside ``batch.MODELLED_DRIVES``) runs in that process with the serial
-  engine instead. Both sides run at once and share the cores: while both have work,
-  the batch gets half of them (rounded up) and the pool the rest; whichever
-  finishes first hands its cores to the other. Ctrl-C ends both pools' processes at once; the rows
-  written are every design finished by then.
+  engine instead. The chunks and the pool (the other engines) run at once and share the cores: while both
+  have work, the batch gets half of them (rounded up) and the pool the rest; whichever finishes first
+  hands its cores to the other. Ctrl-C ends both pools' processes at once; the rows written are every
+  design finished by then.
 * ``executor=``: any ``concurrent.futures.Executor`` (a Dask ``Client``'s
   ``get_executor()`` for a cluster); every engine of a design runs as one task
   on it, MuJoCo serially.
@@ -255,10 +260,14 @@ def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_desi
 
 
 def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | None = None,
-              batch_mujoco: bool = True, resume: bool = False, workers: int | None = None,
+              batch_mujoco: bool | None = None, resume: bool = False, workers: int | None = None,
               progress: bool = True, on_row: Callable[[dict], None] | None = None,
               timeout_per_design: float | None = None, batch_size: int | None = None) -> Path:
-    """Run ``study``, writing OUT/results.csv; return its path (see the module docstring)."""
+    """Run ``study``, writing OUT/results.csv; return its path (see the module docstring).
+
+    ``batch_mujoco``: True steps the MuJoCo ratchet designs through ``mujoco.batch``, False one by one in
+    the serial engine; None (default) the batch only when ``batch_size`` is given or the serial engine's
+    compiled loop is not built."""
     out = check_sweep_options(out, resume, workers, timeout_per_design, batch_size)
     meta = out / "sweep.json"
     record = {"fingerprint": study.fingerprint(), "study": study.to_json()}
@@ -276,6 +285,10 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
     todo = [i for i in range(len(designs)) if i not in results_file.done]
     bar = Progress(len(designs), len(designs) - len(todo), progress)
     engines = study.engines
+    if batch_mujoco is None:
+        from ..engine.stepper import compiled_status
+
+        batch_mujoco = batch_size is not None or not compiled_status()[0]
     batched = (BATCHED,) if batch_mujoco and executor is None and BATCHED in engines else ()
     pooled = tuple(e for e in engines if e not in batched)
     options = {"until_steady": study.until_steady, "wall_budget_s": timeout_per_design}
