@@ -8,12 +8,14 @@ not merely close.
 
 from __future__ import annotations
 
+import ctypes
+
 import mujoco
 import numpy as np
 import pytest
 
 from ipir_mujoco.analytic import RobotParams, SimulationError
-from ipir_mujoco.engine import CrankServo, simulate_mujoco, stepper
+from ipir_mujoco.engine import CrankServo, native, simulate_mujoco, stepper
 from ipir_mujoco.engine.batch import run_ratchet_batch
 from ipir_mujoco.engine.clutches import Ratchet
 from ipir_mujoco.engine.model import (MOTOR, SolverSettings, build_model, build_spec, default_mjcf, drive_control,
@@ -24,7 +26,7 @@ def built() -> tuple[bool, str]:
     """Whether the compiled loop is built and checks out here (whatever IPIR_MUJOCO_STEPPER says: these
     tests choose the loop themselves)."""
     try:
-        stepper._compiled()
+        native.compiled()
     except stepper.LayoutError as exc:
         return False, str(exc)
     return True, ""
@@ -181,8 +183,8 @@ def test_a_mujoco_error_inside_the_compiled_loop_is_the_bindings_error():
             steps.run(200)
         errors.append(str(failure.value))
     assert errors[0] == errors[1] and errors[0].startswith("mj_stackAlloc")
-    handler = stepper._library()["mju_user_error"]
-    assert handler and stepper.ctypes.c_void_p.from_address(handler).value is None
+    handler = native._library()["mju_user_error"]
+    assert handler and ctypes.c_void_p.from_address(handler).value is None
 
 
 @needs_compiled
@@ -192,12 +194,12 @@ def test_what_does_not_check_out_steps_in_python(monkeypatch):
     model = build_model(params, SolverSettings(), ratchet=True)
     data, ratchet = ratcheted(params, model)
     assert loops(model, data, ratchet)[0].compiled
-    layout = stepper._mjdata_offsets
+    layout = native.mjdata_offsets
     offsets = dict(layout())
     offsets["efc_force"] += 8  # the next pointer field: not what the bindings report
-    monkeypatch.setattr(stepper, "_mjdata_offsets", lambda: offsets)
+    monkeypatch.setattr(native, "mjdata_offsets", lambda: offsets)
     assert not loops(model, data, ratchet)[0].compiled
-    monkeypatch.setattr(stepper, "_mjdata_offsets", layout)
+    monkeypatch.setattr(native, "mjdata_offsets", layout)
     servo = CrankServo(lambda t: 10.0 * t, lambda t: 10.0)
     assert type(stepper.make_steps(model, data, ratchet, np.zeros((2, model.nv)), servo=servo,
                                    **loops(model, data, ratchet)[1])) is stepper.PythonSteps

@@ -253,8 +253,9 @@ class _Run:
         new samples ``new`` (first, end) show, in the order the samples were taken: sample i's interval first
         judged row i - 1 (residual ratio, then loop gap), then raised the energy floor to sample i's torque and
         reported its excursion; if MuJoCo warned in the interval after the last new sample (``warned``: it was
-        not recorded, but it judged that sample), the run fails with the last good time. Only the values that beat the monitor's worst so far are fed (the others cannot
-        change it), so a block costs a few array operations."""
+        not recorded, but it judged that sample), the run fails with the last good time. Only the values that
+        beat the monitor's worst so far are fed (the others cannot change it), so a block costs a few array
+        operations."""
         rec, mon = self.recorder, self.monitor
         (a, b), (first, end) = judged, new
         events = []  # (position in the sampling order, kind, row)

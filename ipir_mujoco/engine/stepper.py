@@ -3,40 +3,33 @@
 Between two output samples a run takes k steps, and each step the engine
 updates the clutches before ``mj_step`` (:mod:`.clutches`, :mod:`.compliant`),
 does the clutches' bookkeeping after it and adds the drive's work and the work
-against the resistances. :class:`PythonSteps` is that loop in Python;
-:class:`CompiledSteps` hands the k steps to ``_stepper.c`` (a C extension
-built at install time), which calls the library's own ``mj_step`` and does the
-same double arithmetic in the same order, so both give the same numbers bit
-for bit (``tests/test_mujoco_stepper.py``), and syncs the clutch controller's
-state back after each call. Between the calls (every sample) everything else
-stays in Python: samples, the accuracy monitor, progress, budgets, steady
-state and stalls.
+against the resistances; then it records the sample (:mod:`.recorder`).
+:class:`PythonSteps` is that loop in Python: :meth:`PythonSteps.record` takes a
+block of output intervals and records each. :class:`CompiledSteps` hands the
+block to ``_stepper.c`` (a C extension built at install time), which calls the
+library's own ``mj_step``, does the same double arithmetic in the same order
+and writes the samples (state, torque, works, clutch reactions, the loop's
+force, the excursion, and MuJoCo's energies, loop gap and momentum at each
+sample) into the recorder's arrays, so both give the same numbers bit for bit
+(``tests/test_mujoco_stepper.py``); it syncs the clutch controller's state
+back after each call. Compliant clutches step in C and record in Python (their
+samples read the controller). Between blocks (every BLOCK_TIME of simulated
+time) everything else stays in Python: the accuracy monitor (fed from the
+block's arrays), progress, budgets, steady state and stalls.
 
 Why a loop in C rather than MuJoCo's control callback: ``mjcb_control`` runs
 after the constraint rows are assembled, so a ratchet bound written there acts
 a step late, and the friction rows' forces of a step are gone by the next
 callback; the loop keeps today's order exactly (``mjcf/README.md`` has the
-measurements).
-
-The C code includes no MuJoCo header, so it does not depend on the version it
-was built against: Python passes the address of ``mj_step`` (from the loaded
-libmujoco, checked to be the instance the bindings use), of every array the
-loop touches (fixed for the life of an MjModel/MjData), and of the two mjData
-fields that change between steps, the ``efc_force`` pointer and the counts
-``ne`` and ``nf``; their offsets come from the running mujoco's own description of its
-structs (``mujoco.introspect``) and are checked against the live MjData before
-every run (pointers and counts read there must equal what the bindings
-report). Anything that does not check out, a missing build, a crank servo (a
-Python function of time) or ``IPIR_MUJOCO_STEPPER=python`` in the
-environment selects :class:`PythonSteps`; :func:`compiled_status` says which
-and why.
+measurements). How the C code finds MuJoCo's functions and mjData fields
+without its headers: :mod:`.native`. Anything that does not check out there, a
+crank servo (a Python function of time) or ``IPIR_MUJOCO_STEPPER=python`` in
+the environment selects :class:`PythonSteps`; :func:`compiled_status` says
+which and why.
 """
 
 from __future__ import annotations
 
-import ctypes
-import functools
-import glob
 import os
 from operator import itemgetter
 
@@ -48,12 +41,13 @@ from ipir_mujoco.analytic.errors import ParameterError
 from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
 from .compliant import CompliantClutches
 from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
-from .recorder import DEFERRED, SCALARS, Recorder
+from .native import LayoutError, check_layout, compiled, mjdata_offsets
+from .native import address as array_address
+from .recorder import Recorder
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
 CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant")
-_DATA_FIELDS = ("warning", "time", "energy", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_id", "efc_force")
 FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
 DONE, WARNED = 0, 3  # what record() returns: all intervals taken, or MuJoCo warned in the last one (_stepper.c's)
 NO_REACTIONS = (False, False, 0.0, 0.0)
@@ -185,8 +179,8 @@ class CompiledSteps(PythonSteps):
         if options.get("servo") is not None:
             raise LayoutError("a crank servo is a Python function of time")
         super().__init__(model, data, controller, qvel_before, **options)
-        stepper, library = _compiled()
-        offsets = _check_layout(data)
+        stepper, library = compiled()
+        offsets = check_layout(data)
         self._module = stepper
         self._cfg = np.zeros(len(stepper.CONFIG), dtype=np.int64)
         self._st = np.zeros(len(stepper.STATE))
@@ -202,19 +196,19 @@ class CompiledSteps(PythonSteps):
             model=model._address, data=address, step=library["mj_step"], user_error=library["mju_user_error"],
             efc_force_field=address + offsets["efc_force"], ne_field=address + offsets["ne"],
             nf_field=address + offsets["nf"],
-            qpos=_address(data.qpos), qvel=_address(data.qvel), ctrl=_address(data.ctrl),
-            actuator_force=_address(data.actuator_force), qvel_before=_address(qvel_before),
-            jnt_range=_address(model.jnt_range), eq_data=_address(model.eq_data),
-            eq_data_stride=model.eq_data.shape[1], eq_active=_address(data.eq_active),
-            biasprm=_address(model.actuator_biasprm), biasprm_stride=model.actuator_biasprm.shape[1],
+            qpos=array_address(data.qpos), qvel=array_address(data.qvel), ctrl=array_address(data.ctrl),
+            actuator_force=array_address(data.actuator_force), qvel_before=array_address(qvel_before),
+            jnt_range=array_address(model.jnt_range), eq_data=array_address(model.eq_data),
+            eq_data_stride=model.eq_data.shape[1], eq_active=array_address(data.eq_active),
+            biasprm=array_address(model.actuator_biasprm), biasprm_stride=model.actuator_biasprm.shape[1],
             nv=model.nv, motor=self.motor, crank_q=self.crank_q, crank_v=self.crank_v,
             nfric=len(self.friction_dofs), fric_a=self.fric_a, fric_b=self.fric_b)
         self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
-        self._cfg[self.C["eq_rows"]] = _address(self._eq_rows) if self._eq_rows.size else 0
+        self._cfg[self.C["eq_rows"]] = array_address(self._eq_rows) if self._eq_rows.size else 0
         self._set_state(dt=model.opt.timestep, slope=self.slope, torque=self.torque,
                         motor_work=0.0, friction_work=0.0, omega_prev=self.omega_prev)
         self._load_controller()
-        self._args = (_address(self._cfg), _address(self._st))
+        self._args = (array_address(self._cfg), array_address(self._st))
         self._common = itemgetter(*(self.S[n] for n in ("torque", "motor_work", "friction_work", "omega_prev")))
 
     def run(self, nstep: int, row: int = -1) -> None:
@@ -257,18 +251,19 @@ class CompiledSteps(PythonSteps):
         if rec.qvel_before is not self.qvel_before or not all(
                 a.flags.c_contiguous and a.dtype == np.float64 for a in arrays):
             raise LayoutError("the recorder's arrays are not the loop's C-contiguous float64 buffers")
-        ctl, offsets, address = self.controller, _mjdata_offsets(), self.data._address
+        ctl, offsets, address = self.controller, mjdata_offsets(), self.data._address
         friction = getattr(ctl, "friction", None)
         fric_off, resist = (friction.offsets, friction.resistance) if friction is not None else ([-1, -1], [0, 0])
         self._set_config(
             nq=self.model.nq, nl_field=address + offsets["nl"], time_field=address + offsets["time"],
             warning_field=address + offsets["warning"], n_warning=len(self.data.warning),
-            efc_id_field=address + offsets["efc_id"], subtree_vel=_compiled()[1]["mj_subtreeVel"],
-            energy=address + offsets["energy"], rod_end=_address(rec._rod_end), front_pos=_address(rec._front_pos),
-            subtree_linvel=_address(rec._subtree_linvel), loop_eq=rec.loop_id, fric_off0=fric_off[0],
-            fric_off1=fric_off[1], rec_t=_address(rec.t), rec_qpos=_address(rec.qpos), rec_qvel=_address(rec.qvel),
-            rec_scalars=_address(rec.scalars), rec_deferred=_address(rec.deferred),
-            rec_excursion=_address(rec.excursion))
+            efc_id_field=address + offsets["efc_id"], subtree_vel=compiled()[1]["mj_subtreeVel"],
+            energy=address + offsets["energy"], rod_end=array_address(rec._rod_end),
+            front_pos=array_address(rec._front_pos), subtree_linvel=array_address(rec._subtree_linvel),
+            loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
+            rec_qpos=array_address(rec.qpos), rec_qvel=array_address(rec.qvel),
+            rec_scalars=array_address(rec.scalars), rec_deferred=array_address(rec.deferred),
+            rec_excursion=array_address(rec.excursion))
         ox, oy, oz = rec.pin_offset
         self._set_state(resist0=resist[0], resist1=resist[1], pin_x=ox, pin_y=oy, pin_z=oz,
                         total_mass=rec.total_mass)
@@ -342,10 +337,6 @@ class CompiledSteps(PythonSteps):
         ctl.damped = [damped0 != 0.0, damped1 != 0.0]
 
 
-class LayoutError(RuntimeError):
-    """What the compiled loop relies on does not hold here (the pure-Python loop is used instead)."""
-
-
 def make_steps(model, data, controller, qvel_before, **options) -> PythonSteps:
     """The compiled loop if it is available and checks out for this run, else the Python loop."""
     if os.environ.get(ENV, "").strip().lower() != "python":
@@ -362,132 +353,9 @@ def compiled_status() -> tuple[bool, str]:
     if os.environ.get(ENV, "").strip().lower() == "python":
         return False, f"{ENV}=python is set"
     try:
-        _compiled()
+        compiled()
     except LayoutError as exc:
         return False, str(exc)
     return True, "compiled"
 
 
-def _address(array: np.ndarray) -> int:
-    return int(array.ctypes.data)
-
-
-@functools.lru_cache(maxsize=None)
-def _compiled_cached():
-    try:
-        from . import _stepper
-    except ImportError as exc:
-        return None, f"the compiled stepper is not built ({exc}); reinstall with a C compiler"
-    if (tuple(_stepper.SCALARS), tuple(_stepper.DEFERRED)) != (SCALARS, DEFERRED):
-        return None, "the compiled stepper was built from other sources than this package's; reinstall it"
-    try:
-        library = _library()
-        _mjdata_offsets()
-    except (LayoutError, ImportError, OSError, AttributeError, KeyError, TypeError, ValueError) as exc:
-        return None, f"the compiled stepper cannot be used with mujoco {mujoco.__version__}: {exc}"
-    return (_stepper, library), "compiled"
-
-
-def _compiled():
-    found, why = _compiled_cached()
-    if found is None:
-        raise LayoutError(why)
-    return found
-
-
-def _library() -> dict[str, int]:
-    """Addresses of ``mj_step`` and of the legacy error handler pointer in the libmujoco the bindings use."""
-    folder = os.path.dirname(mujoco.__file__)
-    paths = sorted(glob.glob(os.path.join(folder, "libmujoco.so*"))
-                   + glob.glob(os.path.join(folder, "libmujoco*.dylib")))
-    if not paths:
-        raise LayoutError(f"no libmujoco beside the bindings in {folder}")
-    lib = ctypes.CDLL(paths[0])
-    # the instance the bindings use: a warning handler set through them shows in this library's global
-    if mujoco.get_mju_user_warning() is not None:
-        same = ctypes.c_void_p.in_dll(lib, "mju_user_warning").value is not None
-    else:
-        try:
-            mujoco.set_mju_user_warning(lambda message: None)
-            same = ctypes.c_void_p.in_dll(lib, "mju_user_warning").value is not None
-        finally:
-            mujoco.set_mju_user_warning(None)
-    if not same:
-        raise LayoutError(f"{paths[0]} is not the library instance the bindings use")
-    try:
-        user_error = ctypes.addressof(ctypes.c_void_p.in_dll(lib, "mju_user_error"))
-    except ValueError:  # no legacy handler: a MuJoCo error inside the loop is then MuJoCo's default (exit)
-        user_error = 0
-    return {"mj_step": ctypes.cast(lib.mj_step, ctypes.c_void_p).value,
-            "mj_subtreeVel": ctypes.cast(lib.mj_subtreeVel, ctypes.c_void_p).value, "mju_user_error": user_error}
-
-
-_SCALARS = {"mjtNum": ctypes.c_double, "double": ctypes.c_double, "float": ctypes.c_float, "int": ctypes.c_int,
-            "unsigned int": ctypes.c_uint, "size_t": ctypes.c_size_t, "uintptr_t": ctypes.c_size_t,
-            "mjtSize": ctypes.c_int64, "mjtBool": ctypes.c_bool, "mjtByte": ctypes.c_ubyte}
-
-
-@functools.lru_cache(maxsize=None)
-def _mjdata_offsets() -> dict[str, int]:
-    """Byte offsets of :data:`_DATA_FIELDS` in mjData, from ``mujoco.introspect``'s declaration of the
-    struct laid out by ctypes (the platform's C rules); only the fields up to the last one needed."""
-    from mujoco.introspect import ast_nodes, enums, structs
-
-    def ctype(t):
-        if isinstance(t, ast_nodes.PointerType):
-            return ctypes.c_void_p
-        if isinstance(t, ast_nodes.ArrayType):
-            inner = ctype(t.inner_type)
-            for extent in reversed(t.extents):
-                inner = inner * extent
-            return inner
-        if isinstance(t, ast_nodes.ValueType):
-            if t.name in _SCALARS:
-                return _SCALARS[t.name]
-            if t.name in enums.ENUMS:
-                return ctypes.c_int
-            if t.name in structs.STRUCTS:
-                return struct(t.name, None)
-        raise LayoutError(f"mjData field type {t!r} is not understood")
-
-    def struct(name, last):
-        fields = []
-        for field in structs.STRUCTS[name].fields:
-            fields.append((field.name, ctype(field.type)))
-            if field.name == last:
-                break
-        return type(name, (ctypes.Structure,), {"_fields_": fields})
-
-    stat = [(f.name, getattr(f.type, "name", None)) for f in structs.STRUCTS["mjWarningStat"].fields]
-    if stat != [("lastinfo", "int"), ("number", "int")]:  # _stepper.c counts warnings on this layout
-        raise LayoutError(f"mjWarningStat is {stat}, not (int lastinfo, int number)")
-    names = [f.name for f in structs.STRUCTS["mjData"].fields]
-    missing = [n for n in _DATA_FIELDS if n not in names]
-    if missing:
-        raise LayoutError(f"mjData has no field {missing[0]!r}")
-    layout = struct("mjData", max(_DATA_FIELDS, key=names.index))
-    return {n: getattr(layout, n).offset for n in _DATA_FIELDS}
-
-
-def _check_layout(data: mujoco.MjData) -> dict[str, int]:
-    """The offsets, checked on ``data`` (after ``mj_forward``): every field read at its offset must be what
-    the bindings report."""
-    offsets = _mjdata_offsets()
-    base = data._address
-    read = {n: ctypes.c_int.from_address(base + offsets[n]).value for n in ("ne", "nf", "nl", "nefc")}
-    read["time"] = ctypes.c_double.from_address(base + offsets["time"]).value
-    for n in ("qpos", "qvel", "efc_id", "efc_force"):
-        read[n] = ctypes.c_void_p.from_address(base + offsets[n]).value
-    # each mjWarningStat is (lastinfo, number), two ints
-    read["warning"] = [ctypes.c_int.from_address(base + offsets["warning"] + 8 * w + 4).value
-                       for w in range(len(data.warning))]
-    read["energy"] = base + offsets["energy"]
-    expected = {n: int(getattr(data, n)) for n in ("ne", "nf", "nl", "nefc")}
-    expected["time"] = float(data.time)
-    for n in ("qpos", "qvel", "efc_id", "efc_force"):
-        expected[n] = _address(getattr(data, n)) if getattr(data, n).size else read[n]
-    expected["warning"] = [int(stat.number) for stat in data.warning]
-    expected["energy"] = _address(data.energy)
-    if data.nefc == 0 or read != expected:
-        raise LayoutError(f"the mjData layout does not check out: read {read}, expected {expected}")
-    return offsets
