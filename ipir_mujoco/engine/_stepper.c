@@ -284,8 +284,11 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
   const int ne = *PTR(const int *, ne_field), nf = *PTR(const int *, nf_field), nl = *PTR(const int *, nl_field);
   const double r[2] = {st[S_resist0], st[S_resist1]};
   double f[2], hold[2];
-  /* as FrictionRows.forces: never a row that is not a slide's */
-  if (cfg[C_clutch] != NO_CLUTCH && nf != cfg[C_nfric]) return MISSING_FRICTION_ROWS;
+  /* as FrictionRows.forces (the rigid clutches' reactions read it): never a row that is not a slide's */
+  const int64_t kind = cfg[C_clutch];
+  if ((kind == RATCHET || kind == LOCK_KINEMATIC || kind == LOCK_UNILATERAL) && nf != cfg[C_nfric]) {
+    return MISSING_FRICTION_ROWS;
+  }
   switch (cfg[C_clutch]) {
     case RATCHET: {
       /* Ratchet.reactions: the limit rows follow the equality and friction rows, in joint order */
@@ -338,7 +341,7 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
       }
       return STEPS_DONE;
     }
-    default: /* NoClutch (the compliant clutches are recorded by Python) */
+    default: /* NoClutch; the compliant clutches' samples take their forces from the deferred values */
       out[0] = out[1] = out[2] = out[3] = 0.0;
       return STEPS_DONE;
   }
@@ -366,12 +369,13 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
   out[R_lambda2] = held[3];
   out[R_motor_work] = st[S_motor_work];
   out[R_friction_work] = st[S_friction_work];
-  out[R_clutch_damper_work] = 0.0;
+  out[R_clutch_damper_work] = cfg[C_clutch] == COMPLIANT ? st[S_damper_work] : 0.0;
   PTR(double *, rec_excursion)[row] = st[S_excursion];
   return STEPS_DONE;
 }
 
-/* Recorder.fill_deferred (rigid clutches): MuJoCo's values at the start of the step just taken */
+/* Recorder.fill_deferred: MuJoCo's values at the start of the step just taken; with compliant clutches also
+ * their forces, the overlaps their before_step set for that state and CompliantClutches.stepped_spring_energy */
 static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   const double *energy = PTR(const double *, energy), *rod = PTR(const double *, rod_end);
   const double *front = PTR(const double *, front_pos);
@@ -386,6 +390,18 @@ static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   out[D_kinetic] = energy[1];
   out[D_clutch_force1] = out[D_clutch_force2] = out[D_clutch_overlap1] = out[D_clutch_overlap2] = 0.0;
   out[D_clutch_spring] = 0.0;
+  if (cfg[C_clutch] == COMPLIANT) {
+    const double *force = PTR(const double *, actuator_force);
+    const double k = st[S_k], dt = st[S_dt];
+    double spring = 0.0;
+    for (int i = 0; i < 2; i++) {
+      double d = st[S_overlap0 + i];
+      out[D_clutch_force1 + i] = force[cfg[C_act0 + i]];
+      out[D_clutch_overlap1 + i] = d;
+      if (d > 0.0) spring += 0.5 * k * d * (d + dt * st[S_v_before0 + i]);
+    }
+    out[D_clutch_spring] = spring;
+  }
 }
 
 /* how many warnings MuJoCo has raised on this mjData so far (each mjWarningStat: lastinfo, number) */

@@ -12,8 +12,7 @@ and writes the samples (state, torque, works, clutch reactions, the loop's
 force, the excursion, and MuJoCo's energies, loop gap and momentum at each
 sample) into the recorder's arrays, so both give the same numbers bit for bit
 (``tests/test_mujoco_stepper.py``); it syncs the clutch controller's state
-back after each call. Compliant clutches step in C and record in Python (their
-samples read the controller). Between blocks (every BLOCK_TIME of simulated
+back after each call. Between blocks (every BLOCK_TIME of simulated
 time) everything else stays in Python: the accuracy monitor (fed from the
 block's arrays), progress, budgets, steady state and stalls.
 
@@ -226,8 +225,6 @@ class CompiledSteps(PythonSteps):
 
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
                messages: list[str]) -> tuple[int, int]:
-        if self._kind == "compliant":  # its deferred values and reactions are the controller's (Python)
-            return super().record(rec, nsamples, sps, remaining, pending, messages)
         if rec is not self._rec:
             self._bind(rec)
         st, S = self._st, self.S
@@ -316,7 +313,7 @@ class CompiledSteps(PythonSteps):
         else:
             raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
         self._set_config(clutch=CLUTCH_KINDS.index(kind))
-        self._kind, self._rec = kind, None
+        self._rec = None
 
     def _getter(self, *names):
         return itemgetter(*(self.S[n] for n in names))
