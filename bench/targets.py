@@ -14,9 +14,9 @@ Targets (ratios measured in this one run; absolute times printed too):
   torque they grow like t^2, under the motor like t);
 - a serial MuJoCo ratchet run, 5 s, dt_out 1 ms: at most 1.5x a plain
   ``mj_step`` over the same steps of the same compiled model (in a C loop);
-- a 20 x 20 sweep of L and m2 (MuJoCo ratchet + analytic one-way, 1 s each):
-  at most 1.5x the MuJoCo batched floor, the designs' steps x a plain
-  ``mj_step`` / the cores.
+- a 20 x 20 sweep of L and m2 (MuJoCo ratchet + analytic one-way, 1 s each,
+  the sweep's defaults): at most 1.5x the MuJoCo floor, the designs' steps x a
+  plain ``mj_step`` / the cores.
 
 The single-component benchmarks give more detail: ``bench/analytic_speed.py``
 (every analytic case, first-call and fallback costs), ``bench/ratchet_step.py``
@@ -97,7 +97,10 @@ def sweep_row(plain_step_s: float) -> tuple:
         started = time.perf_counter()
         run_sweep(study, Path(folder) / "s", progress=False)
         wall = time.perf_counter() - started
-    return ("20 x 20 sweep (MuJoCo ratchet + analytic one-way, 1 s)",
+    from ipir_mujoco.engine.stepper import compiled_status
+
+    how = "serial MuJoCo, compiled loop" if compiled_status()[0] else "mujoco.batch (no compiled loop here)"
+    return (f"20 x 20 sweep (MuJoCo ratchet + analytic one-way, 1 s; {how})",
             f"{wall:.1f} s ({400 / wall:.1f} designs/s); floor {floor:.1f} s ({steps} steps x {plain_step_s * 1e6:.2f}"
             f" us / {cores} cores)", wall / floor, "<= 1.5 x floor")
 

@@ -1,18 +1,20 @@
-/* The per-step loop of a serial MuJoCo run, compiled: see ipir_mujoco/engine/stepper.py.
+/* The per-step loop of a serial MuJoCo run, compiled, and its sampling: see ipir_mujoco/engine/stepper.py.
  *
- * It does, step for step, what the pure-Python loop (stepper.PythonSteps and the clutch controllers in
- * clutches.py and compliant.py) does: the clutch update before each mj_step, the clutch bookkeeping after
- * it, the drive's work and the work against the resistances; the same double arithmetic in the same order
- * (built with -ffp-contract=off, so no fused multiply-add changes a rounding), so the two paths agree bit for
- * bit. It includes no MuJoCo header: Python passes the address of mj_step (from the loaded libmujoco), of
- * every array it touches, and of the two mjData fields that move between steps (the efc_force pointer and
- * the counts ne and nf), whose offsets it reads from the running mujoco's own struct description and checks on the
- * live MjData before every run.
+ * It does, step for step, what the pure-Python loop (stepper.PythonSteps, the clutch controllers in
+ * clutches.py and compliant.py, the recorder in recorder.py) does: the clutch update before each mj_step, the
+ * clutch bookkeeping after it, the drive's work and the work against the resistances, and at each output
+ * sample the record (state, torque, works, clutch reactions, the loop's force, the excursion, and MuJoCo's
+ * energies, loop gap and momentum at the start of the next step); the same double arithmetic in the same
+ * order (built with -ffp-contract=off, so no fused multiply-add changes a rounding), so the two paths agree
+ * bit for bit. It includes no MuJoCo header: Python passes the addresses of mj_step and mj_subtreeVel (from
+ * the loaded libmujoco), of every array it touches, and of the mjData fields it reads (the efc_force and
+ * efc_id pointers, the counts ne, nf and nl, time, energy, the warning counters), whose offsets it reads from
+ * the running mujoco's own struct description and checks on the live MjData before every run (native.py).
  *
  * Layout: two arrays owned by Python, one int64 per CONFIG field (addresses, indices, flags) and one double
  * per STATE field (what the loop reads and writes); the field names are exported, so stepper.py builds its
- * indices from this file.
- */
+ * indices from this file, as are the names of the recorder's SCALARS and DEFERRED columns, which native.py
+ * checks against recorder.py's. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
@@ -30,8 +32,8 @@
   X(nv) X(clutch) X(motor) X(crank_q) X(crank_v) X(nfric) X(fric_a) X(fric_b)                    \
   X(slide_q0) X(slide_q1) X(slide_v0) X(slide_v1) X(joint0) X(joint1)                            \
   X(eq0) X(eq1) X(rod_q) X(rod_v) X(act0) X(act1) X(implicit)                                   \
-  X(nq) X(nl_field) X(time_field) X(warning_field) X(n_warning) X(efc_id_field) X(subtree_vel) X(energy)       \
-  X(rod_end) X(front_pos) X(subtree_linvel) X(loop_eq) X(fric_off0) X(fric_off1)                 \
+  X(nq) X(nl_field) X(time_field) X(warning_field) X(n_warning) X(efc_id_field) X(subtree_vel)   \
+  X(energy) X(rod_end) X(front_pos) X(subtree_linvel) X(loop_eq) X(fric_off0) X(fric_off1)       \
   X(rec_t) X(rec_qpos) X(rec_qvel) X(rec_scalars) X(rec_deferred) X(rec_excursion)
 
 #define STATE_FIELDS(X)                                                                          \
@@ -289,7 +291,7 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
   if ((kind == RATCHET || kind == LOCK_KINEMATIC || kind == LOCK_UNILATERAL) && nf != cfg[C_nfric]) {
     return MISSING_FRICTION_ROWS;
   }
-  switch (cfg[C_clutch]) {
+  switch (kind) {
     case RATCHET: {
       /* Ratchet.reactions: the limit rows follow the equality and friction rows, in joint order */
       const int start = ne + nf;
@@ -323,7 +325,7 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
     case LOCK_KINEMATIC:
     case LOCK_UNILATERAL: {
       /* Locks.reactions */
-      const int kinematic = cfg[C_clutch] == LOCK_KINEMATIC;
+      const int kinematic = kind == LOCK_KINEMATIC;
       const int locked[2] = {st[S_held0] != 0.0, st[S_held1] != 0.0};
       const int whole = kinematic && !(locked[0] && locked[1]);
       friction_forces(cfg, efc_force, ne, f);
