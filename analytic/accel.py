@@ -26,7 +26,7 @@ except ImportError:  # the fallback: the kernels run as Python
     numba = None
 
 ACCELERATED = numba is not None  # True: the kernels are compiled
-_COMPILED_MODULES = ("kernels", "dop853")  # the modules whose functions are compiled and call each other
+_COMPILED_MODULES = ("kernels", "dense", "dop853")  # the modules whose functions are compiled and call each other
 
 
 def _drop_stale_cache() -> None:
