@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from .accel import ACCELERATED, jit
-from .kernels import guard
+from .kernels import guards_at
 
 GRAZE_POINTS = 8  # interior points checked per accepted step for a guard that dipped below zero and came back
 CLEAR = 1e-9  # "clearly" positive or negative: beyond this fraction of the guard's largest value in the segment
@@ -94,12 +94,13 @@ def graze_scan(model, mode, n_events, p, ts, t_old, y_old, F, h_safe, times, neg
             times[i * per + j] = ts[i] + width * (j / per)
     times[times.size - 1] = ts[ts.size - 1]
     values = np.empty((n_events, times.size))
-    state = np.empty(y_old.shape[1])
+    state, at = np.empty(y_old.shape[1]), np.empty(max(n_events, 1))
     never = np.full(max(n_events, 1), -math.inf)
     for i in range(times.size):
         _interpolate(ts, t_old, y_old, F, h_safe, times[i], state)
+        guards_at(model, mode, n_events, times[i], state, p, never, at)
         for k in range(n_events):
-            values[k, i] = guard(model, mode, k, times[i], state, p, never)
+            values[k, i] = at[k]
     for k in range(n_events):
         scale = 0.0
         for i in range(times.size):

@@ -19,11 +19,12 @@ Python per sample). Units: those of the state; times in s.
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _coefficients
 
-from .accel import jit
+from .accel import ACCELERATED, jit
 from .dense import DenseSolution, dense_at as _dense
 from .kernels import guard, rhs
 
@@ -322,8 +323,9 @@ def solve(model: int, mode: int, t0: float, t_end: float, y0, p: np.ndarray, rto
     y0, h = np.array(y0, dtype=float), float(first_step or 0.0)
     parts, resumed = [], 0
     while True:
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # as Python (no numba), trial steps
-            # of a fast crank can overflow; the step controller rejects them, and the output is checked finite
+        with nullcontext() if ACCELERATED else np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            # as Python (no numba; compiled, numpy's warnings never fire), trial steps of a fast crank can overflow;
+            # the step controller rejects them, and the output is checked finite
             out = integrate(int(model), int(mode), float(t0), float(t_end), y0, p, float(rtol), float(atol), h,
                             n_events, directions, quiet, int(max_steps or 0), resumed)
         ts, ys, F, t_full, status, hit, t_hit, y_hit, nfev, h = out

@@ -336,7 +336,10 @@ def simulate_unilateral(
                                  model.graze_scan(sol, mode))
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
-        step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
+        if grazed is None and sol.t.size >= 2 and sol.t[-2] < t_stop:  # the usual end: every step ends before
+            step_ends = sol.t
+        else:
+            step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
         piece = raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol, _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
