@@ -70,6 +70,24 @@ def _interpolate(ts, t_old, y_old, F, h_safe, t, out):
 
 
 @jit
+def component_at(ts, t_old, y_old, F, h, j, t):
+    """State component j at time t as :meth:`DenseSolution.__call__` computes it for one time (its bisection,
+    a constant piece's value, :func:`dense_at`'s order), without a Python call per evaluation."""
+    step = 0 if t != t else _step_of(ts, t, h.size)  # bisect_left puts a nan first
+    if h[step] == 0:
+        return y_old[step, j]
+    x = (t - t_old[step]) / h[step]
+    acc = 0.0
+    for i in range(7):
+        acc += F[step, 6 - i, j]
+        if i % 2 == 0:
+            acc *= x
+        else:
+            acc *= 1.0 - x
+    return acc + y_old[step, j]
+
+
+@jit
 def dense_table(ts, t_old, y_old, F, h_safe, times, out):
     """The state at each of ``times`` (k,) into ``out`` (n, k)."""
     buf = np.empty(out.shape[0])
@@ -160,6 +178,12 @@ class DenseSolution:
         step -= 1
         np.minimum(np.maximum(step, 0, out=step), self.h.size - 1, out=step)
         return self.evaluate(step, times).T
+
+    def phi_at(self, t: float) -> float:
+        """The first state component (the crank angle, rad) at one time t [s]: ``self(t)[0]``, compiled."""
+        if not ACCELERATED:
+            return float(self(t)[0])
+        return component_at(self.ts, self.t_old, self.y_old, self.F, self.h, 0, float(t))
 
     def evaluate(self, step: np.ndarray, times: np.ndarray) -> np.ndarray:
         """Step ``step[i]``'s interpolant at ``times[i]``: array (k, n) (scipy's Horner order)."""

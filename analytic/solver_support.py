@@ -177,6 +177,7 @@ class RunMonitor:
         phis = np.asarray(dense(step_ends))[0]
         if not phis[1:].max(initial=-math.inf) >= self.next_end:  # no revolution ends here: the common case
             return ends
+        phi_at = getattr(dense, "phi_at", None) or (lambda s: dense(s)[0])  # phi at one time (compiled if it can)
         for i in range(1, len(step_ends)):
             while phis[i] >= self.next_end:
                 target = self.next_end
@@ -184,8 +185,8 @@ class RunMonitor:
                 if phis[i - 1] >= target:  # reached at the start of the step (or a segment's start)
                     when = lo
                 else:
-                    when = brentq(lambda s: dense(s)[0] - target, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
-                    while dense(when)[0] < target and when < hi:
+                    when = brentq(lambda s: phi_at(s) - target, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+                    while phi_at(when) < target and when < hi:
                         when = min(np.nextafter(when, hi), hi)
                 ends.append(float(when))
                 self.next_end += 2 * math.pi
