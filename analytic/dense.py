@@ -198,7 +198,7 @@ class DenseSolution:
         return y
 
     def graze_scan(self, model: int, mode: int, n_events: int, p: np.ndarray):
-        """(times, negative, positive) of :func:`graze_scan` for the kernels' ``model``/``mode`` with constants ``p``."""
+        """(times, negative, positive) of :func:`graze_scan` for the kernels' ``model``/``mode``, constants ``p``."""
         times = np.empty((self.ts.size - 1) * (GRAZE_POINTS + 1) + 1)
         negative, positive = np.empty(n_events, dtype=np.int64), np.empty(n_events, dtype=np.int64)
         graze_scan(model, mode, n_events, p, self.ts, self.t_old, self.y_old, self.F, self._h_safe, times, negative,

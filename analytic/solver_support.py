@@ -39,6 +39,13 @@ def sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
     return times
 
 
+def steps_until(ends: np.ndarray, t_stop: float) -> np.ndarray:
+    """A segment's step ends ``ends`` (ascending) before t_stop [s], then t_stop: its steps up to where it stopped."""
+    if ends.size >= 2 and ends[-2] < t_stop == ends[-1]:  # stopped where it was integrated to: the usual end
+        return ends
+    return np.append(ends[ends < t_stop], t_stop)
+
+
 def check_finite(series: dict[str, np.ndarray]) -> None:
     for name, values in series.items():
         bad = np.flatnonzero(~np.isfinite(values))

@@ -60,7 +60,7 @@ from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
 from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, raw_piece,
-                             restart_step, spurious_start, stall_reason, truncate)
+                             restart_step, spurious_start, stall_reason, steps_until, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -193,11 +193,9 @@ class UnilateralModel:
         return np.array([np.broadcast_to(r, np.shape(t)) for r in rows], dtype=float)
 
     def graze_scan(self, sol, mode: Mode):
-        """The compiled scan of :func:`.solver_support.missed_crossing` over ``sol`` (a callable), where the
-        guards are the kernels' (the drive of params, numba present); else None (the numpy reference)."""
-        if not (ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment)):
-            return None
-        return lambda: sol.sol.graze_scan(kernels.UNILATERAL, int(mode), 2, self.constants)
+        """missed_crossing's scan of ``sol`` compiled (a callable) where the guards are the kernels', else None."""
+        if ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment):
+            return lambda: sol.sol.graze_scan(kernels.UNILATERAL, int(mode), 2, self.constants)
 
     # --- choosing the next mode ----------------------------------------------------------
     def choose(self, t, y, velocities, fired: tuple[str, int] | None = None, previous: Mode | None = None) -> Mode:
@@ -336,11 +334,8 @@ def simulate_unilateral(
                                  model.graze_scan(sol, mode))
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
-        if grazed is None and sol.t.size >= 2 and sol.t[-2] < t_stop:  # the usual end: every step ends before
-            step_ends = sol.t
-        else:
-            step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
-        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol, _STATES)
+        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, steps_until(sol.t, t_stop), sol.sol), sol.sol,
+                          _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or grazed is None and sol.status != 1:
