@@ -356,9 +356,9 @@ def simulate_unilateral(
 
     with model.linkage.reusing():  # the same samples' kinematics, asked for by every column
         series = assemble(pieces, lambda mode, rows: _columns(model, Mode(mode), rows))
-        monitor.report(float(series["t"][-1]), final=True)
         series.update(model.dyn.energy_columns(series))
         add_kinetostatics(series, model.dyn)
+    monitor.report(float(series["t"][-1]), final=True)
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
