@@ -1,6 +1,6 @@
 """The optional compiler for the analytic integration kernels (numba), and the switch to turn it off.
 
-The kernels (:mod:`.kernels`, :mod:`.dop853`) are plain Python on scalars and
+The kernels (:mod:`.kernels`, :mod:`.dop853`, :mod:`.dense`) are plain Python on scalars and
 small float arrays. With numba installed (``pip install 'ipir-mujoco[fast]'``)
 they are compiled on their first call and cached on disk (``cache=True``: the
 first run on a machine pays the compilation, about 10 s, later processes load

@@ -7,7 +7,7 @@ graze scan of :func:`.solver_support.missed_crossing` (every guard at each
 step's start and interior points, and where each is first clearly negative)
 is one more (:func:`graze_scan`). Without numba (:mod:`.accel`) the same
 numbers come from numpy: the same operations in the same order, so the two
-paths agree bit for bit (``tests/test_fast_kernels.py``). Units: those of the
+paths agree bit for bit (``tests/test_dense_output.py``). Units: those of the
 state; times in s.
 """
 
