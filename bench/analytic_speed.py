@@ -54,7 +54,8 @@ CASES = {
     # post-processing is a third to a half of a 1 s one-way run)
     "one-way model, 1 s, dt_out 1 ms (a sweep design)": (RobotParams(), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
     **{f"one-way model, 1 s, dt_out 1 ms, {k}={v:g}": (RobotParams(**{k: v}), "exact", "unilateral", 1.0,
-                                                       {"dt_out": 1e-3}) for k, v in (("L", 0.06), ("L", 0.5), ("m2", 3.0))},
+                                                       {"dt_out": 1e-3})
+       for k, v in (("L", 0.06), ("L", 0.5), ("m2", 3.0))},
     "motor, one-way model, 1 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
     "motor, one-way model, 10 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 10.0, {"dt_out": 1e-3}),
 }
