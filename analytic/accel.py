@@ -1,6 +1,6 @@
 """The optional compiler for the analytic integration kernels (numba), and the switch to turn it off.
 
-The kernels (:mod:`.kernels`, :mod:`.dop853`) are plain Python on scalars and
+The kernels (:mod:`.kernels`, :mod:`.dop853`, :mod:`.dense`) are plain Python on scalars and
 small float arrays. With numba installed (``pip install 'ipir-mujoco[fast]'``)
 they are compiled on their first call and cached on disk (``cache=True``: the
 first run on a machine pays the compilation, about 10 s, later processes load
@@ -26,7 +26,7 @@ except ImportError:  # the fallback: the kernels run as Python
     numba = None
 
 ACCELERATED = numba is not None  # True: the kernels are compiled
-_COMPILED_MODULES = ("kernels", "dop853")  # the modules whose functions are compiled and call each other
+_COMPILED_MODULES = ("kernels", "dense", "dop853")  # the modules whose functions are compiled and call each other
 
 
 def _drop_stale_cache() -> None:

@@ -215,6 +215,11 @@ class SteadyWatch:
 
     def update(self, t, phi, position) -> bool:
         t, phi, position = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, phi, position))
+        if self.last is not None:  # the common case first: no revolution ends in these samples
+            top = np.maximum((phi - self.phi0).max(), self.reach)  # the running maximum's last value (nan wins)
+            if top < 2 * math.pi * (self.turns + 1):
+                self.reach, self.last = float(top), (t[-1], top, position[-1])
+                return self.steady_at is not None
         reach = np.maximum.accumulate(np.maximum(phi - self.phi0, self.reach))
         if self.last is None:
             self.last = (t[0], reach[0], position[0])

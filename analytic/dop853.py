@@ -12,19 +12,20 @@ The model's equations are the kernels' (:mod:`.kernels`), chosen by number.
 :func:`solve` wraps it in what the solvers read from a solve_ivp result:
 ``t``, ``y``, ``status`` (0: reached t_end, 1: a terminal event, -1: failed),
 ``message``, ``t_events``/``y_events`` (the first event only: every event here
-is terminal) and ``sol``, a vectorized dense output (numpy over the samples,
-no Python per sample). Units: those of the state; times in s.
+is terminal) and ``sol``, the dense output (:class:`.dense.DenseSolution`: no
+Python per sample). Units: those of the state; times in s.
 """
 
 from __future__ import annotations
 
-import bisect
 import math
+from contextlib import nullcontext
 
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _coefficients
 
-from .accel import jit
+from .accel import ACCELERATED, jit
+from .dense import DenseSolution, dense_at as _dense
 from .kernels import guard, rhs
 
 _A = np.ascontiguousarray(_coefficients.A, dtype=float)  # (16, 16): stages 0-11, the error stage 12, extra 13-15
@@ -45,21 +46,6 @@ def _spacing(t):
         return 5e-324
     mantissa, exponent = math.frexp(t)
     return math.ldexp(1.0, exponent - 53)
-
-
-@jit
-def _dense(F, y_old, t_old, h, t, out):
-    """The step's DOP853 interpolant at time t, into ``out`` (scipy's Dop853DenseOutput)."""
-    x = (t - t_old) / h
-    for j in range(out.size):
-        acc = 0.0
-        for i in range(7):
-            acc += F[6 - i, j]
-            if i % 2 == 0:
-                acc *= x
-            else:
-                acc *= 1.0 - x
-        out[j] = acc + y_old[j]
 
 
 @jit
@@ -112,6 +98,14 @@ def _root(model, mode, k, p, quiet, F, y_old, t_old, h, xa, xb, buf):
             xcur += delta if sbis > 0 else -delta
         fcur = _event_value(model, mode, k, p, quiet, F, y_old, t_old, h, xcur, buf)
     return xcur
+
+
+@jit
+def _maximum(a, b):
+    """np.maximum of two floats: a nan in either is the result."""
+    if a != a or b != b:
+        return math.nan
+    return a if a >= b else b
 
 
 @jit
@@ -177,6 +171,7 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
     K = np.empty((16, n))
     y, f = y0.copy(), np.empty(n)
     y_new, f_new, tmp, buf = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    d5, d3, dD = np.empty(n), np.empty(n), np.empty((4, n))  # the products below, without a new array per step
     rhs(model, mode, t0, y, p, f)
     nfev = 1
     if first_step > 0:
@@ -214,13 +209,19 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
             for s in range(1, 12):
                 _combine(K, s, _A, s, y, h, tmp)
                 rhs(model, mode, t + _C[s] * h, tmp, p, K[s])
-            y_new[:] = y + h * np.dot(_B, K[:12])
+            np.dot(_B, K[:12], y_new)
+            for j in range(n):
+                y_new[j] = y[j] + h * y_new[j]
             rhs(model, mode, t + h, y_new, p, f_new)
             K[12, :] = f_new
             nfev += 12
-            scale = atol + np.maximum(np.abs(y), np.abs(y_new)) * rtol
-            e5 = np.sum((np.dot(_E5, K[:13]) / scale) ** 2)
-            e3 = np.sum((np.dot(_E3, K[:13]) / scale) ** 2)
+            np.dot(_E5, K[:13], d5)
+            np.dot(_E3, K[:13], d3)
+            e5, e3 = 0.0, 0.0
+            for j in range(n):  # the scaled error norms, element by element in numpy's order
+                scale = atol + _maximum(abs(y[j]), abs(y_new[j])) * rtol
+                e5 += (d5[j] / scale) ** 2
+                e3 += (d3[j] / scale) ** 2
             if e5 == 0.0 and e3 == 0.0:
                 error = 0.0
             else:
@@ -253,11 +254,14 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
             ts2[:m + 1], ys2[:m + 1], Fs2[:m], tf2[:m] = ts[:m + 1], ys[:m + 1], Fs[:m], t_full[:m]
             ts, ys, Fs, t_full = ts2, ys2, Fs2, tf2
         F = Fs[m]
-        dy = y_new - tmp
-        F[0] = dy
-        F[1] = h * K[0] - dy
-        F[2] = 2 * dy - h * (f_new + K[0])
-        F[3:] = h * np.dot(_D, K)
+        np.dot(_D, K, dD)
+        for j in range(n):
+            dy = y_new[j] - tmp[j]
+            F[0, j] = dy
+            F[1, j] = h * K[0, j] - dy
+            F[2, j] = 2 * dy - h * (f_new[j] + K[0, j])
+            for i in range(4):
+                F[3 + i, j] = h * dD[i, j]
         t = t_new
         for j in range(n):
             y[j] = y_new[j]
@@ -292,66 +296,6 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
     return ts[:m + 1], ys[:m + 1], Fs[:m], t_full[:m], status, hit, t_hit, y_hit, nfev, h_abs
 
 
-class DenseSolution:
-    """The run's dense output over one segment: ``sol(t)`` for a float (-> (n,)) or an array (k,) (-> (n, k)).
-
-    Each step's interpolant serves the times from its start up to and including its end (scipy's
-    OdeSolution: a time on a step end takes the step that ends there); times outside extrapolate
-    the first or last step.
-    """
-
-    def __init__(self, ts, ys, F, t_full):
-        self.ts, self.F, self.t_full = ts, F, t_full
-        self.t_old, self.y_old = ts[:-1], ys[:-1]
-        self.h = t_full - self.t_old
-        self._h_safe = np.where(self.h != 0, self.h, 1.0)  # a constant piece (h = 0) has F = 0: any x will do
-        self._by_power = np.ascontiguousarray(F.transpose(1, 0, 2))  # (7, m, n): row gathers per power
-        self._ends = ts.tolist()
-
-    def __call__(self, t):
-        times = np.asarray(t, dtype=float)
-        if times.ndim == 0:  # one time (root searches): no array machinery
-            step = min(max(bisect.bisect_left(self._ends, float(times)) - 1, 0), self.h.size - 1)
-            out = np.empty(self.y_old.shape[1])
-            if self.h[step] == 0:
-                out[:] = self.y_old[step]
-            else:
-                _dense(self.F[step], self.y_old[step], self.t_old[step], self.h[step], float(times), out)
-            return out
-        step = np.searchsorted(self.ts, times, side="left")
-        step -= 1
-        np.minimum(np.maximum(step, 0, out=step), self.h.size - 1, out=step)
-        return self.evaluate(step, times).T
-
-    def evaluate(self, step: np.ndarray, times: np.ndarray) -> np.ndarray:
-        """Step ``step[i]``'s interpolant at ``times[i]``: array (k, n) (scipy's Horner order)."""
-        x = ((times - self.t_old[step]) / self._h_safe[step])[:, None]
-        rest = 1 - x
-        y = self._by_power[6][step]
-        y *= x
-        for i in range(1, 7):
-            y += self._by_power[6 - i][step]
-            y *= x if i % 2 == 0 else rest
-        y += self.y_old[step]
-        return y
-
-    @property
-    def interpolants(self):
-        """Step views with ``t_old``, ``t`` (the step's own end, also where an event cut it short) and a call."""
-        return [_Step(self, i) for i in range(self.h.size)]
-
-
-class _Step:
-    def __init__(self, dense: DenseSolution, i: int):
-        self.dense, self.i = dense, i
-        self.t_old, self.t = float(dense.t_old[i]), float(dense.t_full[i])
-
-    def __call__(self, t):
-        times = np.asarray(t, dtype=float)
-        y = self.dense.evaluate(np.full(max(times.size, 1), self.i), np.atleast_1d(times))
-        return y[0] if times.ndim == 0 else y.T
-
-
 class Segment:
     """What :func:`solve` returns: the fields of a solve_ivp result that the solvers read."""
 
@@ -379,8 +323,9 @@ def solve(model: int, mode: int, t0: float, t_end: float, y0, p: np.ndarray, rto
     y0, h = np.array(y0, dtype=float), float(first_step or 0.0)
     parts, resumed = [], 0
     while True:
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # as Python (no numba), trial steps
-            # of a fast crank can overflow; the step controller rejects them, and the output is checked finite
+        with nullcontext() if ACCELERATED else np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            # as Python (no numba; compiled, numpy's warnings never fire), trial steps of a fast crank can overflow;
+            # the step controller rejects them, and the output is checked finite
             out = integrate(int(model), int(mode), float(t0), float(t_end), y0, p, float(rtol), float(atol), h,
                             n_events, directions, quiet, int(max_steps or 0), resumed)
         ts, ys, F, t_full, status, hit, t_hit, y_hit, nfev, h = out

@@ -181,12 +181,34 @@ def guard(model, mode, k, t, y, p, quiet):
 
 
 @jit
+def guards_at(model, mode, n_events, t, y, p, never, out):
+    """Every event function of ``mode`` at (t, y), none quiet (``never``: -inf each), into ``out`` (n_events,):
+    :func:`guard`'s values. A one-way mode evaluates its mass terms once for both events (the moving
+    module's velocity needs only the K that comes with a held module's hold or with the gap rate)."""
+    phi, omega = y[0], y[1]
+    if model == UNILATERAL and abs(phi) < 1e300 and abs(omega) < 1e300 and t > -math.inf:
+        if mode == BOTH_MOVING:
+            out[0], out[1] = y[4], y[4] + mass_terms(p, phi)[5] * omega
+            return
+        _, hold, K, _ = one_dof(p, mode, phi, omega, drive_torque(p, omega))
+        if mode == CONTRACTION:  # module 1 moves, module 2 is held
+            out[0], out[1] = -K * omega, hold + p[P_FR1] + p[P_FR2]
+        else:
+            out[0], out[1] = hold + p[P_FR2] + p[P_FR1], K * omega
+        return
+    for k in range(n_events):
+        out[k] = guard(model, mode, k, t, y, p, never)
+
+
+@jit
 def guard_table(model, mode, n_events, p, times, states, out):
     """Every event function of ``mode`` (none quiet) at ``times`` (n,) and ``states`` (n, d), into out (n_events, n)."""
     never = np.full(max(n_events, 1), -math.inf)
+    values = np.empty(max(n_events, 1))
     for i in range(times.size):
+        guards_at(model, mode, n_events, times[i], states[i], p, never, values)
         for k in range(n_events):
-            out[k, i] = guard(model, mode, k, times[i], states[i], p, never)
+            out[k, i] = values[k]
 
 
 # --- compliant one-way clutches (:mod:`.compliant_clutch`) -------------------------------------------

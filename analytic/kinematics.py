@@ -11,6 +11,7 @@ returns values of the same shape; lengths are in metres.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from enum import Enum
 from typing import NamedTuple
 
@@ -64,14 +65,50 @@ class Linkage:
         self.geometry = Geometry(geometry)
         if self.geometry is Geometry.EXACT and not self.L > self.r:
             raise ValueError(f"exact slider-crank needs L > r, got L={L} m, r={r} m")
+        self._last = (math.nan, None)  # (phi, transfer) of the last single angle: a mode switch asks for it 3 times
+        self._memo: dict | None = None  # see reusing
+
+    @contextmanager
+    def reusing(self):
+        """Within this context, :meth:`transfer`, :meth:`rod_motion` and the rod's projection of one and the
+        same array object are computed once (that array must not change meanwhile): a run's post-processing
+        asks for them of the same samples a dozen times."""
+        self._memo = {}
+        try:
+            yield self
+        finally:
+            self._memo = None
+
+    def _remembered(self, name: str, compute, phi):
+        """compute(phi), or its value from :meth:`reusing`'s memo for this very array."""
+        memo = self._memo
+        if memo is None or not isinstance(phi, np.ndarray):
+            return compute(phi)
+        seen = memo.get((name, id(phi)))
+        if seen is None or seen[0] is not phi:
+            seen = memo[(name, id(phi))] = (phi, compute(phi))  # phi kept alive: its id stays its own
+        return seen[1]
 
     def _root(self, phi):
         """sqrt(L^2 - r^2 sin^2 phi): the rod's projection on x [m] (exact geometry)."""
+        return self._remembered("root", self._compute_root, phi)
+
+    def _compute_root(self, phi):
         sin, _, sqrt = _functions(phi)
         return sqrt(self.L**2 - (self.r * sin(phi)) ** 2)
 
     def transfer(self, phi) -> Transfer:
         """S(phi), K = dS/dphi and dK/dphi."""
+        if isinstance(phi, float):
+            last, found = self._last
+            if phi == last and math.copysign(1.0, phi) == math.copysign(1.0, last):  # (-0.0 gives K = -0.0)
+                return found
+            found = self._transfer(phi)
+            self._last = (phi, found)
+            return found
+        return self._remembered("transfer", self._transfer, phi)
+
+    def _transfer(self, phi) -> Transfer:
         sin, cos, _ = _functions(phi)
         r, s, c = self.r, sin(phi), cos(phi)
         if self.geometry is Geometry.APPROX:
@@ -99,6 +136,9 @@ class Linkage:
         """Velocity coefficients of the rod (exact geometry only; see :class:`RodMotion`)."""
         if self.geometry is not Geometry.EXACT:
             raise ValueError("the first-order geometry has no rigid rod; rod motion needs geometry 'exact'")
+        return self._remembered("rod", self._rod_motion, phi)
+
+    def _rod_motion(self, phi) -> RodMotion:
         sin, cos, _ = _functions(phi)
         r, s, c = self.r, sin(phi), cos(phi)
         D = self._root(phi)

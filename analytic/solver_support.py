@@ -10,6 +10,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .cycles import SteadyWatch
+from .dense import CLEAR, GRAZE_POINTS
 from .errors import ParameterError, SimulationError
 from .params import check_real
 from .params import check_run_options as check_time_options
@@ -31,7 +32,18 @@ def sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
     Located by bisection, not by a mask over the whole grid: a run's cost must not grow with
     (segments x grid points)."""
     inside = grid[np.searchsorted(grid, t0, side="right"):max(np.searchsorted(grid, t1, side="left"), 0)]
-    return np.concatenate([[t0], inside, [t1]]) if t1 > t0 else np.array([t0])
+    if not t1 > t0:
+        return np.array([t0])
+    times = np.empty(inside.size + 2)
+    times[0], times[1:-1], times[-1] = t0, inside, t1
+    return times
+
+
+def steps_until(ends: np.ndarray, t_stop: float) -> np.ndarray:
+    """A segment's step ends ``ends`` (ascending) before t_stop [s], then t_stop: its steps up to where it stopped."""
+    if ends.size >= 2 and ends[-2] < t_stop == ends[-1]:  # stopped where it was integrated to: the usual end
+        return ends
+    return np.append(ends[ends < t_stop], t_stop)
 
 
 def check_finite(series: dict[str, np.ndarray]) -> None:
@@ -51,22 +63,20 @@ def restart_step(sol, previous: float | None, t_end: float) -> float | None:
     2.4 ms step where 0.65 ms steps were needed: 3e-6 of the run's energy lost in one step).
     Starting each segment from the step size the previous one settled on avoids that guess.
     """
-    steps = np.diff(sol.t)
-    h = float(steps[-2]) if steps.size >= 2 else previous
-    left = t_end - float(sol.t[-1])
+    ends = sol.t
+    h = float(ends[-2] - ends[-3]) if ends.size >= 3 else previous
+    left = t_end - float(ends[-1])
     return None if h is None or not h > 0 or not left > 0 else min(h, left)
 
 
-# interior points checked per accepted step for a guard that dipped below zero and came back
-_GRAZE_POINTS = 8
-
-
-def missed_crossing(sol, guards, events):
+def missed_crossing(sol, guards, events, scan=None):
     """A guard crossing that solve_ivp missed: (t, event index, state) of the first, or None.
 
     ``sol``: a solve_ivp result with dense output; ``guards(t (n,), Y (d, n))``: every
     event function at once, array (n_events, n); ``events``: the event functions,
-    each falling through zero where its mode ends.
+    each falling through zero where its mode ends; ``scan()``: (times, negative,
+    positive) as :func:`graze_signs` finds them, computed elsewhere (the compiled
+    :meth:`.dense.DenseSolution.graze_scan`), or None: from ``guards`` here.
 
     solve_ivp reports a crossing only where an event function is >= 0 at one step
     end and <= 0 at the next. Two kinds slip through: a guard that dips below zero
@@ -80,27 +90,41 @@ def missed_crossing(sol, guards, events):
     sample is located with brentq (at the segment's start if it never was clearly
     positive). "Clearly": beyond 1e-9 of the guard's largest value in the segment.
     """
-    ends = sol.t
-    if ends.size < 2:
+    if sol.t.size < 2:
         return None
-    fractions = np.arange(_GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)  # each step's start and interior points
-    times = np.append((ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel(), ends[-1])
-    values = guards(times, sol.sol(times))
-    scale = np.maximum(np.abs(values).max(axis=1), 1e-300)
+    times, negative, positive = graze_signs(sol, guards) if scan is None else scan()
     first = None
-    for k, row in enumerate(values):
-        negative = np.flatnonzero(row < -1e-9 * scale[k])
-        if negative.size == 0 or first is not None and times[negative[0]] >= first[0]:
+    for k, (j, before) in enumerate(zip(negative.tolist(), positive.tolist())):
+        if j < 0 or first is not None and times[j] >= first[0]:
             continue
-        j = negative[0]
-        before = np.flatnonzero(row[:j] > 1e-9 * scale[k])  # clearly positive: out of the roundoff at the start
-        if before.size == 0:  # never clearly above zero since the segment's start: it left zero downward at once
+        if before < 0:  # never clearly above zero since the segment's start: it left zero downward at once
             first = (float(times[0]), k)
             continue
         event = events[k]
-        first = (brentq(lambda time: event(time, sol.sol(time)), times[before[-1]], times[j], xtol=1e-15,
+        first = (brentq(lambda time: event(time, sol.sol(time)), times[before], times[j], xtol=1e-15,
                         rtol=4 * np.finfo(float).eps), k)
     return None if first is None else (first[0], first[1], sol.sol(first[0]))
+
+
+def graze_signs(sol, guards) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The samples of :func:`missed_crossing`: (times (N,), negative (n_events,), positive (n_events,)).
+
+    ``times``: each step's start and GRAZE_POINTS interior points, then the last end; per guard,
+    ``negative`` the first sample where it is clearly negative and ``positive`` the last before that
+    where it is clearly positive (-1: none). The reference of :func:`.dense.graze_scan`."""
+    ends = sol.t
+    fractions = np.arange(GRAZE_POINTS + 1) / (GRAZE_POINTS + 1)  # each step's start and interior points
+    times = np.append((ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel(), ends[-1])
+    values = guards(times, sol.sol(times))
+    scale = np.maximum(np.abs(values).max(axis=1), 1e-300)
+    negative, positive = np.full(len(values), -1), np.full(len(values), -1)
+    for k, row in enumerate(values):
+        below = np.flatnonzero(row < -CLEAR * scale[k])
+        if below.size:
+            negative[k] = below[0]
+            above = np.flatnonzero(row[:below[0]] > CLEAR * scale[k])  # out of the roundoff at the start
+            positive[k] = above[-1] if above.size else -1
+    return times, negative, positive
 
 
 PROGRESS_EVERY_S = 0.1  # simulated seconds between two progress calls, at least
@@ -158,6 +182,9 @@ class RunMonitor:
         """
         ends = []
         phis = np.asarray(dense(step_ends))[0]
+        if not phis[1:].max(initial=-math.inf) >= self.next_end:  # no revolution ends here: the common case
+            return ends
+        phi_at = getattr(dense, "phi_at", None) or (lambda s: dense(s)[0])  # phi at one time (compiled if it can)
         for i in range(1, len(step_ends)):
             while phis[i] >= self.next_end:
                 target = self.next_end
@@ -165,8 +192,8 @@ class RunMonitor:
                 if phis[i - 1] >= target:  # reached at the start of the step (or a segment's start)
                     when = lo
                 else:
-                    when = brentq(lambda s: dense(s)[0] - target, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
-                    while dense(when)[0] < target and when < hi:
+                    when = brentq(lambda s: phi_at(s) - target, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+                    while phi_at(when) < target and when < hi:
                         when = min(np.nextafter(when, hi), hi)
                 ends.append(float(when))
                 self.next_end += 2 * math.pi

@@ -60,7 +60,7 @@ from .kinetostatics import add_kinetostatics
 from .params import RobotParams
 from .results import Mode, RunResult
 from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, raw_piece,
-                             restart_step, spurious_start, stall_reason, truncate)
+                             restart_step, spurious_start, stall_reason, steps_until, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -89,6 +89,8 @@ class UnilateralModel:
     def motor(self, t, phi, omega):
         """Motor torque [N m] at time t (array-friendly)."""
         if self.torque is None:
+            if isinstance(phi, float):  # one state (the event loop): the same sum without a numpy call
+                return drive_torque(self.params, omega) + 0.0 * phi
             return drive_torque(self.params, omega) + 0.0 * np.asarray(phi, dtype=float)
         return self.torque(t, phi, omega)
 
@@ -107,7 +109,8 @@ class UnilateralModel:
     def motion(self, phi, omega, v1, mode: Mode, M=None) -> dict:
         """alpha, a1, a2 and holding forces R1, R2 (nan where not held) in ``mode``; M [N m] the torque."""
         M = self.dyn.torque(omega, M)
-        if np.ndim(phi) == 0 and np.ndim(M) == 0 and mode is not Mode.BOTH_LOCKED:  # one state: the scalar kernels
+        if (isinstance(phi, float) and isinstance(M, float) or np.ndim(phi) == 0 and np.ndim(M) == 0) \
+                and mode is not Mode.BOTH_LOCKED:  # one state: the scalar kernels
             alpha, a1, a2, R1, R2 = kernels.mode_motion(self.constants, int(mode), float(phi), float(omega), float(M))
             return {"alpha": alpha, "a1": a1, "a2": a2, "R1": R1, "R2": R2}
         nan = np.nan * np.asarray(phi, dtype=float)
@@ -189,13 +192,17 @@ class UnilateralModel:
                 rows.append(v1 if i == 0 else v2)
         return np.array([np.broadcast_to(r, np.shape(t)) for r in rows], dtype=float)
 
+    def graze_scan(self, sol, mode: Mode):
+        """missed_crossing's scan of ``sol`` compiled (a callable) where the guards are the kernels', else None."""
+        if ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment):
+            return lambda: sol.sol.graze_scan(kernels.UNILATERAL, int(mode), 2, self.constants)
+
     # --- choosing the next mode ----------------------------------------------------------
     def choose(self, t, y, velocities, fired: tuple[str, int] | None = None, previous: Mode | None = None) -> Mode:
         """Solve the complementarity problem at time t, state ``y``, module velocities ``velocities``."""
         p, r = self.params, self.linkage.r
         phi, omega = float(y[0]), float(y[1])
         M = float(self.motor(t, phi, omega))
-        tr = self.linkage.transfer(phi)
         v1, v2 = (float(v) for v in velocities)
         v_scale = r * abs(omega) + abs(v1) + abs(v2)
         at_rest = [abs(v) <= _TOL_V * v_scale + _REST_SPEED for v in (v1, v2)]
@@ -214,7 +221,7 @@ class UnilateralModel:
             if any(h and not z for h, z in zip(held, at_rest)):
                 continue  # a held module must stand still
             if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + _REST_SPEED
-                                             or (abs(tr.K) <= 1e-12 * r and M != 0)):
+                                             or (abs(self.linkage.transfer(phi).K) <= 1e-12 * r and M != 0)):
                 continue  # a static hold needs the crank at rest, and a torque the linkage can resist
             m = motions[mode] if mode in motions else self.motion(phi, omega, v1, mode, M)
             tests = []
@@ -237,7 +244,7 @@ class UnilateralModel:
             keep = [m for m in consistent if HELD[m][i] == (kind == "velocity")]
             consistent = keep or consistent
         if len(consistent) > 1 and {Mode.CONTRACTION, Mode.EXPANSION} <= set(consistent):
-            consistent = [Mode.CONTRACTION if tr.dK < 0 else Mode.EXPANSION]
+            consistent = [Mode.CONTRACTION if self.linkage.transfer(phi).dK < 0 else Mode.EXPANSION]
         if len(consistent) > 1:
             # remaining ties: every candidate holds its conditions with equality; the
             # one with the largest margin is the one the motion moves into
@@ -323,11 +330,12 @@ def simulate_unilateral(
             events = model.events(mode, quiet=dict([spurious]))
             sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0, dict([spurious]))
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
-        grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events])
+        grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events],
+                                 model.graze_scan(sol, mode))
         if grazed is not None:
             t_stop, hit, y_grazed = grazed
-        step_ends = np.append(sol.t[sol.t < t_stop], t_stop)
-        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, step_ends, sol.sol), sol.sol, _STATES)
+        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, steps_until(sol.t, t_stop), sol.sol), sol.sol,
+                          _STATES)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
         if steady_at is not None or grazed is None and sol.status != 1:
@@ -346,10 +354,11 @@ def simulate_unilateral(
         if t >= t_end:
             break
 
-    series = assemble(pieces, lambda mode, rows: _columns(model, Mode(mode), rows))
+    with model.linkage.reusing():  # the same samples' kinematics, asked for by every column
+        series = assemble(pieces, lambda mode, rows: _columns(model, Mode(mode), rows))
+        series.update(model.dyn.energy_columns(series))
+        add_kinetostatics(series, model.dyn)
     monitor.report(float(series["t"][-1]), final=True)
-    series.update(model.dyn.energy_columns(series))
-    add_kinetostatics(series, model.dyn)
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
@@ -385,7 +394,7 @@ def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, 
 def _columns(model: UnilateralModel, mode: Mode, rows: dict) -> dict[str, np.ndarray]:
     """Every column of the samples ``rows`` (:data:`_STATES` and ``mode``) of one mode."""
     times, phi, omega = rows["t"], rows["phi"], rows["omega"]
-    y = np.array([phi, omega, rows["x1"], rows["x2"], rows["state_v1"], rows["motor_work"]])
+    y = (phi, omega, rows["x1"], rows["x2"], rows["state_v1"], rows["motor_work"])  # phi itself: see reusing
     v1, v2 = model.velocities(y, mode)
     v1 = np.broadcast_to(v1, phi.shape).astype(float)
     v2 = np.broadcast_to(v2, phi.shape).astype(float)

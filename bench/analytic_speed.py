@@ -50,11 +50,21 @@ CASES = {
                                               {"until_steady": True}),
     "motor, one-way model, 1 s": (RobotParams(**MOTOR), "exact", "unilateral", 1.0, {}),
     "motor, one-way model, 10 s": (RobotParams(**MOTOR), "exact", "unilateral", 10.0, {}),
+    # a sweep's design: samples every 1 ms (the cases above keep the default 0.1 ms, whose per-sample
+    # post-processing is a third to a half of a 1 s one-way run)
+    "one-way model, 1 s, dt_out 1 ms (a sweep design)": (RobotParams(), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
+    **{f"one-way model, 1 s, dt_out 1 ms, {k}={v:g}": (RobotParams(**{k: v}), "exact", "unilateral", 1.0,
+                                                       {"dt_out": 1e-3})
+       for k, v in (("L", 0.06), ("L", 0.5), ("m2", 3.0))},
+    "motor, one-way model, 1 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
+    "motor, one-way model, 10 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 10.0, {"dt_out": 1e-3}),
 }
-LONG = {"paper model, 10 s", "one-way model, 10 s", "motor, one-way model, 10 s"}
+LONG = {"paper model, 10 s", "one-way model, 10 s", "motor, one-way model, 10 s",
+        "motor, one-way model, 10 s, dt_out 1 ms"}
 PAIRS = [("paper model (approx, kinematic), 1 s", "paper model, 10 s"),
          ("one-way model (exact, unilateral), 1 s", "one-way model, 10 s"),
-         ("motor, one-way model, 1 s", "motor, one-way model, 10 s")]
+         ("motor, one-way model, 1 s", "motor, one-way model, 10 s"),
+         ("motor, one-way model, 1 s, dt_out 1 ms", "motor, one-way model, 10 s, dt_out 1 ms")]
 
 
 def load_before(rev: str, folder: Path):
@@ -134,19 +144,19 @@ def main() -> None:
             new = best(analytic, case, 3 if long else args.repeats)
             rows[name] = (old, new)
             ratio = f"{new[0] / old[0]:7.3f}" if old[0] else "      -"
-            print(f"{name:42s} before {old[0] or float('nan'):8.3f} s  after {new[0] * 1e3:8.1f} ms  "
+            print(f"{name:48s} before {old[0] or float('nan'):8.3f} s  after {new[0] * 1e3:8.1f} ms  "
                   f"after/before {ratio}  revolutions {new[1].summary['revolutions']:8.2f}  "
                   f"t_end {new[1].t_end:6.3f} s", flush=True)
             if old[1] is not None:
                 check = max(abs(new[1].summary[k] - old[1].summary[k]) / max(abs(old[1].summary[k]), 1e-12)
                             for k in ("revolutions", "x1_final", "x2_final"))
-                print(f"{'':42s} same run: revolutions, x1, x2 agree to {check:.1e} relative")
+                print(f"{'':48s} same run: revolutions, x1, x2 agree to {check:.1e} relative")
     print("\ncost linear in the work: 10 s against 1 s")
     for short, long in PAIRS:
         (old1, new1), (old10, new10) = rows[short], rows[long]
         revs = new10[1].summary["revolutions"] / new1[1].summary["revolutions"]
         before = f"{old10[0] / old1[0]:6.1f}x" if old10[0] else "     -"
-        print(f"{long:30s} before {before}  after {new10[0] / new1[0]:6.1f}x  revolutions {revs:6.1f}x  "
+        print(f"{long:40s} before {before}  after {new10[0] / new1[0]:6.1f}x  revolutions {revs:6.1f}x  "
               f"after per revolution: {new1[0] / new1[1].summary['revolutions'] * 1e3:.2f} ms (1 s), "
               f"{new10[0] / new10[1].summary['revolutions'] * 1e3:.2f} ms (10 s)")
     with tempfile.TemporaryDirectory() as cache:
