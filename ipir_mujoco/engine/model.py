@@ -14,6 +14,7 @@ constants below.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -112,13 +113,21 @@ def check_params(params: RobotParams) -> None:
                              "engine; allowed: rod_inertia > 0")
 
 
+@functools.lru_cache(maxsize=8)
+def _parsed(path: str, mtime_ns: int, size: int) -> mujoco.MjSpec:
+    """The file as parsed (keyed by its modification time and size too, so an edited file is read again)."""
+    return mujoco.MjSpec.from_file(path)
+
+
 def load_spec(mjcf: str | Path | None = None) -> mujoco.MjSpec:
-    """Parse an MJCF file into an MjSpec; a missing or broken file is a ParameterError."""
+    """Parse an MJCF file into an MjSpec (a copy of the file's parse, kept: a sweep builds hundreds of
+    models from one file); a missing or broken file is a ParameterError."""
     path = Path(mjcf) if mjcf is not None else default_mjcf()
     if not path.is_file():
         raise ParameterError(f"MJCF file {str(path)!r} does not exist")
+    stat = path.stat()
     try:
-        return mujoco.MjSpec.from_file(str(path))
+        return _parsed(str(path), stat.st_mtime_ns, stat.st_size).copy()
     except ValueError as exc:
         message = " ".join(str(exc).split())
         raise ParameterError(f"MJCF file {str(path)!r} is not a valid model: {message}") from None
@@ -349,14 +358,16 @@ def set_closed_loop_state(model: mujoco.MjModel, data: mujoco.MjData, params: Ro
     mujoco.mj_forward(model, data)
 
 
-def pin_offset(model: mujoco.MjModel) -> tuple[int, int, np.ndarray]:
+def pin_offset(model: mujoco.MjModel, data: mujoco.MjData | None = None) -> tuple[int, int, np.ndarray]:
     """(rod-end site id, front module body id, module 2's pin relative to that body in the world [m], (3,)).
 
     The loop gap is |site_xpos[site] - xpos[front] - offset|: the pin is fixed in module 2's frame and that
-    body only slides, so its world offset is the same in every state (computed at qpos0).
+    body only slides, so its world offset is the same in every state: read from ``data`` (after its
+    kinematics), or computed at qpos0.
     """
-    data = mujoco.MjData(model)
-    mujoco.mj_kinematics(model, data)
+    if data is None:
+        data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, data)
     front = model.body("front_module").id
     offset = data.xmat[front].reshape(3, 3) @ model.eq_data[model.equality(LOOP).id, 3:6]
     return model.site(ROD_END).id, front, offset

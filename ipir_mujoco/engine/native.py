@@ -146,7 +146,7 @@ def check_layout(data: mujoco.MjData) -> dict[str, int]:
     expected["time"] = float(data.time)
     for n in ("qpos", "qvel", "efc_id", "efc_force"):
         expected[n] = address(getattr(data, n)) if getattr(data, n).size else read[n]
-    expected["warning"] = [int(stat.number) for stat in data.warning]
+    expected["warning"] = data.warning.number.tolist()
     expected["energy"] = address(data.energy)
     if data.nefc == 0 or read != expected:
         raise LayoutError(f"the mjData layout does not check out: read {read}, expected {expected}")

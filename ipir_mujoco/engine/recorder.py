@@ -77,7 +77,8 @@ def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarra
 
 
 class Recorder:
-    """Preallocated sample rows for ``capacity`` samples (see the module docstring)."""
+    """Preallocated sample rows for ``capacity`` samples (see the module docstring); ``data`` after
+    ``mj_forward`` on the run's initial state."""
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int,
                  clutch=None):
@@ -87,7 +88,7 @@ class Recorder:
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
         # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
-        self.site, self.front, offset = pin_offset(model)
+        self.site, self.front, offset = pin_offset(model, data)  # data: after mj_forward
         self.pin_offset = offset.tolist()
         self.t = np.empty(capacity)
         self.qpos = np.empty((capacity, model.nq))

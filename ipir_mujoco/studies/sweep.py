@@ -326,8 +326,9 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
                                            study.dt_out, 1, study.until_steady)
                 batch_running[future] = chunk
                 future.add_done_callback(lambda f: events.put(("batch", None, f)))
-            # no task queued ahead: an idle worker would take it and overrun the cores the batch holds
-            slots = cores.pool_slots() if own_pool else len(waiting)
+            # beside the batch no task is queued ahead (an idle worker would take it and overrun the cores the
+            # batch holds); alone, one per worker is, so that no worker waits for the main process between designs
+            slots = (cores.pool_slots() * (1 if cores.batch_active else 2)) if own_pool else len(waiting)
             while waiting and len(running) < slots:
                 i = waiting.popleft()
                 try:
