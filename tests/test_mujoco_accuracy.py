@@ -230,3 +230,36 @@ def test_a_timestep_below_the_floor_names_the_limit_that_set_it(params, servo, t
     message = str(refused.value)
     assert "MuJoCo would need a timestep of" in message and f">= {DT_MIN:g} s" in message and "\n" not in message
     assert ("crank can reach" in message) == named.startswith("^t_end")
+
+
+def _fed_in_turn(values, times, worst, tolerance, mode, rows=None):
+    """The monitor's loop-gap record (or its error) after feeding ``values`` at ``times``: each in turn as the
+    per-sample loop did (a value that beats the worst), or only ``rows``."""
+    from ipir_mujoco.engine.monitor import AccuracyError, AccuracyMonitor, Tolerances
+
+    monitor = AccuracyMonitor(Tolerances(1.0, tolerance, 1.0), mode)
+    monitor.worst["loop_gap_m"] = worst
+    try:
+        for i in (range(len(values)) if rows is None else rows):
+            if values[i] > monitor.worst["loop_gap_m"]:
+                monitor.loop_gap(times[i], values[i])
+    except AccuracyError as exc:
+        return str(exc)
+    return monitor.record()
+
+
+@pytest.mark.parametrize("mode", ["stop", "warn"])
+def test_a_block_feeds_the_monitor_what_feeding_every_sample_would(mode):
+    """The engine feeds the monitor a block's first crossing of the tolerance and its worst only: the record
+    (worst, when, violations) and any error equal those of feeding every sample in turn, on blocks with
+    ties, NaN, crossings before, at and after the worst, and a worst already past the tolerance."""
+    rng = np.random.default_rng(7)
+    for _ in range(400):
+        n = int(rng.integers(1, 60))
+        values = np.round(rng.uniform(0, 2, n), 1)  # rounded: ties
+        values[rng.random(n) < 0.05] = np.nan
+        times = np.arange(n) * 1e-3
+        worst, tolerance = float(rng.choice([0.0, 0.5, 1.2, 1.9])), float(rng.choice([0.7, 1.0, 1.5]))
+        rows = engine_simulate._rising(values, worst, tolerance, 0)
+        assert _fed_in_turn(values, times, worst, tolerance, mode, rows) == \
+            _fed_in_turn(values, times, worst, tolerance, mode)

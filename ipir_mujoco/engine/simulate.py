@@ -253,10 +253,11 @@ class _Run:
         new samples ``new`` (first, end) show, in the order the samples were taken: sample i's interval first
         judged row i - 1 (residual ratio, then loop gap), then raised the energy floor to sample i's torque and
         reported its excursion; if MuJoCo warned in the interval after the last new sample (``warned``: it was
-        not recorded, but it judged that sample), the run fails with the last good time. Only the values that
-        beat the monitor's worst so far are fed (the others cannot change it), so a block costs a few array
-        operations."""
+        not recorded, but it judged that sample), the run fails with the last good time. Of each figure only the
+        values that leave the monitor as feeding every one would are fed (:func:`_rising`: its first crossing
+        of the tolerance and the block's worst), so a block costs a few array operations."""
         rec, mon = self.recorder, self.monitor
+        tol = mon.tolerances
         (a, b), (first, end) = judged, new
         events = []  # (position in the sampling order, kind, row)
         if b > a:
@@ -265,12 +266,14 @@ class _Run:
             floors = np.fmax.accumulate(np.append(self.energy_floor, revolution))[1:]
             residual, scale = self._audit(a, b, floors)
             ratio = np.divide(residual, scale, out=np.zeros_like(residual), where=scale > 0)
-            events += [(2 * j + 2, 0, j) for j in _rising(ratio, mon.worst["residual_ratio"], a)]
-            events += [(2 * j + 2, 1, j) for j in _rising(rec.deferred[a:b, _GAP], mon.worst["loop_gap_m"], a)]
+            events += [(2 * j + 2, 0, j) for j in _rising(ratio, mon.worst["residual_ratio"], tol.residual_ratio, a)]
+            events += [(2 * j + 2, 1, j) for j in _rising(rec.deferred[a:b, _GAP], mon.worst["loop_gap_m"],
+                                                          tol.loop_gap_m, a)]
         if warned and messages:  # in the interval after the last new sample, once it had judged the one before
             events.append((2 * end, 2, end - 1))
         if end > first:
-            events += [(2 * i + 1, 3, i) for i in _rising(rec.excursion[first:end], mon.worst["excursion_m"], first)]
+            events += [(2 * i + 1, 3, i) for i in _rising(rec.excursion[first:end], mon.worst["excursion_m"],
+                                                          tol.excursion_m, first)]
         for _, kind, j in sorted(events):
             t = rec.t.item(j)
             if kind == 0:
@@ -303,14 +306,23 @@ class _Run:
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
 
 
-def _rising(values: np.ndarray, worst: float, offset: int) -> list[int]:
-    """Rows (index + ``offset``) of ``values`` whose magnitude beats every one before it and ``worst`` (NaN
-    never does): the values the monitor would take."""
+def _rising(values: np.ndarray, worst: float, tolerance: float, offset: int) -> list[int]:
+    """Rows (index + ``offset``) of ``values`` the monitor must be fed to end as if fed each in turn (each
+    that beats the worst so far, starting from ``worst``): the first fed one beyond ``tolerance`` (it is
+    the first beyond both, and the one that stops a run or is recorded as its crossing), and the first of
+    the largest, if it beats ``worst`` (NaN never does). Every other value would only be overtaken."""
     size = np.abs(values)
-    if not np.fmax.reduce(size) > abs(worst):  # the common case once a run is under way: nothing to feed
+    largest = np.fmax.reduce(size)
+    if not largest > abs(worst):  # the common case once a run is under way: nothing to feed
         return []
-    before = np.fmax.accumulate(np.append(abs(worst), size[:-1]))
-    return (np.flatnonzero(size > before) + offset).tolist()
+    rows = []
+    threshold = max(abs(worst), tolerance)
+    if largest > threshold:
+        rows.append(int(np.argmax(size > threshold)))
+    top = int(np.argmax(size == largest))
+    if not rows or top != rows[0]:
+        rows.append(top)
+    return [row + offset for row in rows]
 
 
 class _BlockChecks:
