@@ -229,7 +229,7 @@ class _Run:
             status, taken = steps.record(rec, block - samples % block, sps, n_steps - done, pending, messages)
             done += taken
             samples += rec.count - first
-            pending = rec.count - 1
+            pending = rec.count - 1 if rec.count > first else pending
             # each interval judged the sample before it, from its first step on (none before the first interval);
             # an interval in which MuJoCo warned is not recorded, but it judged the last sample first
             warned = status == WARNED

@@ -226,7 +226,10 @@ class CompiledSteps(PythonSteps):
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
                messages: list[str]) -> tuple[int, int]:
         if rec is not self._rec:
-            self._bind(rec)
+            try:
+                self._bind(rec)
+            except LayoutError:  # not arrays the C loop can write: the Python record around the C steps
+                return super().record(rec, nsamples, sps, remaining, pending, messages)
         st, S = self._st, self.S
         st[S["count"]], st[S["steps_done"]] = rec.count, 0.0
         try:
