@@ -398,9 +398,11 @@ def test_the_batch_runs_a_motor_design_as_the_motor(tmp_path):
 def test_mujoco_peak_forces_that_measure_the_numerics_are_left_empty():
     """A rigid MuJoCo clutch takes up its load within a few steps: the peak reaction read from the sweep's
     1 ms samples is whichever step a sample hits, and differs from the peak over every step of the same run
-    (the same trajectory: only the output interval changes). The sweep leaves it empty, and the lock's rod
-    force with it; a compliant clutch read at every step keeps its (physical) peak."""
+    (the same trajectory: only the output interval changes); where an engagement is hard its jolt reaches
+    the rod, whose peak then changes with the step. The sweep leaves both empty, for the ratchet and the
+    locks; a compliant clutch read at every step keeps its (physical) peaks."""
     from ipir_mujoco.engine import simulate_mujoco
+    from ipir_mujoco.engine.model import SolverSettings
 
     params = RobotParams()
     sampled = simulate_mujoco(params, "unilateral", "ratchet", 0.5, dt_out=1e-3)
@@ -408,19 +410,27 @@ def test_mujoco_peak_forces_that_measure_the_numerics_are_left_empty():
     assert sampled.settings["timestep"] < 1e-3
     # the artefact: the same run's peak differs by far more than its accuracy monitor's 1e-3 with the sampling
     assert abs(every_step.summary["peak_clutch_force_n"] / sampled.summary["peak_clutch_force_n"] - 1) > 1e-2
+    # a hard engagement (from rest, light front module): the ratchet's peak rod force, read at every step,
+    # moves by more than the monitor's 1e-3 when the step is halved
+    hard = RobotParams(L=0.3742, m2=0.2)
+    rod = [np.abs(simulate_mujoco(hard, "unilateral", "ratchet", 0.5, dt_out=dt, settings=SolverSettings(timestep=dt))
+                  .series["rod_force"]).max() for dt in (1e-4, 5e-5)]
+    assert abs(rod[1] / rod[0] - 1) > 1e-2
     for run in (sampled, every_step):
         metrics = run_metrics(run)
-        assert np.isnan(metrics["peak_clutch_force_n"])
-        assert np.isfinite(metrics["peak_rod_force_n"])  # the ratchet's rod force does not depend on the step
+        assert np.isnan(metrics["peak_clutch_force_n"]) and np.isnan(metrics["peak_rod_force_n"])
     lock = run_metrics(simulate_mujoco(params, "kinematic", "lock", 0.3, dt_out=1e-3))
     assert np.isnan(lock["peak_clutch_force_n"]) and np.isnan(lock["peak_rod_force_n"])
     # the analytic engines keep theirs; MuJoCo with a compliant clutch read at every step keeps its peak
     assert run_metrics(steady_run())["peak_clutch_force_n"] == 3.0
     compliant = steady_run("mujoco")
     compliant.settings = {"clutch_model": "compliant", "mujoco_clutch": "ratchet", "timestep": 1e-5, "dt_out": 1e-5}
-    assert run_metrics(compliant)["peak_clutch_force_n"] == 3.0
+    compliant.series["rod_force"] = np.linspace(-5.0, 4.0, compliant.series["t"].size)
+    kept = run_metrics(compliant)
+    assert kept["peak_clutch_force_n"] == 3.0 and kept["peak_rod_force_n"] == 5.0
     compliant.settings = {**compliant.settings, "dt_out": 1e-3}
     assert np.isnan(run_metrics(compliant)["peak_clutch_force_n"])
+    assert np.isnan(run_metrics(compliant)["peak_rod_force_n"])
 
 
 def test_the_heatmap_colours_the_first_engine_that_gives_the_metric():
@@ -478,7 +488,7 @@ def test_a_metric_equal_in_every_design_names_no_best_design():
 
 def test_the_default_sweep_runs_mujoco_serially_where_its_loop_is_compiled(tmp_path):
     """Where the serial engine steps in C, the default sweep runs the ratchet designs through it: each row
-    is the serial run's metrics (rod force included, which the batch cannot measure), not the batch's."""
+    is the serial run's metrics, not the batch's."""
     from ipir_mujoco.engine.stepper import compiled_status
     from ipir_mujoco.studies.sweep import engine_metrics
     from ipir_mujoco.studies.sweep_files import _cell, make_row
@@ -493,7 +503,7 @@ def test_the_default_sweep_runs_mujoco_serially_where_its_loop_is_compiled(tmp_p
         serial = engine_metrics("mujoco-ratchet", study.base.replace(**design), study.t_end, study.dt_out, {})
         expected = make_row(i, design, {"mujoco-ratchet": serial}, study.engines)
         assert row == {k: _cell(v) for k, v in expected.items()}
-        assert float(row["mujoco-ratchet:peak_rod_force_n"]) > 0
+        assert float(row["mujoco-ratchet:revolutions"]) > 0
 
 
 def test_no_batch_with_a_batch_size_is_refused(tmp_path, capsys):
