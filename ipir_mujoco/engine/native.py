@@ -27,8 +27,8 @@ class LayoutError(RuntimeError):
     """What the compiled loop relies on does not hold here (the pure-Python loop is used instead)."""
 
 
-
 def address(array: np.ndarray) -> int:
+    """The address of an array's first element (fixed for the life of the array)."""
     return int(array.ctypes.data)
 
 
@@ -56,7 +56,8 @@ def compiled():
 
 
 def _library() -> dict[str, int]:
-    """Addresses of ``mj_step`` and of the legacy error handler pointer in the libmujoco the bindings use."""
+    """Addresses of ``mj_step``, ``mj_subtreeVel`` and the legacy error handler pointer in the libmujoco the
+    bindings use."""
     folder = os.path.dirname(mujoco.__file__)
     paths = sorted(glob.glob(os.path.join(folder, "libmujoco.so*"))
                    + glob.glob(os.path.join(folder, "libmujoco*.dylib")))

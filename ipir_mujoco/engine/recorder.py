@@ -41,15 +41,13 @@ from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_ad
 # With compliant clutches also: overlaps clutch_overlap1/2 d_i [m] (> 0: the spring is compressed), the springs'
 # stored energy clutch_spring_energy and the dampers' cumulative dissipation clutch_damper_work [J].
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
-# the per-sample scalars, in their order in Recorder.scalars (the compiled loop writes them too: stepper.py checks
+# the per-sample scalars, in their order in Recorder.scalars (the compiled loop writes them too: native.py checks
 # the order against _stepper.c's)
 SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
            "friction_work", "clutch_damper_work")
 # MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
 DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
             "clutch_overlap2", "clutch_spring")
-_S = {name: i for i, name in enumerate(SCALARS)}
-_D = {name: i for i, name in enumerate(DEFERRED)}
 
 
 def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarray) -> np.ndarray:
