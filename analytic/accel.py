@@ -25,7 +25,8 @@ try:
 except ImportError:  # the fallback: the kernels run as Python
     numba = None
 
-ACCELERATED = numba is not None  # True: the kernels are compiled
+# True: the kernels are compiled (numba's own NUMBA_DISABLE_JIT=1 leaves them Python)
+ACCELERATED = numba is not None and not numba.config.DISABLE_JIT
 _COMPILED_MODULES = ("kernels", "dense", "dop853")  # the modules whose functions are compiled and call each other
 
 

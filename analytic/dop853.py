@@ -112,7 +112,8 @@ def _maximum(a, b):
 def _rms_scaled(v, scale):
     total = 0.0
     for j in range(v.size):
-        total += (v[j] / scale[j]) ** 2
+        q = v[j] / scale[j]
+        total += q * q  # as numpy's square and numba's x ** 2: Python's ** would call pow, rounding otherwise
     return math.sqrt(total) / math.sqrt(v.size)
 
 
@@ -220,8 +221,9 @@ def integrate(model, mode, t0, t_bound, y0, p, rtol, atol, first_step, n_events,
             e5, e3 = 0.0, 0.0
             for j in range(n):  # the scaled error norms, element by element in numpy's order
                 scale = atol + _maximum(abs(y[j]), abs(y_new[j])) * rtol
-                e5 += (d5[j] / scale) ** 2
-                e3 += (d3[j] / scale) ** 2
+                q5, q3 = d5[j] / scale, d3[j] / scale
+                e5 += q5 * q5
+                e3 += q3 * q3
             if e5 == 0.0 and e3 == 0.0:
                 error = 0.0
             else:

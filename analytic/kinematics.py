@@ -86,7 +86,11 @@ class Linkage:
             return compute(phi)
         seen = memo.get((name, id(phi)))
         if seen is None or seen[0] is not phi:
-            seen = memo[(name, id(phi))] = (phi, compute(phi))  # phi kept alive: its id stays its own
+            value = compute(phi)
+            for array in (value if isinstance(value, tuple) else (value,)):
+                if isinstance(array, np.ndarray):
+                    array.flags.writeable = False  # shared by every later caller: none may change it
+            seen = memo[(name, id(phi))] = (phi, value)  # phi kept alive: its id stays its own
         return seen[1]
 
     def _root(self, phi):
@@ -101,7 +105,8 @@ class Linkage:
         """S(phi), K = dS/dphi and dK/dphi."""
         if isinstance(phi, float):
             last, found = self._last
-            if phi == last and math.copysign(1.0, phi) == math.copysign(1.0, last):  # (-0.0 gives K = -0.0)
+            # -0.0 == 0.0, but their K differ in sign (transfer(0.0).K is -0.0, transfer(-0.0).K is +0.0)
+            if phi == last and math.copysign(1.0, phi) == math.copysign(1.0, last):
                 return found
             found = self._transfer(phi)
             self._last = (phi, found)

@@ -105,20 +105,23 @@ def test_the_compiled_graze_scan_is_the_reference_scan(case):
 
 def test_both_guards_at_once_are_each_guard():
     """guards_at shares one evaluation of the mass terms between a mode's two guards: each value is guard's,
-    bit for bit, in every moving mode, also where the state has overflowed (nan: the controller's cue)."""
+    bit for bit, in every moving mode, also where the state has overflowed (nan: the controller's cue), and at
+    a nan or -inf time (where guard's "quiet until -inf" rule reads at least +tiny)."""
     model = UnilateralModel(PARAMS, "exact")
-    never = np.full(2, -math.inf)
+    never = np.full(2, -math.inf)  # guards_at's contract: no guard quiet
     rng = np.random.default_rng(7)
     states = [np.array([phi, omega, 0.01, 0.02, v1, 0.3]) for phi, omega, v1 in
               zip(rng.uniform(-4, 10, 40), rng.uniform(-30, 60, 40), rng.uniform(-0.5, 1.0, 40))]
     states += [np.array([1e301, 1.0, 0, 0, 0, 0]), np.array([0.5, math.inf, 0, 0, 0, 0])]
     for guards_at in kernel_variants(kernels.guards_at):
         for mode in (Mode.CONTRACTION, Mode.EXPANSION, Mode.BOTH_MOVING):
-            for y in states:
-                out = np.empty(2)
-                guards_at(kernels.UNILATERAL, int(mode), 2, 0.1, y, model.constants, never, out)
-                each = [kernels.guard(kernels.UNILATERAL, int(mode), k, 0.1, y, model.constants, never) for k in (0, 1)]
-                assert np.array_equal(out, each, equal_nan=True)
+            for t in (0.1, math.nan, -math.inf):
+                for y in states:
+                    out = np.empty(2)
+                    guards_at(kernels.UNILATERAL, int(mode), 2, t, y, model.constants, never, out)
+                    each = [kernels.guard(kernels.UNILATERAL, int(mode), k, t, y, model.constants, never)
+                            for k in (0, 1)]
+                    assert np.array_equal(out, each, equal_nan=True)
 
 
 def test_the_linkage_remembers_only_what_it_may():
