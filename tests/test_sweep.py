@@ -560,3 +560,34 @@ def test_the_acceleration_jump_is_read_exactly_at_the_event_instants():
     # no event instant, no jump; and MuJoCo's runs leave the metric empty
     assert accel_jump({"t": np.array([0.0, 1.0]), "a1": np.zeros(2), "a2": np.array([0.0, 5.0])}) == 0.0
     assert np.isnan(run_metrics(simulate_mujoco(params, "unilateral", "ratchet", 0.2, dt_out=1e-3))["accel_jump_mps2"])
+
+
+def test_revolutions_of_runs_stopped_at_their_steady_state_are_not_compared():
+    """Under --until-steady a run ends where its engine's detection fired, which two engines agreeing on
+    the steady speed may do a revolution apart: the divergence of revolutions is left empty there (the
+    steady speed still compares them); runs of the same length keep it."""
+    from ipir_mujoco.studies.sweep_files import make_row
+
+    engines = ("a", "b")
+    a = {"revolutions": 11.0, "steady": 1.0, "steady_speed_m_s": 0.2}
+    b = {"revolutions": 12.0, "steady": 1.0, "steady_speed_m_s": 0.20004}
+    stopped = make_row(0, {"L": 0.1}, {"a": a, "b": b}, engines, until_steady=True)
+    assert stopped["divergence:b:revolutions"] is None
+    assert stopped["divergence:b:steady_speed_m_s"] == pytest.approx(2e-4, rel=1e-9)
+    full = make_row(0, {"L": 0.1}, {"a": a, "b": b}, engines)
+    assert full["divergence:b:revolutions"] == pytest.approx(1 / 11, rel=1e-12)
+
+
+def test_the_heatmap_compares_the_steady_speed_where_revolutions_are_not_compared():
+    """--until-steady --plot-metric t_steady_s: t_steady has no divergence column, and the revolutions of runs
+    stopped at their steady state are not compared; the map's contours then follow the steady speed."""
+    from ipir_mujoco.report.sweep_plots import compared_metric
+
+    engines = ["mujoco-ratchet", "analytic-unilateral"]
+    columns = {f"divergence:analytic-unilateral:{m}": np.full(3, np.nan)
+               for m in ("revolutions", "steady_speed_m_s", "mean_speed_mps")}
+    columns["divergence:analytic-unilateral:steady_speed_m_s"] = np.array([1e-4, np.nan, 2e-4])
+    assert compared_metric(columns, engines, "t_steady_s") == "steady_speed_m_s"
+    assert compared_metric(columns, engines, "mean_speed_mps") == "mean_speed_mps"
+    columns["divergence:analytic-unilateral:revolutions"] = np.array([3e-4, 1e-4, 2e-4])
+    assert compared_metric(columns, engines, "t_steady_s") == "revolutions"

@@ -4,7 +4,8 @@ The heatmap colours one metric of the first engine that gives it (a batched
 MuJoCo run gives no peak forces) over the first two varied parameters (the steady speed for a sweep run to steady state, else the mean
 forward speed; ``--plot-metric`` chooses another) and draws over it the
 contours where the second engine diverges from the first by 1 % and 5 % in
-that metric (in revolutions for a metric without a divergence column): where
+that metric (for a metric without a divergence column in revolutions, else in
+the steady or mean speed where revolutions are not compared): where
 the simpler model can be trusted, and where not. A second panel maps that
 divergence itself. Axes carry their units; an axis swept log-spaced (``:log``)
 is drawn on a log scale.
@@ -155,6 +156,16 @@ def coloured_engine(columns: dict[str, np.ndarray], engines: list[str], metric: 
     return None, f"no engine gives {metric} for these designs"
 
 
+def compared_metric(columns: dict[str, np.ndarray], engines: list[str], metric: str) -> str:
+    """The metric whose divergence the heatmap draws: ``metric`` if it has a divergence column, else the
+    revolutions, else (not compared between runs stopped at their steady state) the steady or mean speed."""
+    if metric in DIVERGENCE:
+        return metric
+    given = [m for m in ("revolutions", "steady_speed_m_s", "mean_speed_mps")
+             if np.isfinite(columns[f"divergence:{engines[1]}:{m}"]).any()]
+    return (given or ["revolutions"])[0]
+
+
 def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
     x, y = columns[ax_x.name], columns[ax_y.name]
     shown, heading = coloured_engine(columns, engines, metric)
@@ -167,7 +178,7 @@ def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
     else:
         _colour_map(fig, ax, x, y, columns[f"{shown}:{metric}"], f"{shown}: {metric} [{UNITS[metric]}]")
     if len(engines) > 1:
-        compared = metric if metric in DIVERGENCE else "revolutions"
+        compared = compared_metric(columns, engines, metric)
         divergence = np.abs(columns[f"divergence:{engines[1]}:{compared}"]) * 100
         finite = divergence[np.isfinite(divergence)]
         low, high = (finite.min(), finite.max()) if finite.size else (np.nan, np.nan)

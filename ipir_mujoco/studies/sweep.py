@@ -302,7 +302,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             return
         partial[i].update(results)
         if len(partial[i]) == len(engines):
-            row = make_row(i, designs[i], partial.pop(i), engines)
+            row = make_row(i, designs[i], partial.pop(i), engines, study.until_steady)
             results_file.write(row)
             if on_row is not None:
                 on_row(row)
