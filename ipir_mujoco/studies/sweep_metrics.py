@@ -12,7 +12,9 @@ mean_speed_mps             m/s     forward speed of the robot (mean of the two m
                                    last whole crank revolutions (up to 3, counted back from the
                                    run's end); 0 if none was completed
 steady                     0/1     1 if the run reached its periodic steady state
-t_steady_s                 s       when it did (end of the settled window); empty if not steady
+t_steady_s                 s       when it did (end of the settled window); empty if not steady;
+                                   a revolution's resolution: two engines agreeing on the steady
+                                   speed to 2e-4 may settle a revolution apart (up to 13 % in t)
 steady_speed_m_s           m/s     mean speed over the settled window; empty if not steady
 distance_per_rev_m         m       distance per crank revolution: settled window, else whole run
 energy_per_metre_j_m       J/m     motor work per metre over the settled window; empty if not steady
