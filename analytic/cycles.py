@@ -215,19 +215,15 @@ class SteadyWatch:
 
     def update(self, t, phi, position) -> bool:
         t, phi, position = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, phi, position))
-        if self.last is not None:  # the common case first: no revolution ends in these samples
-            top = np.maximum((phi - self.phi0).max(), self.reach)  # the running maximum's last value (nan wins)
-            if top < 2 * math.pi * (self.turns + 1):
-                self.reach, self.last = float(top), (t[-1], top, position[-1])
-                return self.steady_at is not None
-        reach = np.maximum.accumulate(np.maximum(phi - self.phi0, self.reach))
         if self.last is None:
-            self.last = (t[0], reach[0], position[0])
+            self.last = (t[0], np.maximum(phi[0] - self.phi0, self.reach), position[0])
             self.boundary = (t[0], position[0])
         target = 2 * math.pi * (self.turns + 1)
-        if reach[-1] < target:  # no revolution ends in these samples: the common case
-            self.reach, self.last = float(reach[-1]), (t[-1], reach[-1], position[-1])
+        top = np.maximum((phi - self.phi0).max(), self.reach)  # the running maximum's last value (nan wins)
+        if top < target:  # no revolution ends in these samples: the common case
+            self.reach, self.last = float(top), (t[-1], top, position[-1])
             return self.steady_at is not None
+        reach = np.maximum.accumulate(np.maximum(phi - self.phi0, self.reach))
         prev_t, prev_r, prev_x = self.last
         for ti, ri, xi in zip(t, reach, position):
             while ri >= target:

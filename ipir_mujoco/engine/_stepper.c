@@ -243,7 +243,8 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
     step(m, d);
     const double *efc_force = *efc_field;
     const int ne = *ne_field;
-    if (after_step(cfg, st, efc_force, ne) != STEPS_DONE) return MISSING_LOCK_ROW;
+    int status = after_step(cfg, st, efc_force, ne);
+    if (status != STEPS_DONE) return status;
     double omega = qvel[crank_v];
     torque = force[motor] + slope * (omega - omega_prev);
     wm += torque * omega * dt;
@@ -371,7 +372,7 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
   out[R_lambda2] = held[3];
   out[R_motor_work] = st[S_motor_work];
   out[R_friction_work] = st[S_friction_work];
-  out[R_clutch_damper_work] = cfg[C_clutch] == COMPLIANT ? st[S_damper_work] : 0.0;
+  out[R_clutch_damper_work] = st[S_damper_work]; /* 0 but for the compliant clutches' dampers */
   PTR(double *, rec_excursion)[row] = st[S_excursion];
   return STEPS_DONE;
 }
@@ -414,7 +415,7 @@ static long long warnings(const int64_t *cfg) {
   return total;
 }
 
-/* simulate._integrate's sampling loop for rigid clutches: up to nsamples output intervals of sps steps
+/* simulate._integrate's sampling loop (stepper.PythonSteps.record): up to nsamples output intervals of sps steps
  * (the last one cut at ``remaining`` steps), each recorded as a row; the first step of an interval fills the
  * deferred values of the row before it (``pending``, -1: none). Rows go from st[count] on; st[count] and
  * st[steps_done] count them. Returns STEPS_DONE, RECORD_WARNED (MuJoCo warned in the last interval, not recorded) or a

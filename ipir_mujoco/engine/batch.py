@@ -45,8 +45,8 @@ from ipir_mujoco.analytic.params import RobotParams
 from .model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
                     drive_torque_slope, pin_offset, qpos_address, set_closed_loop_state)
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_run_options, climb_energy, rest_since,
-                     stall_reason, steps_per_output)
+from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_run_options, climb_energy, mujoco_failure,
+                     rest_since, stall_reason, steps_per_output)
 from .timestep import DT_MIN, choose_settings
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
@@ -275,8 +275,7 @@ class _Batch:
                 k = int(k)
                 row = int(self.last_row[k])
                 t_good = float(self.record["t"][row, k]) if np.isfinite(self.record["t"][row, k]) else 0.0
-                reason = " ".join(self.batch.error(k).split())
-                self._finish(k, error=f"MuJoCo failed after t={t_good:.6g} s: {reason}")
+                self._finish(k, error=mujoco_failure(t_good, self.batch.error(k)))
             return np.asarray(exc.ids, dtype=int)
         return _NONE
 

@@ -109,6 +109,7 @@ class Ratchet:
 
     name = "ratchet"
     after_step = None
+    damper_work = 0.0  # no damper: the compliant clutches' cumulative dissipation [J]
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
         self.model, self.data = model, data
@@ -193,6 +194,7 @@ class Locks:
     """
 
     name = "lock"
+    damper_work = 0.0
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, rule: str, r: float, L: float):
         if rule not in ("kinematic", "unilateral"):
@@ -289,6 +291,7 @@ class NoClutch:
     name = "none"
     after_step = None
     excursion = 0.0
+    damper_work = 0.0
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
         pass

@@ -141,3 +141,8 @@ def stall_reason(since: float, t_stop: float, phi: float) -> str:
     """The one-line stall reason of RunResult.stall (times [s], crank angle [rad])."""
     return (f"crank and modules at rest from t={since:.4g} s (crank at {math.degrees(phi) % 360:.1f} deg "
             f"in its turn); the drive cannot turn the crank on against the load (run stopped at t={t_stop:.4g} s)")
+
+
+def mujoco_failure(t_good: float, reason: str) -> str:
+    """The one-line error of a run in which MuJoCo raised (``t_good`` [s]: the last sample known good)."""
+    return f"MuJoCo failed after t={t_good:.6g} s: {' '.join(reason.split())}"

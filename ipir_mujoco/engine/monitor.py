@@ -86,8 +86,6 @@ def energy_audit(motor_j, dissipated_j, kinetic_gain_j, stored_gain_j, floor_j):
     dissipated, |stored| and the floor. Every run's monitor and energy record use this one audit.
     """
     residual = motor_j - dissipated_j - kinetic_gain_j - stored_gain_j
-    if isinstance(motor_j, float):  # a serial run's sample: Python's max, ten times cheaper than numpy's
-        return residual, max(abs(motor_j), dissipated_j, abs(stored_gain_j), floor_j)
     scale = np.maximum(np.maximum(np.abs(motor_j), dissipated_j), np.maximum(np.abs(stored_gain_j), floor_j))
     return residual, scale
 

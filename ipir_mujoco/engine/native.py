@@ -3,7 +3,7 @@
 ``_stepper.c`` includes no MuJoCo header, so it does not depend on the version it was built against: this
 module finds ``mj_step`` and ``mj_subtreeVel`` in the libmujoco the bindings loaded (checked to be that very
 instance), and the byte offsets of the mjData fields the loop reads between steps (the ``efc_force`` and
-``efc_id`` pointers, the constraint counts, time, energy, the warning counters) from the running mujoco's own
+``efc_id`` pointers, the constraint counts, time, the warning counters) from the running mujoco's own
 description of its structs (``mujoco.introspect``), checked against a live MjData before every run. Anything
 that does not check out raises :class:`LayoutError`, and the engine steps in Python instead.
 """
@@ -20,7 +20,7 @@ import numpy as np
 
 from .recorder import DEFERRED, SCALARS
 
-_DATA_FIELDS = ("warning", "time", "energy", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_id", "efc_force")
+_DATA_FIELDS = ("warning", "time", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_id", "efc_force")
 
 
 class LayoutError(RuntimeError):
@@ -142,13 +142,11 @@ def check_layout(data: mujoco.MjData) -> dict[str, int]:
     # each mjWarningStat is (lastinfo, number), two ints
     read["warning"] = [ctypes.c_int.from_address(base + offsets["warning"] + 8 * w + 4).value
                        for w in range(len(data.warning))]
-    read["energy"] = base + offsets["energy"]
     expected = {n: int(getattr(data, n)) for n in ("ne", "nf", "nl", "nefc")}
     expected["time"] = float(data.time)
     for n in ("qpos", "qvel", "efc_id", "efc_force"):
         expected[n] = address(getattr(data, n)) if getattr(data, n).size else read[n]
     expected["warning"] = data.warning.number.tolist()
-    expected["energy"] = address(data.energy)
     if data.nefc == 0 or read != expected:
         raise LayoutError(f"the mjData layout does not check out: read {read}, expected {expected}")
     return offsets

@@ -45,6 +45,7 @@ EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_g
 # the order against _stepper.c's)
 SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
            "friction_work", "clutch_damper_work")
+_NO_REACTIONS = (0.0, 0.0, 0.0, 0.0)  # a compliant clutch's sample, until its deferred forces (as _stepper.c)
 # MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
 DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
             "clutch_overlap2", "clutch_spring")
@@ -108,15 +109,19 @@ class Recorder:
         ``torque`` [N m]: the drive's torque over the last step; ``motor_work``,
         ``friction_work``, ``damper_work`` (the compliant clutches' dampers) [J]:
         cumulative; ``reactions``: the clutch controller's (rear held, front
-        held, rear reaction [N], front reaction [N]); ``excursion`` [m]: its
-        backward excursion so far.
+        held, rear reaction [N], front reaction [N]; a compliant clutch's are
+        read from its forces at the sample's own state, a step later, so they
+        are stored as none here); ``excursion`` [m]: its backward excursion so
+        far.
         """
         d, i = self.data, self.count
         self.t[i] = d.time
         self.qpos[i] = d.qpos
         self.qvel[i] = d.qvel
-        row = equality_row(self.model, d, self.loop_id) if self.loop_id else 0
+        row = equality_row(self.model, d, self.loop_id)
         fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
+        if self.clutch is not None:
+            reactions = _NO_REACTIONS
         self.scalars[i] = (torque, fx, fy, *reactions, motor_work, friction_work, damper_work)
         self.excursion[i] = excursion
         self.count += 1

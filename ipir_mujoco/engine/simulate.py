@@ -49,7 +49,7 @@ from ipir_mujoco.analytic.results import RunResult
 
 from .clutches import clutch_controller
 from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_run_options,
-                     climb_energy, monotone, rest_since, stall_reason, steps_per_output)
+                     climb_energy, monotone, mujoco_failure, rest_since, stall_reason, steps_per_output)
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
@@ -157,8 +157,7 @@ class _Run:
             except mujoco.FatalError as exc:  # MuJoCo's error inside mj_step or mj_forward: one line, no traceback
                 rec = self.recorder  # None or empty if MuJoCo failed before the first sample
                 t = float(rec.t[rec.count - 1]) if rec is not None and rec.count else 0.0
-                reason = " ".join(str(exc).split())
-                raise SimulationError(f"MuJoCo failed after t={t:.6g} s: {reason}") from None
+                raise SimulationError(mujoco_failure(t, str(exc))) from None
         rec = self.recorder
         series = rec.series(last)
         wm, wf = series["motor_work"][-1], series["friction_work"][-1]
@@ -212,8 +211,7 @@ class _Run:
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
         row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion)
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
-        kinetic, potential, spring = (rec.deferred[row, DEFERRED.index(n)] for n in
-                                      ("kinetic", "potential", "clutch_spring"))
+        kinetic, potential, spring = (rec.deferred.item(row, c) for c in (_KINETIC, _POTENTIAL, _SPRING))
         self.energy0 = (kinetic, potential + spring)  # kinetic; potential with the clutch springs
         self.energy_floor = max(self.energy0[0], 2 * math.pi * abs(torque), climb_energy(m, self.params))
         self._replay((0, 1), (0, 1))

@@ -49,7 +49,6 @@ ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant")
 FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
 DONE, WARNED = 0, 3  # what record() returns: all intervals taken, or MuJoCo warned in the last one (_stepper.c's)
-NO_REACTIONS = (False, False, 0.0, 0.0)
 
 
 def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
@@ -138,7 +137,6 @@ class PythonSteps:
         Stops, without recording it, after an interval in which MuJoCo warned (``messages`` grew). Returns
         (DONE or WARNED, steps taken)."""
         ctl, warned, taken = self.controller, len(messages), 0
-        compliant = isinstance(ctl, CompliantClutches)
         for _ in range(nsamples):
             if remaining <= 0:
                 break
@@ -154,12 +152,8 @@ class PythonSteps:
             taken += k
             if len(messages) != warned:  # the state may be MuJoCo's reset: nothing to record
                 return WARNED, taken
-            if compliant:  # its samples take the clutch forces from the deferred values
-                pending = rec.sample(self.torque, self.motor_work, self.friction_work, NO_REACTIONS,
-                                     ctl.damper_work, ctl.excursion)
-            else:
-                pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(),
-                                     0.0, ctl.excursion)
+            pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(), ctl.damper_work,
+                                 ctl.excursion)
         return DONE, taken
 
 
@@ -179,6 +173,7 @@ class CompiledSteps(PythonSteps):
             raise LayoutError("a crank servo is a Python function of time")
         super().__init__(model, data, controller, qvel_before, **options)
         stepper, library = compiled()
+        self._library = library
         offsets = check_layout(data)
         self._module = stepper
         self._cfg = np.zeros(len(stepper.CONFIG), dtype=np.int64)
@@ -226,10 +221,7 @@ class CompiledSteps(PythonSteps):
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
                messages: list[str]) -> tuple[int, int]:
         if rec is not self._rec:
-            try:
-                self._bind(rec)
-            except LayoutError:  # not arrays the C loop can write: the Python record around the C steps
-                return super().record(rec, nsamples, sps, remaining, pending, messages)
+            self._bind(rec)
         st, S = self._st, self.S
         st[S["count"]], st[S["steps_done"]] = rec.count, 0.0
         try:
@@ -246,19 +238,16 @@ class CompiledSteps(PythonSteps):
         return status, int(state[S["steps_done"]])
 
     def _bind(self, rec: Recorder) -> None:
-        """Where the C loop writes ``rec``'s samples and reads what they hold."""
-        arrays = (rec.t, rec.qpos, rec.qvel, rec.scalars, rec.deferred, rec.excursion)
-        if rec.qvel_before is not self.qvel_before or not all(
-                a.flags.c_contiguous and a.dtype == np.float64 for a in arrays):
-            raise LayoutError("the recorder's arrays are not the loop's C-contiguous float64 buffers")
+        """Where the C loop writes ``rec``'s samples (its arrays: C-contiguous float64, qvel_before the
+        loop's own) and reads what they hold."""
         ctl, offsets, address = self.controller, mjdata_offsets(), self.data._address
         friction = getattr(ctl, "friction", None)
         fric_off, resist = (friction.offsets, friction.resistance) if friction is not None else ([-1, -1], [0, 0])
         self._set_config(
             nq=self.model.nq, nl_field=address + offsets["nl"], time_field=address + offsets["time"],
             warning_field=address + offsets["warning"], n_warning=len(self.data.warning),
-            efc_id_field=address + offsets["efc_id"], subtree_vel=compiled()[1]["mj_subtreeVel"],
-            energy=address + offsets["energy"], rod_end=array_address(rec._rod_end),
+            efc_id_field=address + offsets["efc_id"], subtree_vel=self._library["mj_subtreeVel"],
+            energy=array_address(rec._energy), rod_end=array_address(rec._rod_end),
             front_pos=array_address(rec._front_pos), subtree_linvel=array_address(rec._subtree_linvel),
             loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
             rec_qpos=array_address(rec.qpos), rec_qvel=array_address(rec.qvel),

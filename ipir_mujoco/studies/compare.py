@@ -182,7 +182,8 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
     if a.series["t"][-1] != b.series["t"][-1]:
         # runs of different length (two runs to steady state stop at their own times): the figures that grow
         # with the run are compared at the shorter run's end, not each at its own
-        summary_a, summary_b = (dict(run.summary, **_figures_until(run, t_end)) for run in (a, b))
+        summary_a, summary_b = (dict(summary, **_figures_until(run, t_end))
+                                for run, summary in ((a, summary_a), (b, summary_b)))
     for key in SUMMARY_FIGURES + STEADY_FIGURES:
         va, vb = summary_a.get(key), summary_b.get(key)
         relative = None if va in (None, 0) or vb is None else (vb - va) / abs(va)
@@ -211,14 +212,14 @@ def _notes(label: str, run: RunResult) -> list[str]:
 
 
 def _figures_until(run: RunResult, t_end: float) -> dict:
-    """revolutions, travels [m] at ``t_end`` [s] and peak speeds [m/s] up to it (as RunResult.summary has them
-    at the run's end), from the series interpolated at ``t_end``."""
+    """The figures of :data:`AT_COMPARED_TIME` (revolutions, travels [m] at ``t_end`` [s] and peak speeds [m/s]
+    up to it, as RunResult.summary has them at the run's end), from the series interpolated at ``t_end``."""
     s = run.series
     at = {q: float(np.interp(t_end, *_unique_times(s["t"], s[q]))) for q in ("phi", "x1", "x2", "v1", "v2")}
     within = s["t"] <= t_end
-    return {"revolutions": (at["phi"] - s["phi"][0]) / (2 * np.pi), "x1_final": at["x1"] - s["x1"][0],
-            "x2_final": at["x2"] - s["x2"][0], "v1_max": max(float(np.max(s["v1"][within])), at["v1"]),
-            "v2_max": max(float(np.max(s["v2"][within])), at["v2"])}
+    figures = ((at["phi"] - s["phi"][0]) / (2 * np.pi), at["x1"] - s["x1"][0], at["x2"] - s["x2"][0],
+               max(float(np.max(s["v1"][within])), at["v1"]), max(float(np.max(s["v2"][within])), at["v2"]))
+    return dict(zip(AT_COMPARED_TIME, figures))
 
 
 def format_comparison(result: dict) -> str:

@@ -29,6 +29,7 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic.params import RobotParams
 
 from .compare import compare_runs
+from .validate import relative_change
 from ..engine import simulate_mujoco
 
 FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
@@ -56,8 +57,8 @@ def lr_study(params: RobotParams, ratios: Sequence[float] = RATIOS_FULL, t_end: 
                "exact": {k: exact.summary[k] for k in FIGURES},
                "exact_with_rod": {k: with_rod.summary[k] for k in FIGURES},
                "mujoco": {k: physics.summary[k] for k in FIGURES},
-               "divergence": {k: _relative(first.summary[k], exact.summary[k]) for k in FIGURES},
-               "mujoco_vs_exact": {k: _relative(physics.summary[k], with_rod.summary[k]) for k in FIGURES}}
+               "divergence": {k: relative_change(first.summary[k], exact.summary[k]) for k in FIGURES},
+               "mujoco_vs_exact": {k: relative_change(physics.summary[k], with_rod.summary[k]) for k in FIGURES}}
         row["divergence"]["S_at_angle"] = angle["S"]["max"] / (2 * params.r)
         row["divergence"]["S_dot_at_angle"] = angle["S_dot"]["max"] / angle["S_dot"]["scale"]
         rows.append(row)
@@ -65,12 +66,6 @@ def lr_study(params: RobotParams, ratios: Sequence[float] = RATIOS_FULL, t_end: 
                  f"{100 * row['divergence']['revolutions']:+.2f} % in revolutions "
                  f"({time.perf_counter() - started:.1f} s)")
     return {"ratios": list(ratios), "rows": rows, "thresholds": thresholds(rows)}
-
-
-def _relative(value, reference):
-    if value is None or reference in (None, 0):
-        return None
-    return (value - reference) / abs(reference)
 
 
 def thresholds(rows: list[dict]) -> dict:

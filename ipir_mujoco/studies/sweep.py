@@ -33,7 +33,8 @@ Where work runs:
 Work budget: ``timeout_per_design`` [s] of wall time per design, passed to the
 analytic engines as ``wall_budget_s`` and enforced in the pool's workers by an
 alarm over all of a design's engines, MuJoCo's serial runs included (a design
-past it is a recorded failure naming the budget); a worker that
+past it is a recorded failure naming the budget; a design a batch chunk runs
+serially is not timed); a worker that
 stays stuck past twice the budget is abandoned and killed at the end. Batched
 MuJoCo runs cost a fixed number of steps and are not timed. Pool workers die
 with the main process (Linux: PR_SET_PDEATHSIG; elsewhere a watcher thread).
