@@ -1,20 +1,23 @@
 """The analytic model of the two-module inchworm robot (numpy + scipy only).
 
-This package never imports MuJoCo or ``ipir_mujoco``: it is the independent
-half of the cross-check. It holds the shared parameter set
-(:class:`RobotParams`) and result container (:class:`RunResult`), the
+This package never imports MuJoCo or the MuJoCo engine: it is the independent
+half of the cross-check. Of the rest of ``ipir_mujoco`` it imports only the
+shared vocabulary, :mod:`ipir_mujoco.core` (the parameter set, the result
+container, the errors, the per-revolution figures), and re-exports its names
+(``from ipir_mujoco.analytic import RobotParams`` works). It holds the
 slider-crank kinematics, the paper's hybrid model, the one-way-clutch model
 (rigid, or compliant with a finite ``clutch_stiffness``), kinetostatics and
 inverse kinetostatics.
 """
 
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, require_params
+from ipir_mujoco.core.results import COLUMNS, MODE_NAMES, Mode, RunResult
+
 from .compliant_run import simulate_compliant
-from .errors import ParameterError, SimulationError
 from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
-from .params import PARAMETER_NAMES, RobotParams, load_params, require_params
 from .unilateral_clutch import simulate_unilateral
-from .results import COLUMNS, MODE_NAMES, Mode, RunResult
 
 CLUTCH_RULES = ("kinematic", "unilateral")
 

@@ -58,13 +58,14 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode
+
 from . import kernels
 from .dynamics import MassTerms, OneDofDynamics
-from .errors import SimulationError
 from .forces import drive_torque, gravity_along_pipe
 from .kinematics import Geometry, Transfer
-from .params import RobotParams
-from .results import Mode
 
 
 class Clutch(IntEnum):

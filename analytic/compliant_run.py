@@ -31,15 +31,16 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import RunResult
+
 from . import dop853, kernels
 from .accel import ACCELERATED
 from .compliant_clutch import Clutch, CompliantModel, Regime
-from .cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
-from .errors import ParameterError, SimulationError
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .params import RobotParams
-from .results import RunResult
 from .solver_support import check_finite, check_run_options, sample_times
 
 # DOP853 by measurement (paper's case, 1 s): 3-5x faster than Radau at k = 1e5..1e7 N/m, also with

@@ -38,10 +38,11 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode
+
 from .forces import drive_torque, gravity_along_pipe
 from .kinematics import Geometry, Linkage, Transfer
-from .params import RobotParams
-from .results import Mode
 
 
 class ModeState(NamedTuple):

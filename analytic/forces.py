@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from .params import RobotParams
+from ipir_mujoco.core.params import RobotParams
+
 
 
 def drive_torque(params: RobotParams, omega):

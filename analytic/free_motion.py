@@ -20,13 +20,14 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode, RunResult
+
 from .dynamics import OneDofDynamics
-from .errors import ParameterError, SimulationError
 from .solver_support import check_run_options
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .params import RobotParams
-from .results import Mode, RunResult
 
 
 def free_accelerations(dyn: OneDofDynamics, phi, omega):

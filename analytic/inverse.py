@@ -23,13 +23,14 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode, RunResult
+
 from .dynamics import OneDofDynamics
-from .errors import ParameterError, SimulationError
 from .solver_support import check_run_options, sample_times
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .params import RobotParams
-from .results import Mode, RunResult
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False), Mode.BOTH_MOVING: (False, False)}
 _TOL = 1e-7  # relative tolerance of the sign tests (see unilateral_clutch)

@@ -41,15 +41,16 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
+from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode, RunResult
+
 from . import dop853, kernels
-from .cycles import STEADY_CYCLES, STEADY_TOL
 from .dynamics import OneDofDynamics
-from .errors import SimulationError
 from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .params import RobotParams
-from .results import Mode, RunResult
 from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, raw_piece, restart_step,
                              stall_reason, truncate)
 

@@ -9,15 +9,16 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
-from .cycles import SteadyWatch
+from ipir_mujoco.core.cycles import SteadyWatch
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import check_real
+from ipir_mujoco.core.params import check_run_options as check_time_options
+
 from .dense import CLEAR, GRAZE_POINTS
-from .errors import ParameterError, SimulationError
-from .params import check_real
-from .params import check_run_options as check_time_options
 
 
 def check_run_options(t_end: float, dt_out: float, rtol: float = 1e-10, atol: float = 1e-12) -> tuple[float, float]:
-    """(t_end, dt_out) as floats after the shared run-option check (:func:`analytic.params.check_run_options`:
+    """(t_end, dt_out) as floats after the shared run-option check (:func:`ipir_mujoco.core.params.check_run_options`:
     ranges, the sample budget) and the solver tolerances' own (both > 0, rtol >= 1e-13, DOP853's floor)."""
     t_end, dt_out = check_time_options(t_end, dt_out)
     check_real("atol", atol)

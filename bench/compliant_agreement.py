@@ -39,7 +39,7 @@ import time
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.cycles import cycles, travel
+from ipir_mujoco.core.cycles import cycles, travel
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.model import SolverSettings
 from ipir_mujoco.engine.timestep import choose_settings, clutch_rate

@@ -3,9 +3,12 @@ in-pipe robot against MuJoCo physics.
 
 Layers, bottom up:
 
-- :mod:`ipir_mujoco.analytic`: the parameter set, the result container and the
-  analytic model (numpy and scipy only; it never imports MuJoCo);
-- :mod:`ipir_mujoco.engine`: the MuJoCo model of the real linkage and its runs;
+- :mod:`ipir_mujoco.core`: what both models share: the parameter set, the result
+  container, the errors and the per-revolution figures (numpy only);
+- :mod:`ipir_mujoco.analytic`: the analytic model (numpy and scipy; it never
+  imports MuJoCo);
+- :mod:`ipir_mujoco.engine`: the MuJoCo model of the real linkage and its runs
+  (it never imports the analytic model);
 - :mod:`ipir_mujoco.studies`: compare, validate, sweeps, convergence;
 - :mod:`ipir_mujoco.report`: figures and the validation report;
 - :mod:`ipir_mujoco.cli`: the ``ipir-mujoco`` command.

@@ -9,7 +9,7 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError
 
 
 def check_output_dir(out: str | Path, option: str = "--out") -> Path:

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import Mode, RunResult
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode, RunResult
 
 from .labels import fixed
 

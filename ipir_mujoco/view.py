@@ -26,8 +26,8 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
 
 from .cli.common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 from .engine.clutches import clutch_controller

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ipir_mujoco.analytic.results import COLUMNS, read_csv
+from ipir_mujoco.core.results import COLUMNS, read_csv
 from ipir_mujoco.cli import main
 
 from cli_run import exit_code, run_cli
@@ -119,7 +119,7 @@ def test_every_subcommand_has_help(capsys):
 
 
 def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
-    from ipir_mujoco.analytic.params import PARAMETER_NAMES
+    from ipir_mujoco.core.params import PARAMETER_NAMES
 
     code, out, err = run_cli(capsys, "params", "--json")
     rows = json.loads(out)
@@ -192,7 +192,7 @@ def test_the_text_summary_prints_no_negative_zero_and_no_round_off_terms():
     """A held module's round-off below zero printed 'peak speed -0.000 m/s'; MuJoCo's compliant clutch with
     no damping printed 'clutch dampers -5.99456e-16' in the energy balance."""
     from ipir_mujoco.analytic import RobotParams
-    from ipir_mujoco.analytic.results import COLUMNS, RunResult
+    from ipir_mujoco.core.results import COLUMNS, RunResult
     from ipir_mujoco.cli.simulate import format_summary
 
     t = np.linspace(0.0, 1.0, 11)

@@ -13,7 +13,7 @@ from scipy.optimize import minimize_scalar
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.cycles import travel
+from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult
+from ipir_mujoco.core.results import COLUMNS, Mode, RunResult
 from ipir_mujoco.cli import main
 from ipir_mujoco.studies.compare import compare_runs, load_run
 

@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
-from ipir_mujoco.analytic.cycles import cycles
+from ipir_mujoco.core.cycles import cycles
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 
 from cli_run import run_cli
 

@@ -14,7 +14,7 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, cycles
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
@@ -74,7 +74,7 @@ def test_mujoco_agrees_with_the_equations_of_its_mechanism_at_steady_state(runs,
 
 @pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
 def test_the_energy_audit_closes_over_the_steady_revolutions(runs, pair):
-    """Motor work = work against the resistances + kinetic energy gained, per revolution (analytic.cycles)."""
+    """Motor work = work against the resistances + kinetic energy gained, per revolution (core.cycles)."""
     for run in runs[pair]:
         found = cycles(run.series)
         window = found[-run.settings["steady_cycles"]:]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ipir_mujoco.analytic.cycles import SteadyWatch, cycle_boundaries, cycle_summary, cycles, steady_index
+from ipir_mujoco.core.cycles import SteadyWatch, cycle_boundaries, cycle_summary, cycles, steady_index
 
 
 def settling_run(t_end=6.0, n=60001, tau=0.5, omega_ss=20.0, per_rev=0.05):
@@ -110,7 +110,7 @@ def test_a_speed_that_keeps_drifting_is_never_steady():
 def test_a_run_ending_on_a_revolution_keeps_it_after_a_csv_round_trip(tmp_path):
     """12 significant digits move phi by a few 1e-12 revolutions: the last revolution must still count."""
     from ipir_mujoco.analytic import RobotParams, simulate
-    from ipir_mujoco.analytic.results import read_csv
+    from ipir_mujoco.core.results import read_csv
 
     run = simulate(RobotParams(drive="motor"), "exact", "unilateral", 10.0, dt_out=1e-3, until_steady=True)
     run.write_csv(tmp_path / "ts.csv")
@@ -153,7 +153,7 @@ def test_a_motor_driven_past_its_no_load_speed_absorbs_energy_it_does_not_put_in
     so the input is the kinetic energy released alone, and the figure stays at most 1 (it used to be None
     here, and resistance work / (negative motor work + kinetic energy released) would exceed 1)."""
     from ipir_mujoco.analytic import RobotParams, simulate
-    from ipir_mujoco.analytic.cycles import efficiency
+    from ipir_mujoco.core.cycles import efficiency
 
     assert efficiency(-1.0, 2.0, kinetic_j=-3.0) == pytest.approx(2.0 / 3.0)
     assert efficiency(-1.0, 0.0) is None  # nothing put in

@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from ipir_mujoco.analytic import RobotParams, simulate
-from ipir_mujoco.analytic.params import describe_parameters
+from ipir_mujoco.core.params import describe_parameters
 from ipir_mujoco.cli import COMMANDS, build_parser
 from ipir_mujoco.cli.params import format_table
 

@@ -20,8 +20,8 @@ import pytest
 import sympy as sp
 
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import Mode
 
 ph, w, al, v, a1, x1, c = sp.symbols("phi omega alpha v a1 x1 c", real=True)
 m1, m2, J_A, mr, Ir, r, L, F1, F2 = sp.symbols("m1 m2 J_A m_rod I_rod r L F1 F2", positive=True)

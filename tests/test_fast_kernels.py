@@ -23,7 +23,7 @@ from ipir_mujoco.analytic.accel import ACCELERATED
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.kinematic_clutch import mode_rhs
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
 
 RTOL, ATOL = 1e-10, 1e-12

@@ -10,10 +10,10 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams, SimulationError
-from ipir_mujoco.analytic.cycles import cycles
+from ipir_mujoco.core.cycles import cycles
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.kinematic_clutch import mode_rhs
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
 from ipir_mujoco.cli import main
 
@@ -79,7 +79,7 @@ def test_the_default_motor_reaches_steady_state_and_stops_there(steady_runs, clu
 
 @pytest.mark.parametrize("clutch", ["kinematic", "unilateral"])
 def test_each_revolution_closes_its_energy_audit(steady_runs, clutch):
-    """Motor work = friction work + kinetic energy gained, per revolution (analytic.cycles)."""
+    """Motor work = friction work + kinetic energy gained, per revolution (core.cycles)."""
     run = steady_runs[clutch]
     found = cycles(run.series)
     assert len(found) == run.summary["cycles"] >= 3

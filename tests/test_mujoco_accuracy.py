@@ -10,7 +10,7 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
-from ipir_mujoco.analytic.cycles import travel
+from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine import simulate as engine_simulate

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.batch import run_ratchet_batch
 from ipir_mujoco.engine.model import INTEGRATORS, SolverSettings

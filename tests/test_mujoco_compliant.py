@@ -12,7 +12,7 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams
-from ipir_mujoco.analytic.cycles import cycles, travel
+from ipir_mujoco.core.cycles import cycles, travel
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.batch import run_ratchet_batch
 from ipir_mujoco.engine.compliant import CompliantClutches
@@ -205,7 +205,7 @@ def test_energy_audit_closes_with_the_clutch_spring_and_damper():
     for column in ("friction_work", "clutch_damper_work"):
         assert np.all(np.diff(s[column]) >= -1e-12 * e["motor_work_j"]), column  # dissipation never shrinks
     assert_agree("damper work", an.energy["clutch_damper_j"], e["clutch_damper_j"], half.energy["clutch_damper_j"])
-    # the per-revolution audit of analytic.cycles sees the clutch energy too
+    # the per-revolution audit of core.cycles sees the clutch energy too
     assert mj.summary["cycle_energy_residual_j"] is not None
 
 

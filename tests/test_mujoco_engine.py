@@ -11,7 +11,7 @@ import pytest
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams, SimulationError
 from ipir_mujoco.analytic.free_motion import simulate_free
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.model import SolverSettings

@@ -17,8 +17,8 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, cycles
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.cycles import STEADY_CYCLES, cycles
+from ipir_mujoco.core.results import Mode
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.studies.compare import compare_runs, format_comparison, match_switches
 

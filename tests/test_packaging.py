@@ -10,6 +10,7 @@ import sys
 import zipfile
 from pathlib import Path
 
+import ipir_mujoco
 from ipir_mujoco import analytic
 from ipir_mujoco.resources import docs_dir, mjcf_dir, shipped
 
@@ -38,13 +39,34 @@ def test_mjcf_folder_is_reachable():
     assert Path(shipped("docs/model.md")) == docs_dir() / "model.md"
 
 
+PACKAGE = Path(ipir_mujoco.__file__).resolve().parent
+
+
+def _layer_imports(folder: Path, package: str) -> list[tuple[str, str]]:
+    """(file name, imported module) for every module the .py files of ``folder`` import."""
+    files = sorted(folder.glob("*.py"))
+    assert files, folder
+    return [(path.name, name) for path in files for name in _imports(path, package)]
+
+
 def test_analytic_never_imports_mujoco_or_the_physics_side():
-    """The cross-check is worthless if the analytic side borrows the physics side's code."""
-    for path in Path(analytic.__file__).parent.glob("*.py"):
-        for name in _imports(path, "ipir_mujoco.analytic"):
-            assert name.split(".")[0] != "mujoco", f"{path.name} imports {name}"
-            if name.startswith("ipir_mujoco."):
-                assert name.startswith("ipir_mujoco.analytic"), f"{path.name} imports {name}"
+    """The cross-check is worthless if the analytic side borrows the physics side's code: of ipir_mujoco it
+    imports only itself and the shared vocabulary (ipir_mujoco.core)."""
+    for file, name in _layer_imports(Path(analytic.__file__).parent, "ipir_mujoco.analytic"):
+        assert name.split(".")[0] != "mujoco", f"{file} imports {name}"
+        if name.startswith("ipir_mujoco."):
+            assert name.startswith(("ipir_mujoco.analytic", "ipir_mujoco.core")), f"{file} imports {name}"
+
+
+def test_the_shared_core_imports_neither_model():
+    """ipir_mujoco.core is what both models share: the parameter set, the result container, the errors and
+    the per-revolution figures. It imports no engine, no MuJoCo, no scipy: nothing that computes dynamics."""
+    import ipir_mujoco.core
+
+    for file, name in _layer_imports(Path(ipir_mujoco.core.__file__).parent, "ipir_mujoco.core"):
+        assert name.split(".")[0] not in ("mujoco", "scipy"), f"{file} imports {name}"
+        if name.startswith("ipir_mujoco."):
+            assert name.startswith("ipir_mujoco.core"), f"{file} imports {name}"
 
 
 def test_importing_the_analytic_package_does_not_load_mujoco():
@@ -53,22 +75,23 @@ def test_importing_the_analytic_package_does_not_load_mujoco():
 
 
 def test_the_mujoco_side_never_runs_the_analytic_equations():
-    """The MuJoCo engine may share the parameter set, the result container, the errors and the
-    per-revolution figures (cycles: it reads time series, e.g. the steady-state watch) with the
-    analytic package, nothing that computes dynamics."""
+    """The MuJoCo engine shares the parameter set, the result container, the errors and the per-revolution
+    figures (ipir_mujoco.core) with the analytic package, and imports nothing of the analytic package itself,
+    nor of the layers above it."""
     import ipir_mujoco.engine
 
-    allowed = ("ipir_mujoco.analytic.params", "ipir_mujoco.analytic.results", "ipir_mujoco.analytic.errors",
-               "ipir_mujoco.analytic.cycles")
-    folder = Path(ipir_mujoco.engine.__file__).parent
-    files = sorted(folder.glob("*.py"))
-    assert len(files) >= 4
-    for path in files:
-        for name in _imports(path, "ipir_mujoco.engine"):
-            if name == "ipir_mujoco.analytic" or name.startswith("ipir_mujoco.analytic."):
-                assert name.startswith(allowed), f"{path.name} imports {name}"
-            assert not name.startswith(("ipir_mujoco.studies", "ipir_mujoco.report", "ipir_mujoco.cli")), \
-                f"the engine layer {path.name} imports the layer above it: {name}"
+    for file, name in _layer_imports(Path(ipir_mujoco.engine.__file__).parent, "ipir_mujoco.engine"):
+        assert not (name == "ipir_mujoco.analytic" or name.startswith("ipir_mujoco.analytic.")), \
+            f"{file} imports {name}"
+        assert not name.startswith(("ipir_mujoco.studies", "ipir_mujoco.report", "ipir_mujoco.cli")), \
+            f"the engine layer {file} imports the layer above it: {name}"
+
+
+def test_studies_and_report_never_import_the_command_line():
+    """The command line sits on top: studies and the report are usable from Python without it."""
+    for layer in ("studies", "report"):
+        for file, name in _layer_imports(PACKAGE / layer, f"ipir_mujoco.{layer}"):
+            assert not name.startswith("ipir_mujoco.cli"), f"{layer}/{file} imports {name}"
 
 
 def test_a_local_analytic_module_does_not_shadow_the_package(tmp_path):

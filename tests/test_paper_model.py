@@ -12,7 +12,7 @@ from scipy.optimize import brentq
 from ipir_mujoco.analytic import RobotParams, simulate
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.kinematic_clutch import choose_initial_mode, choose_mode_at_rest_gap
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 from ipir_mujoco.studies.paper_reference import check_identities, check_paper_figures
 
 RTOL, ATOL = 1e-10, 1e-12

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.results import COLUMNS, Mode, RunResult, first_gap_minimum, min_locked_reaction, read_csv, write_json
+from ipir_mujoco.core.results import COLUMNS, Mode, RunResult, first_gap_minimum, min_locked_reaction, read_csv, write_json
 
 
 def synthetic_series(n=2001, t_end=2.0):
@@ -35,7 +35,7 @@ def test_the_first_gap_minimum_of_a_stall_is_where_the_robot_comes_to_rest():
     """A robot that stalls while contracting: S_dot falls to rest at t = 0.36 s and stays there, as an exact
     0 (the analytic engines) or as MuJoCo's creep of a held module (-1.4e-9 m/s, which never turns >= 0): both
     series give the same minimum, the first sample at rest (S_dot reaching 0 between the samples is past it)."""
-    from ipir_mujoco.analytic.results import REST_SPEED
+    from ipir_mujoco.core.results import REST_SPEED
 
     t = np.linspace(0.3, 0.4, 101)  # 1e-3 s apart
     falling = np.where(t < 0.36 - 1e-12, -0.05 * (0.36 - t), 0.0)

@@ -18,7 +18,7 @@ import pytest
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
-from ipir_mujoco.analytic.results import COLUMNS, RunResult
+from ipir_mujoco.core.results import COLUMNS, RunResult
 from ipir_mujoco.studies import sweep as sweep_module
 from ipir_mujoco.cli import main
 from ipir_mujoco.studies.sweep import run_sweep
@@ -308,7 +308,7 @@ def test_steady_state_metrics_come_from_the_run_summary():
 @pytest.mark.parametrize("batch_mujoco", [True, False])
 def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch, batch_mujoco):
     """The engines' until_steady keyword (and the analytic wall_budget_s) are passed; the batched
-    MuJoCo series is read through analytic.cycles; a stalled design is marked, not failed. The fakes
+    MuJoCo series is read through core.cycles; a stalled design is marked, not failed. The fakes
     raise unless they get the keywords: pool and batch processes fork with them in place."""
     import ipir_mujoco.analytic as analytic_package
     import ipir_mujoco.engine as engine_package

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.results import Mode, mode_changes
+from ipir_mujoco.core.results import Mode, mode_changes
 from ipir_mujoco.engine import simulate_mujoco
 
 RTOL, ATOL = 1e-10, 1e-12

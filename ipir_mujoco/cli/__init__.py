@@ -31,7 +31,7 @@ _loading_guard = (threading.current_thread() is threading.main_thread()
 if _loading_guard:
     signal.signal(signal.SIGINT, _interrupted_while_loading)
 try:
-    from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+    from ipir_mujoco.core.errors import ParameterError, SimulationError
 
     from .. import __version__
     from ..resources import shipped

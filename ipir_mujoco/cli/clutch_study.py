@@ -8,9 +8,9 @@ import math
 import sys
 from pathlib import Path
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import check_whole
-from ipir_mujoco.analytic.results import write_json
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import check_whole
+from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
 from ..output import check_output_dir, staged_output

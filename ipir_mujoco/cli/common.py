@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import DRIVES, RobotParams, load_params
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import DRIVES, RobotParams, load_params
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 

@@ -6,9 +6,9 @@ import argparse
 import math
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import check_real, check_run_options, read_text_file
-from ipir_mujoco.analytic.results import write_json
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import check_real, check_run_options, read_text_file
+from ipir_mujoco.core.results import write_json
 
 from ..labels import signed
 from ..output import check_output_dir, staged_output

@@ -6,7 +6,7 @@ import argparse
 import json
 import textwrap
 
-from ipir_mujoco.analytic.params import describe_parameters
+from ipir_mujoco.core.params import describe_parameters
 
 from .common import EXIT_OK
 

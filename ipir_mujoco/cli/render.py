@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError
 
 from .common import EXIT_OK, add_model_options, model_params
 

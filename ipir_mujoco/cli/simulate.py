@@ -6,9 +6,9 @@ import argparse
 import json
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import check_run_options, check_whole
-from ipir_mujoco.analytic.results import RunResult, write_json, write_mode_changes
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import check_run_options, check_whole
+from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
 from ..labels import fixed, significant
 from ..output import check_output_dir, staged_output

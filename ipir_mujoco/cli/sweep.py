@@ -6,8 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.results import write_json
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
 from ..studies.sweep_metrics import METRICS

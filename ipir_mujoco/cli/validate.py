@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ipir_mujoco.analytic.results import write_json
+from ipir_mujoco.core.results import write_json
 
 from ..output import check_output_dir, staged_output
 from .common import EXIT_OK, add_model_options, model_params

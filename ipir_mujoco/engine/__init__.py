@@ -1,7 +1,8 @@
 """The MuJoCo engine: the real linkage built from a parameter set, its clutches, serial and batched runs.
 
-Nothing here computes the analytic model's dynamics: it shares only the
-parameter set, the result container and the errors with
+Nothing here computes the analytic model's dynamics: of the rest of the package it
+imports only the shared vocabulary, :mod:`ipir_mujoco.core` (the parameter set, the
+result container, the errors, the per-revolution figures), never
 :mod:`ipir_mujoco.analytic`.
 """
 

@@ -38,9 +38,9 @@ import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
 
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
 
 from .model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
                     drive_torque_slope, pin_offset, qpos_address, set_closed_loop_state)

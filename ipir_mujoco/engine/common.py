@@ -16,10 +16,10 @@ from typing import Callable, Iterator
 import mujoco
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.params import check_run_options as shared_run_options
-from ipir_mujoco.analytic.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.params import check_run_options as shared_run_options
+from ipir_mujoco.core.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
 
 from .clutches import refuse_compliant
 from .model import check_params

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import mujoco
 
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 

@@ -22,8 +22,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
 
 from ..resources import mjcf_dir
 

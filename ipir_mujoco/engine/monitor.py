@@ -53,8 +53,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
 
 ACCURACY_MODES = ("stop", "warn")
 RESIDUAL_TOL = 1e-3  # of the energy put through the robot (see the module docstring)

@@ -28,8 +28,8 @@ import math
 import mujoco
 import numpy as np
 
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import COLUMNS, Mode
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import COLUMNS, Mode
 
 from .clutches import equality_row
 from .common import REST_SPEED

@@ -42,10 +42,10 @@ from typing import Callable
 import mujoco
 import numpy as np
 
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams, require_params
-from ipir_mujoco.analytic.results import RunResult
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams, require_params
+from ipir_mujoco.core.results import RunResult
 
 from .clutches import clutch_controller
 from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_run_options,

@@ -35,7 +35,7 @@ from operator import itemgetter
 import mujoco
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError
 
 from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
 from .compliant import CompliantClutches

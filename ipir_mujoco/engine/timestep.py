@@ -50,8 +50,8 @@ from __future__ import annotations
 
 import math
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
 
 from .model import SolverSettings
 from .monitor import RESIDUAL_TOL

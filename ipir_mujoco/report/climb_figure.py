@@ -22,7 +22,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 from ..studies.climbing import LABELS
 

@@ -20,8 +20,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
 
 from ..labels import signed_percent
 from .document import Heading, Image, Paragraph, Table, fmt

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 from ..labels import signed_percent, summary_label
 from .document import Heading, Image, Paragraph, Table, fmt, pct

@@ -16,7 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Arc, Circle, FancyArrowPatch, Rectangle
 
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 REAR, FRONT, CRANK, ROD = "0.25", "tab:red", "tab:orange", "tab:blue"
 

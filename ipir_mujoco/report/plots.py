@@ -18,7 +18,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ipir_mujoco.analytic.results import RunResult
+from ipir_mujoco.core.results import RunResult
 
 REAR, FRONT = "black", "tab:red"  # the paper's colours: module 1 black, module 2 red
 STYLES = ("-", "--", ":", "-.")

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 from ..labels import signed_percent
 from ..studies import climbing

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 from . import clutch_section, cruise_section, riser_section
 

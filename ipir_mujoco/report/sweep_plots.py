@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import parameter_units
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import parameter_units
 
 from ..studies.sweep_files import DIVERGENCE
 from ..studies.sweep_metrics import METRICS, UNITS

@@ -17,7 +17,7 @@ from typing import Sequence
 import matplotlib.ticker
 import numpy as np
 
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 
 from ..labels import summary_label
 from ..resources import shipped

@@ -22,7 +22,7 @@ Three limits, in s = sin(incline):
   crank turns forward), so steady climbing needs 2 pi M0 >= 2 r (F_r1 + F_r2 + m g s), m the robot's
   mass: s <= (pi M0 / r - F_r1 - F_r2) / (m g).
 
-Efficiency on a slope: the summary's ``efficiency`` (:func:`ipir_mujoco.analytic.cycles.efficiency`)
+Efficiency on a slope: the summary's ``efficiency`` (:func:`ipir_mujoco.core.cycles.efficiency`)
 counts the work against the resistances and into height as useful, over the energy put in by the
 motor and by gravity where it pulls the robot forward (downhill).
 """
@@ -36,13 +36,13 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles, travel
-from ipir_mujoco.analytic.cycles import steady_window as settled_cycles  # its own steady_window takes a run
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, cycles, travel
+from ipir_mujoco.core.cycles import steady_window as settled_cycles  # its own steady_window takes a run
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
+from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.forces import drive_torque
-from ipir_mujoco.analytic.params import RobotParams, check_real
-from ipir_mujoco.analytic.results import REST_SPEED, RunResult  # REST_SPEED: m/s, at rest below it
+from ipir_mujoco.core.params import RobotParams, check_real
+from ipir_mujoco.core.results import REST_SPEED, RunResult  # REST_SPEED: m/s, at rest below it
 
 from .sweep_metrics import mean_speed
 from .sweep_space import ENGINES as RUNNABLE

@@ -55,9 +55,9 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.cycles import STEADY_CYCLES, STEADY_TOL, cycles, steady_window
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams, check_whole
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, cycles, steady_window
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams, check_whole
 
 from ..engine import SolverSettings, simulate_mujoco
 from .pool import map_unordered

@@ -36,14 +36,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import RobotParams, read_text_file
-from ipir_mujoco.analytic.results import COLUMNS, RunResult, mode_changes
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams, read_text_file
+from ipir_mujoco.core.results import COLUMNS, RunResult, mode_changes
 
 QUANTITIES = ("phi", "omega", "x1", "x2", "v1", "v2", "S", "S_dot")
 SUMMARY_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 AT_COMPARED_TIME = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max")  # depend on how long a run is
-# the periodic steady state (analytic.cycles, through RunResult.summary): over the steady window when a
+# the periodic steady state (core.cycles, through RunResult.summary): over the steady window when a
 # run reached it, else (distance, efficiency, peak force) over the whole run, or null
 STEADY_FIGURES = ("t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m", "efficiency",
                   "peak_clutch_force_n")

@@ -24,9 +24,9 @@ import time
 from typing import Callable, Sequence
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.cycles import travel
-from ipir_mujoco.analytic.errors import SimulationError
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.cycles import travel
+from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.params import RobotParams
 
 from ..engine import simulate_mujoco
 from ..engine.model import SolverSettings

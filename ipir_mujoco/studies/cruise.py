@@ -3,7 +3,7 @@
 Each rung of the validation ladder (the paper's model; exact geometry; the rod's mass; MuJoCo with the
 paper's locks; the one-way-clutch equations; MuJoCo's ratchet) is driven by the same DC gearmotor,
 torque M_stall (1 - omega / omega_noload), from rest until its per-revolution mean speed settles
-(``until_steady``; :mod:`ipir_mujoco.analytic.cycles`), and its steady state is read from the run's
+(``until_steady``; :mod:`ipir_mujoco.core.cycles`), and its steady state is read from the run's
 summary: time to steady state, steady speed, distance per revolution, energy per metre (motor work at
 the crank per metre), efficiency (work against the resistances / motor work), peak clutch reaction;
 and from them the mean crank speed 2 pi v / d [rad/s] and the mean crank torque (motor work per
@@ -45,10 +45,10 @@ from typing import Callable
 import numpy as np
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.cycles import STEADY_TOL, cycles, travel
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import RunResult
+from ipir_mujoco.core.cycles import STEADY_TOL, cycles, travel
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import RunResult
 
 from ..engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
 from .compare import STEADY_FIGURES, compare_runs

@@ -26,7 +26,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.params import RobotParams
+from ipir_mujoco.core.params import RobotParams
 
 from .compare import compare_runs
 from .validate import relative_change

@@ -29,8 +29,8 @@ from typing import Callable
 
 import numpy as np
 
-from ipir_mujoco.analytic.params import RobotParams, describe_parameters, parameter_units
-from ipir_mujoco.analytic.results import RunResult, mode_changes
+from ipir_mujoco.core.params import RobotParams, describe_parameters, parameter_units
+from ipir_mujoco.core.results import RunResult, mode_changes
 
 # The paper's simulation case (its section on the Mathematica implementation),
 # SI units; phi0 = 0 is our reading of "phi(0) near zero", omega0 = 0 of "start-up".

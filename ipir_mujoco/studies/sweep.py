@@ -55,8 +55,8 @@ from pathlib import Path
 from typing import Callable
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.errors import ParameterError, SimulationError
-from ipir_mujoco.analytic.params import RobotParams, check_real, check_whole
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
 from ..output import check_output_dir
 from .sweep_files import Progress, ResultsFile, header_for, make_row

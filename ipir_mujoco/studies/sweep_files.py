@@ -21,7 +21,7 @@ import sys
 import time
 from pathlib import Path
 
-from ipir_mujoco.analytic.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError
 
 from .sweep_metrics import METRICS
 from .sweep_space import Study

@@ -1,6 +1,6 @@
 """Per-design figures of merit, from any engine's run, read the same way for every engine.
 
-The per-revolution figures and the steady state come from :mod:`ipir_mujoco.analytic.cycles`
+The per-revolution figures and the steady state come from :mod:`ipir_mujoco.core.cycles`
 (through ``RunResult.summary`` for a full run, or ``cycle_summary`` for the series a
 ``mujoco.batch`` run returns): nothing here re-derives them.
 
@@ -71,7 +71,7 @@ from typing import Any
 
 import numpy as np
 
-from ipir_mujoco.analytic.cycles import cycle_summary, travel
+from ipir_mujoco.core.cycles import cycle_summary, travel
 
 METRICS = ("revolutions", "mean_speed_mps", "steady", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m",
            "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2",
@@ -160,7 +160,7 @@ def design_metrics(series: dict[str, np.ndarray], summary: dict[str, Any], energ
 
 
 def run_metrics(run) -> dict[str, float]:
-    """Metrics of a :class:`~ipir_mujoco.analytic.results.RunResult`; the analytic engines' accuracy figures
+    """Metrics of a :class:`~ipir_mujoco.core.results.RunResult`; the analytic engines' accuracy figures
     (a solver residual, not a monitor) are left empty, and so are MuJoCo's peak forces where they would
     measure the step or the sampling rather than the robot, and its acceleration jump (module docstring)."""
     summary = dict(run.summary)

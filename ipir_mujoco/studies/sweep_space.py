@@ -41,8 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.analytic.errors import ParameterError
-from ipir_mujoco.analytic.params import (MAX_T_END, PARAMETER_NAMES, RobotParams, as_real, check_real,
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import (MAX_T_END, PARAMETER_NAMES, RobotParams, as_real, check_real,
                                          check_run_options, check_whole, read_toml_file, require_params)
 
 ENGINES = ("analytic-approx", "analytic-exact", "analytic-unilateral", "mujoco-lock", "mujoco-ratchet")

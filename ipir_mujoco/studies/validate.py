@@ -70,8 +70,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import analytic
-from ipir_mujoco.analytic.params import RobotParams
-from ipir_mujoco.analytic.results import MODE_NAMES, Mode, RunResult
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
 from .. import __version__
 from ..engine import simulate_mujoco
@@ -270,7 +270,7 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
 
 def parameter_table(params: RobotParams) -> list[dict]:
     """Each parameter with its value in words: 'rigid' / 'uniform' where the default rule applies."""
-    from ipir_mujoco.analytic.params import describe_parameters
+    from ipir_mujoco.core.params import describe_parameters
 
     rows = []
     values = params.as_dict()
