@@ -22,8 +22,8 @@ import math
 from contextlib import nullcontext
 
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _coefficients
 
+from . import dop853_tableau as _coefficients
 from .accel import ACCELERATED, jit
 from .dense import DenseSolution, dense_at as _dense
 from .kernels import guard, rhs

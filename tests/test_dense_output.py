@@ -16,10 +16,10 @@ import pytest
 
 from ipir_mujoco.analytic import RobotParams, dop853, kernels
 from ipir_mujoco.analytic.accel import ACCELERATED
-from ipir_mujoco.analytic.cycles import SteadyWatch
+from ipir_mujoco.core.cycles import SteadyWatch
 from ipir_mujoco.analytic.dense import DenseSolution, component_at, dense_table, graze_scan
 from ipir_mujoco.analytic.kinematics import Linkage
-from ipir_mujoco.analytic.results import Mode
+from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.solver_support import graze_signs
 from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
 
@@ -177,3 +177,17 @@ def test_the_fallback_dense_output_is_the_compiled_one(monkeypatch):
     monkeypatch.setattr(dense, "ACCELERATED", False)
     assert np.array_equal(seg.sol(times), compiled)
     assert [seg.sol.phi_at(float(t)) for t in times] == phis
+
+
+def test_the_packaged_dop853_tableau_is_scipys_bit_for_bit():
+    """The stepper's tableau (analytic/dop853_tableau.py) is scipy's DOP853, read from its public class: the
+    compiled method is solve_ivp's step for step only with the same floats (np.array_equal, not allclose)."""
+    from scipy.integrate import DOP853
+
+    from ipir_mujoco.analytic import dop853_tableau as tableau
+
+    n = tableau.N_STAGES
+    assert np.array_equal(tableau.A[:n, :n], DOP853.A) and np.array_equal(tableau.A[n + 1:], DOP853.A_EXTRA)
+    assert np.array_equal(tableau.C[:n], DOP853.C) and np.array_equal(tableau.C[n + 1:], DOP853.C_EXTRA)
+    for name in ("B", "E3", "E5", "D"):
+        assert np.array_equal(getattr(tableau, name), getattr(DOP853, name)), name
