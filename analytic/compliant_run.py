@@ -31,8 +31,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import RunResult
 
@@ -41,14 +42,16 @@ from .accel import ACCELERATED
 from .compliant_clutch import Clutch, CompliantModel, Regime
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .solver_support import check_finite, check_run_options, sample_times
+from .solver_support import RunMonitor, check_finite, check_tolerances, sample_times, truncate
 
 # DOP853 by measurement (paper's case, 1 s): 3-5x faster than Radau at k = 1e5..1e7 N/m, also with
 # near-critical damping; LSODA's event location let the stick/slip states chatter, so it is not offered
 METHODS = ("DOP853", "Radau")
 # more zero-length segments in a row than this is chatter, not motion
 _MAX_STALLED_SEGMENTS = 50
-_PROGRESS_EVERY = 0.1  # [s] of simulated time between progress calls
+# regime changes a run may make unless told otherwise: the clutches engage, clamp and release within every
+# stroke, and stick/slip states change at each, so ten times the rigid models' budget
+MAX_SWITCHES = 1_000_000
 _BUDGET_CHECK_EVERY = 2000  # right-hand-side calls between wall-clock checks
 
 
@@ -61,7 +64,7 @@ def simulate_compliant(
     rtol: float = 1e-10,
     atol: float = 1e-12,
     method: str = "DOP853",
-    max_switches: int = 1_000_000,
+    max_switches: int | None = None,
     wall_budget_s: float | None = None,
     until_steady: bool = False,
     steady_tol: float = STEADY_TOL,
@@ -74,32 +77,26 @@ def simulate_compliant(
     (phi [rad], omega [rad/s], x1 [m], v1 [m/s], three cumulative works [J]); ``method``: its
     integrator (DOP853 by default: the clutch springs' oscillations are undamped or lightly
     damped, so they must be resolved, which an explicit method does cheapest). ``max_switches``:
-    most regime changes allowed; ``wall_budget_s`` [s]: most wall-clock time allowed (None: no
-    limit); both raise SimulationError when exceeded. ``until_steady``: stop at the end of the
-    revolution where the per-revolution mean speed has settled (``steady_tol``, ``steady_cycles``;
-    ``t_end`` is the cap). ``progress(t)`` is called about every 0.1 s of simulated time.
-    Initial module velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in
-    the other engines.
+    most regime changes allowed (default :data:`MAX_SWITCHES`); ``wall_budget_s`` [s]: most
+    wall-clock time allowed (None: no limit), checked between segments and within long ones; both
+    raise SimulationError when exceeded. ``until_steady``: stop at the end of the revolution where the
+    per-revolution mean speed has settled (``steady_tol``, ``steady_cycles``; ``t_end`` is the cap).
+    ``progress(t)`` is called about every 0.1 s of simulated time. Budgets, progress and the steady
+    stop are the other analytic models' (:class:`.solver_support.RunMonitor`). Initial module
+    velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in the other engines.
     """
-    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
+    options = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s,
+                         max_switches)
+    rtol, atol = check_tolerances(rtol, atol)
+    t_end, dt_out = options.t_end, options.dt_out
     if params.clutch_stiffness is None:
         raise ParameterError("clutch_stiffness=rigid: the compliant clutch model needs a finite stiffness; "
                              "allowed: 0 < clutch_stiffness <= 1e12 N/m")
     if method not in METHODS:
         raise ParameterError(f"method={method!r} is unknown; allowed: {', '.join(METHODS)}")
-    if isinstance(max_switches, bool) or not isinstance(max_switches, int) or max_switches < 1:
-        raise ParameterError(f"max_switches={max_switches!r} is out of range; allowed: a whole number >= 1")
-    if wall_budget_s is not None and not (isinstance(wall_budget_s, (int, float)) and wall_budget_s > 0
-                                          and math.isfinite(wall_budget_s)):
-        raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number > 0 "
-                             "or None")
-    try:
-        watch = SteadyWatch(params.phi0, steady_tol, steady_cycles)
-    except ValueError as exc:
-        raise ParameterError(str(exc)) from None
-    started = time.perf_counter()
+    monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
     model = CompliantModel(params, geometry)
-    budget = _Budget(started, wall_budget_s)
+    budget = _Budget(monitor)
     grid = np.linspace(0.0, t_end, max(1, math.ceil(t_end / dt_out - 1e-9)) + 1)
 
     K0 = float(model.linkage.transfer(params.phi0).K)
@@ -108,8 +105,7 @@ def simulate_compliant(
     start = Regime(tuple(int(np.sign(v)) for v in (v1_0, v1_0 + K0 * params.omega0)),
                    (Clutch.TRACKING, Clutch.TRACKING), (0.0, 0.0))
     regime, y = model.decide(0.0, y, start, None)
-    t, pieces, switches, short_run, turns = 0.0, [], 0, 0, 0
-    next_report, reported, stall = _PROGRESS_EVERY, None, None
+    t, pieces, switches, short_run, turns, stall = 0.0, [], 0, 0, 0, None
     while True:
         if regime.static:  # both stuck, crank at rest, every load constant: at rest for good
             stall = (f"at rest for good from t={t:.6g} s: both modules held by friction and clutch springs, "
@@ -136,14 +132,12 @@ def simulate_compliant(
         times = sample_times(t, t_stop, grid)
         peaks = _force_peaks(model, regime, t, t_stop, sol)
         piece = _piece(model, regime, np.union1d(times, peaks) if peaks.size else times, sol.sol)
-        pieces.append(piece)
-        if watch.update(piece["t"], piece["phi"], 0.5 * (piece["x1"] + piece["x2"])) and until_steady:
-            _cut(pieces, watch.steady_at)
+        steady_at = monitor.observe(piece)
+        pieces.append(piece if steady_at is None else truncate(piece, steady_at))
+        if steady_at is not None:
             break
-        if progress is not None and t_stop >= next_report:
-            progress(t_stop)
-            reported, next_report = t_stop, (math.floor(t_stop / _PROGRESS_EVERY) + 1) * _PROGRESS_EVERY
-        budget.check(t_stop)
+        monitor.report(t_stop)
+        monitor.check_budget(t_stop)
         if missed is None and sol.status != 1:
             break
         if missed is None:
@@ -163,25 +157,21 @@ def simulate_compliant(
         else:
             regime, y = model.decide(t, y_event, regime, fired)
             switches += 1
-            if switches > max_switches:
-                raise SimulationError(f"more than max_switches={max_switches} clutch and friction switches by "
-                                      f"t={t:.6g} s")
+            monitor.after_switch(t, switches, float(y[0]))
         if t >= t_end:
             break
-    if progress is not None and reported != float(pieces[-1]["t"][-1]):
-        progress(float(pieces[-1]["t"][-1]))  # the end, unless just reported
 
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    monitor.report(float(series["t"][-1]), final=True)
     add_kinetostatics(series, model.dyn)
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
                      t_end=float(series["t"][-1]), series=series, energy=energy_audit(series),
-                     wall_time_s=time.perf_counter() - started, stall=stall,
+                     wall_time_s=time.perf_counter() - monitor.started, stall=stall,
                      settings={"method": method, "rtol": rtol, "atol": atol, "dt_out": dt_out,
                                "rod_modelled": model.dyn.include_rod, "clutch_model": "compliant",
-                               "steady_tol": steady_tol, "steady_cycles": steady_cycles,
-                               "switches": switches})
+                               **monitor.settings, "switches": switches})
 
 
 def energy_audit(series: dict[str, np.ndarray]) -> dict[str, float]:
@@ -197,19 +187,17 @@ def energy_audit(series: dict[str, np.ndarray]) -> dict[str, float]:
 
 
 class _Budget:
-    """The wall-clock budget, checked between segments and every few thousand right-hand-side calls."""
+    """The run's wall-time budget (:meth:`.solver_support.RunMonitor.check_budget`) inside a long segment too:
+    every few thousand right-hand-side calls (Radau), or a pause of the compiled stepper every
+    ``steps`` steps (None: no budget, no pauses)."""
 
-    def __init__(self, started: float, limit: float | None):
-        self.started, self.limit = started, limit
+    def __init__(self, monitor: RunMonitor):
+        self.check = monitor.check_budget
         # the compiled stepper pauses for a check after as many steps (15 right-hand sides each)
-        self.steps = None if limit is None else _BUDGET_CHECK_EVERY // 15
-
-    def check(self, t: float) -> None:
-        if self.limit is not None and time.perf_counter() - self.started > self.limit:
-            raise SimulationError(f"wall_budget_s={self.limit:g} s exceeded at t={t:.6g} s of simulated time")
+        self.steps = None if monitor.wall_budget_s is None else _BUDGET_CHECK_EVERY // 15
 
     def wrap(self, rhs):
-        if self.limit is None:
+        if self.steps is None:
             return rhs
         calls = [0]
 
@@ -293,18 +281,6 @@ def _force_peaks(model: CompliantModel, regime: Regime, t0: float, t1: float, so
                                    bounds=(low, high), method="bounded", options={"xatol": 1e-15})
             found.append(float(best.x))
     return np.array(found)
-
-
-def _cut(pieces: list, t_last: float) -> None:
-    """Drop the samples after the end of the steady revolution, ``t_last`` [s].
-
-    That end is a segment's last sample (a revolution event), which the steady test may place a
-    rounding error earlier (it interpolates where the crank angle reaches the whole turn, and the
-    event may land a hair past it): the first sample at or after t_last - 1e-9 s is the last kept.
-    """
-    last = pieces[-1]
-    keep = int(np.searchsorted(last["t"], t_last - 1e-9 * (1.0 + t_last), side="left")) + 1
-    pieces[-1] = {c: v[:keep] for c, v in last.items()}
 
 
 def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.ndarray]:

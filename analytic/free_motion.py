@@ -22,10 +22,11 @@ from scipy.integrate import solve_ivp
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.options import check_run_options
 from ipir_mujoco.core.results import Mode, RunResult
 
 from .dynamics import OneDofDynamics
-from .solver_support import check_run_options
+from .solver_support import check_tolerances
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 
@@ -46,7 +47,8 @@ def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT
         raise ParameterError(f"F_r1={params.F_r1}, F_r2={params.F_r2}: the free mechanism has no clutches, so "
                              "modules also move backward, where a forward-only resistance is undefined; "
                              "allowed: F_r1 = F_r2 = 0")
-    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
+    t_end, dt_out = check_run_options(t_end, dt_out)
+    rtol, atol = check_tolerances(rtol, atol)
     started = time.perf_counter()
     dyn = OneDofDynamics(params, geometry)
     link = dyn.linkage

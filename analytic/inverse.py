@@ -25,10 +25,11 @@ from scipy.interpolate import CubicSpline
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.options import check_run_options
 from ipir_mujoco.core.results import Mode, RunResult
 
 from .dynamics import OneDofDynamics
-from .solver_support import check_run_options, sample_times
+from .solver_support import check_tolerances, sample_times
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 
@@ -184,7 +185,8 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: kinematic, unilateral")
     t_end = motion.t_end
     dt_out = dt_out or t_end / 2000
-    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
+    t_end, dt_out = check_run_options(t_end, dt_out)
+    rtol, atol = check_tolerances(rtol, atol)
     started = time.perf_counter()
     model = _Prescribed(params, geometry, motion, clutch)
     grid = np.linspace(0.0, t_end, max(1, math.ceil(t_end / dt_out - 1e-9)) + 1)

@@ -43,6 +43,7 @@ from scipy.integrate import solve_ivp
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode, RunResult
 
@@ -51,8 +52,8 @@ from .dynamics import OneDofDynamics
 from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, raw_piece, restart_step,
-                             stall_reason, truncate)
+from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, raw_piece,
+                             restart_step, stall_reason, truncate)
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -104,7 +105,7 @@ def simulate_kinematic(
     dt_out: float = 1e-4,
     rtol: float = 1e-10,
     atol: float = 1e-12,
-    max_switches: int = 100_000,
+    max_switches: int | None = None,
     torque: Callable | None = None,
     until_steady: bool = False,
     steady_tol: float = STEADY_TOL,
@@ -127,10 +128,11 @@ def simulate_kinematic(
     :class:`.cycles.SteadyWatch`); ``t_end`` [s] is the cap. Work budget and
     progress: see :class:`.solver_support.RunMonitor`.
     """
-    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
-    monitor = RunMonitor(t_end, params.phi0, max_switches=max_switches, wall_budget_s=wall_budget_s,
-                         progress=progress, until_steady=until_steady, steady_tol=steady_tol,
-                         steady_cycles=steady_cycles)
+    options = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s,
+                         max_switches)
+    rtol, atol = check_tolerances(rtol, atol)
+    t_end, dt_out = options.t_end, options.dt_out
+    monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
     dyn = OneDofDynamics(params, geometry)
     constants = kernels.pack(dyn)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))

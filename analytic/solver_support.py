@@ -1,5 +1,6 @@
-"""Helpers shared by the analytic solvers: option checks, output sampling, finiteness, and the
-run monitor (work budget, progress, revolution ends, steady state)."""
+"""Helpers shared by the analytic solvers: the tolerance check, output sampling, finiteness, and the
+run monitor (work budgets, progress, revolution ends, steady stop and truncation), written once for every
+analytic driver (the paper's rule, the one-way clutches, the compliant clutches)."""
 
 from __future__ import annotations
 
@@ -11,20 +12,18 @@ from scipy.optimize import brentq
 
 from ipir_mujoco.core.cycles import SteadyWatch
 from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import check_real
-from ipir_mujoco.core.params import check_run_options as check_time_options
 
 from .dense import CLEAR, GRAZE_POINTS
 
 
-def check_run_options(t_end: float, dt_out: float, rtol: float = 1e-10, atol: float = 1e-12) -> tuple[float, float]:
-    """(t_end, dt_out) as floats after the shared run-option check (:func:`ipir_mujoco.core.params.check_run_options`:
-    ranges, the sample budget) and the solver tolerances' own (both > 0, rtol >= 1e-13, DOP853's floor)."""
-    t_end, dt_out = check_time_options(t_end, dt_out)
-    check_real("atol", atol)
+def check_tolerances(rtol: float, atol: float) -> tuple[float, float]:
+    """(rtol, atol) of the DOP853 solver as floats: both > 0, rtol >= 1e-13 (DOP853's floor)."""
+    atol = check_real("atol", atol)
     if check_real("rtol", rtol) < 1e-13:
         raise ParameterError(f"rtol={rtol} is out of range; allowed: rtol >= 1e-13 (DOP853's floor)")
-    return t_end, dt_out
+    return float(rtol), atol
 
 
 def sample_times(t0: float, t1: float, grid: np.ndarray) -> np.ndarray:
@@ -129,42 +128,37 @@ def graze_signs(sol, guards) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 PROGRESS_EVERY_S = 0.1  # simulated seconds between two progress calls, at least
+# mode switches a run of the rigid-clutch models may make unless told otherwise (a work budget for designs that
+# chatter; the compliant model, whose clutches engage and release within each stroke, sets its own)
+MAX_SWITCHES = 100_000
+# a run stopped at its steady state ends on the first sample at or after the steady revolution's end less this
+# (relative to 1 + t): the steady test interpolates that end between samples and may place it a rounding error
+# past the revolution event's own sample, which must then be the last one kept
+STEADY_SLACK = 1e-9
 
 
 class RunMonitor:
-    """What an event-driven solver's loop shares: the work budget, progress, revolutions, steady state.
+    """What every analytic solver's loop shares: the work budgets, progress, revolutions, the steady stop.
 
-    The solver calls :meth:`samples` for each segment's output times (the output
-    grid plus a sample exactly where each crank revolution ends), :meth:`observe`
-    with each finished piece (it returns the time to stop at once the periodic
-    steady state is reached, with ``until_steady``), and :meth:`after_switch` at
-    each mode switch (budget checks and progress).
+    The solver calls :meth:`samples` for each segment's output times (the output grid plus a sample exactly
+    where each crank revolution ends), :meth:`observe` with each finished piece (with ``until_steady`` it
+    returns the time of the last sample to keep once the periodic steady state is reached, and the piece is
+    then cut there with :func:`truncate`), :meth:`after_switch` at each mode switch (the switch budget, the
+    wall-time budget and progress), :meth:`check_budget` wherever else a long stretch without switches may
+    run (a stiff clutch's oscillations), and :meth:`report` at the end.
 
-    ``max_switches``: mode switches allowed; ``wall_budget_s``: wall-clock seconds
-    allowed (None: no limit), checked between segments; ``progress(t)``: called
-    with the simulated time [s] at most every :data:`PROGRESS_EVERY_S` of it.
+    ``options``: the run's :class:`~ipir_mujoco.core.options.RunOptions` (checked); ``phi0`` [rad]: the
+    crank angle at t = 0; ``max_switches``: the engine's switch budget where the options give none.
     """
 
-    def __init__(self, t_end: float, phi0: float, *, max_switches: int, wall_budget_s: float | None,
-                 progress, until_steady: bool, steady_tol: float, steady_cycles: int):
-        if isinstance(max_switches, bool) or not isinstance(max_switches, (int, np.integer)) or max_switches < 0:
-            raise ParameterError(f"max_switches={max_switches!r} is out of range; allowed: a whole number >= 0")
-        if wall_budget_s is not None and not (isinstance(wall_budget_s, (int, float)) and not isinstance(
-                wall_budget_s, bool) and math.isfinite(wall_budget_s) and wall_budget_s > 0):
-            raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number of "
-                                 "seconds > 0, or None (no limit)")
-        if progress is not None and not callable(progress):
-            raise ParameterError(f"progress={progress!r} is not callable; allowed: a function of the simulated "
-                                 "time [s], or None")
-        if not isinstance(until_steady, (bool, np.bool_)):
-            raise ParameterError(f"until_steady={until_steady!r} is not a bool; allowed: True or False")
-        try:
-            self.watch = SteadyWatch(phi0, steady_tol, steady_cycles)
-        except (TypeError, ValueError) as exc:
-            raise ParameterError(str(exc)) from None
-        self.t_end, self.phi0 = t_end, float(phi0)
-        self.max_switches, self.wall_budget_s, self.progress = int(max_switches), wall_budget_s, progress
-        self.until_steady = bool(until_steady)
+    def __init__(self, options: RunOptions, phi0: float, max_switches: int):
+        self.options = options
+        self.t_end, self.phi0 = options.t_end, float(phi0)
+        self.watch = SteadyWatch(phi0, options.steady_tol, options.steady_cycles)
+        self.max_switches = options.max_switches if options.max_switches is not None else int(max_switches)
+        self.wall_budget_s, self.progress, self.until_steady = (options.wall_budget_s, options.progress,
+                                                                options.until_steady)
+        self.switches = 0
         self.started = time.perf_counter()
         self.next_report = PROGRESS_EVERY_S
         self.next_end = float(phi0) + 2 * math.pi  # crank angle at which the current revolution ends
@@ -172,7 +166,7 @@ class RunMonitor:
     @property
     def settings(self) -> dict:
         """What a run records so that its summary applies the same steady-state test."""
-        return {"until_steady": self.until_steady, "steady_tol": self.watch.tol, "steady_cycles": self.watch.n}
+        return self.options.steady_settings
 
     def revolution_ends(self, t0: float, step_ends: np.ndarray, dense) -> list[float]:
         """Times in (t0, step_ends[-1]] where the running maximum of phi first reaches phi0 + 2 pi k.
@@ -210,29 +204,36 @@ class RunMonitor:
         return np.union1d(times, ends) if ends else times
 
     def observe(self, piece: dict[str, np.ndarray]) -> float | None:
-        """Feed a finished piece; with ``until_steady``, the time [s] to stop at once steady, else None."""
+        """Feed a finished piece; with ``until_steady``, the time [s] of its last sample to keep once steady
+        (cut the piece there with :func:`truncate`), else None."""
         position = 0.5 * (np.asarray(piece["x1"]) + np.asarray(piece["x2"]))
         if not (self.watch.update(piece["t"], piece["phi"], position) and self.until_steady):
             return None
-        # the watch interpolates the end of the revolution between samples; the sample there (the
-        # first at or after it: the exact revolution end, where phi >= its target) is the last kept
-        t = piece["t"]
-        return float(t[min(np.searchsorted(t, self.watch.steady_at), t.size - 1)])
+        # the watch interpolates the end of the revolution between samples; the sample there (the exact
+        # revolution end) is the last kept, also where the interpolation lands a rounding error past it
+        t, end = piece["t"], self.watch.steady_at
+        return float(t[min(np.searchsorted(t, end - STEADY_SLACK * (1.0 + end)), t.size - 1)])
 
     def after_switch(self, t: float, switches: int, phi: float) -> None:
         """Budget checks and progress at a mode switch at time t [s] (the ``switches``-th) at crank angle phi."""
+        self.switches = switches
         if switches > self.max_switches:
             raise SimulationError(
                 f"the work budget max_switches={self.max_switches} is spent at t={t:.6g} s of {self.t_end:g} s "
                 f"(crank at {(phi - self.phi0) / (2 * math.pi):.4g} revolutions): raise max_switches or shorten "
                 "t_end")
-        spent = time.perf_counter() - self.started
-        if self.wall_budget_s is not None and spent > self.wall_budget_s:
-            raise SimulationError(
-                f"the work budget wall_budget_s={self.wall_budget_s:g} s is spent at t={t:.6g} s of "
-                f"{self.t_end:g} s ({switches} mode switches, crank at "
-                f"{(phi - self.phi0) / (2 * math.pi):.4g} revolutions): raise wall_budget_s or shorten t_end")
+        self.check_budget(t, phi)
         self.report(t)
+
+    def check_budget(self, t: float, phi: float | None = None) -> None:
+        """Raise once the run has spent its wall-time budget (at simulated time t [s], crank angle phi [rad]
+        where known)."""
+        if self.wall_budget_s is None or time.perf_counter() - self.started <= self.wall_budget_s:
+            return
+        crank = "" if phi is None else f", crank at {(phi - self.phi0) / (2 * math.pi):.4g} revolutions"
+        raise SimulationError(
+            f"the work budget wall_budget_s={self.wall_budget_s:g} s is spent at t={t:.6g} s of "
+            f"{self.t_end:g} s ({self.switches} mode switches{crank}): raise wall_budget_s or shorten t_end")
 
     def report(self, t: float, final: bool = False) -> None:
         """Call ``progress(t)`` if PROGRESS_EVERY_S of simulated time has passed since the last call (or at the end)."""

@@ -51,6 +51,7 @@ from scipy.integrate import solve_ivp
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode, RunResult
 
@@ -60,8 +61,8 @@ from .dynamics import OneDofDynamics
 from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .solver_support import (RunMonitor, assemble, check_finite, check_run_options, missed_crossing, raw_piece,
-                             restart_step, spurious_start, stall_reason, steps_until, truncate)
+from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, missed_crossing,
+                             raw_piece, restart_step, spurious_start, stall_reason, steps_until, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -279,7 +280,7 @@ def simulate_unilateral(
     dt_out: float = 1e-4,
     rtol: float = 1e-10,
     atol: float = 1e-12,
-    max_switches: int = 100_000,
+    max_switches: int | None = None,
     torque=None,
     until_steady: bool = False,
     steady_tol: float = STEADY_TOL,
@@ -299,10 +300,11 @@ def simulate_unilateral(
     ``t_end`` [s] is the cap. Work budget and progress: see
     :class:`.solver_support.RunMonitor`. Each revolution's end is an exact sample.
     """
-    t_end, dt_out = check_run_options(t_end, dt_out, rtol, atol)
-    monitor = RunMonitor(t_end, params.phi0, max_switches=max_switches, wall_budget_s=wall_budget_s,
-                         progress=progress, until_steady=until_steady, steady_tol=steady_tol,
-                         steady_cycles=steady_cycles)
+    options = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s,
+                         max_switches)
+    rtol, atol = check_tolerances(rtol, atol)
+    t_end, dt_out = options.t_end, options.dt_out
+    monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
     model = UnilateralModel(params, geometry, torque)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)

@@ -7,10 +7,11 @@ Run on demand, from the repository root, before and after a change, and compare 
     python bench/fingerprint.py > after.txt && diff before.txt after.txt
 
 Each line is a case and the SHA-256 of what it produced: every series column's bytes (in name
-order), the energy audit, the summary and the accuracy record as canonical JSON (wall times
-and software versions left out). Studies (a small sweep, the cruise study, a climb study) are
-fingerprinted from their JSON or CSV output with the same exclusions. Numbers that depend on the
-machine's load (wall times) never enter a fingerprint; everything else does.
+order), the energy audit, the summary and the accuracy record as canonical JSON (wall times,
+software versions and the ladder rungs' wording, ``isolates``, left out). Studies (a small sweep, the
+cruise study, a climb study) are fingerprinted from their JSON or CSV output with the same
+exclusions. Numbers that depend on the machine's load (wall times) never enter a fingerprint;
+every other figure does.
 """
 
 from __future__ import annotations
@@ -65,7 +66,8 @@ def _clean(value):
     """JSON-ready ``value`` without wall times and versions (machine-dependent)."""
     if isinstance(value, dict):
         return {k: _clean(v) for k, v in sorted(value.items())
-                if not (k.startswith("wall") or k.endswith("_wall") or k in ("versions", "workers", "mujoco_version"))}
+                if not (k.startswith("wall") or k.endswith("_wall")
+                        or k in ("versions", "workers", "mujoco_version", "isolates"))}
     if isinstance(value, (list, tuple)):
         return [_clean(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):

@@ -28,7 +28,7 @@ from hypothesis import strategies as st
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams
-from ipir_mujoco.core.params import MAX_SAMPLES, check_run_options
+from ipir_mujoco.core.options import MAX_SAMPLES, check_run_options
 from ipir_mujoco.cli import main
 from ipir_mujoco.studies.sweep_space import MAX_DESIGNS, Study, parse_vary
 

@@ -252,11 +252,11 @@ def _hang_on_short_rods(engine, params, t_end, dt_out, options):
     return _real_run_engine(engine, params, t_end, dt_out, {})
 
 
-_real_run_engine = sweep_module._run_engine
+_real_run_engine = sweep_module.run_engine
 
 
 def test_a_design_past_its_time_budget_is_a_recorded_failure_not_a_hang(tmp_path, monkeypatch):
-    monkeypatch.setattr(sweep_module, "_run_engine", _hang_on_short_rods)  # pool workers fork with it
+    monkeypatch.setattr(sweep_module, "run_engine", _hang_on_short_rods)  # pool workers fork with it
     study = Study((parse_vary("L=0.1,0.2"),), engines=("analytic-approx",), t_end=0.2)
     rows = {int(r["design_id"]): r for r in rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=2,
                                                                 timeout_per_design=0.5))}

@@ -9,7 +9,9 @@ import sys
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import check_real, check_run_options
+from ipir_mujoco import registry
+from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.params import check_real
 from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
@@ -59,16 +61,16 @@ def parse_inclines(text: str) -> tuple[float, ...]:
 
 
 def parse_engines(text: str | None) -> tuple[str, ...]:
+    """The engines (variant names of :mod:`ipir_mujoco.registry`) of ``--engines``, or the study's default."""
     from ..studies.climbing import ENGINES
-    from ..studies.sweep_space import ENGINES as RUNNABLE
 
     if text is None:
         return ENGINES
     names = tuple(dict.fromkeys(e.strip() for e in text.split(",") if e.strip()))
-    unknown = [e for e in names if e not in RUNNABLE]
+    unknown = [e for e in names if e not in registry.VARIANTS and e not in registry.ALIASES]
     if not names or unknown:
         raise ParameterError(f"--engines {text!r}: " + (f"unknown {', '.join(unknown)}" if unknown else "no engine")
-                             + f"; allowed: a comma-separated list from: {', '.join(RUNNABLE)}")
+                             + f"; allowed: a comma-separated list from: {', '.join(registry.NAMES)}")
     return names
 
 

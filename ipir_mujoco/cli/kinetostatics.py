@@ -7,7 +7,8 @@ import math
 
 from ipir_mujoco import analytic
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import check_real, check_run_options, read_text_file
+from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.params import check_real, read_text_file
 from ipir_mujoco.core.results import write_json
 
 from ..labels import signed

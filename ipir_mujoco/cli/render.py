@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
 
 from .common import EXIT_OK, add_model_options, model_params
@@ -19,7 +19,7 @@ def add_parser(commands) -> None:
                                           "holds) and the time, playback speed and speeds as text.")
     ren.add_argument("--out", metavar="FILE", default="inchworm.gif",
                      help="video file, .gif (default inchworm.gif) or .mp4 (pip install 'ipir-mujoco[video]')")
-    ren.add_argument("--clutch", choices=analytic.CLUTCH_RULES, default="unilateral",
+    ren.add_argument("--clutch", choices=registry.RULES, default="unilateral",
                      help="unilateral: one-way clutches (default); kinematic: the paper's rule (locks)")
     ren.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
                      help="ratchet (default with unilateral) or lock (default with kinematic)")
@@ -45,12 +45,10 @@ def run(args: argparse.Namespace) -> int:
     if out.is_dir():
         raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
     params = model_params(args)
-    from ..engine import simulate_mujoco
-
-    implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
-    result = simulate_mujoco(params, args.clutch, implementation, args.t_end)
-    title = f"MuJoCo, {'one-way clutches' if args.clutch == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
-            f"({implementation})"
+    variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch)
+    result = registry.run(variant, params, args.t_end)
+    title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
+            f"({variant.clutch})"
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial{out.suffix}")
     try:

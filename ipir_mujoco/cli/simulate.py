@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 
-from ipir_mujoco import analytic
-from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import check_run_options, check_whole
+from ipir_mujoco import registry
+from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.params import check_whole
 from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
 from ..labels import fixed, significant
@@ -25,7 +25,7 @@ def add_parser(commands) -> None:
     sim.add_argument("--geometry", choices=("approx", "exact"), default=None,
                      help="first-order kinematics as in the paper (approx; analytic default) or the exact "
                           "slider-crank (exact; MuJoCo always models it)")
-    sim.add_argument("--clutch", choices=analytic.CLUTCH_RULES, default="kinematic",
+    sim.add_argument("--clutch", choices=registry.RULES, default="kinematic",
                      help="kinematic: the paper's rule, lock by the sign of S_dot (default); "
                           "unilateral: one-way clutches that can only push")
     sim.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
@@ -72,57 +72,36 @@ def output_interval(args: argparse.Namespace) -> float:
 T_END, T_END_STEADY = 1.0, 30.0  # s: the default run, and the default cap of a run to steady state
 
 
-def check_options(args: argparse.Namespace) -> None:
-    """Every option of ``simulate`` that the engines do not check themselves, before any work."""
+FLAGS = {"max_switches": "--max-switches", "mjcf": "--mjcf", "timestep": "--timestep", "accuracy": "--accuracy"}
+
+
+def check_options(args: argparse.Namespace) -> registry.Variant:
+    """Every option of ``simulate`` that the engines do not check themselves, before any work; the variant
+    the flags name (:func:`ipir_mujoco.registry.from_flags`)."""
     if args.t_end is None:
         args.t_end = T_END_STEADY if args.until_steady else T_END
     args.dt_out = output_interval(args)
     check_run_options(args.t_end, args.dt_out)
     if args.max_switches is not None:
         check_whole("--max-switches", args.max_switches, low=1)
-    if args.engine == "mujoco":
-        if args.geometry == "approx":
-            raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real "
-                                 "linkage; allowed: --geometry exact (or leave it out)")
-        if args.max_switches is not None:
-            raise ParameterError(f"--max-switches {args.max_switches} applies only to --engine analytic "
-                                 "(MuJoCo's cost is its step count, t_end / timestep)")
-        if args.mjcf is not None:
-            check_input_file("--mjcf", args.mjcf)
-        return
-    for option, value in (("--mjcf", args.mjcf), ("--timestep", args.timestep)):
-        if value is not None:
-            raise ParameterError(f"{option} {value} applies only to --engine mujoco")
-    if args.mujoco_clutch is not None:
-        raise ParameterError(f"--mujoco-clutch {args.mujoco_clutch} applies only to --engine mujoco")
-    if args.accuracy != "stop":
-        raise ParameterError(f"--accuracy {args.accuracy} applies only to --engine mujoco (the analytic "
-                             "engines hold their solver tolerance)")
+    variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch)
+    engine_options = {"max_switches": args.max_switches, "mjcf": args.mjcf, "timestep": args.timestep,
+                      "accuracy": None if args.accuracy == "stop" else args.accuracy}
+    registry.check_options(variant, engine_options, FLAGS.get)
+    if args.mjcf is not None:
+        check_input_file("--mjcf", args.mjcf)
+    return variant
 
 
 def run_simulation(args: argparse.Namespace) -> RunResult:
     """The run ``simulate`` asks for (raises ParameterError on bad input)."""
-    check_options(args)
+    variant = check_options(args)
     params = model_params(args)
-    extra = {"until_steady": True} if args.until_steady else {}
     progress = progress_printer(args.t_end) if not args.json else None
-    if progress is not None:
-        extra["progress"] = progress
-    if args.engine == "mujoco":
-        from ..engine import simulate_mujoco
-        from ..engine.model import SolverSettings
-
-        implementation = args.mujoco_clutch or ("lock" if args.clutch == "kinematic" else "ratchet")
-        if args.timestep is not None:  # otherwise the engine's own choice
-            extra["settings"] = SolverSettings(timestep=args.timestep)
-        if args.accuracy != "stop":
-            extra["accuracy"] = args.accuracy
-        return simulate_mujoco(params, args.clutch, implementation, args.t_end, dt_out=args.dt_out,
-                               mjcf=args.mjcf, **extra)
-    if args.max_switches is not None:
-        extra["max_switches"] = args.max_switches
-    return analytic.simulate(params, args.geometry or "approx", args.clutch, args.t_end, dt_out=args.dt_out,
-                             **extra)
+    accuracy = None if args.accuracy == "stop" else args.accuracy
+    return registry.run(variant, params, args.t_end, dt_out=args.dt_out, until_steady=args.until_steady or None,
+                        progress=progress, max_switches=args.max_switches, timestep=args.timestep, mjcf=args.mjcf,
+                        accuracy=accuracy)
 
 
 def format_summary(run: RunResult, until_steady: bool = False) -> str:

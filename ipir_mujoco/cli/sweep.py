@@ -11,7 +11,7 @@ from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
 from ..studies.sweep_metrics import METRICS
-from ..studies.sweep_space import DEFAULT_ENGINES, ENGINES
+from ..studies.sweep_space import DEFAULT_ENGINES, ENGINES, T_END_STEADY
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
 
@@ -54,7 +54,6 @@ def add_parser(commands) -> None:
     swp.set_defaults(handler=run)
 
 
-T_END_STEADY = 10.0  # s: the default cap of a run to steady state in a sweep
 
 
 def study_from_args(args: argparse.Namespace):

@@ -328,13 +328,7 @@ def load_params(
 
 
 # ----------------------------------------------------------------------------------------------------
-# Run options: the one check every engine and interface calls (simulate, sweep, study files, Python API)
-
-MAX_T_END = 3600.0  # s: an hour of simulated motion; a motor reaches its steady state in seconds, and a
-# MuJoCo run at its 1e-4 s step already takes 3.6e7 steps for an hour
-MAX_SAMPLES = 10_000_000  # samples kept per run: ~20 float64 columns -> 1.6 GB in memory, ~4 GB as CSV
-SAMPLE_BYTES = 20 * 8  # bytes per kept sample (about 20 float64 columns)
-
+# Value checks shared by the run options (:mod:`.options`), the study files and the Python API
 
 def check_real(name: str, value: Any, *, low: float = 0.0, high: float = math.inf, low_open: bool = True,
                unit: str = "") -> float:
@@ -369,25 +363,6 @@ def check_whole(name: str, value: Any, *, low: int = 0, high: int | None = None,
     if whole < low or (high is not None and whole > high):
         raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
     return whole
-
-
-def check_run_options(t_end: Any, dt_out: Any) -> tuple[float, float]:
-    """(t_end [s], dt_out [s]) as floats, checked once for every engine and interface.
-
-    t_end: 0 < t_end <= MAX_T_END; dt_out: 0 < dt_out <= t_end; and the run keeps at most
-    MAX_SAMPLES samples (t_end / dt_out + 1), with the size it would need named in the message.
-    """
-    t_end = check_real("t_end", t_end, high=MAX_T_END, unit="s")
-    dt_out = check_real("dt_out", dt_out, unit="s")
-    if dt_out > t_end:
-        raise ParameterError(f"dt_out={dt_out:g} s is out of range; allowed: dt_out <= t_end ({t_end:g} s)")
-    samples = t_end / dt_out + 1
-    if samples > MAX_SAMPLES:
-        raise ParameterError(
-            f"t_end={t_end:g} s with dt_out={dt_out:g} s would keep {samples:.3g} samples "
-            f"(~{samples * SAMPLE_BYTES / 1e9:.3g} GB); allowed: at most {MAX_SAMPLES:.0e} samples "
-            f"(dt_out >= {t_end / (MAX_SAMPLES - 1):.3g} s for this t_end)")
-    return t_end, dt_out
 
 
 def require_params(params: Any) -> RobotParams:

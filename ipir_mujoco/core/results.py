@@ -114,11 +114,17 @@ class RunResult:
             raise ValueError(f"time series columns {bad} do not have shape ({n},)")
 
     @property
+    def steady_test(self) -> tuple[float, int]:
+        """(tol, cycles) of the steady-state test the run applied (its settings), or the defaults
+        (:data:`.cycles.STEADY_TOL`, :data:`.cycles.STEADY_CYCLES`): what every figure read off its steady
+        window must apply too."""
+        return (self.settings.get("steady_tol", STEADY_TOL), self.settings.get("steady_cycles", STEADY_CYCLES))
+
+    @property
     def summary(self) -> dict[str, Any]:
         """The summary figures of the command-line contract (docs/cli.md)."""
         summary = summarize(self.series, self.energy)
-        summary.update(cycle_summary(self.series, self.settings.get("steady_tol", STEADY_TOL),
-                                     self.settings.get("steady_cycles", STEADY_CYCLES)))
+        summary.update(cycle_summary(self.series, *self.steady_test))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall
         accuracy = dict(self.accuracy or {})

@@ -40,12 +40,13 @@ from mujoco import batch as mjbatch
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
 from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 
 from .model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
                     drive_torque_slope, pin_offset, qpos_address, set_closed_loop_state)
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_run_options, climb_energy, mujoco_failure,
+from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_clutch_options, climb_energy, mujoco_failure,
                      rest_since, stall_reason, steps_per_output)
 from .timestep import DT_MIN, choose_settings
 
@@ -96,12 +97,12 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
     halvings are in the outcome's ``settings["refinements"]``.
     """
     check_accuracy_mode(accuracy)
-    SteadyWatch(0.0, steady_tol, steady_cycles)  # validates both
+    RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles)  # the one check of the run options
     results: list[dict | None] = [None] * len(designs)
     chosen: dict[int, SolverSettings] = {}
     for i, params in enumerate(designs):
         try:
-            check_run_options(params, t_end, dt_out)
+            check_clutch_options(params)
             if params.clutch_stiffness is not None:
                 raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m: batched runs have rigid "
                                      "ratchets only; allowed: clutch_stiffness=rigid (run compliant clutches "

@@ -1,4 +1,4 @@
-"""What serial and batched MuJoCo runs (and the viewer) share: option checks, warnings, the crank servo, stalls.
+"""What serial and batched MuJoCo runs (and the viewer) share: the clutch check, warnings, the crank servo, stalls.
 
 Stall: under a constant torque or the motor (loads that do not change with
 time), a robot whose crank pin and modules have all been slower than
@@ -18,7 +18,6 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.params import check_run_options as shared_run_options
 from ipir_mujoco.core.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
 
 from .clutches import refuse_compliant
@@ -82,14 +81,6 @@ def check_clutch_options(params: RobotParams, clutch: str = "unilateral", implem
                                      f"clutch has no spring for it to act with); allowed: {getattr(defaults, name)!r} "
                                      "with clutch_stiffness=rigid")
     check_params(params)
-
-
-def check_run_options(params: RobotParams, t_end: float, dt_out: float, clutch: str = "unilateral",
-                      implementation: str = "ratchet") -> tuple[float, float]:
-    """The checks every MuJoCo run shares (ParameterError, one line): :func:`check_clutch_options` and the
-    run options; returns (t_end, dt_out) [s] as floats."""
-    check_clutch_options(params, clutch, implementation)
-    return shared_run_options(t_end, dt_out)  # the one check of run options every engine and interface shares
 
 
 def steps_per_output(dt_out: float, timestep: float) -> int:

@@ -43,12 +43,13 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
-from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
 from .clutches import clutch_controller
-from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_run_options,
+from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_clutch_options,
                      climb_energy, monotone, mujoco_failure, rest_since, stall_reason, steps_per_output)
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
@@ -104,15 +105,14 @@ def simulate_mujoco(
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
     """
     params = require_params(params)
-    t_end, dt_out = check_run_options(params, t_end, dt_out, clutch, implementation)
+    check_clutch_options(params, clutch, implementation)
+    run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
-    SteadyWatch(0.0, steady_tol, steady_cycles)  # validates both
-    if wall_budget_s is not None and not (math.isfinite(wall_budget_s) and wall_budget_s > 0):
-        raise ParameterError(f"wall_budget_s={wall_budget_s!r} is out of range; allowed: a finite number > 0")
+    t_end, dt_out = run.t_end, run.dt_out
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
-                   progress=monotone(progress), servo=servo, accuracy=accuracy, until_steady=until_steady,
-                   steady_tol=steady_tol, steady_cycles=steady_cycles, wall_budget_s=wall_budget_s)
+                   progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
+                   steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()

@@ -24,7 +24,7 @@ from matplotlib.lines import Line2D
 
 from ipir_mujoco.core.params import RobotParams
 
-from ..studies.climbing import LABELS
+from .. import registry
 
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
 FIRST = {"ls": "-", "marker": ".", "lw": 1.6}  # the first engine: the reference the others are drawn over
@@ -48,7 +48,7 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
     limits: dict[float, list[str]] = {}
     for j, engine in enumerate(study["engines"]):
         colour, style = COLOURS[j % len(COLOURS)], FIRST if j == 0 else OTHER
-        label = LABELS.get(engine, engine)
+        label = registry.variant(engine).label
         stalled = np.array([("error" not in r["engines"][engine]) and bool(r["engines"][engine]["stalled"])
                             for r in rows])
         speed = _column(rows, engine, "steady_speed_m_s" if motor else "mean_speed_m_s")

@@ -144,8 +144,7 @@ GRID = {"stiffness": (1e4, 1e5, 1e6, 1e7), "backlash": (0.0, 1e-3)}  # the curve
 
 def compute(params: RobotParams, quick: bool, progress) -> dict:
     """The realistic clutches (and, unless ``quick``, a grid for the curves) at both operating points."""
-    from ipir_mujoco import analytic
-
+    from .. import registry
     from ..studies.clutch_study import run_study
 
     designs = [(p["clutch_stiffness"], p["clutch_backlash"]) for p in REALISTIC]
@@ -155,8 +154,8 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     study = run_study(base, designs=designs, progress=progress)
     # the ideal clutch's spikes: the paper's own model (first order, massless rod, ideal locks) at start-up
     try:
-        paper = analytic.simulate(base.replace(drive="torque", rod_mass=0.0, rod_inertia=0.0), "approx", "kinematic",
-                                  1.0, dt_out=1e-4)
+        paper = registry.run("analytic-approx", base.replace(drive="torque", rod_mass=0.0, rod_inertia=0.0), 1.0,
+                             dt_out=1e-4)
     except (ParameterError, SimulationError) as exc:  # a design the paper's model does not cover: said, not fatal
         ideal = {"error": " ".join(str(exc).split())}
     else:

@@ -20,6 +20,7 @@ from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.core.params import RobotParams
 
 from ..labels import signed_percent
+from .. import registry
 from ..studies import climbing
 from .climb_figure import write_climb_figure
 from .document import Heading, Image, Paragraph, Table, fmt
@@ -104,15 +105,15 @@ def render(metrics: dict, figures_dir: Path) -> list:
     rows = []
     for engine, m in default.items():
         if "error" in m:
-            rows.append([climbing.LABELS[engine], f"failed: {m['error']}", "", "", "", "", "", ""])
+            rows.append([registry.variant(engine).label, f"failed: {m['error']}", "", "", "", "", "", ""])
         elif m["stalled"]:
             statics = m.get("statics_n")
-            rows.append([climbing.LABELS[engine], "stalls", fmt(m['stall_t_s'], 4), _deg(m["stall_phi_rad"]),
+            rows.append([registry.variant(engine).label, "stalls", fmt(m['stall_t_s'], 4), _deg(m["stall_phi_rad"]),
                          fmt(m["lambda1_at_rest_n"], 5), fmt(m["lambda2_at_rest_n"], 5),
                          f"{statics[0]:.5g}, {statics[1]:.5g}",
                          ", ".join(f"{v:.4g}" for v in m["statics_resistance_n"])])
         else:
-            rows.append([climbing.LABELS[engine], f"climbs at {fmt(m['steady_speed_m_s'], 4)} m/s"
+            rows.append([registry.variant(engine).label, f"climbs at {fmt(m['steady_speed_m_s'], 4)} m/s"
                          if m["steady"] else "no steady state", "", "", "", "", "", ""])
     blocks.append(Table(header, rows))
     blocks.append(Paragraph(_stronger_text(metrics)))
@@ -122,9 +123,9 @@ def render(metrics: dict, figures_dir: Path) -> list:
     rows = []
     for engine, m in strong.items():
         if "error" in m or not m["steady"]:
-            rows.append([climbing.LABELS[engine], _state(m), "", "", "", "", ""])
+            rows.append([registry.variant(engine).label, _state(m), "", "", "", "", ""])
             continue
-        rows.append([climbing.LABELS[engine], fmt(m["steady_speed_m_s"], 5), _relative(reference, m["steady_speed_m_s"]),
+        rows.append([registry.variant(engine).label, fmt(m["steady_speed_m_s"], 5), _relative(reference, m["steady_speed_m_s"]),
                      fmt(m["peak_clutch_force_n"], 4), fmt(m["mean_clutch_force_n"], 4),
                      fmt(m["efficiency"], 6),
                      "" if m["pull_share"] is None else f"{100 * m['pull_share']:.1f}"])
@@ -148,7 +149,7 @@ def _stall_text(metrics: dict) -> str:
         f"and at {contraction['torque_n_m']:.4g} N m at {_deg(contraction['phi_rad'])} in contraction (module 1 "
         f"moving); the motor gives at most M_stall = {m_stall:g} N m. ")
     if stalls:
-        times = [f"{climbing.LABELS[e]} at t = {default[e]['stall_t_s']:.4g} s, crank at "
+        times = [f"{registry.variant(e).label} at t = {default[e]['stall_t_s']:.4g} s, crank at "
                  f"{_deg(default[e]['stall_phi_rad'])}" for e in EXACT]
         head += (f"Started from rest at phi0, the crank passes {_deg(metrics['first_short_phi_rad'])}, where the "
                  "torque at rest first falls short, on its kinetic energy and stops for good where that is spent: "
@@ -211,7 +212,7 @@ def _caption(metrics: dict) -> str:
 
 def _limits_text(study: dict) -> str:
     restart, bound = study["restart"], study["energy_bound"]
-    limits = [f"{climbing.LABELS[e]} {lim['bracket'][0]:.1f}-{lim['bracket'][1]:.1f} deg"
+    limits = [f"{registry.variant(e).label} {lim['bracket'][0]:.1f}-{lim['bracket'][1]:.1f} deg"
               for e, lim in study["steady_climb"].items() if lim["incline_deg"] is not None]
     where = ("at no incline" if restart["incline_deg"] is None else f"up to {restart['incline_deg']:.1f} deg")
     return (f"Limits of the motor: it restarts from rest at every crank angle {where} "
@@ -234,7 +235,7 @@ def verdict(metrics: dict) -> dict:
     speeds = [m.get("steady_speed_m_s") for m in strong]
     answer = (("No, not" if stalls else "Yes,") + f" with the motor of M_stall {metrics['motor']['M_stall_n_m']:g} N m: "
               + ("both exact models stall in the first turn (" + "; ".join(
-                  f"{climbing.LABELS[e]} at {_deg(default[e]['stall_phi_rad'])}" for e in EXACT)
+                  f"{registry.variant(e).label} at {_deg(default[e]['stall_phi_rad'])}" for e in EXACT)
                  + f"), since lifting a module needs up to {need['torque_n_m']:.4g} N m at rest"
                  if stalls else "both exact models climb")
               + ((f"; the paper's model wrongly says it climbs, at {fmt(paper['steady_speed_m_s'], 3)} m/s")

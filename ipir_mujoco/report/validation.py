@@ -25,7 +25,7 @@ from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Paragraph, Table, fmt, pct, to_html, to_markdown
 from .plots import new_figure, write_paper_figures
 from ..studies.paper_reference import describe_differences
-from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, Rung
+from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, LadderRun
 
 
 # The report's animation: the start of the MuJoCo ratchet run (t_end [s] simulated), ten times slower than
@@ -35,7 +35,7 @@ ANIMATION_QUICK = {"t_end": 0.2, "width": 320, "height": 180, "fps": 10.0, "spee
 ANIMATION_RUNG = "MuJoCo ratchet"
 
 
-def figure_clutch_reactions(rung: Rung, path: Path) -> None:
+def figure_clutch_reactions(rung: LadderRun, path: Path) -> None:
     """Reaction of each locked clutch against crank angle, negative (pulling) intervals shaded."""
     s = rung.run.series
     fig, (ax,) = new_figure(1, height=3.4)
@@ -323,7 +323,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     return blocks
 
 
-def write_animation(rung: Rung, path: Path, quick: bool) -> tuple[str | None, dict]:
+def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | None, dict]:
     """The report's animation of ``rung``'s run; (None, settings) if written, else (why not, settings)."""
     from ..video import RenderUnavailable, VideoSettings, write_video
 
@@ -336,7 +336,7 @@ def write_animation(rung: Rung, path: Path, quick: bool) -> tuple[str | None, di
     return None, settings
 
 
-def write_report(folder: Path, metrics: dict, rungs: list[Rung], sections: Sequence = ()) -> None:
+def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: Sequence = ()) -> None:
     """Write figures/, report.md and index.html into ``folder`` (metrics.json is the caller's).
 
     ``sections`` (:class:`ipir_mujoco.report.sections.Section`) draw their parts

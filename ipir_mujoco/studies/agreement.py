@@ -41,7 +41,7 @@ import time
 
 import numpy as np
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
 
 TIGHT, LOOSE = 1e-3, 1e-2  # relative: the 0.1 % the convergence evidence promises; a clear disagreement
@@ -74,17 +74,11 @@ def run_pair(params: RobotParams, t_end: float, budget_s: float | None = None) -
 
     status 'ok' with (revolutions, travel [m]), or 'refused' / 'failed' with the engine's one-line reason.
     """
-    from ipir_mujoco.engine import simulate_mujoco
-
     row: dict = {"params": params}
-    runs = (("analytic", lambda: analytic.simulate(params, "exact", "unilateral", t_end, dt_out=1e-3,
-                                                   wall_budget_s=budget_s)),
-            ("mujoco", lambda: simulate_mujoco(params, "unilateral", "ratchet", t_end, dt_out=1e-3,
-                                               wall_budget_s=budget_s)))
-    for name, call in runs:
+    for name, variant in (("analytic", "analytic-unilateral"), ("mujoco", "mujoco-ratchet")):
         started = time.perf_counter()
         try:
-            run = call()
+            run = registry.run(variant, params, t_end, dt_out=1e-3, wall_budget_s=budget_s)
         except ParameterError as exc:
             row[name] = ("refused", str(exc))
         except SimulationError as exc:

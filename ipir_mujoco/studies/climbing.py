@@ -36,7 +36,8 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, cycles, travel
+from ipir_mujoco import registry
+from ipir_mujoco.core.cycles import cycles, travel
 from ipir_mujoco.core.cycles import steady_window as settled_cycles  # its own steady_window takes a run
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.core.errors import ParameterError, SimulationError
@@ -45,16 +46,13 @@ from ipir_mujoco.core.params import RobotParams, check_real
 from ipir_mujoco.core.results import REST_SPEED, RunResult  # REST_SPEED: m/s, at rest below it
 
 from .sweep_metrics import mean_speed
-from .sweep_space import ENGINES as RUNNABLE
+from .sweep_space import DT_OUT as SWEEP_DT_OUT, T_END_STEADY
 
 ENGINES = ("analytic-unilateral", "mujoco-ratchet")  # the exact models with one-way clutches: the default pair
-LABELS = {"analytic-approx": "paper's model", "analytic-exact": "analytic, paper's rule",
-          "analytic-unilateral": "analytic one-way clutches", "mujoco-lock": "MuJoCo, paper's rule",
-          "mujoco-ratchet": "MuJoCo ratchet"}
 GRID = 3600  # crank angles per revolution scanned before refining the hardest one
-T_END = 10.0  # s: cap of a run to steady state (the sweep's)
+T_END = T_END_STEADY  # s: cap of a run to steady state
 T_END_TORQUE = 1.0  # s: length of a constant-torque run (the paper's); it accelerates, so a longer one costs more
-DT_OUT = 1e-3  # s: output interval of the study's runs (the sweep's)
+DT_OUT = SWEEP_DT_OUT  # s: output interval of the study's runs
 TOLERANCE_DEG = 0.1  # width of the bracket the bisection stops at [deg]
 Progress = Callable[[str], None]
 
@@ -153,25 +151,17 @@ def default_t_end(params: RobotParams) -> float:
 
 def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = DT_OUT,
                every_step: bool = False) -> RunResult:
-    """One run of ``engine`` (a sweep engine name): to the steady state under the motor (``t_end`` [s] the
-    cap), else for ``t_end``. ``every_step``: MuJoCo sampled at each of its steps (the timestep it chooses
-    for ``dt_out``), so that a mean over a window is its impulse: a sample holds its step's force, and
-    read every 1 ms a rigid clutch's one-step engagement peaks alias it (the paper's rule's locks at the
-    default motor's cruise: 0.765 N against 0.998 N at every step and the equations' 1.000 N)."""
-    from .sweep import _run_engine  # the sweep's mapping of engine names to runs: one place for it
-
-    if every_step and engine.startswith("mujoco"):
-        from ..engine.timestep import choose_settings
-
-        clutch = "lock" if engine == "mujoco-lock" else "ratchet"
-        dt_out = choose_settings(params, t_end, dt_out, clutch=clutch)[0].timestep
-    return _run_engine(engine, params, t_end, dt_out, {"until_steady": params.drive == "motor"})
+    """One run of ``engine`` (a variant name of :mod:`ipir_mujoco.registry`): to the steady state under the
+    motor (``t_end`` [s] the cap), else for ``t_end``. ``every_step``: MuJoCo sampled at each of its steps
+    (the timestep it chooses for ``dt_out``), so that a mean over a window is its impulse: a sample holds its
+    step's force, and read every 1 ms a rigid clutch's one-step engagement peaks alias it."""
+    return registry.run(engine, params, t_end, dt_out=dt_out, until_steady=params.drive == "motor",
+                        every_step=every_step and registry.variant(engine).is_mujoco)
 
 
 def steady_window(run: RunResult) -> tuple[float, float, bool]:
     """(t0, t1) [s] of the steady window (the revolutions the steady test used), else the whole run; steady?"""
-    window = settled_cycles(cycles(run.series), run.settings.get("steady_tol", STEADY_TOL),
-                           run.settings.get("steady_cycles", STEADY_CYCLES))
+    window = settled_cycles(cycles(run.series), *run.steady_test)
     if window is None:
         return float(run.series["t"][0]), float(run.series["t"][-1]), False
     return window[0].t_start, window[-1].t_end, True
@@ -302,8 +292,7 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
     started = time.perf_counter()
     t_end = default_t_end(params) if t_end is None else t_end
     for engine in engines:
-        if engine not in RUNNABLE:
-            raise ParameterError(f"engine {engine!r} is unknown; allowed: {', '.join(RUNNABLE)}")
+        registry.variant(engine)  # an unknown name is refused before any run
     inclines = [check_real("incline", float(i), low=-90.0, high=90.0, low_open=False, unit="deg") for i in inclines]
     restart = restart_limit(params)
     paper = restart_limit(params.replace(rod_mass=0.0, rod_inertia=0.0), "approx")

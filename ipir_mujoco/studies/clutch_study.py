@@ -54,14 +54,13 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ipir_mujoco import analytic
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, cycles, steady_window
+from ipir_mujoco import registry
+from ipir_mujoco.core.cycles import cycles, steady_window
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams, check_whole
 
-from ..engine import SolverSettings, simulate_mujoco
+from ..engine.timestep import clutch_rate
 from .pool import map_unordered
-from ..engine.timestep import choose_settings, clutch_rate
 
 
 @dataclass(frozen=True)
@@ -81,6 +80,9 @@ POINTS = {
                               False),
 }
 ENGINES = ("analytic", "mujoco")
+# the variant each engine of the study runs (ipir_mujoco.registry): the exact one-way clutches, compliant where
+# the design has a finite clutch_stiffness
+VARIANTS = {"analytic": "analytic-unilateral", "mujoco": "mujoco-ratchet"}
 STIFFNESS = tuple(float(k) for k in np.geomspace(1e3, 1e7, 9))  # N/m: two per decade
 BACKLASH = (0.0, 5e-4, 1e-3, 2e-3)  # m
 STIFFNESS_QUICK, BACKLASH_QUICK = (1e4, 1e5, 1e6), (0.0, 1e-3)
@@ -170,10 +172,10 @@ def plan(base: RobotParams, designs: Sequence[tuple[float, float]], points: Sequ
     for key in points:
         point = points_table[key]
         rigid = design(base, point, None, 0.0)
-        rigid_steps[key] = {choose_settings(rigid, point.t_end, DT_OUT_MAX)[0].timestep}
+        rigid_steps[key] = {registry.timestep(VARIANTS["mujoco"], rigid, point.t_end, DT_OUT_MAX)}
         for k, b in designs:
             params = design(base, point, k, b)
-            h = choose_settings(params, point.t_end, DT_OUT_MAX)[0].timestep  # refuses an unresolvable k
+            h = registry.timestep(VARIANTS["mujoco"], params, point.t_end, DT_OUT_MAX)  # refuses an unresolvable k
             tasks += [Task(key, "analytic", k, b), Task(key, "mujoco", k, b, h)]
             rigid_steps[key].add(h)
         tasks.append(Task(key, "analytic", None, 0.0))
@@ -195,14 +197,13 @@ def run_task(base: RobotParams, point: OperatingPoint, task: Task) -> dict:
     try:
         if task.engine == "analytic":
             dt_out = analytic_dt_out(params)
-            run = analytic.simulate(params, "exact", "unilateral", point.t_end, dt_out=dt_out, **steady)
+            run = registry.run(VARIANTS["analytic"], params, point.t_end, dt_out=dt_out, **steady)
         else:
             dt_out = task.timestep  # sampled at every step: an impact peaks between coarser samples
             # compliant: the engine's own step rule (it halves the step if its accuracy monitor fails);
             # rigid: the step of the compliant runs it is compared with
-            settings = None if task.stiffness is not None else SolverSettings(timestep=task.timestep)
-            run = simulate_mujoco(params, "unilateral", "ratchet", point.t_end, dt_out=dt_out, settings=settings,
-                                  **steady)
+            step = None if task.stiffness is not None else task.timestep
+            run = registry.run(VARIANTS["mujoco"], params, point.t_end, dt_out=dt_out, timestep=step, **steady)
     except (ParameterError, SimulationError) as exc:
         return {"error": " ".join(str(exc).split())}
     metrics = run_metrics(run, point)
@@ -228,8 +229,7 @@ def run_metrics(run, point: OperatingPoint) -> dict:
     s, summary = run.series, run.summary
     found = cycles(s)
     if point.until_steady:
-        window = steady_window(found, run.settings.get("steady_tol", STEADY_TOL),
-                               run.settings.get("steady_cycles", STEADY_CYCLES))
+        window = steady_window(found, *run.steady_test)
         if window is None:
             why = run.stall or f"no periodic steady state by t_end = {point.t_end:g} s"
             return {"error": why}
@@ -339,7 +339,7 @@ def run_study(base: RobotParams, stiffness: Sequence[float] = STIFFNESS, backlas
     rigid = {}
     for key in points:
         point = points_table[key]
-        auto = choose_settings(design(base, point, None, 0.0), point.t_end, DT_OUT_MAX)[0].timestep
+        auto = registry.timestep(VARIANTS["mujoco"], design(base, point, None, 0.0), point.t_end, DT_OUT_MAX)
         by_step = {t.timestep: results[t] for t in tasks if t.point == key and t.engine == "mujoco"
                    and t.stiffness is None}
         rigid[key] = {"analytic": results[Task(key, "analytic", None, 0.0)], "mujoco": by_step[auto],

@@ -49,6 +49,13 @@ STEADY_FIGURES = ("t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energ
                   "peak_clutch_force_n")
 
 
+def relative_change(new: float | None, old: float | None) -> float | None:
+    """(new - old) / |old|, or None where either is missing or old is zero."""
+    if new is None or old is None or old == 0:
+        return None
+    return (new - old) / abs(old)
+
+
 def load_run(folder: str | Path) -> RunResult:
     """A run written by ``simulate --out`` (timeseries.csv and summary.json).
 

@@ -23,13 +23,11 @@ import sys
 import time
 from typing import Callable, Sequence
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams
 
-from ..engine import simulate_mujoco
-from ..engine.model import SolverSettings
 
 FIGURES = ("revolutions", "x1_final", "x2_final")
 TIMESTEPS = (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5)
@@ -38,7 +36,10 @@ CASES = {
     "short rod, L/r = 1.5": RobotParams(L=0.075),
     "light front, heavy resistance": RobotParams(m2=0.3, F_r1=3.0, F_r2=3.0),
 }
-CLUTCHES = (("lock", "kinematic"), ("ratchet", "unilateral"))
+CLUTCHES = (("lock", "kinematic"), ("ratchet", "unilateral"))  # MuJoCo's clutch and its rule
+# each MuJoCo clutch (ipir_mujoco.registry's variant) and the equations of the same mechanism: the exact geometry
+# with the rod, under the paper's rule for the locks and with one-way clutches for the ratchet
+PAIRS = {"lock": ("mujoco-lock", "analytic-exact"), "ratchet": ("mujoco-ratchet", "analytic-unilateral")}
 TOLERANCE = 1e-3  # the envelope's target: MuJoCo within 0.1 % of the analytic model in revolutions and travel
 
 
@@ -54,14 +55,13 @@ def timestep_study(cases: dict[str, RobotParams] = CASES, timesteps: Sequence[fl
     """
     rows = []
     for case, params in cases.items():
-        references = {rule: analytic.simulate(params, "exact", rule, t_end).summary for _, rule in CLUTCHES}
+        references = {c: registry.run(PAIRS[c][1], params, t_end).summary for c, _ in CLUTCHES}
         for implementation, rule in CLUTCHES:
-            reference = references[rule]
+            reference = references[implementation]
             for dt in timesteps:
                 progress(f"{case}, {implementation}, dt = {dt:g} s")
                 started = time.perf_counter()
-                run = simulate_mujoco(params, rule, implementation, t_end, dt_out=4e-4,
-                                      settings=SolverSettings(timestep=dt), accuracy="warn")
+                run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=4e-4, timestep=dt, accuracy="warn")
                 s = run.summary
                 row = {"case": case, "clutch": implementation, "rule": rule, "timestep": dt,
                        "wall_s": time.perf_counter() - started,
@@ -110,10 +110,10 @@ def envelope_study(quick: bool = False, progress: Callable[[str], None] = lambda
         for implementation, rule in clutches:
             progress(f"{label}, {implementation}")
             started = time.perf_counter()
-            reference = analytic.simulate(params, "exact", rule, t_end, dt_out=1e-3)
+            reference = registry.run(PAIRS[implementation][1], params, t_end, dt_out=1e-3)
             analytic_wall = time.perf_counter() - started
             try:
-                run = simulate_mujoco(params, rule, implementation, t_end, dt_out=1e-3)
+                run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=1e-3)
             except SimulationError as exc:  # default options: a run the monitor stops is a finding, not a crash
                 rows.append({"case": label, "clutch": implementation, "rule": rule, "t_end": t_end,
                              "stopped": str(exc), "analytic_wall_s": analytic_wall})
@@ -174,10 +174,8 @@ def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[s
     """MuJoCo's figures against its timestep, the equations' against their tolerance (paper's case)."""
     from .paper_reference import differences_from_paper
 
-    from ..engine.timestep import choose_settings
-
     # the step the engine chooses by itself for each clutch at this design (the ladder's 1 s runs), and half of it
-    auto = {implementation: choose_settings(params, 1.0, 1e-4, clutch=implementation)[0].timestep
+    auto = {implementation: registry.timestep(PAIRS[implementation][0], params, 1.0, 1e-4)
             for implementation, _ in CLUTCHES}
     timesteps = (1e-4, 5e-5, 2.5e-5) if quick else (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5)
     timesteps = tuple(sorted(set(timesteps) | {h / 2 for h in auto.values()}, reverse=True))
@@ -185,7 +183,7 @@ def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[s
     rows = timestep_study({label: params}, timesteps, progress=progress)
     equations = []
     for rtol in ((1e-10, 1e-12) if quick else (1e-6, 1e-8, 1e-10, 1e-12)):
-        run = analytic.simulate(params, "exact", "unilateral", 1.0, rtol=rtol, atol=rtol * 1e-2, dt_out=1e-3)
+        run = registry.run("analytic-unilateral", params, 1.0, rtol=rtol, atol=rtol * 1e-2, dt_out=1e-3)
         equations.append({"rtol": rtol, **{k: run.summary[k] for k in ("revolutions", "x1_final", "x2_final")},
                           "residual_fraction": run.summary["energy"]["residual_j"] / run.summary["energy"]["motor_work_j"]})
     def spread(items, key_filter):

@@ -39,21 +39,20 @@ import functools
 import math
 import os
 import time
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.cycles import STEADY_TOL, cycles, travel
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import RunResult
 
 from ..engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
-from .compare import STEADY_FIGURES, compare_runs
+from .compare import STEADY_FIGURES, compare_runs, relative_change
+from .ladder import CROSS_CHECKS, LADDER, Rung
 from .pool import map_unordered
-from .validate import relative_change
 
 T_CAP = 10.0  # s: cap of every run; the default motor settles in about 2 s
 DT_OUT = 1e-3  # s: the equations' output interval (each revolution's end is an exact sample whatever it is);
@@ -79,31 +78,7 @@ CROSS_CHECK_TOL = RESIDUAL_TOL + EXCURSION_PER_R / 2 + 2 * STEADY_TOL  # 1.3e-3
 Progress = Callable[[str], None]
 
 
-@dataclass(frozen=True)
-class CruiseRung:
-    """One rung of the ladder under the motor: which engine, geometry, clutch rule, and with or without rod."""
-
-    name: str
-    isolates: str  # the assumption it removes, against the rung before
-    engine: str  # 'analytic' | 'mujoco'
-    clutch: str  # the rule: 'kinematic' (paper's) | 'unilateral'
-    geometry: str = "exact"  # analytic only
-    implementation: str | None = None  # MuJoCo: 'lock' | 'ratchet'
-    massless_rod: bool = False
-
-
-RUNGS = (
-    CruiseRung("paper model", "nothing: first-order kinematics, massless rod, ideal locks", "analytic", "kinematic",
-               "approx", massless_rod=True),
-    CruiseRung("exact geometry", "L >> r: the exact slider-crank", "analytic", "kinematic", massless_rod=True),
-    CruiseRung("with rod mass", "the massless rod", "analytic", "kinematic"),
-    CruiseRung("MuJoCo, paper's rule", "the equations: MuJoCo physics, locks by the paper's rule", "mujoco",
-               "kinematic", implementation="lock"),
-    CruiseRung("one-way clutches", "ideal locks: clutches that can only push (equations)", "analytic", "unilateral"),
-    CruiseRung("MuJoCo ratchet", "the equations again: MuJoCo physics with one-way clutches (ratchet)", "mujoco",
-               "unilateral", implementation="ratchet"),
-)
-CROSS_CHECKS = (("MuJoCo, paper's rule", "with rod mass"), ("MuJoCo ratchet", "one-way clutches"))
+RUNGS = LADDER  # every rung of the model ladder, each run to its steady state
 
 
 def motor_params(params: RobotParams) -> RobotParams:
@@ -111,30 +86,22 @@ def motor_params(params: RobotParams) -> RobotParams:
     return params.replace(drive="motor")
 
 
-def run_rung(params: RobotParams, rung: CruiseRung, t_cap: float = T_CAP, dt_out: float = DT_OUT,
+def run_rung(params: RobotParams, rung: Rung, t_cap: float = T_CAP, dt_out: float = DT_OUT,
              settings=None) -> RunResult:
-    """One rung to its steady state (``t_cap`` [s] caps it); ``settings``: MuJoCo SolverSettings, else automatic.
+    """One rung to its steady state (``t_cap`` [s] caps it); ``settings``: MuJoCo's SolverSettings, else automatic.
 
     The equations are sampled every ``dt_out`` [s] (and at every mode switch, where their rigid clutches'
     reactions peak); MuJoCo at every step (the step it would choose for ``dt_out``, or ``settings``'):
     its rigid clutches engage through a soft constraint within a few steps, and sampled every ``dt_out``
-    the peak reaction lands on whichever step the sample hits (at the default motor's cruise the ratchet's
-    reads 11.84 N every 1 ms against 16.34 N at its 0.1 ms steps).
+    the peak reaction lands on whichever step the sample hits.
     """
-    p = params.replace(rod_mass=0.0, rod_inertia=0.0) if rung.massless_rod else params
-    if rung.engine == "analytic":
-        return analytic.simulate(p, rung.geometry, rung.clutch, t_cap, dt_out=dt_out, until_steady=True)
-    from ..engine import simulate_mujoco
-    from ..engine.timestep import choose_settings
-
-    if settings is None:
-        step = choose_settings(p, t_cap, dt_out, clutch=rung.implementation)[0].timestep  # what it would choose
-        return simulate_mujoco(p, rung.clutch, rung.implementation, t_cap, dt_out=step, until_steady=True)
-    return simulate_mujoco(p, rung.clutch, rung.implementation, t_cap, dt_out=settings.timestep, until_steady=True,
-                           settings=settings)
+    p = rung.params(params)
+    if not registry.variant(rung.variant).is_mujoco:
+        return registry.run(rung.variant, p, t_cap, dt_out=dt_out, until_steady=True)
+    return registry.run(rung.variant, p, t_cap, dt_out=dt_out, until_steady=True, settings=settings, every_step=True)
 
 
-def _task(params: RobotParams, rung: CruiseRung, t_cap: float, dt_out: float, halve: bool):
+def _task(params: RobotParams, rung: Rung, t_cap: float, dt_out: float, halve: bool):
     """A pool task: the rung's run (or its one-line failure), and with ``halve`` MuJoCo at half its step."""
     started = time.perf_counter()
     try:
@@ -142,13 +109,9 @@ def _task(params: RobotParams, rung: CruiseRung, t_cap: float, dt_out: float, ha
     except (ParameterError, SimulationError) as exc:
         return {"error": " ".join(str(exc).split())}, None, time.perf_counter() - started
     halved = None
-    if halve and rung.engine == "mujoco":
-        from ..engine.model import SolverSettings
-
-        s = run.settings
-        finer = SolverSettings(timestep=s["timestep"] / 2, integrator=s["integrator"], solimp=tuple(s["solimp"]))
+    if halve and registry.variant(rung.variant).is_mujoco:
         try:
-            halved = run_rung(params, rung, t_cap, dt_out, finer)
+            halved = run_rung(params, rung, t_cap, dt_out, registry.halved_settings(run))
         except (ParameterError, SimulationError) as exc:
             halved = {"error": " ".join(str(exc).split())}
     return run, halved, time.perf_counter() - started
@@ -158,7 +121,7 @@ def _run_all(params, t_cap, dt_out, halve, workers, progress) -> dict:
     """{rung name: (run or {"error"}, halved, wall [s])}: in a process pool of ``workers`` (1: here)."""
     done: dict = {}
 
-    def finished(rung: CruiseRung, outcome) -> None:
+    def finished(rung: Rung, outcome) -> None:
         done[rung.name] = outcome
         run = outcome[0]
         status = run["error"] if isinstance(run, dict) else (
@@ -167,7 +130,7 @@ def _run_all(params, t_cap, dt_out, halve, workers, progress) -> dict:
         progress(f"[{len(done)}/{len(RUNGS)}] {rung.name}: {status} ({outcome[2]:.2f} s)")
 
     # the MuJoCo rungs first: the longest tasks
-    order = sorted(RUNGS, key=lambda r: r.engine != "mujoco")
+    order = sorted(RUNGS, key=lambda r: not registry.variant(r.variant).is_mujoco)
     map_unordered(functools.partial(_rung_task, params, t_cap, dt_out, halve), order, workers, finished)
     return done
 
@@ -180,11 +143,11 @@ def _rounded(values, digits: int = 6) -> list[float]:
     return [float(f"{v:.{digits}g}") for v in np.asarray(values, dtype=float)]
 
 
-def rung_record(rung: CruiseRung, run: RunResult, wall_s: float) -> dict:
+def rung_record(rung: Rung, run: RunResult, wall_s: float) -> dict:
     """The steady-state figures and the time histories of one rung's run (see the module docstring)."""
     s = run.summary
-    record = {"name": rung.name, "isolates": rung.isolates, "engine": run.engine, "geometry": run.geometry,
-              "clutch": run.clutch, "mujoco_clutch": rung.implementation, "timestep": run.settings.get("timestep"),
+    record = {"name": rung.name, "isolates": rung.describe(run.params), "engine": run.engine,
+              "geometry": run.geometry, "clutch": run.clutch, "mujoco_clutch": registry.variant(rung.variant).clutch, "timestep": run.settings.get("timestep"),
               "wall_s": wall_s, "steady": s["steady"], "stalled": s["stalled"], "stall_reason": s["stall_reason"],
               "revolutions": s["revolutions"], **{k: s[k] for k in STEADY_FIGURES}}
     v, d, e = s["steady_speed_m_s"], s["distance_per_rev_m"], s["energy_per_metre_j_m"]
@@ -194,7 +157,7 @@ def rung_record(rung: CruiseRung, run: RunResult, wall_s: float) -> dict:
     series = run.series
     t = np.asarray(series["t"], dtype=float)
     found = cycles(series)
-    window = t >= (found[-run.settings["steady_cycles"]].t_start if steady else t[-1])
+    window = t >= (found[-run.steady_test[1]].t_start if steady else t[-1])
     omega = np.asarray(series["omega"])[window]
     record["crank_speed_range_rad_s"] = [float(omega.min()), float(omega.max())] if steady else None
     keep = np.concatenate([np.diff(t) > 0, [True]])  # of a duplicated switch instant, the later sample
@@ -234,7 +197,7 @@ def cruise_study(params: RobotParams, quick: bool = False, progress: Progress = 
     for rung in RUNGS:
         run, _, wall = outcomes[rung.name]
         if isinstance(run, dict):
-            rungs.append({"name": rung.name, "isolates": rung.isolates, **run})
+            rungs.append({"name": rung.name, "isolates": rung.describe(motor), **run})
             continue
         runs[rung.name] = run
         rungs.append(rung_record(rung, run, wall))

@@ -25,12 +25,10 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
 
-from .compare import compare_runs
-from .validate import relative_change
-from ..engine import simulate_mujoco
+from .compare import compare_runs, relative_change
 
 FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 ANGLE_FIGURES = ("S_at_angle", "S_dot_at_angle")
@@ -47,10 +45,10 @@ def lr_study(params: RobotParams, ratios: Sequence[float] = RATIOS_FULL, t_end: 
     for i, ratio in enumerate(ratios, start=1):
         started = time.perf_counter()
         L = ratio * params.r
-        first = analytic.simulate(massless.replace(L=L), "approx", "kinematic", t_end, dt_out=dt_out)
-        exact = analytic.simulate(massless.replace(L=L), "exact", "kinematic", t_end, dt_out=dt_out)
-        with_rod = analytic.simulate(params.replace(L=L), "exact", "kinematic", t_end, dt_out=dt_out)
-        physics = simulate_mujoco(params.replace(L=L), "kinematic", "lock", t_end, dt_out=dt_out)
+        first = registry.run("analytic-approx", massless.replace(L=L), t_end, dt_out=dt_out)
+        exact = registry.run("analytic-exact", massless.replace(L=L), t_end, dt_out=dt_out)
+        with_rod = registry.run("analytic-exact", params.replace(L=L), t_end, dt_out=dt_out)
+        physics = registry.run("mujoco-lock", params.replace(L=L), t_end, dt_out=dt_out)
         angle = compare_runs(exact, first)["angle_grid"]
         row = {"ratio": ratio, "L": L,
                "first_order": {k: first.summary[k] for k in FIGURES},

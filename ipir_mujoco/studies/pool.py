@@ -1,12 +1,56 @@
-"""Run a study's independent tasks on all cores: a process pool whose workers die with the caller."""
+"""Run a study's independent tasks on all cores: process pools whose workers die with the caller.
+
+:func:`worker_init` and :func:`kill_workers` are what every pool of the package shares (the sweep's two
+pools, :func:`map_unordered`'s); :func:`map_unordered` runs independent tasks and hands back each result as
+it finishes.
+"""
 
 from __future__ import annotations
 
 import concurrent.futures as futures
 import os
+import signal
+import sys
+import threading
+import time
 from typing import Callable, Iterable, TypeVar
 
 Item = TypeVar("Item")
+
+
+def worker_init(parent: int) -> None:
+    """A pool worker's start: Ctrl-C is the main process's business (``parent``: its pid); the worker dies
+    with it (Linux: PR_SET_PDEATHSIG; elsewhere a watcher thread that polls the parent every second)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            PR_SET_PDEATHSIG = 1
+            if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0:
+                if os.getppid() != parent:  # the parent died before the request took effect
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):
+            pass
+
+    def watch() -> None:  # elsewhere: notice the parent's death within a second
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="parent-watch").start()
+
+
+def kill_workers(pool: futures.ProcessPoolExecutor) -> None:
+    """End a process pool's workers at once (they ignore Ctrl-C and may be deep in a long task)."""
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if terminate is not None:
+        terminate()
+        return
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.kill()
 
 
 def map_unordered(task: Callable[[Item], object], items: Iterable[Item], workers: int,
@@ -16,16 +60,14 @@ def map_unordered(task: Callable[[Item], object], items: Iterable[Item], workers
     ``workers`` processes (1: one by one in this process, in the given order, which is also the order
     the pool starts them: put the longest first). ``task`` must be picklable (a module-level function or
     a functools.partial of one). Workers ignore Ctrl-C and die with this process (see
-    :func:`ipir_mujoco.studies.sweep._worker_init`); if anything goes wrong here, they are killed.
+    :func:`worker_init`); if anything goes wrong here, they are killed.
     """
     items = list(items)
     if workers <= 1 or len(items) <= 1:
         for item in items:
             on_result(item, task(item))
         return
-    from .sweep import _kill_workers, _worker_init
-
-    pool = futures.ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),))
+    pool = futures.ProcessPoolExecutor(max_workers=workers, initializer=worker_init, initargs=(os.getpid(),))
     complete = False
     try:
         pending = {pool.submit(task, item): item for item in items}
@@ -34,5 +76,5 @@ def map_unordered(task: Callable[[Item], object], items: Iterable[Item], workers
         complete = True
     finally:
         if not complete:
-            _kill_workers(pool)
+            kill_workers(pool)
         pool.shutdown(wait=complete, cancel_futures=True)

@@ -17,12 +17,12 @@ Where work runs:
   of MuJoCo's own step cost for a 1-s run, so the analytic and MuJoCo work of
   the designs fills every core).
 * with ``batch_size`` (``batch_mujoco=True``), or where the serial engine's
-  compiled loop is not built (``engine.stepper.compiled_status``): MuJoCo's
-  ratchet through ``mujoco.batch`` in chunks of ``batch_size`` designs, each
-  chunk in a process of its own on one thread, so rows stream as chunks
-  finish; a design the batch does not model (compliant clutches, a drive
-  outside ``batch.MODELLED_DRIVES``) runs in that process with the serial
-  engine instead. The chunks and the pool (the other engines) run at once and share the cores: while both
+  compiled loop is not built (``registry.compiled_status``): MuJoCo's
+  ratchet through ``mujoco.batch`` (``registry.run_batch``) in chunks of
+  ``batch_size`` designs, each chunk in a process of its own on one thread,
+  so rows stream as chunks finish; a design the batch does not model
+  (``registry.batch_models``: compliant clutches, a drive it does not
+  declare) runs in that process with the serial engine instead. The chunks and the pool (the other engines) run at once and share the cores: while both
   have work, the batch gets half of them (rounded up) and the pool the rest; whichever finishes first
   hands its cores to the other. Ctrl-C ends both pools' processes at once; the rows written are every
   design finished by then.
@@ -47,24 +47,23 @@ import json
 import os
 import queue
 import signal
-import sys
 import threading
 import time
 from collections import deque
 from pathlib import Path
 from typing import Callable
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
 from ..output import check_output_dir
+from .pool import kill_workers, worker_init
 from .sweep_files import Progress, ResultsFile, header_for, make_row
 from .sweep_metrics import batch_metrics, run_metrics
 from .sweep_space import Study
 
 BATCH_SIZE = 64  # MuJoCo designs stepped together: ~2 s of work per chunk for 1 s runs on 2 cores
-BATCHED = "mujoco-ratchet"
 
 
 class SweepInterrupted(RuntimeError):
@@ -75,25 +74,20 @@ class DesignTimeout(Exception):
     """A design ran past the sweep's wall-time budget (raised by the worker's alarm)."""
 
 
-def _run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float, options: dict):
-    """One engine on one design; ``options``: until_steady, wall_budget_s (analytic engines only)."""
-    steady = {"until_steady": True} if options.get("until_steady") else {}
-    if engine.startswith("analytic-"):
-        budget = {"wall_budget_s": options["wall_budget_s"]} if options.get("wall_budget_s") else {}
-        geometry, clutch = {"analytic-approx": ("approx", "kinematic"), "analytic-exact": ("exact", "kinematic"),
-                            "analytic-unilateral": ("exact", "unilateral")}[engine]
-        return analytic.simulate(params, geometry, clutch, t_end, dt_out=dt_out, **steady, **budget)
-    from ..engine import simulate_mujoco
-
-    if engine == "mujoco-lock":
-        return simulate_mujoco(params, "kinematic", "lock", t_end, dt_out=dt_out, **steady)
-    return simulate_mujoco(params, "unilateral", "ratchet", t_end, dt_out=dt_out, **steady)
+def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float, options: dict):
+    """One engine (a variant name of :mod:`ipir_mujoco.registry`) on one design; ``options``: until_steady,
+    wall_budget_s (passed to the analytic engines; the pool's alarm covers MuJoCo's runs), every_step
+    (MuJoCo sampled at every step)."""
+    v = registry.variant(engine)
+    return registry.run(v, params, t_end, dt_out=dt_out, until_steady=bool(options.get("until_steady")),
+                        wall_budget_s=None if v.is_mujoco else options.get("wall_budget_s") or None,
+                        every_step=bool(options.get("every_step")) and v.is_mujoco)
 
 
 def engine_metrics(engine: str, params: RobotParams, t_end: float, dt_out: float, options: dict) -> dict:
     """Metrics of one engine on one design, or {"error": message}; a stall adds {"note": reason}."""
     try:
-        run = _run_engine(engine, params, t_end, dt_out, options)
+        run = run_engine(engine, params, t_end, dt_out, options)
     except (ParameterError, SimulationError) as exc:
         return {"error": f"{engine}: {exc}"}
     except DesignTimeout:
@@ -142,39 +136,6 @@ def _raise_timeout(signum, frame):
     raise DesignTimeout()
 
 
-def _worker_init(parent: int) -> None:
-    """Pool workers: Ctrl-C is the main process's business; die with the main process."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            PR_SET_PDEATHSIG = 1
-            if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0:
-                if os.getppid() != parent:  # the parent died before the request took effect
-                    os._exit(1)
-                return
-        except (OSError, AttributeError):
-            pass
-
-    def watch() -> None:  # elsewhere: notice the parent's death within a second
-        while os.getppid() == parent:
-            time.sleep(1.0)
-        os._exit(1)
-
-    threading.Thread(target=watch, daemon=True, name="parent-watch").start()
-
-
-def _kill_workers(pool: futures.ProcessPoolExecutor) -> None:
-    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
-    if terminate is not None:
-        terminate()
-        return
-    for process in list((getattr(pool, "_processes", None) or {}).values()):
-        process.kill()
-
-
 class _Cores:
     """How the cores are shared between the batch processes and the pool while both have work.
 
@@ -199,17 +160,16 @@ class _Cores:
 
 
 def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out: float, nthread: int,
-                    until_steady: bool = False) -> list[dict]:
-    """The batched engine on one chunk of designs: [{BATCHED: metrics or {"error": ...}}] in their order.
+                    until_steady: bool = False, engine: str = "mujoco-ratchet") -> list[dict]:
+    """The batched ``engine`` (:func:`ipir_mujoco.registry.batched`) on one chunk of designs: [{engine:
+    metrics or {"error": ...}}] in their order.
 
     Runs in a process of its own (the batch pool), so that Ctrl-C can end it at once and its per-step
     Python work does not compete with the main process.
     """
-    from ..engine import batch
-
     params: list[RobotParams | None] = []
     serial: dict[int, dict] = {}
-    # what the batch does not model (a drive it does not declare in batch.MODELLED_DRIVES, compliant clutches)
+    # what the batch does not model (registry.batch_models: a drive it does not declare, compliant clutches)
     # runs here one by one in the serial engine, never as a silently different robot
     for k, design in enumerate(values):
         try:
@@ -218,22 +178,22 @@ def run_batch_chunk(values: list[dict], base: RobotParams, t_end: float, dt_out:
             params.append(None)
             continue
         p = params[-1]
-        if p.drive not in batch.MODELLED_DRIVES or p.clutch_stiffness is not None:
-            serial[k] = engine_metrics(BATCHED, p, t_end, dt_out, {"until_steady": until_steady})
+        if not registry.batch_models(p):
+            serial[k] = engine_metrics(engine, p, t_end, dt_out, {"until_steady": until_steady})
             params[-1] = None
     valid = [p for p in params if p is not None]
-    steady = {"until_steady": True} if until_steady else {}
     try:
-        outcomes = iter(batch.run_ratchet_batch(valid, t_end, dt_out, nthread=nthread, **steady) if valid else [])
+        outcomes = iter(registry.run_batch(engine, valid, t_end, dt_out, nthread=nthread, until_steady=until_steady)
+                        if valid else [])
     except Exception as exc:  # noqa: BLE001 (recorded per design; the analytic side goes on)
         outcomes = iter([{"error": f"batch failed: {type(exc).__name__}: {exc}"}] * len(valid))
     results = []
     for k, p in enumerate(params):
         if p is None:
-            results.append({BATCHED: serial.get(k, {"error": "invalid design"})})
+            results.append({engine: serial.get(k, {"error": "invalid design"})})
             continue
         outcome = next(outcomes)
-        results.append({BATCHED: {"error": f"{BATCHED}: {outcome['error']}"} if "error" in outcome
+        results.append({engine: {"error": f"{engine}: {outcome['error']}"} if "error" in outcome
                         else _batch_design_metrics(outcome)})
     return results
 
@@ -288,10 +248,8 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
     bar = Progress(len(designs), len(designs) - len(todo), progress)
     engines = study.engines
     if batch_mujoco is None:
-        from ..engine.stepper import compiled_status
-
-        batch_mujoco = batch_size is not None or not compiled_status()[0]
-    batched = (BATCHED,) if batch_mujoco and executor is None and BATCHED in engines else ()
+        batch_mujoco = batch_size is not None or not registry.compiled_status()[0]
+    batched = tuple(e for e in engines if registry.batched(e))[:1] if batch_mujoco and executor is None else ()
     pooled = tuple(e for e in engines if e not in batched)
     options = {"until_steady": study.until_steady, "wall_budget_s": timeout_per_design}
     partial: dict[int, dict[str, dict]] = {i: {} for i in todo}
@@ -310,11 +268,11 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             bar.advance()
 
     own_pool = executor is None and bool(pooled) and bool(todo)
-    pool = (futures.ProcessPoolExecutor(max_workers=cores.total, initializer=_worker_init, initargs=(os.getpid(),))
+    pool = (futures.ProcessPoolExecutor(max_workers=cores.total, initializer=worker_init, initargs=(os.getpid(),))
             if own_pool else executor)
     chunks = deque([todo[k:k + (batch_size or BATCH_SIZE)] for k in range(0, len(todo), batch_size or BATCH_SIZE)]
                    if batched else [])
-    batch_pool = (futures.ProcessPoolExecutor(max_workers=cores.total, initializer=_worker_init,
+    batch_pool = (futures.ProcessPoolExecutor(max_workers=cores.total, initializer=worker_init,
                                               initargs=(os.getpid(),)) if chunks else None)
     waiting = deque(todo if pooled else [])
     running: dict[futures.Future, list] = {}  # pool future -> [design, first seen running (monotonic s) or None]
@@ -325,7 +283,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             while chunks and len(batch_running) < cores.batch_slots():  # on the cores the pool leaves
                 chunk = chunks.popleft()
                 future = batch_pool.submit(run_batch_chunk, [designs[i] for i in chunk], study.base, study.t_end,
-                                           study.dt_out, 1, study.until_steady)
+                                           study.dt_out, 1, study.until_steady, batched[0])
                 batch_running[future] = chunk
                 future.add_done_callback(lambda f: events.put(("batch", None, f)))
             # beside the batch no task is queued ahead (an idle worker would take it and overrun the cores the
@@ -355,8 +313,8 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
                 try:
                     outcomes = future.result()
                 except Exception as exc:  # noqa: BLE001 (the batch's process died: recorded, the sweep goes on)
-                    outcomes = [{BATCHED: {"error": f"{BATCHED}: the batch process failed: {type(exc).__name__}: "
-                                                    f"{exc}"}}] * len(chunk)
+                    outcomes = [{batched[0]: {"error": f"{batched[0]}: the batch process failed: "
+                                                       f"{type(exc).__name__}: {exc}"}}] * len(chunk)
                 for i, result in zip(chunk, outcomes):
                     finish(i, result)
             elif kind == "pool" and future in running:
@@ -377,7 +335,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
         for own, kill in ((pool if own_pool else None, interrupted or abandoned), (batch_pool, interrupted)):
             if own is not None:
                 if kill:  # workers ignore Ctrl-C and may be deep in a long design: end them now
-                    _kill_workers(own)
+                    kill_workers(own)
                 own.shutdown(wait=not kill, cancel_futures=True)
         if executor is not None:
             for future in running:

@@ -41,16 +41,19 @@ from pathlib import Path
 
 import numpy as np
 
+from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import (MAX_T_END, PARAMETER_NAMES, RobotParams, as_real, check_real,
-                                         check_run_options, check_whole, read_toml_file, require_params)
+from ipir_mujoco.core.options import MAX_T_END, check_run_options
+from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
+                                     read_toml_file, require_params)
 
-ENGINES = ("analytic-approx", "analytic-exact", "analytic-unilateral", "mujoco-lock", "mujoco-ratchet")
+ENGINES = registry.NAMES  # every variant (ipir_mujoco.registry); their aliases are accepted too
 DEFAULT_ENGINES = ("mujoco-ratchet", "analytic-unilateral")
 # designs per sweep: about 3.5 h at the 8 designs/s measured for 1 s runs of the default engines on
 # 2 cores (runs to a steady state cost more), and the grid stays small in memory; split a larger study
 MAX_DESIGNS = 100_000
 DT_OUT = 1e-3  # s: output interval of the sweep's runs; enough for the metrics, light on memory
+T_END_STEADY = 10.0  # s: the default cap of a run to steady state (the default motor settles in about 2 s)
 
 
 @dataclass(frozen=True)
@@ -149,10 +152,9 @@ class Study:
         set_("engines", tuple(self.engines))
         if not self.engines:
             raise ParameterError(f"engines=[] names no engine; allowed: one or more of {', '.join(ENGINES)}")
-        unknown = [e for e in self.engines if e not in ENGINES]
-        if unknown:
-            raise ParameterError(f"engine {unknown[0]!r} is unknown; allowed: {', '.join(ENGINES)}")
-        if len(set(self.engines)) != len(self.engines):
+        # names as given (aliases included) head the results' columns; the variants they name must differ
+        variants = [registry.variant(e).name for e in self.engines]
+        if len(set(variants)) != len(variants):
             raise ParameterError(f"engines={list(self.engines)} names an engine twice")
         set_("t_end", check_run_options(self.t_end, self.dt_out)[0])
         if self.sample is not None:

@@ -69,14 +69,15 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
 from .. import __version__
-from ..engine import simulate_mujoco
-from ..engine.model import SolverSettings
+from .compare import relative_change
 from .convergence import convergence_evidence
+from .ladder import LADDER
+from .lr_study import RATIOS_FULL, RATIOS_QUICK, describe_threshold, lr_study
 from .paper_reference import PAPER_CASE, check_identities, check_paper_figures, describe_differences, differences_from_paper
 
 LADDER_FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s",
@@ -87,8 +88,8 @@ FIGURE_RUNGS = ("paper model", "MuJoCo, paper's rule", "MuJoCo ratchet")
 
 
 @dataclass
-class Rung:
-    """One step of the model ladder."""
+class LadderRun:
+    """One rung of the model ladder (:data:`.ladder.LADDER`) and its run."""
 
     name: str
     isolates: str  # the assumption this rung removes, in words
@@ -96,45 +97,19 @@ class Rung:
 
 
 def run_ladder(params: RobotParams, t_end: float, dt_out: float, rtol: float, atol: float,
-               progress: Callable[[str], None]) -> list[Rung]:
-    """Run the rungs that exist, from the paper's model up to MuJoCo's ratchet."""
-    massless = params.replace(rod_mass=0.0, rod_inertia=0.0)
-
-    def equations(rung_params, geometry, clutch="kinematic"):
-        return lambda: analytic.simulate(rung_params, geometry, clutch, t_end, dt_out=dt_out,
-                                         rtol=rtol, atol=atol)
-
-    def physics(rule, implementation):
-        return lambda: simulate_mujoco(params, rule, implementation, t_end, dt_out=dt_out)
-
-    plan = (
-        ("paper model", "nothing: first-order kinematics (L >> r), massless rod, ideal locks",
-         equations(massless, "approx")),
-        ("exact geometry", "L >> r: the exact slider-crank", equations(massless, "exact")),
-        ("with rod mass", f"the massless rod: rod of {params.rod_mass:g} kg", equations(params, "exact")),
-        ("MuJoCo, paper's rule", "the equations: MuJoCo physics of the same linkage, locks by the paper's rule",
-         physics("kinematic", "lock")),
-        ("one-way clutches", "ideal locks: clutches that can only push (equations, complementarity)",
-         equations(params, "exact", "unilateral")),
-        ("MuJoCo ratchet", "the equations again: MuJoCo physics with one-way clutches (joint-limit ratchet)",
-         physics("unilateral", "ratchet")),
-    )
+               progress: Callable[[str], None]) -> list[LadderRun]:
+    """Every rung of the ladder for ``t_end`` [s], from the paper's model up to MuJoCo's ratchet: the
+    equations at the solver tolerances ``rtol``/``atol``, MuJoCo with its automatic settings."""
     rungs = []
-    for i, (name, isolates, simulate) in enumerate(plan, start=1):
+    for i, rung in enumerate(LADDER, start=1):
         started = time.perf_counter()
-        progress(f"[{i}/{len(plan)}] {name} ...")
-        run = simulate()
-        progress(f"[{i}/{len(plan)}] {name}: {run.summary['revolutions']:.3f} rev "
+        progress(f"[{i}/{len(LADDER)}] {rung.name} ...")
+        tolerances = {} if registry.variant(rung.variant).is_mujoco else {"rtol": rtol, "atol": atol}
+        run = registry.run(rung.variant, rung.params(params), t_end, dt_out=dt_out, **tolerances)
+        progress(f"[{i}/{len(LADDER)}] {rung.name}: {run.summary['revolutions']:.3f} rev "
                  f"({time.perf_counter() - started:.2f} s)")
-        rungs.append(Rung(name, isolates, run))
+        rungs.append(LadderRun(rung.name, rung.describe(params), run))
     return rungs
-
-
-def relative_change(new: float | None, old: float | None) -> float | None:
-    """(new - old) / |old|, or None where either is missing or old is zero."""
-    if new is None or old is None or old == 0:
-        return None
-    return (new - old) / abs(old)
 
 
 def locked_reaction(s: dict[str, np.ndarray]) -> np.ndarray:
@@ -200,10 +175,9 @@ def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> di
     return {"question": question, "answer": answer, "evidence": "paper_checks, identities"}
 
 
-def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list[Rung], pull: dict, study: dict,
+def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list[LadderRun], pull: dict, study: dict,
              ladder: list[dict], convergence: dict) -> list[dict]:
     """The report's opening: plain questions, plain answers, the numbers behind them."""
-    from .lr_study import describe_threshold
     paper, exact, rod, locks, one_way, ratchet = (r.run.summary for r in rungs[:6])
     modelling = {r["name"]: max(abs(r["change_vs_previous"][k]) for k in ("revolutions", "x1_final", "x2_final")
                                 if r["change_vs_previous"][k] is not None)
@@ -287,7 +261,7 @@ def parameter_table(params: RobotParams) -> list[dict]:
     return rows
 
 
-def build_metrics(params: RobotParams, rungs: list[Rung], settings: dict, study: dict, convergence: dict) -> dict:
+def build_metrics(params: RobotParams, rungs: list[LadderRun], settings: dict, study: dict, convergence: dict) -> dict:
     differences = differences_from_paper(params)
     case = {"is_paper_case": not differences, "differences": differences}
     checks = check_paper_figures(rungs[0].run) if case["is_paper_case"] else []
@@ -329,10 +303,8 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
     one's metrics go to ``metrics["sections"][key]`` and its verdict, if it
     gives one, joins the verdicts.
     """
-    from .lr_study import RATIOS_FULL, RATIOS_QUICK, lr_study
-
     settings = {"t_end_s": 1.0, "quick": quick, "dt_out_s": 1e-3 if quick else 1e-4, "rtol": 1e-10, "atol": 1e-12,
-                "mujoco": SolverSettings().as_dict()}
+                "mujoco": registry.mujoco_defaults()}
     rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
     # MuJoCo's settings are chosen per run from the motion: record what each MuJoCo rung used
     settings["mujoco_runs"] = {r.name: {k: r.run.settings[k] for k in ("timestep", "integrator",

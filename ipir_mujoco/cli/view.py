@@ -1,0 +1,144 @@
+"""``python -m ipir_mujoco.view``: the robot in MuJoCo's interactive viewer, clutches working.
+
+The one entry point beside the registry that steps the MuJoCo engine itself: the viewer needs the live
+model and data between steps, which a finished run does not give.
+
+The shipped MJCF alone does not crawl: its one-way clutches are not MJCF
+elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.clutches`),
+which move a joint limit or switch a lock before every step. This command
+builds the model from a parameter set exactly as ``simulate --engine mujoco``
+does and steps it in a passive viewer loop with the engine's own stepping loop
+(:mod:`ipir_mujoco.engine.stepper`: the same controller, compiled where it can be), in
+real time (or slower with ``--slow``), and starts the run again every
+``--t-end`` seconds of simulated time (a constant torque accelerates the robot
+without bound). A module's housing turns green while its clutch holds it; the
+camera follows module 1 (drag to turn it, scroll to zoom). Needs a screen (on macOS, run it with ``mjpython``); without
+one, use ``ipir-mujoco render`` for a video.
+
+    python -m ipir_mujoco.view [--clutch unilateral|kinematic] [--mujoco-clutch ratchet|lock]
+                               [--set NAME=VALUE]... [--config FILE.toml] [--slow FACTOR] [--t-end SECONDS]
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from typing import Sequence
+
+import mujoco
+import numpy as np
+
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
+
+from ..engine.clutches import clutch_controller
+from ..engine.common import check_clutch_options
+from ..engine.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
+from ..engine.stepper import loop_options, make_steps
+from ..engine.timestep import choose_settings
+from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS
+from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
+
+
+class ViewedRobot:
+    """The model, its data and the engine's clutch controller, stepped by the engine's stepping loop.
+
+    Refuses (ParameterError, one line) exactly the parameters and clutch choices ``simulate_mujoco``
+    refuses (:func:`ipir_mujoco.engine.common.check_clutch_options`).
+    """
+
+    def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,
+                 settings: SolverSettings | None = None, t_end: float = 4.0):
+        self.params, self.clutch = params, clutch
+        self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
+        check_clutch_options(params, clutch, self.implementation)
+        if settings is None:  # the step the engine would choose for a run of t_end [s]
+            settings, _ = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
+        self.settings = settings
+        self.model = build_model(params, settings, ratchet=self.implementation == "ratchet")
+        self.data = mujoco.MjData(self.model)
+        self.housings = [self.model.geom(name).id for name in HOUSINGS]
+        self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the start: the loop-consistent initial state, a fresh clutch controller."""
+        m, d = self.model, self.data
+        set_closed_loop_state(m, d, self.params)
+        self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
+        d.ctrl[m.actuator(MOTOR).id] = drive_control(self.params)
+        mujoco.mj_forward(m, d)
+        self.steps = make_steps(m, d, self.controller, self._qvel_before, **loop_options(m, d))
+        self.held: tuple[bool, bool] | None = None
+        self._colour()
+
+    def step(self, n: int = 1) -> None:
+        """``n`` MuJoCo steps with the clutch controller around each, by the engine's own loop; then the
+        housings take the clutches' colours (rewritten only when a clutch's state changed)."""
+        self.steps.run(n)
+        self._colour()
+
+    def _colour(self) -> None:
+        held = tuple(self.controller.reactions()[:2])
+        if held != self.held:
+            self.held = held
+            for geom, on in zip(self.housings, held):
+                self.model.geom_rgba[geom] = HELD_RGBA if on else FREE_RGBA
+
+
+def build_parser() -> Parser:
+    parser = Parser(prog="python -m ipir_mujoco.view",
+                    description="Open the robot in MuJoCo's interactive viewer with its one-way clutches working "
+                                "(the engine's own clutch controller runs in the viewer loop).")
+    parser.add_argument("--clutch", choices=("unilateral", "kinematic"), default="unilateral",
+                        help="unilateral: one-way clutches (default); kinematic: the paper's rule")
+    parser.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+                        help="ratchet (default with unilateral) or lock (default with kinematic)")
+    parser.add_argument("--slow", type=float, default=1.0, metavar="FACTOR",
+                        help="play FACTOR times slower than real time (default 1; the crank reaches ~10 rev/s "
+                             "within a second)")
+    parser.add_argument("--t-end", type=float, default=4.0, metavar="SECONDS",
+                        help="start again after this much simulated time (default 4 s)")
+    add_model_options(parser)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        if not (1.0 <= args.slow <= 1000.0):
+            raise ParameterError(f"--slow {args.slow} is out of range; allowed: 1 <= FACTOR <= 1000")
+        if not (0.0 < args.t_end <= 60.0):
+            raise ParameterError(f"--t-end {args.t_end} is out of range; allowed: 0 < SECONDS <= 60")
+        robot = ViewedRobot(model_params(args), args.clutch, args.mujoco_clutch, t_end=args.t_end)
+        if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise ParameterError("the viewer needs a screen and none is set (no DISPLAY); "
+                                 "write a video instead: ipir-mujoco render")
+    except ParameterError as exc:
+        print(f"python -m ipir_mujoco.view: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    import mujoco.viewer
+
+    frame = 1.0 / 60.0  # wall-clock seconds between two viewer updates
+    # the panels start hidden so the robot has the window (Tab and Shift+Tab show them)
+    with mujoco.viewer.launch_passive(robot.model, robot.data, show_left_ui=False,
+                                      show_right_ui=False) as viewer:
+        with viewer.lock():  # a camera that follows module 1, close enough to see the crank turn
+            viewer.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+            viewer.cam.trackbodyid = robot.model.body("rear_module").id
+            viewer.cam.distance, viewer.cam.azimuth, viewer.cam.elevation = 0.6, 90.0, -45.0
+        while viewer.is_running():
+            started = time.perf_counter()
+            with viewer.lock():
+                # a frame's steps at once: as fast as real time allows, slower if the machine cannot
+                robot.step(max(1, round(frame / args.slow / robot.settings.timestep)))
+                if robot.data.time >= args.t_end:
+                    robot.reset()
+            viewer.sync()
+            time.sleep(max(0.0, frame - (time.perf_counter() - started)))
+    return EXIT_OK
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,102 @@
+"""The options of a run, checked once for every engine and interface.
+
+:class:`RunOptions` is the one check: the simulated time and output interval, the steady-state stop, the work
+budgets and the progress callback, each refused with a one-line :class:`ParameterError` naming the value and
+what is allowed. Both models' entry points (:func:`ipir_mujoco.analytic.simulate`,
+:func:`ipir_mujoco.engine.simulate_mujoco`) build one from their keywords; the registry
+(:mod:`ipir_mujoco.registry`), the command line and the study files reach it through them. What only one
+engine has (the analytic solver's tolerances, MuJoCo's solver settings and clutch choice) is that engine's
+own check.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from .cycles import STEADY_CYCLES, STEADY_TOL
+from .errors import ParameterError
+from .params import as_real, check_real, check_whole
+
+MAX_T_END = 3600.0  # s: an hour of simulated motion; a motor reaches its steady state in seconds, and a
+# MuJoCo run at its 1e-4 s step already takes 3.6e7 steps for an hour
+MAX_SAMPLES = 10_000_000  # samples kept per run: ~20 float64 columns -> 1.6 GB in memory, ~4 GB as CSV
+SAMPLE_BYTES = 20 * 8  # bytes per kept sample (about 20 float64 columns)
+
+
+def check_run_options(t_end: Any, dt_out: Any) -> tuple[float, float]:
+    """(t_end [s], dt_out [s]) as floats: 0 < t_end <= MAX_T_END, 0 < dt_out <= t_end, and at most
+    MAX_SAMPLES samples kept (t_end / dt_out + 1), with the size it would need named in the message."""
+    t_end = check_real("t_end", t_end, high=MAX_T_END, unit="s")
+    dt_out = check_real("dt_out", dt_out, unit="s")
+    if dt_out > t_end:
+        raise ParameterError(f"dt_out={dt_out:g} s is out of range; allowed: dt_out <= t_end ({t_end:g} s)")
+    samples = t_end / dt_out + 1
+    if samples > MAX_SAMPLES:
+        raise ParameterError(
+            f"t_end={t_end:g} s with dt_out={dt_out:g} s would keep {samples:.3g} samples "
+            f"(~{samples * SAMPLE_BYTES / 1e9:.3g} GB); allowed: at most {MAX_SAMPLES:.0e} samples "
+            f"(dt_out >= {t_end / (MAX_SAMPLES - 1):.3g} s for this t_end)")
+    return t_end, dt_out
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What every engine's run takes beside the parameter set, checked on construction.
+
+    ``t_end`` [s]: the simulated time (with ``until_steady``, the cap); ``dt_out`` [s]: the output interval;
+    ``until_steady``: stop at the end of the revolution where the periodic steady state is reached
+    (:class:`.cycles.SteadyWatch` with ``steady_tol`` and ``steady_cycles``); ``progress(t)``: called with
+    the simulated time [s] now and then (about every 0.1 s of it), or None; ``wall_budget_s`` [s]: the most
+    wall-clock time a run may take (None: no limit); ``max_switches``: the most mode switches an
+    event-driven engine may make (None: the engine's default; MuJoCo has none to count).
+    """
+
+    t_end: float = 1.0
+    dt_out: float = 1e-4
+    until_steady: bool = False
+    steady_tol: float = STEADY_TOL
+    steady_cycles: int = STEADY_CYCLES
+    progress: Callable[[float], None] | None = None
+    wall_budget_s: float | None = None
+    max_switches: int | None = None
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        t_end, dt_out = check_run_options(self.t_end, self.dt_out)
+        set_(self, "t_end", t_end)
+        set_(self, "dt_out", dt_out)
+        if not isinstance(self.until_steady, (bool, np.bool_)):
+            raise ParameterError(f"until_steady={self.until_steady!r} is not a bool; allowed: True or False")
+        set_(self, "until_steady", bool(self.until_steady))
+        tol = as_real(self.steady_tol)
+        if tol is None or not (math.isfinite(tol) and 0 < tol < 1):
+            raise ParameterError(f"steady_tol={self.steady_tol!r} is out of range; allowed: 0 < steady_tol < 1")
+        set_(self, "steady_tol", tol)
+        cycles = self.steady_cycles
+        if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 2:
+            raise ParameterError(f"steady_cycles={cycles!r} is out of range; allowed: a whole number >= 2")
+        set_(self, "steady_cycles", int(cycles))
+        if self.progress is not None and not callable(self.progress):
+            raise ParameterError(f"progress={self.progress!r} is not callable; allowed: a function of the "
+                                 "simulated time [s], or None")
+        if self.wall_budget_s is not None:
+            budget = None if isinstance(self.wall_budget_s, bool) else as_real(self.wall_budget_s)
+            if budget is None or not (math.isfinite(budget) and budget > 0):
+                raise ParameterError(f"wall_budget_s={self.wall_budget_s!r} is out of range; allowed: a finite "
+                                     "number of seconds > 0, or None (no limit)")
+            set_(self, "wall_budget_s", budget)
+        if self.max_switches is not None:
+            if isinstance(self.max_switches, bool) or not isinstance(self.max_switches, (int, np.integer)):
+                raise ParameterError(f"max_switches={self.max_switches!r} is out of range; allowed: a whole "
+                                     "number >= 1")
+            set_(self, "max_switches", check_whole("max_switches", self.max_switches, low=1))
+
+    @property
+    def steady_settings(self) -> dict[str, Any]:
+        """What a run records in its settings so that its summary applies the same steady-state test."""
+        return {"until_steady": self.until_steady, "steady_tol": self.steady_tol,
+                "steady_cycles": self.steady_cycles}

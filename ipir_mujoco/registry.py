@@ -1,0 +1,235 @@
+"""One way to run an engine: every model variant by name, and one ``run(variant, params, ...)`` for all.
+
+A *variant* is one model of the robot in one engine: the analytic equations with the paper's first-order
+geometry or the exact slider-crank, under the paper's clutch rule or with one-way clutches; MuJoCo's model
+of the real linkage with joint-limit ratchets or velocity-triggered locks. Every study, the command line and
+the report reach the engines through :func:`run` (and :func:`run_batch` for MuJoCo's batched ratchet), so
+that an engine, an option or an effect is added in one place.
+
+Names (one scheme everywhere: ``simulate``'s flags map to them, sweeps, ``climb`` and the report use them)::
+
+    ENGINE-MODEL[-RULE]
+
+``ENGINE`` is ``analytic`` or ``mujoco``; ``MODEL`` is the geometry for the equations (``approx``: the paper's
+first order, L >> r; ``exact``: the exact slider-crank with the rod) and the clutch for MuJoCo (``ratchet``:
+a joint-limit ratchet, one-way by construction; ``lock``: velocity-triggered locks); ``RULE`` is the clutch
+rule (``kinematic``: the paper's, locks by the sign of S_dot; ``unilateral``: one-way clutches that can only
+push), left out where it is the model's usual one (the paper's rule for the equations and the locks; the
+ratchet has only one). So ``analytic-approx`` is the paper's model, ``mujoco-ratchet`` MuJoCo with one-way
+clutches. ``analytic-unilateral`` (the exact one-way equations, the sweep's name since its first release) is
+kept as the canonical name of ``analytic-exact-unilateral``; every name spelled with its rule in full is an
+alias. ``simulate``'s ``--engine``, ``--geometry``, ``--clutch`` and ``--mujoco-clutch`` name a variant
+through :func:`from_flags`.
+
+What the parameter set decides stays in it: a finite ``clutch_stiffness`` makes a one-way variant's clutches
+compliant (both engines), ``drive`` chooses the constant torque or the motor, ``incline`` the slope.
+
+The MuJoCo engine is imported only when a MuJoCo variant runs (its import costs a few tenths of a second).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Sequence
+
+from .core.errors import ParameterError
+from .core.params import RobotParams
+from .core.results import RunResult
+
+ENGINES = ("analytic", "mujoco")
+RULES = ("kinematic", "unilateral")
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One model of the robot in one engine (see the module docstring for the names)."""
+
+    name: str  # canonical
+    engine: str  # 'analytic' | 'mujoco'
+    rule: str  # the clutch rule: 'kinematic' (the paper's) | 'unilateral' (one-way clutches)
+    geometry: str  # 'approx' | 'exact' (MuJoCo always models the exact linkage)
+    clutch: str | None  # MuJoCo's clutch: 'ratchet' | 'lock'; None for the equations
+    label: str  # in words, for figures and reports
+
+    @property
+    def is_mujoco(self) -> bool:
+        return self.engine == "mujoco"
+
+    def describe(self) -> dict[str, Any]:
+        """The variant as a run's JSON records it: name, engine, geometry, clutch rule and MuJoCo's clutch."""
+        return {"variant": self.name, "engine": self.engine, "geometry": self.geometry, "clutch": self.rule,
+                "mujoco_clutch": self.clutch}
+
+
+VARIANTS: dict[str, Variant] = {v.name: v for v in (
+    Variant("analytic-approx", "analytic", "kinematic", "approx", None, "paper's model"),
+    Variant("analytic-exact", "analytic", "kinematic", "exact", None, "analytic, paper's rule"),
+    Variant("analytic-approx-unilateral", "analytic", "unilateral", "approx", None,
+            "analytic first order, one-way clutches"),
+    Variant("analytic-unilateral", "analytic", "unilateral", "exact", None, "analytic one-way clutches"),
+    Variant("mujoco-lock", "mujoco", "kinematic", "exact", "lock", "MuJoCo, paper's rule"),
+    Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
+    Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
+)}
+ALIASES = {
+    "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
+    "analytic-exact-unilateral": "analytic-unilateral", "mujoco-ratchet-unilateral": "mujoco-ratchet",
+    "mujoco-lock-kinematic": "mujoco-lock",
+}
+NAMES = tuple(VARIANTS)
+
+# the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
+# until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
+ANALYTIC_OPTIONS = ("rtol", "atol", "max_switches", "method", "torque")
+MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step")
+_WHY_NOT = {"analytic": "the analytic engines hold their solver tolerance and have no timestep, clutch "
+                        "implementation or MJCF",
+            "mujoco": "MuJoCo's cost is its step count, t_end / timestep, and its accuracy its own monitor's"}
+
+
+def variant(name: str | Variant) -> Variant:
+    """The variant named ``name`` (canonical or an alias); ParameterError listing the names otherwise."""
+    if isinstance(name, Variant):
+        return name
+    if isinstance(name, str):
+        key = ALIASES.get(name, name)
+        if key in VARIANTS:
+            return VARIANTS[key]
+    raise ParameterError(f"engine {name!r} is unknown; allowed: {', '.join(NAMES)}")
+
+
+def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str = "kinematic",
+               clutch: str | None = None) -> Variant:
+    """The variant the command line's ``--engine``, ``--geometry``, ``--clutch`` and ``--mujoco-clutch`` name
+    (each refused in one line where it does not apply): the analytic geometry defaults to the paper's first
+    order, MuJoCo's clutch to the lock for the paper's rule and to the ratchet for one-way clutches."""
+    if engine not in ENGINES:
+        raise ParameterError(f"--engine {engine!r} is unknown; allowed: {', '.join(ENGINES)}")
+    if rule not in RULES:
+        raise ParameterError(f"--clutch {rule!r} is unknown; allowed: {', '.join(RULES)}")
+    if engine == "analytic":
+        if clutch is not None:
+            raise ParameterError(f"--mujoco-clutch {clutch} applies only to --engine mujoco")
+        geometry = geometry or "approx"
+        if geometry not in ("approx", "exact"):
+            raise ParameterError(f"--geometry {geometry!r} is unknown; allowed: approx, exact")
+        return _find(engine, rule, geometry, None)
+    if geometry == "approx":
+        raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real linkage; "
+                             "allowed: --geometry exact (or leave it out)")
+    clutch = clutch or ("lock" if rule == "kinematic" else "ratchet")
+    if clutch == "ratchet" and rule == "kinematic":
+        raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
+                             "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
+    if clutch not in ("ratchet", "lock"):
+        raise ParameterError(f"--mujoco-clutch {clutch!r} is unknown; allowed: ratchet, lock")
+    return _find(engine, rule, "exact", clutch)
+
+
+def _find(engine: str, rule: str, geometry: str, clutch: str | None) -> Variant:
+    return next(v for v in VARIANTS.values()
+                if (v.engine, v.rule, v.geometry, v.clutch) == (engine, rule, geometry, clutch))
+
+
+def check_options(name: str | Variant, options: dict[str, Any], spelled: Callable[[str], str] = str) -> Variant:
+    """The variant, after refusing (one line) each option in ``options`` whose value is not None and that
+    its engine does not take; ``spelled(keyword)`` is how the message names it (e.g. as a command-line flag)."""
+    v = variant(name)
+    foreign = MUJOCO_OPTIONS if v.engine == "analytic" else ANALYTIC_OPTIONS
+    for key, value in options.items():
+        if key in foreign and value is not None and value is not False:
+            own = "the MuJoCo engine" if v.engine == "analytic" else "the analytic engines"
+            raise ParameterError(f"{spelled(key)} {value!r} applies only to {own} ({_WHY_NOT[v.engine]})")
+    return v
+
+
+def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float) -> float | None:
+    """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s]
+    (:func:`ipir_mujoco.engine.timestep.choose_settings`); None for the analytic engines."""
+    v = variant(name)
+    if not v.is_mujoco:
+        return None
+    from .engine.timestep import choose_settings
+
+    return choose_settings(params, t_end, dt_out, clutch=v.clutch)[0].timestep
+
+
+def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options) -> RunResult:
+    """Run the variant ``name`` on ``params`` for ``t_end`` [s] (with ``until_steady``, the cap).
+
+    Options every engine takes (:class:`ipir_mujoco.core.options.RunOptions`): ``dt_out`` [s],
+    ``until_steady``, ``steady_tol``, ``steady_cycles``, ``progress``, ``wall_budget_s`` [s]. The analytic
+    engines also take ``rtol``, ``atol``, ``max_switches``, ``method`` (compliant clutches) and ``torque``
+    (a torque profile); MuJoCo ``settings`` (:class:`ipir_mujoco.engine.SolverSettings`), ``timestep`` [s]
+    (short for settings with that step), ``mjcf``, ``accuracy`` ('stop' | 'warn'), ``servo`` and
+    ``every_step`` (sample at every step of the timestep MuJoCo chooses for ``dt_out``: where a sample holds
+    its step's force, so that a mean over a window is the impulse, and no engagement peak falls between
+    samples). An option the variant's engine does not take is refused in one line.
+    """
+    v = check_options(name, options)
+    foreign = MUJOCO_OPTIONS if not v.is_mujoco else ANALYTIC_OPTIONS  # given as None or False: not given
+    options = {k: value for k, value in options.items() if value is not None and k not in foreign}
+    if not v.is_mujoco:
+        from . import analytic
+
+        return analytic.simulate(params, v.geometry, v.rule, t_end, **options)
+    from .engine import SolverSettings, simulate_mujoco
+
+    step = options.pop("timestep", None)
+    if step is not None:
+        if "settings" in options:
+            raise ParameterError("timestep and settings given together; allowed: one of them")
+        options["settings"] = SolverSettings(timestep=step)
+    if options.pop("every_step", False):
+        settings = options.get("settings")
+        options["dt_out"] = settings.timestep if settings is not None else timestep(
+            v, params, t_end, options.get("dt_out", 1e-4))
+    return simulate_mujoco(params, v.rule, v.clutch, t_end, **options)
+
+
+def halved_settings(run: RunResult):
+    """MuJoCo's settings of ``run`` (a MuJoCo run) at half its timestep: the run again, one step finer."""
+    from .engine import SolverSettings
+
+    s = run.settings
+    return SolverSettings(timestep=s["timestep"] / 2, integrator=s["integrator"], solimp=tuple(s["solimp"]))
+
+
+def mujoco_defaults() -> dict[str, Any]:
+    """MuJoCo's default solver settings as a run records them (timestep [s], integrator, constraint time
+    constant [s], solimp): the largest step the engine chooses by itself."""
+    from .engine import SolverSettings
+
+    return SolverSettings().as_dict()
+
+
+def batched(name: str | Variant) -> bool:
+    """Whether the variant has a batched engine (:func:`run_batch`): MuJoCo's ratchet."""
+    return variant(name).name == "mujoco-ratchet"
+
+
+def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float, dt_out: float, *,
+              nthread: int = 1, until_steady: bool = False) -> list[dict]:
+    """The variant on many designs at once through ``mujoco.batch`` (:func:`batched` variants only): one
+    outcome per design, as :func:`ipir_mujoco.engine.batch.run_ratchet_batch` gives them."""
+    if not batched(name):
+        raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
+    from .engine import batch
+
+    steady = {"until_steady": True} if until_steady else {}
+    return batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
+
+
+def batch_models(params: RobotParams) -> bool:
+    """Whether the batched engine models the design (:data:`ipir_mujoco.engine.batch.MODELLED_DRIVES`, rigid
+    clutches); others run serially."""
+    from .engine import batch
+
+    return params.drive in batch.MODELLED_DRIVES and params.clutch_stiffness is None
+
+
+def compiled_status() -> tuple[bool, str]:
+    """(whether serial MuJoCo runs step in compiled code, why not if they do not)."""
+    from .engine.stepper import compiled_status as status
+
+    return status()
