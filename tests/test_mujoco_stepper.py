@@ -8,7 +8,9 @@ not merely close.
 
 from __future__ import annotations
 
-import ctypes
+import os
+import subprocess
+import sys
 
 import mujoco
 import numpy as np
@@ -190,23 +192,23 @@ def test_a_mujoco_error_inside_the_compiled_loop_is_the_bindings_error():
             steps.run(200)
         errors.append(str(failure.value))
     assert errors[0] == errors[1] and errors[0].startswith("mj_stackAlloc")
-    handler = native._library()["mju_user_error"]
-    assert handler and ctypes.c_void_p.from_address(handler).value is None
+    assert native.compiled().handlers()[0] is False  # mju_user_error, as the library has it
 
 
 @needs_compiled
 def test_what_does_not_check_out_steps_in_python(monkeypatch):
-    """A wrong mjData offset, a crank servo or the environment variable: the Python loop."""
+    """An MjData._address that is not that MjData's mjData, a crank servo or the environment variable: the
+    Python loop."""
     params = RobotParams()
     model = build_model(params, SolverSettings(), ratchet=True)
     data, ratchet = ratcheted(params, model)
     assert loops(model, data, ratchet)[0].compiled
-    layout = native.mjdata_offsets
-    offsets = dict(layout())
-    offsets["efc_force"] += 8  # the next pointer field: not what the bindings report
-    monkeypatch.setattr(native, "mjdata_offsets", lambda: offsets)
-    assert not loops(model, data, ratchet)[0].compiled
-    monkeypatch.setattr(native, "mjdata_offsets", layout)
+    other = mujoco.MjData(model)  # a live mjData of the same model, not this one
+    with monkeypatch.context() as patch:
+        patch.setattr(mujoco.MjData, "_address", property(lambda self, other=other._address: other))
+        with pytest.raises(stepper.LayoutError, match=r"MjData._address do not check out: read \("):
+            stepper.CompiledSteps(model, data, ratchet, np.zeros((2, model.nv)), **stepper.loop_options(model, data))
+        assert not loops(model, data, ratchet)[0].compiled
     servo = CrankServo(lambda t: 10.0 * t, lambda t: 10.0)
     assert type(stepper.make_steps(model, data, ratchet, np.zeros((2, model.nv)), servo=servo,
                                    **loops(model, data, ratchet)[1])) is stepper.PythonSteps
@@ -216,13 +218,110 @@ def test_what_does_not_check_out_steps_in_python(monkeypatch):
 
 
 def test_a_built_stepper_is_used_with_this_mujoco():
-    """Where the extension was built (a C compiler at install), the running mujoco's mjData layout and
-    library check out and serial runs step in C: this fails when a new mujoco moves what the loop reads."""
-    try:
-        from ipir_mujoco.engine import _stepper  # noqa: F401
-    except ImportError:
+    """Where the extension was built (a C compiler at install), it was built against this mujoco's headers,
+    calls the bindings' libmujoco and serial runs step in C: this fails when the installed extension no longer
+    fits the running mujoco."""
+    import importlib.util
+
+    if importlib.util.find_spec(native.EXTENSION) is None:
         pytest.skip("the compiled stepper is not built here (installed without a C compiler)")
     assert stepper.compiled_status() == (True, "compiled")
+    assert native.compiled().MJVERSION_HEADER == mujoco.mj_version()
+    params = RobotParams()
+    model = build_model(params, SolverSettings(), ratchet=True)
+    data, ratchet = ratcheted(params, model)
+    assert type(loops(model, data, ratchet)[0]) is stepper.CompiledSteps
+
+
+@needs_compiled
+def test_the_bindings_addresses_are_their_mjmodel_and_mjdata():
+    """The one private attribute the loop relies on (the bindings give no public way to their mjModel and
+    mjData): ``_address``, read by the C module through MuJoCo's headers, gives the sizes, timestep, time
+    and array pointers the bindings report, before and after steps. Fails if a mujoco release changes it."""
+    params = RobotParams()
+    model = build_model(params, SolverSettings(), ratchet=True)
+    data, _ = ratcheted(params, model)
+    assert native.pointers(native.compiled(), model, data) == (model._address, data._address)
+    mujoco.mj_step(model, data, 10)
+    assert native.pointers(native.compiled(), model, data) == (model._address, data._address)
+
+
+@pytest.fixture
+def fresh_check():
+    """The compiled stepper's once-per-process check made again in the test, and again after it."""
+    native._compiled_cached.cache_clear()
+    yield
+    native._compiled_cached.cache_clear()
+
+
+@needs_compiled
+def test_a_mujoco_of_another_version_is_refused_in_one_line(monkeypatch, fresh_check):
+    """A running mujoco whose version is not the headers' the extension was built against (simulated: the
+    bindings report another version): the compiled stepper is not used, one line says why, runs step in
+    Python."""
+    header = native.compiled().MJVERSION_HEADER
+    native._compiled_cached.cache_clear()
+    monkeypatch.setattr(mujoco, "mj_version", lambda: header + 1)
+    compiled, why = stepper.compiled_status()
+    assert not compiled and "\n" not in why
+    assert why.startswith(f"the compiled stepper was built against MuJoCo's headers of version {header}, the "
+                          f"running mujoco {mujoco.__version__} is version {header + 1}: reinstall ipir-mujoco")
+    params = RobotParams()
+    model = build_model(params, SolverSettings(), ratchet=True)
+    data, ratchet = ratcheted(params, model)
+    assert type(loops(model, data, ratchet)[0]) is stepper.PythonSteps
+
+
+@needs_compiled
+@pytest.mark.parametrize("failure, line", [
+    (ImportError("libmujoco.so.3.9.0: cannot open shared object file: No such file or directory"),
+     "the compiled stepper cannot be loaded with mujoco {} (libmujoco.so.3.9.0: cannot open shared object file: "
+     "No such file or directory): reinstall ipir-mujoco with pip's --no-build-isolation to build it against the "
+     "running mujoco"),
+    (None, "the compiled stepper's libmujoco is not the one mujoco {} loaded: reinstall ipir-mujoco"),
+])
+def test_a_libmujoco_that_cannot_be_loaded_or_is_another_is_refused_in_one_line(monkeypatch, fresh_check, failure,
+                                                                                line):
+    """The extension cannot load its libmujoco (built against a mujoco that is not installed: simulated), or
+    loads another instance than the bindings' (simulated: it never sees the bindings' warning handler):
+    not used, in one line."""
+    module = native.compiled()
+    native._compiled_cached.cache_clear()
+    if failure is not None:
+        def load(name):
+            raise failure
+        monkeypatch.setattr(native.importlib, "import_module", load)
+    else:
+        monkeypatch.setattr(module, "handlers", lambda: (False, False))
+    compiled, why = stepper.compiled_status()
+    assert not compiled and "\n" not in why and why.startswith(line.format(mujoco.__version__))
+
+
+RUN = (  # a short run in a fresh process: which loops recorded, the one line, every column saved to NAME
+    "import numpy as np\n"
+    "from ipir_mujoco.analytic import RobotParams\n"
+    "from ipir_mujoco.engine import simulate_mujoco, stepper\n"
+    "used, python_record = set(), stepper.PythonSteps.record\n"
+    "stepper.PythonSteps.record = lambda self, *a: used.add(type(self).__name__) or python_record(self, *a)\n"
+    "run = simulate_mujoco(RobotParams(), 'unilateral', 'ratchet', 0.05, dt_out=1e-3)\n"
+    "np.save(NAME, np.column_stack([run.series[k] for k in sorted(run.series)]))\n"
+    "print(stepper.compiled_status()[1]); print(sorted(used))\n")
+
+
+@needs_compiled
+def test_the_fallback_runs_the_python_loop_with_no_traceback(tmp_path):
+    """In a fresh process whose mujoco reports another version (simulated before the package is imported):
+    simulate_mujoco steps in Python, gives the numbers of the Python loop IPIR_MUJOCO_STEPPER=python selects,
+    and nothing reaches stderr."""
+    mismatched = "import mujoco\nheader = mujoco.mj_version()\nmujoco.mj_version = lambda: header + 1\n"
+    done = subprocess.run([sys.executable, "-c", mismatched + RUN.replace("NAME", "'run.npy'")], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    line, used = done.stdout.splitlines()
+    assert line.startswith("the compiled stepper was built against MuJoCo's headers") and used == "['PythonSteps']"
+    subprocess.run([sys.executable, "-c", RUN.replace("NAME", "'reference.npy'")], cwd=tmp_path, check=True,
+                   env={**os.environ, stepper.ENV: "python"}, capture_output=True)
+    np.testing.assert_array_equal(np.load(tmp_path / "run.npy"), np.load(tmp_path / "reference.npy"))
 
 
 def edited_template(old: str, new: str) -> str:

@@ -6,10 +6,10 @@
  * sample the record (state, torque, works, clutch reactions, the loop's force, the excursion, and MuJoCo's
  * energies, loop gap and momentum at the start of the next step); the same double arithmetic in the same
  * order (built with -ffp-contract=off, so no fused multiply-add changes a rounding), so the two paths agree
- * bit for bit. It includes no MuJoCo header: Python passes the addresses of mj_step and mj_subtreeVel (from
- * the loaded libmujoco), of every array it touches, and of the mjData fields it reads (the efc_force and
- * efc_id pointers, the counts ne, nf and nl, time, energy, the warning counters), whose offsets it reads from
- * the running mujoco's own struct description and checks on the live MjData before every run (native.py).
+ * bit for bit. It is compiled against the headers of the installed mujoco and linked against its libmujoco
+ * (setup.py), and reads mjModel and mjData through their structs; the module records the header's version
+ * (MJVERSION_HEADER), which native.py checks against the running library before any use, with the library
+ * instance (handlers()) and the mjModel and mjData behind the bindings' objects (check()).
  *
  * Layout: two arrays owned by Python, one int64 per CONFIG field (addresses, indices, flags) and one double
  * per STATE field (what the loop reads and writes); the field names are exported, so stepper.py builds its
@@ -17,6 +17,8 @@
  * checks against recorder.py's. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+
+#include <mujoco/mujoco.h>
 
 #include <math.h>
 #include <setjmp.h>
@@ -26,14 +28,11 @@
 #include <string.h>
 
 #define CONFIG_FIELDS(X)                                                                         \
-  X(model) X(data) X(step) X(user_error) X(efc_force_field) X(ne_field) X(nf_field)              \
-  X(qpos) X(qvel) X(ctrl) X(actuator_force) X(qvel_before)                                       \
-  X(jnt_range) X(eq_data) X(eq_data_stride) X(eq_active) X(eq_rows) X(biasprm) X(biasprm_stride) \
-  X(nv) X(clutch) X(motor) X(crank_q) X(crank_v) X(nfric) X(fric_a) X(fric_b)                    \
+  X(model) X(data) X(qvel_before) X(eq_rows)                                                     \
+  X(clutch) X(motor) X(crank_q) X(crank_v) X(nfric) X(fric_a) X(fric_b)                          \
   X(slide_q0) X(slide_q1) X(slide_v0) X(slide_v1) X(joint0) X(joint1)                            \
   X(eq0) X(eq1) X(rod_q) X(rod_v) X(act0) X(act1) X(implicit)                                   \
-  X(nq) X(nl_field) X(time_field) X(warning_field) X(n_warning) X(efc_id_field) X(subtree_vel)   \
-  X(energy) X(rod_end) X(front_pos) X(subtree_linvel) X(loop_eq) X(fric_off0) X(fric_off1)       \
+  X(rod_site) X(front_body) X(loop_eq) X(fric_off0) X(fric_off1)                                 \
   X(rec_t) X(rec_qpos) X(rec_qvel) X(rec_scalars) X(rec_deferred) X(rec_excursion)
 
 #define STATE_FIELDS(X)                                                                          \
@@ -74,11 +73,14 @@ enum { STEPS_DONE = 0, MISSING_LOCK_ROW = 1, MISSING_FRICTION_ROWS = 2 };
 /* what record() returns besides STEPS_DONE: MuJoCo raised a warning in the last sample's interval */
 enum { RECORD_WARNED = 3 };
 
-typedef void (*step_fn)(const void *m, void *d);
-typedef void (*subtree_vel_fn)(const void *m, void *d);
 typedef void (*error_fn)(const char *msg);
 
+/* the recorder's and the loop's arrays are numpy float64, MuJoCo's arrays are read as such */
+_Static_assert(sizeof(mjtNum) == sizeof(double), "MuJoCo built with single-precision mjtNum");
+
 #define PTR(type, field) ((type)(intptr_t)cfg[C_##field])
+#define MODEL(cfg) ((mjModel *)(intptr_t)(cfg)[C_model])
+#define DATA(cfg) ((mjData *)(intptr_t)(cfg)[C_data])
 
 /* A MuJoCo error inside mj_step: MuJoCo's legacy error handler, borrowed while loops run (installed by
  * the first to start, given back by the last to end: both under the GIL), jumps back into the loop of
@@ -103,7 +105,7 @@ static void on_mujoco_error(const char *msg) {
 
 /* first constraint row of equality eq (active): the active equalities' rows come first, in id order */
 static int64_t equality_row(const int64_t *cfg, int64_t eq) {
-  const unsigned char *active = PTR(const unsigned char *, eq_active);
+  const mjtBool *active = DATA(cfg)->eq_active;
   const int64_t *rows = PTR(const int64_t *, eq_rows);
   int64_t row = 0;
   for (int64_t e = 0; e < eq; e++) {
@@ -114,25 +116,25 @@ static int64_t equality_row(const int64_t *cfg, int64_t eq) {
 
 /* Locks._apply: engage (anchored where the module stands) or release each lock */
 static void apply_locks(const int64_t *cfg, double *st, int want0, int want1) {
-  const double *qpos = PTR(const double *, qpos);
-  double *eq_data = PTR(double *, eq_data);
-  unsigned char *active = PTR(unsigned char *, eq_active);
+  const mjtNum *qpos = DATA(cfg)->qpos;
+  mjtNum *eq_data = MODEL(cfg)->eq_data;
+  mjtBool *active = DATA(cfg)->eq_active;
   const int want[2] = {want0, want1};
   const int64_t eq[2] = {cfg[C_eq0], cfg[C_eq1]}, adr[2] = {cfg[C_slide_q0], cfg[C_slide_q1]};
   for (int i = 0; i < 2; i++) {
     int now = st[S_held0 + i] != 0.0;
-    if (want[i] && !now) eq_data[eq[i] * cfg[C_eq_data_stride]] = qpos[adr[i]];
-    if (want[i] != now) active[eq[i]] = (unsigned char)want[i];
+    if (want[i] && !now) eq_data[eq[i] * mjNEQDATA] = qpos[adr[i]];
+    if (want[i] != now) active[eq[i]] = (mjtBool)want[i];
     st[S_held0 + i] = want[i] ? 1.0 : 0.0;
   }
 }
 
 /* the clutch update before a step: Ratchet, Locks, CompliantClutches.before_step */
 static void before_step(const int64_t *cfg, double *st) {
-  const double *qpos = PTR(const double *, qpos), *qvel = PTR(const double *, qvel);
+  const mjtNum *qpos = DATA(cfg)->qpos, *qvel = DATA(cfg)->qvel;
   switch (cfg[C_clutch]) {
     case RATCHET: {
-      double *range = PTR(double *, jnt_range);
+      mjtNum *range = MODEL(cfg)->jnt_range;
       for (int i = 0; i < 2; i++) {
         double x = qpos[cfg[C_slide_q0 + i]];
         if (x > st[S_bound0 + i]) {
@@ -146,10 +148,10 @@ static void before_step(const int64_t *cfg, double *st) {
     }
     case LOCK_KINEMATIC:
     case LOCK_UNILATERAL: {
-      const double *eq_data = PTR(const double *, eq_data);
+      const mjtNum *eq_data = MODEL(cfg)->eq_data;
       for (int i = 0; i < 2; i++) {
         if (st[S_held0 + i] != 0.0) {
-          double back = eq_data[cfg[C_eq0 + i] * cfg[C_eq_data_stride]] - qpos[cfg[C_slide_q0 + i]];
+          double back = eq_data[cfg[C_eq0 + i] * mjNEQDATA] - qpos[cfg[C_slide_q0 + i]];
           if (back > st[S_excursion]) st[S_excursion] = back;
         }
       }
@@ -171,7 +173,7 @@ static void before_step(const int64_t *cfg, double *st) {
       break;
     }
     case COMPLIANT: {
-      double *ctrl = PTR(double *, ctrl), *biasprm = PTR(double *, biasprm);
+      mjtNum *ctrl = DATA(cfg)->ctrl, *biasprm = MODEL(cfg)->actuator_biasprm;
       for (int i = 0; i < 2; i++) {
         int64_t act = cfg[C_act0 + i];
         double x = qpos[cfg[C_slide_q0 + i]];
@@ -184,7 +186,7 @@ static void before_step(const int64_t *cfg, double *st) {
         st[S_v_before0 + i] = qvel[cfg[C_slide_v0 + i]];
         if ((d > 0.0) != (st[S_damped0 + i] != 0.0)) {
           st[S_damped0 + i] = d > 0.0 ? 1.0 : 0.0;
-          biasprm[act * cfg[C_biasprm_stride] + 2] = d > 0.0 ? -st[S_c] : 0.0;
+          biasprm[act * mjNBIAS + 2] = d > 0.0 ? -st[S_c] : 0.0;
         }
       }
       break;
@@ -208,7 +210,7 @@ static int after_step(const int64_t *cfg, double *st, const double *efc_force, i
       }
     }
   } else if (cfg[C_clutch] == COMPLIANT) {
-    const double *force = PTR(const double *, actuator_force), *qvel = PTR(const double *, qvel);
+    const mjtNum *force = DATA(cfg)->actuator_force, *qvel = DATA(cfg)->qvel;
     double work = 0.0;
     for (int i = 0; i < 2; i++) {
       double d = st[S_overlap0 + i], applied = force[cfg[C_act0 + i]];
@@ -227,29 +229,26 @@ static int after_step(const int64_t *cfg, double *st, const double *efc_force, i
 /* nstep steps; before the last one the velocities are copied into ``dest`` (if not NULL). Returns
  * STEPS_DONE, or the MISSING_* code of the rows a step did not produce (the state is then not written back) */
 static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) {
-  const void *m = PTR(const void *, model);
-  void *d = PTR(void *, data);
-  step_fn step = PTR(step_fn, step);
-  double *const *efc_field = PTR(double *const *, efc_force_field);
-  const int *ne_field = PTR(const int *, ne_field), *nf_field = PTR(const int *, nf_field);
-  const double *qvel = PTR(const double *, qvel), *force = PTR(const double *, actuator_force);
+  const mjModel *m = MODEL(cfg);
+  mjData *d = DATA(cfg);
+  const mjtNum *qvel = d->qvel, *force = d->actuator_force;
   const int64_t motor = cfg[C_motor], crank_v = cfg[C_crank_v], nfric = cfg[C_nfric];
   const int64_t fa = cfg[C_fric_a], fb = cfg[C_fric_b];
   const double dt = st[S_dt], slope = st[S_slope];
   double torque = st[S_torque], wm = st[S_motor_work], wf = st[S_friction_work], omega_prev = st[S_omega_prev];
   for (long long n = 0; n < nstep; n++) {
     before_step(cfg, st);
-    if (n == nstep - 1 && dest != NULL) memcpy(dest, qvel, (size_t)cfg[C_nv] * sizeof(double));
-    step(m, d);
-    const double *efc_force = *efc_field;
-    const int ne = *ne_field;
+    if (n == nstep - 1 && dest != NULL) memcpy(dest, qvel, (size_t)m->nv * sizeof(mjtNum));
+    mj_step(m, d);
+    const mjtNum *efc_force = d->efc_force;
+    const int ne = d->ne;
     int status = after_step(cfg, st, efc_force, ne);
     if (status != STEPS_DONE) return status;
     double omega = qvel[crank_v];
     torque = force[motor] + slope * (omega - omega_prev);
     wm += torque * omega * dt;
     /* the frictionloss rows follow the ne equality rows, one per dof with friction: read only if there */
-    if (nfric > 0 && *nf_field != nfric) return MISSING_FRICTION_ROWS;
+    if (nfric > 0 && d->nf != nfric) return MISSING_FRICTION_ROWS;
     if (nfric == 2) {
       double f0 = efc_force[ne], f1 = efc_force[ne + 1];
       wf -= (f0 * qvel[fa] + f1 * qvel[fb]) * dt;
@@ -283,8 +282,9 @@ static void friction_forces(const int64_t *cfg, const double *efc_force, int ne,
 
 /* the clutch controller's reactions() after the last step: (rear held, front held, rear [N], front [N]) */
 static int reactions(const int64_t *cfg, const double *st, double out[4]) {
-  const double *efc_force = *PTR(double *const *, efc_force_field);
-  const int ne = *PTR(const int *, ne_field), nf = *PTR(const int *, nf_field), nl = *PTR(const int *, nl_field);
+  const mjData *d = DATA(cfg);
+  const mjtNum *efc_force = d->efc_force;
+  const int ne = d->ne, nf = d->nf, nl = d->nl;
   const double r[2] = {st[S_resist0], st[S_resist1]};
   double f[2], hold[2];
   /* as FrictionRows.forces (the rigid clutches' reactions read it): never a row that is not a slide's */
@@ -306,8 +306,7 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
           front = swap;
         }
       } else if (nl == 1) {
-        const int *efc_id = *PTR(int *const *, efc_id_field);
-        if (efc_id[start] == cfg[C_joint0]) {
+        if (d->efc_id[start] == cfg[C_joint0]) {
           rear = efc_force[start];
         } else {
           front = efc_force[start];
@@ -352,15 +351,16 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
 
 /* Recorder.sample: the state after the last step as row ``row`` */
 static int sample(const int64_t *cfg, const double *st, int64_t row) {
-  const int64_t nq = cfg[C_nq], nv = cfg[C_nv];
-  const double *efc_force = *PTR(double *const *, efc_force_field);
-  const int ne = *PTR(const int *, ne_field);
+  const int64_t nq = MODEL(cfg)->nq, nv = MODEL(cfg)->nv;
+  const mjData *d = DATA(cfg);
+  const mjtNum *efc_force = d->efc_force;
+  const int ne = d->ne;
   double held[4];
   int status = reactions(cfg, st, held);
   if (status != STEPS_DONE) return status;
-  PTR(double *, rec_t)[row] = *PTR(const double *, time_field);
-  memcpy(PTR(double *, rec_qpos) + row * nq, PTR(const double *, qpos), (size_t)nq * sizeof(double));
-  memcpy(PTR(double *, rec_qvel) + row * nv, PTR(const double *, qvel), (size_t)nv * sizeof(double));
+  PTR(double *, rec_t)[row] = d->time;
+  memcpy(PTR(double *, rec_qpos) + row * nq, d->qpos, (size_t)nq * sizeof(mjtNum));
+  memcpy(PTR(double *, rec_qvel) + row * nv, d->qvel, (size_t)nv * sizeof(mjtNum));
   double *out = PTR(double *, rec_scalars) + row * N_SCALARS;
   int64_t loop = equality_row(cfg, cfg[C_loop_eq]);
   out[R_motor_torque] = st[S_torque];
@@ -380,21 +380,22 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
 /* Recorder.fill_deferred: MuJoCo's values at the start of the step just taken; with compliant clutches also
  * their forces, the overlaps their before_step set for that state and CompliantClutches.stepped_spring_energy */
 static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
-  const double *energy = PTR(const double *, energy), *rod = PTR(const double *, rod_end);
-  const double *front = PTR(const double *, front_pos);
+  const mjModel *m = MODEL(cfg);
+  mjData *d = DATA(cfg);
+  const mjtNum *rod = d->site_xpos + 3 * cfg[C_rod_site], *front = d->xpos + 3 * cfg[C_front_body];
   double *out = PTR(double *, rec_deferred) + row * N_DEFERRED;
   double sx = rod[0], sy = rod[1], sz = rod[2], bx = front[0], by = front[1], bz = front[2];
   double ox = st[S_pin_x], oy = st[S_pin_y], oz = st[S_pin_z];
   double dx = sx - bx - ox, dy = sy - by - oy, dz = sz - bz - oz;
   out[D_loop_gap] = sqrt(dx * dx + dy * dy + dz * dz);
-  PTR(subtree_vel_fn, subtree_vel)(PTR(const void *, model), PTR(void *, data));
-  out[D_momentum] = PTR(const double *, subtree_linvel)[0] * st[S_total_mass];
-  out[D_potential] = energy[0];
-  out[D_kinetic] = energy[1];
+  mj_subtreeVel(m, d);
+  out[D_momentum] = d->subtree_linvel[0] * st[S_total_mass];
+  out[D_potential] = d->energy[0];
+  out[D_kinetic] = d->energy[1];
   out[D_clutch_force1] = out[D_clutch_force2] = out[D_clutch_overlap1] = out[D_clutch_overlap2] = 0.0;
   out[D_clutch_spring] = 0.0;
   if (cfg[C_clutch] == COMPLIANT) {
-    const double *force = PTR(const double *, actuator_force);
+    const mjtNum *force = d->actuator_force;
     const double k = st[S_k], dt = st[S_dt];
     double spring = 0.0;
     for (int i = 0; i < 2; i++) {
@@ -407,11 +408,10 @@ static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   }
 }
 
-/* how many warnings MuJoCo has raised on this mjData so far (each mjWarningStat: lastinfo, number) */
-static long long warnings(const int64_t *cfg) {
-  const int *stat = PTR(const int *, warning_field);
+/* how many warnings MuJoCo has raised on this mjData so far */
+static long long warnings(const mjData *d) {
   long long total = 0;
-  for (int64_t w = 0; w < cfg[C_n_warning]; w++) total += stat[2 * w + 1];
+  for (int w = 0; w < mjNWARNING; w++) total += d->warning[w].number;
   return total;
 }
 
@@ -422,12 +422,12 @@ static long long warnings(const int64_t *cfg) {
  * MISSING_* code. */
 static int record(const int64_t *cfg, double *st, long long nsamples, long long sps, long long remaining,
                   long long pending) {
-  const int64_t nv = cfg[C_nv];
+  const int64_t nv = MODEL(cfg)->nv;
   double *before = PTR(double *, qvel_before);
   for (long long s = 0; s < nsamples && remaining > 0; s++) {
     const long long k = sps < remaining ? sps : remaining;
     const int64_t row = (int64_t)st[S_count];
-    const long long warned = warnings(cfg);
+    const long long warned = warnings(DATA(cfg));
     int status;
     if (pending >= 0) {
       status = steps(cfg, st, 1, k == 1 ? before + row * nv : NULL);
@@ -439,7 +439,7 @@ static int record(const int64_t *cfg, double *st, long long nsamples, long long 
     }
     remaining -= k;
     st[S_steps_done] += (double)k;
-    if (warnings(cfg) != warned) return RECORD_WARNED; /* as the Python loop: the interval is not recorded */
+    if (warnings(DATA(cfg)) != warned) return RECORD_WARNED; /* as the Python loop: the interval is not recorded */
     if ((status = sample(cfg, st, row)) != STEPS_DONE) return status;
     st[S_count] = (double)(row + 1);
     pending = row;
@@ -452,13 +452,12 @@ static int record(const int64_t *cfg, double *st, long long nsamples, long long 
  * then as the bindings leave it after such an error, not to be stepped on) or LookupError (the MISSING_* code
  * as its argument: a step did not produce the rows the loop reads) set. */
 static int guarded(const int64_t *cfg, double *st, char what, const long long *a, double *dest) {
-  error_fn *user_error = PTR(error_fn *, user_error);
   int failed = 0;
   volatile int status = STEPS_DONE; /* set between setjmp and a possible longjmp */
   jmp_buf jump;
-  if (user_error != NULL && loops_running++ == 0) {
-    previous_error = *user_error;
-    *user_error = on_mujoco_error;
+  if (loops_running++ == 0) {
+    previous_error = mju_user_error;
+    mju_user_error = on_mujoco_error;
   }
   Py_BEGIN_ALLOW_THREADS
   error_jump = &jump;
@@ -469,7 +468,7 @@ static int guarded(const int64_t *cfg, double *st, char what, const long long *a
   }
   error_jump = NULL;
   Py_END_ALLOW_THREADS
-  if (user_error != NULL && --loops_running == 0) *user_error = previous_error;
+  if (--loops_running == 0) mju_user_error = previous_error;
   if (failed) {
     PyErr_SetString(PyExc_RuntimeError, error_text);
     return -1;
@@ -492,7 +491,7 @@ static PyObject *run(PyObject *self, PyObject *args) {
   long long nstep, row;
   if (!PyArg_ParseTuple(args, "KKLL", &cfg_adr, &st_adr, &nstep, &row)) return NULL;
   const int64_t *cfg = (const int64_t *)(intptr_t)cfg_adr;
-  double *dest = row >= 0 ? PTR(double *, qvel_before) + row * cfg[C_nv] : NULL;
+  double *dest = row >= 0 ? PTR(double *, qvel_before) + row * MODEL(cfg)->nv : NULL;
   if (guarded(cfg, (double *)(intptr_t)st_adr, 's', &nstep, dest) < 0) return NULL;
   Py_RETURN_NONE;
 }
@@ -508,10 +507,32 @@ static PyObject *record_samples(PyObject *self, PyObject *args) {
   return status < 0 ? NULL : PyLong_FromLong(status);
 }
 
+/* check(model address, data address): what this module reads there, to compare with what the bindings report
+ * for the same objects: (nq, nv, timestep, jnt_range, eq_data, qpos, qvel, time), the pointers as ints */
+static PyObject *check(PyObject *self, PyObject *args) {
+  (void)self;
+  unsigned long long m_adr, d_adr;
+  if (!PyArg_ParseTuple(args, "KK", &m_adr, &d_adr)) return NULL;
+  const mjModel *m = (const mjModel *)(intptr_t)m_adr;
+  const mjData *d = (const mjData *)(intptr_t)d_adr;
+  return Py_BuildValue("LLdKKKKd", (long long)m->nq, (long long)m->nv, m->opt.timestep,
+                       (unsigned long long)(uintptr_t)m->jnt_range, (unsigned long long)(uintptr_t)m->eq_data,
+                       (unsigned long long)(uintptr_t)d->qpos, (unsigned long long)(uintptr_t)d->qvel, d->time);
+}
+
+/* handlers(): whether the linked library's mju_user_error and mju_user_warning are set (bools) */
+static PyObject *handlers(PyObject *self, PyObject *args) {
+  (void)self;
+  (void)args;
+  return Py_BuildValue("(NN)", PyBool_FromLong(mju_user_error != NULL), PyBool_FromLong(mju_user_warning != NULL));
+}
+
 static PyMethodDef methods[] = {
     {"run", run, METH_VARARGS, "run(config, state, nstep, row): nstep steps of a serial run (see stepper.py)"},
     {"record", record_samples, METH_VARARGS,
      "record(config, state, nsamples, sps, remaining, pending): recorded output intervals (see stepper.py)"},
+    {"check", check, METH_VARARGS, "check(model, data): fields read at these addresses (see native.py)"},
+    {"handlers", handlers, METH_NOARGS, "handlers(): whether mju_user_error, mju_user_warning are set"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -545,7 +566,8 @@ PyMODINIT_FUNC PyInit__stepper(void) {
       PyModule_AddObject(mod, "STATE", names(state_names, N_STATE)) < 0 ||
       PyModule_AddObject(mod, "SCALARS", names(scalar_names, N_SCALARS)) < 0 ||
       PyModule_AddObject(mod, "DEFERRED", names(deferred_names, N_DEFERRED)) < 0 ||
-      PyModule_AddIntConstant(mod, "WARNED", RECORD_WARNED) < 0) {
+      PyModule_AddIntConstant(mod, "WARNED", RECORD_WARNED) < 0 ||
+      PyModule_AddIntConstant(mod, "MJVERSION_HEADER", mjVERSION_HEADER) < 0) {
     Py_DECREF(mod);
     return NULL;
   }

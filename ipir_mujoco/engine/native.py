@@ -1,26 +1,32 @@
-"""The compiled stepping loop's binding: the extension module, the MuJoCo library it calls, the mjData layout.
+"""The compiled stepping loop's binding: the extension module, checked against the running mujoco.
 
-``_stepper.c`` includes no MuJoCo header, so it does not depend on the version it was built against: this
-module finds ``mj_step`` and ``mj_subtreeVel`` in the libmujoco the bindings loaded (checked to be that very
-instance), and the byte offsets of the mjData fields the loop reads between steps (the ``efc_force`` and
-``efc_id`` pointers, the constraint counts, time, the warning counters) from the running mujoco's own
-description of its structs (``mujoco.introspect``), checked against a live MjData before every run. Anything
-that does not check out raises :class:`LayoutError`, and the engine steps in Python instead.
+``_stepper.c`` is compiled against the headers of the mujoco installed where it was built and linked against
+that mujoco's libmujoco by its SONAME, with no search path (``setup.py``): imported after ``mujoco``, it calls
+the libmujoco the bindings loaded. It is used only if, checked once per process: it imports, it was built
+from this package's sources (the recorder's columns), the headers' version (``MJVERSION_HEADER``) is the
+running library's (``mujoco.mj_version()``), and the library it calls is the bindings' very instance. If
+not, :func:`compiled` raises :class:`LayoutError` with one line saying why (``stepper.compiled_status()``
+reports it) and the engine steps in Python.
+
+The mjModel and mjData behind the bindings' objects: the bindings have no public accessor for them, so
+their ``_address`` (the bindings' own, covered by their test suite) is read, only once the versions agree,
+and checked before every run: what the C module reads there must be what the bindings report
+(:func:`pointers`).
 """
 
 from __future__ import annotations
 
-import ctypes
 import functools
-import glob
-import os
+import importlib
+import importlib.util
 
 import mujoco
 import numpy as np
 
 from .recorder import DEFERRED, SCALARS
 
-_DATA_FIELDS = ("warning", "time", "qpos", "qvel", "ne", "nf", "nl", "nefc", "efc_id", "efc_force")
+EXTENSION = f"{__package__}._stepper"
+REBUILD = "reinstall ipir-mujoco with pip's --no-build-isolation to build it against the running mujoco"
 
 
 class LayoutError(RuntimeError):
@@ -32,121 +38,63 @@ def address(array: np.ndarray) -> int:
     return int(array.ctypes.data)
 
 
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
 @functools.lru_cache(maxsize=None)
 def _compiled_cached():
+    """(the extension module, "compiled"), or (None, the one line saying why it is not used)."""
+    if importlib.util.find_spec(EXTENSION) is None:
+        return None, "the compiled stepper is not built; reinstall with a C compiler"
     try:
-        from . import _stepper
-    except ImportError as exc:
-        return None, f"the compiled stepper is not built ({exc}); reinstall with a C compiler"
-    if (tuple(_stepper.SCALARS), tuple(_stepper.DEFERRED)) != (SCALARS, DEFERRED):
+        stepper = importlib.import_module(EXTENSION)
+    except ImportError as exc:  # its libmujoco is neither the one loaded nor anywhere the linker looks
+        return None, _one_line(f"the compiled stepper cannot be loaded with mujoco {mujoco.__version__} "
+                               f"({exc}): {REBUILD}")
+    if (tuple(stepper.SCALARS), tuple(stepper.DEFERRED)) != (SCALARS, DEFERRED):
         return None, "the compiled stepper was built from other sources than this package's; reinstall it"
+    header, running = stepper.MJVERSION_HEADER, mujoco.mj_version()
+    if header != running:
+        return None, (f"the compiled stepper was built against MuJoCo's headers of version {header}, the running "
+                      f"mujoco {mujoco.__version__} is version {running}: {REBUILD}")
+    if not _same_library(stepper):
+        return None, f"the compiled stepper's libmujoco is not the one mujoco {mujoco.__version__} loaded: {REBUILD}"
+    return stepper, "compiled"
+
+
+def _same_library(stepper) -> bool:
+    """Whether the libmujoco the extension calls is the bindings' instance: a warning handler set through the
+    bindings (and only then) shows in its ``mju_user_warning``."""
+    if mujoco.get_mju_user_warning() is not None:
+        return stepper.handlers()[1]
+    unset = not stepper.handlers()[1]
     try:
-        library = _library()
-        mjdata_offsets()
-    except (LayoutError, ImportError, OSError, AttributeError, KeyError, TypeError, ValueError) as exc:
-        return None, f"the compiled stepper cannot be used with mujoco {mujoco.__version__}: {exc}"
-    return (_stepper, library), "compiled"
+        mujoco.set_mju_user_warning(lambda message: None)
+        return unset and stepper.handlers()[1]
+    finally:
+        mujoco.set_mju_user_warning(None)
 
 
 def compiled():
+    """The extension module, checked to fit the running mujoco; raises :class:`LayoutError` (one line)."""
     found, why = _compiled_cached()
     if found is None:
         raise LayoutError(why)
     return found
 
 
-def _library() -> dict[str, int]:
-    """Addresses of ``mj_step``, ``mj_subtreeVel`` and the legacy error handler pointer in the libmujoco the
-    bindings use."""
-    folder = os.path.dirname(mujoco.__file__)
-    paths = sorted(glob.glob(os.path.join(folder, "libmujoco.so*"))
-                   + glob.glob(os.path.join(folder, "libmujoco*.dylib")))
-    if not paths:
-        raise LayoutError(f"no libmujoco beside the bindings in {folder}")
-    lib = ctypes.CDLL(paths[0])
-    # the instance the bindings use: a warning handler set through them shows in this library's global
-    if mujoco.get_mju_user_warning() is not None:
-        same = ctypes.c_void_p.in_dll(lib, "mju_user_warning").value is not None
-    else:
-        try:
-            mujoco.set_mju_user_warning(lambda message: None)
-            same = ctypes.c_void_p.in_dll(lib, "mju_user_warning").value is not None
-        finally:
-            mujoco.set_mju_user_warning(None)
-    if not same:
-        raise LayoutError(f"{paths[0]} is not the library instance the bindings use")
+def pointers(stepper, model: mujoco.MjModel, data: mujoco.MjData) -> tuple[int, int]:
+    """The addresses of ``model``'s mjModel and ``data``'s mjData (``data`` of ``model``), checked: the sizes,
+    timestep, time and array pointers the C module reads there are the bindings'."""
     try:
-        user_error = ctypes.addressof(ctypes.c_void_p.in_dll(lib, "mju_user_error"))
-    except ValueError:  # no legacy handler: a MuJoCo error inside the loop is then MuJoCo's default (exit)
-        user_error = 0
-    return {"mj_step": ctypes.cast(lib.mj_step, ctypes.c_void_p).value,
-            "mj_subtreeVel": ctypes.cast(lib.mj_subtreeVel, ctypes.c_void_p).value, "mju_user_error": user_error}
-
-
-_SCALARS = {"mjtNum": ctypes.c_double, "double": ctypes.c_double, "float": ctypes.c_float, "int": ctypes.c_int,
-            "unsigned int": ctypes.c_uint, "size_t": ctypes.c_size_t, "uintptr_t": ctypes.c_size_t,
-            "mjtSize": ctypes.c_int64, "mjtBool": ctypes.c_bool, "mjtByte": ctypes.c_ubyte}
-
-
-@functools.lru_cache(maxsize=None)
-def mjdata_offsets() -> dict[str, int]:
-    """Byte offsets of :data:`_DATA_FIELDS` in mjData, from ``mujoco.introspect``'s declaration of the
-    struct laid out by ctypes (the platform's C rules); only the fields up to the last one needed."""
-    from mujoco.introspect import ast_nodes, enums, structs
-
-    def ctype(t):
-        if isinstance(t, ast_nodes.PointerType):
-            return ctypes.c_void_p
-        if isinstance(t, ast_nodes.ArrayType):
-            inner = ctype(t.inner_type)
-            for extent in reversed(t.extents):
-                inner = inner * extent
-            return inner
-        if isinstance(t, ast_nodes.ValueType):
-            if t.name in _SCALARS:
-                return _SCALARS[t.name]
-            if t.name in enums.ENUMS:
-                return ctypes.c_int
-            if t.name in structs.STRUCTS:
-                return struct(t.name, None)
-        raise LayoutError(f"mjData field type {t!r} is not understood")
-
-    def struct(name, last):
-        fields = []
-        for field in structs.STRUCTS[name].fields:
-            fields.append((field.name, ctype(field.type)))
-            if field.name == last:
-                break
-        return type(name, (ctypes.Structure,), {"_fields_": fields})
-
-    stat = [(f.name, getattr(f.type, "name", None)) for f in structs.STRUCTS["mjWarningStat"].fields]
-    if stat != [("lastinfo", "int"), ("number", "int")]:  # _stepper.c counts warnings on this layout
-        raise LayoutError(f"mjWarningStat is {stat}, not (int lastinfo, int number)")
-    names = [f.name for f in structs.STRUCTS["mjData"].fields]
-    missing = [n for n in _DATA_FIELDS if n not in names]
-    if missing:
-        raise LayoutError(f"mjData has no field {missing[0]!r}")
-    layout = struct("mjData", max(_DATA_FIELDS, key=names.index))
-    return {n: getattr(layout, n).offset for n in _DATA_FIELDS}
-
-
-def check_layout(data: mujoco.MjData) -> dict[str, int]:
-    """The offsets, checked on ``data`` (after ``mj_forward``): every field read at its offset must be what
-    the bindings report."""
-    offsets = mjdata_offsets()
-    base = data._address
-    read = {n: ctypes.c_int.from_address(base + offsets[n]).value for n in ("ne", "nf", "nl", "nefc")}
-    read["time"] = ctypes.c_double.from_address(base + offsets["time"]).value
-    for n in ("qpos", "qvel", "efc_id", "efc_force"):
-        read[n] = ctypes.c_void_p.from_address(base + offsets[n]).value
-    # each mjWarningStat is (lastinfo, number), two ints
-    read["warning"] = [ctypes.c_int.from_address(base + offsets["warning"] + 8 * w + 4).value
-                       for w in range(len(data.warning))]
-    expected = {n: int(getattr(data, n)) for n in ("ne", "nf", "nl", "nefc")}
-    expected["time"] = float(data.time)
-    for n in ("qpos", "qvel", "efc_id", "efc_force"):
-        expected[n] = address(getattr(data, n)) if getattr(data, n).size else read[n]
-    expected["warning"] = data.warning.number.tolist()
-    if data.nefc == 0 or read != expected:
-        raise LayoutError(f"the mjData layout does not check out: read {read}, expected {expected}")
-    return offsets
+        found = model._address, data._address
+    except AttributeError as exc:
+        raise LayoutError(f"mujoco {mujoco.__version__}'s bindings do not give the mjModel and mjData: {exc}")
+    expected = (model.nq, model.nv, model.opt.timestep, address(model.jnt_range), address(model.eq_data),
+                address(data.qpos), address(data.qvel), data.time)
+    read = stepper.check(*found)
+    if read != expected:
+        raise LayoutError(f"mujoco {mujoco.__version__}'s MjModel and MjData._address do not check out: "
+                          f"read {read}, expected {expected}")
+    return found

@@ -20,11 +20,11 @@ Why a loop in C rather than MuJoCo's control callback: ``mjcb_control`` runs
 after the constraint rows are assembled, so a ratchet bound written there acts
 a step late, and the friction rows' forces of a step are gone by the next
 callback; the loop keeps today's order exactly (``mjcf/README.md`` has the
-measurements). How the C code finds MuJoCo's functions and mjData fields
-without its headers: :mod:`.native`. Anything that does not check out there, a
-crank servo (a Python function of time) or ``IPIR_MUJOCO_STEPPER=python`` in
-the environment selects :class:`PythonSteps`; :func:`compiled_status` says
-which and why.
+measurements). The C code is built against MuJoCo's headers and checked
+against the running mujoco by :mod:`.native`. Anything that does not check out
+there, a crank servo (a Python function of time) or ``IPIR_MUJOCO_STEPPER=python``
+in the environment selects :class:`PythonSteps`; :func:`compiled_status` says
+which and why, in one line.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from ipir_mujoco.core.errors import ParameterError
 from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
 from .compliant import CompliantClutches
 from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
-from .native import LayoutError, check_layout, compiled, mjdata_offsets
+from .native import LayoutError, compiled, pointers
 from .native import address as array_address
 from .recorder import Recorder
 
@@ -172,9 +172,8 @@ class CompiledSteps(PythonSteps):
         if options.get("servo") is not None:
             raise LayoutError("a crank servo is a Python function of time")
         super().__init__(model, data, controller, qvel_before, **options)
-        stepper, library = compiled()
-        self._library = library
-        offsets = check_layout(data)
+        stepper = compiled()
+        model_address, data_address = pointers(stepper, model, data)
         self._module = stepper
         self._cfg = np.zeros(len(stepper.CONFIG), dtype=np.int64)
         self._st = np.zeros(len(stepper.STATE))
@@ -183,20 +182,10 @@ class CompiledSteps(PythonSteps):
         if not (qvel_before.flags.c_contiguous and qvel_before.dtype == np.float64
                 and qvel_before.shape[1:] == (model.nv,)):
             raise LayoutError("qvel_before must be a C-contiguous float64 array of rows of nv")
-        if data.eq_active.itemsize != 1 or model.jnt_range.shape[1:] != (2,):
-            raise LayoutError("eq_active must hold one byte per equality and jnt_range two bounds per joint")
-        address = data._address
         self._set_config(
-            model=model._address, data=address, step=library["mj_step"], user_error=library["mju_user_error"],
-            efc_force_field=address + offsets["efc_force"], ne_field=address + offsets["ne"],
-            nf_field=address + offsets["nf"],
-            qpos=array_address(data.qpos), qvel=array_address(data.qvel), ctrl=array_address(data.ctrl),
-            actuator_force=array_address(data.actuator_force), qvel_before=array_address(qvel_before),
-            jnt_range=array_address(model.jnt_range), eq_data=array_address(model.eq_data),
-            eq_data_stride=model.eq_data.shape[1], eq_active=array_address(data.eq_active),
-            biasprm=array_address(model.actuator_biasprm), biasprm_stride=model.actuator_biasprm.shape[1],
-            nv=model.nv, motor=self.motor, crank_q=self.crank_q, crank_v=self.crank_v,
-            nfric=len(self.friction_dofs), fric_a=self.fric_a, fric_b=self.fric_b)
+            model=model_address, data=data_address, qvel_before=array_address(qvel_before), motor=self.motor,
+            crank_q=self.crank_q, crank_v=self.crank_v, nfric=len(self.friction_dofs), fric_a=self.fric_a,
+            fric_b=self.fric_b)
         self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
         self._cfg[self.C["eq_rows"]] = array_address(self._eq_rows) if self._eq_rows.size else 0
         self._set_state(dt=model.opt.timestep, slope=self.slope, torque=self.torque,
@@ -239,17 +228,12 @@ class CompiledSteps(PythonSteps):
 
     def _bind(self, rec: Recorder) -> None:
         """Where the C loop writes ``rec``'s samples (its arrays: C-contiguous float64, qvel_before the
-        loop's own) and reads what they hold."""
-        ctl, offsets, address = self.controller, mjdata_offsets(), self.data._address
+        loop's own) and what it reads for them (the rod end's site, the front module's body, the loop)."""
+        ctl = self.controller
         friction = getattr(ctl, "friction", None)
         fric_off, resist = (friction.offsets, friction.resistance) if friction is not None else ([-1, -1], [0, 0])
         self._set_config(
-            nq=self.model.nq, nl_field=address + offsets["nl"], time_field=address + offsets["time"],
-            warning_field=address + offsets["warning"], n_warning=len(self.data.warning),
-            efc_id_field=address + offsets["efc_id"], subtree_vel=self._library["mj_subtreeVel"],
-            energy=array_address(rec._energy), rod_end=array_address(rec._rod_end),
-            front_pos=array_address(rec._front_pos), subtree_linvel=array_address(rec._subtree_linvel),
-            loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
+            rod_site=rec.site, front_body=rec.front, loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
             rec_qpos=array_address(rec.qpos), rec_qvel=array_address(rec.qvel),
             rec_scalars=array_address(rec.scalars), rec_deferred=array_address(rec.deferred),
             rec_excursion=array_address(rec.excursion))
