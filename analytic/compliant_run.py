@@ -25,13 +25,11 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
@@ -55,38 +53,21 @@ MAX_SWITCHES = 1_000_000
 _BUDGET_CHECK_EVERY = 2000  # right-hand-side calls between wall-clock checks
 
 
-def simulate_compliant(
-    params: RobotParams,
-    geometry: Geometry | str = Geometry.EXACT,
-    t_end: float = 1.0,
-    *,
-    dt_out: float = 1e-4,
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
-    method: str = "DOP853",
-    max_switches: int | None = None,
-    wall_budget_s: float | None = None,
-    until_steady: bool = False,
-    steady_tol: float = STEADY_TOL,
-    steady_cycles: int = STEADY_CYCLES,
-    progress: Callable[[float], None] | None = None,
-) -> RunResult:
+def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.EXACT, t_end: float = 1.0, *,
+                       rtol: float = 1e-10, atol: float = 1e-12, method: str = "DOP853", **run) -> RunResult:
     """Simulate the robot with compliant one-way clutches (``params.clutch_stiffness`` finite).
 
-    ``dt_out`` [s]: output grid. ``rtol``/``atol``: ``solve_ivp`` tolerances on the state
-    (phi [rad], omega [rad/s], x1 [m], v1 [m/s], three cumulative works [J]); ``method``: its
-    integrator (DOP853 by default: the clutch springs' oscillations are undamped or lightly
-    damped, so they must be resolved, which an explicit method does cheapest). ``max_switches``:
-    most regime changes allowed (default :data:`MAX_SWITCHES`); ``wall_budget_s`` [s]: most
-    wall-clock time allowed (None: no limit), checked between segments and within long ones; both
-    raise SimulationError when exceeded. ``until_steady``: stop at the end of the revolution where the
-    per-revolution mean speed has settled (``steady_tol``, ``steady_cycles``; ``t_end`` is the cap).
-    ``progress(t)`` is called about every 0.1 s of simulated time. Budgets, progress and the steady
-    stop are the other analytic models' (:class:`.solver_support.RunMonitor`). Initial module
-    velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in the other engines.
+    ``rtol``/``atol``: the solver's tolerances on the state (phi [rad], omega [rad/s], x1 [m],
+    v1 [m/s], three cumulative works [J]); ``method``: its integrator (DOP853 by default: the
+    clutch springs' oscillations are undamped or lightly damped, so they must be resolved, which
+    an explicit method does cheapest). ``run``: the run options every engine takes
+    (:class:`ipir_mujoco.core.options.RunOptions`; ``max_switches`` counts regime changes,
+    default :data:`MAX_SWITCHES`; the wall-time budget is checked between segments and within long
+    ones), run by :class:`.solver_support.RunMonitor` as in the other analytic models. Initial
+    module velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in the
+    other engines.
     """
-    options = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s,
-                         max_switches)
+    options = RunOptions.given(t_end, run)
     rtol, atol = check_tolerances(rtol, atol)
     t_end, dt_out = options.t_end, options.dt_out
     if params.clutch_stiffness is None:

@@ -41,7 +41,6 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
@@ -97,39 +96,24 @@ def choose_initial_mode(dyn: OneDofDynamics, phi: float, omega: float, M: float 
     return choose_mode_at_rest_gap(dyn, phi, omega, M)
 
 
-def simulate_kinematic(
-    params: RobotParams,
-    geometry: Geometry | str = Geometry.APPROX,
-    t_end: float = 1.0,
-    *,
-    dt_out: float = 1e-4,
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
-    max_switches: int | None = None,
-    torque: Callable | None = None,
-    until_steady: bool = False,
-    steady_tol: float = STEADY_TOL,
-    steady_cycles: int = STEADY_CYCLES,
-    progress: Callable[[float], None] | None = None,
-    wall_budget_s: float | None = None,
-) -> RunResult:
+def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.APPROX, t_end: float = 1.0, *,
+                       rtol: float = 1e-10, atol: float = 1e-12, torque: Callable | None = None, **run) -> RunResult:
     """Simulate the robot with the paper's clutch rule.
 
     ``geometry`` 'approx' is the paper's model (rod ignored); 'exact' uses the
-    exact slider-crank with the rod's mass and inertia. ``dt_out`` [s] is the
-    output grid; mode-switch instants are added to it (twice: once per mode),
-    and so is each revolution's end. ``rtol``/``atol`` go to ``solve_ivp``
-    (DOP853) on the state (phi [rad], omega [rad/s], x1 [m], x2 [m], motor work [J]).
-    ``torque(t, phi, omega)`` [N m], vectorized, replaces the drive of ``params``
-    (e.g. a torque from inverse kinetostatics); a stall under it is an error,
-    since a stall is only final where the torque at rest is constant. With
-    ``until_steady`` the run stops at the end of the revolution where the
-    periodic steady state is reached (``steady_tol``, ``steady_cycles``: see
-    :class:`.cycles.SteadyWatch`); ``t_end`` [s] is the cap. Work budget and
-    progress: see :class:`.solver_support.RunMonitor`.
+    exact slider-crank with the rod's mass and inertia. ``rtol``/``atol``: the
+    DOP853 tolerances on the state (phi [rad], omega [rad/s], x1 [m], x2 [m],
+    motor work [J]). ``torque(t, phi, omega)`` [N m], vectorized, replaces the
+    drive of ``params`` (e.g. a torque from inverse kinetostatics); a stall under
+    it is an error, since a stall is only final where the torque at rest is
+    constant. ``run``: the run options every engine takes
+    (:class:`ipir_mujoco.core.options.RunOptions`: ``dt_out``, ``until_steady``,
+    ``steady_tol``, ``steady_cycles``, ``progress``, ``wall_budget_s``,
+    ``max_switches``, default :data:`.solver_support.MAX_SWITCHES`), run by
+    :class:`.solver_support.RunMonitor`. The output grid gets each mode-switch
+    instant (twice: once per mode) and each revolution's end.
     """
-    options = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s,
-                         max_switches)
+    options = RunOptions.given(t_end, run)
     rtol, atol = check_tolerances(rtol, atol)
     t_end, dt_out = options.t_end, options.dt_out
     monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)

@@ -45,11 +45,11 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
@@ -272,36 +272,22 @@ class UnilateralModel:
         return y
 
 
-def simulate_unilateral(
-    params: RobotParams,
-    geometry: Geometry | str = Geometry.EXACT,
-    t_end: float = 1.0,
-    *,
-    dt_out: float = 1e-4,
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
-    max_switches: int | None = None,
-    torque=None,
-    until_steady: bool = False,
-    steady_tol: float = STEADY_TOL,
-    steady_cycles: int = STEADY_CYCLES,
-    progress=None,
-    wall_budget_s: float | None = None,
-) -> RunResult:
+def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry.EXACT, t_end: float = 1.0, *,
+                        rtol: float = 1e-10, atol: float = 1e-12, torque: Callable | None = None, **run) -> RunResult:
     """Simulate the robot with one-way clutches (see the module docstring).
 
     Initial module velocities from (phi0, omega0) follow the MuJoCo engine's
     start: module 1 at rest unless the gap shrinks. ``torque(t, phi, omega)``
     [N m], vectorized, replaces the drive of ``params``; a stall under it is an
     error (a stall is only final where the torque at rest is constant, as for the
-    constant torque and the motor). With ``until_steady`` the run stops at the
-    end of the revolution where the periodic steady state is reached
-    (:class:`.cycles.SteadyWatch` with ``steady_tol``, ``steady_cycles``);
-    ``t_end`` [s] is the cap. Work budget and progress: see
+    constant torque and the motor). ``rtol``/``atol``: the DOP853 tolerances.
+    ``run``: the run options every engine takes
+    (:class:`ipir_mujoco.core.options.RunOptions`: ``dt_out``, ``until_steady``,
+    ``steady_tol``, ``steady_cycles``, ``progress``, ``wall_budget_s``,
+    ``max_switches``, default :data:`.solver_support.MAX_SWITCHES`), run by
     :class:`.solver_support.RunMonitor`. Each revolution's end is an exact sample.
     """
-    options = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s,
-                         max_switches)
+    options = RunOptions.given(t_end, run)
     rtol, atol = check_tolerances(rtol, atol)
     t_end, dt_out = options.t_end, options.dt_out
     monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)

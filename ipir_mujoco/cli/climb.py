@@ -35,8 +35,8 @@ def add_parser(commands) -> None:
                      help="pipe inclines above the horizontal [deg], -90..90: a comma-separated list or N evenly "
                           "spaced values from START to STOP (default 0:90:10)")
     cmd.add_argument("--engines", metavar="LIST", default=None,
-                     help="comma-separated, from: analytic-approx, analytic-exact, analytic-unilateral, mujoco-lock, "
-                          "mujoco-ratchet (default: analytic-unilateral,mujoco-ratchet)")
+                     help=f"comma-separated, from: {', '.join(registry.NAMES)} (default: "
+                          "analytic-unilateral,mujoco-ratchet)")
     cmd.add_argument("--tolerance", type=float, default=None, metavar="DEG",
                      help="width of the bracket at which the bisection for the motor's steady-climb limit stops "
                           "(default 0.1 deg)")

@@ -95,8 +95,20 @@ class RunOptions:
                                      "number >= 1")
             set_(self, "max_switches", check_whole("max_switches", self.max_switches, low=1))
 
+    @classmethod
+    def given(cls, t_end: Any, options: dict[str, Any]) -> "RunOptions":
+        """The options of a run of ``t_end`` [s] from an engine's keywords ``options`` (the fields of this
+        class but ``t_end``); a keyword that is not one of them is refused in one line, naming it."""
+        unknown = [k for k in options if k not in _FIELDS]
+        if unknown:
+            raise ParameterError(f"option {unknown[0]!r} is unknown; allowed: {', '.join(_FIELDS)}")
+        return cls(t_end, **options)
+
     @property
     def steady_settings(self) -> dict[str, Any]:
         """What a run records in its settings so that its summary applies the same steady-state test."""
         return {"until_steady": self.until_steady, "steady_tol": self.steady_tol,
                 "steady_cycles": self.steady_cycles}
+
+
+_FIELDS = tuple(name for name in RunOptions.__dataclass_fields__ if name != "t_end")

@@ -126,25 +126,20 @@ class Ratchet:
             self.range[j, 0] = b - margin
         self.excursion = 0.0
         self._qpos = data.qpos
+        self._slides = tuple(zip(self.qpos_adr, self.joint_ids))  # (qpos address, joint id) per module
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
         self.friction = FrictionRows(model, self.dof_adr)  # and F_r1, F_r2 [N]
 
     def before_step(self) -> None:
-        # unrolled for the two slides: this runs before every step
-        q, bounds = self._qpos, self.bounds
-        (a0, a1), (j0, j1) = self.qpos_adr, self.joint_ids
-        x = float(q[a0])
-        if x > bounds[0]:
-            bounds[0] = x
-            self.range[j0, 0] = x - self.margins[0]
-        elif bounds[0] - x > self.excursion:
-            self.excursion = bounds[0] - x
-        x = float(q[a1])
-        if x > bounds[1]:
-            bounds[1] = x
-            self.range[j1, 0] = x - self.margins[1]
-        elif bounds[1] - x > self.excursion:
-            self.excursion = bounds[1] - x
+        """Raise each module's bound to its running maximum, or note how far it is below it."""
+        q, bounds, margins = self._qpos, self.bounds, self.margins
+        for k, (a, j) in enumerate(self._slides):
+            x = float(q[a])
+            if x > bounds[k]:
+                bounds[k] = x
+                self.range[j, 0] = x - margins[k]
+            elif bounds[k] - x > self.excursion:
+                self.excursion = bounds[k] - x
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
