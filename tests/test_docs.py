@@ -60,3 +60,11 @@ def test_docs_link_only_to_files_that_exist():
         for target in re.findall(r"\]\(([^)#]+)\)", page.read_text()):
             if not target.startswith("http"):
                 assert (page.parent / target).exists(), f"{page.name} links to {target}"
+
+
+def test_every_model_variant_and_alias_is_documented():
+    from ipir_mujoco import registry
+
+    section = CLI.split("## Model variants: one name per model")[1].split("\n## ")[0]
+    for name in (*registry.NAMES, *registry.ALIASES):
+        assert f"`{name}`" in section, name
