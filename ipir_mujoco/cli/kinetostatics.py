@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ipir_mujoco import analytic
+from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.options import check_run_options
 from ipir_mujoco.core.params import check_real, read_text_file
@@ -28,7 +28,7 @@ def add_parser(commands) -> None:
                         help="CSV with columns t (s, from 0, increasing) and phi (rad); a cubic spline goes through them")
     kin.add_argument("--revolutions", type=float, default=2.0, help="turns at constant speed (default 2)")
     kin.add_argument("--geometry", choices=("approx", "exact"), default="exact", help="default: exact")
-    kin.add_argument("--clutch", choices=analytic.CLUTCH_RULES, default="kinematic",
+    kin.add_argument("--clutch", choices=registry.RULES, default="kinematic",
                      help="kinematic (the paper's rule, default) or unilateral (one-way clutches)")
     add_model_options(kin)
     kin.add_argument("--out", metavar="DIR", default="kinetostatics",

@@ -12,7 +12,6 @@ from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
 from ..labels import fixed, significant
 from ..output import check_output_dir, staged_output
-from ..report.plots import write_paper_figures
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
 
 
@@ -160,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
     result = run_simulation(args)
     record = result.to_json_dict()
     if args.out is not None:
+        from ..report.plots import write_paper_figures  # matplotlib: only where figures are written
+
         with staged_output(args.out) as staging:
             result.write_csv(staging / "timeseries.csv")
             write_mode_changes(staging / "mode_changes.csv", result.series)
