@@ -71,9 +71,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("ipir-mujoco: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     prefix = f"ipir-mujoco {args.command}"
-    if args.command not in QUIET_COMMANDS:
-        _note_first_compilation(prefix)
     try:
+        if args.command not in QUIET_COMMANDS:  # it imports the analytic package: inside the one-line net
+            _note_first_compilation(prefix)
         return args.handler(args)
     except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
         if args.debug or isinstance(exc, SystemExit):
