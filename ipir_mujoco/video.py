@@ -23,6 +23,7 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -193,6 +194,13 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
         context.free()
 
 
+def _counted(frames, total: int, progress: Callable[[int, int], None]):
+    """``frames``, calling ``progress(done, total)`` after each."""
+    for done, frame in enumerate(frames, start=1):
+        yield frame
+        progress(done, total)
+
+
 def _read_frame(settings: VideoSettings, viewport, renderer) -> np.ndarray:
     """The rendered frame as uint8 (height, width, 3), top row first."""
     import mujoco
@@ -218,11 +226,15 @@ def check_writer(path: str | Path) -> str:
 
 
 def write_video(run: RunResult, path: str | Path, settings: VideoSettings = VideoSettings(),
-                t_end: float | None = None, title: str | None = None) -> int:
-    """Render ``run`` up to ``t_end`` [s] into ``path`` (.gif or .mp4); returns the number of frames."""
+                t_end: float | None = None, title: str | None = None,
+                progress: Callable[[int, int], None] | None = None) -> int:
+    """Render ``run`` up to ``t_end`` [s] into ``path`` (.gif or .mp4); returns the number of frames.
+    ``progress(done, total)`` is called with the frames rendered so far, after each frame."""
     path = Path(path)
     kind = check_writer(path)
     frames = render_frames(run, settings, t_end, title)
+    if progress is not None:
+        frames = _counted(frames, len(frame_times(run, settings, t_end)), progress)
     if kind == "gif":
         from PIL import Image
 

@@ -95,6 +95,10 @@ CASES = [
     (["simulate", "--engine", "mujoco", "--mjcf", "{f}/folder"], 2, "is a folder"),
     (["simulate", "--engine", "mujoco", "--max-switches", "10"], 2, "--max-switches 10 applies only"),
     (["simulate", "--max-switches", "0"], 2, "--max-switches=0 is out of range"),
+    # a constant torque has no periodic steady state: refused before any run, not run to the cap
+    (["simulate", "--until-steady"], 2, "until_steady with drive=torque"),
+    (["simulate", "--engine", "mujoco", "--until-steady", "--set", "drive=torque"], 2, "--drive motor"),
+    (["sweep", "--vary", "L=0.1,0.2", "--until-steady", "--out", "{f}/steady"], 2, "until_steady with drive=torque"),
     (["simulate", "--t-end", "0.1", "--out", "{f}/afile/sub"], 2, "is a file, not a folder"),
     (["simulate", "--t-end", "0.1", "--out", "{f}/afile"], 2, "is not a folder"),
     (["compare", "{f}/run", "{f}/empty"], 2, "is empty"),

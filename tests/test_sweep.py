@@ -340,8 +340,9 @@ def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch, b
     monkeypatch.setattr(analytic_package, "simulate", fake_analytic)
     monkeypatch.setattr(engine_package, "simulate_mujoco", fake_mujoco)
     monkeypatch.setattr(batch_module, "run_ratchet_batch", fake_batch)
-    study = Study((parse_vary("L=0.1,0.2"),), engines=("mujoco-ratchet", "analytic-unilateral", "mujoco-lock"),
-                  t_end=2.0, until_steady=True)
+    # under the motor: a sweep to steady state under the constant torque is refused up front
+    study = Study((parse_vary("L=0.1,0.2"),), base=RobotParams(drive="motor"),
+                  engines=("mujoco-ratchet", "analytic-unilateral", "mujoco-lock"), t_end=2.0, until_steady=True)
     rows = rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=1, timeout_per_design=30,
                              batch_mujoco=batch_mujoco))
     assert all(r["error"] == "" for r in rows)

@@ -74,7 +74,11 @@ def test_render_command_writes_the_video(tmp_path, capsys):
                  "--out", str(out)]) == 0
     with Image.open(out) as gif:
         assert gif.n_frames == 4 and gif.size == (80, 64)  # t = 0, 0.01, 0.02, 0.03 s
-    assert "4 frames" in capsys.readouterr().out
+    printed = capsys.readouterr()
+    assert "4 frames" in printed.out
+    # progress on stderr while it works: the run, then the frames (a line per tenth in a log; all 4 here)
+    assert printed.err.splitlines() == ["simulating 0.03 s in MuJoCo ...", *[f"rendered {k} / 4 frames"
+                                                                            for k in range(1, 5)]]
     assert [p.name for p in out.parent.iterdir()] == ["run.gif"]  # no partial file left
 
 

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, model_params, progress_printer
 
 
 def add_parser(commands) -> None:
@@ -46,16 +47,33 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
     params = model_params(args)
     variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch)
-    result = registry.run(variant, params, args.t_end)
+    print(f"simulating {args.t_end:g} s in MuJoCo ...", file=sys.stderr, flush=True)
+    result = registry.run(variant, params, args.t_end, progress=progress_printer(args.t_end))
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
             f"({variant.clutch})"
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial{out.suffix}")
     try:
-        count = write_video(result, partial, settings, title=title)
+        count = write_video(result, partial, settings, title=title, progress=frame_printer())
         partial.replace(out)
     finally:
         partial.unlink(missing_ok=True)
     print(f"wrote {out}: {count} frames of {settings.width} x {settings.height} px at {settings.fps:g} fps, "
           f"{result.t_end:g} s simulated shown in {count / settings.fps:.1f} s ({settings.speed:g}x real time)")
     return EXIT_OK
+
+
+def frame_printer():
+    """Progress of the rendering on stderr, ``report(done, total)``: on a terminal one line rewritten in place,
+    in a log one line per tenth of the frames."""
+    tty = sys.stderr.isatty()
+    shown = [0]
+
+    def report(done: int, total: int) -> None:
+        if tty:
+            print(f"\rrendered {done} / {total} frames", end="\n" if done == total else "", file=sys.stderr,
+                  flush=True)
+        elif done == total or done * 10 // total > shown[0]:
+            shown[0] = done * 10 // total
+            print(f"rendered {done} / {total} frames", file=sys.stderr, flush=True)
+    return report

@@ -6,7 +6,7 @@ import argparse
 import json
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.options import check_run_options, refuse_steady_without_motor
 from ipir_mujoco.core.params import check_whole
 from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
@@ -153,7 +153,8 @@ def _energy_line(e: dict) -> str:
 
 def run(args: argparse.Namespace) -> int:
     check_options(args)
-    model_params(args)  # bad parameters are reported before the output folder is looked at
+    # bad parameters are reported before the output folder is looked at
+    refuse_steady_without_motor(model_params(args).drive, args.until_steady)
     if args.out is not None:
         check_output_dir(args.out)
     result = run_simulation(args)

@@ -43,6 +43,15 @@ def check_run_options(t_end: Any, dt_out: Any) -> tuple[float, float]:
     return t_end, dt_out
 
 
+def refuse_steady_without_motor(drive: str, until_steady: bool) -> None:
+    """A run asked to stop at its periodic steady state under the constant torque, which has none (the crank
+    speeds up for ever or comes to rest): refused in one line, with what has a steady state."""
+    if until_steady and drive == "torque":
+        raise ParameterError("until_steady with drive=torque: a constant torque has no periodic steady state (the "
+                             "crank speeds up for ever, or comes to rest); allowed: drive=motor (--drive motor), or "
+                             "a run of fixed length without until_steady")
+
+
 @dataclass(frozen=True)
 class RunOptions:
     """What every engine's run takes beside the parameter set, checked on construction.

@@ -43,7 +43,7 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import MAX_T_END, check_run_options
+from ipir_mujoco.core.options import MAX_T_END, check_run_options, refuse_steady_without_motor
 from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
                                      read_toml_file, require_params)
 
@@ -162,6 +162,7 @@ class Study:
         set_("seed", check_whole("seed", self.seed, low=0))
         if not isinstance(self.until_steady, bool):
             raise ParameterError(f"until_steady={self.until_steady!r} is not true or false")
+        refuse_steady_without_motor(self.base.drive, self.until_steady)
         ranges = [a for a in self.axes if a.is_range]
         if self.sample is None and ranges:
             raise ParameterError(f"--vary {ranges[0].name}=LO:HI is a range: give --sample N, or N points (LO:HI:N)")
