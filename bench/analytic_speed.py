@@ -51,14 +51,14 @@ CASES = {
     "motor, one-way model, 1 s": (RobotParams(**MOTOR), "exact", "unilateral", 1.0, {}),
     "motor, one-way model, 10 s": (RobotParams(**MOTOR), "exact", "unilateral", 10.0, {}),
     # a sweep's design: samples every 1 ms (the cases above keep the default 0.1 ms, whose per-sample
-    # post-processing is a third to a half of a 1 s one-way run)
+    # post-processing weighs on a 1 s one-way run: the two cases side by side show how much)
     "one-way model, 1 s, dt_out 1 ms (a sweep design)": (RobotParams(), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
     **{f"one-way model, 1 s, dt_out 1 ms, {k}={v:g}": (RobotParams(**{k: v}), "exact", "unilateral", 1.0,
                                                        {"dt_out": 1e-3})
        for k, v in (("L", 0.06), ("L", 0.5), ("m2", 3.0))},
     "motor, one-way model, 1 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
     "motor, one-way model, 10 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 10.0, {"dt_out": 1e-3}),
-    # at its steady speed (reached in about 1 s) the motor's crank turns as fast at 20 s as at 10 s
+    # at its steady speed (reached in the first seconds) the motor's crank turns as fast at 20 s as at 10 s
     "motor, one-way model, 20 s, dt_out 1 ms": (RobotParams(**MOTOR), "exact", "unilateral", 20.0, {"dt_out": 1e-3}),
 }
 LONG = {"paper model, 10 s", "one-way model, 10 s", "motor, one-way model, 10 s",
@@ -119,7 +119,8 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.analytic.accel import ACCELERATED
 out = {"accelerated": ACCELERATED}
-for name, g, c, p in (("paper", "approx", "kinematic", RobotParams()), ("one-way", "exact", "unilateral", RobotParams()),
+for name, g, c, p in (("paper", "approx", "kinematic", RobotParams()),
+                      ("one-way", "exact", "unilateral", RobotParams()),
                       ("compliant", "exact", "unilateral", RobotParams(clutch_stiffness=1e6))):
     times = []
     for _ in range(3):
@@ -161,7 +162,8 @@ def main() -> None:
         before = f"{old10[0] / old1[0]:6.1f}x" if old10[0] else "     -"
         print(f"{long:40s} before {before}  after {new10[0] / new1[0]:6.1f}x  revolutions {revs:6.1f}x  "
               f"after per revolution: {new1[0] / new1[1].summary['revolutions'] * 1e3:.2f} ms "
-              f"({new1[1].t_end:g} s), {new10[0] / new10[1].summary['revolutions'] * 1e3:.2f} ms ({new10[1].t_end:g} s)")
+              f"({new1[1].t_end:g} s), {new10[0] / new10[1].summary['revolutions'] * 1e3:.2f} ms "
+              f"({new10[1].t_end:g} s)")
     with tempfile.TemporaryDirectory() as cache:
         cold = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache})
         warm = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache})

@@ -8,16 +8,20 @@ Reports, measured in one run on this machine:
 - designs per second of the analytic one-way-clutch model through the process
   pool with 1 and 2 workers;
 - designs per second of MuJoCo's ratchet through mujoco.batch with 1 and 2 threads,
-  and through the serial engine (one design after another, Python loop);
+  in two one-thread processes of half the designs each (how the sweep runs its
+  batch chunks; process start included), and through the serial engine (one
+  design after another; it steps in C where its compiled loop is built);
 - the cost of one batched ratcheted step per design as a ratio to one step of the
-  serial Python loop (ipir_mujoco.engine), both on one thread.
+  serial engine (ipir_mujoco.engine), both on one thread.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import tempfile
 import time
+from concurrent import futures
 
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.engine import simulate_mujoco
@@ -51,6 +55,13 @@ def main() -> None:
     for threads in (1, 2):
         batched[threads] = timed(lambda: run_ratchet_batch(designs, t_end, 1e-3, nthread=threads))
         print(f"  MuJoCo ratchet, mujoco.batch, {threads} thread(s):          {n / batched[threads]:7.2f} designs/s")
+
+    def two_processes():
+        chunk = functools.partial(run_ratchet_batch, t_end=t_end, dt_out=1e-3, nthread=1)
+        with futures.ProcessPoolExecutor(2) as pool:
+            list(pool.map(chunk, [designs[:n // 2], designs[n // 2:]]))
+    processes = timed(two_processes)
+    print(f"  MuJoCo ratchet, mujoco.batch, 2 processes of 1 thread:   {n / processes:7.2f} designs/s")
     serial = timed(lambda: [simulate_mujoco(p, "unilateral", "ratchet", t_end, dt_out=1e-3) for p in designs])
     print(f"  MuJoCo ratchet, serial engine (Python loop):             {n / serial:7.2f} designs/s")
     per_step_batch = batched[1] / (n * steps)

@@ -24,7 +24,7 @@ through :func:`from_flags`.
 What the parameter set decides stays in it: a finite ``clutch_stiffness`` makes a one-way variant's clutches
 compliant (both engines), ``drive`` chooses the constant torque or the motor, ``incline`` the slope.
 
-The MuJoCo engine is imported only when a MuJoCo variant runs (its import costs a few tenths of a second).
+The MuJoCo engine is imported only when a MuJoCo variant runs (its import is slow beside the rest).
 """
 
 from __future__ import annotations

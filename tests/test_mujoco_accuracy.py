@@ -16,6 +16,7 @@ from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine import simulate as engine_simulate
 from ipir_mujoco.engine.model import SolverSettings
 from ipir_mujoco.engine.monitor import RESIDUAL_TOL
+from ipir_mujoco.engine.timestep import DT_MAX, DT_MAX_CLUTCH
 
 TARGET = 1e-3  # MuJoCo within 0.1 % of the analytic model of the same mechanism
 
@@ -54,6 +55,19 @@ def test_a_light_rod_with_default_options_stays_within_0_1_percent():
         assert abs(error) < TARGET, figure
     # the loop gap tells the leak: 3e-4 m at impedance 0.99; its tolerance is 1e-3 r
     assert run.accuracy["loop_gap_m"] < run.accuracy["tolerances"]["loop_gap_m"] == pytest.approx(1e-3 * params.r)
+
+
+def test_the_locks_need_their_own_smaller_largest_step():
+    """DT_MAX_CLUTCH: under the paper's rule a lock stops its module within one step at every engagement,
+    so at the paper's 1 s case the locks' energy residual crosses the monitor's tolerance at the ratchet's
+    largest step and stays inside it at their own."""
+    assert DT_MAX_CLUTCH["lock"] < DT_MAX == DT_MAX_CLUTCH["ratchet"]
+    worst = {}
+    for step in (DT_MAX, DT_MAX_CLUTCH["lock"]):
+        run = simulate_mujoco(RobotParams(), "kinematic", "lock", 1.0, dt_out=1e-3,
+                              settings=SolverSettings(timestep=step), accuracy="warn")
+        worst[step] = abs(run.accuracy["residual_ratio"])
+    assert worst[DT_MAX] > RESIDUAL_TOL > worst[DT_MAX_CLUTCH["lock"]], worst
 
 
 def test_the_monitor_stops_a_coarse_run_and_warn_records_it(capsys, tmp_path, monkeypatch):

@@ -23,8 +23,8 @@ when the mean speeds of the last ``cycles`` revolutions (k - cycles + 1 .. k)
 all lie within ``tol`` * |mean of them| of each other, that mean is > 0, and
 the speed's remaining drift, extrapolated from the last two changes, is within
 ``tol`` * mean as well (see :func:`steady_at_end`): a heavy flywheel settles so
-slowly that three revolutions agree to 1e-4 while the speed is still 2e-3
-short of its final value.
+slowly that three revolutions can agree within ``tol`` while the speed is still
+many times ``tol`` short of its final value.
 The steady *window* is those revolutions; the steady figures are averages over
 it (totals over the window divided by its time, distance or revolutions).
 """

@@ -45,9 +45,9 @@ from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .params import RobotParams
 
 # [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
-# far above the creep of MuJoCo's soft constraints (a held module creeps at 1e-9..1e-8 m/s), so every engine's
-# series reads rest alike (the analytic engines' rest is an exact 0). The summary's first minimum of S and
-# MuJoCo's stall test use it.
+# orders of magnitude above the creep of a module MuJoCo's soft constraints hold, so every engine's series
+# reads rest alike (the analytic engines' rest is an exact 0). The summary's first minimum of S and MuJoCo's
+# stall test use it.
 REST_SPEED = 1e-6
 
 COLUMNS: tuple[str, ...] = (

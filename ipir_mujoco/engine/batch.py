@@ -14,7 +14,8 @@ ratchet raises each simulation's lower slide bounds (the rule of
 What a batch can measure is the state and MuJoCo's energies: positions and
 speeds, the drive's work (from MuJoCo's actuator force, as the serial engine),
 the work against the resistances (F_r |v| per step, which equals the
-frictionloss rows' work to 1e-9 of the motor work on the paper's case),
+frictionloss rows' work while a module slides and differs only in the steps
+where one starts or stops: tests/test_mujoco_batch.py bounds the difference),
 kinetic and potential energy, the loop gap and the backward excursion, so the
 same accuracy monitor as a serial run, the steady state and stalls. Constraint
 forces (clutch reactions, rod force) are not exposed per simulation and are

@@ -10,16 +10,16 @@ A held module stands on two supports at once, its clutch row and its
 resistance's frictionloss row, and a rigid model leaves the split between them
 undetermined; only their sum, the module's total hold R_i, is. MuJoCo's soft
 solution splits it its own way: while the soft ratchet limit relaxes, the held
-module creeps forward at ~1e-9 m/s and its friction row pulls back with the
-whole F_r, which the limit row then carries on top of the load (+0.135 N of the
-mean clutch force at the default motor's cruise, 8 %); where neither saturates
-the two rows share the load about equally. So the reported reaction follows the
-package's one convention (:func:`clutch_share`, the analytic models' too): of
-the total hold, the resistance takes a forward push (R_i < 0, up to F_ri), the
-clutch everything else. And a module is held while it stands, i.e. while its
-clutch row pushes or its friction row sticks (below F_ri): not only while the
-clutch row pushes, which flickers on and off for ~1 ms before each release as
-the friction row takes over the last of the load.
+module creeps forward (far below REST_SPEED) and its friction row pulls back
+with the whole F_r, which the limit row then carries on top of the load, so the
+limit row alone would overstate the clutch's mean force; where neither
+saturates the two rows share the load about equally. So the reported reaction
+follows the package's one convention (:func:`clutch_share`, the analytic
+models' too): of the total hold, the resistance takes a forward push (R_i < 0,
+up to F_ri), the clutch everything else. And a module is held while it stands,
+i.e. while its clutch row pushes or its friction row sticks (below F_ri): not
+only while the clutch row pushes, which flickers on and off in the last
+moments before each release as the friction row takes over the last of the load.
 These run every step, so they work on Python floats and touch only the few
 entries they need; :mod:`.stepper` runs the same rules compiled (a change here
 is a change there: its test compares the two bit for bit).
@@ -264,7 +264,7 @@ class Locks:
         while the other module moves, as the paper's model has it (a held module there has no resistance,
         and a lock that pulls is what the rule reveals). Under the one-way rule a module is held while it
         stands, locked or on its static friction (its row above -F_r: a lock lets go as soon as its row
-        would pull, up to ~5 ms before the push on the module exceeds F_r), as the ratchet's; there, and
+        would pull, which can be well before the push on the module exceeds F_r), as the ratchet's; there, and
         with both locked under the paper's rule, the resistance takes a forward push up to F_r
         (:func:`clutch_share`), as the analytic models do.
         """

@@ -42,8 +42,8 @@ RANGE_FAR = 1e6
 CLUTCH_FORCE_MAX = 1e10
 
 # The integrators the engines allow. Not RK4: the engines read a step's energies, drive torque and
-# frictionloss forces from mjData after mj_step, which under RK4 are its last stage's, not the step's (the
-# serial engine's kinetic energy at t = 1 ms of the motor case read 1.47e-4 J against 1.22e-4 J).
+# frictionloss forces from mjData after mj_step, which under RK4 are its last stage's, not the step's, so
+# the energy audit would book values the step never had.
 INTEGRATORS = {"euler": mujoco.mjtIntegrator.mjINT_EULER, "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT}
 # the integrators that treat an actuator's velocity term (its damping) implicitly, through MuJoCo's D matrix;

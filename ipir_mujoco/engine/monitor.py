@@ -18,18 +18,18 @@ figures show it while the run goes, each measured on the run's own state:
     still tiny, and for a robot that gravity moves). A compliant clutch's spring
     is counted as the step conserves it (:meth:`.compliant.CompliantClutches.stepped_spring_energy`),
     so an impact under way does not swing the figure by 1/2 omega dt of its
-    energy. Tolerance 1e-3: over the cases of the
-    convergence study the error in revolutions stayed below 0.8 x the residual
-    ratio (a light rod dissipates: -0.29 % revolutions at +3.8e-3; a fast
-    crank creates energy: +0.087 % at -3.1e-3), so 1e-3 keeps the revolutions
-    within 0.1 % of the converged mechanism.
+    energy. Tolerance 1e-3: over the cases of the convergence study
+    (:mod:`ipir_mujoco.studies.convergence`) the relative error in revolutions
+    stays below the residual ratio, whether the soft constraints dissipate (a
+    light rod) or the stepping creates energy (a fast crank), so 1e-3 keeps the
+    revolutions within 0.1 % of the converged mechanism.
 ``loop_gap_m``
     Distance between the rod's end C and module 2's pin [m]: how far the
     loop-closing constraint gives. A gap g moves the linkage's angles by about
     g / r and does not accumulate. The tolerance is 1e-3 r (5e-5 m for the paper's
-    crank): the converged paper's case runs with a 1.5e-5 m gap at 0.02 % error in
-    revolutions, and a 2 s run at 1e-4 s reaches 5.8e-5 m at +0.12 %, past the
-    0.1 % target (mjcf/README.md).
+    crank): in the timestep studies a gap past it came with an error in
+    revolutions past the 0.1 % target, and a gap well inside it with an error
+    well inside the target (the evidence is in mjcf/README.md).
 ``excursion_m``
     How far a module slid back below its furthest position so far [m] (the
     ratchet's give; 0 for an ideal one-way clutch). Each hold lets the module

@@ -2,24 +2,26 @@
 
 MuJoCo's first-order step creates energy on the rotating linkage: over a run
 the audit's residual grows like (omega dt)^3 times the number of revolutions
-(measured at the paper's case from 1 to 5 s with the ratchet and the locks,
-``python -m ipir_mujoco.studies.convergence``). So the step is chosen from two
-bounds known before the run, the crank speed ``omega_b`` and the revolutions
-``N_b``, such that the predicted residual ratio
+(the law ``python -m ipir_mujoco.studies.convergence`` measures with the
+ratchet and the locks). So the step is chosen from two bounds known before the
+run, the crank speed ``omega_b`` and the revolutions ``N_b``, such that the
+predicted residual ratio
 
     C (omega_b dt)^3 N_b
 
 is half the accuracy monitor's tolerance (1e-3), with C fitted to the measured
-residuals against these same bounds (largest of the fits: 0.36 for the
-ratchet, 2.4 for the locks, whose engagements add their own error). The step
-never exceeds 1e-4 s, the default proven at the paper's 1 s case (5e-5 s for
-the locks), and is a whole fraction of the output interval. Further limits:
+residuals against these same bounds (:data:`RESIDUAL_CONSTANT`, the largest of
+the fits per clutch: the locks' engagements add their own error). The step
+never exceeds :data:`DT_MAX_CLUTCH` (1e-4 s, the default proven at the paper's
+1 s case; 5e-5 s for the locks) and is a whole fraction of the output
+interval. Further limits:
 
 - a very light rod: MuJoCo's soft loop leaks (1 - d) of the rod end's free
   acceleration, which grows as the module-to-rod mass ratio; with the
-  impedance d = 0.9999 a ratio of 1e4 (rod 1e-4 kg) costs 3e-5 of the
-  revolutions at 1e-4 s and the error falls as dt^2, so above the ratio 3e4
-  the step shrinks as sqrt(3e4 / ratio);
+  impedance d = 0.9999 the error it costs in revolutions grows with that ratio
+  and falls as dt^2; at 1e-4 s it stays a small part of the 0.1 % target up to
+  the ratio :data:`LEAK_RATIO`, so above it the step shrinks as
+  sqrt(LEAK_RATIO / ratio);
 - a crank servo: 0.2 / max(sqrt(kp / J_A), kv / J_A), a tenth of the explicit
   stability limit of its stiffness and damping;
 - compliant clutches: MuJoCo steps a spring explicitly, so its period must be
@@ -30,10 +32,10 @@ the locks), and is a whole fraction of the output interval. Further limits:
   (63 steps per period 2 pi / omega_c): an impact's peak force then comes out
   within (omega dt)^2 / 4 = 2.5e-3 of its converged value by the step's own
   error bound (entering the spring between two steps and sampling its
-  turning point, each up to (omega dt)^2 / 8), measured within 1e-3 over the
-  impacts of the paper's start and the default motor's cruise at k = 1e6..1e8
-  N/m (tests/test_mujoco_compliant.py, mjcf/README.md), while revolutions and
-  travel are set by the speed rule above.
+  turning point, each up to (omega dt)^2 / 8); tests/test_mujoco_compliant.py
+  holds the impacts of the paper's start and the default motor's cruise to it
+  against the analytic clutch, while revolutions and travel are set by the
+  speed rule above.
 
 Bounds on the crank: for a constant torque M, the energy the drive put in
 bounds the crank's kinetic energy, J_A omega^2 / 2 <= KE(0) + |M| (phi - phi0),
@@ -57,8 +59,9 @@ from .model import SolverSettings
 from .monitor import RESIDUAL_TOL
 
 DT_MAX = 1e-4  # s: the default proven at the paper's 1 s case (mjcf/README.md)
-# the locks with the paper's rule stop a module within a step at every engagement: at the paper's 1 s
-# case their residual is -1.45e-3 at 1e-4 s (over the tolerance) and +1.9e-4 at 5e-5 s
+# the locks with the paper's rule stop a module within a step at every engagement: at the paper's 1 s case
+# their energy residual crosses the monitor's tolerance at 1e-4 s and stays inside it at 5e-5 s
+# (tests/test_mujoco_accuracy.py holds both)
 DT_MAX_CLUTCH = {"ratchet": DT_MAX, "lock": 5e-5, "none": DT_MAX}
 DT_MIN = 1e-6  # s: a run needing less is refused (over a million steps per simulated second)
 TARGET = 0.5 * RESIDUAL_TOL  # predicted residual ratio to aim at: half the monitor's tolerance

@@ -6,8 +6,9 @@ solid, the others as open markers over it), the inclines where an engine stalled
 speed, and the limits of :mod:`ipir_mujoco.studies.climbing` as vertical lines: the restart limit
 (dashed) and each engine's steady-climb limit (dotted). Bottom panel: the peak clutch reaction
 (over the steady window, or the whole run; none for MuJoCo's rigid clutches, whose peak is set by its
-step) and the mean total clutch reaction over the steady window, with the weight along the pipe, (m1 + m2 + m_rod) g sin(incline), that the clutches hold
-on average beside the moving module's resistance. Lines and markers carry gids (``speed:ENGINE``,
+step) and the mean total clutch reaction over the steady window, with the weight along the pipe,
+(m1 + m2 + m_rod) g sin(incline), that the clutches hold on average beside the moving module's
+resistance. Lines and markers carry gids (``speed:ENGINE``,
 ``stalled:ENGINE``, ``peak:ENGINE``, ``stalled-peak:ENGINE``, ``mean:ENGINE``, ``restart``,
 ``steady-limit:ENGINE``, ``weight``): the data a test can read back.
 """
@@ -76,8 +77,8 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
         speed_handles.append(Line2D([], [], color="grey", ls="--",
                                     label=f"restart limit (restarts at every crank angle): {restart:.1f} deg"))
     for limit, names in limits.items():
-        speed_handles.append(Line2D([], [], color="black", ls=(0, (2, 2)), label=f"steady-climb limit from rest: {limit:.1f} "
-                                    f"deg ({', '.join(names)})"))
+        speed_handles.append(Line2D([], [], color="black", ls=(0, (2, 2)),
+                                    label=f"steady-climb limit from rest: {limit:.1f} deg ({', '.join(names)})"))
     speed_handles.append(Line2D([], [], ls="none", marker="x", mew=2, color="black", label="stalled"))
     fine = np.linspace(min(x.min(), 0.0), x.max(), 200)
     mass = params.m1 + params.m2 + params.rod_mass

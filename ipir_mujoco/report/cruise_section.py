@@ -34,7 +34,8 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
 
 
 def fine_pct(value) -> str:
-    """A fraction as a signed percentage to 4 decimals (engine agreement is ~1e-5); 'n/a' for None."""
+    """A fraction as a signed percentage to 4 decimals (the engines agree to far less than the 0.01 % two
+    decimals show); 'n/a' for None."""
     return "n/a" if value is None else signed_percent(value, 4)
 
 
@@ -251,10 +252,12 @@ def verdict(metrics: dict) -> dict | None:
         f"{one_way['steady_speed_m_s']:.4g} m/s{mj}: "
         f"{pct((paper['steady_speed_m_s'] - one_way['steady_speed_m_s']) / one_way['steady_speed_m_s'])}, because its "
         f"locks stop each module instead of letting it coast ({fmt(paper['distance_per_rev_m'])} against "
-        f"{fmt(one_way['distance_per_rev_m'])} m per revolution). Energy per metre is set by the load, not by the model: "
+        f"{fmt(one_way['distance_per_rev_m'])} m per revolution). Energy per metre is set by the load, not by the "
+        "model: "
         f"{paper['energy_per_metre_j_m']:.4f} against {one_way['energy_per_metre_j_m']:.4f} J/m ("
         + ("= F_r1 + F_r2" if metrics["params"]["incline"] == 0 else "the resistances and the climb")
-        + f": rigid clutches dissipate nothing); the peak clutch reaction at cruise is {paper['peak_clutch_force_n']:.3g} N "
+        + ": rigid clutches dissipate nothing); the peak clutch reaction at cruise is "
+        f"{paper['peak_clutch_force_n']:.3g} N "
         f"against {one_way['peak_clutch_force_n']:.3g} N.")
     return {"question": "What does the paper's model get wrong at cruise, under a real motor?", "answer": answer,
             "evidence": "sections.cruise"}

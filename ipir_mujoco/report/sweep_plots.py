@@ -1,8 +1,9 @@
 """Pictures of a sweep: lines for one varied parameter, heatmaps for two, best designs.
 
 The heatmap colours one metric of the first engine that gives it (a batched
-MuJoCo run gives no peak forces) over the first two varied parameters (the steady speed for a sweep run to steady state, else the mean
-forward speed; ``--plot-metric`` chooses another) and draws over it the
+MuJoCo run gives no peak forces) over the first two varied parameters (the
+steady speed for a sweep run to steady state, else the mean forward speed;
+``--plot-metric`` chooses another) and draws over it the
 contours where the second engine diverges from the first by 1 % and 5 % in
 that metric (for a metric without a divergence column in revolutions, else in
 the steady or mean speed where revolutions are not compared): where

@@ -192,8 +192,8 @@ def run_metrics(run: RunResult) -> dict:
     peak = summary["peak_clutch_force_n"]
     if run.engine == "mujoco" and run.settings.get("clutch_model") != "compliant":
         # a rigid MuJoCo clutch is a soft constraint whose engagement overshoot is set by the step, and read
-        # every DT_OUT it is whichever step a sample hits: at 90 deg under a 0.57 N m motor 41.37 N every 1 ms,
-        # 78.2 N at every 0.1 ms step, against the equations' 41.39 N (sweep_metrics' docstring has more)
+        # every DT_OUT it is whichever step a sample hits: a figure of the numerics, not of the robot, so
+        # none is shown (sweep_metrics' docstring says more)
         peak = None
     out = {"revolutions": summary["revolutions"], "travel_m": float(moved[-1] - moved[0]), "t_end_s": run.t_end,
            "steady": steady, "steady_speed_m_s": summary["steady_speed_m_s"], "t_steady_s": summary["t_steady_s"],

@@ -19,7 +19,8 @@ Per run (:func:`run_metrics`; cruise: over the steady window, the last
   solver's dense output with a bounded Brent search, to scipy's time tolerance
   sqrt(eps) t (bound (omega_c sqrt(eps) t_end)^2: 2.2e-9 for the default
   grid's stiffest clutch, 1e7 N/m, at t_end = 1 s, 2.2e-7 at the 10 s cap;
-  the peak reads the same to the last digit at dt_out 1e-4, 2.5e-5 and 1e-5 s). MuJoCo is sampled at every step
+  so the peak does not depend on the output grid, as tests/test_compliant_clutch.py
+  holds). MuJoCo is sampled at every step
   h <= 0.1 / omega_c: its peak lies within (omega_c h)^2 / 4 <= 2.5e-3 of the
   converged one (entering the spring between two steps, and the turning point
   between samples, each up to (omega_c h)^2 / 8; mjcf/README.md).
@@ -270,7 +271,8 @@ def _engagement(s: dict, peak: int) -> dict | None:
     i = int(before[-1])
     v, a, gap = -float(s[f"v{module}"][i]), -float(s[f"a{module}"][i]), -float(s[column][i])
     # backward speed on reaching the clutch: the remaining play crossed at the sample's acceleration
-    return {"module": module, "t_s": float(s["t"][i]), "phi_rad": float(s["phi"][i]), "omega_rad_s": float(s["omega"][i]),
+    return {"module": module, "t_s": float(s["t"][i]), "phi_rad": float(s["phi"][i]),
+            "omega_rad_s": float(s["omega"][i]),
             "speed_m_s": math.sqrt(max(v * v + 2.0 * a * gap, 0.0)) if v > 0 else 0.0,
             "accel_m_s2": float(s[f"a{module}"][i])}
 
@@ -357,7 +359,8 @@ def run_study(base: RobotParams, stiffness: Sequence[float] = STIFFNESS, backlas
                 run["lost_per_stroke_m"] = _lost_per_stroke(point, run, reference)
         rows.append({"point": task.point, "clutch_stiffness_n_m": task.stiffness, "clutch_backlash_m": task.backlash,
                      "analytic": an, "mujoco": mj, "divergence": divergence(an, mj)})
-    study = {"points": {key: asdict(points_table[key]) for key in points}, "stiffness_n_m": sorted({k for k, _ in designs}),
+    study = {"points": {key: asdict(points_table[key]) for key in points},
+             "stiffness_n_m": sorted({k for k, _ in designs}),
              "backlash_m": sorted({b for _, b in designs}), "rows": rows, "rigid": rigid, "params": base.as_dict(),
              "settings": {"analytic": {"geometry": "exact", "clutch": "unilateral", "rtol": 1e-10,
                                        "dt_out": f"min({DT_OUT_MAX:g} s, clutch period / {OUTPUT_PERIODS})"},

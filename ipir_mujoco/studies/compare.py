@@ -164,7 +164,7 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
         on_time[id(run)] = {q: np.interp(grid, *_unique_times(run.series["t"], run.series[q])) for q in QUANTITIES}
     time_errors = {q: _errors(on_time[id(a)][q], on_time[id(b)][q]) for q in QUANTITIES}
     # a quantity a holds at zero (a held module: x2 = 0, v2 = 0) has no scale of its own: every round-off of b
-    # then exceeded 'tolerance x 0' (58 nm of MuJoCo's ratchet in a vertical pipe read as over 1 %)
+    # (a soft constraint's give) would then exceed 'tolerance x 0'
     crank_speed = float(np.max(np.abs(a.series["omega"])))
     floors = {"phi": 2 * np.pi, "x1": 2 * a.params.r, "x2": 2 * a.params.r, "S": 2 * a.params.r,
               "v1": a.params.r * crank_speed, "v2": a.params.r * crank_speed, "S_dot": a.params.r * crank_speed}
@@ -203,7 +203,8 @@ def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: in
         first[q] = float(grid[over[0]]) if over.size and scale > 0 else None
 
     return {"a": f"{a.engine}/{a.geometry}/{a.clutch}", "b": f"{b.engine}/{b.geometry}/{b.clutch}",
-            "t_compared_s": float(t_end), "t_end_a_s": float(a.series["t"][-1]), "t_end_b_s": float(b.series["t"][-1]), "time_grid": time_errors, "angle_grid": angle_errors,
+            "t_compared_s": float(t_end), "t_end_a_s": float(a.series["t"][-1]), "t_end_b_s": float(b.series["t"][-1]),
+            "time_grid": time_errors, "angle_grid": angle_errors,
             "summary": summary, "switches": match_switches(a, b), "first_exceedance": first,
             "tolerance": tolerance, "notes": [n for label, run in (("a", a), ("b", b)) for n in _notes(label, run)]}
 

@@ -102,8 +102,8 @@ def envelope_study(quick: bool = False, progress: Callable[[str], None] = lambda
     signed), the accuracy figures, and both wall times; or, for a run the
     accuracy monitor stopped, ``stopped`` (its message). The runs use the
     default options (accuracy 'stop', automatic timestep). ``quick`` runs the
-    corners only (about a minute on a quiet machine). ``cases`` replaces the
-    envelope by other (label, parameters, t_end [s]) triples.
+    corners only. ``cases`` replaces the envelope by other (label, parameters,
+    t_end [s]) triples.
     """
     rows = []
     for label, params, t_end in (envelope_cases(quick) if cases is None else cases):
@@ -184,8 +184,9 @@ def convergence_evidence(params: RobotParams, quick: bool, progress: Callable[[s
     equations = []
     for rtol in ((1e-10, 1e-12) if quick else (1e-6, 1e-8, 1e-10, 1e-12)):
         run = registry.run("analytic-unilateral", params, 1.0, rtol=rtol, atol=rtol * 1e-2, dt_out=1e-3)
+        energy = run.summary["energy"]
         equations.append({"rtol": rtol, **{k: run.summary[k] for k in ("revolutions", "x1_final", "x2_final")},
-                          "residual_fraction": run.summary["energy"]["residual_j"] / run.summary["energy"]["motor_work_j"]})
+                          "residual_fraction": energy["residual_j"] / energy["motor_work_j"]})
     def spread(items, key_filter):
         chosen = [r for r in items if key_filter(r)]
         return max(abs(a[k] - b[k]) / abs(b[k]) for a in chosen for b in chosen

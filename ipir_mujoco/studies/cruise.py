@@ -54,10 +54,10 @@ from .compare import STEADY_FIGURES, compare_runs, relative_change
 from .ladder import CROSS_CHECKS, LADDER, Rung
 from .pool import map_unordered
 
-T_CAP = 10.0  # s: cap of every run; the default motor settles in about 2 s
+T_CAP = 10.0  # s: cap of every run; several times the default motor's settling time
 DT_OUT = 1e-3  # s: the equations' output interval (each revolution's end is an exact sample whatever it is);
 # MuJoCo is sampled at every step (run_rung)
-HISTORY_DT = 4e-3  # s: interval of the stored time histories (about 60 points per crank revolution at cruise)
+HISTORY_DT = 4e-3  # s: interval of the stored time histories (dozens of points per crank revolution at cruise)
 # Figures held to CROSS_CHECK_TOL. The peak clutch reaction is not: a rigid clutch's reaction jumps where
 # it engages, which MuJoCo's soft constraint resolves over a few steps with an overshoot that depends on
 # the step and on whether a sample falls on it.
@@ -147,7 +147,8 @@ def rung_record(rung: Rung, run: RunResult, wall_s: float) -> dict:
     """The steady-state figures and the time histories of one rung's run (see the module docstring)."""
     s = run.summary
     record = {"name": rung.name, "isolates": rung.describe(run.params), "engine": run.engine,
-              "geometry": run.geometry, "clutch": run.clutch, "mujoco_clutch": registry.variant(rung.variant).clutch, "timestep": run.settings.get("timestep"),
+              "geometry": run.geometry, "clutch": run.clutch, "mujoco_clutch": registry.variant(rung.variant).clutch,
+              "timestep": run.settings.get("timestep"),
               "wall_s": wall_s, "steady": s["steady"], "stalled": s["stalled"], "stall_reason": s["stall_reason"],
               "revolutions": s["revolutions"], **{k: s[k] for k in STEADY_FIGURES}}
     v, d, e = s["steady_speed_m_s"], s["distance_per_rev_m"], s["energy_per_metre_j_m"]
@@ -185,9 +186,8 @@ def cruise_study(params: RobotParams, quick: bool = False, progress: Progress = 
     """Every rung to its steady state under ``params``' motor, and the cross-checks (module docstring).
 
     ``quick`` leaves out the MuJoCo runs at half their timestep. ``workers``: processes for the rungs
-    (default: the cores, at most one per rung; 1 runs them here). A pool pays even for these short runs:
-    on 2 cores under a load of ~2 from other work, the quick study took 0.80 s with 2 workers against
-    1.15 s with 1, the full one 1.19 s against 2.07 s (medians of 3).
+    (default: the cores, at most one per rung; 1 runs them here): the rungs are independent, and a pool
+    pays for its start even for these short runs.
     """
     started = time.perf_counter()
     motor = motor_params(params)

@@ -6,7 +6,7 @@ each ratio four runs under the paper's clutch rule: the first-order equations
 (so the difference is the L >> r assumption alone), and MuJoCo's real linkage
 beside the exact equations of that same linkage (the parameter set's rod: MuJoCo
 needs a rod with mass, and comparing it with the massless equations would
-measure the rod, -0.4 % in revolutions at the paper's case, not the engine).
+measure the rod, not the engine).
 The divergence of each summary figure is (first order - exact) / |exact|
 (``divergence``), MuJoCo's (MuJoCo - exact with the rod) / |exact with the rod|
 (``mujoco_vs_exact``); at matching crank angle the gap S and its rate S_dot are

@@ -13,19 +13,21 @@ of one study give byte-identical files.
 Where work runs:
 
 * default: every engine of a design, one after the other, as one task of a
-  process pool (the serial MuJoCo engine steps and records in C, within ~1.2x
-  of MuJoCo's own step cost for a 1-s run, so the analytic and MuJoCo work of
-  the designs fills every core).
+  process pool (the serial MuJoCo engine steps and records in C, close to
+  MuJoCo's own step cost: bench/ratchet_step.py measures it; so the analytic
+  and MuJoCo work of the designs fills every core).
 * with ``batch_size`` (``batch_mujoco=True``), or where the serial engine's
   compiled loop is not built (``registry.compiled_status``): MuJoCo's
   ratchet through ``mujoco.batch`` (``registry.run_batch``) in chunks of
   ``batch_size`` designs, each chunk in a process of its own on one thread,
   so rows stream as chunks finish; a design the batch does not model
   (``registry.batch_models``: compliant clutches, a drive it does not
-  declare) runs in that process with the serial engine instead. The chunks and the pool (the other engines) run at once and share the cores: while both
-  have work, the batch gets half of them (rounded up) and the pool the rest; whichever finishes first
-  hands its cores to the other. Ctrl-C ends both pools' processes at once; the rows written are every
-  design finished by then.
+  declare) runs in that process with the serial engine instead. The chunks
+  and the pool (the other engines) run at once and share the cores: while
+  both have work, the batch gets half of them (rounded up) and the pool the
+  rest; whichever finishes first hands its cores to the other. Ctrl-C ends
+  both pools' processes at once; the rows written are every design finished
+  by then.
 * ``executor=``: any ``concurrent.futures.Executor`` (a Dask ``Client``'s
   ``get_executor()`` for a cluster); every engine of a design runs as one task
   on it, MuJoCo serially.
@@ -63,7 +65,9 @@ from .sweep_files import Progress, ResultsFile, header_for, make_row
 from .sweep_metrics import batch_metrics, run_metrics
 from .sweep_space import Study
 
-BATCH_SIZE = 64  # MuJoCo designs stepped together: ~2 s of work per chunk for 1 s runs on 2 cores
+# MuJoCo designs stepped together: enough work per chunk that its process's start costs little, few enough
+# that rows stream as chunks finish (bench/sweep_throughput.py measures a batch's designs per second)
+BATCH_SIZE = 64
 
 
 class SweepInterrupted(RuntimeError):
@@ -141,7 +145,7 @@ class _Cores:
 
     Each batch chunk runs in a process of its own on one thread: the batch's per-step Python work
     (the ratchet's bounds) then runs in parallel too, where threads of one batch would wait for it
-    (measured on 2 cores, 400 designs, 1 s: two one-thread processes 11.4 s, one two-thread process 13.9 s).
+    (bench/sweep_throughput.py times both ways).
     """
 
     def __init__(self, total: int, batch: bool, pool: bool):
@@ -239,7 +243,8 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
         except (ValueError, UnicodeDecodeError, AttributeError):
             previous = None
         if previous != record["fingerprint"]:
-            raise ParameterError(f"{str(out)!r} holds another study (its sweep.json differs); resume needs the same one")
+            raise ParameterError(f"{str(out)!r} holds another study (its sweep.json differs); resume needs the "
+                                 "same one")
     designs = study.designs()
     out.mkdir(parents=True, exist_ok=True)
     results_file = ResultsFile(out / "results.csv", header_for(study), resume)

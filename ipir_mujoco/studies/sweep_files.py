@@ -6,10 +6,9 @@ metric (:mod:`ipir_mujoco.studies.sweep_metrics`), then ``divergence:ENGINE:METR
 (stall reasons: a stalled design is a result) and ``error`` (why an engine gave no result).
 
 A run that stopped at its steady state ends where its engine's detection fired, which two engines that
-agree on the steady speed to 2e-4 may do a revolution apart (54 of 400 designs of the 20 x 20 motor
-sweep of L and m2 with --until-steady: revolutions 5-9 % apart, t_steady 0.25 s apart): the divergence
-of revolutions is left empty where either run stopped so; the steady speed and energy per metre compare
-those runs.
+agree on the steady speed may do a revolution apart, so that their revolutions differ by a whole turn
+out of the few the run made: the divergence of revolutions is left empty where either run stopped so;
+the steady speed and energy per metre compare those runs.
 """
 
 from __future__ import annotations

@@ -13,8 +13,8 @@ mean_speed_mps             m/s     forward speed of the robot (mean of the two m
                                    run's end); 0 if none was completed
 steady                     0/1     1 if the run reached its periodic steady state
 t_steady_s                 s       when it did (end of the settled window); empty if not steady;
-                                   a revolution's resolution: two engines agreeing on the steady
-                                   speed to 2e-4 may settle a revolution apart (up to 13 % in t)
+                                   a revolution's resolution: two engines that agree on the steady
+                                   speed may settle a revolution apart
 steady_speed_m_s           m/s     mean speed over the settled window; empty if not steady
 distance_per_rev_m         m       distance per crank revolution: settled window, else whole run
 energy_per_metre_j_m       J/m     motor work per metre over the settled window; empty if not steady
@@ -41,27 +41,19 @@ instant the engine resolves as an event (a mode switch: a clutch engages or lets
 clutch's contact), read exactly where the run writes that instant twice, before and after, as the
 analytic engines do; 0 if the run has no event. MuJoCo leaves it empty: its clutches engage over a
 few steps of a soft constraint, so no instant holds a jump, and an estimate from its samples measures
-the sampling. The former definition (each side's acceleration fitted over a 3 ms window 2 ms clear
-of the event and extrapolated to it, meant to read the same in a rigid and a soft engine) read 0.47-1.26
-of the equations' exact jump in the equations' own series and 0.55-1.50 of it in MuJoCo's, over 40
-designs of the L x m2 grid (1 s, 1 ms samples): where the acceleration changes fast before a switch
-(-105 to -75 m/s^2 in the last 1.3 ms), a parabola through 1 ms samples cannot carry it to the event.
+the sampling: where the acceleration changes fast just before a switch, a fit through 1 ms samples on
+either side cannot carry it to the event, in the equations' series as in MuJoCo's.
 
 Peak forces from MuJoCo, left empty where they would measure the numerics. A rigid MuJoCo clutch is a
-soft constraint that takes up its load within a few steps and overshoots for a step or two, by an
-amount set by the step; read every 1 ms (the sweep's output), the peak is whichever step a sample
-hits. At the default motor's cruise the ratchet's peak reaction reads 11.84 N every 1 ms, 16.34 N at
-its 0.1 ms steps and 12.09 N at 0.05 ms (the equations: 12.13 N); the lock's 96.0, 141.3 and 110.9 N
-(equations 97.5 N), and the clutch's jolt reaches the rod: the lock's peak rod force reads 96.0,
-119.4 and 139.7 N at 0.05 ms read every 1 ms, at every step, and at 0.025 ms. The ratchet's holds at
-that cruise (36.67-36.68 N) but not where an engagement is hard: starting from rest at L = 0.3742 m,
-m2 = 0.2 kg its peak rod force reads 226.5, 217.6, 197.1 and 162.1 N read at every step of 1e-4,
-5e-5, 2.5e-5 and 1.25e-5 s (the equations: 127.6 N); over the 20 x 20 sweep of L and m2 the ratchet's
-1 ms peak differed from the equations' by -16 % to +78 %. A compliant clutch's spring force is
-physical, but its peak falls between 1 ms samples. So MuJoCo's ``peak_clutch_force_n`` and
-``peak_rod_force_n`` are given only for compliant clutches sampled at every step; the analytic engines
-give the rigid model's values (its reactions peak at mode switches, which are sampled exactly), and
-``clutch-study`` the engagement loads of real clutches in both engines.
+soft constraint that takes up its load within a few steps and overshoots for a step or two, by an amount
+set by the step; read every 1 ms (the sweep's output), the peak is whichever step a sample hits, and
+read at every step it still moves with the step. Where an engagement is hard (a light module started
+from rest) its jolt reaches the rod, whose peak force then moves with the step too (tests/test_sweep.py
+holds both artefacts). A compliant clutch's spring force is physical, but its peak falls between 1 ms
+samples. So MuJoCo's ``peak_clutch_force_n`` and ``peak_rod_force_n`` are given only for compliant
+clutches sampled at every step; the analytic engines give the rigid model's values (its reactions peak
+at mode switches, which are sampled exactly), and ``clutch-study`` the engagement loads of real clutches
+in both engines.
 """
 
 from __future__ import annotations
@@ -100,10 +92,9 @@ def mean_speed(series: dict[str, np.ndarray]) -> float:
     0 if no revolution was completed.
 
     Counted from the end, not from the start's crank angle: two runs that agree to a fraction of a turn
-    then average over the same strokes. Counted from the start, a MuJoCo run just past its 6th turn and
-    the equations 1.4e-3 of a turn short of it averaged over turns 4-6 and 3-5 of an accelerating crank
-    and read 1.415 and 1.219 m/s (-14 %) where their revolutions agreed to 2.3e-4 (L = 0.0831 m,
-    m2 = 1.674 kg, 1 s)."""
+    then average over the same strokes. Counted from the start, a run just past a whole turn and one just
+    short of it average over different strokes of an accelerating crank, and their mean speeds can differ
+    by far more than their revolutions do."""
     t, phi = np.asarray(series["t"], dtype=float), np.asarray(series["phi"], dtype=float)
     reach = np.maximum.accumulate(phi) - phi[0]  # the running maximum, as the revolution count
     turns = min(LAST_CYCLES, int(math.floor(reach[-1] / (2 * math.pi) + 1e-9)))

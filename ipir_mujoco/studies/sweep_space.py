@@ -49,11 +49,11 @@ from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, chec
 
 ENGINES = registry.NAMES  # every variant (ipir_mujoco.registry); their aliases are accepted too
 DEFAULT_ENGINES = ("mujoco-ratchet", "analytic-unilateral")
-# designs per sweep: about 3.5 h at the 8 designs/s measured for 1 s runs of the default engines on
-# 2 cores (runs to a steady state cost more), and the grid stays small in memory; split a larger study
+# designs per sweep: hours of work for 1 s runs of the default engines on a few cores (runs to a steady
+# state cost more; bench/targets.py measures the rate), and the grid stays small in memory; split a larger study
 MAX_DESIGNS = 100_000
 DT_OUT = 1e-3  # s: output interval of the sweep's runs; enough for the metrics, light on memory
-T_END_STEADY = 10.0  # s: the default cap of a run to steady state (the default motor settles in about 2 s)
+T_END_STEADY = 10.0  # s: the default cap of a run to steady state (several times the default motor's settling)
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,8 @@ def parse_vary(text: str) -> Axis:
     if not sep or not spec:
         raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N, NAME=A,B,C or NAME=LO:HI")
     if name not in PARAMETER_NAMES:
-        raise ParameterError(f"--vary {text!r}: unknown parameter {name!r}; known parameters: {' '.join(PARAMETER_NAMES)}")
+        raise ParameterError(f"--vary {text!r}: unknown parameter {name!r}; known parameters: "
+                             f"{' '.join(PARAMETER_NAMES)}")
     if "," in spec:
         try:
             values = tuple(float(v) for v in spec.split(","))
@@ -114,7 +115,8 @@ def parse_vary(text: str) -> Axis:
                                  f"axis alone; allowed: N <= {MAX_DESIGNS} (designs per sweep)")
         spaced = np.geomspace if log else np.linspace
         return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))), log=log)
-    raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N[:log], NAME=A,B,C or NAME=LO:HI[:log]")
+    raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N[:log], NAME=A,B,C or "
+                         "NAME=LO:HI[:log]")
 
 
 @dataclass(frozen=True)
@@ -197,7 +199,8 @@ class Study:
             design = {}
             for axis, u in zip(self.axes, point):
                 if axis.log:
-                    design[axis.name] = float(math.exp(math.log(axis.low) + u * (math.log(axis.high) - math.log(axis.low))))
+                    lo, hi = math.log(axis.low), math.log(axis.high)
+                    design[axis.name] = float(math.exp(lo + u * (hi - lo)))
                 else:
                     design[axis.name] = float(axis.low + u * (axis.high - axis.low))
             designs.append(design)
