@@ -156,17 +156,19 @@ def test_sweep_command_writes_results_heatmap_and_best_designs(tmp_path, capsys)
     assert main(["sweep", "--vary", "L=0.08:0.3:3", "--vary", "m2=0.5,1.5", "--engines",
                  "analytic-unilateral,analytic-approx", "--t-end", "0.5", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "best mean_speed_mps" in printed
+    assert re.search(r"^  best mean_speed_m_s +\(highest\) ", printed, flags=re.M), printed
     # each best value keeps its 4 significant digits ('2.000 J/m' for the rigid clutches' F_r1 + F_r2, not '2')
-    values = re.findall(r"^  best \S+ +\S+ +(\S+) at ", printed, flags=re.M)
+    values = re.findall(r"^  best \S+ +\((?:highest|lowest ?)\) +\S+ +(\S+)(?: \S+)? at ", printed, flags=re.M)
     assert values and all(len(re.sub(r"[^0-9]", "", v.split("e")[0]).lstrip("0")) == 4 for v in values), printed
     ranking = json.loads((out / "best.json").read_text())["ranking"]
     assert set(ranking["analytic-unilateral"]) == {"steady_speed_m_s", "energy_per_metre_j_m"}
     assert (out / "sweep_heatmap.png").read_bytes()[:4] == b"\x89PNG"
     columns = read_results(out / "results.csv")
     best = best_designs(columns, ["L", "m2"], ["analytic-unilateral"])
-    speed = next(b for b in best if b["metric"] == "mean_speed_mps")
-    assert speed["value"] == np.nanmax(columns["analytic-unilateral:mean_speed_mps"])
+    speed = next(b for b in best if b["metric"] == "mean_speed_m_s")
+    assert speed["value"] == np.nanmax(columns["analytic-unilateral:mean_speed_m_s"])
+    # the first spelling stays in every row, with the same values, for scripts written against it
+    assert np.array_equal(columns["analytic-unilateral:mean_speed_mps"], columns["analytic-unilateral:mean_speed_m_s"])
     assert main(["sweep", "--vary", "L=0.1:0.3:3", "--engines", "analytic-approx", "--t-end", "0.3",
                  "--out", str(tmp_path / "line")]) == 0
     assert (tmp_path / "line" / "sweep_lines.png").is_file()
@@ -447,8 +449,8 @@ def test_the_heatmap_colours_the_first_engine_that_gives_the_metric():
                "mujoco-ratchet:revolutions": np.ones(4), "analytic-unilateral:revolutions": np.ones(4)}
     engines = ["mujoco-ratchet", "analytic-unilateral"]
     engine, heading = coloured_engine(columns, engines, "peak_clutch_force_n")
-    assert engine == "analytic-unilateral" and "mujoco-ratchet gives no peak_clutch_force_n" in heading
-    assert coloured_engine(columns, engines, "revolutions") == ("mujoco-ratchet", "revolutions of mujoco-ratchet")
+    assert engine == "analytic-unilateral" and "mujoco-ratchet gives no peak clutch force" in heading
+    assert coloured_engine(columns, engines, "revolutions") == ("mujoco-ratchet", "crank revolutions of mujoco-ratchet")
     columns["analytic-unilateral:peak_clutch_force_n"] = nan
     assert coloured_engine(columns, engines, "peak_clutch_force_n")[0] is None
 
@@ -462,10 +464,10 @@ def test_the_line_plot_does_not_draw_a_stalled_design_as_a_point_of_the_curve():
 
     x = np.array([0.02, 0.04, 0.06, 0.08])
     columns = {"M_stall": x, "a:stalled": np.array([1.0, 0.0, 0.0, 0.0])}
-    for metric in ("mean_speed_mps", "distance_per_rev_m"):
+    for metric in ("mean_speed_m_s", "distance_per_rev_m"):
         columns[f"a:{metric}"] = np.array([0.06, 0.11, 0.12, 0.125])
     for metric in ("steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n",
-                   "peak_rod_force_n", "accel_jump_mps2"):
+                   "peak_rod_force_n", "accel_jump_m_s2"):
         columns[f"a:{metric}"] = np.full(4, np.nan)
     fig = lines_figure(columns, SimpleNamespace(name="M_stall", log=False), ["a"])
     lines = {line.get_gid(): line for ax in fig.axes for line in ax.get_lines() if line.get_gid()}
@@ -481,10 +483,10 @@ def test_a_metric_equal_in_every_design_names_no_best_design():
 
     columns = {"design_id": np.arange(3.0), "L": np.array([0.1, 0.2, 0.3]), "a:revolutions": np.ones(3),
                "a:stalled": np.zeros(3)}
-    for metric in ("mean_speed_mps", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m",
-                   "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2"):
+    for metric in ("mean_speed_m_s", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m",
+                   "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2"):
         columns[f"a:{metric}"] = np.full(3, np.nan)
-    columns["a:mean_speed_mps"] = np.zeros(3)
+    columns["a:mean_speed_m_s"] = np.zeros(3)
     columns["a:efficiency"] = np.array([0.1, 0.3, 0.2])
     best = best_designs(columns, ["L"], ["a"])
     assert [(b["metric"], b["L"]) for b in best] == [("efficiency", 0.2)]
@@ -586,9 +588,57 @@ def test_the_heatmap_compares_the_steady_speed_where_revolutions_are_not_compare
 
     engines = ["mujoco-ratchet", "analytic-unilateral"]
     columns = {f"divergence:analytic-unilateral:{m}": np.full(3, np.nan)
-               for m in ("revolutions", "steady_speed_m_s", "mean_speed_mps")}
+               for m in ("revolutions", "steady_speed_m_s", "mean_speed_m_s")}
     columns["divergence:analytic-unilateral:steady_speed_m_s"] = np.array([1e-4, np.nan, 2e-4])
     assert compared_metric(columns, engines, "t_steady_s") == "steady_speed_m_s"
-    assert compared_metric(columns, engines, "mean_speed_mps") == "mean_speed_mps"
+    assert compared_metric(columns, engines, "mean_speed_m_s") == "mean_speed_m_s"
     columns["divergence:analytic-unilateral:revolutions"] = np.array([3e-4, 1e-4, 2e-4])
     assert compared_metric(columns, engines, "t_steady_s") == "revolutions"
+
+
+def test_a_panel_flat_within_what_the_runs_resolve_says_so_and_names_no_best():
+    """At steady state energy per metre is F_r1 + F_r2 whatever L (rigid clutches): a design-to-design wiggle of
+    1e-4 is the steady window's numerics. Drawn across the resolved band with a note, and ranked nowhere; a
+    metric that does vary is drawn to its own range and ranked."""
+    from types import SimpleNamespace
+
+    from ipir_mujoco.report.sweep_plots import RESOLVED, best_designs, lines_figure
+
+    x = np.array([0.1, 0.2, 0.3, 0.4])
+    columns = {"design_id": np.arange(4.0), "L": x, "a:stalled": np.zeros(4), "a:revolutions": np.ones(4)}
+    for metric in ("mean_speed_m_s", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "efficiency",
+                   "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2"):
+        columns[f"a:{metric}"] = np.full(4, np.nan)
+    columns["a:energy_per_metre_j_m"] = 2.0 * (1 + np.array([1e-4, -2e-4, 3e-4, 0.0]))  # within RESOLVED
+    columns["a:steady_speed_m_s"] = np.array([0.55, 0.54, 0.53, 0.53])
+    fig = lines_figure(columns, SimpleNamespace(name="L", log=False), ["a"], caption="a sweep")
+    notes = {text.get_gid() for ax in fig.axes for text in ax.texts}
+    assert "flat:energy_per_metre_j_m" in notes and "flat:steady_speed_m_s" not in notes
+    energy_axis = next(ax for ax in fig.axes if ax.texts and ax.texts[-1].get_gid() == "flat:energy_per_metre_j_m")
+    low, high = energy_axis.get_ylim()
+    assert high - low == pytest.approx(3 * RESOLVED * 2.0, rel=1e-3)  # the band, not the wiggle's own 1e-3 J/m
+    assert [b["metric"] for b in best_designs(columns, ["L"], ["a"])] == ["steady_speed_m_s"]
+
+
+def test_a_stalled_design_has_no_per_revolution_figures_in_either_engine():
+    """A robot at rest for good in a vertical riser: its 'distance per revolution' of a partial turn and its
+    efficiency are not figures of a design; the row leaves them empty, and says it stalled."""
+    from ipir_mujoco import registry
+    from ipir_mujoco.studies.sweep_metrics import PER_REVOLUTION, run_metrics
+
+    params = RobotParams(incline=90.0)
+    for engine in ("analytic-unilateral", "mujoco-ratchet"):
+        run = registry.run(engine, params, 1.0, dt_out=1e-3)
+        assert run.stall is not None, engine
+        metrics = run_metrics(run)
+        assert metrics["stalled"] == 1 and all(np.isnan(metrics[m]) for m in PER_REVOLUTION), (engine, metrics)
+
+
+def test_the_first_metric_spellings_still_name_their_metrics():
+    from ipir_mujoco.report.sweep_plots import check_plot_metric
+
+    assert check_plot_metric("mean_speed_mps", False) == "mean_speed_m_s"
+    assert check_plot_metric("accel_jump_mps2", False) == "accel_jump_m_s2"
+    assert check_plot_metric(None, False) == "mean_speed_m_s"
+    with pytest.raises(ParameterError, match="--plot-metric 'speed' is unknown"):
+        check_plot_metric("speed", False)

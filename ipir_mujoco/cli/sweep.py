@@ -10,7 +10,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
-from ..studies.sweep_metrics import METRICS
+from ..studies.sweep_metrics import METRICS, UNITS
 from ..studies.sweep_space import DEFAULT_ENGINES, ENGINES, T_END_STEADY
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
@@ -48,7 +48,7 @@ def add_parser(commands) -> None:
                           "is used without this option); rows reach results.csv as chunks finish")
     swp.add_argument("--plot-metric", default=None, metavar="METRIC",
                      help="metric the heatmap colours (default: steady_speed_m_s with --until-steady, else "
-                          "mean_speed_mps); any of: " + ", ".join(METRICS))
+                          "mean_speed_m_s); any of: " + ", ".join(METRICS))
     swp.add_argument("--scheduler", metavar="ADDRESS",
                      help="run on a Dask distributed scheduler (needs the 'dask' extra), e.g. tcp://host:8786")
     swp.set_defaults(handler=run)
@@ -80,7 +80,8 @@ def study_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.sweep_plots import best_designs, check_plot_metric, plot_sweep, rankings, read_results
+    from ..report.sweep_plots import (LARGER_IS_BETTER, best_designs, check_plot_metric, plot_sweep, rankings,
+                                      read_results)
     from ..studies.sweep import SweepInterrupted, check_sweep_options, run_sweep
 
     if args.study is not None:
@@ -121,6 +122,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"{len(columns['design_id'])} designs, {failed} failed, {stalled} stalled; results in {results}")
     for item in best:
         where = ", ".join(f"{a}={item[a]:.4g}" for a in axes)
-        print(f"  best {item['metric']:24s} {item['engine']:20s} {significant(item['value'], 4)} at {where}")
+        order = "highest" if item["metric"] in LARGER_IS_BETTER else "lowest"
+        unit = "" if UNITS[item["metric"]] == "-" else f" {UNITS[item['metric']]}"
+        print(f"  best {item['metric']:22s} ({order:7s}) {item['engine']:20s} {significant(item['value'], 4)}{unit} "
+              f"at {where}")
     print(f"  figures: {', '.join(str(f) for f in figures)}; best designs: {args.out}/best.json")
     return EXIT_OK

@@ -24,23 +24,29 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import parameter_units
 
 from ..studies.sweep_files import DIVERGENCE
-from ..studies.sweep_metrics import METRICS, UNITS
+from ..studies.sweep_metrics import LEGACY, METRICS, UNITS, described
 from .plots import new_figure
 
 # metrics where larger is better; the rest (energy per metre, forces, jumps, time to settle) are better small
-LARGER_IS_BETTER = ("mean_speed_mps", "steady_speed_m_s", "distance_per_rev_m", "efficiency")
-NOT_RANKED = ("revolutions", "steady", "stalled", "residual_ratio", "loop_gap_m")
+LARGER_IS_BETTER = ("mean_speed_m_s", "steady_speed_m_s", "distance_per_rev_m", "efficiency")
+NOT_RANKED = ("revolutions", "steady", "stalled", "residual_ratio", "loop_gap_m", *LEGACY)
+# a panel whose values all lie within this relative band of their mean is drawn flat across that band: MuJoCo's
+# accuracy monitor holds its runs' energy to 1e-3 of what the robot is given (mjcf/README.md), and an engine's
+# steady figures lie within 1e-4 to 1e-3 of the periodic limit, so a design-to-design wiggle inside it is
+# numerics, not design
+RESOLVED = 1e-3
 RANKING = (("steady_speed_m_s", "highest first"), ("energy_per_metre_j_m", "lowest first"))
 RANKED = 10  # designs listed per ranking
 
 
 def check_plot_metric(metric: str | None, until_steady: bool) -> str:
-    """The heatmap's metric: ``metric`` if it is one, else the default for the kind of sweep."""
+    """The heatmap's metric: ``metric`` if it is one (a legacy spelling names its new metric), else the default
+    for the kind of sweep."""
     if metric is None:
-        return "steady_speed_m_s" if until_steady else "mean_speed_mps"
+        return "steady_speed_m_s" if until_steady else "mean_speed_m_s"
     if metric not in METRICS:
         raise ParameterError(f"--plot-metric {metric!r} is unknown; allowed: {', '.join(METRICS)}")
-    return metric
+    return LEGACY.get(metric, metric)
 
 
 def read_results(path: str | Path) -> dict[str, np.ndarray]:
@@ -70,8 +76,10 @@ def best_designs(columns: dict[str, np.ndarray], axes: list[str], engines: list[
             if metric in NOT_RANKED:
                 continue
             values = np.where(ok, columns[f"{engine}:{metric}"], np.nan)
-            if np.all(np.isnan(values)) or np.nanmin(values) == np.nanmax(values):
-                continue  # nothing to rank (e.g. mean speed 0 in every design of runs too short for a revolution)
+            if np.all(np.isnan(values)) or np.nanmax(values) - np.nanmin(values) <= RESOLVED * abs(np.nanmean(values)):
+                # nothing to rank: equal everywhere (mean speed 0 in every design of runs too short for a
+                # revolution), or within what the runs resolve (energy per metre F_r1 + F_r2 at steady state)
+                continue
             i = int(np.nanargmax(values) if metric in LARGER_IS_BETTER else np.nanargmin(values))
             best.append({"engine": engine, "metric": metric, "value": float(values[i]),
                          "design_id": int(columns["design_id"][i]), **{a: float(columns[a][i]) for a in axes}})
@@ -99,33 +107,51 @@ def _label(name: str) -> str:
     return f"{name} [{parameter_units(name)}]"
 
 
-def plot_sweep(results: str | Path, study, out: str | Path, metric: str = "mean_speed_mps") -> list[Path]:
+def study_caption(study) -> str:
+    """What was swept, how, and the base design where it is not the defaults, in one line for a figure."""
+    from ipir_mujoco.core.params import RobotParams
+
+    defaults = RobotParams()
+    changed = [f"{name}={getattr(study.base, name):g}" if isinstance(getattr(study.base, name), float)
+               else f"{name}={getattr(study.base, name)}" for name in study.base.as_dict()
+               if getattr(study.base, name) != getattr(defaults, name) and name not in [a.name for a in study.axes]]
+    how = f"to the steady state (cap {study.t_end:g} s)" if study.until_steady else f"{study.t_end:g} s each"
+    base = "base: the paper's case" + (f" with {', '.join(changed)}" if changed else "")
+    return f"sweep of {', '.join(a.name for a in study.axes)}, {len(study.designs())} designs, {how}; {base}"
+
+
+def plot_sweep(results: str | Path, study, out: str | Path, metric: str = "mean_speed_m_s") -> list[Path]:
     """Write the sweep's figures into ``out``; return their paths."""
     columns = read_results(results)
     axes, engines = list(study.axes), list(study.engines)
     out = Path(out)
     if not len(columns.get("design_id", [])):
         return []
+    caption = study_caption(study)
     if len(axes) == 1:
-        return [_lines(columns, axes[0], engines, out)]
-    return [_heatmap(columns, axes[0], axes[1], engines, metric, out)]
+        return [_lines(columns, axes[0], engines, out, caption)]
+    return [_heatmap(columns, axes[0], axes[1], engines, LEGACY.get(metric, metric), out, caption)]
 
 
-def _lines(columns, axis, engines, out: Path) -> Path:
+def _lines(columns, axis, engines, out: Path, caption: str) -> Path:
     path = out / "sweep_lines.png"
-    lines_figure(columns, axis, engines).savefig(path, dpi=110)
+    lines_figure(columns, axis, engines, caption).savefig(path, dpi=110)
     return path
 
 
-def lines_figure(columns, axis, engines):
+def lines_figure(columns, axis, engines, caption: str | None = None):
     """One panel per metric any engine gives, against the one varied parameter; lines carry gids
-    ``ENGINE:METRIC`` (stalled designs left out) and ``stalled:ENGINE:METRIC`` (their crosses)."""
+    ``ENGINE:METRIC`` (stalled designs left out) and ``stalled:ENGINE:METRIC`` (their crosses). A panel
+    whose values lie within :data:`RESOLVED` of their mean is drawn across that band and says so (gid
+    ``flat:METRIC`` on its note)."""
     x = columns[axis.name]
     order = np.argsort(x)
-    shown = ("mean_speed_mps", "steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "distance_per_rev_m",
-             "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2")
+    shown = ("mean_speed_m_s", "steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "distance_per_rev_m",
+             "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2")
     shown = [m for m in shown if any(np.isfinite(columns[f"{e}:{m}"]).any() for e in engines)]
     fig, panels = new_figure(len(shown), height=2.0)
+    if caption:
+        fig.suptitle("\n".join(textwrap.wrap(caption, 90)), fontsize="medium")
     for ax, metric in zip(panels, shown):
         for j, engine in enumerate(engines):
             values = columns[f"{engine}:{metric}"][order]
@@ -137,7 +163,13 @@ def lines_figure(columns, axis, engines):
             if stalled.any():
                 ax.plot(x[order][stalled], values[stalled], "x", ms=6, color=line.get_color(),
                         label=f"{engine}: stalled" if metric == shown[0] else None, gid=f"stalled:{engine}:{metric}")
-        ax.set(ylabel=f"{metric}\n[{UNITS[metric]}]")
+        absent = [e for e in engines if not np.isfinite(columns[f"{e}:{metric}"]).any()]
+        if absent:  # e.g. MuJoCo's rigid clutches' peak forces, which would measure its step (docs/cli.md)
+            ax.text(0.99, 0.96, f"not given by {', '.join(absent)}", transform=ax.transAxes, ha="right", va="top",
+                    fontsize="x-small", color="0.3")
+        ax.set_ylabel("\n".join(textwrap.wrap(described(metric), 22)), fontsize="small")
+        ax.ticklabel_format(axis="y", useOffset=False)
+        _flatten(ax, metric, [columns[f"{e}:{metric}"] for e in engines])
         ax.grid(alpha=0.3)
         if axis.log:
             ax.set_xscale("log")
@@ -146,14 +178,32 @@ def lines_figure(columns, axis, engines):
     return fig
 
 
+def _flatten(ax, metric: str, values: list[np.ndarray]) -> None:
+    """Draw a panel whose finite values all lie within RESOLVED of their mean across that band, and say so."""
+    finite = np.concatenate([v[np.isfinite(v)] for v in values])
+    if finite.size < 2:
+        return
+    mean = float(finite.mean())
+    half = RESOLVED * abs(mean)
+    if half > 0 and float(finite.max() - finite.min()) <= 2 * half:
+        ax.set_ylim(mean - 1.5 * half, mean + 1.5 * half)
+        ax.text(0.01, 0.04, f"flat: within {100 * RESOLVED:g} % of {mean:.5g} everywhere (below what the runs "
+                "resolve)", transform=ax.transAxes, fontsize="x-small", color="0.3", gid=f"flat:{metric}")
+
+
+def _words(metric: str) -> str:
+    """A metric in words, without its unit."""
+    return described(metric).rsplit(" [", 1)[0]
+
+
 def coloured_engine(columns: dict[str, np.ndarray], engines: list[str], metric: str) -> tuple[str | None, str]:
     """The engine whose ``metric`` the heatmap colours: the first that gives it for some design (a batched
     MuJoCo run gives no peak forces, for one), and the title's words for it; (None, words) if none does."""
     for engine in engines:
         if np.isfinite(columns[f"{engine}:{metric}"]).any():
             skipped = engines[:engines.index(engine)]
-            return engine, f"{metric} of {engine}" + (
-                f" ({', '.join(skipped)} gives no {metric})" if skipped else "")
+            return engine, f"{_words(metric)} of {engine}" + (
+                f" ({', '.join(skipped)} gives no {_words(metric)})" if skipped else "")
     return None, f"no engine gives {metric} for these designs"
 
 
@@ -162,12 +212,12 @@ def compared_metric(columns: dict[str, np.ndarray], engines: list[str], metric: 
     revolutions, else (not compared between runs stopped at their steady state) the steady or mean speed."""
     if metric in DIVERGENCE:
         return metric
-    given = [m for m in ("revolutions", "steady_speed_m_s", "mean_speed_mps")
+    given = [m for m in ("revolutions", "steady_speed_m_s", "mean_speed_m_s")
              if np.isfinite(columns[f"divergence:{engines[1]}:{m}"]).any()]
     return (given or ["revolutions"])[0]
 
 
-def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
+def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path, caption: str = "") -> Path:
     x, y = columns[ax_x.name], columns[ax_y.name]
     shown, heading = coloured_engine(columns, engines, metric)
     panels_count = 2 if len(engines) > 1 else 1
@@ -177,7 +227,7 @@ def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
         ax.text(0.5, 0.5, heading, transform=ax.transAxes, ha="center", va="center")
         ax.set(xlim=(np.nanmin(x), np.nanmax(x)), ylim=(np.nanmin(y), np.nanmax(y)))
     else:
-        _colour_map(fig, ax, x, y, columns[f"{shown}:{metric}"], f"{shown}: {metric} [{UNITS[metric]}]")
+        _colour_map(fig, ax, x, y, columns[f"{shown}:{metric}"], f"{shown}: {described(metric)}")
     if len(engines) > 1:
         compared = compared_metric(columns, engines, metric)
         divergence = np.abs(columns[f"divergence:{engines[1]}:{compared}"]) * 100
@@ -191,15 +241,16 @@ def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
                             colors=["white", "red"][:len(levels)], linewidths=1.5)
             ax.clabel(contours, fmt=lambda v: f"{v:g} %", fontsize="small")
             title = (f"{heading}; contours: {engines[1]} differs from {engines[0]} by "
-                     f"{' / '.join(f'{v} %' for v in levels)} in {compared}")
+                     f"{' / '.join(f'{v} %' for v in levels)} in {_words(compared)}")
         elif finite.size:
-            title = (f"{heading}; {engines[1]} differs from {engines[0]} by {low:.2g} to {high:.2g} % in {compared} "
-                     "everywhere (no 1 % / 5 % contour inside the map)")
+            title = (f"{heading}; {engines[1]} differs from {engines[0]} by {low:.2g} to {high:.2g} % in "
+                     f"{_words(compared)} everywhere (no 1 % / 5 % contour inside the map)")
         else:
-            title = f"{heading}; no design where both engines give {compared}"
+            title = f"{heading}; no design where both engines give {_words(compared)}"
         _colour_map(fig, panels[1], x, y, divergence, f"|{engines[1]} - {engines[0]}| / |{engines[0]}| "
-                                                         f"in {compared} [%]")
-        panels[1].set_title(f"divergence of {engines[1]} from {engines[0]} in {compared}", fontsize="medium")
+                                                         f"in {_words(compared)} [%]")
+        panels[1].set_title(f"divergence of {engines[1]} from {engines[0]} in {_words(compared)}",
+                            fontsize="medium")
     else:
         title = heading
     failed = np.array([bool(e) for e in columns["error"]])
@@ -212,6 +263,8 @@ def _heatmap(columns, ax_x, ax_y, engines, metric, out: Path) -> Path:
     if (failed | stalled).any():
         ax.legend(fontsize="small", loc="upper right")
     ax.set_title("\n".join(textwrap.wrap(title, 80)), fontsize="medium")
+    if caption:
+        fig.suptitle("\n".join(textwrap.wrap(caption, 90)), fontsize="medium")
     for panel in panels:
         panel.set(xlabel=_label(ax_x.name), ylabel=_label(ax_y.name))
         if ax_x.log:

@@ -25,7 +25,9 @@ from ipir_mujoco.core.errors import ParameterError
 from .sweep_metrics import METRICS
 from .sweep_space import Study
 
-DIVERGENCE = ("revolutions", "mean_speed_mps", "steady_speed_m_s", "energy_per_metre_j_m", "accel_jump_mps2")
+# the legacy spellings (sweep_metrics.LEGACY) last, for scripts written against them
+DIVERGENCE = ("revolutions", "mean_speed_m_s", "steady_speed_m_s", "energy_per_metre_j_m", "accel_jump_m_s2",
+              "mean_speed_mps", "accel_jump_mps2")
 
 
 def header_for(study: Study) -> list[str]:

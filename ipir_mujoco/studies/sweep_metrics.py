@@ -8,7 +8,7 @@ The per-revolution figures and the steady state come from :mod:`ipir_mujoco.core
 metric                     units   meaning
 =========================  ======  ==============================================================
 revolutions                rev     crank turns in the run
-mean_speed_mps             m/s     forward speed of the robot (mean of the two modules) over the
+mean_speed_m_s             m/s     forward speed of the robot (mean of the two modules) over the
                                    last whole crank revolutions (up to 3, counted back from the
                                    run's end); 0 if none was completed
 steady                     0/1     1 if the run reached its periodic steady state
@@ -25,7 +25,7 @@ peak_clutch_force_n        N       largest clutch reaction (settled window, else
                                    clutches or any MuJoCo run not sampled at every step, see below)
 peak_rod_force_n           N       largest |rod force| (empty where the engine cannot say: as
                                    peak_clutch_force_n, see below)
-accel_jump_mps2            m/s^2   largest jump of a module's acceleration where a clutch engages or
+accel_jump_m_s2            m/s^2   largest jump of a module's acceleration where a clutch engages or
                                    lets go (exact, at the analytic engines' event instants; empty for
                                    MuJoCo, see below)
 stalled                    0/1     1 if the robot ended at rest for good (the engine's stall
@@ -36,7 +36,14 @@ loop_gap_m                 m       MuJoCo accuracy monitor: worst loop-closure g
                                    the analytic engines, whose accuracy is their solver tolerance)
 =========================  ======  ==============================================================
 
-``accel_jump_mps2``: the largest jump |a_after - a_before| of either module's acceleration at an
+Per-revolution figures of a stalled design (a robot at rest: a partial revolution's "distance per
+revolution", an efficiency of a run that did no work at the end) are left empty: ``distance_per_rev_m``,
+``energy_per_metre_j_m``, ``efficiency``.
+
+``mean_speed_mps`` and ``accel_jump_mps2`` (:data:`LEGACY`) are the first spellings of ``mean_speed_m_s``
+and ``accel_jump_m_s2``, kept in every row with the same values for scripts written against them.
+
+``accel_jump_m_s2``: the largest jump |a_after - a_before| of either module's acceleration at an
 instant the engine resolves as an event (a mode switch: a clutch engages or lets go; a compliant
 clutch's contact), read exactly where the run writes that instant twice, before and after, as the
 analytic engines do; 0 if the run has no event. MuJoCo leaves it empty: its clutches engage over a
@@ -65,13 +72,26 @@ import numpy as np
 
 from ipir_mujoco.core.cycles import cycle_summary, travel
 
-METRICS = ("revolutions", "mean_speed_mps", "steady", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m",
-           "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_mps2",
-           "stalled", "residual_ratio", "loop_gap_m")
-UNITS = {"revolutions": "rev", "mean_speed_mps": "m/s", "steady": "0/1", "t_steady_s": "s", "steady_speed_m_s": "m/s",
-         "distance_per_rev_m": "m", "energy_per_metre_j_m": "J/m", "efficiency": "-", "peak_clutch_force_n": "N",
-         "peak_rod_force_n": "N", "accel_jump_mps2": "m/s^2", "stalled": "0/1", "residual_ratio": "-",
-         "loop_gap_m": "m"}
+LEGACY = {"mean_speed_mps": "mean_speed_m_s", "accel_jump_mps2": "accel_jump_m_s2"}  # old spelling -> new
+# metric: (in words, unit)
+DESCRIBED = {
+    "revolutions": ("crank revolutions", "rev"), "mean_speed_m_s": ("mean forward speed", "m/s"),
+    "steady": ("steady state reached", "0/1"), "t_steady_s": ("time to steady state", "s"),
+    "steady_speed_m_s": ("steady forward speed", "m/s"), "distance_per_rev_m": ("distance per revolution", "m"),
+    "energy_per_metre_j_m": ("energy per metre", "J/m"), "efficiency": ("efficiency", "-"),
+    "peak_clutch_force_n": ("peak clutch force", "N"), "peak_rod_force_n": ("peak rod force", "N"),
+    "accel_jump_m_s2": ("acceleration jump at a clutch switch", "m/s^2"), "stalled": ("stalled", "0/1"),
+    "residual_ratio": ("MuJoCo energy residual / motor work", "-"), "loop_gap_m": ("MuJoCo loop gap", "m"),
+}
+METRICS = (*DESCRIBED, *LEGACY)  # every column a row carries per engine, the legacy spellings last
+UNITS = {**{m: unit for m, (_, unit) in DESCRIBED.items()}, **{old: DESCRIBED[new][1] for old, new in LEGACY.items()}}
+PER_REVOLUTION = ("distance_per_rev_m", "energy_per_metre_j_m", "efficiency")  # empty for a stalled design
+
+
+def described(metric: str) -> str:
+    """'mean forward speed [m/s]': a metric (or its legacy spelling) in words, with its unit."""
+    words, unit = DESCRIBED[LEGACY.get(metric, metric)]
+    return f"{words} [{unit}]"
 LAST_CYCLES = 3
 
 
@@ -132,9 +152,10 @@ def design_metrics(series: dict[str, np.ndarray], summary: dict[str, Any], energ
     if efficiency is None and energy and energy.get("motor_work_j", 0) > 0 and "friction_j" in energy:
         efficiency = energy["friction_j"] / energy["motor_work_j"]
     accuracy = summary.get("accuracy") or {}
-    return {
+    stalled = bool(stalled or summary.get("stalled"))
+    metrics = {
         "revolutions": float(revolutions),
-        "mean_speed_mps": float(mean_speed(series)),
+        "mean_speed_m_s": float(mean_speed(series)),
         "steady": float(bool(summary.get("steady"))),
         "t_steady_s": _number(summary.get("t_steady_s")),
         "steady_speed_m_s": _number(summary.get("steady_speed_m_s")),
@@ -143,11 +164,21 @@ def design_metrics(series: dict[str, np.ndarray], summary: dict[str, Any], energ
         "efficiency": _number(efficiency),
         "peak_clutch_force_n": _number(summary.get("peak_clutch_force_n")),
         "peak_rod_force_n": float(np.abs(series["rod_force"]).max()) if "rod_force" in series else math.nan,
-        "accel_jump_mps2": accel_jump(series) if len(t) > 1 else 0.0,
-        "stalled": float(bool(stalled or summary.get("stalled"))),
+        "accel_jump_m_s2": accel_jump(series) if len(t) > 1 else 0.0,
+        "stalled": float(stalled),
         "residual_ratio": _number(accuracy.get("residual_ratio")),
         "loop_gap_m": _number(accuracy.get("loop_gap_m")),
     }
+    if stalled:  # a robot at rest for good: no revolution to be per (module docstring)
+        metrics.update({m: math.nan for m in PER_REVOLUTION})
+    return with_legacy(metrics)
+
+
+def with_legacy(metrics: dict[str, float]) -> dict[str, float]:
+    """``metrics`` with each :data:`LEGACY` spelling holding its new metric's value (in place)."""
+    for old, new in LEGACY.items():
+        metrics[old] = metrics[new]
+    return metrics
 
 
 def run_metrics(run) -> dict[str, float]:
@@ -164,8 +195,8 @@ def run_metrics(run) -> dict[str, float]:
         every_step = settings.get("dt_out") == settings.get("timestep")
         if settings.get("clutch_model") != "compliant" or not every_step:
             metrics["peak_clutch_force_n"] = metrics["peak_rod_force_n"] = math.nan
-        metrics["accel_jump_mps2"] = math.nan  # no instant of a soft engagement holds a jump (module docstring)
-    return metrics
+        metrics["accel_jump_m_s2"] = math.nan  # no instant of a soft engagement holds a jump (module docstring)
+    return with_legacy(metrics)
 
 
 def batch_metrics(outcome: dict, steady_tol: float | None = None, steady_cycles: int | None = None) -> dict[str, float]:
@@ -178,8 +209,8 @@ def batch_metrics(outcome: dict, steady_tol: float | None = None, steady_cycles:
     stalled = outcome.get("stall") is not None if "stall" in outcome else _at_rest(series)
     energy = {"motor_work_j": outcome["motor_work_j"], "friction_j": outcome["friction_work_j"]}
     metrics = design_metrics(series, summary, energy, stalled=stalled)
-    metrics["accel_jump_mps2"] = math.nan  # MuJoCo: no instant of a soft engagement holds a jump
-    return metrics
+    metrics["accel_jump_m_s2"] = math.nan  # MuJoCo: no instant of a soft engagement holds a jump
+    return with_legacy(metrics)
 
 
 def _at_rest(series: dict[str, np.ndarray]) -> bool:
