@@ -38,7 +38,7 @@ def pack(dyn: OneDofDynamics) -> np.ndarray:
     """The constants of ``dyn`` (its parameters, geometry, rod and drive) as the kernels' float array (16,)."""
     p = dyn.params
     motor = p.drive == "motor"
-    return np.array([p.m1, p.m2, p.r, p.L, p.J_A, p.F_r1, p.F_r2, p.M, p.rod_mass, p.rod_inertia_value,
+    return np.array([p.m1, p.m2, p.r, p.L, p.J_A, *dyn.resistance, p.M, p.rod_mass, p.rod_inertia_value,
                      float(dyn.geometry.value == "exact"), float(dyn.include_rod), float(motor),
                      p.M_stall if motor else 0.0, p.omega_noload if motor else 1.0, gravity_along_pipe(p)],
                     dtype=float)
