@@ -43,6 +43,9 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"geometry={geometry!r} is unknown; allowed: approx, exact") from None
     if clutch not in CLUTCH_RULES:
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(CLUTCH_RULES)}")
+    if params.mu_wall is not None:  # the analytic models of finite grip come in the next commits
+        raise ParameterError(f"mu_wall={params.mu_wall!r} is not modelled yet; allowed: mu_wall=unlimited")
+    _refuse_unused_normal_force(params)
     if params.clutch_stiffness is not None:
         if clutch != "unilateral":
             raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
@@ -62,6 +65,16 @@ def _refuse_unmodelled(params: RobotParams) -> None:
             raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid clutch "
                                  f"has no spring for it to act with); allowed: {getattr(defaults, name)!r} with "
                                  "clutch_stiffness=rigid")
+
+
+def _refuse_unused_normal_force(params: RobotParams) -> None:
+    """The wheels' normal forces act only through a finite grip: refused with unlimited grip, never ignored."""
+    defaults = RobotParams()
+    for name in ("F_n1", "F_n2"):
+        if params.mu_wall is None and getattr(params, name) != getattr(defaults, name):
+            raise ParameterError(f"{name}={getattr(params, name)!r} N needs a finite mu_wall (with unlimited grip the "
+                                 f"normal force holds nothing); allowed: {getattr(defaults, name)!r} with "
+                                 "mu_wall=unlimited")
 
 
 __all__ = [
