@@ -354,7 +354,8 @@ class CompliantModel:
         loads the modules), with the clutch overlaps kept as they are."""
         free_crank = self.motion(y, Regime((0, 1), clutch, peak)).alpha  # module 1 at rest, K = 0: M22 alpha = T
         if abs(float(free_crank)) * self.linkage.r <= 1e-12:  # [m/s^2] at the crank pin: no drive at all
-            return (0, 0)  # nothing turns the crank: at rest it stays
+            # the crank stays, and only gravity and the clutches load the modules: the friction states at rest
+            return self._enumerate(t, y, clutch, peak, [True, True], True, None)
         step = math.copysign(_DEAD_CENTRE_STEP, float(free_crank))
         ahead = np.array(y, dtype=float)
         ahead[0] += step
