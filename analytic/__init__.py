@@ -52,9 +52,6 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         if clutch != "unilateral":
             raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
                                  "paper's rule locks rigidly; allowed: clutch='unilateral' or clutch_stiffness=rigid")
-        if params.mu_wall is not None:  # TEMPORARY: the compliant clutches' grip comes in its own commit
-            raise ParameterError(f"mu_wall={params.mu_wall!r} with a compliant clutch is not modelled yet; "
-                                 "allowed: mu_wall=unlimited")
         return simulate_compliant(params, geometry, t_end, **options)
     _refuse_unmodelled(params)
     if clutch == "unilateral":

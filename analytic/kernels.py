@@ -222,10 +222,13 @@ def guard_table(model, mode, n_events, p, times, states, out):
 # of rhs/guard says whether an event reads its raw value (RAW) or what the root search sees (GUARDED).
 COMPLIANT = 2
 RAW, GUARDED = 0, 1
-TRACKING, FREE, ENGAGED, CLIPPED = 0, 1, 2, 3  # .compliant_clutch.Clutch
+TRACKING, FREE, ENGAGED, CLIPPED, SLIDING = 0, 1, 2, 3, 4  # .compliant_clutch.Clutch
 P_K, P_C, P_DELTA, P_S0, P_S1, P_S2, P_C1, P_C2, P_PK1, P_PK2, P_T0 = range(16, 27)
-P_EVENTS = 27  # then four numbers per event: kind, module, direction, offset
-EV_MARGIN, EV_VELOCITY, EV_OVERLAP, EV_TRACK, EV_PUSH, EV_PHI = range(6)
+# finite grip (:mod:`.compliant_grip`): each module's grip [N] (inf: unlimited), and while its clutch's
+# anchor slides the slide's start [s] and the overlap then [m]
+P_GR1, P_GR2, P_TS1, P_DS1, P_TS2, P_DS2 = range(27, 33)
+P_EVENTS = 33  # then four numbers per event: kind, module, direction, offset
+EV_MARGIN, EV_VELOCITY, EV_OVERLAP, EV_TRACK, EV_PUSH, EV_PHI, EV_GRIP, EV_STICK = range(8)
 
 
 @jit
@@ -248,8 +251,8 @@ def compliant_motion(p, y):
     k, c, delta = p[P_K], p[P_C], p[P_DELTA]
     d1 = -delta if p[P_C1] == TRACKING else p[P_PK1] - delta - x1
     d2 = -delta if p[P_C2] == TRACKING else p[P_PK2] - delta - x2
-    f1 = k * d1 - c * v1 if p[P_C1] == ENGAGED else 0.0
-    f2 = k * d2 - c * v2 if p[P_C2] == ENGAGED else 0.0
+    f1 = k * d1 - c * v1 if p[P_C1] == ENGAGED else (p[P_GR1] if p[P_C1] == SLIDING else 0.0)
+    f2 = k * d2 - c * v2 if p[P_C2] == ENGAGED else (p[P_GR2] if p[P_C2] == SLIDING else 0.0)
     s1, s2 = p[P_S1], p[P_S2]
     sliding1, sliding2 = -s1 * p[P_FR1], -s2 * p[P_FR2]
     torque = drive_torque(p, omega)
@@ -296,6 +299,17 @@ def compliant_rhs(y, p, out):
 
 
 @jit
+def slide_rate(p, i, t):
+    """d(overlap)/dt [m/s] of module i's clutch while its anchor slides (:func:`.compliant_grip.slide_overlap`):
+    the spring relaxes towards G / k through the damper, (G - k d(t)) / c; 0 without a damper (d = G / k)."""
+    k, c = p[P_K], p[P_C]
+    if c == 0.0:
+        return 0.0
+    G, ts, d0 = (p[P_GR1], p[P_TS1], p[P_DS1]) if i == 0 else (p[P_GR2], p[P_TS2], p[P_DS2])
+    return (G - k * d0) / c * math.exp(-(t - ts) * k / c)
+
+
+@jit
 def compliant_guard(guarded, k, t, y, p):
     """Event k of the segment (:meth:`.CompliantModel.events`): its raw value, or (``guarded``) as solve_ivp sees it."""
     base = P_EVENTS + 4 * k
@@ -315,8 +329,12 @@ def compliant_guard(guarded, k, t, y, p):
             value = position - peak + offset
         elif kind == EV_OVERLAP:
             value = peak - p[P_DELTA] - position + offset
-        else:  # EV_PUSH
+        elif kind == EV_PUSH:
             value = p[P_K] * (peak - p[P_DELTA] - position) - p[P_C] * v + offset
+        elif kind == EV_GRIP:  # the grip less the force the clutch would push with: its anchor slides at 0
+            value = offset - (p[P_K] * (peak - p[P_DELTA] - position) - p[P_C] * v)
+        else:  # EV_STICK: the sliding anchor's speed backward (+ offset)
+            value = offset - v - slide_rate(p, i, t)
     if guarded != 0 and (value == 0 or (t == p[P_T0] and direction * value > 0)):
         return -direction * 1e-300
     return value

@@ -356,3 +356,64 @@ def test_engines_without_grip_columns_summarize():
     from ipir_mujoco.core.results import summarize
     summary = summarize(series, run.energy)
     assert (summary["slip1_m"], summary["slip2_m"], summary["peak_grip_use"]) == (0.0, 0.0, None)
+
+
+# --- compliant clutches: the force is capped by the grip, the anchor slides ------------------------
+@pytest.mark.parametrize("damping", [0.0, 50.0])
+def test_a_compliant_clutchs_force_is_capped_by_the_grip_and_the_audit_closes(damping):
+    """The motor's cruise on 5 N of grip with 1e6 N/m clutches: a clutch pushes with at most G (beyond it by the
+    switch's hysteresis, 1e-10 of G or k * 1 pm = 1e-6 N), exactly G while its anchor slides; the anchors' slides
+    are the slips; the audit closes with the spring, the damper (its slide share closed-form) and the skid work."""
+    p = RobotParams(**MOTOR, clutch_stiffness=1e6, clutch_damping=damping, **CRUISE_GRIP)
+    run = simulate(p, 2.0)
+    s, summary = run.series, run.summary
+    G = 5.0
+    assert summary["slip1_m"] > 1e-3 and summary["slip2_m"] > 1e-3
+    hysteresis = max(1e-10 * G, 1e6 * 1e-12)  # [N] 1e-6 N here: a grip use of 1 + 2e-7 at the slide's start
+    # and the force's roundoff: k times a few ulp of the positions (the overlap is a difference of them)
+    roundoff = 1e6 * 4 * np.spacing(max(np.abs(s["x1"]).max(), np.abs(s["x2"]).max()))
+    assert 1.0 <= summary["peak_grip_use"] <= 1.0 + (hysteresis + roundoff) / G
+    for i in (1, 2):
+        lam, sliding = s[f"lambda{i}"], s[f"wheels{i}"] == -1
+        assert lam.max() <= G + hysteresis + roundoff
+        assert sliding.any() and np.all(lam[sliding] == G)
+        # the anchor (x + d) only goes back while sliding, and what it slides is the slip
+        anchor = s[f"x{i}"] + s[f"clutch_overlap{i}"]
+        assert np.all(np.diff(anchor)[sliding[1:]] <= 1e-15)
+    e = run.energy
+    assert e["skid_j"] == pytest.approx(G * (summary["slip1_m"] + summary["slip2_m"]), rel=1e-12)
+    if damping:
+        assert e["clutch_damper_j"] > 1e-6  # the damper works, while engaged and while sliding
+    # rtol 1e-10 per step over ~1e4 steps and ~100 switches, as the compliant model's own audits (1e-7 there)
+    assert abs(e["residual_j"]) < 1e-8 * _flow(e)
+    assert summary["cycle_energy_residual_j"] < 1e-8 * _flow(e)
+
+
+def test_a_compliant_riser_on_little_grip_slides_at_the_hand_computed_rate():
+    """Drive off at a dead centre in a riser: both modules go back, each clutch's spring charges to G / k and
+    its anchor slides (c = 0: at once). From then on the module meets its grip G_i through the clutch and its
+    own Coulomb resistance F_ri (the compliant model's, either way): a = (G1 + G2 + F_r1 + F_r2) / m - g, to
+    roundoff. The rigid model's skidding module meets G_i alone (locked wheels do not roll)."""
+    p = RobotParams(M=0.0, clutch_stiffness=1e6, **RISER_GRIP)
+    s = simulate(p, 0.5).series
+    both = (s["wheels1"] == -1) & (s["wheels2"] == -1)
+    assert both[-1] and both.sum() > 1000
+    a = (12.0 + p.F_r1 + p.F_r2) / (p.m1 + p.m2 + p.rod_mass) - p.g
+    np.testing.assert_allclose(s["a1"][both], a, rtol=1e-9)
+    np.testing.assert_allclose(s["a2"][both], a, rtol=1e-9)
+    np.testing.assert_array_equal(s["lambda1"][both], 6.0)
+
+
+def test_a_stiff_compliant_clutch_on_finite_grip_approaches_the_rigid_model():
+    """k = 1e8 N/m, the motor's cruise on 5 N of grip: the compliant clutch's module meets G + F_r while its
+    anchor slides, so the run approaches the rigid model with a grip of G + F_r = 6 N: the travel to 2e-4
+    (the compliant model's departure from rigid at this stiffness, ~k^-1/2, 1e-3 at 1e6 N/m) and the slips to
+    2 %; the rigid model with 5 N slips 80 % more."""
+    compliant = simulate(RobotParams(**MOTOR, clutch_stiffness=1e8, **CRUISE_GRIP), 2.0, dt_out=1e-3).summary
+    same = simulate(RobotParams(**MOTOR, mu_wall=0.5, F_n1=12.0, F_n2=12.0), 2.0, dt_out=1e-3).summary
+    less = simulate(RobotParams(**MOTOR, **CRUISE_GRIP), 2.0, dt_out=1e-3).summary
+    for key in ("x1_final", "x2_final"):
+        assert compliant[key] == pytest.approx(same[key], rel=5e-4)
+    for key in ("slip1_m", "slip2_m"):
+        assert compliant[key] == pytest.approx(same[key], rel=0.02)
+        assert less[key] > 1.5 * compliant[key]
