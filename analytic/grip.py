@@ -79,17 +79,24 @@ class GripMode(IntEnum):
 
     @property
     def kinematics(self) -> Mode:
-        return Mode(self & 3)
+        return _KINEMATICS[self]
 
     @property
     def skids(self) -> tuple[bool, bool]:
-        return bool(self & _SKID1), bool(self & _SKID2)
+        return _SKIDS[self]
 
     @property
     def states(self) -> tuple[int, int]:
         """Per module: +1 rolls forward, 0 stands, -1 skids back."""
-        held = (self.kinematics.rear_locked, self.kinematics.front_locked)
-        return tuple(0 if h else (-1 if s else 1) for h, s in zip(held, self.skids))
+        return _STATES_OF[self]
+
+
+# the properties' values, looked up (the mode choice reads them some 40 times per event)
+_KINEMATICS = {mode: Mode(mode & 3) for mode in GripMode}
+_SKIDS = {mode: (bool(mode & _SKID1), bool(mode & _SKID2)) for mode in GripMode}
+_STATES_OF = {mode: tuple(0 if held else (-1 if skid else 1) for held, skid in
+                          zip((_KINEMATICS[mode].rear_locked, _KINEMATICS[mode].front_locked), _SKIDS[mode]))
+              for mode in GripMode}
 
 
 class GripModel:
