@@ -18,7 +18,10 @@ it slides, the force keeping it at rest while stuck), ``clutch_overlap1``/
 its play), the cumulative ``motor_work``, ``friction_work`` (integral of
 F_r1 |v1| + F_r2 |v2|) and ``clutch_damper_work`` [J], ``kinetic``,
 ``potential`` (from t = 0) and ``clutch_spring_energy`` [J], and the
-kinetostatic ``rod_force``, ``crank_pin_force``, ``motor_power``.
+kinetostatic ``rod_force``, ``crank_pin_force``, ``motor_power``. With finite
+grip also ``slip1``/``slip2`` [m] (each anchor's backward slide so far),
+``skid_work`` [J], ``grip_use1``/``grip_use2`` and ``wheels1``/``wheels2``
+(:mod:`.compliant_grip`).
 """
 
 from __future__ import annotations

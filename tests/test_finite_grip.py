@@ -417,3 +417,15 @@ def test_a_stiff_compliant_clutch_on_finite_grip_approaches_the_rigid_model():
     for key in ("slip1_m", "slip2_m"):
         assert compliant[key] == pytest.approx(same[key], rel=0.02)
         assert less[key] > 1.5 * compliant[key]
+
+
+def test_a_torque_profile_runs_the_same_grip_model_through_solve_ivp():
+    """A torque profile is a Python function, so the run goes through solve_ivp with the model's Python
+    right-hand sides and events (not the kernels): the paper's constant torque given as a profile is the same
+    motion, to the integrations' tolerance (two DOP853 runs at rtol 1e-10 whose roundoff differs)."""
+    p = RobotParams(mu_wall=0.5, F_n1=20.0, F_n2=20.0)
+    kernels_run = simulate(p, 0.5)
+    profile_run = simulate(p, 0.5, torque=lambda t, phi, omega: 0.25 + 0.0 * np.asarray(phi))
+    for key in ("slip1_m", "slip2_m", "x1_final", "x2_final", "revolutions", "mode_switches"):
+        assert profile_run.summary[key] == pytest.approx(kernels_run.summary[key], rel=1e-8), key
+    assert profile_run.energy["skid_j"] == pytest.approx(kernels_run.energy["skid_j"], rel=1e-8)
