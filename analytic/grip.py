@@ -141,8 +141,21 @@ class GripModel:
         return kernels.GRIP, int(mode.kinematics), self.constants[mode]
 
     def project(self, y, mode: GripMode, velocities) -> np.ndarray:
-        """The state with the standing modules' velocities exactly zero."""
-        return self._inner[(False, False)].project(y, mode.kinematics, velocities)
+        """The state with the standing modules' velocities exactly zero, and so the speed of a module that
+        starts to move from rest (both moving): its event then starts on its safe side (exactly 0 reads
+        +tiny, :func:`.kernels.grip_guard`), and a start that reverses within the first step, shorter than
+        the step's graze samples resolve, is still found as a crossing (not put at the segment's start)."""
+        y = self._inner[(False, False)].project(y, mode.kinematics, velocities)
+        if mode.kinematics is Mode.BOTH_MOVING:
+            v = [float(x) for x in velocities]
+            scale = self.linkage.r * abs(float(y[1])) + abs(v[0]) + abs(v[1])
+            rest = [abs(x) <= _TOL_V * scale + _REST_SPEED for x in v]
+            K = float(self.linkage.transfer(float(y[0])).K)
+            if rest[0]:
+                y[4] = 0.0
+            elif rest[1]:
+                y[4] = -K * float(y[1])  # v2 = v1 + K omega = 0 exactly
+        return y
 
     # --- events ----------------------------------------------------------------------------
     def _hold_margin(self, R, i):
@@ -168,6 +181,7 @@ class GripModel:
             else:
                 def velocity(t, y, i=i, until=until, state=state):
                     value = state * self.velocities(y, mode)[i]
+                    value = _TINY if value == 0 else value  # exactly 0 (a start from rest): the safe side
                     return value if t > until else max(value, _TINY)
                 event, meaning = velocity, ("velocity", i)
             event.terminal, event.direction = True, -1.0
@@ -189,7 +203,8 @@ class GripModel:
                 m = m or self.motion(Y[0], Y[1], Y[4], mode, self.motor(t, Y[0], Y[1]))
                 rows.append(self._hold_margin(m["R1"] if i == 0 else m["R2"], i))
             else:
-                rows.append(state * v[i])
+                value = state * v[i]
+                rows.append(np.where(value == 0, _TINY, value))
         return np.array([np.broadcast_to(r, np.shape(t)) for r in rows], dtype=float)
 
     def graze_scan(self, sol, mode: GripMode):

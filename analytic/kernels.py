@@ -359,7 +359,8 @@ def grip_guard(mode, k, y, p):
         else:
             K = mass_terms(p, phi)[5]
             v = -K * omega if k == 0 else K * omega
-        return direction * v
+        value = direction * v
+        return TINY if value == 0.0 else value  # exactly 0, a start from rest (:meth:`.GripModel.project`): safe
     hold = one_dof(p, mode, phi, omega, drive_torque(p, omega))[1]
     other = p[P_FR2] if k == 0 else p[P_FR1]  # the moving module's backward force
     own, grip = (p[P_FR1], p[P_G1]) if k == 0 else (p[P_FR2], p[P_G2])
