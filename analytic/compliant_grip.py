@@ -72,11 +72,12 @@ def head(grip: tuple[float, float], slide: tuple) -> list[float]:
 
 def grip_hysteresis(model, G: float) -> float:
     """How far [N] beyond the grip G an engaged clutch's force goes before its anchor slides: 1e-10 of it, or
-    the force of the overlap hysteresis (k * 1 pm), what the positions resolve (a float overlap of a module
-    1 m along is known to 1e-16 m, k times that in force), whichever is larger (as the clutch's own switches)."""
+    twice the force of the overlap hysteresis (k * 1 pm, at which a clutch engages), what the positions
+    resolve (a float overlap of a module 1 m along is known to 1e-16 m, k times that in force), whichever is
+    larger: so that on no grip (G = 0) a clutch that engages is not beyond its grip at once."""
     from .compliant_clutch import _HYSTERESIS_FORCE, _HYSTERESIS_OVERLAP
 
-    return max(_HYSTERESIS_FORCE * max(1.0, G), model.k * _HYSTERESIS_OVERLAP)
+    return max(_HYSTERESIS_FORCE * max(1.0, G), 2.0 * model.k * _HYSTERESIS_OVERLAP)
 
 
 def add_events(model, regime, i: int, add, hysteresis_speed: float) -> None:
@@ -101,6 +102,8 @@ def transitions(model, t: float, y: np.ndarray, fired, clutch: list, peak: list,
     anchor + backlash) and, at a slide's end, the damper work its slide dissipated, into y[6] (J)."""
     from .compliant_clutch import Clutch
 
+    from .compliant_clutch import _HYSTERESIS_OVERLAP
+
     if fired is None or fired[0] not in ("grip", "stick"):
         return
     kind, i = fired
@@ -110,7 +113,14 @@ def transitions(model, t: float, y: np.ndarray, fired, clutch: list, peak: list,
         return
     d = float(slide_overlap(t, slide[i], model.k, model.c, model.grip[i]))
     y[6] += float(slide_damper_work(t, slide[i], model.k, model.c, model.grip[i]))
-    clutch[i], peak[i], slide[i] = Clutch.ENGAGED, x + d + model.delta, NO_SLIDE
+    v = y[3] if i == 0 else float(model.velocity2(y))
+    # the anchor stops where it would move forward, at k d - c v = G - c (hysteresis): on (almost) no grip the
+    # damper would then pull (the clutch is clipped), and on none the spring has relaxed to nothing (released)
+    if d <= _HYSTERESIS_OVERLAP:
+        state = Clutch.TRACKING if model.delta == 0 else Clutch.FREE
+    else:
+        state = Clutch.ENGAGED if model.k * d - model.c * v > 0 else Clutch.CLIPPED
+    clutch[i], peak[i], slide[i] = state, x + d + model.delta, NO_SLIDE
 
 
 def start_slides(model, t: float, y: np.ndarray, regime, fired):
