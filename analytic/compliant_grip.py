@@ -87,7 +87,7 @@ def add_events(model, regime, i: int, add, hysteresis_speed: float) -> None:
     from .compliant_clutch import Clutch
 
     G = model.grip[i]
-    if regime.clutch[i] is Clutch.ENGAGED and math.isfinite(G):
+    if regime.clutch[i] is Clutch.ENGAGED and math.isfinite(G) and regime.slip[i] != 0:  # stuck: k d stays
         offset = G + grip_hysteresis(model, G)
         add("grip", i, -1.0, lambda t, y: offset - model._push(y, regime, i), kernels.EV_GRIP, offset)
     elif regime.clutch[i] is Clutch.SLIDING:
