@@ -11,7 +11,7 @@ inverse kinetostatics.
 """
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, require_params
+from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, refuse_idle_parameters, require_params
 from ipir_mujoco.core.results import COLUMNS, MODE_NAMES, Mode, RunResult
 
 from .compliant_run import simulate_compliant
@@ -30,7 +30,8 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     ``clutch``: 'kinematic' (the paper's rule: lock by the sign of S_dot) or
     'unilateral' (one-way clutches that can only push; with a finite
     ``params.clutch_stiffness`` the compliant clutch model, which also models
-    clutch damping and backlash).
+    clutch damping and backlash; with a finite ``params.mu_wall`` the wheels
+    grip the wall with at most mu_wall F_ni, and a held module may skid back).
     ``options``: ``dt_out``, ``rtol``, ``atol``, ``until_steady``, ``steady_tol``,
     ``steady_cycles``, ``progress``, ``max_switches``, ``wall_budget_s``, ``torque``
     (see :func:`simulate_kinematic`, :func:`simulate_unilateral` and
@@ -43,25 +44,18 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"geometry={geometry!r} is unknown; allowed: approx, exact") from None
     if clutch not in CLUTCH_RULES:
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: {', '.join(CLUTCH_RULES)}")
+    if params.mu_wall is not None and clutch != "unilateral":
+        raise ParameterError(f"mu_wall={params.mu_wall!r} with clutch={clutch!r}: the paper's rule locks its "
+                             "modules whatever the load; allowed: clutch='unilateral' or mu_wall=unlimited")
+    refuse_idle_parameters(params)
     if params.clutch_stiffness is not None:
         if clutch != "unilateral":
             raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
                                  "paper's rule locks rigidly; allowed: clutch='unilateral' or clutch_stiffness=rigid")
         return simulate_compliant(params, geometry, t_end, **options)
-    _refuse_unmodelled(params)
     if clutch == "unilateral":
         return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
-
-
-def _refuse_unmodelled(params: RobotParams) -> None:
-    """Clutch damping and backlash need a clutch with a spring: refused with rigid clutches, never ignored."""
-    defaults = RobotParams()
-    for name in ("clutch_damping", "clutch_backlash"):
-        if getattr(params, name) != getattr(defaults, name):
-            raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid clutch "
-                                 f"has no spring for it to act with); allowed: {getattr(defaults, name)!r} with "
-                                 "clutch_stiffness=rigid")
 
 
 __all__ = [

@@ -30,7 +30,9 @@ so the right-hand side is smooth in each segment:
 * clutch of module i: TRACKING (at its running maximum: the anchor moves with
   it, no force), FREE (behind its maximum but inside the backlash, d_i <= 0),
   ENGAGED (d_i > 0 and k d_i - c v_i > 0: force k d_i - c v_i) or CLIPPED
-  (d_i > 0 but k d_i - c v_i <= 0: a damper that would pull, so no force).
+  (d_i > 0 but k d_i - c v_i <= 0: a damper that would pull, so no force);
+  with finite grip also SLIDING (the force would exceed the grip G_i: the
+  anchor slides back and the force is G_i, :mod:`.compliant_grip`).
 
 Events end a segment where a sliding module's velocity reaches zero, a stuck
 module's needed friction reaches F_ri (|R_i| = F_ri), an overlap or a clipped
@@ -62,7 +64,7 @@ from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode
 
-from . import kernels
+from . import compliant_grip, kernels
 from .dynamics import MassTerms, OneDofDynamics
 from .forces import drive_torque, gravity_along_pipe
 from .kinematics import Geometry, Transfer
@@ -75,6 +77,7 @@ class Clutch(IntEnum):
     FREE = 1  # behind its maximum, inside the backlash (d <= 0): no force
     ENGAGED = 2  # d > 0 and k d - c v > 0: pushes with k d - c v
     CLIPPED = 3  # d > 0 but k d - c v <= 0: the damper would pull, so no force
+    SLIDING = 4  # finite grip: k d - c v would exceed G, so the anchor slides and the force is G (.compliant_grip)
 
 
 class Regime(NamedTuple):
@@ -83,6 +86,7 @@ class Regime(NamedTuple):
     slip: tuple[int, int]  # per module: +1 sliding forward, -1 backward, 0 stuck
     clutch: tuple[Clutch, Clutch]
     peak: tuple[float, float]  # running maximum of x1, x2 [m] (of a TRACKING module: at the segment's start)
+    slide: tuple = (compliant_grip.NO_SLIDE,) * 2  # per module, while its anchor slides: (start [s], overlap then [m])
 
     @property
     def static(self) -> bool:
@@ -92,7 +96,7 @@ class Regime(NamedTuple):
     @property
     def mode(self) -> Mode:
         """The rigid model's mode that best describes it: a module is held while stuck or pushed by its clutch."""
-        held = [s == 0 or c is Clutch.ENGAGED for s, c in zip(self.slip, self.clutch)]
+        held = [s == 0 or c in (Clutch.ENGAGED, Clutch.SLIDING) for s, c in zip(self.slip, self.clutch)]
         return {(False, True): Mode.CONTRACTION, (True, False): Mode.EXPANSION,
                 (False, False): Mode.BOTH_MOVING, (True, True): Mode.BOTH_LOCKED}[tuple(held)]
 
@@ -141,6 +145,7 @@ class CompliantModel:
         self.delta = params.clutch_backlash
         self.g = gravity_along_pipe(params)
         self.F = (params.F_r1, params.F_r2)
+        self.grip = params.grip or (math.inf, math.inf)  # [N] each clutch's anchor holds at most this
         self.base = kernels.pack(self.dyn)
 
     # --- dynamics in a regime ------------------------------------------------------------
@@ -159,8 +164,8 @@ class CompliantModel:
         K, dK = mt.transfer.K, mt.transfer.dK
         x2, v2 = x1 + mt.transfer.S - self.S0, v1 + K * omega
         d = self.overlaps((x1, x2), regime)
-        f = tuple(self.k * di - self.c * vi if c is Clutch.ENGAGED else 0.0 * di
-                  for di, vi, c in zip(d, (v1, v2), regime.clutch))
+        f = tuple(self.k * di - self.c * vi if c is Clutch.ENGAGED else (G + 0.0 * di if c is Clutch.SLIDING else 0.0 * di)
+                  for di, vi, c, G in zip(d, (v1, v2), regime.clutch, self.grip))
         sliding = tuple(-s * F + 0.0 * di for s, F, di in zip(regime.slip, self.F, d))  # 0 where stuck
         torque = drive_torque(self.params, omega)
         w2 = omega * omega
@@ -208,7 +213,8 @@ class CompliantModel:
 
     def constants(self, regime: Regime, events: list = (), t0: float = math.nan) -> np.ndarray:
         """The kernels' constants (:data:`.kernels.P_K` on) for ``regime`` and ``events`` (:meth:`events`) from t0."""
-        head = [self.k, self.c, self.delta, self.S0, *regime.slip, *(int(c) for c in regime.clutch), *regime.peak, t0]
+        head = [self.k, self.c, self.delta, self.S0, *regime.slip, *(int(c) for c in regime.clutch), *regime.peak, t0,
+                *compliant_grip.head(self.grip, regime.slide)]
         return np.concatenate([self.base, head, [x for _, raw, _ in events for x in raw.code]])
 
     # --- events --------------------------------------------------------------------------
@@ -219,7 +225,8 @@ class CompliantModel:
         solve_ivp missed inside a step.
 
         Kinds: 'velocity' (a sliding module stops), 'margin' (a stuck module's friction reaches F_ri),
-        'engage', 'release', 'clip', 'track' (clutch changes) and 'revolution' (the crank's running
+        'engage', 'release', 'clip', 'track', 'grip', 'stick' (clutch changes; the last two: the anchor
+        slides, stops, :func:`.compliant_grip.add_events`) and 'revolution' (the crank's running
         maximum reaches the next whole turn; nothing changes there, the run just samples it).
 
         A segment starts where some function just crossed zero, so at ``t0`` one is zero or a rounding
@@ -248,6 +255,7 @@ class CompliantModel:
                 eps_f = _HYSTERESIS_FORCE * max(1.0, self.F[i])
                 add("margin", i, -1.0, lambda t, y, i=i, e=eps_f: self.F[i] + e - abs(self.motion(y, regime).friction[i]),
                     kernels.EV_MARGIN, self.F[i] + eps_f)
+                compliant_grip.add_events(self, regime, i, add, eps_v)  # a slide goes on
                 continue  # a stuck module's overlap and velocity are constant: no clutch event
             # s v falls below -eps_v: the module has stopped and turned
             add("velocity", i, -1.0, lambda t, y, i=i, s=s: s * (y[3] if i == 0 else self.velocity2(y)) + eps_v,
@@ -265,6 +273,7 @@ class CompliantModel:
                 add("engage", i, 1.0, lambda t, y, i=i: self._push(y, regime, i) - self.k * eps_d, kernels.EV_PUSH,
                     -(self.k * eps_d))
                 add("release", i, -1.0, lambda t, y, i=i: self._overlap(y, regime, i), kernels.EV_OVERLAP)
+            compliant_grip.add_events(self, regime, i, add, eps_v)
         add("revolution", -1, 1.0, lambda t, y: y[0] - next_revolution, kernels.EV_PHI, -next_revolution)
         return found
 
@@ -299,6 +308,9 @@ class CompliantModel:
                          "release": Clutch.TRACKING if self.delta == 0 else Clutch.FREE}[kind]
             if clutch[i] is Clutch.TRACKING:
                 peak = tuple(max(pk, x[j]) if j == i else pk for j, pk in enumerate(peak))
+        peak, slide = list(peak), list(regime.slide)
+        compliant_grip.transitions(self, t, y, fired, clutch, peak, slide)  # an anchor slides, stops
+        peak = tuple(peak)
         omega = float(y[1])
         v_scale = r * abs(omega) + abs(v[0]) + abs(v[1])
         rest = [regime.slip[i] == 0 or fired == ("velocity", i) or abs(v[i]) <= _TOL_V * v_scale + _REST_SPEED
@@ -320,9 +332,10 @@ class CompliantModel:
                 clutch[i] = Clutch.ENGAGED if self.delta == 0 else Clutch.FREE
                 if self.delta == 0:  # engaged from the start: the hysteresis as if it had come from FREE
                     peak[i] = x[i] + _HYSTERESIS_OVERLAP
-        peak = tuple(peak)
-        chosen = Regime(slip, tuple(clutch), peak)
-        return chosen, self.project(y, chosen)
+        chosen = Regime(slip, tuple(clutch), tuple(peak), tuple(slide))
+        y = self.project(y, chosen)
+        chosen = compliant_grip.start_slides(self, t, y, chosen, fired)  # engaged beyond the grip
+        return chosen, y
 
     def _enumerate(self, t, y, clutch, peak, rest, crank_rest, fired) -> tuple[int, int]:
         """The consistent friction states of the modules at rest (unique but on a boundary, see the module
@@ -354,7 +367,8 @@ class CompliantModel:
         loads the modules), with the clutch overlaps kept as they are."""
         free_crank = self.motion(y, Regime((0, 1), clutch, peak)).alpha  # module 1 at rest, K = 0: M22 alpha = T
         if abs(float(free_crank)) * self.linkage.r <= 1e-12:  # [m/s^2] at the crank pin: no drive at all
-            return (0, 0)  # nothing turns the crank: at rest it stays
+            # the crank stays, and only gravity and the clutches load the modules: the friction states at rest
+            return self._enumerate(t, y, clutch, peak, [True, True], True, None)
         step = math.copysign(_DEAD_CENTRE_STEP, float(free_crank))
         ahead = np.array(y, dtype=float)
         ahead[0] += step

@@ -18,7 +18,10 @@ it slides, the force keeping it at rest while stuck), ``clutch_overlap1``/
 its play), the cumulative ``motor_work``, ``friction_work`` (integral of
 F_r1 |v1| + F_r2 |v2|) and ``clutch_damper_work`` [J], ``kinetic``,
 ``potential`` (from t = 0) and ``clutch_spring_energy`` [J], and the
-kinetostatic ``rod_force``, ``crank_pin_force``, ``motor_power``.
+kinetostatic ``rod_force``, ``crank_pin_force``, ``motor_power``. With finite
+grip also ``slip1``/``slip2`` [m] (each anchor's backward slide so far),
+``skid_work`` [J], ``grip_use1``/``grip_use2`` and ``wheels1``/``wheels2``
+(:mod:`.compliant_grip`).
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import RunResult
 
-from . import dop853, kernels
+from . import compliant_grip, dop853, kernels
 from .accel import ACCELERATED
 from .compliant_clutch import Clutch, CompliantModel, Regime
 from .kinematics import Geometry
@@ -143,6 +146,8 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
             break
 
     series = {c: np.concatenate([piece[c] for piece in pieces]) for c in pieces[0]}
+    if params.grip is not None:  # each anchor's slide and the grip's work against it
+        series.update(compliant_grip.run_columns(series, params.grip))
     monitor.report(float(series["t"][-1]), final=True)
     add_kinetostatics(series, model.dyn)
     del series["motor_torque"]  # folded into motor_power
@@ -157,12 +162,14 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
 
 def energy_audit(series: dict[str, np.ndarray]) -> dict[str, float]:
     """Motor work = kinetic + potential energy gained + friction work + clutch spring energy gained
-    + clutch damper work + residual [J], from a run's cumulative columns."""
+    + clutch damper work (+ skid work, with finite grip) + residual [J], from a run's cumulative columns."""
     def gained(column):
         return float(series[column][-1] - series[column][0])
     parts = {"motor_work_j": gained("motor_work"), "kinetic_j": gained("kinetic"),
              "potential_j": gained("potential"), "friction_j": gained("friction_work"),
              "clutch_spring_j": gained("clutch_spring_energy"), "clutch_damper_j": gained("clutch_damper_work")}
+    if "skid_work" in series:
+        parts["skid_j"] = gained("skid_work")
     parts["residual_j"] = parts["motor_work_j"] - sum(v for k, v in parts.items() if k != "motor_work_j")
     return parts
 
@@ -279,7 +286,7 @@ def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.
     spring = sum(0.5 * model.k * np.maximum(d, 0.0) ** 2 for d in m.overlap)
     # from the start: x1 = x2 = 0 at phi0
     potential = dyn.potential_energy(phi, x1, m.x2) - dyn.potential_energy(p.phi0, 0.0, 0.0)
-    return {
+    columns = {
         "t": times, "phi": phi, "omega": omega, "alpha": full(m.alpha), "x1": x1, "x2": full(m.x2),
         "v1": v1, "v2": full(m.v2), "a1": full(m.a1), "a2": full(m.a2),
         "S": full(mt.transfer.S), "S_dot": full(mt.transfer.K * omega),
@@ -294,3 +301,5 @@ def _piece(model: CompliantModel, regime: Regime, times, dense) -> dict[str, np.
         "potential": full(potential), "clutch_spring_energy": full(spring),
         "motor_torque": full(m.torque),
     }
+    compliant_grip.piece_columns(model, regime, times, columns)  # sliding anchors; grip use and wheel states
+    return columns

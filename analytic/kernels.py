@@ -13,7 +13,9 @@ A model's constants travel as one float array ``p`` (:func:`pack`, the
 :data:`UNILATERAL` (one-way clutches; state [phi, omega, x1, x2, v1, motor
 work]; event k of a mode watches module k: its velocity while it moves, its
 hold margin R_k + F_rk while held), both with :class:`.results.Mode` values as
-modes, and :data:`COMPLIANT` (compliant one-way clutches, see below).
+modes, :data:`COMPLIANT` (compliant one-way clutches, see below) and :data:`GRIP`
+(one-way clutches on wheels of finite grip, :mod:`.grip`: the one-way model's
+right-hand sides, its own events).
 Units: rad, rad/s, m, m/s, kg, N, N m, J.
 """
 
@@ -27,7 +29,7 @@ from .accel import jit
 from .dynamics import OneDofDynamics
 from .forces import gravity_along_pipe
 
-KINEMATIC, UNILATERAL = 0, 1
+KINEMATIC, UNILATERAL = 0, 1  # COMPLIANT = 2 and GRIP = 3: see their sections below
 CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # Mode values (BOTH_LOCKED is never integrated)
 (P_M1, P_M2, P_R, P_L, P_JA, P_FR1, P_FR2, P_M, P_ROD_M, P_ROD_I, P_EXACT, P_ROD, P_MOTOR, P_MSTALL, P_WNL,
  P_AG) = range(16)
@@ -38,7 +40,7 @@ def pack(dyn: OneDofDynamics) -> np.ndarray:
     """The constants of ``dyn`` (its parameters, geometry, rod and drive) as the kernels' float array (16,)."""
     p = dyn.params
     motor = p.drive == "motor"
-    return np.array([p.m1, p.m2, p.r, p.L, p.J_A, p.F_r1, p.F_r2, p.M, p.rod_mass, p.rod_inertia_value,
+    return np.array([p.m1, p.m2, p.r, p.L, p.J_A, *dyn.resistance, p.M, p.rod_mass, p.rod_inertia_value,
                      float(dyn.geometry.value == "exact"), float(dyn.include_rod), float(motor),
                      p.M_stall if motor else 0.0, p.omega_noload if motor else 1.0, gravity_along_pipe(p)],
                     dtype=float)
@@ -165,6 +167,9 @@ def guard(model, mode, k, t, y, p, quiet):
         return math.nan
     if model == COMPLIANT:
         return compliant_guard(mode, k, t, y, p)
+    if model == GRIP:
+        value = grip_guard(mode, k, y, p)
+        return value if t > quiet[k] else max(value, TINY)
     if model == KINEMATIC:
         return mass_terms(p, phi)[5] * omega
     if mode == BOTH_MOVING:
@@ -217,10 +222,13 @@ def guard_table(model, mode, n_events, p, times, states, out):
 # of rhs/guard says whether an event reads its raw value (RAW) or what the root search sees (GUARDED).
 COMPLIANT = 2
 RAW, GUARDED = 0, 1
-TRACKING, FREE, ENGAGED, CLIPPED = 0, 1, 2, 3  # .compliant_clutch.Clutch
+TRACKING, FREE, ENGAGED, CLIPPED, SLIDING = 0, 1, 2, 3, 4  # .compliant_clutch.Clutch
 P_K, P_C, P_DELTA, P_S0, P_S1, P_S2, P_C1, P_C2, P_PK1, P_PK2, P_T0 = range(16, 27)
-P_EVENTS = 27  # then four numbers per event: kind, module, direction, offset
-EV_MARGIN, EV_VELOCITY, EV_OVERLAP, EV_TRACK, EV_PUSH, EV_PHI = range(6)
+# finite grip (:mod:`.compliant_grip`): each module's grip [N] (inf: unlimited), and while its clutch's
+# anchor slides the slide's start [s] and the overlap then [m]
+P_GR1, P_GR2, P_TS1, P_DS1, P_TS2, P_DS2 = range(27, 33)
+P_EVENTS = 33  # then four numbers per event: kind, module, direction, offset
+EV_MARGIN, EV_VELOCITY, EV_OVERLAP, EV_TRACK, EV_PUSH, EV_PHI, EV_GRIP, EV_STICK = range(8)
 
 
 @jit
@@ -243,8 +251,8 @@ def compliant_motion(p, y):
     k, c, delta = p[P_K], p[P_C], p[P_DELTA]
     d1 = -delta if p[P_C1] == TRACKING else p[P_PK1] - delta - x1
     d2 = -delta if p[P_C2] == TRACKING else p[P_PK2] - delta - x2
-    f1 = k * d1 - c * v1 if p[P_C1] == ENGAGED else 0.0
-    f2 = k * d2 - c * v2 if p[P_C2] == ENGAGED else 0.0
+    f1 = k * d1 - c * v1 if p[P_C1] == ENGAGED else (p[P_GR1] if p[P_C1] == SLIDING else 0.0)
+    f2 = k * d2 - c * v2 if p[P_C2] == ENGAGED else (p[P_GR2] if p[P_C2] == SLIDING else 0.0)
     s1, s2 = p[P_S1], p[P_S2]
     sliding1, sliding2 = -s1 * p[P_FR1], -s2 * p[P_FR2]
     torque = drive_torque(p, omega)
@@ -291,6 +299,17 @@ def compliant_rhs(y, p, out):
 
 
 @jit
+def slide_rate(p, i, t):
+    """d(overlap)/dt [m/s] of module i's clutch while its anchor slides (:func:`.compliant_grip.slide_overlap`):
+    the spring relaxes towards G / k through the damper, (G - k d(t)) / c; 0 without a damper (d = G / k)."""
+    k, c = p[P_K], p[P_C]
+    if c == 0.0:
+        return 0.0
+    G, ts, d0 = (p[P_GR1], p[P_TS1], p[P_DS1]) if i == 0 else (p[P_GR2], p[P_TS2], p[P_DS2])
+    return (G - k * d0) / c * math.exp(-(t - ts) * k / c)
+
+
+@jit
 def compliant_guard(guarded, k, t, y, p):
     """Event k of the segment (:meth:`.CompliantModel.events`): its raw value, or (``guarded``) as solve_ivp sees it."""
     base = P_EVENTS + 4 * k
@@ -310,8 +329,40 @@ def compliant_guard(guarded, k, t, y, p):
             value = position - peak + offset
         elif kind == EV_OVERLAP:
             value = peak - p[P_DELTA] - position + offset
-        else:  # EV_PUSH
+        elif kind == EV_PUSH:
             value = p[P_K] * (peak - p[P_DELTA] - position) - p[P_C] * v + offset
+        elif kind == EV_GRIP:  # the grip less the force the clutch would push with: its anchor slides at 0
+            value = offset - (p[P_K] * (peak - p[P_DELTA] - position) - p[P_C] * v)
+        else:  # EV_STICK: the sliding anchor's speed backward (+ offset)
+            value = offset - v - slide_rate(p, i, t)
     if guarded != 0 and (value == 0 or (t == p[P_T0] and direction * value > 0)):
         return -direction * 1e-300
     return value
+
+
+# --- one-way clutches with finite grip (:mod:`.grip`) ------------------------------------------------
+# the one-way model's state and right-hand sides; ``p`` is :func:`pack` of the dynamics whose resistance of
+# a module skidding back is -G_i (its grip pushes it forward), then the grips and each module's state
+GRIP = 3
+P_G1, P_G2, P_DIR1, P_DIR2 = range(16, 20)  # grips [N]; per module +1 rolling forward, -1 skidding back, 0 held
+
+
+@jit
+def grip_guard(mode, k, y, p):
+    """Event k of a finite-grip mode (:meth:`.GripModel.events`): a moving module's speed in its own sense of
+    motion (falls to 0 where it stops), a held module's smaller margin, min(R_k + F_rk, G_k - R_k)."""
+    phi, omega = y[0], y[1]
+    direction = p[P_DIR1] if k == 0 else p[P_DIR2]
+    if direction != 0.0:
+        if mode == BOTH_MOVING:
+            v = y[4] if k == 0 else y[4] + mass_terms(p, phi)[5] * omega
+        else:
+            K = mass_terms(p, phi)[5]
+            v = -K * omega if k == 0 else K * omega
+        value = direction * v
+        return TINY if value == 0.0 else value  # exactly 0, a start from rest (:meth:`.GripModel.project`): safe
+    hold = one_dof(p, mode, phi, omega, drive_torque(p, omega))[1]
+    other = p[P_FR2] if k == 0 else p[P_FR1]  # the moving module's backward force
+    own, grip = (p[P_FR1], p[P_G1]) if k == 0 else (p[P_FR2], p[P_G2])
+    R = hold + other
+    return min(R + own, grip - R)

@@ -12,6 +12,14 @@ software versions and the ladder rungs' wording, ``isolates``, left out). Studie
 cruise study, a climb study) are fingerprinted from their JSON or CSV output with the same
 exclusions. Numbers that depend on the machine's load (wall times) never enter a fingerprint;
 every other figure does.
+
+A change that adds a summary key or a parameter changes every fingerprint that holds them. To
+check that it changed nothing else, leave the new names out of the later fingerprint:
+
+    python bench/fingerprint.py --leave-out slip1_m,slip2_m,peak_grip_use,mu_wall,F_n1,F_n2 > after.txt
+
+(every dictionary key and sweep column of those names is dropped before hashing; a name that does
+not occur changes nothing, so the earlier fingerprint compares as it is).
 """
 
 from __future__ import annotations
@@ -62,12 +70,16 @@ MUJOCO = {
 }
 
 
+LEFT_OUT: set[str] = set()  # names --leave-out drops from every dictionary and the sweep's columns
+
+
 def _clean(value):
     """JSON-ready ``value`` without wall times and versions (machine-dependent)."""
     if isinstance(value, dict):
         return {k: _clean(v) for k, v in sorted(value.items())
                 if not (k.startswith("wall") or k.endswith("_wall")
-                        or k in ("versions", "workers", "mujoco_version", "isolates"))}
+                        or k in ("versions", "workers", "mujoco_version", "isolates"))
+                and k not in LEFT_OUT}
     if isinstance(value, (list, tuple)):
         return [_clean(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
@@ -94,7 +106,10 @@ def digest_run(run) -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--skip-studies", action="store_true")
+    parser.add_argument("--leave-out", default="", metavar="NAME,...",
+                        help="summary keys and parameters to leave out (names added since the fingerprint compared)")
     args = parser.parse_args()
+    LEFT_OUT.update(name for name in args.leave_out.split(",") if name)
     from ipir_mujoco.engine import simulate_mujoco
 
     for name, (params, geometry, clutch, t_end, options) in ANALYTIC.items():
@@ -114,7 +129,7 @@ def main() -> int:
         csv = run_sweep(study, Path(folder) / "sweep", progress=False, workers=1)
         rows = csv.read_text().splitlines()
         header = rows[0].split(",")
-        keep = [i for i, c in enumerate(header) if "wall" not in c]
+        keep = [i for i, c in enumerate(header) if "wall" not in c and c.rsplit(":", 1)[-1] not in LEFT_OUT]
         print(f"{'sweep 2 x 2, 4 engines':45s} {digest_json([[r.split(',')[i] for i in keep] for r in rows])}")
     print(f"{'cruise study quick':45s} {digest_json(cruise_study(RobotParams(), quick=True, workers=1))}", flush=True)
     climb = climb_study(RobotParams(drive="motor"), [0.0, 30.0], tolerance=10.0)

@@ -302,3 +302,16 @@ def test_cli_runs_the_compliant_clutch(capsys):
     energy = record["summary"]["energy"]
     assert {"clutch_spring_j", "clutch_damper_j", "potential_j"} <= set(energy)
     assert abs(energy["residual_j"]) < 1e-7 * energy["motor_work_j"]
+
+
+def test_a_dead_centre_at_rest_with_the_drive_off_is_decided_by_friction_not_assumed_at_rest():
+    """A riser, drive off (M = 0), at a dead centre from rest: nothing turns the crank, but gravity pulls both
+    modules back, which friction (F_r = 1 N each) cannot hold; the clutches must catch them. The robot sinks
+    until its springs carry the weight (mg/k ~ 1e-5 m at 1e6 N/m) and friction never exceeds F_r."""
+    p = RobotParams(M=0.0, incline=90.0, clutch_stiffness=1e6)
+    run = compliant(p, 0.1)
+    s = run.series
+    assert np.abs(s["resistance1"]).max() <= p.F_r1 * (1 + 1e-9)
+    assert np.abs(s["resistance2"]).max() <= p.F_r2 * (1 + 1e-9)
+    weight = (p.m1 + p.m2 + p.rod_mass) * p.g
+    assert s["x1"][-1] < 0 and s["lambda1"][-1] + s["lambda2"][-1] >= weight - p.F_r1 - p.F_r2 - 1e-6

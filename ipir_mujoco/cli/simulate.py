@@ -127,6 +127,11 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      f"{significant(s['energy_per_metre_j_m'], 5)} J/m, efficiency {significant(s['efficiency'], 5)}")
     elif until_steady:
         lines.append(f"  steady state            not reached by {run.t_end:g} s")
+    if run.params.grip is not None:
+        use = s.get("peak_grip_use")
+        lines.append(f"  wheels' grip {run.params.grip[0]:.4g} N / {run.params.grip[1]:.4g} N: skidded back "
+                     f"{fixed(s['slip1_m'], 4)} m (rear), {fixed(s['slip2_m'], 4)} m (front); peak clutch load "
+                     + ("none" if use is None else f"{use:.3g} of the grip"))
     if s["stalled"]:
         lines.append(f"  stalled: {s['stall_reason']}")
     accuracy = s.get("accuracy") or {}
@@ -140,12 +145,12 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
 
 
 def _energy_line(e: dict) -> str:
-    """motor = kinetic + friction (+ potential, clutch springs and dampers where the run has them) + residual;
+    """motor = kinetic + friction (+ potential, clutch springs and dampers, skid where the run has them) + residual;
     a term within round-off of zero (1e-12 of the motor's work: a clutch damper of zero damping) is left out."""
     terms = [f"kinetic {e['kinetic_j']:.6g}", f"friction {e['friction_j']:.6g}"]
     negligible = 1e-12 * abs(e["motor_work_j"])
     for key, word in (("potential_j", "potential"), ("clutch_spring_j", "clutch springs"),
-                      ("clutch_damper_j", "clutch dampers")):
+                      ("clutch_damper_j", "clutch dampers"), ("skid_j", "skid")):
         if key in e and abs(e[key]) > negligible:
             terms.append(f"{word} {e[key]:.6g}")
     return f"motor {e['motor_work_j']:.6g} = " + " + ".join(terms) + f" + residual {e['residual_j']:.2e}"

@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
 from ipir_mujoco.core.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
 
 from .clutches import refuse_compliant
@@ -73,13 +73,10 @@ def check_clutch_options(params: RobotParams, clutch: str = "unilateral", implem
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
     refuse_compliant(params, implementation)
-    if params.clutch_stiffness is None:
-        defaults = RobotParams()
-        for name in ("clutch_damping", "clutch_backlash"):
-            if getattr(params, name) != getattr(defaults, name):  # refused, never silently ignored
-                raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid "
-                                     f"clutch has no spring for it to act with); allowed: {getattr(defaults, name)!r} "
-                                     "with clutch_stiffness=rigid")
+    refuse_idle_parameters(params)
+    if params.mu_wall is not None:
+        raise ParameterError(f"mu_wall={params.mu_wall!r}: the MuJoCo engine does not model a finite grip yet; "
+                             "allowed: mu_wall=unlimited (the analytic engine analytic-unilateral models it)")
     check_params(params)
 
 
