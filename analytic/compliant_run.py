@@ -30,8 +30,6 @@ import math
 import time
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq, minimize_scalar
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
@@ -43,6 +41,7 @@ from .accel import ACCELERATED
 from .compliant_clutch import Clutch, CompliantModel, Regime
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
+from .roots import brentq
 from .solver_support import RunMonitor, check_finite, check_tolerances, sample_times, truncate
 
 # DOP853 by measurement (paper's case, 1 s): 3-5x faster than Radau at k = 1e5..1e7 N/m, also with
@@ -104,6 +103,8 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
             sol = dop853.solve(kernels.COMPLIANT, kernels.GUARDED, t, t_end, y, constants, rtol, atol, None,
                                [raw.direction for _, raw, _ in events], max_steps=budget.steps, pause=budget.check)
         else:
+            from scipy.integrate import solve_ivp  # Radau only: not on the compiled DOP853's path
+
             constants = None
             sol = solve_ivp(budget.wrap(model.rhs(regime)), (t, t_end), y, method=method, rtol=rtol, atol=atol,
                             events=[e for e, _, _ in events], dense_output=True)
@@ -260,6 +261,8 @@ def _force_peaks(model: CompliantModel, regime: Regime, t0: float, t1: float, so
     fractions = np.arange(_PEAK_POINTS) / _PEAK_POINTS
     times = np.append((ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel(), t1)
     force = model.motion(sol.sol(times), regime).force
+    from scipy.optimize import minimize_scalar  # damped clutches only
+
     found = []
     for i in engaged:
         f = np.concatenate([[-np.inf], np.asarray(force[i], dtype=float), [-np.inf]])  # an end may hold the max

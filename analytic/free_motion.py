@@ -18,7 +18,6 @@ import math
 import time
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
@@ -62,6 +61,8 @@ def simulate_free(params: RobotParams, geometry: Geometry | str = Geometry.EXACT
 
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     times = np.linspace(0.0, t_end, n_out + 1)
+    from scipy.integrate import solve_ivp
+
     sol = solve_ivp(rhs, (0.0, t_end), [params.phi0, params.omega0, 0.0, v10, 0.0], method="DOP853",
                     rtol=rtol, atol=atol, t_eval=times)
     if sol.status != 0:

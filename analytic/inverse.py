@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
@@ -198,6 +197,8 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
     pieces, short_run = [], 0
     while True:
         events = model.events(mode)
+        from scipy.integrate import solve_ivp
+
         sol = solve_ivp(model.rhs(mode), (t, t_end), y, method="DOP853", rtol=rtol, atol=atol,
                         events=[e for e, _ in events], dense_output=True)
         if sol.status < 0:

@@ -39,7 +39,6 @@ import time
 from typing import Callable
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
@@ -211,6 +210,8 @@ def _integrate_mode(dyn, mode, t0, t_end, y0, rtol, atol, torque=None, first_ste
 
     gap_rate.terminal = True
     gap_rate.direction = direction
+    from scipy.integrate import solve_ivp  # a torque profile's path only: not the compiled DOP853's
+
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,

@@ -8,7 +8,6 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ipir_mujoco.core.cycles import SteadyWatch
 from ipir_mujoco.core.errors import ParameterError, SimulationError
@@ -16,6 +15,7 @@ from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import check_real
 
 from .dense import CLEAR, GRAZE_POINTS
+from .roots import brentq
 
 
 def check_tolerances(rtol: float, atol: float) -> tuple[float, float]:

@@ -48,7 +48,6 @@ import time
 from typing import Callable
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
@@ -392,6 +391,8 @@ def _integrate(model, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step,
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: "
                                   f"{sol.message}")
         return sol
+    from scipy.integrate import solve_ivp  # a torque profile's path only: not the compiled DOP853's
+
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a fast crank can overflow; the step
         # controller rejects them, and the output is checked finite
         sol = solve_ivp(model.rhs(mode), (t0, t_end), y0, method="DOP853", rtol=rtol, atol=atol,

@@ -184,3 +184,38 @@ def test_the_command_line_says_when_it_compiles_the_kernels_first(tmp_path, monk
     assert not accel.compilation_pending()
     assert main(["simulate", "--t-end", "0.05", "--json"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_the_packaged_brentq_is_scipys_float_for_float():
+    """analytic.roots.brentq replaces scipy.optimize.brentq on the runs' common path: the same iterates, so the
+    same root to the last bit (==, not approx), on smooth, steep, flat and kinked functions and both sign
+    orders; and the same refusals."""
+    from scipy.optimize import brentq as scipy_brentq
+
+    from ipir_mujoco.analytic.roots import brentq
+
+    rng = np.random.default_rng(7)
+    functions = [lambda x, c=c: math.sin(x) - c for c in rng.uniform(-0.9, 0.9, 20)]
+    functions += [lambda x, c=c: (x - c) ** 3 for c in rng.uniform(0.1, 0.9, 10)]
+    functions += [lambda x, c=c: math.tanh(50 * (x - c)) for c in rng.uniform(0.1, 0.9, 10)]
+    functions += [lambda x, c=c: abs(x - c) - 0.05 for c in rng.uniform(0.2, 0.5, 10)]
+    def outcome(solver, *args, **tolerances):  # the root, or the refusal (e.g. no convergence at a kink)
+        try:
+            return solver(*args, **tolerances)
+        except (ValueError, RuntimeError) as exc:
+            return type(exc).__name__
+
+    checked = 0
+    for f in functions:
+        for a, b in ((0.0, 1.0), (1.0, 0.0), (-0.3, 0.95)):
+            if (f(a) > 0) == (f(b) > 0):
+                continue
+            for xtol, rtol in ((2e-12, 4 * np.finfo(float).eps), (1e-15, 4 * np.finfo(float).eps), (1e-6, 1e-8)):
+                ours, theirs = (outcome(g, f, a, b, xtol=xtol, rtol=rtol) for g in (brentq, scipy_brentq))
+                assert ours == theirs, (a, b, xtol, rtol)
+                checked += 1
+    assert checked > 200
+    for call in (lambda g: g(lambda x: x + 1, 0.0, 1.0), lambda g: g(lambda x: math.nan, 0.0, 1.0)):
+        for g in (brentq, scipy_brentq):
+            with pytest.raises(ValueError):
+                call(g)
