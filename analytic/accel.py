@@ -1,33 +1,105 @@
-"""The optional compiler for the analytic integration kernels (numba), and the switch to turn it off.
+"""The optional compiler for the analytic integration kernels (numba), when it is worth loading, and its switch.
 
-The kernels (:mod:`.kernels`, :mod:`.dop853`, :mod:`.dense`) are plain Python on scalars and
-small float arrays. With numba installed (``pip install 'ipir-mujoco[fast]'``)
-they are compiled on their first call and cached on disk (``cache=True``: the
-first run on a machine pays the compilation, about 10 s, later processes load
-it in well under a second); without it the same source runs as Python, slower
-but with the same results (same operations, same order; the compiled code uses
-no fast-math, so it rounds as Python does).
+The kernels (:mod:`.kernels`, :mod:`.dop853`, :mod:`.dense`) are plain Python on scalars and small float
+arrays, marked with :func:`jit`. Compiled by numba (a dependency of the package where its wheels exist),
+they run the same operations in the same order, so they give the same floats (no fast-math: the compiled
+code rounds as Python does; tests/test_fast_kernels.py holds the two paths equal); a run may start in
+Python and go on compiled, and give the same result.
 
-Set the environment variable ``IPIR_MUJOCO_JIT=0`` before the first import to
-run the Python source even where numba is installed (a test compares the two).
+Compiling has a price: importing numba and loading the machine code cached on disk cost several tenths of
+a second in every process (the first run on a machine also compiles, about 15 s, once), more than a short
+run's whole integration in Python. So by default the kernels start as Python, and a process compiles them
+(:func:`accelerate`) once its analytic runs have spent :data:`LOAD_COST_S` in Python: rent until the rent
+paid equals the price, then buy, which never costs more than twice the better choice made in hindsight.
+A long run, a sweep's worker or a validation switches within its first half second; a default
+``ipir-mujoco simulate`` never loads numba.
+
+``IPIR_MUJOCO_JIT`` (read at import): ``auto`` (default) as above; ``1`` compiles at the first run; ``0``
+never compiles (the Python source only). numba's own ``NUMBA_DISABLE_JIT=1`` counts as ``0``.
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib.util
+import logging
 import os
+import sys
 from pathlib import Path
 
-try:
-    if os.environ.get("IPIR_MUJOCO_JIT", "1") == "0":
-        raise ImportError("compilation turned off by IPIR_MUJOCO_JIT=0")
-    import numba
-except ImportError:  # the fallback: the kernels run as Python
-    numba = None
+MODES = ("auto", "1", "0")
+MODE = os.environ.get("IPIR_MUJOCO_JIT", "auto").strip().lower() or "auto"
+if MODE not in MODES:  # an unknown value means what it would mean to numba users: leave the default
+    MODE = "auto"
+LOAD_COST_S = 0.5  # s of Python-mode integration after which a process compiles (about numba's load cost)
 
-# True: the kernels are compiled (numba's own NUMBA_DISABLE_JIT=1 leaves them Python)
-ACCELERATED = numba is not None and not numba.config.DISABLE_JIT
+ACCELERATED = False  # True once the kernels run compiled in this process (read it as accel.ACCELERATED)
 _COMPILED_MODULES = ("kernels", "dense", "dop853")  # the modules whose functions are compiled and call each other
+_FUNCTIONS: list = []  # every @jit function, in definition order
+_spent = 0.0  # s of analytic integration run in Python so far (auto mode)
+_refused = False  # numba is missing, disabled, or failed to compile: never try again
+log = logging.getLogger("ipir_mujoco")
+
+
+def jit(function):
+    """Mark ``function`` as a kernel :func:`accelerate` compiles; until then it runs as the Python it is."""
+    _FUNCTIONS.append(function)
+    return function
+
+
+def available() -> bool:
+    """Whether the kernels may be compiled here: numba installed, and neither IPIR_MUJOCO_JIT=0 nor
+    NUMBA_DISABLE_JIT=1 set."""
+    if MODE == "0" or os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
+        return False
+    return importlib.util.find_spec("numba") is not None
+
+
+def accelerate() -> bool:
+    """Compile the kernels now (load them from numba's cache where it holds them) and run them compiled from
+    here on in this process; True if they are compiled. Each kernel module's functions, and every name other
+    kernel modules bound them to, are replaced by their compiled dispatchers, so compiled kernels call
+    compiled kernels."""
+    global ACCELERATED, _refused
+    if ACCELERATED or _refused:
+        return ACCELERATED
+    if not available():
+        _refused = True
+        return False
+    import numba
+
+    if numba.config.DISABLE_JIT:
+        _refused = True
+        return False
+    _drop_stale_cache()
+    if compilation_pending():
+        log.info("compiling the analytic engines' kernels for this machine, once (about 15 s; later runs reuse "
+                 "them)")
+    compiled = {id(f): numba.njit(cache=True, nogil=True, error_model="numpy")(f) for f in _FUNCTIONS}
+    for name in _COMPILED_MODULES:
+        module = sys.modules[f"{__package__}.{name}"]
+        for attribute, value in list(vars(module).items()):
+            if id(value) in compiled:
+                setattr(module, attribute, compiled[id(value)])
+    ACCELERATED = True
+    return True
+
+
+def run_started() -> None:
+    """An analytic run begins: with IPIR_MUJOCO_JIT=1, compile before it."""
+    if MODE == "1":
+        accelerate()
+
+
+def spent(seconds: float) -> None:
+    """An analytic run spent ``seconds`` [s] integrating; in auto mode, compile once the Python-mode time of
+    the process reaches LOAD_COST_S (module docstring)."""
+    global _spent
+    if ACCELERATED or _refused or MODE != "auto":
+        return
+    _spent += seconds
+    if _spent >= LOAD_COST_S:
+        accelerate()
 
 
 def _drop_stale_cache() -> None:
@@ -55,23 +127,12 @@ def _drop_stale_cache() -> None:
         pass
 
 
-if ACCELERATED:
-    _drop_stale_cache()
-
-
-def jit(function):
-    """``function`` compiled in nopython mode with an on-disk cache, or ``function`` itself without numba."""
-    if numba is None:
-        return function
-    return numba.njit(cache=True, nogil=True, error_model="numpy")(function)
-
-
 def compilation_pending() -> bool:
-    """True when the kernels will be compiled on their first call in this process (no cached machine
-    code where numba keeps it: NUMBA_CACHE_DIR if set, else beside the sources or, where those cannot
-    be written, the user's cache folder), so that a caller can say why the first run takes longer.
-    False without numba."""
-    if numba is None:
+    """True when compiling the kernels would compile rather than load them (no cached machine code where
+    numba keeps it: NUMBA_CACHE_DIR if set, else beside the sources or, where those cannot be written, the
+    user's cache folder), so that a caller can say why a run takes longer. False where they cannot be
+    compiled."""
+    if not available():
         return False
     if os.environ.get("NUMBA_CACHE_DIR"):
         places = [Path(os.environ["NUMBA_CACHE_DIR"])]

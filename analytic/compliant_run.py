@@ -36,8 +36,7 @@ from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import RunResult
 
-from . import compliant_grip, dop853, kernels
-from .accel import ACCELERATED
+from . import accel, compliant_grip, dop853, kernels
 from .compliant_clutch import Clutch, CompliantModel, Regime
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
@@ -217,7 +216,7 @@ def _missed_crossing(events: list, sol, constants=None):
     fractions = np.arange(1, _GRAZE_POINTS + 1) / (_GRAZE_POINTS + 1)
     times = (ends[:-1, None] + np.diff(ends)[:, None] * fractions).ravel()
     states = sol.sol(times)
-    if constants is not None and ACCELERATED:  # every raw value in one compiled call
+    if constants is not None and accel.ACCELERATED:  # every raw value in one compiled call
         values = np.empty((len(events), times.size))
         kernels.guard_table(kernels.COMPLIANT, kernels.RAW, len(events), constants, times,
                             np.ascontiguousarray(states.T), values)

@@ -18,7 +18,8 @@ import math
 
 import numpy as np
 
-from .accel import ACCELERATED, jit
+from . import accel
+from .accel import jit
 from .kernels import guards_at
 
 GRAZE_POINTS = 8  # interior points checked per accepted step for a guard that dipped below zero and came back
@@ -170,7 +171,7 @@ class DenseSolution:
                 dense_at(self.F[step], self.y_old[step], self.t_old[step], self.h[step], t, out)
             return out
         times = np.asarray(t, dtype=float)
-        if ACCELERATED:
+        if accel.ACCELERATED:
             out = np.empty((self.y_old.shape[1], times.size))
             dense_table(self.ts, self.t_old, self.y_old, self.F, self._h_safe, times, out)
             return out
@@ -181,7 +182,7 @@ class DenseSolution:
 
     def phi_at(self, t: float) -> float:
         """The first state component (the crank angle, rad) at one time t [s]: ``self(t)[0]``, compiled."""
-        if not ACCELERATED:
+        if not accel.ACCELERATED:
             return float(self(t)[0])
         return component_at(self.ts, self.t_old, self.y_old, self.F, self.h, 0, float(t))
 

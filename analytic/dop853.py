@@ -23,8 +23,9 @@ from contextlib import nullcontext
 
 import numpy as np
 
+from . import accel
 from . import dop853_tableau as _coefficients
-from .accel import ACCELERATED, jit
+from .accel import jit
 from .dense import DenseSolution, dense_at as _dense
 from .kernels import guard, rhs
 
@@ -325,7 +326,7 @@ def solve(model: int, mode: int, t0: float, t_end: float, y0, p: np.ndarray, rto
     y0, h = np.array(y0, dtype=float), float(first_step or 0.0)
     parts, resumed = [], 0
     while True:
-        with nullcontext() if ACCELERATED else np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        with nullcontext() if accel.ACCELERATED else np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             # as Python (no numba; compiled, numpy's warnings never fire), trial steps of a fast crank can overflow;
             # the step controller rejects them, and the output is checked finite
             out = integrate(int(model), int(mode), float(t0), float(t_end), y0, p, float(rtol), float(atol), h,

@@ -52,8 +52,7 @@ from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode
 
-from . import dop853, kernels
-from .accel import ACCELERATED
+from . import accel, dop853, kernels
 from .kinematics import Geometry
 from .unilateral_clutch import _REST_SPEED, _TINY, _TOL_A, _TOL_F, _TOL_V, UnilateralModel, _columns
 
@@ -190,7 +189,7 @@ class GripModel:
 
     def guards(self, t, Y, mode: GripMode) -> np.ndarray:
         """Every event function of ``mode`` at times t (n,) and states Y (6, n): array (2, n)."""
-        if ACCELERATED and self.torque is None and np.ndim(t) == 1:
+        if accel.ACCELERATED and self.torque is None and np.ndim(t) == 1:
             t = np.asarray(t, dtype=float)
             out = np.empty((2, t.size))
             kernels.guard_table(kernels.GRIP, int(mode.kinematics), 2, self.constants[mode], t,
@@ -209,7 +208,7 @@ class GripModel:
 
     def graze_scan(self, sol, mode: GripMode):
         """missed_crossing's scan of ``sol`` compiled (a callable) where the guards are the kernels', else None."""
-        if ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment):
+        if accel.ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment):
             return lambda: sol.sol.graze_scan(kernels.GRIP, int(mode.kinematics), 2, self.constants[mode])
 
     # --- choosing the next mode --------------------------------------------------------------

@@ -14,6 +14,7 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import check_real
 
+from . import accel
 from .dense import CLEAR, GRAZE_POINTS
 from .roots import brentq
 
@@ -159,7 +160,8 @@ class RunMonitor:
         self.wall_budget_s, self.progress, self.until_steady = (options.wall_budget_s, options.progress,
                                                                 options.until_steady)
         self.switches = 0
-        self.started = time.perf_counter()
+        accel.run_started()
+        self.started = self._clock = time.perf_counter()
         self.next_report = PROGRESS_EVERY_S
         self.next_end = float(phi0) + 2 * math.pi  # crank angle at which the current revolution ends
 
@@ -214,6 +216,14 @@ class RunMonitor:
         t, end = piece["t"], self.watch.steady_at
         return float(t[min(np.searchsorted(t, end - STEADY_SLACK * (1.0 + end)), t.size - 1)])
 
+    def _tick(self) -> float:
+        """The wall time now [s]; the time since the last tick goes to :func:`.accel.spent`, which compiles the
+        kernels once Python-mode integration has cost what loading them would."""
+        now = time.perf_counter()
+        accel.spent(now - self._clock)
+        self._clock = now
+        return now
+
     def after_switch(self, t: float, switches: int, phi: float) -> None:
         """Budget checks and progress at a mode switch at time t [s] (the ``switches``-th) at crank angle phi."""
         self.switches = switches
@@ -228,7 +238,8 @@ class RunMonitor:
     def check_budget(self, t: float, phi: float | None = None) -> None:
         """Raise once the run has spent its wall-time budget (at simulated time t [s], crank angle phi [rad]
         where known)."""
-        if self.wall_budget_s is None or time.perf_counter() - self.started <= self.wall_budget_s:
+        now = self._tick()
+        if self.wall_budget_s is None or now - self.started <= self.wall_budget_s:
             return
         crank = "" if phi is None else f", crank at {(phi - self.phi0) / (2 * math.pi):.4g} revolutions"
         raise SimulationError(
@@ -237,6 +248,8 @@ class RunMonitor:
 
     def report(self, t: float, final: bool = False) -> None:
         """Call ``progress(t)`` if PROGRESS_EVERY_S of simulated time has passed since the last call (or at the end)."""
+        if final:
+            self._tick()
         if self.progress is not None and (t >= self.next_report or final):
             self.progress(t)
             self.next_report = t + PROGRESS_EVERY_S

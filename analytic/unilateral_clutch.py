@@ -54,8 +54,7 @@ from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode, RunResult
 
-from . import dop853, kernels
-from .accel import ACCELERATED
+from . import accel, dop853, kernels
 from .dynamics import OneDofDynamics
 from .forces import drive_torque
 from .kinematics import Geometry
@@ -174,7 +173,7 @@ class UnilateralModel:
 
     def guards(self, t, Y, mode: Mode) -> np.ndarray:
         """Every event function of ``mode`` at times t (n,) and states Y (6, n): array (n_events, n)."""
-        if ACCELERATED and self.torque is None and np.ndim(t) == 1:  # compiled: no numpy calls per segment
+        if accel.ACCELERATED and self.torque is None and np.ndim(t) == 1:  # compiled: no numpy calls per segment
             t = np.asarray(t, dtype=float)
             out = np.empty((2, t.size))
             kernels.guard_table(kernels.UNILATERAL, int(mode), 2, self.constants, t,
@@ -195,7 +194,7 @@ class UnilateralModel:
 
     def graze_scan(self, sol, mode: Mode):
         """missed_crossing's scan of ``sol`` compiled (a callable) where the guards are the kernels', else None."""
-        if ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment):
+        if accel.ACCELERATED and self.torque is None and isinstance(sol, dop853.Segment):
             return lambda: sol.sol.graze_scan(kernels.UNILATERAL, int(mode), 2, self.constants)
 
     # --- choosing the next mode ----------------------------------------------------------

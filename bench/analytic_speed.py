@@ -32,7 +32,7 @@ from pathlib import Path
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.accel import ACCELERATED
+from ipir_mujoco.analytic import accel
 
 ROOT = Path(__file__).resolve().parents[1]
 BEFORE = "5590109"  # the last main whose analytic models integrate with solve_ivp
@@ -117,8 +117,8 @@ FALLBACK = """
 import json, time
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.accel import ACCELERATED
-out = {"accelerated": ACCELERATED}
+from ipir_mujoco.analytic import accel
+out = {"accelerated": accel.ACCELERATED}
 for name, g, c, p in (("paper", "approx", "kinematic", RobotParams()),
                       ("one-way", "exact", "unilateral", RobotParams()),
                       ("compliant", "exact", "unilateral", RobotParams(clutch_stiffness=1e6))):
@@ -136,7 +136,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--skip-long", action="store_true", help="skip the 10 s cases before (about 40 s)")
     args = parser.parse_args()
-    print(f"numba compiled kernels: {ACCELERATED}; before = {args.before}; best of {args.repeats}; "
+    print(f"numba compiled kernels: {accel.accelerate()}; before = {args.before}; best of {args.repeats}; "
           f"machine load (1 min) {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as folder:
         before = load_before(args.before, Path(folder))
@@ -165,8 +165,8 @@ def main() -> None:
               f"({new1[1].t_end:g} s), {new10[0] / new10[1].summary['revolutions'] * 1e3:.2f} ms "
               f"({new10[1].t_end:g} s)")
     with tempfile.TemporaryDirectory() as cache:
-        cold = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache})
-        warm = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache})
+        cold = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache, "IPIR_MUJOCO_JIT": "1"})
+        warm = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache, "IPIR_MUJOCO_JIT": "1"})
     print("\nfirst call in a new process (paper model 1 s; then the one-way and compliant models' first runs):")
     for label, t in (("empty numba cache", cold), ("warm numba cache", warm)):
         print(f"  {label:18s} import {t['import']:.2f} s, first run {t['first']:.2f} s, other models' first runs "

@@ -143,6 +143,16 @@ def check_options(name: str | Variant, options: dict[str, Any], spelled: Callabl
     return v
 
 
+def prepare_for_many(names) -> None:
+    """A process about to run many designs of the variants ``names`` (a sweep's worker): compile the analytic
+    kernels now rather than after their first half second in Python (:mod:`ipir_mujoco.analytic.accel`); for
+    MuJoCo variants there is nothing to prepare. Cheap when already done."""
+    if any(not variant(n).is_mujoco for n in names):
+        from .analytic import accel
+
+        accel.accelerate()
+
+
 def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float) -> float | None:
     """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s]
     (:func:`ipir_mujoco.engine.timestep.choose_settings`); None for the analytic engines."""

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from ipir_mujoco.analytic import RobotParams, dop853, kernels
-from ipir_mujoco.analytic.accel import ACCELERATED
+from ipir_mujoco.analytic import accel
 from ipir_mujoco.core.cycles import SteadyWatch
 from ipir_mujoco.analytic.dense import DenseSolution, component_at, dense_table, graze_scan
 from ipir_mujoco.analytic.kinematics import Linkage
@@ -23,6 +23,7 @@ from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.solver_support import graze_signs
 from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
 
+ACCELERATED = accel.accelerate()  # the compiled scans, where numba is installed, against the numpy reference
 RTOL, ATOL = 1e-10, 1e-12
 PARAMS = RobotParams(drive="motor", incline=10.0, rod_mass=0.2)
 
@@ -169,12 +170,10 @@ def test_the_watch_gives_the_same_answer_fed_in_any_chunks():
 @pytest.mark.skipif(not ACCELERATED, reason="numba is not installed: the numpy path is the only one")
 def test_the_fallback_dense_output_is_the_compiled_one(monkeypatch):
     """Without numba DenseSolution evaluates with numpy: the same floats as the compiled loop."""
-    from ipir_mujoco.analytic import dense
-
     _, _, seg = segments()[0]
     times = np.linspace(seg.sol.ts[0], seg.sol.ts[-1], 101)
     compiled, phis = seg.sol(times), [seg.sol.phi_at(float(t)) for t in times]
-    monkeypatch.setattr(dense, "ACCELERATED", False)
+    monkeypatch.setattr(accel, "ACCELERATED", False)
     assert np.array_equal(seg.sol(times), compiled)
     assert [seg.sol.phi_at(float(t)) for t in times] == phis
 

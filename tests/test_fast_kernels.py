@@ -19,13 +19,17 @@ from scipy.integrate import solve_ivp
 
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams, dop853, kernels
-from ipir_mujoco.analytic.accel import ACCELERATED
+from ipir_mujoco.analytic import accel
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.kinematic_clutch import mode_rhs
 from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
 
+# compiled for the whole test session where numba is installed (by default a process compiles only once its
+# runs have spent accel.LOAD_COST_S in Python): every test then checks the compiled kernels, and the Python
+# source is checked against them in child processes
+ACCELERATED = accel.accelerate()
 RTOL, ATOL = 1e-10, 1e-12
 DESIGNS = {
     "paper": RobotParams(),
@@ -132,11 +136,13 @@ import json, sys
 import numpy as np
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.analytic.accel import ACCELERATED
-out = {"accelerated": ACCELERATED}
+from ipir_mujoco.analytic import accel
+out = {}
 for name, (params, geometry, clutch, t_end) in json.loads(sys.argv[1]).items():
     run = analytic.simulate(RobotParams(**params), geometry, clutch, t_end, dt_out=1e-3)
     out[name] = {c: np.asarray(v, dtype=float).tolist() for c, v in run.series.items()}
+out["accelerated"] = accel.ACCELERATED
+out["numba_loaded"] = "numba" in sys.modules
 print(json.dumps(out))
 """
 
@@ -154,7 +160,7 @@ def test_compiled_and_python_paths_give_the_same_runs():
     done = subprocess.run([sys.executable, "-c", _RUN, json.dumps(spec)], capture_output=True, text=True, env=env,
                           check=True)
     python = json.loads(done.stdout)
-    assert python.pop("accelerated") is False
+    assert python.pop("accelerated") is False and python.pop("numba_loaded") is False
     for name, (params, geometry, clutch, t_end) in CASES.items():
         run = analytic.simulate(params, geometry, clutch, t_end, dt_out=1e-3)
         assert set(python[name]) == set(run.series), name
@@ -166,24 +172,71 @@ def test_compiled_and_python_paths_give_the_same_runs():
         assert math.isfinite(run.energy["residual_j"])
 
 
-def test_the_command_line_says_when_it_compiles_the_kernels_first(tmp_path, monkeypatch, capsys):
-    """A cold numba cache makes the first run slow: the command line says why, in one line on stderr;
-    a warm one (the cached index numba writes beside its machine code) says nothing."""
-    from ipir_mujoco.analytic import accel
+def test_a_short_run_never_loads_numba_and_a_long_one_goes_on_compiled_with_the_same_floats():
+    """By default (IPIR_MUJOCO_JIT unset) a process compiles the kernels only once its runs have spent
+    accel.LOAD_COST_S in Python: a default simulate (6 ms of work compiled) never imports numba; a run that
+    outlasts that switches to the compiled kernels part way and gives exactly the floats of the Python path
+    (the same source, the same operations)."""
+    if not ACCELERATED:
+        pytest.skip("numba is not installed: nothing is compiled")
+    env = {k: v for k, v in os.environ.items() if k != "IPIR_MUJOCO_JIT"}
+    short = {"paper": (RobotParams().as_dict(), "approx", "kinematic", 1.0)}
+    done = subprocess.run([sys.executable, "-c", _RUN, json.dumps(short)], capture_output=True, text=True, env=env,
+                          check=True)
+    result = json.loads(done.stdout)
+    assert result["accelerated"] is False and result["numba_loaded"] is False
+    # a motor run for 20 s: about 15 times LOAD_COST_S of work in Python, so it switches within its first tenth
+    long = {"motor": (RobotParams(drive="motor", incline=10.0).as_dict(), "exact", "unilateral", 20.0)}
+    runs = {}
+    for mode in ("auto", "0"):
+        done = subprocess.run([sys.executable, "-c", _RUN, json.dumps(long)], capture_output=True, text=True,
+                              env=dict(env, IPIR_MUJOCO_JIT=mode), check=True)
+        runs[mode] = json.loads(done.stdout)
+    assert runs["auto"]["accelerated"] is True and runs["0"]["accelerated"] is False
+    assert runs["auto"]["motor"] == runs["0"]["motor"]  # every column, every float
+
+
+def test_compiling_is_announced_once_in_one_line_where_it_compiles(tmp_path, monkeypatch, capsys):
+    """A cold numba cache makes the first compiled run slow: accelerate() says why (logger 'ipir_mujoco'), and
+    the command line shows that as one line on stderr; with the cache warm it says nothing."""
+    import logging
+
     from ipir_mujoco.cli import main
 
-    if not accel.ACCELERATED:
+    if not ACCELERATED:
         pytest.skip("numba is not installed: nothing is compiled")
+    import numba
+
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
-    assert accel.compilation_pending()
+    monkeypatch.setattr(accel, "ACCELERATED", False)  # a process that has not compiled yet
+    real = numba.njit
+
+    def no_compiling(*args, **options):  # accelerate()'s njit(**options)(function) compiles nothing; numba's
+        return real(*args, **options) if args else (lambda function: function)  # own calls go through
+    monkeypatch.setattr(numba, "njit", no_compiling)
+    records = []
+    handler = logging.Handler()
+    handler.emit = records.append
+    accel.log.addHandler(handler)
+    monkeypatch.setattr(accel.log, "level", logging.INFO)
+    try:
+        assert accel.compilation_pending() and accel.accelerate()
+        (tmp_path / "analytic_x").mkdir()
+        (tmp_path / "analytic_x" / "dop853.step-1.py311.nbi").write_bytes(b"")
+        monkeypatch.setattr(accel, "ACCELERATED", False)
+        assert not accel.compilation_pending() and accel.accelerate()
+    finally:
+        accel.log.removeHandler(handler)
+    assert [r.getMessage() for r in records] == ["compiling the analytic engines' kernels for this machine, once "
+                                                 "(about 15 s; later runs reuse them)"]
+    # the command line prints what the package logs, one line with the command's name
+    monkeypatch.setattr(accel, "MODE", "1")
+    monkeypatch.setattr(accel, "ACCELERATED", False)
+    (tmp_path / "analytic_x" / "dop853.step-1.py311.nbi").unlink()
     assert main(["simulate", "--t-end", "0.05", "--json"]) == 0
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "compiling the analytic engines' kernels" in err
-    (tmp_path / "analytic_x").mkdir()
-    (tmp_path / "analytic_x" / "dop853.step-1.py311.nbi").write_bytes(b"")
-    assert not accel.compilation_pending()
-    assert main(["simulate", "--t-end", "0.05", "--json"]) == 0
-    assert capsys.readouterr().err == ""
+    assert err == "ipir-mujoco simulate: compiling the analytic engines' kernels for this machine, once (about 15 s; " \
+                  "later runs reuse them)\n"
 
 
 def test_the_packaged_brentq_is_scipys_float_for_float():

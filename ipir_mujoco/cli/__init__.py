@@ -10,6 +10,7 @@ subcommand lives in its own module with ``add_parser(commands)`` and
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import sys
@@ -71,9 +72,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("ipir-mujoco: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     prefix = f"ipir-mujoco {args.command}"
+    notes = _show_notes(prefix)
     try:
-        if args.command not in QUIET_COMMANDS:  # it imports the analytic package: inside the one-line net
-            _note_first_compilation(prefix)
         return args.handler(args)
     except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
         if args.debug or isinstance(exc, SystemExit):
@@ -83,9 +83,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         code, message = _describe_failure(exc)
         print(f"{prefix}: {message}", file=sys.stderr)
         return code
+    finally:
+        logging.getLogger("ipir_mujoco").removeHandler(notes)
 
 
-QUIET_COMMANDS = ("params", "compare")  # they run no analytic engine
 EXIT_PIPE_CLOSED = 141  # 128 + SIGPIPE, as shells report a writer whose reader left
 
 
@@ -100,13 +101,16 @@ def _reader_gone() -> int:
     return EXIT_PIPE_CLOSED
 
 
-def _note_first_compilation(prefix: str) -> None:
-    """Say why the first run on a machine takes longer: the analytic kernels compile once (numba)."""
-    from ipir_mujoco.analytic.accel import compilation_pending
-
-    if compilation_pending():
-        print(f"{prefix}: compiling the analytic engines' kernels for this machine, once (about 15 s; later runs "
-              "reuse them)", file=sys.stderr, flush=True)
+def _show_notes(prefix: str) -> logging.Handler:
+    """What the package says while it works (logger 'ipir_mujoco' at INFO, e.g. that the analytic kernels
+    compile once, the first time a machine runs them long enough) goes to stderr as one line each, with the
+    command's name; returns the handler, to remove when the command ends."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(f"{prefix}: %(message)s"))
+    logger = logging.getLogger("ipir_mujoco")
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    return handler
 
 
 def _describe_failure(exc: BaseException) -> tuple[int, str]:

@@ -112,6 +112,7 @@ def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end:
     thread of a process of our own).
     """
     options = options or {}
+    registry.prepare_for_many(engines)
     try:
         params = base.replace(**values)
     except ValueError as exc:
