@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numbers
 
+from ipir_mujoco.core.results import SERIES_UNITS
+
 # summary key -> (name, unit)
 SUMMARY: dict[str, tuple[str, str]] = {
     "revolutions": ("crank revolutions", "rev"),
@@ -27,18 +29,12 @@ SUMMARY: dict[str, tuple[str, str]] = {
     "t_steady_s": ("time to steady state", "s"),
 }
 
-# time-series column -> (name, unit)
-SERIES: dict[str, tuple[str, str]] = {
-    "t": ("time", "s"),
-    "phi": ("crank angle", "rad"),
-    "omega": ("crank speed", "rad/s"),
-    "x1": ("module 1 position", "m"),
-    "x2": ("module 2 position", "m"),
-    "v1": ("module 1 velocity", "m/s"),
-    "v2": ("module 2 velocity", "m/s"),
-    "S": ("gap S", "m"),
-    "S_dot": ("gap rate S_dot", "m/s"),
-}
+# time-series column -> (name, unit); the units are the result container's (core.results.SERIES_UNITS)
+SERIES: dict[str, tuple[str, str]] = {column: (name, SERIES_UNITS[column]) for column, name in {
+    "t": "time", "phi": "crank angle", "omega": "crank speed", "x1": "module 1 position",
+    "x2": "module 2 position", "v1": "module 1 velocity", "v2": "module 2 velocity", "S": "gap S",
+    "S_dot": "gap rate S_dot",
+}.items()}
 
 
 def summary_label(key: str) -> str:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ipir_mujoco.analytic import RobotParams
+from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.core.results import COLUMNS, Mode, RunResult, first_gap_minimum, min_locked_reaction, read_csv, write_json
 
 
@@ -105,3 +105,41 @@ def test_the_residual_ratio_is_against_the_energy_put_through_the_robot():
         start = run.series["kinetic"][0]  # 1.8 J at 60 rad/s: the largest energy in play
         assert ratio == pytest.approx(e["residual_j"] / max(e["friction_j"], -e["kinetic_j"], start), rel=1e-12)
         assert abs(ratio) < 1e-6
+
+
+def test_a_run_as_a_dataframe_keeps_every_column_its_units_and_summary():
+    import pandas
+
+    from ipir_mujoco import registry
+    from ipir_mujoco.core.results import SERIES_UNITS
+
+    run = registry.run("analytic-unilateral", RobotParams(drive="motor"), 0.3, dt_out=1e-3)
+    frame = run.to_pandas()
+    assert isinstance(frame, pandas.DataFrame) and list(frame.columns) == list(run.series)
+    assert all(np.array_equal(frame[c].to_numpy(), run.series[c]) for c in run.series)
+    assert frame.attrs["units"]["x1"] == "m" and frame.attrs["units"]["omega"] == "rad/s"
+    assert set(frame.attrs["units"]) == set(run.series) and all(frame.attrs["units"][c] for c in run.series)
+    assert frame.attrs["summary"]["revolutions"] == run.summary["revolutions"]
+    # every column either engine writes has its unit in the one table
+    physics = registry.run("mujoco-ratchet", RobotParams(clutch_stiffness=1e6), 0.05, dt_out=1e-3)
+    assert set(physics.series) <= set(SERIES_UNITS)
+
+
+def test_a_run_draws_the_papers_figures_and_a_sweep_reads_as_one_frame(tmp_path):
+    from ipir_mujoco import registry
+    from ipir_mujoco.studies.frames import read_sweep
+    from ipir_mujoco.studies.sweep import run_sweep
+    from ipir_mujoco.studies.sweep_space import Study, parse_vary
+
+    one, other = (registry.run(v, RobotParams(), 0.2, dt_out=1e-3) for v in ("analytic-approx", "mujoco-lock"))
+    figures = one.plot(other, path=tmp_path / "figs")
+    assert len(figures) == 3 and all(len(f.axes[0].get_lines()) >= 2 for f in figures)  # both runs drawn
+    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == ["fig2_crank.png", "fig3_modules.png",
+                                                                     "fig4_gap.png"]
+    study = Study((parse_vary("L=0.1,0.2"),), engines=("analytic-approx",), t_end=0.2)
+    run_sweep(study, tmp_path / "sweep", progress=False, workers=1)
+    frame = read_sweep(tmp_path / "sweep")
+    assert list(frame["L"]) == [0.1, 0.2] and frame.attrs["units"]["L"] == "m"
+    assert frame.attrs["units"]["analytic-approx:steady_speed_m_s"] == "m/s"
+    with pytest.raises(ParameterError, match="holds no sweep results"):
+        read_sweep(tmp_path / "figs")

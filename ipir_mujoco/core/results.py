@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
+from .errors import ParameterError
 from .params import RobotParams
 
 # [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
@@ -74,6 +75,18 @@ COLUMNS: tuple[str, ...] = (
     "t", "phi", "omega", "alpha", "x1", "x2", "v1", "v2", "a1", "a2",
     "S", "S_dot", "lambda1", "lambda2", "mode",
 )
+
+
+# every series column any engine writes, and its unit (a column an engine adds is listed here too)
+SERIES_UNITS: dict[str, str] = {
+    "t": "s", "phi": "rad", "omega": "rad/s", "alpha": "rad/s^2", "x1": "m", "x2": "m", "v1": "m/s", "v2": "m/s",
+    "a1": "m/s^2", "a2": "m/s^2", "S": "m", "S_dot": "m/s", "lambda1": "N", "lambda2": "N", "mode": "-",
+    "motor_work": "J", "friction_work": "J", "kinetic": "J", "potential": "J", "clutch_spring_energy": "J",
+    "clutch_damper_work": "J", "skid_work": "J", "motor_torque": "N m", "motor_power": "W", "rod_force": "N",
+    "crank_pin_force": "N", "resistance1": "N", "resistance2": "N", "clutch_overlap1": "m", "clutch_overlap2": "m",
+    "slip1": "m", "slip2": "m", "grip_use1": "-", "grip_use2": "-", "wheels1": "-", "wheels2": "-",
+    "loop_gap": "m", "momentum": "kg m/s",
+}
 
 
 class Mode(IntEnum):
@@ -176,6 +189,30 @@ class RunResult:
             "settings": self.settings,
             "mode_names": {str(k): v for k, v in MODE_NAMES.items()},
         }
+
+    def to_pandas(self):
+        """The time series as a ``pandas.DataFrame``, one column per series column (shape (n,)), indexed by
+        sample; ``df.attrs`` holds ``units`` ({column: unit}), ``summary`` and ``engine``/``geometry``/
+        ``clutch``. pandas is optional: ``pip install pandas`` (a ParameterError says so where it is missing)."""
+        try:
+            import pandas
+        except ImportError:
+            raise ParameterError("to_pandas needs pandas: pip install pandas (or 'ipir-mujoco[notebook]')") from None
+        frame = pandas.DataFrame({c: np.asarray(v) for c, v in self.series.items()})
+        frame.attrs.update(units={c: SERIES_UNITS.get(c, "") for c in self.series}, summary=self.summary,
+                           engine=self.engine, geometry=self.geometry, clutch=self.clutch)
+        return frame
+
+    def plot(self, *others: "RunResult", path: str | Path | None = None):
+        """The paper's figures (crank, modules, gap against time) of this run and any ``others`` drawn over it:
+        a list of three matplotlib figures; with ``path`` (a folder) also written there as fig2-4 PNG."""
+        from ipir_mujoco.report import plots  # drawing only: the one import of a layer above, kept lazy
+
+        runs = [self, *others]
+        if path is not None:
+            Path(path).mkdir(parents=True, exist_ok=True)
+            plots.write_paper_figures(runs, path)
+        return [plots.figure_crank(runs), plots.figure_modules(runs), plots.figure_gap(runs)]
 
     def write_csv(self, path: str | Path) -> None:
         """Write the time series as CSV with a header row of :data:`COLUMNS`."""
