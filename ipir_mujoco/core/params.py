@@ -392,23 +392,29 @@ def check_whole(name: str, value: Any, *, low: int = 0, high: int | None = None,
     return whole
 
 
+# (parameter, the parameters that act only through it when it is not None, what they need, its value that
+# leaves them idle, the unit the message gives them): refused together (refuse_idle_parameters)
+_ACTS_THROUGH = (
+    ("clutch_stiffness", ("clutch_damping", "clutch_backlash"),
+     "a finite clutch_stiffness (a rigid clutch has no spring for it to act with)", "rigid", ""),
+    ("mu_wall", ("F_n1", "F_n2"), "a finite mu_wall (with unlimited grip the normal force holds nothing)",
+     "unlimited", " N"),
+)
+
+
 def refuse_idle_parameters(params: RobotParams) -> None:
     """Parameters that act only through another one, given without it, refused in one line (never silently
     ignored), for every engine: clutch damping and backlash need a clutch with a spring (a finite
     ``clutch_stiffness``); the wheels' normal forces act only through a finite grip (``mu_wall``)."""
     defaults = RobotParams()
-    if params.clutch_stiffness is None:
-        for name in ("clutch_damping", "clutch_backlash"):
-            if getattr(params, name) != getattr(defaults, name):
-                raise ParameterError(f"{name}={getattr(params, name)!r} needs a finite clutch_stiffness (a rigid "
-                                     f"clutch has no spring for it to act with); allowed: {getattr(defaults, name)!r} "
-                                     "with clutch_stiffness=rigid")
-    if params.mu_wall is None:
-        for name in ("F_n1", "F_n2"):
-            if getattr(params, name) != getattr(defaults, name):
-                raise ParameterError(f"{name}={getattr(params, name)!r} N needs a finite mu_wall (with unlimited grip "
-                                     f"the normal force holds nothing); allowed: {getattr(defaults, name)!r} with "
-                                     "mu_wall=unlimited")
+    for through, names, needs, idle, unit in _ACTS_THROUGH:
+        if getattr(params, through) is not None:
+            continue
+        for name in names:
+            value, default = getattr(params, name), getattr(defaults, name)
+            if value != default:
+                raise ParameterError(f"{name}={value!r}{unit} needs {needs}; allowed: {default!r} with "
+                                     f"{through}={idle}")
 
 
 def require_params(params: Any) -> RobotParams:
