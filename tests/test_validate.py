@@ -296,7 +296,7 @@ def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_valid
     write_report(tmp_path, metrics, rungs, (toy,))
     markdown = (tmp_path / "report.md").read_text()
     # the section sits after the core sections and before the numerical evidence
-    assert markdown.index("Energy audit") < markdown.index("twice L is 0.6 m") < markdown.index("Numerical convergence")
+    assert markdown.index("## Energy audit") < markdown.index("twice L is 0.6 m") < markdown.index("## Numerical convergence")
     assert "](figures/toy.png)" in markdown and "**Is L positive?** Yes" in markdown
 
 
@@ -347,3 +347,25 @@ def test_a_relative_difference_that_rounds_to_zero_is_printed_without_a_sign():
     from ipir_mujoco.labels import fixed
 
     assert fixed(-1e-4, 2) == "0.00" and fixed(-0.006, 2) == "-0.01" and fixed(3.14159, 1) == "3.1"
+
+
+def test_the_report_opens_with_a_summary_table_that_links_each_verdict_to_its_section(quick_validation):
+    """One row per verdict (question, verdict, key figure, where), before the verdicts' paragraphs; each link
+    goes to a heading the report has (in HTML, to that heading's id)."""
+    from ipir_mujoco.report.document import Heading, Link, Table, anchor, to_html
+    from ipir_mujoco.report.validation import build_blocks, verdict_short
+
+    assert verdict_short("Yes: MuJoCo matches to +0.02 % in revolutions") == ("Yes", "+0.02 %")
+    metrics, _ = quick_validation
+    figures = {name: f"figures/{name}" for name in ("mechanism.png", "fig2_crank.png", "fig3_modules.png",
+                                                    "fig4_gap.png", "lr_study.png", "clutch_reactions.png",
+                                                    "pull_per_stroke.png")}
+    blocks = build_blocks(metrics, figures, "no animation here")
+    headings = [b.text for b in blocks if isinstance(b, Heading)]
+    assert headings.index("Summary") < headings.index("Verdicts")
+    summary = next(b for b in blocks if isinstance(b, Table) and list(b.header)[:2] == ["question", "verdict"])
+    assert len(summary.rows) == len(metrics["verdicts"])
+    links = [row[3] for row in summary.rows]
+    assert all(isinstance(link, Link) and link.heading in headings for link in links)
+    page = to_html([Heading(links[0].heading), Table(["where"], [[links[0]]])], Path("."))
+    assert f'id="{anchor(links[0].heading)}"' in page and f'href="#{anchor(links[0].heading)}"' in page

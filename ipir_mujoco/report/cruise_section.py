@@ -259,5 +259,7 @@ def verdict(metrics: dict) -> dict | None:
         + ": rigid clutches dissipate nothing); the peak clutch reaction at cruise is "
         f"{paper['peak_clutch_force_n']:.3g} N "
         f"against {one_way['peak_clutch_force_n']:.3g} N.")
+    change = (paper['steady_speed_m_s'] - one_way['steady_speed_m_s']) / one_way['steady_speed_m_s']
     return {"question": "What does the paper's model get wrong at cruise, under a real motor?", "answer": answer,
-            "evidence": "sections.cruise"}
+            "evidence": "sections.cruise", "short": "its cruise speed; energy per metre it gets right",
+            "key": f"{pct(change)} in steady speed"}

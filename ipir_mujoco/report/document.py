@@ -11,6 +11,7 @@ from __future__ import annotations
 import base64
 import html
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -33,6 +34,31 @@ class Paragraph:
 class Table:
     header: Sequence[str]
     rows: Sequence[Sequence[str]]
+
+
+@dataclass
+class Link:
+    """A table cell that links to a heading of the report (its text)."""
+
+    text: str
+    heading: str
+
+
+def anchor(text: str) -> str:
+    """A heading's anchor, as GitHub makes one for Markdown: lower case, spaces to hyphens, no punctuation."""
+    return re.sub(r"[^\w\- ]", "", text.lower()).strip().replace(" ", "-")
+
+
+def _cell_markdown(cell) -> str:
+    if isinstance(cell, Link):
+        return f"[{cell.text}](#{anchor(cell.heading)})"
+    return str(cell).replace("|", "\\|")
+
+
+def _cell_html(cell) -> str:
+    if isinstance(cell, Link):
+        return f'<a href="#{anchor(cell.heading)}">{html.escape(cell.text)}</a>'
+    return html.escape(str(cell))
 
 
 @dataclass
@@ -66,7 +92,7 @@ def to_markdown(blocks: list) -> str:
         elif isinstance(block, Table):
             out.append("| " + " | ".join(block.header) + " |")
             out.append("|" + "---|" * len(block.header))
-            out.extend("| " + " | ".join(str(c).replace("|", "\\|") for c in row) + " |" for row in block.rows)
+            out.extend("| " + " | ".join(_cell_markdown(c) for c in row) + " |" for row in block.rows)
         elif isinstance(block, Image):
             out.append(f"![{block.caption}]({block.path})\n\n*{block.caption}*")
         out.append("")
@@ -88,12 +114,12 @@ def to_html(blocks: list, folder: Path) -> str:
     body = []
     for block in blocks:
         if isinstance(block, Heading):
-            body.append(f"<h{block.level}>{html.escape(block.text)}</h{block.level}>")
+            body.append(f'<h{block.level} id="{anchor(block.text)}">{html.escape(block.text)}</h{block.level}>')
         elif isinstance(block, Paragraph):
             body.append(f"<p>{_inline(block.text)}</p>")
         elif isinstance(block, Table):
             head = "".join(f"<th>{html.escape(h)}</th>" for h in block.header)
-            rows = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
+            rows = "".join("<tr>" + "".join(f"<td>{_cell_html(c)}</td>" for c in row) + "</tr>"
                            for row in block.rows)
             body.append(f"<table><tr>{head}</tr>{rows}</table>")
         elif isinstance(block, Image):

@@ -10,6 +10,8 @@ place and is otherwise complete.
 
 from __future__ import annotations
 
+import re
+
 import math
 from pathlib import Path
 from typing import Sequence
@@ -22,7 +24,7 @@ from ipir_mujoco.core.results import Mode
 from ..labels import summary_label
 from ..resources import shipped
 from .diagram import write_mechanism_diagram
-from .document import Heading, Image, Paragraph, Table, fmt, pct, to_html, to_markdown
+from .document import Heading, Image, Link, Paragraph, Table, fmt, pct, to_html, to_markdown
 from .plots import new_figure, write_paper_figures
 from ..studies.paper_reference import describe_differences
 from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, LadderRun
@@ -203,6 +205,26 @@ def _envelope_blocks(envelope: dict) -> list:
                    "worst energy residual / energy [-]", "worst loop gap [m]", "MuJoCo wall [s]"], rows)]
 
 
+# a figure with its unit as the verdicts state them: a signed percentage, a number with a unit, or a count
+_KEY_FIGURE = re.compile(r"[+-]?\d[\d.]*(?:e[+-]?\d+)? ?(?:%|N m|N|m/s|m|deg|s\b)|\d+ of the \d+")
+
+
+def verdict_short(answer: str) -> tuple[str, str]:
+    """(the verdict in a few words, its first figure) of a verdict's answer: the words before its first colon
+    (or its first sentence), and the first number with its unit in what follows ('' if none)."""
+    head, colon, rest = answer.partition(": ")
+    if not colon or len(head) > 80:
+        head, rest = answer.split(". ", 1)[0][:80], answer
+    found = _KEY_FIGURE.search(rest)
+    return head.rstrip("."), found.group(0) if found else ""
+
+
+def _short(verdict: dict) -> tuple[str, str]:
+    """(verdict in a few words, key figure): the verdict's own where it gives them, else read off its answer."""
+    head, key = verdict_short(verdict["answer"])
+    return verdict.get("short", head), verdict.get("key", key)
+
+
 def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | None = None,
                  animation: dict | None = None, extra: Sequence = ()) -> list:
     case = metrics["paper_case"]
@@ -212,6 +234,10 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                     Paragraph("The paper's analytic model of the two-module inchworm robot, reproduced and "
                               f"taken apart one idealization at a time {where} "
                               f"(simulated {metrics['settings']['t_end_s']:g} s from rest).")]
+    blocks.append(Heading("Summary"))
+    blocks.append(Table(["question", "verdict", "key figure", "where"],
+                        [[v["question"], *_short(v),
+                          Link(v["section"], v["section"]) if v.get("section") else ""] for v in metrics["verdicts"]]))
     blocks.append(Heading("Verdicts"))
     for verdict in metrics["verdicts"]:
         blocks.append(Paragraph(f"**{verdict['question']}** {verdict['answer']}"))

@@ -144,7 +144,7 @@ def _percent(x: float | None) -> str:
 def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> dict:
     question = "Does the paper's model, as implemented here, give the figures the paper reports?"
     if not case["is_paper_case"]:
-        return {"question": question, "evidence": "paper_case",
+        return {"question": question, "evidence": "paper_case", "section": "Not the paper's case",
                 "answer": "Not checked: this is not the paper's case (" + describe_differences(case["differences"])
                           + "), and the paper prints figures for its own case only. Every rung below is "
                           "compared with the paper's model at this design instead (the ladder's first rung)."}
@@ -172,7 +172,8 @@ def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> di
     held = all(i["holds"] for i in identities)
     answer += (". The paper's S_min = L - r and S_max = L + r " + ("hold" if held else "do NOT hold")
                + " by construction of the slider-crank and are not counted as reproduced figures.")
-    return {"question": question, "answer": answer, "evidence": "paper_checks, identities"}
+    return {"question": question, "answer": answer, "evidence": "paper_checks, identities",
+            "section": "The paper's figures, reproduced"}
 
 
 def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list[LadderRun], pull: dict, study: dict,
@@ -200,7 +201,7 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
                   "Against the paper's first-order equations MuJoCo differs by "
                   f"{_percent(relative_change(locks['revolutions'], paper['revolutions']))} in revolutions: the cost "
                   "of L >> r and of the rod, not of the engine.",
-        "evidence": "ladder, convergence",
+        "evidence": "ladder, convergence", "section": "The model ladder",
     }
     p = rungs[0].run.params
     ratio = (f"At the paper's L/r = {p.L / p.r:g}" if case["is_paper_case"]
@@ -227,7 +228,10 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
             f"agree with that physics to {_percent(relative_change(ratchet['revolutions'], one_way['revolutions']))} "
             "in revolutions."
         ),
-        "evidence": "ladder, clutch_pull, lr_study",
+        "evidence": "ladder, clutch_pull, lr_study", "section": "Where L >> r breaks down",
+        "short": "first-order kinematics off by > 1 % in revolutions "
+                 + describe_threshold(study["thresholds"]["revolutions"]["1%"]).split(" (")[0],
+        "key": f"{_percent(relative_change(exact['revolutions'], paper['revolutions']))} at this L/r",
     }
     numerical = max(convergence["mujoco_default_error"], convergence["equations_default_error"])
     trust = {
@@ -237,7 +241,7 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
                   f"tightening the equations' tolerance 100-fold by {100 * convergence['equations_default_error']:.1e} %; the "
                   f"smallest modelling effect in the ladder ({smallest_name}) changes them by up to "
                   f"{100 * smallest:.2f} %.",
-        "evidence": "convergence",
+        "evidence": "convergence", "section": "Numerical convergence",
     }
     return [_paper_verdict(checks, identities, case), engine, costs, trust]
 
@@ -327,7 +331,7 @@ def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Call
         result = section.compute(params, quick, lambda m, s=section: progress(f"{s.title}: {m}"))
         metrics["sections"][section.key] = result
         if section.verdict is not None and (verdict := section.verdict(result)) is not None:
-            metrics["verdicts"].append(verdict)
+            metrics["verdicts"].append({**verdict, "section": section.title})
         progress(f"{section.title}: done ({time.perf_counter() - started:.1f} s)")
 
 
