@@ -315,6 +315,6 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
     rows = incline_curve(params, inclines, engines, t_end, progress)
     return {"drive": params.drive, "torque_at_rest_n_m": restart["torque_at_rest_n_m"], "restart": restart,
             "restart_paper_model": paper, "energy_bound": bound,
-            "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "traction": traction, "rows": rows,
-            "engines": list(engines), "tolerance_deg": tolerance, "t_end_s": t_end,
+            "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "traction": traction,
+            "rows": rows, "engines": list(engines), "tolerance_deg": tolerance, "t_end_s": t_end,
             "wall_s": time.perf_counter() - started}

@@ -160,7 +160,7 @@ def measure(engine: str, params: RobotParams, t_end: float | None = None) -> dic
         return {"error": " ".join(str(exc).split())}
     out = climbing.run_metrics(run)
     out.update(steady_slip_m=steady_skid(run), peak_grip_use=run.summary.get("peak_grip_use"),
-               slip_m=[run.summary.get("slip1_m"), run.summary.get("slip2_m")])
+               slips_m=[run.summary.get("slip1_m"), run.summary.get("slip2_m")])
     return out
 
 
