@@ -151,12 +151,15 @@ def steady_skid(metrics_run) -> float | None:
 
 
 def measure(engine: str, params: RobotParams, t_end: float | None = None) -> dict:
-    """:func:`.climbing.run_metrics` of one run with "steady_slip_m" and "peak_grip_use", or {"error"}."""
+    """:func:`.climbing.run_metrics` of one run with "steady_slip_m" and "peak_grip_use", or {"error"} (with
+    "refused": True where the engine refuses the parameters, a ParameterError)."""
     from ipir_mujoco.core.errors import ParameterError, SimulationError
 
     try:
         run = climbing.run_engine(engine, params, climbing.default_t_end(params) if t_end is None else t_end)
-    except (ParameterError, SimulationError) as exc:
+    except ParameterError as exc:  # the engine refuses the design (MuJoCo without finite grip)
+        return {"error": " ".join(str(exc).split()), "refused": True}
+    except SimulationError as exc:  # a run that fails at this incline: a result, not the engine's refusal
         return {"error": " ".join(str(exc).split())}
     out = climbing.run_metrics(run)
     out.update(steady_slip_m=steady_skid(run), peak_grip_use=run.summary.get("peak_grip_use"),
@@ -180,11 +183,11 @@ def steady_limit(params: RobotParams, engine: str, high: float, tolerance: float
 
     def verdict(incline: float) -> bool:
         m = measure(engine, params.replace(incline=incline), t_end)
-        if "error" in m:
+        if m.get("refused"):
             raise _Refused(m["error"])
         ok = climbing.climbs(m, params.drive) and not skids(m)
-        runs.append({"incline_deg": incline, "holds": ok, "steady_slip_m": m["steady_slip_m"],
-                     "climbs": climbing.climbs(m, params.drive)})
+        runs.append({"incline_deg": incline, "holds": ok, "steady_slip_m": m.get("steady_slip_m"),
+                     "climbs": climbing.climbs(m, params.drive), "note": m.get("error", "")})
         progress(f"{engine} at {incline:.4g} deg: " + ("climbs, no skid" if ok else "skids or stalls"))
         return ok
 
