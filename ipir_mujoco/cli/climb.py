@@ -76,7 +76,6 @@ def parse_engines(text: str | None) -> tuple[str, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.climb_figure import write_climb_figure
     from ..studies import climbing
 
     params = model_params(args)
@@ -97,11 +96,39 @@ def run(args: argparse.Namespace) -> int:
     with staged_output(args.out) as staging:
         write_csv(staging / FILES[0], study)
         write_json(staging / FILES[1], study)
-        write_climb_figure(study, params, staging / FILES[2])
+        write_figure(study, params, staging / FILES[2])
     print(format_study(study, params))
     print(f"{len(inclines)} inclines x {len(engines)} engines in {study['wall_s']:.1f} s; results: "
           + ", ".join(str(Path(args.out) / f) for f in FILES))
     return EXIT_OK
+
+
+def write_figure(study: dict, params, path: Path) -> None:
+    """climb.png (:func:`ipir_mujoco.report.climb_figure.climb_figure`); with a finite grip also the rest
+    traction limit that binds (dash-dot, speed panel) and each module's grip G_i (dotted, force panel)."""
+    from matplotlib.lines import Line2D
+
+    from ..report.climb_figure import climb_figure
+
+    fig = climb_figure(study, params)
+    traction = study.get("traction") or {}
+    if traction.get("grip") is not None:
+        speed_ax, force_ax = fig.axes[:2]
+        rest = traction["rest"][traction["rest"]["binds"]]
+        added = {speed_ax: [], force_ax: []}
+        if rest["sin"] > -1.0:
+            speed_ax.axvline(rest["incline_deg"], color="darkred", ls="-.", lw=1.2, gid="traction-rest")
+            added[speed_ax].append(Line2D([], [], color="darkred", ls="-.", label=(
+                f"traction limit at rest ({traction['rest']['binds'].replace('_', ' ')}): "
+                f"{rest['incline_deg']:.1f} deg")))
+        for i, G in enumerate(traction["grip"]):
+            force_ax.axhline(G, color="darkred", ls=":" if i else (0, (1, 3)), lw=1.2, gid=f"grip{i + 1}")
+        added[force_ax].append(Line2D([], [], color="darkred", ls=":", label="grip G_i = mu_wall F_ni: " + " / ".join(
+            f"{G:.3g}" for G in traction["grip"]) + " N"))
+        for ax, extra in added.items():
+            legend = ax.get_legend()
+            ax.legend(handles=(list(legend.legend_handles) if legend else []) + extra, fontsize="x-small", loc="best")
+    fig.savefig(path, dpi=110)
 
 
 def write_csv(path: Path, study: dict) -> None:
