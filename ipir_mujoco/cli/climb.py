@@ -186,7 +186,9 @@ def format_study(study: dict, params) -> str:
     for engine, limit in study["steady_climb"].items():
         low, high = limit["bracket"]
         lines.append(f"  steady climb from rest at phi0, {engine}: " + (
-            "not even at the restart limit" if limit["incline_deg"] is None else
+            (f"not even at {high:.2f} deg" + (f" ({limit['runs'][0]['note']})" if limit["runs"][0]["note"] else "")
+             if study.get("traction", {}).get("grip") is not None else "not even at the restart limit")
+            if limit["incline_deg"] is None else
             f"up to {high:.2f} deg (climbs at all inclines tried)" if low == high else
             f"up to {low:.2f} deg (stalls at {high:.2f} deg)"))
     lines.extend(format_traction(study.get("traction")))
