@@ -21,6 +21,7 @@ from .common import EXIT_OK, add_model_options, model_params
 FILES = ("climb.csv", "climb.json", "climb.png")
 KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
         "mean_clutch_force_n", "efficiency", "stalled", "stall_t_s", "stall_phi_rad", "t_end_s")
+GRIP_KEYS = ("slip_m", "peak_grip_use")  # columns added with a finite grip (mu_wall)
 
 
 def add_parser(commands) -> None:
@@ -75,7 +76,6 @@ def parse_engines(text: str | None) -> tuple[str, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.climb_figure import write_climb_figure
     from ..studies import climbing
 
     params = model_params(args)
@@ -96,16 +96,45 @@ def run(args: argparse.Namespace) -> int:
     with staged_output(args.out) as staging:
         write_csv(staging / FILES[0], study)
         write_json(staging / FILES[1], study)
-        write_climb_figure(study, params, staging / FILES[2])
+        write_figure(study, params, staging / FILES[2])
     print(format_study(study, params))
     print(f"{len(inclines)} inclines x {len(engines)} engines in {study['wall_s']:.1f} s; results: "
           + ", ".join(str(Path(args.out) / f) for f in FILES))
     return EXIT_OK
 
 
+def write_figure(study: dict, params, path: Path) -> None:
+    """climb.png (:func:`ipir_mujoco.report.climb_figure.climb_figure`); with a finite grip also the rest
+    traction limit that binds (dash-dot, speed panel) and each module's grip G_i (dotted, force panel)."""
+    from matplotlib.lines import Line2D
+
+    from ..report.climb_figure import climb_figure
+
+    fig = climb_figure(study, params)
+    traction = study.get("traction") or {}
+    if traction.get("grip") is not None:
+        speed_ax, force_ax = fig.axes[:2]
+        rest = traction["rest"][traction["rest"]["binds"]]
+        added = {speed_ax: [], force_ax: []}
+        if rest["sin"] > -1.0:
+            speed_ax.axvline(rest["incline_deg"], color="darkred", ls="-.", lw=1.2, gid="traction-rest")
+            added[speed_ax].append(Line2D([], [], color="darkred", ls="-.", label=(
+                f"traction limit at rest ({traction['rest']['binds'].replace('_', ' ')}): "
+                f"{rest['incline_deg']:.1f} deg")))
+        for i, G in enumerate(traction["grip"]):
+            force_ax.axhline(G, color="darkred", ls=":" if i else (0, (1, 3)), lw=1.2, gid=f"grip{i + 1}")
+        added[force_ax].append(Line2D([], [], color="darkred", ls=":", label="grip G_i = mu_wall F_ni: " + " / ".join(
+            f"{G:.3g}" for G in traction["grip"]) + " N"))
+        for ax, extra in added.items():
+            legend = ax.get_legend()
+            ax.legend(handles=(list(legend.legend_handles) if legend else []) + extra, fontsize="x-small", loc="best")
+    fig.savefig(path, dpi=110)
+
+
 def write_csv(path: Path, study: dict) -> None:
     """One row per incline: the torque needed at rest, then ENGINE:KEY for each engine, then the errors."""
-    columns = ["incline_deg", "torque_needed_n_m"] + [f"{e}:{k}" for e in study["engines"] for k in KEYS] + ["error"]
+    keys = KEYS + (GRIP_KEYS if study.get("traction", {}).get("grip") is not None else ())
+    columns = ["incline_deg", "torque_needed_n_m"] + [f"{e}:{k}" for e in study["engines"] for k in keys] + ["error"]
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(columns)
@@ -113,7 +142,7 @@ def write_csv(path: Path, study: dict) -> None:
             cells = {"incline_deg": row["incline_deg"], "torque_needed_n_m": row["torque_needed_n_m"],
                      "error": "; ".join(f"{e}: {m['error']}" for e, m in row["engines"].items() if "error" in m)}
             for engine, metrics in row["engines"].items():
-                cells.update({f"{engine}:{k}": metrics.get(k) for k in KEYS})
+                cells.update({f"{engine}:{k}": metrics.get(k) for k in keys})
             writer.writerow(["" if cells.get(c) is None else _cell(cells[c]) for c in columns])
 
 
@@ -157,9 +186,12 @@ def format_study(study: dict, params) -> str:
     for engine, limit in study["steady_climb"].items():
         low, high = limit["bracket"]
         lines.append(f"  steady climb from rest at phi0, {engine}: " + (
-            "not even at the restart limit" if limit["incline_deg"] is None else
+            (f"not even at {high:.2f} deg" + (f" ({limit['runs'][0]['note']})" if limit["runs"][0]["note"] else "")
+             if study.get("traction", {}).get("grip") is not None else "not even at the restart limit")
+            if limit["incline_deg"] is None else
             f"up to {high:.2f} deg (climbs at all inclines tried)" if low == high else
             f"up to {low:.2f} deg (stalls at {high:.2f} deg)"))
+    lines.extend(format_traction(study.get("traction")))
     speed = "steady speed" if motor else f"mean speed over the last 3 revolutions of {study['t_end_s']:g} s"
     lines.append(f"\nincline [deg], torque needed at rest [N m]; per engine: {speed} [m/s], peak / mean clutch "
                  "reaction [N], climbing efficiency [-]")
@@ -182,3 +214,44 @@ def format_study(study: dict, params) -> str:
         lines.append(MUJOCO_NOTE)
     return "\n".join(lines)
 
+
+
+def format_traction(traction: dict | None) -> list[str]:
+    """The traction figures (:mod:`ipir_mujoco.studies.traction`) as lines; one line with unlimited grip."""
+    if traction is None:
+        return []
+    if traction["grip"] is None:
+        return [f"  traction: {traction['note']}"]
+    G1, G2 = traction["grip"]
+    rest, riser = traction["rest"], traction["riser"]
+    names = {"drive_off": "drive off", "drive_at_rest": "drive's torque at rest"}
+
+    def at_rest(key: str) -> str:
+        r = rest[key]
+        where = f"module {r['module']} skids first" + (
+            f", at crank angle {math.degrees(r['phi_rad']) % 360:.1f} deg" if key == "drive_off" else
+            " wherever the drive moves the other module (it then holds m g sin + F_r)")
+        return "any incline (90 deg)" if r["any_incline"] else (
+            f"up to {r['incline_deg']:.2f} deg ({where})" if r["sin"] > -1 else f"none ({where})")
+
+    lines = [f"  traction (mu_wall {traction['mu_wall']:g}, F_n {traction['F_n'][0]:g} / {traction['F_n'][1]:g} N: "
+             f"grip G {G1:.4g} / {G2:.4g} N)",
+             f"    standing at any crank angle, no skid, {names['drive_off']}: {at_rest('drive_off')}",
+             f"    standing at any crank angle, no skid, {names['drive_at_rest']} "
+             f"({rest['torque_at_rest_n_m']:g} N m): {at_rest('drive_at_rest')}",
+             f"    binds: {names[rest['binds']]}",
+             "    a vertical riser needs a press per module of "
+             + " / ".join(f"{f:.4g}" for f in riser["needed_n"]) + " N at this mu_wall ("
+             + "; ".join(f"{names[k]}: " + " / ".join(f"{f:.4g}" for f in riser["press_n"][k]) + " N"
+                         for k in ("drive_off", "drive_at_rest")) + f"; {names[riser['binds']]} binds)"]
+    for engine, limit in traction["steady"].items():
+        if "error" in limit:
+            text = f"refused ({limit['error']})"
+        elif limit["incline_deg"] is None:
+            text = "skids (or stalls) even on the level"
+        else:
+            low, high = limit["bracket"]
+            text = (f"up to {high:.2f} deg (no skid at the steady-climb limit)" if low == high
+                    else f"up to {low:.2f} deg (skids or stalls at {high:.2f} deg)")
+        lines.append(f"    steady climb with no skid in the steady window, {engine}: {text}")
+    return lines

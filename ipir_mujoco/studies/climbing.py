@@ -202,6 +202,9 @@ def run_metrics(run: RunResult) -> dict:
            "efficiency": summary["efficiency"],
            "pull_share": locked_pull_share(run), "stalled": run.stall is not None, "stall_reason": run.stall,
            "timestep_s": run.settings.get("timestep"), "wall_s": run.wall_time_s}
+    if run.params.grip is not None:  # finite grip: how far the modules skidded back [m], the peak share of G used
+        out.update(slip_m=float((summary.get("slip1_m") or 0.0) + (summary.get("slip2_m") or 0.0)),
+                   peak_grip_use=summary.get("peak_grip_use"))
     if run.stall is not None:  # when and where it stopped, and what the clutches hold there
         moving = np.flatnonzero((run.params.r * np.abs(s["omega"]) > REST_SPEED) | (np.abs(s["v1"]) > REST_SPEED)
                                 | (np.abs(s["v2"]) > REST_SPEED))
@@ -287,7 +290,8 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
     {"drive", "torque_at_rest_n_m", "restart": :func:`restart_limit` (exact geometry, the rod included),
     "restart_paper_model": the same for the paper's first-order, massless-rod model, "energy_bound",
     "vertical": :func:`torque_needed` at 90 deg, "steady_climb": {engine: :func:`steady_climb_limit`}
-    (motor only; empty for a constant torque), "rows": :func:`incline_curve`, "engines", "wall_s"}.
+    (motor only; empty for a constant torque), "traction": :func:`.traction.traction_study` (finite grip:
+    the wheels' limits; unlimited: a note), "rows": :func:`incline_curve`, "engines", "wall_s"}.
     """
     started = time.perf_counter()
     t_end = default_t_end(params) if t_end is None else t_end
@@ -300,12 +304,17 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
     limits = {}
     if params.drive == "motor":
         low = min(max(restart["incline_deg"] if restart["incline_deg"] is not None else -90.0, 0.0), 90.0)
+        if params.grip is not None:  # a finite grip may skid below the restart limit: search from the level
+            low = 0.0
         high = 90.0 if bound["incline_deg"] is None or bound["sin"] >= 1 else max(bound["incline_deg"], low)
         for engine in engines:
             limits[engine] = steady_climb_limit(params, engine, low, high, tolerance, t_end, progress)
+    from .traction import traction_study
+
+    traction = traction_study(params, engines, limits, tolerance, t_end, progress)
     rows = incline_curve(params, inclines, engines, t_end, progress)
     return {"drive": params.drive, "torque_at_rest_n_m": restart["torque_at_rest_n_m"], "restart": restart,
             "restart_paper_model": paper, "energy_bound": bound,
-            "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "rows": rows,
-            "engines": list(engines), "tolerance_deg": tolerance, "t_end_s": t_end,
+            "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "traction": traction,
+            "rows": rows, "engines": list(engines), "tolerance_deg": tolerance, "t_end_s": t_end,
             "wall_s": time.perf_counter() - started}

@@ -1,0 +1,164 @@
+"""The validation report's section "Finite grip": what wheels that hold by friction do to the robot.
+
+Two cases of the design: the paper's start-up (its constant torque, 1 s from rest) and the motor's
+cruise (the design's motor, run to its steady state). For each, the grip the models demand: the peak
+clutch reaction of the paper's model (``analytic-approx``) and of the one-way model
+(``analytic-unilateral``) on unlimited grip, i.e. what G = mu_wall F_n would have to be for no skid.
+Then realistic wheels, mu_wall in MU and a stated press F_n in PRESS (both modules alike), in the
+one-way model: travel, speed and how far the modules skid back, beside the unlimited-grip run; MuJoCo
+beside it where it accepts a finite grip, else its refusal (one line) is shown. Last, the press per
+module a vertical riser needs at mu_wall = RISER_MU (:func:`ipir_mujoco.studies.traction.riser_press`).
+``quick``: one mu, so a handful of runs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ipir_mujoco.core.params import RobotParams
+
+from ..studies import traction
+from .document import Heading, Image, Paragraph, Table, fmt
+
+MU = {False: (0.3, 0.5, 0.8), True: (0.5,)}  # wheel-wall friction coefficients tried, full / quick
+PRESS = (10.0, 50.0)  # N: wall press per module tried (50 N is the parameters' default)
+RISER_MU = 0.5
+ONE_WAY, PAPER, MUJOCO = "analytic-unilateral", "analytic-approx", "mujoco-ratchet"
+
+
+def _cases(params: RobotParams) -> dict:
+    base = params.replace(mu_wall=None, F_n1=50.0, F_n2=50.0, incline=0.0)
+    return {"startup": base.replace(drive="torque"), "cruise": base.replace(drive="motor")}
+
+
+def _speed(m: dict, drive: str) -> float | None:
+    """[m/s]: the steady speed (motor), the mean speed over the run (the start-up: travel over its 1 s)."""
+    if "error" in m:
+        return None
+    return m["steady_speed_m_s"] if drive == "motor" else m["travel_m"] / m["t_end_s"]
+
+
+def compute(params: RobotParams, quick: bool, progress) -> dict:
+    """The demands, the runs on finite grip and the riser press (module docstring)."""
+    out = {"quick": quick, "mu": list(MU[quick]), "press_n": list(PRESS), "cases": {}}
+    for name, case in _cases(params).items():
+        unlimited = {engine: traction.measure(engine, case) for engine in (PAPER, ONE_WAY)}
+        rows = []
+        for mu in MU[quick]:
+            for press in PRESS:
+                grip = case.replace(mu_wall=mu, F_n1=press, F_n2=press)
+                row = {"mu": mu, "press_n": press, "grip_n": mu * press, ONE_WAY: traction.measure(ONE_WAY, grip)}
+                if not quick or not rows:  # quick: MuJoCo once per case, enough to show it accepts or refuses
+                    row[MUJOCO] = traction.measure(MUJOCO, grip)
+                rows.append(row)
+                progress(f"finite grip, {name}, mu {mu:g}, F_n {press:g} N: " + (
+                    row[ONE_WAY].get("error") or f"travel {row[ONE_WAY]['travel_m']:.4g} m"))
+        out["cases"][name] = {"drive": case.drive, "unlimited": unlimited, "rows": rows}
+    riser = params.replace(mu_wall=RISER_MU, drive="motor")
+    out["riser"] = {"mu": RISER_MU, **traction.riser_press(riser)}
+    return out
+
+
+def _demand(m: dict) -> str:
+    return m["error"] if "error" in m else fmt(m["peak_clutch_force_n"])
+
+
+def _mujoco(m: dict | None, drive: str) -> str:
+    if m is None:
+        return "-"
+    if "error" in m:
+        return "refused"
+    return f"{fmt(m['travel_m'])} m, {fmt(_speed(m, drive))} m/s"
+
+
+def render(metrics: dict, figures_dir: Path) -> list:
+    """The demands and finite-grip tables, the figure (figures/finite_grip.png), the riser press and a verdict."""
+    titles = {"startup": "the paper's start-up (constant torque, 1 s from rest)",
+              "cruise": "the motor's cruise (to its steady state)"}
+    blocks: list = [Heading("Finite grip"), Paragraph(
+        "A held module's locked wheels hold by friction, at most G = mu_wall F_n on the wall; beyond that the "
+        "module skids back (docs/model.md, \"Finite grip\"). The peak clutch reaction on unlimited grip is the "
+        "grip a run needs for no skid.")]
+    blocks.append(Table(["case", "paper's model: peak reaction [N]", "one-way model: peak reaction [N]"],
+                        [[titles[k], _demand(c["unlimited"][PAPER]), _demand(c["unlimited"][ONE_WAY])]
+                         for k, c in metrics["cases"].items()]))
+    header = ["case", "mu_wall", "F_n [N]", "G [N]", "travel [m] (cruise: to its steady state)",
+              "speed [m/s] (steady, or mean over 1 s)", "skid back 1 + 2 [m]",
+              "MuJoCo (travel, speed)"]
+    rows, refusals = [], set()
+    for key, case in metrics["cases"].items():
+        base = case["unlimited"][ONE_WAY]
+        rows.append([titles[key], "unlimited", "-", "-", fmt(base.get("travel_m")),
+                     fmt(_speed(base, case["drive"])), "0", "-"])
+        for row in case["rows"]:
+            m = row[ONE_WAY]
+            mj = row.get(MUJOCO)
+            if mj is not None and "error" in mj:
+                refusals.add(mj["error"])
+            rows.append(["", fmt(row["mu"], 2), fmt(row["press_n"], 3), fmt(row["grip_n"], 3),
+                         m.get("error") or fmt(m["travel_m"]), fmt(_speed(m, case["drive"])),
+                         "n/a" if "error" in m else fmt(m["slip_m"]), _mujoco(mj, case["drive"])])
+    blocks.append(Table(header, rows))
+    write_figure(metrics, Path(figures_dir) / "finite_grip.png")
+    blocks.append(Image("figures/finite_grip.png", "Speed on finite grip over the speed on unlimited grip, against "
+                        "the grip G = mu_wall F_n (one-way model); the dashed line is the peak clutch reaction the "
+                        "run demands on unlimited grip, the grip it needs for no skid."))
+    if refusals:
+        blocks.append(Paragraph("MuJoCo (" + MUJOCO + ") refused the finite grip: " + "; ".join(sorted(refusals))))
+    riser = metrics["riser"]
+    blocks.append(Paragraph(
+        f"A vertical riser at mu_wall {riser['mu']:g} needs a press per module of "
+        + " / ".join(fmt(f) for f in riser["needed_n"]) + " N (modules 1 / 2) for a standing robot to hold at "
+        "every crank angle with the drive's torque at rest (each module then holds the whole weight and the "
+        "other's rolling resistance, m g + F_r); with the drive off, "
+        + " / ".join(fmt(f) for f in riser["press_n"]["drive_off"]) + " N (each module its own weight share)."))
+    blocks.append(Paragraph(verdict(metrics)["answer"]))
+    return blocks
+
+
+def write_figure(metrics: dict, path: Path) -> None:
+    """One panel per case: relative speed [-] against the grip G [N] (log axis), with the demanded grip."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import NullFormatter
+
+    fig = Figure(figsize=(8.0, 3.0), layout="constrained")
+    FigureCanvasAgg(fig)
+    for ax, (key, case) in zip(fig.subplots(1, len(metrics["cases"]), squeeze=False)[0], metrics["cases"].items()):
+        base = _speed(case["unlimited"][ONE_WAY], case["drive"])
+        points = sorted((r["grip_n"], _speed(r[ONE_WAY], case["drive"])) for r in case["rows"]
+                        if "error" not in r[ONE_WAY])
+        if base and points:
+            ax.plot([g for g, _v in points], [v / base for _g, v in points], "o-")
+        need = case["unlimited"][ONE_WAY].get("peak_clutch_force_n")
+        if need:
+            ax.axvline(need, linestyle="--", color="gray")
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel("grip G = mu_wall F_n [N]")
+        ax.set_ylabel("speed / unlimited-grip speed [-]")
+        ax.set_title("paper's start-up (1 s)" if key == "startup" else "motor's cruise (steady)", fontsize=9)
+    fig.savefig(path, dpi=110)
+
+
+def verdict(metrics: dict) -> dict:
+    """{question, answer, evidence}: how much grip the runs need against what realistic wheels give."""
+    parts = []
+    for key, case in metrics["cases"].items():
+        need = case["unlimited"][ONE_WAY].get("peak_clutch_force_n")
+        base = case["unlimited"][ONE_WAY]
+        weakest = min((r for r in case["rows"] if "error" not in r[ONE_WAY]), key=lambda r: r["grip_n"],
+                      default=None)
+        if need is None or weakest is None:
+            continue
+        m = weakest[ONE_WAY]
+        v0, v1 = _speed(base, case["drive"]), _speed(m, case["drive"])
+        change = "n/a" if not v0 or v1 is None else f"{100.0 * (v1 / v0 - 1.0):+.1f} %"
+        parts.append(f"{'the start-up' if key == 'startup' else 'the cruise'} needs {fmt(need, 3)} N of grip; "
+                     f"on G = {fmt(weakest['grip_n'], 3)} N (mu {weakest['mu']:g}, F_n {weakest['press_n']:g} N) "
+                     f"the modules skid back {fmt(m['slip_m'], 3)} m and the speed changes {change}")
+    answer = ("The one-way model: " + "; ".join(parts) + ".") if parts else "No finite-grip run completed."
+    return {"question": "How much wall grip does the robot need, and what does realistic grip cost?",
+            "answer": answer,
+            "evidence": f"riser press at mu {metrics['riser']['mu']:g}: "
+                        + " / ".join(fmt(f) for f in metrics["riser"]["needed_n"]) + " N per module"}
