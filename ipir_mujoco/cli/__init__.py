@@ -10,12 +10,8 @@ subcommand lives in its own module with ``add_parser(commands)`` and
 
 from __future__ import annotations
 
-import logging
 import os
 import signal
-import sys
-import threading
-from typing import Sequence
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 
@@ -27,11 +23,19 @@ def _interrupted_while_loading(signum, frame):  # pragma: no cover (timing)
     os._exit(EXIT_INTERRUPTED)
 
 
-_loading_guard = (threading.current_thread() is threading.main_thread()
-                  and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
-if _loading_guard:
-    signal.signal(signal.SIGINT, _interrupted_while_loading)
+# installed first thing, before any further import: only from the main thread (signal.signal raises elsewhere)
+# and never over a handler the caller set
 try:
+    _loading_guard = signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    if _loading_guard:
+        signal.signal(signal.SIGINT, _interrupted_while_loading)
+except ValueError:
+    _loading_guard = False
+try:
+    import logging
+    import sys
+    from typing import Sequence
+
     from ipir_mujoco.core.errors import ParameterError, SimulationError
 
     from .. import __version__
