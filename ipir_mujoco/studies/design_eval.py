@@ -27,7 +27,7 @@ from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams
 
 from .pool import kill_workers, worker_init
 from .sweep import run_design
-from .sweep_files import Progress, ResultsFile
+from .sweep_files import Progress, ResultsFile, _cell
 from .sweep_metrics import METRICS
 
 KEYS = (*METRICS, *PARAMETER_NAMES)
@@ -53,6 +53,12 @@ def key_value(key: str, row: dict, base: RobotParams):
     if key in row:
         return row[key]
     return getattr(base, key)
+
+
+def _parse(raw: dict) -> dict:
+    row = {k: _number(v) for k, v in raw.items()}
+    row["notes"], row["error"], row["eval_id"] = raw["notes"], raw["error"], int(raw["eval_id"])
+    return row
 
 
 def _number(text: str):
@@ -82,10 +88,9 @@ class Evaluator:
         self.cache: dict[tuple, dict] = {}
         with path.open(newline="", encoding="utf-8") as fh:
             for raw in csv.DictReader(fh):
-                row = {k: _number(v) for k, v in raw.items()}
-                row["notes"], row["error"] = raw["notes"], raw["error"]
-                self.cache[tuple(raw[n] for n in self.names)] = row
-        self.next_id = len(self.cache)
+                self.cache[tuple(raw[n] for n in self.names)] = _parse(raw)
+        self.asked = 0  # distinct designs asked for so far: the next one's eval_id (the same on every run)
+        self.seen: set[tuple] = set()
         self.resumed = set(self.cache)  # designs of the file resumed, not yet asked for again
         self.reused = 0  # of those, how many the study asked for (and were not re-run)
         self.workers = workers or os.cpu_count() or 1
@@ -103,8 +108,10 @@ class Evaluator:
                 kill_workers(self.pool)
             self.pool.shutdown(wait=not interrupted, cancel_futures=True)
         self.file.close()
+        if not interrupted:
+            self.file.sort()  # in eval_id order: two runs of one study give the same bytes
         if kind is KeyboardInterrupt:
-            raise StudyInterrupted(f"interrupted; the {self.next_id} evaluations so far are in "
+            raise StudyInterrupted(f"interrupted; the {len(self.cache)} evaluations so far are in "
                                    f"{self.file.path}; run again with --resume to complete it") from None
         return False
 
@@ -116,18 +123,23 @@ class Evaluator:
         evaluated (this run or the file resumed) are not run again."""
         keys = [self.key(d) for d in designs]
         todo = {}
+        ids = {}
         for k, d in zip(keys, designs):
+            if k not in self.seen:
+                self.seen.add(k)
+                ids[k] = self.asked
+                self.asked += 1
             if k in self.resumed:
                 self.resumed.discard(k)
                 self.reused += 1
             if k in self.cache:
                 continue
-            if k not in todo:
+            if k not in todo:  # ids in the order asked, not finished: a study's ids are the same every run
                 todo[k] = {n: float(v) for n, v in zip(self.names, k)}
         if todo:
             if self.workers <= 1 or len(todo) == 1:
                 for k, d in todo.items():
-                    self._record(k, d, self._task(d))
+                    self._record(k, ids[k], d, self._task(d))
             else:
                 if self.pool is None:
                     self.pool = futures.ProcessPoolExecutor(max_workers=self.workers, initializer=worker_init,
@@ -136,19 +148,20 @@ class Evaluator:
                                             self.options, True): k for k, d in todo.items()}
                 for future in futures.as_completed(pending):
                     k = pending[future]
-                    self._record(k, todo[k], future.result())
+                    self._record(k, ids[k], todo[k], future.result())
         return [self.cache[k] for k in keys]
 
     def _task(self, design: dict) -> dict:
         return run_design(design, self.base, (self.engine,), self.t_end, self.dt_out, self.options)
 
-    def _record(self, key: tuple, design: dict, results: dict) -> None:
+    def _record(self, key: tuple, eval_id: int, design: dict, results: dict) -> None:
         metrics = results[self.engine]
-        row = {"eval_id": self.next_id, **design, **{m: metrics.get(m) for m in METRICS},
+        row = {"eval_id": eval_id, **design, **{m: metrics.get(m) for m in METRICS},
                "notes": metrics.get("note", ""), "error": metrics.get("error", "")}
-        self.file.write({**row, **dict(zip(self.names, key))})
-        self.cache[key] = row
-        self.next_id += 1
+        row.update(zip(self.names, key))  # full precision: a resumed study finds its designs exactly
+        self.file.write(row)
+        # kept as the file holds it (metrics to 10 digits), so that a resumed study decides as the first run did
+        self.cache[key] = _parse({c: _cell(row.get(c)) for c in self.header})
         if self.bar is not None:
             self.bar.advance()
 

@@ -312,12 +312,11 @@ def _finite(data):
 
 
 def _summary(row: dict, problem: Problem, keys: list[str]) -> dict:
-    from .sweep_metrics import METRICS
+    """A design of the result: its parameters and metrics at the top level, its verification beside."""
+    from .sweep_metrics import DESCRIBED
 
     item = {n: row[n] for n in problem.names}
-    item.update({m: row.get(m) for m in METRICS if m in keys or m in ("steady_speed_m_s", "mean_speed_m_s",
-                                                                         "energy_per_metre_j_m",
-                                                                         "peak_clutch_force_n", "efficiency")})
+    item.update({m: row.get(m) for m in DESCRIBED})
     item["eval_id"] = row["eval_id"]
     if problem.verify:
         item["verify"] = {k: row.get(k) for k in row if k.startswith(f"{problem.verify}:")
