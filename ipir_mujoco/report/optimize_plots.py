@@ -43,7 +43,12 @@ def plot_pareto(out: str | Path, problem) -> Path:
     out = Path(out)
     evaluations, front = _rows(out / "evaluations.csv"), _rows(out / "pareto.csv")
     keys = [o.key for o in problem.objectives]
-    pairs = [(problem.names[0], keys[0])] if len(keys) == 1 else list(itertools.combinations(keys, 2))
+    if len(keys) == 1:  # the objective against the first varied parameter, or the first constraint where they agree
+        y = keys[0] if keys[0] != problem.names[0] else (problem.constraints[0].key if problem.constraints
+                                                          else "steady_speed_m_s")
+        pairs = [(problem.names[0], y)]
+    else:
+        pairs = list(itertools.combinations(keys, 2))
     cols = min(3, len(pairs))
     rows_n = (len(pairs) + cols - 1) // cols
     fig = Figure(figsize=(4.6 * cols, 0.8 + 3.8 * rows_n), layout="constrained")
@@ -62,11 +67,16 @@ def plot_pareto(out: str | Path, problem) -> Path:
         if verified:
             vx, vy = _values(verified, kx, problem), _values(verified, ky, problem)
             ax.scatter(vx, vy, s=80, facecolors="none", edgecolors="C0", label=f"verified ({problem.verify})")
+        for c in problem.constraints:  # a constraint on a plotted key: its bound
+            if c.key == ky:
+                ax.axhline(c.value, color="C2", lw=0.8, ls="--", label=f"{c.key} {c.op} {c.value:g}")
+            elif c.key == kx:
+                ax.axvline(c.value, color="C2", lw=0.8, ls="--", label=f"{c.key} {c.op} {c.value:g}")
         ax.set_xlabel(kx)
         ax.set_ylabel(ky)
         ax.legend(fontsize="small")
     senses = ", ".join(f"{o.sense} {o.key}" for o in problem.objectives)
-    fig.suptitle(f"{problem.engine}: {senses}; {len(evaluations)} evaluations", fontsize="medium")
+    fig.suptitle(f"{problem.engine}: {senses}\n{len(evaluations)} evaluations", fontsize="small")
     path = out / "pareto.png"
     fig.savefig(path, dpi=110)
     return path
