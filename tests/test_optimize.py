@@ -6,14 +6,18 @@ import csv
 import json
 
 import pytest
+from cli_run import run_cli
 
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.studies import design_eval
 from ipir_mujoco.studies.design_eval import StudyInterrupted
-from ipir_mujoco.studies.optimize import Problem, parse_constraint, parse_objective, run_optimize
+from ipir_mujoco.studies.optimize import (
+    Problem,
+    parse_constraint,
+    parse_objective,
+    run_optimize,
+)
 from ipir_mujoco.studies.sweep_space import parse_vary
-
-from cli_run import run_cli
 
 MOTOR = RobotParams().replace(drive="motor")
 
@@ -28,7 +32,7 @@ def test_smallest_stall_torque_for_half_a_metre_per_second(tmp_path, capsys):
     """(a) The default motor line cruises at 0.5 m/s from M_stall ~ 0.3162 N m (the steady speed rises
     ~0.28 m/s per N m there, so the 0.316..0.321 window is 1.4 mm/s of speed wide): found in <= 60 runs,
     and MuJoCo agrees on the optimum's steady speed within 0.1 %."""
-    code, out, err = run_cli(capsys, "optimize", "--drive", "motor", "--until-steady", "--objective", "min:M_stall",
+    code, _, err = run_cli(capsys, "optimize", "--drive", "motor", "--until-steady", "--objective", "min:M_stall",
                              "--constraint", "steady_speed_m_s>=0.5", "--vary", "M_stall=0.1:1", "--budget", "60",
                              "--workers", "1", "--out", tmp_path / "o")
     assert code == 0, err
@@ -48,7 +52,7 @@ def test_energy_per_metre_depends_on_the_resistances_only(tmp_path, capsys):
     resistance has half the variance (ST = S1 = 0.5; tolerance: twice SALib's 95 % half-width, about four
     standard errors of the bootstrap), L none (its share is below (5e-4 J/m)^2 / var(F_r1 + F_r2) ~ 1e-6:
     the engine's residual from the exact sum)."""
-    code, out, err = run_cli(capsys, "sensitivity", "--drive", "motor", "--until-steady", "--vary", "F_r1=0.5:2",
+    code, _, err = run_cli(capsys, "sensitivity", "--drive", "motor", "--until-steady", "--vary", "F_r1=0.5:2",
                              "--vary", "F_r2=0.5:2", "--vary", "L=0.1:0.4", "--metric", "energy_per_metre_j_m",
                              "--samples", "32", "--workers", "1", "--out", tmp_path / "s")
     assert code == 0, err
@@ -107,7 +111,7 @@ BAD = [
 @pytest.mark.parametrize("extra, words", BAD)
 def test_bad_optimize_input_is_one_line_and_writes_nothing(tmp_path, capsys, extra, words):
     """(e) Bad input: exit 2, one line naming it, no folder created."""
-    code, out, err = run_cli(capsys, "optimize", "--vary", "M_stall=0.1:1", *extra, "--out", tmp_path / "o")
+    code, _, err = run_cli(capsys, "optimize", "--vary", "M_stall=0.1:1", *extra, "--out", tmp_path / "o")
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and words in err
     assert not (tmp_path / "o").exists()
@@ -117,7 +121,7 @@ def test_bad_optimize_input_is_one_line_and_writes_nothing(tmp_path, capsys, ext
                                           (["--metric", "steady_speed_m_s", "--vary", "L=0.4:0.1"], "LO < HI"),
                                           (["--metric", "steady_speed_m_s", "--samples", "1"], "samples")])
 def test_bad_sensitivity_input_is_one_line_and_writes_nothing(tmp_path, capsys, extra, words):
-    code, out, err = run_cli(capsys, "sensitivity", "--vary", "M_stall=0.1:1", *extra, "--out", tmp_path / "s")
+    code, _, err = run_cli(capsys, "sensitivity", "--vary", "M_stall=0.1:1", *extra, "--out", tmp_path / "s")
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and words in err
     assert not (tmp_path / "s").exists()
@@ -150,7 +154,7 @@ def test_missing_extra_is_a_one_line_refusal(tmp_path, capsys, monkeypatch, modu
     for name in [m for m in sys.modules if m == module or m.startswith(module + ".")]:
         monkeypatch.delitem(sys.modules, name)
     monkeypatch.setitem(sys.modules, module, None)  # import fails as if not installed
-    code, out, err = run_cli(capsys, *argv, "--out", tmp_path / "o")
+    code, _, err = run_cli(capsys, *argv, "--out", tmp_path / "o")
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and "ipir-mujoco[optimize]" in err
     assert not (tmp_path / "o").exists()

@@ -40,8 +40,14 @@ def add_parser(commands) -> None:
 
 
 def problem_from_args(args: argparse.Namespace):
-    from ..studies.optimize import DEFAULT_BUDGET, DEFAULT_ENGINE, DEFAULT_VERIFY, Problem, parse_constraint, \
-        parse_objective
+    from ..studies.optimize import (
+        DEFAULT_BUDGET,
+        DEFAULT_ENGINE,
+        DEFAULT_VERIFY,
+        Problem,
+        parse_constraint,
+        parse_objective,
+    )
     from ..studies.sweep_space import parse_vary
 
     if not args.vary:

@@ -16,10 +16,10 @@ design's: varied, or the base's).
 
 from __future__ import annotations
 
-import concurrent.futures as futures
 import csv
 import math
 import os
+from concurrent import futures
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError

@@ -319,8 +319,8 @@ def _summary(row: dict, problem: Problem, keys: list[str]) -> dict:
     item.update({m: row.get(m) for m in DESCRIBED})
     item["eval_id"] = row["eval_id"]
     if problem.verify:
-        item["verify"] = {k: row.get(k) for k in row if k.startswith(f"{problem.verify}:")
-                          or k.startswith("divergence:") or k == "verify_error"}
+        item["verify"] = {k: row.get(k) for k in row if k.startswith((f"{problem.verify}:", "divergence:"))
+                          or k == "verify_error"}
     return item
 
 

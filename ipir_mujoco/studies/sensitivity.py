@@ -44,11 +44,12 @@ def _salib():
 
 
 def run_sensitivity(axes: tuple[Axis, ...], metrics: tuple[str, ...], out: str | Path, *,
-                    base: RobotParams = RobotParams(), engine: str = "analytic-unilateral", t_end: float = 1.0,
+                    base: RobotParams | None = None, engine: str = "analytic-unilateral", t_end: float = 1.0,
                     until_steady: bool = False, samples: int = 64, seed: int = 0, resume: bool = False,
                     workers: int | None = None, progress: bool = True) -> list[dict]:
     """Sobol indices of ``metrics`` over the ranges ``axes``; writes OUT/indices.csv, sensitivity.json,
     evaluations.csv; returns the rows of indices.csv."""
+    base = RobotParams() if base is None else base
     if not metrics:
         raise ParameterError("sensitivity needs at least one --metric KEY")
     if any(not a.is_range for a in axes):
