@@ -158,3 +158,18 @@ def test_missing_extra_is_a_one_line_refusal(tmp_path, capsys, monkeypatch, modu
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and "ipir-mujoco[optimize]" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_scheduler_gives_the_local_pool_s_files(tmp_path, capsys):
+    """--scheduler: the same evaluations and front on a Dask cluster as on the local pool."""
+    distributed = pytest.importorskip("distributed", reason="Dask is the optional 'dask' extra")
+    argv = ["optimize", "--drive", "motor", "--until-steady", "--vary", "L=0.06:0.5", "--vary", "m2=0.2:3",
+            "--objective", "max:steady_speed_m_s", "--objective", "min:peak_clutch_force_n", "--budget", "20",
+            "--verify", "none"]
+    code, _, err = run_cli(capsys, *argv, "--workers", "2", "--out", tmp_path / "local")
+    assert code == 0, err
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
+        code, _, err = run_cli(capsys, *argv, "--scheduler", cluster.scheduler_address, "--out", tmp_path / "dask")
+    assert code == 0, err
+    for name in ("evaluations.csv", "pareto.csv"):
+        assert (tmp_path / "dask" / name).read_bytes() == (tmp_path / "local" / name).read_bytes()

@@ -36,7 +36,27 @@ def add_parser(commands) -> None:
     opt.add_argument("--out", metavar="DIR", default="optimize", help="results folder (default ./optimize)")
     opt.add_argument("--resume", action="store_true", help="complete an interrupted optimization in DIR")
     opt.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    add_scheduler_option(opt)
     opt.set_defaults(handler=run)
+
+
+def add_scheduler_option(parser) -> None:
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on a Dask distributed scheduler (needs the 'dask' extra), e.g. tcp://host:8786")
+
+
+def connect(address: str | None):
+    """A Dask client of ``--scheduler`` (the caller closes it), or None; a one-line ParameterError otherwise."""
+    if not address:
+        return None
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
+    try:
+        return Client(address, timeout="20s")
+    except (OSError, TimeoutError) as exc:
+        raise ParameterError(f"--scheduler {address!r} cannot be reached: {exc}") from None
 
 
 def problem_from_args(args: argparse.Namespace):
@@ -69,11 +89,16 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    client = connect(args.scheduler)
     try:
-        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers)
+        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers,
+                              executor=client.get_executor() if client else None)
     except StudyInterrupted as exc:
         print(f"ipir-mujoco optimize: {exc}", file=sys.stderr)
         return 130
+    finally:
+        if client is not None:
+            client.close()
     from ..report.optimize_plots import plot_pareto
 
     figure = plot_pareto(args.out, problem)

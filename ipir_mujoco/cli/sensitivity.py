@@ -9,6 +9,7 @@ from ipir_mujoco.core.errors import ParameterError
 
 from ..studies.sweep_space import T_END_STEADY
 from .common import EXIT_OK, add_model_options, model_params
+from .optimize import add_scheduler_option, connect
 
 
 def add_parser(commands) -> None:
@@ -29,6 +30,7 @@ def add_parser(commands) -> None:
     sen.add_argument("--out", metavar="DIR", default="sensitivity", help="results folder (default ./sensitivity)")
     sen.add_argument("--resume", action="store_true", help="complete an interrupted study in DIR")
     sen.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    add_scheduler_option(sen)
     sen.set_defaults(handler=run)
 
 
@@ -43,15 +45,21 @@ def run(args: argparse.Namespace) -> int:
     axes = tuple(parse_vary(v) for v in args.vary)
     metrics = tuple(check_key(m, f"--metric {m!r}") for m in args.metric)
     t_end = args.t_end if args.t_end is not None else (T_END_STEADY if args.until_steady else 1.0)
+    client = None
     try:
+        client = connect(args.scheduler)
         indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
                                   engine=args.engine or "analytic-unilateral", t_end=t_end,
                                   until_steady=bool(args.until_steady), samples=64 if args.samples is None
                                   else args.samples, seed=0 if args.seed is None else args.seed,
-                                  resume=args.resume, workers=args.workers)
+                                  resume=args.resume, workers=args.workers,
+                                  executor=client.get_executor() if client else None)
     except StudyInterrupted as exc:
         print(f"ipir-mujoco sensitivity: {exc}", file=sys.stderr)
         return 130
+    finally:
+        if client is not None:
+            client.close()
     figure = plot_indices(args.out, indices, list(metrics))
     for i in indices:
         print(f"  {i['metric']:22s} {i['parameter']:12s} S1 {i['S1']:+.3f} +- {i['S1_conf']:.3f}   "

@@ -80,7 +80,7 @@ class Evaluator:
 
     def __init__(self, path: Path, names: list[str], base: RobotParams, engine: str, t_end: float,
                  dt_out: float, options: dict, resume: bool, workers: int | None, progress: bool = True,
-                 label: str = "evaluations", total: int = 0):
+                 label: str = "evaluations", total: int = 0, executor: futures.Executor | None = None):
         self.names, self.base, self.engine = list(names), base, engine
         self.t_end, self.dt_out, self.options = t_end, dt_out, options
         self.header = ["eval_id", *self.names, *METRICS, "notes", "error"]
@@ -94,7 +94,8 @@ class Evaluator:
         self.resumed = set(self.cache)  # designs of the file resumed, not yet asked for again
         self.reused = 0  # of those, how many the study asked for (and were not re-run)
         self.workers = workers or os.cpu_count() or 1
-        self.pool = None
+        self.pool = executor  # a Dask client's executor (--scheduler), else our own pool when first needed
+        self.own_pool = executor is None
         self.bar = Progress(total, 0, progress) if total else None
         self.label = label
 
@@ -103,7 +104,7 @@ class Evaluator:
 
     def __exit__(self, kind, exc, tb):
         interrupted = kind is not None
-        if self.pool is not None:
+        if self.pool is not None and self.own_pool:  # a caller's executor is the caller's to end
             if interrupted:
                 kill_workers(self.pool)
             self.pool.shutdown(wait=not interrupted, cancel_futures=True)
@@ -137,7 +138,7 @@ class Evaluator:
             if k not in todo:  # ids in the order asked, not finished: a study's ids are the same every run
                 todo[k] = {n: float(v) for n, v in zip(self.names, k)}
         if todo:
-            if self.workers <= 1 or len(todo) == 1:
+            if self.own_pool and (self.workers <= 1 or len(todo) == 1):
                 for k, d in todo.items():
                     self._record(k, ids[k], d, self._task(d))
             else:
@@ -171,7 +172,8 @@ def usable(value) -> bool:
 
 
 def verify_rows(rows: list[dict], names: list[str], base: RobotParams, reference: str, engine: str,
-                keys: list[str], t_end: float, dt_out: float, options: dict, workers: int | None) -> list[dict]:
+                keys: list[str], t_end: float, dt_out: float, options: dict, workers: int | None,
+                executor: futures.Executor | None = None) -> list[dict]:
     """Each row re-run in ``engine``: columns ``ENGINE:KEY`` and ``divergence:KEY``, (engine - reference) /
     |reference|, for every metric of ``keys``; ``verify_error`` why a run gave nothing. Runs on the pool."""
     from .pool import map_unordered
@@ -179,8 +181,12 @@ def verify_rows(rows: list[dict], names: list[str], base: RobotParams, reference
     results: dict[int, dict] = {}
     designs = [{n: row[n] for n in names} for row in rows]
     task = _VerifyTask(base, engine, t_end, dt_out, options)
-    map_unordered(task, list(enumerate(designs)), min(workers or os.cpu_count() or 1, max(1, len(designs))),
-                  lambda item, r: results.__setitem__(item[0], r))
+    if executor is not None:
+        for k, r in enumerate(executor.map(task, list(enumerate(designs)))):
+            results[k] = r
+    else:
+        map_unordered(task, list(enumerate(designs)), min(workers or os.cpu_count() or 1, max(1, len(designs))),
+                      lambda item, r: results.__setitem__(item[0], r))
     out = []
     for k, row in enumerate(rows):
         metrics = results[k].get(engine, {})

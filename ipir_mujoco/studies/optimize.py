@@ -252,9 +252,10 @@ def _multi(problem: Problem, ev: Evaluator) -> None:
 
 
 def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, workers: int | None = None,
-                 progress: bool = True) -> dict:
+                 progress: bool = True, executor=None) -> dict:
     """Run ``problem``; write OUT/evaluations.csv, pareto.csv, optimize.json; return optimize.json's record.
 
+    ``executor``: any ``concurrent.futures.Executor`` (a Dask client's, ``--scheduler``) instead of the pool.
     Ctrl-C raises :class:`~ipir_mujoco.studies.design_eval.StudyInterrupted` with every evaluation kept.
     """
     if workers is not None:
@@ -271,7 +272,8 @@ def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, wor
     write_json(out / "optimize.json", {"fingerprint": problem.fingerprint(), "settings": settings, "status": "running"})
     options = {"until_steady": problem.until_steady}
     with Evaluator(out / "evaluations.csv", problem.names, problem.base, problem.engine, problem.t_end,
-                   problem.study.dt_out, options, resume, workers, progress, total=problem.budget) as ev:
+                   problem.study.dt_out, options, resume, workers, progress, total=problem.budget,
+                   executor=executor) as ev:
         (_single if len(problem.objectives) == 1 else _multi)(problem, ev)
         rows = list(ev.cache.values())
         reused = ev.reused
@@ -289,7 +291,7 @@ def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, wor
                               + ["steady_speed_m_s" if problem.until_steady else "mean_speed_m_s"]))
     if problem.verify and front:
         front = verify_rows(front, problem.names, problem.base, problem.engine, problem.verify, keys,
-                            problem.t_end, problem.study.dt_out, options, workers)
+                            problem.t_end, problem.study.dt_out, options, workers, executor)
     _write_front(out / "pareto.csv", front, problem, keys)
     record = {"fingerprint": problem.fingerprint(), "settings": settings, "status": "done",
               "evaluations": len(rows), "feasible": len(feasible), "reused_on_resume": reused}

@@ -46,7 +46,7 @@ def _salib():
 def run_sensitivity(axes: tuple[Axis, ...], metrics: tuple[str, ...], out: str | Path, *,
                     base: RobotParams | None = None, engine: str = "analytic-unilateral", t_end: float = 1.0,
                     until_steady: bool = False, samples: int = 64, seed: int = 0, resume: bool = False,
-                    workers: int | None = None, progress: bool = True) -> list[dict]:
+                    workers: int | None = None, progress: bool = True, executor=None) -> list[dict]:
     """Sobol indices of ``metrics`` over the ranges ``axes``; writes OUT/indices.csv, sensitivity.json,
     evaluations.csv; returns the rows of indices.csv."""
     base = RobotParams() if base is None else base
@@ -84,7 +84,8 @@ def run_sensitivity(axes: tuple[Axis, ...], metrics: tuple[str, ...], out: str |
     write_json(meta, {"fingerprint": fingerprint, "settings": settings, "status": "running"})
     names = problem["names"]
     with Evaluator(out / "evaluations.csv", names, study.base, engine, study.t_end, study.dt_out,
-                   {"until_steady": until_steady}, resume, workers, progress, total=len(points)) as ev:
+                   {"until_steady": until_steady}, resume, workers, progress, total=len(points),
+                   executor=executor) as ev:
         rows = ev.evaluate([dict(zip(names, map(float, p))) for p in points])
     indices = []
     for metric in metrics:
