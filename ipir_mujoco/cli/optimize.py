@@ -110,13 +110,14 @@ def run(args: argparse.Namespace) -> int:
         if item is None:
             continue
         where = ", ".join(f"{n}={item[n]:.6g}" for n in problem.names)
-        objs = ", ".join(f"{o.key}={_fmt(item.get(o.key, getattr(problem.base, o.key, None)))}"
-                         for o in problem.objectives)
+        shown = dict.fromkeys([o.key for o in problem.objectives] + [c.key for c in problem.constraints])
+        objs = ", ".join(f"{k}={_fmt(item.get(k, getattr(problem.base, k, None)))}" for k in shown
+                         if k not in problem.names)
         div = ""
         if problem.verify:
             divs = {k[len("divergence:"):]: v for k, v in item["verify"].items() if k.startswith("divergence:")}
             div = "; divergence " + ", ".join(f"{k} {_fmt(v)}" for k, v in divs.items())
-        print(f"  {'best' if 'best' in record else 'front'}: {where}: {objs}{div}")
+        print(f"  {'best' if 'best' in record else 'front'}: {where}{': ' + objs if objs else ''}{div}")
     print(f"  files: {args.out}/evaluations.csv, pareto.csv, optimize.json, {figure}")
     return EXIT_OK
 

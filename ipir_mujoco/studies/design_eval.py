@@ -74,13 +74,14 @@ class Evaluator:
     """One engine on designs, cached by their exact values, rows streamed to ``path``.
 
     ``names``: the varied parameters (columns after ``eval_id``); ``options``: the sweep's engine options
-    (until_steady). ``workers``: processes (1: here, one by one). Use as a context manager: the pool is
+    (until_steady). ``label``: the study's name on the progress lines (stderr), ``total``: the designs it may ask
+    for (0: no progress lines). ``workers``: processes (1: here, one by one). Use as a context manager: the pool is
     ended on leaving, at once if interrupted.
     """
 
     def __init__(self, path: Path, names: list[str], base: RobotParams, engine: str, t_end: float,
                  dt_out: float, options: dict, resume: bool, workers: int | None, progress: bool = True,
-                 label: str = "evaluations", total: int = 0, executor: futures.Executor | None = None):
+                 label: str = "optimize", total: int = 0, executor: futures.Executor | None = None):
         self.names, self.base, self.engine = list(names), base, engine
         self.t_end, self.dt_out, self.options = t_end, dt_out, options
         self.header = ["eval_id", *self.names, *METRICS, "notes", "error"]
@@ -96,8 +97,7 @@ class Evaluator:
         self.workers = workers or os.cpu_count() or 1
         self.pool = executor  # a Dask client's executor (--scheduler), else our own pool when first needed
         self.own_pool = executor is None
-        self.bar = Progress(total, 0, progress) if total else None
-        self.label = label
+        self.bar = Progress(total, 0, progress, what=label) if total else None
 
     def __enter__(self):
         return self

@@ -271,6 +271,7 @@ def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, wor
     settings = problem.to_json()
     write_json(out / "optimize.json", {"fingerprint": problem.fingerprint(), "settings": settings, "status": "running"})
     options = {"until_steady": problem.until_steady}
+    # progress against the budget: the most the search may ask for (COBYQA may converge before it)
     with Evaluator(out / "evaluations.csv", problem.names, problem.base, problem.engine, problem.t_end,
                    problem.study.dt_out, options, resume, workers, progress, total=problem.budget,
                    executor=executor) as ev:

@@ -84,7 +84,7 @@ def run_sensitivity(axes: tuple[Axis, ...], metrics: tuple[str, ...], out: str |
     write_json(meta, {"fingerprint": fingerprint, "settings": settings, "status": "running"})
     names = problem["names"]
     with Evaluator(out / "evaluations.csv", names, study.base, engine, study.t_end, study.dt_out,
-                   {"until_steady": until_steady}, resume, workers, progress, total=len(points),
+                   {"until_steady": until_steady}, resume, workers, progress, label="sensitivity", total=len(points),
                    executor=executor) as ev:
         rows = ev.evaluate([dict(zip(names, map(float, p))) for p in points])
     indices = []
