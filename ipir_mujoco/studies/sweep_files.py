@@ -112,8 +112,9 @@ class ResultsFile:
 class Progress:
     """Designs done, rate and time left, on stderr (a line per tenth when not a terminal)."""
 
-    def __init__(self, total: int, already: int, enabled: bool = True):
+    def __init__(self, total: int, already: int, enabled: bool = True, what: str = "sweep"):
         self.total, self.done, self.start, self.enabled = total, already, time.perf_counter(), enabled
+        self.what = what  # the study's name, heading each line
         self.first = already
         self.tty = sys.stderr.isatty()
         self.next_line = already + max(1, total // 10)
@@ -125,7 +126,7 @@ class Progress:
         elapsed = time.perf_counter() - self.start
         rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
         left = (self.total - self.done) / rate if rate > 0 else float("inf")
-        text = f"sweep {self.done}/{self.total} designs, {rate:.2f} designs/s, {left:.0f} s left"
+        text = f"{self.what} {self.done}/{self.total} designs, {rate:.2f} designs/s, {left:.0f} s left"
         if self.tty:
             print("\r" + text, end="\n" if self.done >= self.total else "", file=sys.stderr, flush=True)
         elif self.done >= self.next_line or self.done >= self.total:

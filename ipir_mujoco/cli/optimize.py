@@ -1,0 +1,126 @@
+"""``ipir-mujoco optimize``: the best design, or the Pareto front, within bounds and constraints."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ipir_mujoco.core.errors import ParameterError
+
+from ..studies.sweep_space import T_END_STEADY
+from .common import EXIT_OK, add_model_options, model_params
+
+
+def add_parser(commands) -> None:
+    opt = commands.add_parser("optimize", help="optimize designs: one objective or a Pareto front",
+                              description="Search the box of --vary ranges for the design that minimises or "
+                                          "maximises one objective (Sobol start + COBYQA), or for the Pareto front "
+                                          "of several (NSGA-II, pymoo), under constraints, in the fast engine; "
+                                          "verify the optimum or front in MuJoCo. Ctrl-C keeps what is done; "
+                                          "--resume completes it without re-running any design.")
+    opt.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI[:log]", help="a bounded parameter")
+    opt.add_argument("--objective", action="append", default=[], metavar="min:KEY|max:KEY",
+                     help="KEY: a sweep metric (e.g. steady_speed_m_s) or a parameter name; give several for a "
+                          "Pareto front")
+    opt.add_argument("--constraint", action="append", default=[], metavar="KEY<=V|KEY>=V",
+                     help="a constraint on a metric or parameter; a stalled or failed design is infeasible")
+    opt.add_argument("--budget", type=int, default=None, help="designs to evaluate, >= 1 (default 100)")
+    opt.add_argument("--engine", default=None, help="engine of the search (default analytic-unilateral)")
+    opt.add_argument("--verify", default=None, metavar="ENGINE|none",
+                     help="engine re-running the optimum / front (default mujoco-ratchet; none: skip)")
+    opt.add_argument("--seed", type=int, default=None, help="seed, >= 0 (default 0)")
+    opt.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+                     help="simulated time per design (default 1 s; with --until-steady the cap, default 10 s)")
+    opt.add_argument("--until-steady", action="store_true", help="run every design to its periodic steady state")
+    add_model_options(opt)
+    opt.add_argument("--out", metavar="DIR", default="optimize", help="results folder (default ./optimize)")
+    opt.add_argument("--resume", action="store_true", help="complete an interrupted optimization in DIR")
+    opt.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    add_scheduler_option(opt)
+    opt.set_defaults(handler=run)
+
+
+def add_scheduler_option(parser) -> None:
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on a Dask distributed scheduler (needs the 'dask' extra), e.g. tcp://host:8786")
+
+
+def connect(address: str | None):
+    """A Dask client of ``--scheduler`` (the caller closes it), or None; a one-line ParameterError otherwise."""
+    if not address:
+        return None
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
+    try:
+        return Client(address, timeout="20s")
+    except (OSError, TimeoutError) as exc:
+        raise ParameterError(f"--scheduler {address!r} cannot be reached: {exc}") from None
+
+
+def problem_from_args(args: argparse.Namespace):
+    from ..studies.optimize import (
+        DEFAULT_BUDGET,
+        DEFAULT_ENGINE,
+        DEFAULT_VERIFY,
+        Problem,
+        parse_constraint,
+        parse_objective,
+    )
+    from ..studies.sweep_space import parse_vary
+
+    if not args.vary:
+        raise ParameterError("optimize needs at least one --vary NAME=LO:HI")
+    axes = tuple(parse_vary(v) for v in args.vary)
+    objectives = tuple(parse_objective(o) for o in args.objective)
+    constraints = tuple(parse_constraint(c) for c in args.constraint)
+    verify = DEFAULT_VERIFY if args.verify is None else (None if args.verify.strip() == "none" else args.verify)
+    t_end = args.t_end if args.t_end is not None else (T_END_STEADY if args.until_steady else 1.0)
+    return Problem(axes, objectives, constraints, model_params(args), args.engine or DEFAULT_ENGINE, verify, t_end,
+                   bool(args.until_steady), DEFAULT_BUDGET if args.budget is None else args.budget,
+                   0 if args.seed is None else args.seed)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..studies.design_eval import StudyInterrupted
+    from ..studies.optimize import run_optimize
+
+    problem = problem_from_args(args)
+    if args.workers is not None and args.workers < 1:
+        raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    client = connect(args.scheduler)
+    try:
+        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers,
+                              executor=client.get_executor() if client else None)
+    except StudyInterrupted as exc:
+        print(f"ipir-mujoco optimize: {exc}", file=sys.stderr)
+        return 130
+    finally:
+        if client is not None:
+            client.close()
+    from ..report.optimize_plots import plot_pareto
+
+    figure = plot_pareto(args.out, problem)
+    print(f"{record['evaluations']} evaluations ({record['reused_on_resume']} re-used), {record['feasible']} feasible")
+    items = [record["best"]] if "best" in record else record["front"]
+    if "best" in record and record["best"] is None:
+        print("  no feasible design found")
+    for item in items:
+        if item is None:
+            continue
+        where = ", ".join(f"{n}={item[n]:.6g}" for n in problem.names)
+        shown = dict.fromkeys([o.key for o in problem.objectives] + [c.key for c in problem.constraints])
+        objs = ", ".join(f"{k}={_fmt(item.get(k, getattr(problem.base, k, None)))}" for k in shown
+                         if k not in problem.names)
+        div = ""
+        if problem.verify:
+            divs = {k[len("divergence:"):]: v for k, v in item["verify"].items() if k.startswith("divergence:")}
+            div = "; divergence " + ", ".join(f"{k} {_fmt(v)}" for k, v in divs.items())
+        print(f"  {'best' if 'best' in record else 'front'}: {where}{': ' + objs if objs else ''}{div}")
+    print(f"  files: {args.out}/evaluations.csv, pareto.csv, optimize.json, {figure}")
+    return EXIT_OK
+
+
+def _fmt(v) -> str:
+    return "-" if v is None else f"{v:.6g}"

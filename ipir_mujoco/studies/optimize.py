@@ -1,0 +1,346 @@
+"""Design optimization: the best design, or the Pareto front, of bounded parameters under constraints.
+
+Designs are evaluated in the fast engine (default ``analytic-unilateral``) by
+:class:`~ipir_mujoco.studies.design_eval.Evaluator` (the sweep's per-design task and pool, streamed to
+``OUT/evaluations.csv``); the optimum or every point of the front is then re-run in the verifying engine
+(default ``mujoco-ratchet``), its divergence (verify - engine) / |engine| beside it in ``OUT/pareto.csv``.
+A design that stalls or fails is infeasible.
+
+One objective: a scrambled Sobol warm start (``n0`` points of the budget, run at once on the pool),
+then COBYQA (scipy.optimize.minimize: derivative-free trust-region, bounds and nonlinear constraints,
+a hard cap on function evaluations) from the best start, on the unit box (log axes in log space). The
+metrics are smooth in the parameters but carry a steady-state detection's small noise, which rules
+out finite-difference gradients; a few parameters and a budget of tens of evaluations suit a model-based
+local method better than a population method such as differential evolution, whose populations alone
+would spend the budget. The reported optimum is the best feasible design ever evaluated.
+
+Several objectives: NSGA-II (pymoo 0.6), one population evaluated at once on the pool per generation.
+
+Both are seeded, so a resumed study proposes the same designs again, finds them in evaluations.csv and
+runs only the rest.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import re
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams, check_whole
+from ipir_mujoco.core.results import write_json
+
+from ..output import check_output_dir
+from .design_eval import Evaluator, check_key, key_value, usable, verify_rows
+from .sweep_space import Axis, Study
+
+DEFAULT_ENGINE = "analytic-unilateral"
+DEFAULT_VERIFY = "mujoco-ratchet"
+DEFAULT_BUDGET = 100
+POPULATION = 20  # NSGA-II designs per generation (fewer if the budget is small)
+
+
+@dataclass(frozen=True)
+class Objective:
+    sense: str  # "min" or "max"
+    key: str
+
+
+@dataclass(frozen=True)
+class Constraint:
+    key: str
+    op: str  # "<=" or ">="
+    value: float
+
+    def slack(self, value) -> float:
+        """>= 0 where satisfied; -inf where the value is missing (a stalled or failed design)."""
+        if not usable(value):
+            return -math.inf
+        return self.value - value if self.op == "<=" else value - self.value
+
+
+def parse_objective(text: str) -> Objective:
+    sense, sep, key = text.partition(":")
+    if not sep or sense.strip() not in ("min", "max"):
+        raise ParameterError(f"--objective {text!r} is malformed; expected min:KEY or max:KEY")
+    return Objective(sense.strip(), check_key(key, f"--objective {text!r}"))
+
+
+def parse_constraint(text: str) -> Constraint:
+    match = re.fullmatch(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=)\s*(\S+)\s*", text)
+    try:
+        value = float(match.group(3)) if match else math.nan
+    except ValueError:
+        value = math.nan
+    if not match or not math.isfinite(value):
+        raise ParameterError(f"--constraint {text!r} does not parse; expected 'KEY<=VALUE' or 'KEY>=VALUE' with a "
+                             "finite number")
+    return Constraint(check_key(match.group(1), f"--constraint {text!r}"), match.group(2), value)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What to optimize: ranges, objectives, constraints, the model and its engines, the budget."""
+
+    axes: tuple[Axis, ...]
+    objectives: tuple[Objective, ...]
+    constraints: tuple[Constraint, ...] = ()
+    base: RobotParams = field(default_factory=RobotParams)
+    engine: str = DEFAULT_ENGINE
+    verify: str | None = DEFAULT_VERIFY
+    t_end: float = 1.0
+    until_steady: bool = False
+    budget: int = DEFAULT_BUDGET
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not self.objectives:
+            raise ParameterError("optimize needs at least one --objective min:KEY or max:KEY")
+        for axis in self.axes:
+            if not axis.is_range:
+                raise ParameterError(f"--vary {axis.name}: give a range NAME=LO:HI[:log]")
+        object.__setattr__(self, "budget", check_whole("budget", self.budget, low=1, high=100_000))
+        engines = (self.engine,) + ((self.verify,) if self.verify and self.verify != self.engine else ())
+        # the sweep's checks of axes, base, engines, t_end, seed and until_steady, in one place
+        object.__setattr__(self, "study", Study(self.axes, self.base, engines, self.t_end, sample=self.budget, seed=self.seed,
+                           until_steady=self.until_steady))
+
+    @property
+    def names(self) -> list[str]:
+        return [a.name for a in self.axes]
+
+    def to_json(self) -> dict:
+        return {"axes": [asdict(a) for a in self.axes], "objectives": [asdict(o) for o in self.objectives],
+                "constraints": [asdict(c) for c in self.constraints], "base": self.base.as_dict(),
+                "engine": self.engine, "verify": self.verify, "t_end": self.t_end,
+                "until_steady": self.until_steady, "budget": self.budget, "seed": self.seed}
+
+    def fingerprint(self) -> str:
+        return hashlib.sha256(json.dumps(self.to_json(), sort_keys=True).encode()).hexdigest()[:16]
+
+    # the unit box <-> parameters (log axes in log space)
+    def design(self, u) -> dict:
+        out = {}
+        for axis, x in zip(self.axes, np.clip(np.asarray(u, dtype=float), 0.0, 1.0)):
+            if axis.log:
+                lo, hi = math.log(axis.low), math.log(axis.high)
+                out[axis.name] = float(math.exp(lo + x * (hi - lo)))
+            else:
+                out[axis.name] = float(axis.low + x * (axis.high - axis.low))
+        return out
+
+    def objective_values(self, row: dict) -> list[float]:
+        """Every objective as a value to minimise (max: negated); nan where missing."""
+        values = []
+        for o in self.objectives:
+            v = key_value(o.key, row, self.base)
+            values.append((-v if o.sense == "max" else v) if usable(v) else math.nan)
+        return values
+
+    def feasible(self, row: dict) -> bool:
+        if row.get("error") or row.get("stalled") == 1:
+            return False
+        if not all(math.isfinite(v) for v in self.objective_values(row)):
+            return False
+        return all(c.slack(key_value(c.key, row, self.base)) >= 0 for c in self.constraints)
+
+
+def check_resume(out: Path, problem: Problem, resume: bool) -> None:
+    meta = out / "optimize.json"
+    if resume and out.is_dir() and any(out.iterdir()):
+        try:
+            previous = json.loads(meta.read_text(encoding="utf-8")).get("fingerprint")
+        except (OSError, ValueError, UnicodeDecodeError, AttributeError):
+            raise ParameterError(f"--resume --out {str(out)!r}: the folder holds no optimization (no readable "
+                                 "optimize.json)") from None
+        if previous != problem.fingerprint():
+            raise ParameterError(f"{str(out)!r} holds another optimization (its settings differ); resume needs the "
+                                 "same one")
+    elif (out / "evaluations.csv").exists():
+        raise ParameterError(f"{str(out / 'evaluations.csv')!r} exists; use --resume to complete it, or another --out")
+
+
+def non_dominated(points: np.ndarray) -> np.ndarray:
+    """Indices of the rows of ``points`` (to minimise) that no other row dominates."""
+    keep = []
+    for i, p in enumerate(points):
+        dominated = np.any(np.all(points <= p, axis=1) & np.any(points < p, axis=1))
+        if not dominated:
+            keep.append(i)
+    return np.asarray(keep, dtype=int)
+
+
+def _single(problem: Problem, ev: Evaluator) -> None:
+    from scipy.optimize import NonlinearConstraint, minimize
+    from scipy.stats import qmc
+
+    d = len(problem.axes)
+    n0 = min(problem.budget, max(8, 4 * d))
+    unit = qmc.Sobol(d=d, scramble=True, seed=problem.seed).random(n0)
+    rows = ev.evaluate([problem.design(u) for u in unit])
+    left = problem.budget - n0
+    if left < 2:
+        return
+    starts = [(problem.feasible(r), problem.objective_values(r)[0], -_violation(problem, r), k)
+              for k, r in enumerate(rows)]
+    feasible = [s for s in starts if s[0]]
+    k0 = min(feasible, key=lambda s: s[1])[3] if feasible else max(starts, key=lambda s: s[2])[3]
+    span = [float(np.nanmax([problem.objective_values(r)[0] for r in rows] + [0.0])),
+            float(np.nanmin([problem.objective_values(r)[0] for r in rows] + [0.0]))]
+    worst = span[0] + abs(span[0] - span[1]) + 1.0  # a stalled or failed design's objective: worse than any seen
+
+    def row_at(u):
+        return ev.evaluate([problem.design(u)])[0]
+
+    def fun(u):
+        r = row_at(u)
+        v = problem.objective_values(r)[0]
+        return v if math.isfinite(v) and not (r.get("error") or r.get("stalled") == 1) else worst
+
+    def slacks(u):
+        r = row_at(u)
+        failed = bool(r.get("error")) or r.get("stalled") == 1
+        return np.array([-1.0 if failed else _scaled(c, key_value(c.key, r, problem.base))
+                         for c in problem.constraints])
+
+    constraints = [NonlinearConstraint(slacks, 0.0, np.inf)] if problem.constraints else []
+    minimize(fun, unit[k0], method="COBYQA", bounds=[(0.0, 1.0)] * d, constraints=constraints,
+             options={"maxfev": left, "initial_tr_radius": 0.25, "final_tr_radius": 1e-5})
+
+
+def _scaled(c: Constraint, value) -> float:
+    s = c.slack(value)
+    return max(s / max(abs(c.value), 1e-12), -1.0) if math.isfinite(s) else -1.0
+
+
+def _violation(problem: Problem, row: dict) -> float:
+    if row.get("error") or row.get("stalled") == 1:
+        return math.inf
+    return sum(max(0.0, -_scaled(c, key_value(c.key, row, problem.base))) for c in problem.constraints)
+
+
+def _multi(problem: Problem, ev: Evaluator) -> None:
+    try:
+        from pymoo.algorithms.moo.nsga2 import NSGA2
+        from pymoo.core.problem import Problem as PymooProblem
+        from pymoo.optimize import minimize
+    except ImportError:
+        raise ParameterError("several objectives need pymoo: pip install 'ipir-mujoco[optimize]'") from None
+    pop = min(POPULATION, problem.budget)
+    generations = max(1, problem.budget // pop)
+    n_obj, n_con = len(problem.objectives), len(problem.constraints)
+
+    class _P(PymooProblem):
+        def _evaluate(self, X, out, *args, **kwargs):
+            rows = ev.evaluate([problem.design(x) for x in X])
+            F, G = [], []
+            for r in rows:
+                failed = bool(r.get("error")) or r.get("stalled") == 1
+                f = problem.objective_values(r)
+                F.append([1e30 if failed or not math.isfinite(v) else v for v in f])
+                G.append([1.0 if failed else -_scaled(c, key_value(c.key, r, problem.base))
+                          for c in problem.constraints] + ([1.0 if failed else -1.0] if not n_con else []))
+            out["F"], out["G"] = np.array(F), np.array(G)
+
+    minimize(_P(n_var=len(problem.axes), n_obj=n_obj, n_ieq_constr=max(1, n_con), xl=0.0, xu=1.0),
+             NSGA2(pop_size=pop), ("n_gen", generations), seed=problem.seed, verbose=False)
+
+
+def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, workers: int | None = None,
+                 progress: bool = True, executor=None) -> dict:
+    """Run ``problem``; write OUT/evaluations.csv, pareto.csv, optimize.json; return optimize.json's record.
+
+    ``executor``: any ``concurrent.futures.Executor`` (a Dask client's, ``--scheduler``) instead of the pool.
+    Ctrl-C raises :class:`~ipir_mujoco.studies.design_eval.StudyInterrupted` with every evaluation kept.
+    """
+    if workers is not None:
+        check_whole("workers", workers, low=1, high=1024)
+    out = check_output_dir(out)
+    check_resume(out, problem, resume)
+    if len(problem.objectives) > 1:
+        try:
+            import pymoo  # noqa: F401
+        except ImportError:
+            raise ParameterError("several objectives need pymoo: pip install 'ipir-mujoco[optimize]'") from None
+    out.mkdir(parents=True, exist_ok=True)
+    settings = problem.to_json()
+    write_json(out / "optimize.json", {"fingerprint": problem.fingerprint(), "settings": settings, "status": "running"})
+    options = {"until_steady": problem.until_steady}
+    # progress against the budget: the most the search may ask for (COBYQA may converge before it)
+    with Evaluator(out / "evaluations.csv", problem.names, problem.base, problem.engine, problem.t_end,
+                   problem.study.dt_out, options, resume, workers, progress, total=problem.budget,
+                   executor=executor) as ev:
+        (_single if len(problem.objectives) == 1 else _multi)(problem, ev)
+        rows = list(ev.cache.values())
+        reused = ev.reused
+    rows.sort(key=lambda r: r["eval_id"])
+    feasible = [r for r in rows if problem.feasible(r)]
+    if feasible:
+        points = np.array([problem.objective_values(r) for r in feasible])
+        front = [feasible[i] for i in non_dominated(points)]
+        front.sort(key=lambda r: problem.objective_values(r))
+        if len(problem.objectives) == 1:
+            front = front[:1]
+    else:
+        front = []
+    keys = list(dict.fromkeys([o.key for o in problem.objectives] + [c.key for c in problem.constraints]
+                              + ["steady_speed_m_s" if problem.until_steady else "mean_speed_m_s"]))
+    if problem.verify and front:
+        front = verify_rows(front, problem.names, problem.base, problem.engine, problem.verify, keys,
+                            problem.t_end, problem.study.dt_out, options, workers, executor)
+    _write_front(out / "pareto.csv", front, problem, keys)
+    record = {"fingerprint": problem.fingerprint(), "settings": settings, "status": "done",
+              "evaluations": len(rows), "feasible": len(feasible), "reused_on_resume": reused}
+    summary = [_summary(r, problem, keys) for r in front]
+    if len(problem.objectives) == 1:
+        record["best"] = summary[0] if summary else None
+    else:
+        record["front"] = summary
+    write_json(out / "optimize.json", _finite(record))
+    return record
+
+
+def _finite(data):
+    """JSON has no NaN or infinity: those become null."""
+    if isinstance(data, dict):
+        return {k: _finite(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_finite(v) for v in data]
+    return None if isinstance(data, float) and not math.isfinite(data) else data
+
+
+def _summary(row: dict, problem: Problem, keys: list[str]) -> dict:
+    """A design of the result: its parameters and metrics at the top level, its verification beside."""
+    from .sweep_metrics import DESCRIBED
+
+    item = {n: row[n] for n in problem.names}
+    item.update({m: row.get(m) for m in DESCRIBED})
+    item["eval_id"] = row["eval_id"]
+    if problem.verify:
+        item["verify"] = {k: row.get(k) for k in row if k.startswith((f"{problem.verify}:", "divergence:"))
+                          or k == "verify_error"}
+    return item
+
+
+def _write_front(path: Path, front: list[dict], problem: Problem, keys: list[str]) -> None:
+    import csv
+
+    from .sweep_metrics import METRICS
+
+    header = ["eval_id", *problem.names, *METRICS]
+    if problem.verify:
+        header += [f"{problem.verify}:{k}" for k in keys if k in METRICS] + [f"divergence:{k}" for k in keys
+                                                                            if k in METRICS] + ["verify_error"]
+    staged = path.with_name(f".{path.name}.tmp")
+    with staged.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(header)
+        for row in front:
+            writer.writerow(["" if row.get(c) is None else (repr(row[c]) if isinstance(row[c], float) else row[c])
+                             for c in header])
+    staged.replace(path)
