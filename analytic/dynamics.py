@@ -34,6 +34,7 @@ one shape; results have that shape. Units: rad, rad/s, m, kg, N, J.
 
 from __future__ import annotations
 
+import copy
 from typing import NamedTuple
 
 import numpy as np
@@ -88,6 +89,16 @@ class OneDofDynamics:
             raise ValueError("rod mass needs the exact geometry; the first-order model has no rigid rod")
         self.include_rod = include_rod and (params.rod_mass > 0 or params.rod_inertia_value > 0)
         self.a_g = gravity_along_pipe(params)  # [m/s^2], + forward (downhill)
+        # [N] the backward force on each module while it moves: its resistance F_ri (rolling forward); a
+        # module skidding back on locked wheels has -G_i here (its grip pushes it forward, see with_resistance)
+        self.resistance = (params.F_r1, params.F_r2)
+
+    def with_resistance(self, resistance: tuple[float, float]) -> "OneDofDynamics":
+        """The same robot (sharing its linkage) with ``resistance`` (R1, R2) [N], the backward force on each
+        module while it moves, in place of (F_r1, F_r2): -G_i for a module skidding back with grip G_i."""
+        other = copy.copy(self)
+        other.resistance = (float(resistance[0]), float(resistance[1]))
+        return other
 
     def torque(self, omega, M=None):
         """The crank torque [N m]: ``M`` if given, else the drive's torque at crank speed ``omega``."""
@@ -135,7 +146,8 @@ class OneDofDynamics:
         dJ = 2.0 * mt.m11 * e * de + 2.0 * (mt.dm12 * e + mt.m12 * de) + mt.dm22
         P = mt.m11 * e + mt.m12
         dP = mt.m11 * de + mt.dm12
-        Q = self.torque(omega, M) - p.F_r1 * e - p.F_r2 * f + self.a_g * P
+        F1, F2 = self.resistance
+        Q = self.torque(omega, M) - F1 * e - F2 * f + self.a_g * P
         return J, dJ, Q, P, dP, e, de, f, df, mt.m11, mt.transfer
 
     def both_moving(self, phi, omega, M=None):
@@ -144,10 +156,10 @@ class OneDofDynamics:
         M [x1_ddot, alpha]^T + [M12' omega^2, 1/2 M22' omega^2]^T
             = [-F_r1 - F_r2 + M11 a_g, M - F_r2 K + M12 a_g]^T.
         """
-        p = self.params
+        F1, F2 = self.resistance
         mt = self.mass_terms(phi)
-        rhs1 = -p.F_r1 - p.F_r2 + mt.m11 * self.a_g - mt.dm12 * omega**2
-        rhs2 = self.torque(omega, M) - p.F_r2 * mt.transfer.K + mt.m12 * self.a_g - 0.5 * mt.dm22 * omega**2
+        rhs1 = -F1 - F2 + mt.m11 * self.a_g - mt.dm12 * omega**2
+        rhs2 = self.torque(omega, M) - F2 * mt.transfer.K + mt.m12 * self.a_g - 0.5 * mt.dm22 * omega**2
         det = mt.m11 * mt.m22 - mt.m12**2
         return (mt.m22 * rhs1 - mt.m12 * rhs2) / det, (mt.m11 * rhs2 - mt.m12 * rhs1) / det
 
@@ -163,9 +175,9 @@ class OneDofDynamics:
         hold = dP * omega**2 + P * alpha - m11 * self.a_g  # momentum rate less gravity on the robot
         zero = 0.0 * alpha
         if mode is Mode.CONTRACTION:
-            lambda1, lambda2 = zero, hold + self.params.F_r1
+            lambda1, lambda2 = zero, hold + self.resistance[0]
         else:
-            lambda1, lambda2 = hold + self.params.F_r2, zero
+            lambda1, lambda2 = hold + self.resistance[1], zero
         return ModeState(
             alpha=alpha,
             S=tr.S,

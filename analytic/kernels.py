@@ -13,7 +13,9 @@ A model's constants travel as one float array ``p`` (:func:`pack`, the
 :data:`UNILATERAL` (one-way clutches; state [phi, omega, x1, x2, v1, motor
 work]; event k of a mode watches module k: its velocity while it moves, its
 hold margin R_k + F_rk while held), both with :class:`.results.Mode` values as
-modes, and :data:`COMPLIANT` (compliant one-way clutches, see below).
+modes, :data:`COMPLIANT` (compliant one-way clutches, see below) and :data:`GRIP`
+(one-way clutches on wheels of finite grip, :mod:`.grip`: the one-way model's
+right-hand sides, its own events).
 Units: rad, rad/s, m, m/s, kg, N, N m, J.
 """
 
@@ -27,7 +29,7 @@ from .accel import jit
 from .dynamics import OneDofDynamics
 from .forces import gravity_along_pipe
 
-KINEMATIC, UNILATERAL = 0, 1
+KINEMATIC, UNILATERAL = 0, 1  # COMPLIANT = 2 and GRIP = 3: see their sections below
 CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # Mode values (BOTH_LOCKED is never integrated)
 (P_M1, P_M2, P_R, P_L, P_JA, P_FR1, P_FR2, P_M, P_ROD_M, P_ROD_I, P_EXACT, P_ROD, P_MOTOR, P_MSTALL, P_WNL,
  P_AG) = range(16)
@@ -38,7 +40,7 @@ def pack(dyn: OneDofDynamics) -> np.ndarray:
     """The constants of ``dyn`` (its parameters, geometry, rod and drive) as the kernels' float array (16,)."""
     p = dyn.params
     motor = p.drive == "motor"
-    return np.array([p.m1, p.m2, p.r, p.L, p.J_A, p.F_r1, p.F_r2, p.M, p.rod_mass, p.rod_inertia_value,
+    return np.array([p.m1, p.m2, p.r, p.L, p.J_A, *dyn.resistance, p.M, p.rod_mass, p.rod_inertia_value,
                      float(dyn.geometry.value == "exact"), float(dyn.include_rod), float(motor),
                      p.M_stall if motor else 0.0, p.omega_noload if motor else 1.0, gravity_along_pipe(p)],
                     dtype=float)
@@ -165,6 +167,9 @@ def guard(model, mode, k, t, y, p, quiet):
         return math.nan
     if model == COMPLIANT:
         return compliant_guard(mode, k, t, y, p)
+    if model == GRIP:
+        value = grip_guard(mode, k, y, p)
+        return value if t > quiet[k] else max(value, TINY)
     if model == KINEMATIC:
         return mass_terms(p, phi)[5] * omega
     if mode == BOTH_MOVING:
@@ -315,3 +320,30 @@ def compliant_guard(guarded, k, t, y, p):
     if guarded != 0 and (value == 0 or (t == p[P_T0] and direction * value > 0)):
         return -direction * 1e-300
     return value
+
+
+# --- one-way clutches with finite grip (:mod:`.grip`) ------------------------------------------------
+# the one-way model's state and right-hand sides; ``p`` is :func:`pack` of the dynamics whose resistance of
+# a module skidding back is -G_i (its grip pushes it forward), then the grips and each module's state
+GRIP = 3
+P_G1, P_G2, P_DIR1, P_DIR2 = range(16, 20)  # grips [N]; per module +1 rolling forward, -1 skidding back, 0 held
+
+
+@jit
+def grip_guard(mode, k, y, p):
+    """Event k of a finite-grip mode (:meth:`.GripModel.events`): a moving module's speed in its own sense of
+    motion (falls to 0 where it stops), a held module's smaller margin, min(R_k + F_rk, G_k - R_k)."""
+    phi, omega = y[0], y[1]
+    direction = p[P_DIR1] if k == 0 else p[P_DIR2]
+    if direction != 0.0:
+        if mode == BOTH_MOVING:
+            v = y[4] if k == 0 else y[4] + mass_terms(p, phi)[5] * omega
+        else:
+            K = mass_terms(p, phi)[5]
+            v = -K * omega if k == 0 else K * omega
+        return direction * v
+    hold = one_dof(p, mode, phi, omega, drive_torque(p, omega))[1]
+    other = p[P_FR2] if k == 0 else p[P_FR1]  # the moving module's backward force
+    own, grip = (p[P_FR1], p[P_G1]) if k == 0 else (p[P_FR2], p[P_G2])
+    R = hold + other
+    return min(R + own, grip - R)

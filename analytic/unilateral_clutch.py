@@ -81,9 +81,9 @@ _STATES = ("phi", "omega", "x1", "x2", "state_v1", "motor_work")  # y, as series
 class UnilateralModel:
     """Mode kinematics, accelerations and holding forces of the one-way-clutch robot."""
 
-    def __init__(self, params: RobotParams, geometry: Geometry | str, torque=None):
+    def __init__(self, params: RobotParams, geometry: Geometry | str, torque=None, dyn: OneDofDynamics | None = None):
         self.params = params
-        self.dyn = OneDofDynamics(params, geometry)
+        self.dyn = OneDofDynamics(params, geometry) if dyn is None else dyn  # given: another resistance (.grip)
         self.linkage = self.dyn.linkage
         self.torque = torque  # (t, phi, omega) -> N m, or None for the drive of params
         self.constants = kernels.pack(self.dyn)  # the scalar kernels' copy of the constants
@@ -257,6 +257,22 @@ class UnilateralModel:
                 f"v1={v1:.3g}, v2={v2:.3g} m/s (margins {({m.name: f'{v:.3g}' for m, v in margins.items()})})")
         return consistent[0]
 
+    def kernel_call(self, mode: Mode) -> tuple[int, int, np.ndarray]:
+        """(kernel model, kernel mode, constants) with which :mod:`.dop853` integrates ``mode``."""
+        return kernels.UNILATERAL, int(mode), self.constants
+
+    def columns(self, mode: int, rows: dict) -> dict[str, np.ndarray]:
+        """Every series column of the samples ``rows`` of one mode (see :func:`_columns`)."""
+        return _columns(self, Mode(mode), rows)
+
+    def energy_columns(self, series: dict) -> dict[str, np.ndarray]:
+        """The cumulative energy columns of a run's series (:meth:`.OneDofDynamics.energy_columns`)."""
+        return self.dyn.energy_columns(series)
+
+    def energy_audit(self, series: dict) -> dict[str, float]:
+        """The run's energy audit [J] (:meth:`.OneDofDynamics.energy_audit`)."""
+        return self.dyn.energy_audit(series)
+
     def project(self, y, mode: Mode, velocities) -> np.ndarray:
         """The state with the mode's constraints exact (held velocities zero)."""
         y = np.array(y, dtype=float)
@@ -291,7 +307,11 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     rtol, atol = check_tolerances(rtol, atol)
     t_end, dt_out = options.t_end, options.dt_out
     monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
-    model = UnilateralModel(params, geometry, torque)
+    if params.grip is None:
+        model = UnilateralModel(params, geometry, torque)
+    else:  # wheels of finite grip: a held module may skid back
+        from .grip import GripModel
+        model = GripModel(params, geometry, torque)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)
 
@@ -303,7 +323,7 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
     t, pieces, switches, short_run, stall, h0 = 0.0, [], 0, 0, None, None
     while True:
-        if mode is Mode.BOTH_LOCKED:
+        if mode == Mode.BOTH_LOCKED:
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque at rest")
@@ -344,20 +364,20 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
             break
 
     with model.linkage.reusing():  # the same samples' kinematics, asked for by every column
-        series = assemble(pieces, lambda mode, rows: _columns(model, Mode(mode), rows))
-        series.update(model.dyn.energy_columns(series))
+        series = assemble(pieces, model.columns)
+        series.update(model.energy_columns(series))
         add_kinetostatics(series, model.dyn)
     monitor.report(float(series["t"][-1]), final=True)
     del series["motor_torque"]  # folded into motor_power
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
-                     t_end=float(series["t"][-1]), series=series, energy=model.dyn.energy_audit(series),
+                     t_end=float(series["t"][-1]), series=series, energy=model.energy_audit(series),
                      wall_time_s=time.perf_counter() - monitor.started, stall=stall,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
                                "rod_modelled": model.dyn.include_rod, **monitor.settings})
 
 
-def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
+def _integrate(model, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
     """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end.
 
     The drive of ``params`` runs on the scalar kernels (:mod:`.kernels`: the same events, event k
@@ -365,7 +385,8 @@ def _integrate(model: UnilateralModel, mode: Mode, events, t0, t_end, y0, rtol, 
     """
     if model.torque is None:
         quiet = quiet or {}
-        sol = dop853.solve(kernels.UNILATERAL, int(mode), t0, t_end, y0, model.constants, rtol, atol, first_step,
+        kernel, kernel_mode, constants = model.kernel_call(mode)
+        sol = dop853.solve(kernel, kernel_mode, t0, t_end, y0, constants, rtol, atol, first_step,
                            [e.direction for e, _ in events], [quiet.get(k, -math.inf) for k in range(len(events))])
         if sol.status < 0:
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s in {mode.name.lower()}: "

@@ -122,6 +122,8 @@ CASES = {
     "one-way reversing start": (RobotParams(phi0=2.0, omega0=-20.0, F_r2=3.0), "approx", "unilateral", 0.4),
     "compliant, damped, backlash": (RobotParams(clutch_stiffness=1e6, clutch_damping=20.0, clutch_backlash=2e-4,
                                                 drive="motor"), "exact", "unilateral", 0.3),
+    "one-way on 5 N of grip": (RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0), "exact", "unilateral",
+                               0.6),
 }
 _RUN = """
 import json, sys

@@ -11,9 +11,10 @@ and where present the cumulative energy columns every engine writes:
 ``motor_work`` (work done by the motor since t = 0, J), ``friction_work``
 (work done against the resistances since t = 0, J, >= 0), ``kinetic`` (kinetic
 energy, J) and ``potential`` (gravitational potential energy from the start,
-J), and with compliant clutches ``clutch_spring_energy`` (energy stored in the
+J), with compliant clutches ``clutch_spring_energy`` (energy stored in the
 clutch springs, J) and ``clutch_damper_work`` (cumulative work dissipated by the
-clutch dampers, J); plus ``lambda1``/``lambda2`` (clutch reactions, N), ``rod_force`` (N) and
+clutch dampers, J), and with finite grip ``skid_work`` (cumulative work of the
+grip against skidding wheels, J); plus ``lambda1``/``lambda2`` (clutch reactions, N), ``rod_force`` (N) and
 ``a1``/``a2`` (m/s^2) for the peaks. At a cycle boundary that falls between
 two samples the columns are interpolated linearly; engines that can (the
 analytic ones) put a sample exactly on each boundary.
@@ -40,7 +41,7 @@ STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that count
 STEADY_CYCLES = 3  # revolutions the spread is measured over
 _WHOLE_TOL = 1e-9  # revolutions: see cycle_boundaries
 ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential", "clutch_spring_energy",
-                  "clutch_damper_work")
+                  "clutch_damper_work", "skid_work")
 
 
 def travel(series: dict[str, np.ndarray]) -> np.ndarray:
@@ -94,6 +95,7 @@ class Cycle:
     clutch_energy_change_j: float | None  # spring energy stored + damper work, compliant clutches only
     peak_clutch_force_n: float | None
     peak_rod_force_n: float | None
+    skid_work_j: float | None = None  # work of the grip against skidding wheels, finite grip only
 
     @property
     def period_s(self) -> float:
@@ -105,11 +107,12 @@ class Cycle:
 
     @property
     def residual_j(self) -> float | None:
-        """Motor work - friction work - kinetic, potential and clutch energy gained: the audit's error."""
+        """Motor work - friction and skid work - kinetic, potential and clutch energy gained: the audit's error."""
         parts = (self.motor_work_j, self.friction_work_j, self.kinetic_change_j)
         if any(p is None for p in parts):
             return None
-        return parts[0] - parts[1] - parts[2] - (self.potential_change_j or 0.0) - (self.clutch_energy_change_j or 0.0)
+        residual = parts[0] - parts[1] - parts[2] - (self.potential_change_j or 0.0) - (self.clutch_energy_change_j or 0.0)
+        return residual if self.skid_work_j is None else residual - self.skid_work_j
 
 
 def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
@@ -138,7 +141,8 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
         clutch = None if spring is None and damper is None else (spring or 0.0) + (damper or 0.0)
         out.append(Cycle(float(starts[j]), float(ends[j]), float(pos[j + 1] - pos[j]),
                          delta("motor_work"), delta("friction_work"), delta("kinetic"), delta("potential"), clutch,
-                         peak(("lambda1", "lambda2"), first[j], idx[j]), peak(("rod_force",), first[j], idx[j])))
+                         peak(("lambda1", "lambda2"), first[j], idx[j]), peak(("rod_force",), first[j], idx[j]),
+                         delta("skid_work")))
     return out
 
 

@@ -54,7 +54,8 @@ class RobotParams:
     field's meaning, unit, default and allowed range. ``rod_inertia`` left as
     ``None`` means a uniform slender rod, ``rod_mass * L**2 / 12`` (read the
     value in use from :attr:`rod_inertia_value`); ``clutch_stiffness`` left as
-    ``None`` means rigid, ideal clutches.
+    ``None`` means rigid, ideal clutches; ``mu_wall`` left as ``None`` means unlimited grip (read the
+    grips in use from :attr:`grip`).
     """
 
     m1: float = _number("kg", "mass of module 1 (rear, carries the crank and motor)", 1.0, 0.0, 1e4, low_open=True)
@@ -88,6 +89,16 @@ class RobotParams:
     incline: float = _number("deg", "pipe axis above the horizontal (90 = vertical climb, negative = downhill)",
                              0.0, -90.0, 90.0)
     g: float = _number("m/s^2", "gravitational acceleration", 9.81, 0.0, 100.0)
+    mu_wall: float | None = _number("-", "wheel-wall friction coefficient, static = kinetic: a held module's locked "
+                                    "wheels grip the wall with at most G_i = mu_wall F_ni, beyond that it skids "
+                                    "back (rubber on steel 0.5-1; the bound 10 is far above any wheel)",
+                                    None, 0.0, 10.0, none_word="unlimited",
+                                    none_text="a held module's clutch holds any force")
+    F_n1: float = _number("N", "wall-press normal force on module 1's wheels, all together (with finite mu_wall); "
+                          "the default with F_r1 = 1 N is a rolling-resistance coefficient of 0.02, as for hard "
+                          "polyurethane wheels on steel", 50.0, 0.0, 1e6)
+    F_n2: float = _number("N", "wall-press normal force on module 2's wheels, all together (with finite mu_wall); "
+                          "default as F_n1", 50.0, 0.0, 1e6)
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -111,6 +122,12 @@ class RobotParams:
             raise ParameterError(
                 f"L={self.L} m with r={self.r} m: the connecting rod must be longer than the crank "
                 f"(allowed: L > r), or the linkage locks or cannot close")
+        if self.mu_wall is not None:
+            for name in ("F_n1", "F_n2"):
+                if not getattr(self, name) > 0:
+                    raise ParameterError(
+                        f"{name}={getattr(self, name)!r} N with mu_wall={self.mu_wall!r}: a finite grip needs the "
+                        f"wheels pressed on; allowed: 0 < {name} <= 1e+06 N, or mu_wall=unlimited")
         if not self.clutch_backlash <= 0.5 * self.r:
             raise ParameterError(
                 f"clutch_backlash={self.clutch_backlash} m is out of range; allowed: 0 <= clutch_backlash <= "
@@ -127,6 +144,14 @@ class RobotParams:
     def rigid_clutches(self) -> bool:
         """True for ideal clutches (no ``clutch_stiffness`` given)."""
         return self.clutch_stiffness is None
+
+    @property
+    def grip(self) -> tuple[float, float] | None:
+        """(G1, G2) [N], the most each module's locked wheels hold against the wall (mu_wall F_ni); None
+        with unlimited grip (``mu_wall`` left as None)."""
+        if self.mu_wall is None:
+            return None
+        return self.mu_wall * self.F_n1, self.mu_wall * self.F_n2
 
     def as_dict(self) -> dict[str, Any]:
         """Every parameter with the value in use (rod inertia resolved; rigid clutch stiffness None)."""
@@ -188,11 +213,13 @@ def allowed_text(name: str) -> str:
         return " or ".join(meta["choices"])
     low = f"{meta['low']:g} {'<' if meta['low_open'] else '<='} "
     high = f" {'<' if meta['high_open'] else '<='} {meta['high']:g}"
-    text = f"{low}{name}{high} {meta['units']}"
+    text = f"{low}{name}{high}" + (f" {meta['units']}" if meta["units"] != "-" else "")  # no unit: a ratio
     if name == "L":
         text += ", and L > r"
     if name == "clutch_backlash":
         text = f"0 <= clutch_backlash <= r / 2 {meta['units']}"
+    if name in ("F_n1", "F_n2"):
+        text += f", and {name} > 0 with a finite mu_wall"
     if meta["none_word"]:
         text += f", or '{meta['none_word']}' ({meta['none_text']})"
     return text

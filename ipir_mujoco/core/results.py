@@ -21,13 +21,33 @@ a1, a2     m/s^2     module accelerations
 S          m         gap x2_abs - x1_abs between A and C
 S_dot      m/s       gap rate
 lambda1/2  N         clutch reaction on module 1 / 2, positive pushing the
-                     module forward; 0 while the module moves
+                     module forward; 0 while the module rolls forward (a
+                     module skidding back on finite grip: its grip G_i)
 mode       -         :class:`Mode` as an integer
 =========  ========  ======================================================
 
 Engines add their own columns beside these; every engine that drives the
 robot also writes the cumulative energy columns :mod:`.cycles` reads
 (``motor_work``, ``friction_work``, ``kinetic``, ``potential``, all in J).
+
+With finite grip (``mu_wall``, docs/model.md "Finite grip") an engine writes
+these too, and the summary reads them where present (a run without them, as
+with unlimited grip, has slip1_m = slip2_m = 0.0 and peak_grip_use = None):
+
+===========  ====  ====================================================
+column       unit  meaning
+===========  ====  ====================================================
+slip1/2      m     backward skid of module 1 / 2's locked wheels on the
+                   wall since t = 0 (cumulative, >= 0; with a compliant
+                   clutch its anchor's, not the module body's)
+grip_use1/2  -     clutch reaction over the grip, lambda_i / G_i (1 while
+                   the module skids; 0 where G_i = 0 and it does not)
+skid_work    J     cumulative work of the grip against skidding,
+                   sum G_i slip_i; an energy audit term (``skid_j``)
+wheels1/2    -     optional: each module's state, +1 rolling forward, 0
+                   standing, -1 skidding back (mode_switches counts its
+                   changes as mode changes)
+===========  ====  ====================================================
 """
 
 from __future__ import annotations
@@ -134,7 +154,8 @@ class RunResult:
             # alone is no scale where the robot coasts or runs downhill (0 with the drive off)
             e = self.energy
             start = float(self.series["kinetic"][0]) if "kinetic" in self.series else 0.0
-            scale = max(abs(e.get("motor_work_j", 0.0)), e.get("friction_j", 0.0) + e.get("clutch_damper_j", 0.0),
+            scale = max(abs(e.get("motor_work_j", 0.0)),
+                        e.get("friction_j", 0.0) + e.get("clutch_damper_j", 0.0) + e.get("skid_j", 0.0),
                         abs(e.get("potential_j", 0.0) + e.get("clutch_spring_j", 0.0)), abs(e.get("kinetic_j", 0.0)),
                         abs(start))
             if scale > 0:
@@ -220,10 +241,34 @@ def min_locked_reaction(series: dict[str, np.ndarray]) -> float | None:
     return float(values.min()) if values.size else None
 
 
+def mode_switches(series: dict[str, np.ndarray]) -> int:
+    """How often the run changes mode: the ``mode`` column, and with finite grip the module states
+    ``wheels1/2`` too (a module that turns from rolling forward to skidding back changes mode where the
+    kinematics, which say only which modules stand, do not)."""
+    changed = np.diff(np.asarray(series["mode"], dtype=int)) != 0
+    for column in ("wheels1", "wheels2"):
+        if column in series:
+            changed |= np.diff(np.asarray(series[column], dtype=float)) != 0
+    return int(np.count_nonzero(changed))
+
+
+def slip(series: dict[str, np.ndarray], module: int) -> float:
+    """Backward skid [m] of module ``module`` (1 or 2) over the run, >= 0: the growth of its ``slip``
+    column; 0.0 where the series has none (nothing skids: unlimited grip)."""
+    column = series.get(f"slip{module}")
+    return 0.0 if column is None else max(float(column[-1] - column[0]), 0.0)
+
+
+def peak_grip_use(series: dict[str, np.ndarray]) -> float | None:
+    """Largest clutch reaction over the grip, max of ``grip_use1/2`` [-] (1: a module skidded); None
+    where the series has neither (unlimited grip: no ratio exists)."""
+    columns = [np.asarray(series[c], dtype=float) for c in ("grip_use1", "grip_use2") if c in series]
+    return float(max(c.max() for c in columns)) if columns else None
+
+
 def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[str, Any]:
     """The summary figures of a run, computed from its time series."""
     t, phi = series["t"], series["phi"]
-    modes = np.asarray(series["mode"], dtype=int)
     return {
         "revolutions": float((phi[-1] - phi[0]) / (2 * math.pi)),
         "x1_final": float(series["x1"][-1] - series["x1"][0]),
@@ -231,8 +276,11 @@ def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[s
         "v1_max": float(np.max(series["v1"])),
         "v2_max": float(np.max(series["v2"])),
         "first_contraction_end_s": first_gap_minimum(t, series["S_dot"]),
-        "mode_switches": int(np.count_nonzero(np.diff(modes))),
+        "mode_switches": mode_switches(series),
         "min_clutch_reaction_n": min_locked_reaction(series),
+        "slip1_m": slip(series, 1),
+        "slip2_m": slip(series, 2),
+        "peak_grip_use": peak_grip_use(series),
         "energy": dict(energy),
     }
 
