@@ -65,6 +65,11 @@ DESIGNS = {
                                0.3, {}),
     "grip, stall": (RobotParams(incline=90.0, phi0=1.5707963267948966, mu_wall=0.5, F_n1=10.0, F_n2=30.0),
                     "unilateral", "ratchet", 1.0, {}),
+    "compliant grip, damped, play": (RobotParams(drive="motor", clutch_stiffness=1e6, clutch_damping=300.0,
+                                                 clutch_backlash=5e-4, mu_wall=0.5, F_n1=10.0, F_n2=10.0),
+                                     "unilateral", "ratchet", 0.12, {}),
+    "compliant grip, none, climb": (RobotParams(clutch_stiffness=1e5, mu_wall=0.0, F_n1=20.0, F_n2=20.0,
+                                                incline=10.0), "unilateral", "ratchet", 0.15, {}),
 }
 
 

@@ -45,7 +45,7 @@
   X(damper_work) X(k) X(c) X(backlash)                                                          \
   X(resist0) X(resist1) X(pin_x) X(pin_y) X(pin_z) X(total_mass) X(count) X(steps_done)         \
   X(skid_work) X(lmax0) X(lmax1) X(cmin0) X(cmin1) X(tmargin0) X(tmargin1) X(cmargin0) X(cmargin1) \
-  X(grip0) X(grip1) X(rest_speed)
+  X(grip0) X(grip1) X(rest_speed) X(tracking0) X(tracking1)
 
 /* what record() writes per sample: one row of each (Recorder's scalars and deferred arrays, in this order) */
 #define SCALAR_FIELDS(X)                                                                          \
@@ -69,7 +69,10 @@ enum { DEFERRED_FIELDS(AS_ENUM) N_DEFERRED };
 #undef AS_ENUM
 
 /* the clutch kinds (stepper.CLUTCH_KINDS holds the same order) */
-enum { NO_CLUTCH = 0, RATCHET = 1, LOCK_KINEMATIC = 2, LOCK_UNILATERAL = 3, COMPLIANT = 4, GRIP_RATCHET = 5 };
+enum {
+  NO_CLUTCH = 0, RATCHET = 1, LOCK_KINEMATIC = 2, LOCK_UNILATERAL = 3, COMPLIANT = 4, GRIP_RATCHET = 5,
+  COMPLIANT_GRIP = 6
+};
 
 /* what steps() returns: done, or which constraint rows it was to read are absent after a step (the
  * Python loop raises for the same two: clutches.MISSING_ROWS holds the same order) */
@@ -229,6 +232,34 @@ static void before_step(const int64_t *cfg, double *st) {
       }
       break;
     }
+    case COMPLIANT_GRIP: { /* CompliantGrip.before_step: the compliant clutch in the roll's coordinate, the wall */
+      mjtNum *ctrl = DATA(cfg)->ctrl, *biasprm = MODEL(cfg)->actuator_biasprm, *range = MODEL(cfg)->jnt_range;
+      for (int i = 0; i < 2; i++) {
+        int64_t act = cfg[C_act0 + i];
+        double c = qpos[cfg[C_skid_q0 + i]];
+        double roll = qpos[cfg[C_slide_q0 + i]] - c;
+        const int tracking = roll - st[S_backlash] > st[S_anchor0 + i];
+        st[S_tracking0 + i] = tracking ? 1.0 : 0.0;
+        if (tracking) {
+          st[S_anchor0 + i] = roll - st[S_backlash];
+          ctrl[act] = st[S_anchor0 + i];
+        }
+        double d = st[S_anchor0 + i] - roll;
+        st[S_overlap0 + i] = d;
+        st[S_v_before0 + i] = qvel[cfg[C_slide_v0 + i]] - qvel[cfg[C_skid_v0 + i]];
+        if ((d > 0.0) != (st[S_damped0 + i] != 0.0)) {
+          st[S_damped0 + i] = d > 0.0 ? 1.0 : 0.0;
+          biasprm[act * mjNBIAS + 2] = d > 0.0 ? -st[S_c] : 0.0;
+        }
+        if (c < st[S_cmin0 + i]) {
+          st[S_cmin0 + i] = c;
+          range[2 * cfg[C_skid_j0 + i] + 1] = upper_bound(c, st[S_cmargin0 + i]);
+        } else if (c - st[S_cmin0 + i] > st[S_excursion]) {
+          st[S_excursion] = c - st[S_cmin0 + i];
+        }
+      }
+      break;
+    }
     default:
       break;
   }
@@ -247,13 +278,14 @@ static int after_step(const int64_t *cfg, double *st, const double *efc_force, i
         st[S_force0 + i] = 0.0;
       }
     }
-  } else if (cfg[C_clutch] == COMPLIANT) {
+  } else if (cfg[C_clutch] == COMPLIANT || cfg[C_clutch] == COMPLIANT_GRIP) {
     const mjtNum *force = DATA(cfg)->actuator_force, *qvel = DATA(cfg)->qvel;
+    const int on_roll = cfg[C_clutch] == COMPLIANT_GRIP; /* CompliantGrip.after_step: at the roll's speed */
     double work = 0.0;
     for (int i = 0; i < 2; i++) {
       double d = st[S_overlap0 + i], applied = force[cfg[C_act0 + i]];
       if (d <= 0.0 && applied == 0.0) continue;
-      double speed = qvel[cfg[C_slide_v0 + i]];
+      double speed = on_roll ? qvel[cfg[C_slide_v0 + i]] - qvel[cfg[C_skid_v0 + i]] : qvel[cfg[C_slide_v0 + i]];
       if (applied > 0.0 && st[S_damped0 + i] != 0.0 && cfg[C_implicit]) {
         applied -= st[S_c] * (speed - st[S_v_before0 + i]);
       }
@@ -383,6 +415,25 @@ static int reactions(const int64_t *cfg, const double *st, double out[6]) {
   switch (kind) {
     case GRIP_RATCHET:
       return grip_states(cfg, st, out);
+    case COMPLIANT_GRIP: { /* CompliantGrip.wheels; its forces come from the deferred values, as the compliant's */
+      if (nf != cfg[C_nfric]) return MISSING_FRICTION_ROWS;
+      const mjtNum *qvel = d->qvel;
+      out[0] = out[1] = out[2] = out[3] = 0.0;
+      for (int i = 0; i < 2; i++) {
+        const int64_t g = cfg[C_grip_off0 + i];
+        const double grip_force = g >= 0 ? efc_force[ne + g] : 0.0, G = st[S_grip0 + i];
+        const double vc = qvel[cfg[C_skid_v0 + i]];
+        const int skids = G > 0.0 ? grip_force >= G : vc < -st[S_rest_speed];
+        if (skids) {
+          out[4 + i] = -1.0;
+        } else if (st[S_tracking0 + i] != 0.0 && qvel[cfg[C_slide_v0 + i]] - vc > st[S_rest_speed]) {
+          out[4 + i] = 1.0;
+        } else {
+          out[4 + i] = 0.0;
+        }
+      }
+      return STEPS_DONE;
+    }
     case RATCHET: {
       /* Ratchet.reactions: the limit rows follow the equality and friction rows, in joint order */
       const int start = ne + nf;
@@ -487,7 +538,7 @@ static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   out[D_kinetic] = d->energy[1];
   out[D_clutch_force1] = out[D_clutch_force2] = out[D_clutch_overlap1] = out[D_clutch_overlap2] = 0.0;
   out[D_clutch_spring] = 0.0;
-  if (cfg[C_clutch] == COMPLIANT) {
+  if (cfg[C_clutch] == COMPLIANT || cfg[C_clutch] == COMPLIANT_GRIP) {
     const mjtNum *force = d->actuator_force;
     const double k = st[S_k], dt = st[S_dt];
     double spring = 0.0;

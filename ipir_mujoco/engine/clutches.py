@@ -337,9 +337,11 @@ def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotP
     if implementation == "ratchet":
         if params.grip is not None:  # the wheels' finite grip: the carriages' model (.grip_model)
             from .grip import GripRatchet  # here: grip builds on this module
+            from .grip_compliant import CompliantGrip
 
             if params.clutch_stiffness is None:
                 return GripRatchet(model, data, params)
+            return CompliantGrip(model, data, params)
         if params.clutch_stiffness is not None:
             return CompliantClutches(model, data, params)
         return Ratchet(model, data)

@@ -38,9 +38,10 @@ import mujoco
 import numpy as np
 
 from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
-from .common import REST_SPEED
+from .compiled_grip import load_grip
 from .compliant import CompliantClutches
 from .grip import GripRatchet
+from .grip_compliant import CompliantGrip
 from .loop_rows import loop_options  # noqa: F401  (make_steps' options: the viewer imports it from here)
 from .native import LayoutError, compiled, pointers
 from .native import address as array_address
@@ -48,7 +49,7 @@ from .recorder import NO_WHEELS, Recorder
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
-CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant", "grip_ratchet")
+CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant", "grip_ratchet", "compliant_grip")
 DONE, WARNED = 0, 3  # what record() returns: all intervals taken, or MuJoCo warned in the last one (_stepper.c's)
 
 
@@ -304,6 +305,10 @@ class CompiledSteps(PythonSteps):
             set_state(held0=ctl.held[0], held1=ctl.held[1], force0=ctl.forces[0], force1=ctl.forces[1], r=ctl.r,
                       L=ctl.L, excursion=ctl.excursion)
             self._sync, self._get = self._sync_locks, self._getter("held0", "held1", "force0", "force1", "excursion")
+        elif isinstance(ctl, (GripRatchet, CompliantGrip)):  # finite grip (compiled_grip)
+            kind, names, sync = load_grip(ctl, self.grip, self.model.opt.timestep, set_config, set_state)
+            get = self._getter(*names)
+            self._sync = lambda state: sync(self.controller, get(state))
         elif isinstance(ctl, CompliantClutches):
             kind = "compliant"
             set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], slide_v0=ctl.dof_adr[0],
@@ -317,18 +322,6 @@ class CompiledSteps(PythonSteps):
             self._sync = self._sync_compliant
             self._get = self._getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
                                      "damped1", "damper_work")
-        elif isinstance(ctl, GripRatchet):
-            kind = "grip_ratchet"
-            if self.grip is None or [ctl.x_dof, ctl.c_dof] != [self.grip["x_dof"], self.grip["c_dof"]]:
-                raise LayoutError("the grip ratchet's rows are not the loop's")
-            set_config(slide_q0=ctl.x_adr[0], slide_q1=ctl.x_adr[1], skid_q0=ctl.c_adr[0], skid_q1=ctl.c_adr[1],
-                       skid_j0=ctl.skid_ids[0], skid_j1=ctl.skid_ids[1], roll_t0=ctl.roll_ids[0],
-                       roll_t1=ctl.roll_ids[1])
-            set_state(lmax0=ctl.bounds[0], lmax1=ctl.bounds[1], cmin0=ctl.lowest[0], cmin1=ctl.lowest[1],
-                      tmargin0=ctl.roll_margins[0], tmargin1=ctl.roll_margins[1], cmargin0=ctl.skid_margins[0],
-                      cmargin1=ctl.skid_margins[1], grip0=ctl.grip[0], grip1=ctl.grip[1], rest_speed=REST_SPEED,
-                      excursion=ctl.excursion)
-            self._sync, self._get = self._sync_grip, self._getter("lmax0", "lmax1", "cmin0", "cmin1", "excursion")
         elif isinstance(ctl, NoClutch):
             kind = "none"
             self._sync = lambda state: None
@@ -348,11 +341,6 @@ class CompiledSteps(PythonSteps):
         ctl = self.controller
         held0, held1, force0, force1, ctl.excursion = self._get(state)
         ctl.held, ctl.forces = [held0 != 0.0, held1 != 0.0], [force0, force1]
-
-    def _sync_grip(self, state: list[float]) -> None:
-        ctl = self.controller
-        l0, l1, c0, c1, ctl.excursion = self._get(state)
-        ctl.bounds[0], ctl.bounds[1], ctl.lowest[0], ctl.lowest[1] = l0, l1, c0, c1
 
     def _sync_compliant(self, state: list[float]) -> None:
         ctl = self.controller
