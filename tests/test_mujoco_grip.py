@@ -231,8 +231,9 @@ def test_a_riser_at_rest_stands_on_just_enough_grip_and_skids_on_a_little_less()
 
 def test_the_energy_audit_closes_with_the_skid_work(cruise):
     """skid_j is the carriages' friction rows' work; it is G_i times the carriages' travel up to what the
-    rows do below G_i (the creep, < 1e-8 m per revolution: 5e-8 J over these 10 revolutions); with it the
-    residual is within the monitor's tolerance, and without it the audit would miss 6 % of the motor's work."""
+    rows do below G_i (the creep, < 1e-8 m per revolution: 1e-6 J over these 10 revolutions of two 5 N grips;
+    measured 1.5e-8 J); with it the residual is within the monitor's tolerance, and without it the audit would
+    miss 6 % of the motor's work."""
     _, run = cruise
     e, s = run.energy, run.series
     assert e["skid_j"] == pytest.approx(sum(G * s[f"slip{k}"][-1] for k, G in enumerate(CRUISE.grip, 1)), abs=1e-6)
