@@ -1,8 +1,9 @@
 /* The per-step loop of a serial MuJoCo run, compiled, and its sampling: see ipir_mujoco/engine/stepper.py.
  *
  * It does, step for step, what the pure-Python loop (stepper.PythonSteps, the clutch controllers in
- * clutches.py and compliant.py, the recorder in recorder.py) does: the clutch update before each mj_step, the
- * clutch bookkeeping after it, the drive's work and the work against the resistances, and at each output
+ * clutches.py, compliant.py and, on finite grip, grip.py and grip_compliant.py, the recorder in recorder.py)
+ * does: the clutch update before each mj_step, the clutch bookkeeping after it, the drive's work and the work
+ * against the resistances (and the grips' against skidding), and at each output
  * sample the record (state, torque, works, clutch reactions, the loop's force, the excursion, and MuJoCo's
  * energies, loop gap and momentum at the start of the next step); the same double arithmetic in the same
  * order (built with -ffp-contract=off, so no fused multiply-add changes a rounding), so the two paths agree

@@ -17,7 +17,10 @@ do a non-finite state and a MuJoCo error (``mujoco.FatalError``).
 Clutches: rigid one-way clutches are the joint-limit ratchet or the locks
 (:mod:`.clutches`); with a finite ``clutch_stiffness`` the ratchet becomes the
 compliant clutch (:mod:`.compliant`): a ratcheting anchor per module and a
-spring and damper from it to the module, MuJoCo actuator forces.
+spring and damper from it to the module, MuJoCo actuator forces. With a finite
+``mu_wall`` the wheels grip the wall with at most G_i: a light carriage per
+module on the wall, held by friction G_i, carries the clutch (:mod:`.grip_model`,
+:mod:`.grip`, :mod:`.grip_compliant`).
 
 Energy audit, per step with the velocities v_{n+1} that move the positions
 (q_{n+1} = q_n + dt v_{n+1}): drive work tau * (phi_{n+1} - phi_n) with the
@@ -25,8 +28,10 @@ torque MuJoCo applied over the step (for the motor, whose velocity term the
 implicit integrator treats implicitly, tau(omega_{n+1})), work against the
 resistances from the frictionloss rows, kinetic and potential energy from
 MuJoCo's own ``energy``; with compliant clutches also the springs' stored
-energy and the dampers' dissipation (:mod:`.compliant`). ``residual_j`` =
-motor - friction - kinetic - potential (- clutch spring and damper) is what
+energy and the dampers' dissipation (:mod:`.compliant`); with finite grip
+also the grips' work against skidding, from the carriages' friction rows
+(``skid_j``). ``residual_j`` = motor - friction - kinetic - potential
+(- clutch spring and damper - skid) is what
 the soft constraints (rigid clutches, loop, friction rows) and the time
 discretization (the clutch springs' stepping included) took together; the
 monitor holds it to a tolerance.
