@@ -56,6 +56,20 @@ DESIGNS = {
     "stall": (RobotParams(drive="motor", M_stall=0.02), "unilateral", "ratchet", 1.0, {}),
     "coarse step, warned": (RobotParams(), "unilateral", "ratchet", 0.5,
                             {"settings": SolverSettings(timestep=5e-4), "dt_out": 5e-4, "accuracy": "warn"}),
+    # finite grip: skids at the motor's cruise, a riser sliding back, a grip below the rolling resistance, none
+    "grip, motor": (RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0), "unilateral", "ratchet", 0.5, {}),
+    "grip, riser": (RobotParams(drive="motor", M_stall=1.0, incline=90.0, mu_wall=0.3, F_n1=20.0, F_n2=20.0),
+                    "unilateral", "ratchet", 0.3, {}),
+    "grip below F_r": (RobotParams(mu_wall=0.05, F_n1=10.0, F_n2=10.0), "unilateral", "ratchet", 0.3, {}),
+    "no grip, no resistance": (RobotParams(mu_wall=0.0, F_n1=10.0, F_n2=10.0, F_r1=0.0), "unilateral", "ratchet",
+                               0.3, {}),
+    "grip, stall": (RobotParams(incline=90.0, phi0=1.5707963267948966, mu_wall=0.5, F_n1=10.0, F_n2=30.0),
+                    "unilateral", "ratchet", 1.0, {}),
+    "compliant grip, damped, play": (RobotParams(drive="motor", clutch_stiffness=1e6, clutch_damping=300.0,
+                                                 clutch_backlash=5e-4, mu_wall=0.5, F_n1=10.0, F_n2=10.0),
+                                     "unilateral", "ratchet", 0.12, {}),
+    "compliant grip, none, climb": (RobotParams(clutch_stiffness=1e5, mu_wall=0.0, F_n1=20.0, F_n2=20.0,
+                                                incline=10.0), "unilateral", "ratchet", 0.15, {}),
 }
 
 
@@ -94,7 +108,7 @@ def test_the_compiled_loop_equals_the_python_loop_bit_for_bit(monkeypatch, name)
     assert compiled.energy == python.energy and compiled.accuracy == python.accuracy
     assert compiled.stall == python.stall and compiled.settings == python.settings
     assert compiled.t_end == python.t_end and len(python.series["t"]) > 100
-    if name == "stall":
+    if name in ("stall", "grip, stall"):
         assert compiled.stall is not None and compiled.t_end < 1.0
     if name == "coarse step, warned":
         assert not compiled.accuracy["ok"]  # the monitor's crossing, its time and value, alike

@@ -1,8 +1,9 @@
 /* The per-step loop of a serial MuJoCo run, compiled, and its sampling: see ipir_mujoco/engine/stepper.py.
  *
  * It does, step for step, what the pure-Python loop (stepper.PythonSteps, the clutch controllers in
- * clutches.py and compliant.py, the recorder in recorder.py) does: the clutch update before each mj_step, the
- * clutch bookkeeping after it, the drive's work and the work against the resistances, and at each output
+ * clutches.py, compliant.py and, on finite grip, grip.py and grip_compliant.py, the recorder in recorder.py)
+ * does: the clutch update before each mj_step, the clutch bookkeeping after it, the drive's work and the work
+ * against the resistances (and the grips' against skidding), and at each output
  * sample the record (state, torque, works, clutch reactions, the loop's force, the excursion, and MuJoCo's
  * energies, loop gap and momentum at the start of the next step); the same double arithmetic in the same
  * order (built with -ffp-contract=off, so no fused multiply-add changes a rounding), so the two paths agree
@@ -33,7 +34,9 @@
   X(slide_q0) X(slide_q1) X(slide_v0) X(slide_v1) X(joint0) X(joint1)                            \
   X(eq0) X(eq1) X(rod_q) X(rod_v) X(act0) X(act1) X(implicit)                                   \
   X(rod_site) X(front_body) X(loop_eq) X(fric_off0) X(fric_off1)                                 \
-  X(rec_t) X(rec_qpos) X(rec_qvel) X(rec_scalars) X(rec_deferred) X(rec_excursion)
+  X(rec_t) X(rec_qpos) X(rec_qvel) X(rec_scalars) X(rec_deferred) X(rec_excursion)               \
+  X(grip) X(skid_q0) X(skid_q1) X(skid_v0) X(skid_v1) X(skid_j0) X(skid_j1) X(roll_t0) X(roll_t1) \
+  X(roll_off0) X(roll_off1) X(grip_off0) X(grip_off1) X(rolling_tendon)
 
 #define STATE_FIELDS(X)                                                                          \
   X(dt) X(slope) X(torque) X(motor_work) X(friction_work) X(omega_prev) X(excursion)     \
@@ -41,12 +44,14 @@
   X(held0) X(held1) X(force0) X(force1) X(r) X(L)                                                \
   X(anchor0) X(anchor1) X(overlap0) X(overlap1) X(v_before0) X(v_before1) X(damped0) X(damped1) \
   X(damper_work) X(k) X(c) X(backlash)                                                          \
-  X(resist0) X(resist1) X(pin_x) X(pin_y) X(pin_z) X(total_mass) X(count) X(steps_done)
+  X(resist0) X(resist1) X(pin_x) X(pin_y) X(pin_z) X(total_mass) X(count) X(steps_done)         \
+  X(skid_work) X(lmax0) X(lmax1) X(cmin0) X(cmin1) X(tmargin0) X(tmargin1) X(cmargin0) X(cmargin1) \
+  X(grip0) X(grip1) X(rest_speed) X(tracking0) X(tracking1)
 
 /* what record() writes per sample: one row of each (Recorder's scalars and deferred arrays, in this order) */
 #define SCALAR_FIELDS(X)                                                                          \
   X(motor_torque) X(loop_fx) X(loop_fy) X(held1) X(held2) X(lambda1) X(lambda2) X(motor_work)     \
-  X(friction_work) X(clutch_damper_work)
+  X(friction_work) X(clutch_damper_work) X(skid_work) X(wheels1) X(wheels2)
 #define DEFERRED_FIELDS(X)                                                                        \
   X(kinetic) X(potential) X(loop_gap) X(momentum) X(clutch_force1) X(clutch_force2)               \
   X(clutch_overlap1) X(clutch_overlap2) X(clutch_spring)
@@ -65,7 +70,10 @@ enum { DEFERRED_FIELDS(AS_ENUM) N_DEFERRED };
 #undef AS_ENUM
 
 /* the clutch kinds (stepper.CLUTCH_KINDS holds the same order) */
-enum { NO_CLUTCH = 0, RATCHET = 1, LOCK_KINEMATIC = 2, LOCK_UNILATERAL = 3, COMPLIANT = 4 };
+enum {
+  NO_CLUTCH = 0, RATCHET = 1, LOCK_KINEMATIC = 2, LOCK_UNILATERAL = 3, COMPLIANT = 4, GRIP_RATCHET = 5,
+  COMPLIANT_GRIP = 6
+};
 
 /* what steps() returns: done, or which constraint rows it was to read are absent after a step (the
  * Python loop raises for the same two: clutches.MISSING_ROWS holds the same order) */
@@ -129,7 +137,21 @@ static void apply_locks(const int64_t *cfg, double *st, int want0, int want1) {
   }
 }
 
-/* the clutch update before a step: Ratchet, Locks, CompliantClutches.before_step */
+/* grip.lower_bound / grip.upper_bound: one margin below (above) value, moved by ulps until MuJoCo's distance
+ * to it is below the margin */
+static double lower_bound(double value, double margin) {
+  double bound = value - margin;
+  while (value - bound >= margin) bound = nextafter(bound, INFINITY);
+  return bound;
+}
+
+static double upper_bound(double value, double margin) {
+  double bound = value + margin;
+  while (bound - value >= margin) bound = nextafter(bound, -INFINITY);
+  return bound;
+}
+
+/* the clutch update before a step: Ratchet, Locks, CompliantClutches, GripRatchet.before_step */
 static void before_step(const int64_t *cfg, double *st) {
   const mjtNum *qpos = DATA(cfg)->qpos, *qvel = DATA(cfg)->qvel;
   switch (cfg[C_clutch]) {
@@ -191,6 +213,54 @@ static void before_step(const int64_t *cfg, double *st) {
       }
       break;
     }
+    case GRIP_RATCHET: {
+      mjtNum *tendon_range = MODEL(cfg)->tendon_range, *range = MODEL(cfg)->jnt_range;
+      for (int i = 0; i < 2; i++) {
+        double c = qpos[cfg[C_skid_q0 + i]];
+        double roll = qpos[cfg[C_slide_q0 + i]] - c;
+        if (roll > st[S_lmax0 + i]) {
+          st[S_lmax0 + i] = roll;
+          tendon_range[2 * cfg[C_roll_t0 + i]] = lower_bound(roll, st[S_tmargin0 + i]);
+        } else if (st[S_lmax0 + i] - roll > st[S_excursion]) {
+          st[S_excursion] = st[S_lmax0 + i] - roll;
+        }
+        if (c < st[S_cmin0 + i]) {
+          st[S_cmin0 + i] = c;
+          range[2 * cfg[C_skid_j0 + i] + 1] = upper_bound(c, st[S_cmargin0 + i]);
+        } else if (c - st[S_cmin0 + i] > st[S_excursion]) {
+          st[S_excursion] = c - st[S_cmin0 + i];
+        }
+      }
+      break;
+    }
+    case COMPLIANT_GRIP: { /* CompliantGrip.before_step: the compliant clutch in the roll's coordinate, the wall */
+      mjtNum *ctrl = DATA(cfg)->ctrl, *biasprm = MODEL(cfg)->actuator_biasprm, *range = MODEL(cfg)->jnt_range;
+      for (int i = 0; i < 2; i++) {
+        int64_t act = cfg[C_act0 + i];
+        double c = qpos[cfg[C_skid_q0 + i]];
+        double roll = qpos[cfg[C_slide_q0 + i]] - c;
+        const int tracking = roll - st[S_backlash] > st[S_anchor0 + i];
+        st[S_tracking0 + i] = tracking ? 1.0 : 0.0;
+        if (tracking) {
+          st[S_anchor0 + i] = roll - st[S_backlash];
+          ctrl[act] = st[S_anchor0 + i];
+        }
+        double d = st[S_anchor0 + i] - roll;
+        st[S_overlap0 + i] = d;
+        st[S_v_before0 + i] = qvel[cfg[C_slide_v0 + i]] - qvel[cfg[C_skid_v0 + i]];
+        if ((d > 0.0) != (st[S_damped0 + i] != 0.0)) {
+          st[S_damped0 + i] = d > 0.0 ? 1.0 : 0.0;
+          biasprm[act * mjNBIAS + 2] = d > 0.0 ? -st[S_c] : 0.0;
+        }
+        if (c < st[S_cmin0 + i]) {
+          st[S_cmin0 + i] = c;
+          range[2 * cfg[C_skid_j0 + i] + 1] = upper_bound(c, st[S_cmargin0 + i]);
+        } else if (c - st[S_cmin0 + i] > st[S_excursion]) {
+          st[S_excursion] = c - st[S_cmin0 + i];
+        }
+      }
+      break;
+    }
     default:
       break;
   }
@@ -209,13 +279,14 @@ static int after_step(const int64_t *cfg, double *st, const double *efc_force, i
         st[S_force0 + i] = 0.0;
       }
     }
-  } else if (cfg[C_clutch] == COMPLIANT) {
+  } else if (cfg[C_clutch] == COMPLIANT || cfg[C_clutch] == COMPLIANT_GRIP) {
     const mjtNum *force = DATA(cfg)->actuator_force, *qvel = DATA(cfg)->qvel;
+    const int on_roll = cfg[C_clutch] == COMPLIANT_GRIP; /* CompliantGrip.after_step: at the roll's speed */
     double work = 0.0;
     for (int i = 0; i < 2; i++) {
       double d = st[S_overlap0 + i], applied = force[cfg[C_act0 + i]];
       if (d <= 0.0 && applied == 0.0) continue;
-      double speed = qvel[cfg[C_slide_v0 + i]];
+      double speed = on_roll ? qvel[cfg[C_slide_v0 + i]] - qvel[cfg[C_skid_v0 + i]] : qvel[cfg[C_slide_v0 + i]];
       if (applied > 0.0 && st[S_damped0 + i] != 0.0 && cfg[C_implicit]) {
         applied -= st[S_c] * (speed - st[S_v_before0 + i]);
       }
@@ -236,6 +307,8 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
   const int64_t fa = cfg[C_fric_a], fb = cfg[C_fric_b];
   const double dt = st[S_dt], slope = st[S_slope];
   double torque = st[S_torque], wm = st[S_motor_work], wf = st[S_friction_work], omega_prev = st[S_omega_prev];
+  double ws = st[S_skid_work];
+  const int grip = cfg[C_grip] != 0, tendon = cfg[C_rolling_tendon] != 0;
   for (long long n = 0; n < nstep; n++) {
     before_step(cfg, st);
     if (n == nstep - 1 && dest != NULL) memcpy(dest, qvel, (size_t)m->nv * sizeof(mjtNum));
@@ -248,8 +321,20 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
     torque = force[motor] + slope * (omega - omega_prev);
     wm += torque * omega * dt;
     /* the frictionloss rows follow the ne equality rows, one per dof with friction: read only if there */
-    if (nfric > 0 && d->nf != nfric) return MISSING_FRICTION_ROWS;
-    if (nfric == 2) {
+    if (grip) { /* PythonSteps._run_grip: the rolling resistances' rows and the grips' */
+      if (d->nf != nfric) return MISSING_FRICTION_ROWS;
+      double rolling = 0.0, skidding = 0.0;
+      for (int i = 0; i < 2; i++) {
+        const int64_t roll = cfg[C_roll_off0 + i], grip_row = cfg[C_grip_off0 + i];
+        const double vx = qvel[cfg[C_slide_v0 + i]], vc = qvel[cfg[C_skid_v0 + i]];
+        if (roll >= 0) rolling += efc_force[ne + roll] * (tendon ? vx - vc : vx);
+        if (grip_row >= 0) skidding += efc_force[ne + grip_row] * vc;
+      }
+      wf -= rolling * dt;
+      ws -= skidding * dt;
+    } else if (nfric > 0 && d->nf != nfric) {
+      return MISSING_FRICTION_ROWS;
+    } else if (nfric == 2) {
       double f0 = efc_force[ne], f1 = efc_force[ne + 1];
       wf -= (f0 * qvel[fa] + f1 * qvel[fb]) * dt;
     } else if (nfric == 1) {
@@ -261,6 +346,7 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
   st[S_motor_work] = wm;
   st[S_friction_work] = wf;
   st[S_omega_prev] = omega_prev;
+  st[S_skid_work] = ws;
   return STEPS_DONE;
 }
 
@@ -280,8 +366,42 @@ static void friction_forces(const int64_t *cfg, const double *efc_force, int ne,
   }
 }
 
-/* the clutch controller's reactions() after the last step: (rear held, front held, rear [N], front [N]) */
-static int reactions(const int64_t *cfg, const double *st, double out[4]) {
+/* GripRatchet.states: per module its wheels' state (+1 rolling, 0 standing, -1 skidding) and its clutch's share
+ * of the hold, from the rolls' limit rows (the limit rows follow the equality and friction rows) and the
+ * friction rows at their fixed offsets; out as reactions() writes it */
+static int grip_states(const int64_t *cfg, const double *st, double out[6]) {
+  const mjData *d = DATA(cfg);
+  const mjtNum *efc_force = d->efc_force, *qvel = d->qvel;
+  const int ne = d->ne, nf = d->nf, nl = d->nl;
+  double clutch[2] = {0.0, 0.0};
+  const int start = ne + nf;
+  for (int row = start; row < start + nl; row++) {
+    if (d->efc_type[row] == mjCNSTR_LIMIT_TENDON) clutch[d->efc_id[row] == cfg[C_roll_t0] ? 0 : 1] = efc_force[row];
+  }
+  if (nf != cfg[C_nfric]) return MISSING_FRICTION_ROWS;
+  for (int i = 0; i < 2; i++) {
+    const int64_t g = cfg[C_grip_off0 + i], r = cfg[C_roll_off0 + i];
+    const double grip_force = g >= 0 ? efc_force[ne + g] : 0.0, roll_force = r >= 0 ? efc_force[ne + r] : 0.0;
+    const double hold = clutch[i] + roll_force, F = st[S_resist0 + i], G = st[S_grip0 + i];
+    double state, share;
+    if (!(clutch[i] > 0.0 || roll_force > -F)) {
+      state = 1.0;
+      share = 0.0;
+    } else {
+      const int skids = G > 0.0 ? grip_force >= G : qvel[cfg[C_skid_v0 + i]] < -st[S_rest_speed];
+      state = skids ? -1.0 : 0.0;
+      share = clutch_share(hold, F);
+    }
+    out[i] = state == 0.0 ? 1.0 : 0.0;
+    out[2 + i] = share;
+    out[4 + i] = state;
+  }
+  return STEPS_DONE;
+}
+
+/* the clutch controller's reactions() after the last step: (rear held, front held, rear [N], front [N]) and, with
+ * finite grip, the wheels' states (0.0 otherwise) */
+static int reactions(const int64_t *cfg, const double *st, double out[6]) {
   const mjData *d = DATA(cfg);
   const mjtNum *efc_force = d->efc_force;
   const int ne = d->ne, nf = d->nf, nl = d->nl;
@@ -292,7 +412,29 @@ static int reactions(const int64_t *cfg, const double *st, double out[4]) {
   if ((kind == RATCHET || kind == LOCK_KINEMATIC || kind == LOCK_UNILATERAL) && nf != cfg[C_nfric]) {
     return MISSING_FRICTION_ROWS;
   }
+  out[4] = out[5] = 0.0;
   switch (kind) {
+    case GRIP_RATCHET:
+      return grip_states(cfg, st, out);
+    case COMPLIANT_GRIP: { /* CompliantGrip.wheels; its forces come from the deferred values, as the compliant's */
+      if (nf != cfg[C_nfric]) return MISSING_FRICTION_ROWS;
+      const mjtNum *qvel = d->qvel;
+      out[0] = out[1] = out[2] = out[3] = 0.0;
+      for (int i = 0; i < 2; i++) {
+        const int64_t g = cfg[C_grip_off0 + i];
+        const double grip_force = g >= 0 ? efc_force[ne + g] : 0.0, G = st[S_grip0 + i];
+        const double vc = qvel[cfg[C_skid_v0 + i]];
+        const int skids = G > 0.0 ? grip_force >= G : vc < -st[S_rest_speed];
+        if (skids) {
+          out[4 + i] = -1.0;
+        } else if (st[S_tracking0 + i] != 0.0 && qvel[cfg[C_slide_v0 + i]] - vc > st[S_rest_speed]) {
+          out[4 + i] = 1.0;
+        } else {
+          out[4 + i] = 0.0;
+        }
+      }
+      return STEPS_DONE;
+    }
     case RATCHET: {
       /* Ratchet.reactions: the limit rows follow the equality and friction rows, in joint order */
       const int start = ne + nf;
@@ -355,7 +497,7 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
   const mjData *d = DATA(cfg);
   const mjtNum *efc_force = d->efc_force;
   const int ne = d->ne;
-  double held[4];
+  double held[6];
   int status = reactions(cfg, st, held);
   if (status != STEPS_DONE) return status;
   PTR(double *, rec_t)[row] = d->time;
@@ -373,6 +515,9 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
   out[R_motor_work] = st[S_motor_work];
   out[R_friction_work] = st[S_friction_work];
   out[R_clutch_damper_work] = st[S_damper_work]; /* 0 but for the compliant clutches' dampers */
+  out[R_skid_work] = st[S_skid_work];            /* 0 but with finite grip */
+  out[R_wheels1] = held[4];
+  out[R_wheels2] = held[5];
   PTR(double *, rec_excursion)[row] = st[S_excursion];
   return STEPS_DONE;
 }
@@ -394,7 +539,7 @@ static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   out[D_kinetic] = d->energy[1];
   out[D_clutch_force1] = out[D_clutch_force2] = out[D_clutch_overlap1] = out[D_clutch_overlap2] = 0.0;
   out[D_clutch_spring] = 0.0;
-  if (cfg[C_clutch] == COMPLIANT) {
+  if (cfg[C_clutch] == COMPLIANT || cfg[C_clutch] == COMPLIANT_GRIP) {
     const mjtNum *force = d->actuator_force;
     const double k = st[S_k], dt = st[S_dt];
     double spring = 0.0;

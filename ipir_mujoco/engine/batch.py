@@ -108,6 +108,10 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
                 raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m: batched runs have rigid "
                                      "ratchets only; allowed: clutch_stiffness=rigid (run compliant clutches "
                                      "serially, with simulate_mujoco)")
+            if params.mu_wall is not None:
+                raise ParameterError(f"mu_wall={params.mu_wall!r}: batched runs have unlimited grip only (a batch "
+                                     "cannot read the carriages' friction rows per simulation); allowed: "
+                                     "mu_wall=unlimited (run finite grip serially, with simulate_mujoco)")
             chosen[i] = settings if settings is not None else choose_settings(params, t_end, dt_out)[0]
         except ValueError as exc:
             results[i] = {"error": str(exc)}

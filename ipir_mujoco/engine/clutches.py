@@ -306,17 +306,36 @@ def refuse_compliant(params: RobotParams, implementation: str) -> None:
                              "--mujoco-clutch ratchet")
 
 
+def refuse_grip(params: RobotParams, implementation: str) -> None:
+    """ParameterError (one line) for a finite ``mu_wall`` with a clutch that has no grip: the locks (an equality
+    holds whatever the load) and no clutch. (Wheel normal forces given with unlimited grip are refused for
+    every engine by :func:`ipir_mujoco.core.params.refuse_idle_parameters`.)"""
+    if params.mu_wall is not None and implementation != "ratchet":
+        raise ParameterError(f"mu_wall={params.mu_wall!r} with the MuJoCo {implementation!r} clutch: only the ratchet "
+                             "is modelled on wheels of finite grip (a lock holds whatever the load); allowed: "
+                             "--mujoco-clutch ratchet, or mu_wall=unlimited")
+
+
 def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, implementation: str,
                       rule: str = "unilateral"):
     """The clutch controller of a run, for a model built with ``ratchet=implementation == 'ratchet'``.
 
     'ratchet': the joint-limit ratchet, or with a finite ``params.clutch_stiffness`` the compliant clutches
-    (:class:`.compliant.CompliantClutches`); 'lock': the locks with ``rule``; 'none': no clutches. Call it
-    after the initial state is set (the ratchet and the anchors start at the modules' positions). A finite
-    ``clutch_stiffness`` with the locks or no clutch is a ParameterError: they are rigid only.
+    (:class:`.compliant.CompliantClutches`), with a finite ``params.mu_wall`` on wheels of finite grip
+    (:mod:`.grip`); 'lock': the locks with ``rule``; 'none': no clutches. Call it after the initial state is
+    set (the ratchet and the anchors start at the modules' positions). A finite ``clutch_stiffness`` or
+    ``mu_wall`` with the locks or no clutch is a ParameterError: they are rigid only, and hold any force.
     """
     refuse_compliant(params, implementation)
+    refuse_grip(params, implementation)
     if implementation == "ratchet":
+        if params.grip is not None:  # the wheels' finite grip: the carriages' model (.grip_model)
+            from .grip import GripRatchet  # here: grip builds on this module
+            from .grip_compliant import CompliantGrip
+
+            if params.clutch_stiffness is None:
+                return GripRatchet(model, data, params)
+            return CompliantGrip(model, data, params)
         if params.clutch_stiffness is not None:
             return CompliantClutches(model, data, params)
         return Ratchet(model, data)

@@ -20,7 +20,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
 from ipir_mujoco.core.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
 
-from .clutches import refuse_compliant
+from .clutches import refuse_compliant, refuse_grip
 from .model import check_params
 
 REST_TIME = 0.1  # s: at rest this long under constant loads is a stall
@@ -73,10 +73,8 @@ def check_clutch_options(params: RobotParams, clutch: str = "unilateral", implem
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
     refuse_compliant(params, implementation)
+    refuse_grip(params, implementation)
     refuse_idle_parameters(params)
-    if params.mu_wall is not None:
-        raise ParameterError(f"mu_wall={params.mu_wall!r}: the MuJoCo engine does not model a finite grip yet; "
-                             "allowed: mu_wall=unlimited (the analytic engine analytic-unilateral models it)")
     check_params(params)
 
 

@@ -26,6 +26,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
 from ..resources import mjcf_dir
+from .grip_model import scale_grip_rows, write_grip
 
 REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "crank_hinge", "rod_hinge"
 REAR_LOCK, FRONT_LOCK, LOOP = "rear_lock", "front_lock", "rod_to_front"
@@ -148,6 +149,9 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
     engine raises their lower bounds as the modules advance. Only for rigid
     clutches: a compliant ratchet (finite ``clutch_stiffness``) holds its
     modules with its clutch actuators' springs, and its slides stay unlimited.
+    A finite grip (``params.grip``) adds a carriage per module between the
+    module and the wall (:mod:`.grip_model`); the ratchet then acts on the
+    wheels' roll, a tendon, and the slides stay unlimited.
     """
     check_params(params)
     spec = load_spec(mjcf)
@@ -155,6 +159,9 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
     for write in (_write_mechanism, _write_drive, _write_gravity, _write_clutches):
         write(spec, params, hint)
     _write_solver(spec, settings, hint, ratchet and params.clutch_stiffness is None)
+    if params.grip is not None:  # the wheels' finite grip: carriages and tendons (grip_model), rigid or compliant
+        write_grip(spec, params, [settings.time_constant, 1.0], [*settings.solimp, 0.5, 2.0], SLIDES,
+                   (REAR_CLUTCH, FRONT_CLUTCH))
     return spec
 
 
@@ -305,10 +312,13 @@ def build_model(params: RobotParams, settings: SolverSettings = SolverSettings()
     """Compile the robot for ``params`` (see :func:`build_spec`)."""
     spec = build_spec(params, settings, mjcf, ratchet)
     try:
-        return spec.compile()
+        model = spec.compile()
     except ValueError as exc:
         message = " ".join(str(exc).split())
         raise ParameterError(f"the MuJoCo model does not compile for these parameters: {message}") from None
+    if params.grip is not None:
+        scale_grip_rows(model, SLIDES)
+    return model
 
 
 def closed_loop_pose(params: RobotParams, phi: float) -> dict[str, float]:

@@ -38,7 +38,11 @@ figures show it while the run goes, each measured on the run's own state:
     2e-4 r keeps that at 1e-4, a tenth of the 0.1 % target; 1e-5 m for the
     paper's crank. Rigid clutches only: a compliant clutch's module moving back
     is its physics (the series' ``clutch_overlap1``/``clutch_overlap2``), so
-    the figure stays 0 there.
+    the figure stays 0 there. On finite grip (:mod:`.grip`) it is the give of
+    either one-way limit, the wheels' roll below its running maximum and the
+    carriage above its running minimum (compliant clutches: the carriage's);
+    a module skidding back moves its carriage's running minimum itself and is
+    not a give.
 
 Crossing a tolerance stops the run with a :class:`SimulationError` that names
 the time, the figure, its value, the tolerance and the remedy

@@ -32,6 +32,7 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import COLUMNS, Mode
 
 from .clutches import equality_row
+from .grip_model import SKIDS
 from .common import REST_SPEED
 from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
 
@@ -39,21 +40,25 @@ from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_ad
 # along the rod), motor power [W], total momentum along x [kg m/s], motor torque [N m],
 # loop-closure gap [m]; and the cumulative energy columns every driving engine writes [J].
 # With compliant clutches also: overlaps clutch_overlap1/2 d_i [m] (> 0: the spring is compressed), the springs'
-# stored energy clutch_spring_energy and the dampers' cumulative dissipation clutch_damper_work [J].
+# stored energy clutch_spring_energy and the dampers' cumulative dissipation clutch_damper_work [J]. With finite
+# grip also: slip1/2, grip_use1/2, skid_work, wheels1/2 (ipir_mujoco.core.results).
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
 # the per-sample scalars, in their order in Recorder.scalars (the compiled loop writes them too: native.py checks
 # the order against _stepper.c's)
 SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
-           "friction_work", "clutch_damper_work")
+           "friction_work", "clutch_damper_work", "skid_work", "wheels1", "wheels2")
+NO_WHEELS = (0.0, 0.0)  # the wheels' states of a sample without grip (none are written)
 _NO_REACTIONS = (0.0, 0.0, 0.0, 0.0)  # a compliant clutch's sample, until its deferred forces (as _stepper.c)
 # MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
 DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
             "clutch_overlap2", "clutch_spring")
 
 
-def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarray) -> np.ndarray:
+def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarray, *also: np.ndarray):
     """``mode`` with each sample where both modules are held while the crank turns (at it or at the next
     sample) given the mode of the next sample that is not such (arrays of shape (n,); both, turning: bool).
+    Arrays in ``also`` (of shape (n,): the wheels' states with finite grip) are relabeled alike, and then
+    returned after the mode, as a tuple.
 
     With rigid clutches both modules stand still only where the crank is at rest, or for an instant as it
     passes a dead centre (dS/dphi = 0): where one module stops just as the other starts, the equations
@@ -65,14 +70,17 @@ def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarra
     turning = turning | np.concatenate([turning[1:], turning[-1:]])
     passing = both & turning
     if not passing.any():
-        return mode
+        return (mode, *also) if also else mode
     n = mode.size
     # index of the first sample at or after each that is not a passage (n where none is)
     following = np.minimum.accumulate(np.where(passing, n, np.arange(n))[::-1])[::-1]
     relabel = passing & (following < n)
-    out = mode.copy()
-    out[relabel] = mode[following[relabel]]
-    return out
+    outs = []
+    for values in (mode, *also):
+        out = values.copy()
+        out[relabel] = values[following[relabel]]
+        outs.append(out)
+    return tuple(outs) if also else outs[0]
 
 
 class Recorder:
@@ -86,6 +94,8 @@ class Recorder:
         self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
+        # finite grip: the carriages' positions (their running minimum is the wheels' skid so far)
+        self.skid_q = None if params.grip is None else [qpos_address(model, n) for n in SKIDS]
         # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
         self.site, self.front, offset = pin_offset(model, data)  # data: after mj_forward
         self.pin_offset = offset.tolist()
@@ -103,7 +113,7 @@ class Recorder:
         self._energy, self._subtree_linvel = data.energy, data.subtree_linvel
 
     def sample(self, torque: float, motor_work: float, friction_work: float, reactions,
-               damper_work: float = 0.0, excursion: float = 0.0) -> int:
+               damper_work: float = 0.0, excursion: float = 0.0, skid_work: float = 0.0, wheels=NO_WHEELS) -> int:
         """Store the current state as a sample; returns its row (its deferred values come later).
 
         ``torque`` [N m]: the drive's torque over the last step; ``motor_work``,
@@ -112,7 +122,8 @@ class Recorder:
         held, rear reaction [N], front reaction [N]; a compliant clutch's are
         read from its forces at the sample's own state, a step later, so they
         are stored as none here); ``excursion`` [m]: its backward excursion so
-        far.
+        far; with finite grip ``skid_work`` [J]: the grips' cumulative work against skidding, and ``wheels``:
+        each module's wheels (+1.0 rolling, 0.0 standing, -1.0 skidding).
         """
         d, i = self.data, self.count
         self.t[i] = d.time
@@ -122,7 +133,7 @@ class Recorder:
         fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
         if self.clutch is not None:
             reactions = _NO_REACTIONS
-        self.scalars[i] = (torque, fx, fy, *reactions, motor_work, friction_work, damper_work)
+        self.scalars[i] = (torque, fx, fy, *reactions, motor_work, friction_work, damper_work, skid_work, *wheels)
         self.excursion[i] = excursion
         self.count += 1
         return i
@@ -165,8 +176,11 @@ class Recorder:
         mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
                         np.where(held2, int(Mode.CONTRACTION),
                                  np.where(held1, int(Mode.EXPANSION), int(Mode.BOTH_MOVING))))
-        if self.clutch is None:
+        if self.clutch is None and self.skid_q is None:
             mode = _dead_centre_passages(mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED)
+        elif self.clutch is None:  # finite grip: the wheels' states pass through a dead centre with the mode
+            mode, sc["wheels1"], sc["wheels2"] = _dead_centre_passages(
+                mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED, sc["wheels1"], sc["wheels2"])
         out = {
             "t": self.t[:n].copy(), "phi": phi.copy(), "omega": omega.copy(), "alpha": accel[:, cv],
             "x1": q[:, r1] - q[0, r1], "x2": q[:, f2] - q[0, f2], "v1": v[:, r1v].copy(), "v2": v[:, f2v].copy(),
@@ -186,5 +200,21 @@ class Recorder:
                         "clutch_spring_energy": 0.5 * self.clutch.k * (np.maximum(d1, 0.0) ** 2
                                                                        + np.maximum(d2, 0.0) ** 2),
                         "clutch_damper_work": sc["clutch_damper_work"].copy()})
+        if self.skid_q is not None:
+            out.update(self._grip_columns(q, sc, out))
         assert set(COLUMNS) <= set(out)
         return out
+
+    def _grip_columns(self, q: np.ndarray, sc: dict, out: dict) -> dict[str, np.ndarray]:
+        """The finite-grip columns (``ipir_mujoco.core.results``): slip1/2 [m], each carriage's backward travel
+        below its start (its running minimum over the samples: the carriage only skids back, its limit holds
+        it from going forward), grip_use1/2 = lambda_i / G_i (1 while skidding where G_i = 0), the grips'
+        cumulative work skid_work [J] and the wheels' states wheels1/2."""
+        cols = {}
+        for k, (adr, G) in enumerate(zip(self.skid_q, self.params.grip), start=1):
+            wheels = sc[f"wheels{k}"]
+            cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
+            cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"wheels{k}"] = wheels.copy()
+        cols["skid_work"] = sc["skid_work"].copy()
+        return cols

@@ -17,7 +17,10 @@ do a non-finite state and a MuJoCo error (``mujoco.FatalError``).
 Clutches: rigid one-way clutches are the joint-limit ratchet or the locks
 (:mod:`.clutches`); with a finite ``clutch_stiffness`` the ratchet becomes the
 compliant clutch (:mod:`.compliant`): a ratcheting anchor per module and a
-spring and damper from it to the module, MuJoCo actuator forces.
+spring and damper from it to the module, MuJoCo actuator forces. With a finite
+``mu_wall`` the wheels grip the wall with at most G_i: a light carriage per
+module on the wall, held by friction G_i, carries the clutch (:mod:`.grip_model`,
+:mod:`.grip`, :mod:`.grip_compliant`).
 
 Energy audit, per step with the velocities v_{n+1} that move the positions
 (q_{n+1} = q_n + dt v_{n+1}): drive work tau * (phi_{n+1} - phi_n) with the
@@ -25,8 +28,10 @@ torque MuJoCo applied over the step (for the motor, whose velocity term the
 implicit integrator treats implicitly, tau(omega_{n+1})), work against the
 resistances from the frictionloss rows, kinetic and potential energy from
 MuJoCo's own ``energy``; with compliant clutches also the springs' stored
-energy and the dampers' dissipation (:mod:`.compliant`). ``residual_j`` =
-motor - friction - kinetic - potential (- clutch spring and damper) is what
+energy and the dampers' dissipation (:mod:`.compliant`); with finite grip
+also the grips' work against skidding, from the carriages' friction rows
+(``skid_j``). ``residual_j`` = motor - friction - kinetic - potential
+(- clutch spring and damper - skid) is what
 the soft constraints (rigid clutches, loop, friction rows) and the time
 discretization (the clutch springs' stepping included) took together; the
 monitor holds it to a tolerance.
@@ -54,13 +59,13 @@ from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captu
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from .recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
+from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 
 # columns of the recorder's arrays the monitor reads
-_TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK = (SCALARS.index(n) for n in (
-    "motor_torque", "motor_work", "friction_work", "clutch_damper_work"))
+_TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK, _SKID_WORK = (SCALARS.index(n) for n in (
+    "motor_torque", "motor_work", "friction_work", "clutch_damper_work", "skid_work"))
 _KINETIC, _POTENTIAL, _SPRING, _GAP = (DEFERRED.index(n) for n in ("kinetic", "potential", "clutch_spring",
                                                                     "loop_gap"))
 
@@ -170,7 +175,11 @@ class _Run:
             spring = series["clutch_spring_energy"][-1] - series["clutch_spring_energy"][0]
             damper = series["clutch_damper_work"][-1]
             energy["clutch_spring_j"], energy["clutch_damper_j"] = float(spring), float(damper)
-        residual, scale = energy_audit(wm, wf + damper, kinetic, potential + spring, self.energy_floor)
+        dissipated = wf + damper
+        if self.params.grip is not None:
+            energy["skid_j"] = float(series["skid_work"][-1])
+            dissipated = dissipated + series["skid_work"][-1]
+        residual, scale = energy_audit(wm, dissipated, kinetic, potential + spring, self.energy_floor)
         energy["residual_j"] = float(residual)
         label = {"ratchet": "unilateral", "lock": self.clutch, "none": "none"}[self.implementation]
         return RunResult(
@@ -209,7 +218,8 @@ class _Run:
         torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
-        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion)
+        wheels = ctl.wheels() if self.params.grip is not None else NO_WHEELS
+        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=wheels)
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
         kinetic, potential, spring = (rec.deferred.item(row, c) for c in (_KINETIC, _POTENTIAL, _SPRING))
         self.energy0 = (kinetic, potential + spring)  # kinetic; potential with the clutch springs
@@ -290,7 +300,10 @@ class _Run:
         """The energy audit's (residual [J], scale [J]) of samples a..b-1 with energy floors ``floors`` [J]:
         the clutch springs count with the potential energy, their dampers with the friction work."""
         sc, de = self.recorder.scalars[a:b], self.recorder.deferred[a:b]
-        return energy_audit(sc[:, _MOTOR_WORK], sc[:, _FRICTION_WORK] + sc[:, _DAMPER_WORK],
+        dissipated = sc[:, _FRICTION_WORK] + sc[:, _DAMPER_WORK]
+        if self.params.grip is not None:  # and the grips' work against skidding
+            dissipated = dissipated + sc[:, _SKID_WORK]
+        return energy_audit(sc[:, _MOTOR_WORK], dissipated,
                             de[:, _KINETIC] - self.energy0[0], de[:, _POTENTIAL] + de[:, _SPRING] - self.energy0[1],
                             floors)
 

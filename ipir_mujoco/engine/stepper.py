@@ -1,9 +1,11 @@
 """The stepping loop of a serial MuJoCo run: compiled (C) where it can be, the same loop in Python otherwise.
 
 Between two output samples a run takes k steps, and each step the engine
-updates the clutches before ``mj_step`` (:mod:`.clutches`, :mod:`.compliant`),
-does the clutches' bookkeeping after it and adds the drive's work and the work
-against the resistances; then it records the sample (:mod:`.recorder`).
+updates the clutches before ``mj_step`` (:mod:`.clutches`, :mod:`.compliant`,
+:mod:`.grip`), does the clutches' bookkeeping after it and adds the drive's work
+and the work against the resistances (with finite grip also the grips' work
+against skidding; the rows it reads: :mod:`.loop_rows`); then it records the
+sample (:mod:`.recorder`).
 :class:`PythonSteps` is that loop in Python: :meth:`PythonSteps.record` takes a
 block of output intervals and records each. :class:`CompiledSteps` hands the
 block to ``_stepper.c`` (a C extension built at install time), which calls the
@@ -35,42 +37,20 @@ from operator import itemgetter
 import mujoco
 import numpy as np
 
-from ipir_mujoco.core.errors import ParameterError
-
 from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
+from .compiled_grip import load_grip
 from .compliant import CompliantClutches
-from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
+from .grip import GripRatchet
+from .grip_compliant import CompliantGrip
+from .loop_rows import loop_options  # noqa: F401  (make_steps' options: the viewer imports it from here)
 from .native import LayoutError, compiled, pointers
 from .native import address as array_address
-from .recorder import Recorder
+from .recorder import NO_WHEELS, Recorder
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
-CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant")
-FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant", "grip_ratchet", "compliant_grip")
 DONE, WARNED = 0, 3  # what record() returns: all intervals taken, or MuJoCo warned in the last one (_stepper.c's)
-
-
-def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
-    """:func:`make_steps`' keyword arguments for a built model after ``mj_forward`` on its initial state: the
-    crank actuator and joint, the drive's implicit torque slope (:func:`.model.drive_torque_slope`), the
-    dofs with friction and the initial torque [N m]. The loop counts the work against the resistances from
-    the two slides' frictionloss rows only: friction on another dof, or other rows, is a ParameterError."""
-    slides = {dof_address(model, n) for n in SLIDES}
-    friction_dofs = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
-    if not set(friction_dofs) <= slides:
-        names = ", ".join(repr(model.joint(model.dof_jntid[i]).name) for i in friction_dofs if i not in slides)
-        raise ParameterError(f"frictionloss on {names} in the MJCF model: the engine counts resistances on the "
-                             "two slides only; allowed: frictionloss on rear_slide and front_slide (F_r1, F_r2)")
-    # the frictionloss rows follow the equality rows, one per dof with friction, in dof order
-    rows = range(data.ne, data.ne + data.nf)
-    if data.nf != len(friction_dofs) or any(data.efc_type[r] != FRICTION_ROW or data.efc_id[r] != dof
-                                            for r, dof in zip(rows, friction_dofs)):
-        raise ParameterError("the MJCF model has friction rows the engine does not expect (only the slides' "
-                             "frictionloss)")
-    motor = model.actuator(MOTOR).id
-    return dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                slope=drive_torque_slope(model), friction_dofs=friction_dofs, torque=data.actuator_force.item(motor))
 
 
 class PythonSteps:
@@ -85,18 +65,22 @@ class PythonSteps:
     compiled = False
 
     def __init__(self, model, data, controller, qvel_before, *, motor, crank_q, crank_v, slope, friction_dofs,
-                 torque, servo=None):
+                 torque, servo=None, grip=None):
         self.model, self.data, self.controller, self.qvel_before = model, data, controller, qvel_before
         self.motor, self.crank_q, self.crank_v, self.slope = motor, crank_q, crank_v, slope
         self.friction_dofs, self.servo = list(friction_dofs), servo
         self.fric_a, self.fric_b = (self.friction_dofs + [0, 0])[:2]  # the slides' dofs (0: no row)
         self.torque, self.motor_work, self.friction_work = torque, 0.0, 0.0
         self.omega_prev = data.qvel.item(crank_v)
+        self.grip = grip  # a finite-grip model's friction rows (grip_layout), or None
+        self.skid_work = 0.0  # the grips' cumulative work against skidding [J] (finite grip)
 
     def run(self, nstep: int, row: int = -1) -> None:
         """``nstep`` steps; the velocities before the last one go to ``qvel_before[row]`` (row >= 0).
 
         The inner loop works on Python floats (one ``tolist`` per array read)."""
+        if self.grip is not None:
+            return self._run_grip(nstep, row)
         m, d, ctl = self.model, self.data, self.controller
         dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
         step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
@@ -129,6 +113,47 @@ class PythonSteps:
             omega_prev = omega
         self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
 
+    def _run_grip(self, nstep: int, row: int = -1) -> None:
+        """:meth:`run` on a finite-grip model: the work against the rolling resistances from their rows
+        (at the roll's speed v_x - v_c with rigid clutches, the slide's v_x with compliant ones) and the
+        grips' work against skidding from the carriages' rows (at v_c), the friction rows' force times the
+        speed they act at after the step, as without grip."""
+        m, d, ctl = self.model, self.data, self.controller
+        dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
+        step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
+        motor, cq, cv, slope = self.motor, self.crank_q, self.crank_v, self.slope
+        g = self.grip
+        count, tendon = g["count"], g["rolling_tendon"]
+        per_module = tuple(zip(g["roll"], g["grip"], g["x_dof"], g["c_dof"]))
+        torque, wm, wf, ws = self.torque, self.motor_work, self.friction_work, self.skid_work
+        omega_prev = self.omega_prev
+        for j in range(nstep):
+            if servo is not None:
+                ctrl[motor] = servo.torque(d.time, qpos[cq], qvel[cv])
+            before()
+            if j == nstep - 1 and row >= 0:
+                self.qvel_before[row] = qvel
+            step(m, d)
+            if after is not None:
+                after()
+            v = qvel.tolist()
+            omega = v[cv]
+            torque = d.actuator_force.item(motor) + slope * (omega - omega_prev)
+            wm += torque * omega * dt
+            if d.nf != count:
+                raise missing_rows(2, d.time)
+            ne, force, rolling, skidding = d.ne, d.efc_force, 0.0, 0.0  # the rows move in MuJoCo's arena each step
+            for roll, grip, x, c in per_module:
+                if roll >= 0:
+                    rolling += force.item(ne + roll) * ((v[x] - v[c]) if tendon else v[x])
+                if grip >= 0:
+                    skidding += force.item(ne + grip) * v[c]
+            wf -= rolling * dt
+            ws -= skidding * dt
+            omega_prev = omega
+        self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
+        self.skid_work = ws
+
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
                messages: list[str]) -> tuple[int, int]:
         """Up to ``nsamples`` output intervals of ``sps`` steps each (the last one cut at ``remaining``
@@ -153,7 +178,7 @@ class PythonSteps:
             if len(messages) != warned:  # the state may be MuJoCo's reset: nothing to record
                 return WARNED, taken
             pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(), ctl.damper_work,
-                                 ctl.excursion)
+                                 ctl.excursion, self.skid_work, ctl.wheels() if self.grip is not None else NO_WHEELS)
         return DONE, taken
 
 
@@ -186,6 +211,12 @@ class CompiledSteps(PythonSteps):
             model=model_address, data=data_address, qvel_before=array_address(qvel_before), motor=self.motor,
             crank_q=self.crank_q, crank_v=self.crank_v, nfric=len(self.friction_dofs), fric_a=self.fric_a,
             fric_b=self.fric_b)
+        if self.grip is not None:  # the rolling resistances' and the grips' rows (grip_layout)
+            g = self.grip
+            self._set_config(grip=1, nfric=g["count"], roll_off0=g["roll"][0], roll_off1=g["roll"][1],
+                             grip_off0=g["grip"][0], grip_off1=g["grip"][1], slide_v0=g["x_dof"][0],
+                             slide_v1=g["x_dof"][1], skid_v0=g["c_dof"][0], skid_v1=g["c_dof"][1],
+                             rolling_tendon=g["rolling_tendon"])
         self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
         self._cfg[self.C["eq_rows"]] = array_address(self._eq_rows) if self._eq_rows.size else 0
         self._set_state(dt=model.opt.timestep, slope=self.slope, torque=self.torque,
@@ -205,6 +236,7 @@ class CompiledSteps(PythonSteps):
             raise missing_rows(exc.args[0], self.data.time) from None
         state = self._st.tolist()
         self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
+        self.skid_work = state[self.S["skid_work"]]
         self._sync(state)
 
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
@@ -223,6 +255,7 @@ class CompiledSteps(PythonSteps):
             rec.count = int(st[S["count"]])
         state = st.tolist()
         self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
+        self.skid_work = state[S["skid_work"]]
         self._sync(state)
         return status, int(state[S["steps_done"]])
 
@@ -232,6 +265,8 @@ class CompiledSteps(PythonSteps):
         ctl = self.controller
         friction = getattr(ctl, "friction", None)
         fric_off, resist = (friction.offsets, friction.resistance) if friction is not None else ([-1, -1], [0, 0])
+        if isinstance(ctl, GripRatchet):
+            resist = ctl.resistance
         self._set_config(
             rod_site=rec.site, front_body=rec.front, loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
             rec_qpos=array_address(rec.qpos), rec_qvel=array_address(rec.qvel),
@@ -270,6 +305,10 @@ class CompiledSteps(PythonSteps):
             set_state(held0=ctl.held[0], held1=ctl.held[1], force0=ctl.forces[0], force1=ctl.forces[1], r=ctl.r,
                       L=ctl.L, excursion=ctl.excursion)
             self._sync, self._get = self._sync_locks, self._getter("held0", "held1", "force0", "force1", "excursion")
+        elif isinstance(ctl, (GripRatchet, CompliantGrip)):  # finite grip (compiled_grip)
+            kind, names, sync = load_grip(ctl, self.grip, self.model.opt.timestep, set_config, set_state)
+            get = self._getter(*names)
+            self._sync = lambda state: sync(self.controller, get(state))
         elif isinstance(ctl, CompliantClutches):
             kind = "compliant"
             set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], slide_v0=ctl.dof_adr[0],

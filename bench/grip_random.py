@@ -1,0 +1,86 @@
+"""Benchmark: do the two engines agree on random designs on wheels of finite grip, or say why not?
+
+Run on demand (not part of the test suite):
+
+    python bench/grip_random.py [--designs 40] [--seed 3] [--t-end 1] [--budget 60] [--workers 2]
+
+Designs: ipir_mujoco.studies.agreement.draw (geometry, masses, resistances, drive, incline over wide
+ranges; see its docstring) with rigid one-way clutches (this branch's analytic engine has no compliant
+clutch on finite grip), on a grip drawn per design: mu_wall uniform in [0, 1] and each F_ni log-uniform
+in [1, 200] N, so that grips run from none to far above the demand. Each design runs the analytic one-way
+model and MuJoCo's ratchet at their default settings and is judged as the agreement study judges
+(revolutions and travel within 0.1 %, 1 %, refused, failed, DISAGREE); the skids are compared against
+max(skid, 1e-2 stroke), and the worst skid difference is printed with the design.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from concurrent import futures
+from dataclasses import replace
+
+import numpy as np
+
+from ipir_mujoco import registry
+from ipir_mujoco.analytic import ParameterError, SimulationError
+from ipir_mujoco.studies.agreement import describe, draw, judge, run_pair
+
+
+def grip_design(rng: np.random.Generator):
+    base = replace(draw(rng), clutch_stiffness=None, clutch_damping=0.0, clutch_backlash=0.0)
+    log = lambda lo, hi: float(math.exp(rng.uniform(math.log(lo), math.log(hi))))  # noqa: E731
+    return replace(base, mu_wall=float(rng.uniform(0, 1)), F_n1=log(1, 200), F_n2=log(1, 200))
+
+
+def run_one(index: int, params, t_end: float, budget: float) -> dict:
+    row = {"design": index, **run_pair(params, t_end, budget)}
+    slips = {}
+    for name, variant in (("analytic", "analytic-unilateral"), ("mujoco", "mujoco-ratchet")):
+        try:  # the skids of the same runs (run_pair keeps only revolutions and travel)
+            s = registry.run(variant, params, t_end, dt_out=1e-3, wall_budget_s=budget).summary
+            slips[name] = (s["slip1_m"], s["slip2_m"])
+        except (ParameterError, SimulationError):
+            slips[name] = None
+    row["slips"] = slips
+    return row
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--designs", type=int, default=40)
+    parser.add_argument("--seed", type=int, default=3)
+    parser.add_argument("--t-end", type=float, default=1.0, help="simulated time per design [s]")
+    parser.add_argument("--budget", type=float, default=60.0, help="wall-time budget per engine and design [s]")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    rng = np.random.default_rng(args.seed)
+    designs = [grip_design(rng) for _ in range(args.designs)]
+    counts: dict[str, int] = {}
+    worst = 0.0
+    started = time.perf_counter()
+    with futures.ProcessPoolExecutor(args.workers) as pool:
+        jobs = [pool.submit(run_one, i, p, args.t_end, args.budget) for i, p in enumerate(designs)]
+        for job in futures.as_completed(jobs):
+            row = job.result()
+            verdict, detail, _ = judge(row)
+            counts[verdict] = counts.get(verdict, 0) + 1
+            skid = ""
+            a, m = row["slips"]["analytic"], row["slips"]["mujoco"]
+            if a is not None and m is not None:
+                floor = 1e-2 * 2 * row["params"].r
+                rel = max(abs(mj - an) / max(an, floor) for an, mj in zip(a, m))
+                worst = max(worst, rel)
+                skid = f", skids {1e3 * a[0]:.3g} / {1e3 * a[1]:.3g} mm, worst difference {rel:.1e}"
+            print(f"[{row['design']:3d}] {verdict:9s} {detail}{skid}  (wall {row['analytic_wall']:.2f} / "
+                  f"{row['mujoco_wall']:.2f} s)", flush=True)
+            if verdict != "agree":
+                p = row["params"]
+                print(f"      {describe(p)}, mu_wall {p.mu_wall:.3g}, F_n {p.F_n1:.3g} / {p.F_n2:.3g} N", flush=True)
+    print(f"\n{args.designs} designs, {time.perf_counter() - started:.0f} s wall: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + f"; worst skid difference {worst:.1e}")
+
+
+if __name__ == "__main__":
+    main()

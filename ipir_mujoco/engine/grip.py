@@ -1,0 +1,209 @@
+"""The one-way clutches on wheels of finite grip in MuJoCo: two ratchets per module, MuJoCo's rows do the rest.
+
+The model (:mod:`.grip_model`) gives each module a carriage c_i on the wall,
+held by Coulomb friction G_i, and a tendon L_i = x_i - c_i, the wheels' roll,
+with the rolling resistance F_ri. Before every step the controller moves two
+one-sided bounds per module, each as the rigid ratchet does
+(:class:`.clutches.Ratchet`, one margin from the running extreme):
+
+- the clutch: the roll's lower limit follows the running maximum of L_i (the
+  wheels do not roll back);
+- the wall: the carriage's upper limit follows the running minimum of c_i
+  (the locked wheels skid back, never forward).
+
+Everything else is MuJoCo's: a held module's ground force g = clutch row +
+roll friction row is held by the carriage's friction row up to G_i; beyond,
+that row sits at exactly G_i and the carriage slides back with the module; the
+roll's friction row lets the module roll forward at exactly F_ri.
+
+Reported per module (:meth:`GripRatchet.reactions`, :meth:`GripRatchet.wheels`):
+rolling while the roll's friction row slides (at -F_ri) and the clutch row does
+not push (the ratchet's test on x_i without grip); skidding while it does not
+roll and the carriage's friction row is at its bound G_i (with G_i = 0, where
+there is no row, while its hold pushes back at all); standing otherwise. The
+clutch's reaction is the clutch's share of the hold (:func:`.clutches.clutch_share`),
+0 while rolling; a skidding module's is what its clutch carries, G_i and the
+carriage's inertia times its acceleration. ``excursion`` [m]: the largest give
+of either one-way limit so far (L_i below its running maximum, c_i above its
+running minimum), checked before every step: the clutch's and the wall's give,
+never a skid (a skid moves c_i down, which is the running minimum itself).
+
+The same rules run compiled in ``_stepper.c`` (held equal bit for bit by
+``tests/test_mujoco_stepper.py``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+
+from ipir_mujoco.core.params import RobotParams
+
+from .clutches import clutch_share, missing_rows
+from .common import REST_SPEED
+from .grip_model import ROLLS, SKIDS
+from .model import SLIDES, dof_address, qpos_address
+
+FRICTION_DOF, FRICTION_TENDON = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF), int(
+    mujoco.mjtConstraint.mjCNSTR_FRICTION_TENDON)
+LIMIT_TENDON = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON)
+
+
+def lower_bound(value: float, margin: float) -> float:
+    """The lower bound [m] one margin [m] below ``value``, raised by the last ulps until MuJoCo's distance to it,
+    value - bound, is below the margin: so the limit row exists at the running extreme itself (MuJoCo adds a
+    row while the distance is below the margin, and its soft limit pulls the distance to the margin, the
+    row's own edge)."""
+    bound = value - margin
+    while value - bound >= margin:
+        bound = math.nextafter(bound, math.inf)
+    return bound
+
+
+def upper_bound(value: float, margin: float) -> float:
+    """As :func:`lower_bound`, the upper bound one margin above ``value`` (MuJoCo's distance: bound - value)."""
+    bound = value + margin
+    while bound - value >= margin:
+        bound = math.nextafter(bound, -math.inf)
+    return bound
+
+
+class GripRows:
+    """Where each module's friction rows sit among MuJoCo's friction rows: the carriage's (the grip) and the
+    rolling resistance's (the roll tendon with rigid clutches, the module slide with compliant ones).
+
+    MuJoCo puts the friction rows after the equality rows, the dofs' in dof order, then the tendons' in
+    tendon order, one per element with friction: fixed by the model. ``grip``, ``roll``: offsets among them
+    per module (-1: no row, a zero grip or resistance); ``count``: how many; ``grips``, ``resistances`` [N].
+    """
+
+    def __init__(self, model: mujoco.MjModel, roll_on_tendon: bool):
+        dofs = [i for i in range(model.nv) if model.dof_frictionloss[i] > 0]
+        tendons = [i for i in range(model.ntendon) if model.tendon_frictionloss[i] > 0]
+        order = [(FRICTION_DOF, i) for i in dofs] + [(FRICTION_TENDON, i) for i in tendons]
+        self.count = len(order)
+
+        def offset(kind, index):
+            return order.index((kind, index)) if (kind, index) in order else -1
+
+        skid_dofs = [dof_address(model, n) for n in SKIDS]
+        self.grip = [offset(FRICTION_DOF, dof) for dof in skid_dofs]
+        self.grips = [float(model.dof_frictionloss[dof]) for dof in skid_dofs]
+        if roll_on_tendon:
+            rolls = [model.tendon(n).id for n in ROLLS]
+            self.roll = [offset(FRICTION_TENDON, t) for t in rolls]
+            self.resistances = [float(model.tendon_frictionloss[t]) for t in rolls]
+        else:
+            slides = [dof_address(model, n) for n in SLIDES]
+            self.roll = [offset(FRICTION_DOF, dof) for dof in slides]
+            self.resistances = [float(model.dof_frictionloss[dof]) for dof in slides]
+
+    def forces(self, data: mujoco.MjData) -> tuple[list[float], list[float]]:
+        """(grip rows, roll rows) [N] of the last step, per module (0.0 where a module has no row)."""
+        if data.nf != self.count:
+            raise missing_rows(2, data.time)
+        ne, force = data.ne, data.efc_force
+        grip = [force.item(ne + k) if k >= 0 else 0.0 for k in self.grip]
+        roll = [force.item(ne + k) if k >= 0 else 0.0 for k in self.roll]
+        return grip, roll
+
+
+class GripRatchet:
+    """The rigid one-way clutches on finite grip (module docstring): moves the clutch's and the wall's bounds.
+
+    ``model`` built with a finite ``params.grip`` and rigid clutches; call it after the initial state is set.
+    ``bounds`` [m]: running maximum of each roll L_i; ``lowest`` [m]: running minimum of each carriage c_i.
+    """
+
+    name = "grip ratchet"
+    after_step = None
+    damper_work = 0.0
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
+        if params.grip is None or params.clutch_stiffness is not None:
+            raise ValueError("GripRatchet needs a model built with a finite mu_wall and rigid clutches")
+        self.model, self.data = model, data
+        self.x_adr = [qpos_address(model, n) for n in SLIDES]
+        self.c_adr = [qpos_address(model, n) for n in SKIDS]
+        self.c_dof = [dof_address(model, n) for n in SKIDS]
+        self.x_dof = [dof_address(model, n) for n in SLIDES]
+        self.skid_ids = [model.joint(n).id for n in SKIDS]
+        self.roll_ids = [model.tendon(n).id for n in ROLLS]
+        limited = [j for j in range(model.njnt) if model.jnt_limited[j]]
+        if sorted(limited) != sorted(self.skid_ids) or not all(model.tendon_limited[t] for t in self.roll_ids):
+            raise ValueError("the grip ratchet needs the carriages' slides and the rolls limited, and no other "
+                             "joint: build the model from these parameters")
+        self.roll_margins = [float(model.tendon_margin[t]) for t in self.roll_ids]
+        self.skid_margins = [float(model.jnt_margin[j]) for j in self.skid_ids]
+        q = data.qpos
+        self.bounds = [float(q[x]) - float(q[c]) for x, c in zip(self.x_adr, self.c_adr)]
+        self.lowest = [float(q[c]) for c in self.c_adr]
+        self._tendon_range, self._jnt_range = model.tendon_range, model.jnt_range
+        for k in (0, 1):
+            self._tendon_range[self.roll_ids[k], 0] = lower_bound(self.bounds[k], self.roll_margins[k])
+            self._jnt_range[self.skid_ids[k], 1] = upper_bound(self.lowest[k], self.skid_margins[k])
+        self.excursion = 0.0
+        self._qpos, self._qvel = q, data.qvel
+        self._per_module = tuple(zip((0, 1), self.x_adr, self.c_adr, self.roll_ids, self.skid_ids))
+        self.rows = GripRows(model, roll_on_tendon=True)
+        self.grip, self.resistance = self.rows.grips, self.rows.resistances  # G_i, F_ri [N]
+
+    def before_step(self) -> None:
+        """Raise each roll's bound to its running maximum and lower each carriage's to its running minimum,
+        or note how far either has given."""
+        q, bounds, lowest = self._qpos, self.bounds, self.lowest
+        for k, xa, ca, t, j in self._per_module:
+            c = q.item(ca)
+            roll = q.item(xa) - c
+            if roll > bounds[k]:
+                bounds[k] = roll
+                self._tendon_range[t, 0] = lower_bound(roll, self.roll_margins[k])
+            elif bounds[k] - roll > self.excursion:
+                self.excursion = bounds[k] - roll
+            if c < lowest[k]:
+                lowest[k] = c
+                self._jnt_range[j, 1] = upper_bound(c, self.skid_margins[k])
+            elif c - lowest[k] > self.excursion:
+                self.excursion = c - lowest[k]
+
+    def _clutch_rows(self) -> list[float]:
+        """The rolls' limit rows [N] of the last step (0.0 for a roll without one): the limit rows follow the
+        equality and friction rows, the joints' first, then the tendons' in tendon order."""
+        d = self.data
+        out = [0.0, 0.0]
+        start = d.ne + d.nf
+        for row in range(start, start + d.nl):
+            if d.efc_type[row] == LIMIT_TENDON:
+                t = d.efc_id[row]
+                out[0 if t == self.roll_ids[0] else 1] = d.efc_force.item(row)
+        return out
+
+    def states(self) -> tuple[list[int], list[float]]:
+        """Per module, its wheels' state (+1 rolling, 0 standing, -1 skidding) and its clutch's share of
+        the hold [N], of the last step (module docstring)."""
+        clutch = self._clutch_rows()
+        grip_force, roll_force = self.rows.forces(self.data)
+        states, shares = [], []
+        for k in (0, 1):
+            hold = clutch[k] + roll_force[k]
+            F, G = self.resistance[k], self.grip[k]
+            if not (clutch[k] > 0.0 or roll_force[k] > -F):
+                states.append(1)
+                shares.append(0.0)
+                continue
+            skids = grip_force[k] >= G if G > 0.0 else self._qvel.item(self.c_dof[k]) < -REST_SPEED
+            states.append(-1 if skids else 0)
+            shares.append(clutch_share(hold, F))
+        return states, shares
+
+    def reactions(self) -> tuple[bool, bool, float, float]:
+        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step: held while it
+        stands."""
+        states, shares = self.states()
+        return states[0] == 0, states[1] == 0, shares[0], shares[1]
+
+    def wheels(self) -> tuple[float, float]:
+        """Each module's wheels' state of the last step: +1.0 rolling, 0.0 standing, -1.0 skidding."""
+        states, _ = self.states()
+        return float(states[0]), float(states[1])

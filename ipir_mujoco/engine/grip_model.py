@@ -1,0 +1,110 @@
+"""The wheels' finite grip in the MuJoCo model: a light carriage per module, held on the wall by friction.
+
+A real clutch locks its module's wheels, and locked wheels hold by friction on
+the wall, with at most G_i = mu_wall F_ni (``params.grip``). The builder adds,
+per module, only where the grip is finite (unlimited grip builds today's model,
+element for element):
+
+- a **carriage**: a body on its own slide along the pipe (``rear_skid``,
+  ``front_skid``: the wheels' contact on the wall, x = c_i), with Coulomb
+  friction G_i (the slide's ``frictionloss``: MuJoCo holds it up to G_i and lets
+  it slide at exactly G_i beyond), and an upper limit the engine lowers to the
+  running minimum of c_i (:mod:`.grip`): the wheels can roll forward but never
+  skid forward, so a grip below F_ri cannot drag the module forward;
+- a fixed **tendon** L_i = x_i - c_i (``rear_roll``, ``front_roll``): how far
+  the wheels have rolled. The module slides stay absolute (x_i is still one
+  qpos, the loop and every position column unchanged). With rigid clutches
+  the tendon carries the rolling resistance (``frictionloss`` F_ri, the
+  module slide's moved to it: none while the wheels are locked, so none while
+  the module skids) and the one-way clutch (a tendon limit whose lower bound
+  the engine raises to the running maximum of L_i, as the ratchet on x_i
+  without grip). With compliant clutches the clutch actuators act on the
+  tendon (their anchor rides on the carriage, so it slides with it), and the
+  module keeps its own Coulomb resistance F_ri, as the analytic compliant
+  model has it.
+
+So a held module stands while the whole ground force g on it satisfies
+-F_ri <= g <= G_i, skids back at G_i beyond, and rolls forward at F_ri: the
+limits are MuJoCo's friction rows' bounds, by construction.
+
+The carriage's inertia, CARRIAGE_SHARE of its module's mass, is its slide's
+``armature`` (an inertia without weight, so it adds no load in a riser and no
+potential energy; its body has the nominal BODY_MASS MuJoCo requires of a
+moving body). It moves only while its module skids (with it, the clutch
+holding), where it adds its inertia to the module's: a relative bias of at
+most CARRIAGE_SHARE on a skid. MuJoCo scales a row's softness with the
+inverse inertia it sees at qpos0 (``dof_invweight0``, ``tendon_invweight0``),
+which for a carriage row is the carriage's, 1 / CARRIAGE_SHARE times its
+module's: the held module would creep back 1000 times faster than a module
+on its resistance today. The grip acts on the module through the carriage, so
+:func:`scale_grip_rows` gives the carriage's and the tendon's rows the
+module slide's own inverse weight: every row then leaks as today's module
+rows do. ``mjcf/README.md`` has the measurements behind both numbers.
+"""
+
+from __future__ import annotations
+
+import mujoco
+
+from ipir_mujoco.core.params import RobotParams
+
+CARRIAGES = ("rear_carriage", "front_carriage")  # bodies
+SKIDS = ("rear_skid", "front_skid")  # the carriages' slides: c_i
+ROLLS = ("rear_roll", "front_roll")  # tendons L_i = x_i - c_i
+CARRIAGE_SHARE = 1e-3  # carriage inertia over its module's mass
+BODY_MASS = 1e-12  # kg, inertia 1e-12 kg m^2: the carriage body's own (MuJoCo needs > 1e-15 on a moving body)
+MARGIN = 1e-9  # m: the one-way limits' margin, as the ratchet's (clutches.Ratchet)
+RANGE_FAR = 1e6  # m: a bound that never acts (the other side of each one-way limit)
+
+
+def write_grip(spec: mujoco.MjSpec, params: RobotParams, solref: list, solimp: list, slides: tuple[str, str],
+               clutch_actuators: tuple[str, str]) -> None:
+    """Add the carriages, their slides and the tendons for ``params.grip`` (finite); see the module docstring.
+
+    ``solref``, ``solimp``: every constraint's soft parameters (as the slides'); ``slides``: the modules'
+    slide joints, rear first; ``clutch_actuators``: the compliant clutches' actuators, moved onto the tendons
+    when ``params.clutch_stiffness`` is finite.
+    """
+    grips = params.grip
+    masses = (params.m1, params.m2)
+    compliant = params.clutch_stiffness is not None
+    resistances = (params.F_r1, params.F_r2)
+    for i in (0, 1):
+        slide = spec.joint(slides[i])
+        body = spec.worldbody.add_body(name=CARRIAGES[i], pos=list(slide.parent.pos))
+        body.explicitinertial = True
+        body.mass, body.ipos, body.inertia = BODY_MASS, [0, 0, 0], [BODY_MASS] * 3
+        skid = body.add_joint(name=SKIDS[i], type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
+        skid.armature = CARRIAGE_SHARE * masses[i]
+        skid.frictionloss = grips[i]
+        skid.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        skid.range = [-RANGE_FAR, RANGE_FAR]  # the engine sets the upper bound before the first step
+        skid.margin = MARGIN
+        skid.solref_limit, skid.solimp_limit = solref, solimp
+        skid.solref_friction, skid.solimp_friction = solref, solimp
+        roll = spec.add_tendon(name=ROLLS[i])
+        roll.wrap_joint(slides[i], 1.0)
+        roll.wrap_joint(SKIDS[i], -1.0)
+        roll.solref_limit, roll.solimp_limit = solref, solimp
+        roll.solref_friction, roll.solimp_friction = solref, solimp
+        if compliant:  # the clutch spring from the carriage; the module keeps its own resistance
+            act = spec.actuator(clutch_actuators[i])
+            act.trntype, act.target = mujoco.mjtTrn.mjTRN_TENDON, ROLLS[i]
+            roll.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+            roll.frictionloss = 0.0
+        else:  # rolling resistance and the one-way clutch on the wheels' roll
+            slide.frictionloss = 0.0
+            slide.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+            roll.frictionloss = resistances[i]
+            roll.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+            roll.range = [-RANGE_FAR, RANGE_FAR]  # the engine sets the lower bound before the first step
+            roll.margin = MARGIN
+
+
+def scale_grip_rows(model: mujoco.MjModel, slides: tuple[str, str]) -> None:
+    """Give each carriage's slide and each tendon the inverse weight of its module's slide (module
+    docstring): the inertia MuJoCo scales their rows' softness with, not the carriage's."""
+    for i in (0, 1):
+        weight = model.dof_invweight0[model.jnt_dofadr[model.joint(slides[i]).id]]
+        model.dof_invweight0[model.jnt_dofadr[model.joint(SKIDS[i]).id]] = weight
+        model.tendon_invweight0[model.tendon(ROLLS[i]).id] = weight
