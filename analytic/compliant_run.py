@@ -34,10 +34,11 @@ import numpy as np
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.results import RunResult
+from ipir_mujoco.core.results import REST_TIME, RunResult, stall_reason
 
 from . import accel, compliant_grip, dop853, kernels
 from .compliant_clutch import Clutch, CompliantModel, Regime
+from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .roots import brentq
@@ -90,9 +91,9 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
     t, pieces, switches, short_run, turns, stall = 0.0, [], 0, 0, 0, None
     while True:
         if regime.static:  # both stuck, crank at rest, every load constant: at rest for good
-            stall = (f"at rest for good from t={t:.6g} s: both modules held by friction and clutch springs, "
-                     f"crank at phi={y[0]:.6g} rad")
-            pieces.append(_piece(model, regime, sample_times(t, t_end, grid),
+            stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), model.dyn.a_g != 0)
+            # at rest for good: the run goes on REST_TIME at rest and ends, as every engine's does
+            pieces.append(_piece(model, regime, sample_times(t, min(t + REST_TIME, t_end), grid),
                                  lambda ts: np.repeat(y[:, None], np.size(ts), axis=1)))
             break
         target = params.phi0 + 2 * math.pi * (turns + 1)

@@ -43,7 +43,7 @@ import numpy as np
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.results import Mode, RunResult
+from ipir_mujoco.core.results import REST_TIME, Mode, RunResult, stall_reason
 
 from . import dop853, kernels
 from .dynamics import OneDofDynamics
@@ -51,7 +51,7 @@ from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, raw_piece,
-                             restart_step, stall_reason, truncate)
+                             restart_step, truncate)
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -132,9 +132,10 @@ def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # Everything at rest under a torque that is constant at rest: nothing changes any more.
-            stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g)
-            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
-                y[:, None], np.size(ts), axis=1), _STATES))
+            stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g != 0)
+            # at rest for good: the run goes on REST_TIME at rest and ends, as every engine's does
+            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
+                                    lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES))
             break
         sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0, constants)
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)

@@ -313,10 +313,3 @@ def truncate(piece: dict[str, np.ndarray], t_stop: float) -> dict[str, np.ndarra
     """The samples of ``piece`` at or before t_stop [s]."""
     keep = piece["t"] <= t_stop
     return {c: (v[keep] if np.ndim(v) else v) for c, v in piece.items()}
-
-
-def stall_reason(t: float, phi: float, torque: float, a_g: float) -> str:
-    """RunResult.stall for a robot at rest for good from time t [s] at crank angle phi [rad]."""
-    against = "the resistances and gravity" if a_g != 0 else "the resistances"
-    return (f"at rest from t={t:.6g} s at phi={phi:.6g} rad: the drive's torque at rest ({torque:.6g} N m) "
-            f"cannot move the linkage against {against}")

@@ -52,7 +52,7 @@ import numpy as np
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.results import Mode, RunResult
+from ipir_mujoco.core.results import REST_TIME, Mode, RunResult, stall_reason
 
 from . import accel, dop853, kernels
 from .dynamics import OneDofDynamics
@@ -60,7 +60,7 @@ from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, missed_crossing,
-                             raw_piece, restart_step, spurious_start, stall_reason, steps_until, truncate)
+                             raw_piece, restart_step, spurious_start, steps_until, truncate)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -326,9 +326,10 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque at rest")
             # at rest, held by statics, under a torque that is constant at rest: final
-            stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g)
-            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, t_end, grid), lambda ts: np.repeat(
-                y[:, None], np.size(ts), axis=1), _STATES))
+            stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g != 0)
+            # at rest for good: the run goes on REST_TIME at rest and ends, as every engine's does
+            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
+                                    lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES))
             break
         events = model.events(mode)
         sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)

@@ -216,8 +216,8 @@ def test_a_motor_too_weak_to_reach_the_next_dead_centre_stalls(geometry, clutch)
 
 def test_a_constant_torque_too_small_is_a_stall_from_the_start():
     run = analytic.simulate(RobotParams(M=0.005, phi0=0.4), "exact", "unilateral", 0.2)
-    assert run.stall == ("at rest from t=0 s at phi=0.4 rad: the drive's torque at rest (0.005 N m) cannot "
-                         "move the linkage against the resistances")
+    assert run.stall == ("at rest from t=0 s at phi=0.4 rad (22.9 deg in its turn): the drive's torque at rest "
+                         "(0.005 N m) cannot move the linkage against the resistances")
     up = analytic.simulate(RobotParams(M=0.005, phi0=0.4, incline=10.0), "approx", "kinematic", 0.2)
     assert up.stall.endswith("against the resistances and gravity")
 

@@ -60,7 +60,7 @@ def test_batch_stops_steady_and_stalled_designs():
     assert steady["steady"] and steady["stall"] is None
     # the serial run stops at the same sample, at the end of the same steady revolution
     np.testing.assert_array_equal(steady["series"]["t"], serial.series["t"])
-    assert stalled["stall"] is not None and stalled["stall"].startswith("crank and modules at rest")
+    assert stalled["stall"] is not None and stalled["stall"].startswith("at rest from t=")
     assert not stalled["steady"] and stalled["series"]["t"][-1] < 1.0
 
 

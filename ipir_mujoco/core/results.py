@@ -70,6 +70,9 @@ from .params import RobotParams
 # reads rest alike (the analytic engines' rest is an exact 0). The summary's first minimum of S and MuJoCo's
 # stall test use it.
 REST_SPEED = 1e-6
+# [s] how long every engine runs on once the robot is at rest for good (a stall) before it ends the run: MuJoCo
+# needs that long below REST_SPEED to call a rest final, and its soft constraints to settle to the statics
+REST_TIME = 0.1
 
 COLUMNS: tuple[str, ...] = (
     "t", "phi", "omega", "alpha", "x1", "x2", "v1", "v2", "a1", "a2",
@@ -160,6 +163,8 @@ class RunResult:
         summary.update(cycle_summary(self.series, *self.steady_test))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall
+        if self.stall is not None:  # a robot at rest for good has no revolution to be "per": no such figures
+            summary.update(distance_per_rev_m=None, energy_per_metre_j_m=None, efficiency=None)
         accuracy = dict(self.accuracy or {})
         if "residual_ratio" not in accuracy and "residual_j" in self.energy:
             # against the energy put through the robot, as the MuJoCo engine's monitor measures it (its floor:
@@ -320,6 +325,15 @@ def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[s
         "peak_grip_use": peak_grip_use(series),
         "energy": dict(energy),
     }
+
+
+def stall_reason(t: float, phi: float, torque: float, gravity: bool) -> str:
+    """RunResult.stall, in the same words for every engine: the robot at rest for good from time ``t`` [s],
+    the crank at ``phi`` [rad], where the drive's torque at rest ``torque`` [N m] cannot move it;
+    ``gravity``: whether gravity pulls along the pipe (an incline)."""
+    against = "the resistances and gravity" if gravity else "the resistances"
+    return (f"at rest from t={t:.6g} s at phi={phi:.6g} rad ({math.degrees(phi) % 360:.1f} deg in its turn): the "
+            f"drive's torque at rest ({torque:.6g} N m) cannot move the linkage against {against}")
 
 
 def write_json(path: str | Path, data: dict[str, Any]) -> None:

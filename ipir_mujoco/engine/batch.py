@@ -349,7 +349,7 @@ class _Batch:
             since = rest_since(r["t"][:last + 1, k], r["omega"][:last + 1, k], r["v1"][:last + 1, k],
                                r["v2"][:last + 1, k], self.designs[k].r)
             if since is not None:
-                self.stall[k] = stall_reason(since, float(r["t"][last, k]), float(r["phi"][last, k]))
+                self.stall[k] = stall_reason(self.designs[k], since, float(r["phi"][last, k]))
                 self._finish(k)
         self.fed = s + 1
 

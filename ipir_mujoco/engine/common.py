@@ -3,7 +3,8 @@
 Stall: under a constant torque or the motor (loads that do not change with
 time), a robot whose crank pin and modules have all been slower than
 REST_SPEED for REST_TIME is in a static equilibrium it will not leave; the run
-ends there with a one-line reason (:func:`stall_reason`), not an error.
+ends there (REST_TIME after the rest began, as every engine's run does), with a
+one-line reason (:func:`stall_reason`), not an error.
 """
 
 from __future__ import annotations
@@ -18,12 +19,12 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
-from ipir_mujoco.core.results import REST_SPEED  # m/s: modules and crank pin slower are at rest
+from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m/s], this long [s] is a stall
+from ipir_mujoco.core.results import stall_reason as core_stall_reason
 
 from .clutches import refuse_compliant, refuse_grip
 from .model import check_params
 
-REST_TIME = 0.1  # s: at rest this long under constant loads is a stall
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often
 IMPLEMENTATIONS = ("ratchet", "lock", "none")  # the MuJoCo clutches
@@ -123,10 +124,12 @@ def rest_since(t: np.ndarray, omega: np.ndarray, v1: np.ndarray, v2: np.ndarray,
     return float(t[moving[-1] + 1]) if moving.size else float(t[0])
 
 
-def stall_reason(since: float, t_stop: float, phi: float) -> str:
-    """The one-line stall reason of RunResult.stall (times [s], crank angle [rad])."""
-    return (f"crank and modules at rest from t={since:.4g} s (crank at {math.degrees(phi) % 360:.1f} deg "
-            f"in its turn); the drive cannot turn the crank on against the load (run stopped at t={t_stop:.4g} s)")
+def stall_reason(params: RobotParams, since: float, phi: float) -> str:
+    """The one-line RunResult.stall (core.results.stall_reason: the same words as every engine's) of a robot
+    at rest from ``since`` [s] with the crank at ``phi`` [rad]; the drive's torque at rest is its actuator's
+    at zero speed (M, or the motor's M_stall)."""
+    torque = params.M_stall if params.drive == "motor" else params.M
+    return core_stall_reason(since, phi, torque, params.incline != 0 and params.g != 0)
 
 
 def mujoco_failure(t_good: float, reason: str) -> str:

@@ -380,5 +380,5 @@ class _BlockChecks:
                            self.run.params.r)
         if since is None:
             return None
-        self.run.stall = stall_reason(since, t, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
+        self.run.stall = stall_reason(self.run.params, since, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
         return newest
