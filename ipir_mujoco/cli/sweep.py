@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
@@ -114,6 +114,10 @@ def run(args: argparse.Namespace) -> int:
             client.close()
     axes = [a.name for a in study.axes]
     columns = read_results(results)
+    errors = [e for e in columns["error"] if e]
+    if len(columns["design_id"]) and len(errors) == len(columns["design_id"]):  # nothing to draw or rank
+        raise SimulationError(f"every one of the {len(errors)} designs failed, so there is nothing to draw; the "
+                              f"first: {' '.join(str(errors[0]).split())} (the rows are in {results})")
     figures = plot_sweep(results, study, args.out, metric=metric)
     best = best_designs(columns, axes, list(study.engines))
     write_json(Path(args.out) / "best.json", {"best": best, "ranking": rankings(columns, axes, list(study.engines))})

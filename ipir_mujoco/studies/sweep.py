@@ -123,8 +123,9 @@ def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end:
                  and threading.current_thread() is threading.main_thread())
     if armed:
         signal.signal(signal.SIGALRM, _raise_timeout)
-        signal.setitimer(signal.ITIMER_REAL, budget)
     try:
+        if armed:  # inside the try: a tiny budget may fire before the first engine starts
+            signal.setitimer(signal.ITIMER_REAL, budget)
         for engine in engines:
             results[engine] = engine_metrics(engine, params, t_end, dt_out, options)
     except DesignTimeout:
@@ -134,6 +135,7 @@ def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end:
     finally:
         if armed:
             signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, signal.SIG_IGN)  # an alarm already on its way must not land later
     return results
 
 
@@ -226,6 +228,23 @@ def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_desi
     return out
 
 
+def refuse_all_invalid(base: RobotParams, designs: list[dict]) -> None:
+    """A study none of whose designs is a valid parameter set (``L=0.01,0.02`` with r = 0.05: L <= r) is
+    refused before anything is written, naming the first design's fault; one valid design is enough to run
+    (the invalid ones are then recorded as failed rows)."""
+    first = None
+    for values in designs:
+        try:
+            base.replace(**values)
+            return
+        except ValueError as exc:
+            first = first or (values, exc)
+    if first is not None:
+        where = ", ".join(f"{k}={v:g}" for k, v in first[0].items())
+        raise ParameterError(f"every one of the {len(designs)} designs is invalid; the first ({where}): "
+                             f"{' '.join(str(first[1]).split())}")
+
+
 def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | None = None,
               batch_mujoco: bool | None = None, resume: bool = False, workers: int | None = None,
               progress: bool = True, on_row: Callable[[dict], None] | None = None,
@@ -247,6 +266,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             raise ParameterError(f"{str(out)!r} holds another study (its sweep.json differs); resume needs the "
                                  "same one")
     designs = study.designs()
+    refuse_all_invalid(study.base, designs)
     out.mkdir(parents=True, exist_ok=True)
     results_file = ResultsFile(out / "results.csv", header_for(study), resume)
     meta.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
