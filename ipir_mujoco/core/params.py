@@ -310,6 +310,13 @@ def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
+    except ValueError as exc:  # an integer past Python's 4300-digit conversion limit
+        why = "an integer of more than 4300 digits" if "digits" in str(exc) else " ".join(str(exc).split())[:120]
+        raise ParameterError(f"{what} {str(path)!r} holds a value that cannot be read ({why}); allowed: numbers "
+                             "within the ranges 'ipir-mujoco params' lists") from None
+    except RecursionError:  # arrays or tables nested thousands deep
+        raise ParameterError(f"{what} {str(path)!r} nests arrays or tables too deep to read; allowed: the flat "
+                             "tables of a config or study file (docs/cli.md)") from None
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
