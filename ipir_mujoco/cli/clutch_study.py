@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
         check_whole("workers", args.workers, low=1, high=1024)
     designs = [(k, b) for k in stiffness for b in backlash]
     cs.plan(base, designs, points)  # every value checked before anything is written or run
-    check_output_dir(args.out)
+    check_output_dir(args.out, files=FILES)
 
     def progress(message: str) -> None:
         print(f"clutch-study: {message}", file=sys.stderr, flush=True)

@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
                                  f"these revolutions (runs of at most {MAX_T_END:g} s), or fewer --revolutions")
     params = model_params(args)
     samples = _read_crank_samples(args.samples) if args.samples is not None else None
-    check_output_dir(args.out)
+    check_output_dir(args.out, files=("kinetostatics.csv", "summary.json", "kinetostatics.png"))
     if samples is None:
         motion = CrankMotion.constant_speed(args.omega, params.phi0, args.revolutions)
     else:

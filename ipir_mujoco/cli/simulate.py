@@ -181,7 +181,8 @@ def run(args: argparse.Namespace) -> int:
     # bad parameters are reported before the output folder is looked at
     refuse_steady_without_motor(model_params(args).drive, args.until_steady)
     if args.out is not None:
-        check_output_dir(args.out)
+        check_output_dir(args.out, files=("timeseries.csv", "mode_changes.csv", "summary.json", "fig2_crank.png",
+                                          "fig3_modules.png", "fig4_gap.png"))
     result = run_simulation(args)
     record = result.to_json_dict()
     if args.out is not None:

@@ -220,7 +220,7 @@ def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_desi
         check_real("timeout_per_design", timeout_per_design, high=1e6, unit="s")
     if batch_size is not None:
         check_whole("batch_size", batch_size, low=1, high=100_000)
-    out = check_output_dir(out)
+    out = check_output_dir(out, files=("results.csv", "sweep.json", "best.json"))
     meta = out / "sweep.json"
     if resume and out.is_dir() and any(out.iterdir()) and not meta.is_file():
         raise ParameterError(f"--resume --out {str(out)!r}: the folder holds no sweep (no sweep.json); give the "
