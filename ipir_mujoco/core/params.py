@@ -24,6 +24,7 @@ import decimal
 import functools
 import math
 import numbers
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -350,6 +351,8 @@ def load_params(
     """Defaults, then the TOML file ``config``, then ``overrides`` (last wins)."""
     values: dict[str, Any] = {}
     if config is not None:
+        if not isinstance(config, (str, os.PathLike)):
+            raise ParameterError(f"config={config!r} is not a path; allowed: the path of a TOML file, or None")
         values.update(read_toml(config))
     if isinstance(overrides, Mapping):
         unknown = [n for n in overrides if n not in PARAMETER_NAMES]

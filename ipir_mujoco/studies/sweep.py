@@ -57,6 +57,7 @@ from typing import Callable
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.options import check_type
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
 from ..output import check_output_dir
@@ -254,6 +255,8 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
     ``batch_mujoco``: True steps the MuJoCo ratchet designs through ``mujoco.batch``, False one by one in
     the serial engine; None (default) the batch only when ``batch_size`` is given or the serial engine's
     compiled loop is not built."""
+    check_type("study", study, Study, "a Study (ipir_mujoco.studies.sweep_space.Study)")
+    check_type("out", out, (str, os.PathLike), "the path of the results folder")
     out = check_sweep_options(out, resume, workers, timeout_per_design, batch_size)
     meta = out / "sweep.json"
     record = {"fingerprint": study.fingerprint(), "study": study.to_json()}
