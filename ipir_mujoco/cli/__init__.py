@@ -10,12 +10,10 @@ subcommand lives in its own module with ``add_parser(commands)`` and
 
 from __future__ import annotations
 
-import logging
 import os
 import signal
 import sys
 import threading
-from typing import Sequence
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 
@@ -32,6 +30,9 @@ _loading_guard = (threading.current_thread() is threading.main_thread()
 if _loading_guard:
     signal.signal(signal.SIGINT, _interrupted_while_loading)
 try:
+    import logging  # after the guard: even the standard library's imports take a Ctrl-C as a traceback
+    from typing import Sequence
+
     from ipir_mujoco.core.errors import ParameterError, SimulationError
 
     from .. import __version__

@@ -7,7 +7,7 @@ import json
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, MAX_T_END, check_run_options, check_step_count,
+from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
                                       refuse_steady_without_motor)
 from ipir_mujoco.core.params import check_real, check_whole
 from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
@@ -86,9 +86,6 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
         args.t_end = T_END_STEADY if args.until_steady else T_END
     if args.timestep is not None:  # before the output interval is derived from it
         check_real("--timestep", args.timestep, high=1e-2, unit="s")
-    check_real("--t-end", args.t_end, high=MAX_T_END, unit="s")
-    if args.dt_out is not None:
-        check_real("--dt-out", args.dt_out, unit="s")
     args.dt_out = output_interval(args)
     check_run_options(args.t_end, args.dt_out)
     if args.engine == "mujoco" and args.timestep is not None:
