@@ -181,7 +181,9 @@ CASES = [
      "--scheduler 'garbage' is not a scheduler address"),
     (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "tcp://127.0.0.1:1", "--out", "{f}/s"], 2,
      "--scheduler 'tcp://127.0.0.1:1' cannot be reached"),
-    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "inproc://x", "--out", "{f}/s"], 2, "SCHEME://HOST:PORT"),
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "inproc://x", "--out", "{f}/s"], 2,
+     "'inproc://x' did not answer as a Dask scheduler"),
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "udp://h:1", "--out", "{f}/s"], 2, "SCHEME://HOST:PORT"),
     (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "", "--out", "{f}/s"], 2, "is not a scheduler address"),
     # messages that name the option the value came from
     (["simulate", "--engine", "mujoco", "--timestep", "inf"], 2, "--timestep=inf is out of range"),

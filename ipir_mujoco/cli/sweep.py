@@ -63,9 +63,12 @@ CONNECT_TIMEOUT_S = 5.0  # s: a scheduler on the network answers in milliseconds
 def scheduler_address(address: str) -> tuple[str, str, int]:
     """(scheme, host, port) of a Dask scheduler address ``[SCHEME://]HOST:PORT``, or a one-line
     ParameterError naming it and the allowed form."""
-    allowed = f"allowed: SCHEME://HOST:PORT with SCHEME one of {', '.join(SCHEMES)} (e.g. tcp://host:8786)"
+    allowed = (f"allowed: SCHEME://HOST:PORT with SCHEME one of {', '.join(SCHEMES)} (e.g. tcp://host:8786), "
+               "or the inproc:// address of a cluster in this process")
     scheme, _, rest = address.strip().rpartition("://")
     scheme = scheme or "tcp"
+    if scheme == "inproc" and rest:  # a LocalCluster(processes=False) of this process: no socket to probe
+        return scheme, rest, 0
     host, _, port = rest.rpartition(":")
     host = host.strip("[]")
     if scheme not in SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536:
@@ -85,7 +88,8 @@ def connect_scheduler(address: str):
     except ImportError:
         raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
     try:
-        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+        if scheme != "inproc":
+            socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
     except OSError as exc:
         raise ParameterError(f"--scheduler {address!r} cannot be reached ({exc.strerror or exc or 'timed out'}); "
                              "allowed: the address of a running Dask scheduler") from None
