@@ -198,6 +198,11 @@ CASES = [
      "k_header_only.csv' has 0 sample row(s)"),
     (["clutch-study", "--stiffness", "", "--out", "{f}/c"], 2, "--stiffness '' gives 0 values"),
     (["clutch-study", "--backlash", " ", "--out", "{f}/c"], 2, "--backlash ' ' gives 0 values"),
+    # devices read for ever: refused, never read into memory (the wider pass of round 2)
+    (["simulate", "--config", "/dev/zero"], 2, "is not a regular file"),
+    (["sweep", "--study", "/dev/zero", "--out", "{f}/s"], 2, "is not a regular file"),
+    (["kinetostatics", "--samples", "/dev/zero", "--out", "{f}/k"], 2, "is not a regular file"),
+    (["simulate", "--engine", "mujoco", "--mjcf", "/dev/zero"], 2, "is not a regular file"),
     # output folders: a name the command writes, taken by another kind of entry
     (["simulate", "--t-end", "0.01", "--out", "{f}/clash"], 2, "clash/summary.json' is a folder, where"),
 ]

@@ -65,6 +65,8 @@ def check_input_file(option: str, path: str) -> None:
         raise ParameterError(f"{option} {path!r} is a folder; give a file")
     if not target.exists():
         raise ParameterError(f"{option} {path!r} does not exist")
+    if not target.is_file():  # /dev/zero, a pipe: read for ever
+        raise ParameterError(f"{option} {path!r} is not a regular file (a device or pipe); give a file")
 
 
 def progress_printer(t_end: float):

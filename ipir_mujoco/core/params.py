@@ -288,11 +288,23 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     return values
 
 
+MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far past any real one, and a bound
+# on what /dev/zero or a mistyped multi-GB file would make the command read into memory
+
+
 def read_text_file(path: str | Path, what: str) -> str:
-    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read."""
+    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
+    for a device or pipe, /dev/zero, and a file past MAX_TEXT_BYTES)."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        if path.exists() and not path.is_dir() and not path.is_file():
+            raise ParameterError(f"{what} {str(path)!r} is not a regular file (a device or pipe); give a file")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_TEXT_BYTES + 1)
+        if len(data) > MAX_TEXT_BYTES:
+            raise ParameterError(f"{what} {str(path)!r} is larger than {MAX_TEXT_BYTES / 1e6:g} MB; allowed: a "
+                                 "text file of at most that size")
+        return data.decode("utf-8")
     except FileNotFoundError:
         raise ParameterError(f"{what} {str(path)!r} does not exist") from None
     except IsADirectoryError:
