@@ -48,6 +48,8 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"mu_wall={params.mu_wall!r} with clutch={clutch!r}: the paper's rule locks its "
                              "modules whatever the load; allowed: clutch='unilateral' or mu_wall=unlimited")
     refuse_idle_parameters(params)
+    if options.get("torque") is not None:
+        _check_torque(options["torque"], params)
     if params.clutch_stiffness is not None:
         if clutch != "unilateral":
             raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
@@ -56,6 +58,27 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     if clutch == "unilateral":
         return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
+
+
+def _check_torque(torque, params: RobotParams) -> None:
+    """A torque profile is a function torque(t, phi, omega) [N m] of floats giving a finite number: refused in
+    one line, naming the argument, before the solver calls it deep inside (tried once at the start state)."""
+    import math
+
+    import numpy as np
+
+    if not callable(torque):
+        raise ParameterError(f"torque={torque!r} is not callable; allowed: a function torque(t, phi, omega) "
+                             "[N m], or None (the drive of params)")
+    try:
+        value = float(np.asarray(torque(np.float64(0.0), np.float64(params.phi0), np.float64(params.omega0))))
+    except Exception as exc:  # noqa: BLE001 (whatever the user's function raises, said in one line)
+        raise ParameterError(f"torque(t=0, phi={params.phi0:g}, omega={params.omega0:g}) failed: "
+                             f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}; allowed: a function "
+                             "of floats returning a torque [N m]") from None
+    if not math.isfinite(value):
+        raise ParameterError(f"torque(t=0, phi={params.phi0:g}, omega={params.omega0:g})={value} is not finite; "
+                             "allowed: a function returning a finite torque [N m]")
 
 
 __all__ = [

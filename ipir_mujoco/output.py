@@ -1,24 +1,36 @@
-"""Writing output folders so that a failure leaves nothing half-written."""
+"""Writing output folders so that a failure leaves nothing half-written.
+
+The rule every command follows (docs/cli.md, "Output folders"): ``--out DIR`` may exist; the command writes
+its own files into it, replacing earlier copies of those names, and leaves everything else there alone. A name
+it writes that is taken by something of another kind (a folder where ``summary.json`` goes, a file where
+``figures/`` goes, a link) is refused in one line before any work, and again before anything is moved in.
+Files are staged in ``.DIR-partial-PID-*`` beside DIR; one left by a process that was killed (SIGKILL, power
+loss) is removed by the next run that writes DIR.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
 import tempfile
+import time
 from pathlib import Path
-from typing import Iterator
+from typing import Iterable, Iterator
 
 from ipir_mujoco.core.errors import ParameterError
 
 
-def check_output_dir(out: str | Path, option: str = "--out") -> Path:
+def check_output_dir(out: str | Path, option: str = "--out", files: Iterable[str] = (),
+                     folders: Iterable[str] = ()) -> Path:
     """Refuse an output path that cannot become a writable folder, before any work is done.
 
     Checks, in one line each: ``out`` is a folder or does not exist yet; the nearest existing
     folder above it is a folder (not a file, as in ``FILE/sub``); and a file can be created
-    there (tried, then removed: permission bits do not tell for root, read-only mounts or ACLs).
-    Nothing is created.
+    there (tried, then removed: permission bits do not tell for root, read-only mounts or ACLs);
+    and each of the ``files`` and ``folders`` the command will write there is free or of that kind
+    (:func:`check_names`). Nothing is created.
     """
     out = Path(out)
     if out.exists() and not out.is_dir():
@@ -37,24 +49,76 @@ def check_output_dir(out: str | Path, option: str = "--out") -> Path:
     except OSError as exc:
         raise ParameterError(f"{option} {str(out)!r}: cannot write in {str(existing)!r} "
                              f"({exc.strerror or exc}); give a writable folder") from None
+    if out.is_dir():
+        check_names(out, {**{name: False for name in files}, **{name: True for name in folders}}, option)
     return out
+
+
+def check_names(out: Path, names: dict[str, bool], option: str = "--out") -> None:
+    """Each name of ``names`` ({name: is a folder}) in ``out`` is free or of that kind, so that a command
+    replaces only its own earlier output; otherwise a one-line ParameterError naming the path."""
+    for name, folder in names.items():
+        target = out / name
+        if not (target.exists() or target.is_symlink()):
+            continue
+        if target.is_symlink() or target.is_dir() != folder:
+            kind = "a link" if target.is_symlink() else ("a folder" if target.is_dir() else "a file")
+            raise ParameterError(f"{option} {str(out)!r}: {str(target)!r} is {kind}, where this command writes "
+                                 f"its {'folder' if folder else 'file'} {name!r}; move it away or give another "
+                                 f"{option} (a command replaces only its own earlier output)")
+
+
+_PARTIAL = re.compile(r"-partial-(\d+)-")
+STALE_LEGACY_S = 24 * 3600.0  # s: a staging folder of the older naming (no process id) this old is stale
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
+
+
+def remove_stale_staging(out: Path) -> list[Path]:
+    """Remove the ``.OUT-partial-*`` staging folders beside ``out`` whose process is gone (killed while it
+    wrote); return what was removed."""
+    removed = []
+    for candidate in out.parent.glob(f".{out.name}-partial-*"):
+        match = _PARTIAL.search(candidate.name[len(out.name) + 1:])
+        try:
+            stale = (not _alive(int(match.group(1))) if match
+                     else time.time() - candidate.stat().st_mtime > STALE_LEGACY_S)
+        except OSError:
+            continue
+        if stale and candidate.is_dir() and not candidate.is_symlink():
+            shutil.rmtree(candidate, ignore_errors=True)
+            removed.append(candidate)
+    return removed
 
 
 @contextlib.contextmanager
 def staged_output(out: str | Path) -> Iterator[Path]:
     """Yield a staging folder; on success move its contents into ``out``.
 
-    Files are written beside ``out`` first and moved in only when everything
-    succeeded; on an exception the staging folder is removed and ``out`` is
-    left as it was.
+    Files are written beside ``out`` first (``.OUT-partial-PID-*``) and moved in
+    only when everything succeeded and none of their names is taken by
+    something of another kind; on an exception the staging folder is removed
+    and ``out`` is left as it was. Staging folders of killed runs are removed
+    first (:func:`remove_stale_staging`).
     """
     out = check_output_dir(out).resolve()
     out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}-partial-", dir=out.parent))
+    remove_stale_staging(out)
+    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}-partial-{os.getpid()}-", dir=out.parent))
     try:
         yield staging
         out.mkdir(exist_ok=True)
-        for item in sorted(staging.iterdir()):
+        items = sorted(staging.iterdir())
+        check_names(out, {item.name: item.is_dir() for item in items})  # all or nothing
+        for item in items:
             target = out / item.name
             if target.is_dir() and not target.is_symlink():
                 shutil.rmtree(target)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 from .core.errors import ParameterError
-from .core.params import RobotParams
+from .core.params import RobotParams, check_real
 from .core.results import RunResult
 
 ENGINES = ("analytic", "mujoco")
@@ -189,7 +189,7 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
     if step is not None:
         if "settings" in options:
             raise ParameterError("timestep and settings given together; allowed: one of them")
-        options["settings"] = SolverSettings(timestep=step)
+        options["settings"] = SolverSettings(timestep=check_real("timestep", step, high=1e-2, unit="s"))
     if options.pop("every_step", False):
         settings = options.get("settings")
         options["dt_out"] = settings.timestep if settings is not None else timestep(

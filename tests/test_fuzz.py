@@ -26,10 +26,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ipir_mujoco import analytic
-from ipir_mujoco.analytic import ParameterError, RobotParams
-from ipir_mujoco.core.options import MAX_SAMPLES, check_run_options
+from ipir_mujoco import analytic, registry
+from ipir_mujoco.analytic import ParameterError, RobotParams, load_params
 from ipir_mujoco.cli import main
+from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, MAX_SAMPLES, RunOptions, check_run_options,
+                                      check_step_count)
+from ipir_mujoco.studies.sweep import run_sweep
 from ipir_mujoco.studies.sweep_space import MAX_DESIGNS, Study, parse_vary
 
 LONG = os.environ.get("IPIR_FUZZ") == "long"
@@ -75,6 +77,20 @@ def files(tmp_path_factory):
     cells[4] = "nan"
     lines[5] = ",".join(cells)
     (f / "nan" / "timeseries.csv").write_text("\n".join(lines) + "\n")
+    (f / "big_int.toml").write_text("L = " + "1" * 100_000 + "\n")  # past Python's 4300-digit limit
+    (f / "deep.toml").write_text("L = " + "[" * 5000 + "]" * 5000 + "\n")
+    (f / "deep_study.toml").write_text("[sweep]\nvary = " + "[" * 5000 + "]" * 5000 + "\n")
+    (f / "k_header_only.csv").write_text("t,phi\n")
+    (f / "clash").mkdir()
+    (f / "clash" / "summary.json").mkdir()  # a folder where simulate writes a file
+    sweep = f / "swp"
+    assert main(["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05",
+                 "--out", str(sweep)]) == 0
+    for name, tail in {"garbage": b"hello world\n", "binary": b"\xff\xfe\x00\x01\n", "nul": b"5,\x00\n",
+                       "extra": (sweep / "results.csv").read_bytes().splitlines()[1] + b",1,2\n"}.items():
+        shutil.copytree(sweep, f / f"swp_{name}")
+        with (f / f"swp_{name}" / "results.csv").open("ab") as fh:
+            fh.write(tail)
     (f / "k_empty.csv").write_text("")
     (f / "k_semicolon.csv").write_text("t;phi\n0;0\n0.1;0.2\n0.2;0.5\n0.3;0.9\n")
     (f / "k_ragged.csv").write_text("t,phi\n0,0\n0.1\n0.2,0.5\n0.3,0.9\n")
@@ -135,6 +151,60 @@ CASES = [
     (["sweep", "--vary", "L=0.1,0.2", "--plot-metric", "beauty", "--out", "{f}/s"], 2, "'beauty' is unknown"),
     (["sweep", "--vary", "L=0.1,0.2", "--resume", "--out", "{f}/run"], 2, "holds no sweep"),
     (["sweep", "--vary", "L=0.1,0.2", "--out", "{f}/afile/sub"], 2, "is a file, not a folder"),
+    # issue 26, round 2: unbounded runs
+    (["simulate", "--engine", "mujoco", "--clutch", "unilateral", "--timestep", "1e-12", "--t-end", "1"], 2,
+     "would take 1e+12 MuJoCo steps"),
+    (["simulate", "--engine", "mujoco", "--timestep", "1e-9", "--t-end", "3600", "--dt-out", "1"], 2,
+     "allowed: at most 1e+08 steps"),
+    (["simulate", "--wall-budget", "0"], 2, "--wall-budget 0 is out of range"),
+    (["simulate", "--wall-budget", "nan"], 2, "--wall-budget nan is out of range"),
+    (["simulate", "--wall-budget", "-5"], 2, "--wall-budget -5 is out of range"),
+    (["simulate", "--t-end", "0.5", "--wall-budget", "1e-6"], 1, "--wall-budget 1e-06 s; raise it"),
+    # sweeps
+    (["sweep", "--vary", "L=0.01,0.02", "--engines", "analytic-approx", "--t-end", "0.1", "--out", "{f}/s"], 2,
+     "every one of the 2 designs is invalid; the first (L=0.01)"),
+    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+      "--out", "{f}/swp_garbage"], 2, "results.csv' line 4 has 1 cells"),
+    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+      "--out", "{f}/swp_extra"], 2, "results.csv' line 4 has"),
+    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+      "--out", "{f}/swp_binary"], 2, "results.csv' line 4 is not UTF-8"),
+    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+      "--out", "{f}/swp_nul"], 2, "results.csv' line 4"),
+    # configuration files
+    (["simulate", "--config", "{f}/big_int.toml"], 2, "an integer of more than 4300 digits"),
+    (["simulate", "--config", "{f}/deep.toml"], 2, "nests arrays or tables too deep"),
+    (["sweep", "--study", "{f}/deep_study.toml", "--out", "{f}/s"], 2, "nests arrays or tables too deep"),
+    (["sweep", "--study", "{f}/big_int.toml", "--out", "{f}/s"], 2, "an integer of more than 4300 digits"),
+    # Dask addresses
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "garbage", "--out", "{f}/s"], 2,
+     "--scheduler 'garbage' is not a scheduler address"),
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "tcp://127.0.0.1:1", "--out", "{f}/s"], 2,
+     "--scheduler 'tcp://127.0.0.1:1' cannot be reached"),
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "inproc://x", "--out", "{f}/s"], 2,
+     "'inproc://x' did not answer as a Dask scheduler"),
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "udp://h:1", "--out", "{f}/s"], 2, "SCHEME://HOST:PORT"),
+    (["sweep", "--vary", "L=0.1,0.2", "--scheduler", "", "--out", "{f}/s"], 2, "is not a scheduler address"),
+    # messages that name the option the value came from
+    (["simulate", "--engine", "mujoco", "--timestep", "inf"], 2, "--timestep=inf is out of range"),
+    (["simulate", "--engine", "mujoco", "--timestep", "nan"], 2, "--timestep=nan is out of range"),
+    (["kinetostatics", "--omega", "1e-9", "--out", "{f}/k"], 2, "--omega 1e-09 rad/s with --revolutions 2"),
+    (["kinetostatics", "--omega", "-1e-3", "--out", "{f}/k"], 2, "0.003491 <= |omega|"),
+    (["simulate", "--dt-out", "-1e-4"], 2, "dt_out=-0.0001 is out of range"),
+    (["simulate", "--t-end", "-inf"], 2, "t_end=-inf is out of range"),
+    (["simulate", "--t-end", "-1E+2"], 2, "t_end=-100.0 is out of range"),
+    (["sweep", "--vary", "L=0.1,0.2", "--t-end", "-1e-3", "--out", "{f}/s"], 2, "t_end=-0.001 is out of range"),
+    (["kinetostatics", "--samples", "{f}/k_header_only.csv", "--out", "{f}/k"], 2,
+     "k_header_only.csv' has 0 sample row(s)"),
+    (["clutch-study", "--stiffness", "", "--out", "{f}/c"], 2, "--stiffness '' gives 0 values"),
+    (["clutch-study", "--backlash", " ", "--out", "{f}/c"], 2, "--backlash ' ' gives 0 values"),
+    # devices read for ever: refused, never read into memory (the wider pass of round 2)
+    (["simulate", "--config", "/dev/zero"], 2, "is not a regular file"),
+    (["sweep", "--study", "/dev/zero", "--out", "{f}/s"], 2, "is not a regular file"),
+    (["kinetostatics", "--samples", "/dev/zero", "--out", "{f}/k"], 2, "is not a regular file"),
+    (["simulate", "--engine", "mujoco", "--mjcf", "/dev/zero"], 2, "is not a regular file"),
+    # output folders: a name the command writes, taken by another kind of entry
+    (["simulate", "--t-end", "0.01", "--out", "{f}/clash"], 2, "clash/summary.json' is a folder, where"),
 ]
 
 
@@ -146,6 +216,53 @@ def test_bad_input_is_one_line_with_the_right_exit_status_and_creates_nothing(ca
     assert err.count("\n") == 1 and fragment in err, err
     assert caught == []  # no library warning on the way
     assert sorted(p.name for p in files.iterdir()) == before  # no output folder left behind
+
+
+def test_a_sweep_whose_every_design_fails_exits_1_naming_the_first_failure(capsys, tmp_path):
+    code, _, err, _ = run_cli(capsys, ["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end",
+                                       "0.5", "--timeout-per-design", "1e-6", "--out", tmp_path / "s"])
+    assert code == 1 and err.strip().count("\n") == 0 or err.splitlines()[-1].startswith("ipir-mujoco sweep"), err
+    last = err.splitlines()[-1]  # after the progress lines
+    assert code == 1 and "every one of the 2 designs failed" in last and "timeout-per-design" in last, err
+
+
+def test_a_sweep_on_a_full_disk_exits_1_in_one_line(capsys, tmp_path, monkeypatch):
+    import errno
+
+    import matplotlib.figure
+
+    def full(self, path, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", full)
+    code, _, err, _ = run_cli(capsys, ["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx",
+                                       "--t-end", "0.05", "--out", tmp_path / "s"])
+    assert code == 1 and "No space left on device" in err.splitlines()[-1], err
+    assert sum("ipir-mujoco sweep:" in line for line in err.splitlines()) == 1
+
+
+def test_a_run_killed_while_staging_is_cleaned_by_the_next_run(capsys, tmp_path):
+    """A validate (or any command) killed by SIGKILL leaves .NAME-partial-PID-* beside its output: the next
+    run that writes there removes it; one of a live process is left alone."""
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    stale = tmp_path / f".out-partial-{gone.pid}-abc"
+    live = tmp_path / f".out-partial-{os.getpid()}-abc"
+    stale.mkdir()
+    live.mkdir()
+    code, _, err, _ = run_cli(capsys, ["simulate", "--t-end", "0.01", "--out", tmp_path / "out"])
+    assert code == 0, err
+    assert not stale.exists() and live.is_dir() and (tmp_path / "out" / "summary.json").is_file()
+
+
+def test_an_existing_output_folder_keeps_what_the_command_did_not_write(capsys, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    for _ in range(2):  # the second run replaces the first run's files
+        code, _, err, _ = run_cli(capsys, ["simulate", "--t-end", "0.01", "--out", out])
+        assert code == 0, err
+    assert (out / "notes.txt").read_text() == "mine" and (out / "timeseries.csv").is_file()
 
 
 def test_an_unwritable_output_folder_is_refused_before_the_run(capsys, tmp_path):
@@ -232,11 +349,53 @@ def test_numbers_of_every_numeric_type_are_numbers(value):
     (lambda: Study((parse_vary("L=0.1,0.2"),), seed=-1), "seed=-1"),
     (lambda: Study((parse_vary("L=0.1,0.2"),), t_end="abc"), "t_end='abc' is not a number"),
     (lambda: Study((parse_vary("L=0.1,0.2"),), base=None), "params=None is not a RobotParams"),
+    (lambda: Study((parse_vary("L=0.1,0.2"),), engines=None), "engines=None is not a list"),
+    (lambda: parse_vary(None), "vary=None is not a string"),
+    (lambda: parse_vary(3), "vary=3 is not a string"),
+    (lambda: analytic.simulate(RobotParams(), "exact", "kinematic", 0.1, torque="x"), "torque='x' is not callable"),
+    (lambda: analytic.simulate(RobotParams(), "exact", "kinematic", 0.1, torque=lambda t, phi, w: "x"),
+     "torque(t=0, phi=0, omega=0) failed"),
+    (lambda: analytic.simulate(RobotParams(), "exact", "kinematic", 0.1, torque=lambda t, phi, w: np.nan),
+     "is not finite"),
+    (lambda: analytic.simulate(RobotParams(), "exact", "kinematic", 0.1, wall_budget_s=-1), "wall_budget_s=-1"),
+    (lambda: load_params(3), "config=3 is not a path"),
+    (lambda: run_sweep("x", "sweep"), "study='x'"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), 3), "out=3"),
+    (lambda: registry.run("mujoco-ratchet", RobotParams(), timestep="x"), "timestep='x' is not a number"),
+    (lambda: check_step_count(1.0, 1e-12), "would take 1e+12 MuJoCo steps"),
 ])
 def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment):
     with pytest.raises(ParameterError) as info:
         call()
     assert fragment in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("keywords,fragment", [
+    ({"settings": "x"}, "settings='x' (str) is not allowed"),
+    ({"mjcf": 123}, "mjcf=123 (int) is not allowed"),
+    ({"servo": 1}, "servo=1 (int) is not allowed"),
+    ({"wall_budget_s": "1"}, "wall_budget_s='1'"),
+])
+def test_simulate_mujoco_checks_its_arguments(keywords, fragment):
+    from ipir_mujoco.engine import simulate_mujoco
+
+    with pytest.raises(ParameterError) as info:
+        simulate_mujoco(RobotParams(), t_end=0.01, **keywords)
+    assert fragment in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_given_timestep_too_small_for_t_end_is_refused_before_the_run():
+    from ipir_mujoco.engine import SolverSettings, simulate_mujoco
+
+    with pytest.raises(ParameterError, match=r"t_end=1 s with timestep=1e-12 s would take 1e\+12 MuJoCo steps"):
+        simulate_mujoco(RobotParams(), t_end=1.0, settings=SolverSettings(timestep=1e-12))
+
+
+def test_every_run_has_a_wall_budget_by_default_and_inf_lifts_it():
+    assert RunOptions().wall_budget_s == DEFAULT_WALL_BUDGET_S
+    assert RunOptions(wall_budget_s=None).wall_budget_s == DEFAULT_WALL_BUDGET_S
+    assert RunOptions(wall_budget_s=float("inf")).wall_budget_s is None  # no limit
+    assert RunOptions(wall_budget_s=5).wall_budget_s == 5.0
 
 
 def test_mujoco_never_runs_past_t_end_by_a_sample_interval_it_was_not_given():

@@ -92,6 +92,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         logging.getLogger("ipir_mujoco").removeHandler(notes)
 
 
+MAX_MESSAGE = 1000  # characters of a one-line failure message shown (a huge value in it is cut)
 EXIT_PIPE_CLOSED = 141  # 128 + SIGPIPE, as shells report a writer whose reader left
 
 
@@ -120,8 +121,9 @@ def _show_notes(prefix: str) -> logging.Handler:
 
 def _describe_failure(exc: BaseException) -> tuple[int, str]:
     """(exit status, one line) for an exception that reached the command line."""
-    def one_line(text: str) -> str:
-        return " ".join(str(text).split())
+    def one_line(text: str) -> str:  # a value of 100,000 characters is not repeated whole
+        line = " ".join(str(text).split())
+        return line if len(line) <= MAX_MESSAGE else f"{line[:MAX_MESSAGE]}... ({len(line)} characters in all)"
 
     if isinstance(exc, ParameterError):
         return EXIT_BAD_INPUT, f"error: {one_line(exc)}"

@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
         "--tolerance", args.tolerance, high=90.0, unit="deg")
     t_end = climbing.default_t_end(params) if args.t_end is None else args.t_end
     check_run_options(t_end, climbing.DT_OUT)
-    check_output_dir(args.out)
+    check_output_dir(args.out, files=FILES)
 
     def progress(message: str) -> None:
         print(f"climb: {message}", file=sys.stderr, flush=True)

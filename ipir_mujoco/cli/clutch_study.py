@@ -55,16 +55,16 @@ def run(args: argparse.Namespace) -> int:
         if getattr(base, name) != getattr(defaults, name):
             raise ParameterError(f"{name}={getattr(base, name)!r} in --set or --config: the study sets it; "
                                  f"allowed: {instead}")
-    stiffness = cs.parse_values("--stiffness", args.stiffness, log=True) if args.stiffness else \
+    stiffness = cs.parse_values("--stiffness", args.stiffness, log=True) if args.stiffness is not None else \
         (cs.STIFFNESS_QUICK if args.quick else cs.STIFFNESS)
-    backlash = cs.parse_values("--backlash", args.backlash, log=False) if args.backlash else \
+    backlash = cs.parse_values("--backlash", args.backlash, log=False) if args.backlash is not None else \
         (cs.BACKLASH_QUICK if args.quick else cs.BACKLASH)
     points = cs.parse_points(args.points)
     if args.workers is not None:
         check_whole("workers", args.workers, low=1, high=1024)
     designs = [(k, b) for k in stiffness for b in backlash]
     cs.plan(base, designs, points)  # every value checked before anything is written or run
-    check_output_dir(args.out)
+    check_output_dir(args.out, files=FILES)
 
     def progress(message: str) -> None:
         print(f"clutch-study: {message}", file=sys.stderr, flush=True)

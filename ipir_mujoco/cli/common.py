@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 
 from ipir_mujoco.core.errors import ParameterError
@@ -11,8 +12,18 @@ from ipir_mujoco.core.params import DRIVES, RobotParams, load_params
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 
 
+# what argparse reads as a negative number (a value, not an option): its own rule knows -1 and -.5 only, so
+# that `--dt-out -1e-4` or `--t-end -inf` was "expected one argument" and the value never named
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 class Parser(argparse.ArgumentParser):
-    """argparse with a one-line error message and exit status 2."""
+    """argparse with a one-line error message and exit status 2, reading negative numbers in any spelling
+    (-1e-4, -inf) as values, which the command then refuses with their range."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message: str):  # noqa: D102 (argparse API)
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
@@ -54,6 +65,8 @@ def check_input_file(option: str, path: str) -> None:
         raise ParameterError(f"{option} {path!r} is a folder; give a file")
     if not target.exists():
         raise ParameterError(f"{option} {path!r} does not exist")
+    if not target.is_file():  # /dev/zero, a pipe: read for ever
+        raise ParameterError(f"{option} {path!r} is not a regular file (a device or pipe); give a file")
 
 
 def progress_printer(t_end: float):

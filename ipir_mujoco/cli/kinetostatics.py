@@ -7,7 +7,7 @@ import math
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.options import MAX_T_END, check_run_options
 from ipir_mujoco.core.params import check_real, read_text_file
 from ipir_mujoco.core.results import write_json
 
@@ -61,6 +61,9 @@ def _read_crank_samples(path: str):
         except ValueError:
             raise ParameterError(f"--samples {path!r} line {number}: {line.strip()!r} is not a row of "
                                  "numbers") from None
+    if len(rows) < MIN_SAMPLES:
+        raise ParameterError(f"--samples {path!r} has {len(rows)} sample row(s); allowed: at least {MIN_SAMPLES} "
+                             "rows of t,phi under the header (the spline through them needs 4)")
     table = np.array(rows, dtype=float).reshape(len(rows), len(header))
     return table[:, header.index("t")], table[:, header.index("phi")]
 
@@ -69,6 +72,7 @@ def _read_crank_samples(path: str):
 # torque a prescribed motion needs grows as omega^2, and above it the figures are meaningless
 MAX_OMEGA = 1e4
 MAX_REVOLUTIONS = 1e4  # turns at constant speed: two mode switches each
+MIN_SAMPLES = 4  # rows of --samples: the cubic spline through them needs 4
 
 
 def run(args: argparse.Namespace) -> int:
@@ -81,14 +85,23 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(f"omega={args.omega:g} rad/s is out of range; allowed: 0 < |omega| <= "
                                  f"{MAX_OMEGA:g} rad/s (the range of omega0)")
         check_real("--revolutions", args.revolutions, high=MAX_REVOLUTIONS)
+        duration = args.revolutions * 2 * math.pi / abs(args.omega)  # s: the run this motion makes
+        if duration > MAX_T_END:
+            slowest = args.revolutions * 2 * math.pi / MAX_T_END
+            raise ParameterError(f"--omega {args.omega:g} rad/s with --revolutions {args.revolutions:g} would run "
+                                 f"{duration:.4g} s; allowed: {slowest:.4g} <= |omega| <= {MAX_OMEGA:g} rad/s for "
+                                 f"these revolutions (runs of at most {MAX_T_END:g} s), or fewer --revolutions")
     params = model_params(args)
     samples = _read_crank_samples(args.samples) if args.samples is not None else None
-    check_output_dir(args.out)
+    check_output_dir(args.out, files=("kinetostatics.csv", "summary.json", "kinetostatics.png"))
     if samples is None:
         motion = CrankMotion.constant_speed(args.omega, params.phi0, args.revolutions)
     else:
-        motion = CrankMotion.from_samples(*samples)
-        check_run_options(motion.t_end, motion.t_end / 2000)  # its output grid: 2000 intervals
+        try:
+            motion = CrankMotion.from_samples(*samples)
+            check_run_options(motion.t_end, motion.t_end / 2000)  # its output grid: 2000 intervals
+        except ParameterError as exc:
+            raise ParameterError(f"--samples {args.samples!r}: {exc}") from None
     run = inverse_kinetostatics(params, motion, args.geometry, args.clutch)
     s = run.series
     with staged_output(args.out) as staging:

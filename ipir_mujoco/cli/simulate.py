@@ -6,8 +6,10 @@ import argparse
 import json
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import check_run_options, refuse_steady_without_motor
-from ipir_mujoco.core.params import check_whole
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
+                                      refuse_steady_without_motor)
+from ipir_mujoco.core.params import check_real, check_whole
 from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
 from ..labels import fixed, significant
@@ -49,6 +51,9 @@ def add_parser(commands) -> None:
     sim.add_argument("--max-switches", type=int, default=None, metavar="N",
                      help="analytic engines: stop with an error after N mode switches (a work budget for designs "
                           "that chatter; default: the engine's, 100000)")
+    sim.add_argument("--wall-budget", type=float, default=DEFAULT_WALL_BUDGET_S, metavar="SECONDS",
+                     help=f"stop with an error after SECONDS of wall time (default {DEFAULT_WALL_BUDGET_S:g} s, so "
+                          "that no run goes on for hours; 'inf' for no limit)")
     sim.add_argument("--out", metavar="DIR",
                      help="write DIR/timeseries.csv, DIR/mode_changes.csv (time and crank angle of each mode "
                           "change), DIR/summary.json and the paper's figures as PNG")
@@ -79,8 +84,15 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
     the flags name (:func:`ipir_mujoco.registry.from_flags`)."""
     if args.t_end is None:
         args.t_end = T_END_STEADY if args.until_steady else T_END
+    if args.timestep is not None:  # before the output interval is derived from it
+        check_real("--timestep", args.timestep, high=1e-2, unit="s")
     args.dt_out = output_interval(args)
     check_run_options(args.t_end, args.dt_out)
+    if args.engine == "mujoco" and args.timestep is not None:
+        check_step_count(args.t_end, args.timestep, "--t-end", "--timestep")
+    if not (args.wall_budget > 0):  # nan and <= 0; inf is no limit
+        raise ParameterError(f"--wall-budget {args.wall_budget:g} is out of range; allowed: a number of seconds "
+                             "> 0, or inf (no limit)")
     if args.max_switches is not None:
         check_whole("--max-switches", args.max_switches, low=1)
     variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch)
@@ -98,9 +110,14 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
     params = model_params(args)
     progress = progress_printer(args.t_end) if not args.json else None
     accuracy = None if args.accuracy == "stop" else args.accuracy
-    return registry.run(variant, params, args.t_end, dt_out=args.dt_out, until_steady=args.until_steady or None,
-                        progress=progress, max_switches=args.max_switches, timestep=args.timestep, mjcf=args.mjcf,
-                        accuracy=accuracy)
+    try:
+        return registry.run(variant, params, args.t_end, dt_out=args.dt_out, until_steady=args.until_steady or None,
+                            progress=progress, max_switches=args.max_switches, timestep=args.timestep,
+                            mjcf=args.mjcf, accuracy=accuracy, wall_budget_s=args.wall_budget)
+    except SimulationError as exc:
+        if "budget" in str(exc) and "wall" in str(exc):  # say which option raises it
+            raise SimulationError(f"{exc} (--wall-budget {args.wall_budget:g} s; raise it, or 'inf')") from None
+        raise
 
 
 def format_summary(run: RunResult, until_steady: bool = False) -> str:
@@ -161,7 +178,8 @@ def run(args: argparse.Namespace) -> int:
     # bad parameters are reported before the output folder is looked at
     refuse_steady_without_motor(model_params(args).drive, args.until_steady)
     if args.out is not None:
-        check_output_dir(args.out)
+        check_output_dir(args.out, files=("timeseries.csv", "mode_changes.csv", "summary.json", "fig2_crank.png",
+                                          "fig3_modules.png", "fig4_gap.png"))
     result = run_simulation(args)
     record = result.to_json_dict()
     if args.out is not None:

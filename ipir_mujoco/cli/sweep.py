@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
@@ -56,6 +56,50 @@ def add_parser(commands) -> None:
 
 
 
+SCHEMES = ("tcp", "tls", "ws", "wss")  # Dask's network transports
+CONNECT_TIMEOUT_S = 5.0  # s: a scheduler on the network answers in milliseconds; a wrong address is not waited on
+
+
+def scheduler_address(address: str) -> tuple[str, str, int]:
+    """(scheme, host, port) of a Dask scheduler address ``[SCHEME://]HOST:PORT``, or a one-line
+    ParameterError naming it and the allowed form."""
+    allowed = (f"allowed: SCHEME://HOST:PORT with SCHEME one of {', '.join(SCHEMES)} (e.g. tcp://host:8786), "
+               "or the inproc:// address of a cluster in this process")
+    scheme, _, rest = address.strip().rpartition("://")
+    scheme = scheme or "tcp"
+    if scheme == "inproc" and rest:  # a LocalCluster(processes=False) of this process: no socket to probe
+        return scheme, rest, 0
+    host, _, port = rest.rpartition(":")
+    host = host.strip("[]")
+    if scheme not in SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ParameterError(f"--scheduler {address!r} is not a scheduler address; {allowed}")
+    return scheme, host, int(port)
+
+
+def connect_scheduler(address: str):
+    """A Dask ``Client`` of the scheduler at ``address``; an address that is malformed, or where nothing
+    answers within CONNECT_TIMEOUT_S, is a one-line ParameterError naming it (tried with a plain socket
+    first, so that the answer comes in seconds)."""
+    import socket
+
+    scheme, host, port = scheduler_address(address)
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
+    try:
+        if scheme != "inproc":
+            socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as exc:
+        raise ParameterError(f"--scheduler {address!r} cannot be reached ({exc.strerror or exc or 'timed out'}); "
+                             "allowed: the address of a running Dask scheduler") from None
+    try:
+        return Client(address if "://" in address else f"tcp://{address}", timeout=f"{CONNECT_TIMEOUT_S:g}s")
+    except Exception as exc:  # noqa: BLE001 (whatever Dask raises: a handshake that is not a scheduler's)
+        raise ParameterError(f"--scheduler {address!r} did not answer as a Dask scheduler "
+                             f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+
+
 def study_from_args(args: argparse.Namespace):
     """The Study the options describe: defaults, the study file, then the command line (which wins)."""
     from ..studies.sweep_space import Study, parse_vary, read_study
@@ -92,16 +136,7 @@ def run(args: argparse.Namespace) -> int:
     if args.no_batch and args.batch_size is not None:
         raise ParameterError(f"--batch-size {args.batch_size} with --no-batch: the batch size is for mujoco.batch; "
                              "allowed: one of the two")
-    client = None
-    if args.scheduler:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
-        try:
-            client = Client(args.scheduler, timeout="20s")
-        except (OSError, TimeoutError) as exc:
-            raise ParameterError(f"--scheduler {args.scheduler!r} cannot be reached: {exc}") from None
+    client = connect_scheduler(args.scheduler) if args.scheduler is not None else None
     try:
         results = run_sweep(study, args.out, executor=client.get_executor() if client else None,
                             batch_mujoco=False if args.no_batch else None, resume=args.resume, workers=args.workers,
@@ -114,6 +149,10 @@ def run(args: argparse.Namespace) -> int:
             client.close()
     axes = [a.name for a in study.axes]
     columns = read_results(results)
+    errors = [e for e in columns["error"] if e]
+    if len(columns["design_id"]) and len(errors) == len(columns["design_id"]):  # nothing to draw or rank
+        raise SimulationError(f"every one of the {len(errors)} designs failed, so there is nothing to draw; the "
+                              f"first: {' '.join(str(errors[0]).split())} (the rows are in {results})")
     figures = plot_sweep(results, study, args.out, metric=metric)
     best = best_designs(columns, axes, list(study.engines))
     write_json(Path(args.out) / "best.json", {"best": best, "ranking": rankings(columns, axes, list(study.engines))})

@@ -27,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
     from ..report.validation import write_report
     from ..studies.validate import validate
 
-    check_output_dir(args.out)
+    check_output_dir(args.out, files=("metrics.json", "index.html", "report.md"), folders=("figures",))
     params = model_params(args)
 
     def progress(message: str) -> None:

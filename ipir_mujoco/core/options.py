@@ -25,6 +25,24 @@ MAX_T_END = 3600.0  # s: an hour of simulated motion; a motor reaches its steady
 # MuJoCo run at its 1e-4 s step already takes 3.6e7 steps for an hour
 MAX_SAMPLES = 10_000_000  # samples kept per run: ~20 float64 columns -> 1.6 GB in memory, ~4 GB as CSV
 SAMPLE_BYTES = 20 * 8  # bytes per kept sample (about 20 float64 columns)
+MAX_STEPS = 100_000_000  # MuJoCo steps per run: ~7 min at ~4 us a step (bench/ratchet_step.py); the longest
+# run the engine chooses by itself, 3600 s at its 1e-4 s step, is 3.6e7 steps, so only a tiny given timestep
+# with a long t_end reaches it
+DEFAULT_WALL_BUDGET_S = 1800.0  # s of wall time a run may take unless told otherwise: the longest default-step
+# run (3600 s of MuJoCo, ~2.5 min) fits ~10 times over, and no run left alone goes on for hours
+
+
+def check_step_count(t_end: float, timestep: float, t_end_name: str = "t_end",
+                     timestep_name: str = "timestep") -> int:
+    """The MuJoCo step count t_end / timestep (both [s]), or a one-line ParameterError naming both and the
+    allowed maximum MAX_STEPS: bounded up front, so that a run of 1e12 steps is refused, not started."""
+    steps = t_end / timestep
+    if steps > MAX_STEPS:
+        raise ParameterError(
+            f"{t_end_name}={t_end:g} s with {timestep_name}={timestep:g} s would take {steps:.3g} MuJoCo steps "
+            f"(~{steps * 4e-6 / 3600:.3g} h at ~4 us a step); allowed: at most {MAX_STEPS:.0e} steps "
+            f"({timestep_name} >= {t_end / MAX_STEPS:.3g} s for this {t_end_name})")
+    return int(math.ceil(steps))
 
 
 def check_run_options(t_end: Any, dt_out: Any) -> tuple[float, float]:
@@ -60,7 +78,8 @@ class RunOptions:
     ``until_steady``: stop at the end of the revolution where the periodic steady state is reached
     (:class:`.cycles.SteadyWatch` with ``steady_tol`` and ``steady_cycles``); ``progress(t)``: called with
     the simulated time [s] now and then (about every 0.1 s of it), or None; ``wall_budget_s`` [s]: the most
-    wall-clock time a run may take (None: no limit); ``max_switches``: the most mode switches an
+    wall-clock time a run may take (None: :data:`DEFAULT_WALL_BUDGET_S`, so that no run left alone goes on
+    for hours; ``math.inf``: no limit, stored as None); ``max_switches``: the most mode switches an
     event-driven engine may make (None: the engine's default; MuJoCo has none to count).
     """
 
@@ -92,12 +111,15 @@ class RunOptions:
         if self.progress is not None and not callable(self.progress):
             raise ParameterError(f"progress={self.progress!r} is not callable; allowed: a function of the "
                                  "simulated time [s], or None")
-        if self.wall_budget_s is not None:
+        if self.wall_budget_s is None:
+            set_(self, "wall_budget_s", DEFAULT_WALL_BUDGET_S)
+        else:
             budget = None if isinstance(self.wall_budget_s, bool) else as_real(self.wall_budget_s)
-            if budget is None or not (math.isfinite(budget) and budget > 0):
-                raise ParameterError(f"wall_budget_s={self.wall_budget_s!r} is out of range; allowed: a finite "
-                                     "number of seconds > 0, or None (no limit)")
-            set_(self, "wall_budget_s", budget)
+            if budget is None or math.isnan(budget) or not budget > 0:
+                raise ParameterError(f"wall_budget_s={self.wall_budget_s!r} is out of range; allowed: a number "
+                                     f"of seconds > 0, inf (no limit), or None (the default, "
+                                     f"{DEFAULT_WALL_BUDGET_S:g} s)")
+            set_(self, "wall_budget_s", None if math.isinf(budget) else budget)
         if self.max_switches is not None:
             if isinstance(self.max_switches, bool) or not isinstance(self.max_switches, (int, np.integer)):
                 raise ParameterError(f"max_switches={self.max_switches!r} is out of range; allowed: a whole "
@@ -121,3 +143,14 @@ class RunOptions:
 
 
 _FIELDS = tuple(name for name in RunOptions.__dataclass_fields__ if name != "t_end")
+
+
+def check_type(name: str, value: Any, types: type | tuple[type, ...], allowed: str) -> Any:
+    """``value`` if it is an instance of ``types`` (None passes where ``types`` holds ``type(None)``), else a
+    one-line ParameterError naming the argument, what it got and ``allowed``: the public entry points check
+    their arguments so that misuse is not a TypeError from deep inside."""
+    if isinstance(value, bool) and bool not in (types if isinstance(types, tuple) else (types,)):
+        raise ParameterError(f"{name}={value!r} is not allowed; allowed: {allowed}")
+    if not isinstance(value, types):
+        raise ParameterError(f"{name}={value!r} ({type(value).__name__}) is not allowed; allowed: {allowed}")
+    return value

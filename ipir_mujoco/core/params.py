@@ -24,6 +24,7 @@ import decimal
 import functools
 import math
 import numbers
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -287,11 +288,23 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     return values
 
 
+MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far past any real one, and a bound
+# on what /dev/zero or a mistyped multi-GB file would make the command read into memory
+
+
 def read_text_file(path: str | Path, what: str) -> str:
-    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read."""
+    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
+    for a device or pipe, /dev/zero, and a file past MAX_TEXT_BYTES)."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        if path.exists() and not path.is_dir() and not path.is_file():
+            raise ParameterError(f"{what} {str(path)!r} is not a regular file (a device or pipe); give a file")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_TEXT_BYTES + 1)
+        if len(data) > MAX_TEXT_BYTES:
+            raise ParameterError(f"{what} {str(path)!r} is larger than {MAX_TEXT_BYTES / 1e6:g} MB; allowed: a "
+                                 "text file of at most that size")
+        return data.decode("utf-8")
     except FileNotFoundError:
         raise ParameterError(f"{what} {str(path)!r} does not exist") from None
     except IsADirectoryError:
@@ -310,6 +323,13 @@ def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
+    except ValueError as exc:  # an integer past Python's 4300-digit conversion limit
+        why = "an integer of more than 4300 digits" if "digits" in str(exc) else " ".join(str(exc).split())[:120]
+        raise ParameterError(f"{what} {str(path)!r} holds a value that cannot be read ({why}); allowed: numbers "
+                             "within the ranges 'ipir-mujoco params' lists") from None
+    except RecursionError:  # arrays or tables nested thousands deep
+        raise ParameterError(f"{what} {str(path)!r} nests arrays or tables too deep to read; allowed: the flat "
+                             "tables of a config or study file (docs/cli.md)") from None
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
@@ -343,6 +363,8 @@ def load_params(
     """Defaults, then the TOML file ``config``, then ``overrides`` (last wins)."""
     values: dict[str, Any] = {}
     if config is not None:
+        if not isinstance(config, (str, os.PathLike)):
+            raise ParameterError(f"config={config!r} is not a path; allowed: the path of a TOML file, or None")
         values.update(read_toml(config))
     if isinstance(overrides, Mapping):
         unknown = [n for n in overrides if n not in PARAMETER_NAMES]

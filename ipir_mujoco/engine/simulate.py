@@ -40,6 +40,7 @@ monitor holds it to a tolerance.
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import replace
 from typing import Callable
@@ -49,7 +50,7 @@ import numpy as np
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
 from ipir_mujoco.core.errors import SimulationError
-from ipir_mujoco.core.options import RunOptions
+from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
 from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
@@ -110,10 +111,15 @@ def simulate_mujoco(
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
     """
     params = require_params(params)
+    check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
+    check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
+    check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
     check_clutch_options(params, clutch, implementation)
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
     t_end, dt_out = run.t_end, run.dt_out
+    if settings is not None:  # bounded up front: a tiny given timestep is refused, not run for days
+        check_step_count(t_end, settings.timestep)
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,

@@ -315,7 +315,14 @@ def run_tasks(base: RobotParams, tasks: list[Task], points_table: dict[str, Oper
 
 
 def _run_task_item(base: RobotParams, points_table: dict[str, OperatingPoint], task: Task) -> dict:
-    return run_task(base, points_table[task.point], task)
+    """One task in a worker; a surprise inside an engine (r = 1e-300 m divides by zero) ends the study as a
+    SimulationError naming the task, one line, rather than a bare exception from the pool."""
+    try:
+        return run_task(base, points_table[task.point], task)
+    except (ParameterError, SimulationError):
+        raise
+    except Exception as exc:  # noqa: BLE001
+        raise SimulationError(f"{task}: {type(exc).__name__}: {' '.join(str(exc).split())[:200]}") from None
 
 
 def run_study(base: RobotParams, stiffness: Sequence[float] = STIFFNESS, backlash: Sequence[float] = BACKLASH,

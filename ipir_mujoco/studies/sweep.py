@@ -57,6 +57,7 @@ from typing import Callable
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.options import check_type
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
 from ..output import check_output_dir
@@ -123,8 +124,9 @@ def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end:
                  and threading.current_thread() is threading.main_thread())
     if armed:
         signal.signal(signal.SIGALRM, _raise_timeout)
-        signal.setitimer(signal.ITIMER_REAL, budget)
     try:
+        if armed:  # inside the try: a tiny budget may fire before the first engine starts
+            signal.setitimer(signal.ITIMER_REAL, budget)
         for engine in engines:
             results[engine] = engine_metrics(engine, params, t_end, dt_out, options)
     except DesignTimeout:
@@ -134,6 +136,7 @@ def run_design(values: dict, base: RobotParams, engines: tuple[str, ...], t_end:
     finally:
         if armed:
             signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, signal.SIG_IGN)  # an alarm already on its way must not land later
     return results
 
 
@@ -218,12 +221,29 @@ def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_desi
         check_real("timeout_per_design", timeout_per_design, high=1e6, unit="s")
     if batch_size is not None:
         check_whole("batch_size", batch_size, low=1, high=100_000)
-    out = check_output_dir(out)
+    out = check_output_dir(out, files=("results.csv", "sweep.json", "best.json"))
     meta = out / "sweep.json"
     if resume and out.is_dir() and any(out.iterdir()) and not meta.is_file():
         raise ParameterError(f"--resume --out {str(out)!r}: the folder holds no sweep (no sweep.json); give the "
                              "folder of the sweep to complete")
     return out
+
+
+def refuse_all_invalid(base: RobotParams, designs: list[dict]) -> None:
+    """A study none of whose designs is a valid parameter set (``L=0.01,0.02`` with r = 0.05: L <= r) is
+    refused before anything is written, naming the first design's fault; one valid design is enough to run
+    (the invalid ones are then recorded as failed rows)."""
+    first = None
+    for values in designs:
+        try:
+            base.replace(**values)
+            return
+        except ValueError as exc:
+            first = first or (values, exc)
+    if first is not None:
+        where = ", ".join(f"{k}={v:g}" for k, v in first[0].items())
+        raise ParameterError(f"every one of the {len(designs)} designs is invalid; the first ({where}): "
+                             f"{' '.join(str(first[1]).split())}")
 
 
 def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | None = None,
@@ -235,6 +255,8 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
     ``batch_mujoco``: True steps the MuJoCo ratchet designs through ``mujoco.batch``, False one by one in
     the serial engine; None (default) the batch only when ``batch_size`` is given or the serial engine's
     compiled loop is not built."""
+    check_type("study", study, Study, "a Study (ipir_mujoco.studies.sweep_space.Study)")
+    check_type("out", out, (str, os.PathLike), "the path of the results folder")
     out = check_sweep_options(out, resume, workers, timeout_per_design, batch_size)
     meta = out / "sweep.json"
     record = {"fingerprint": study.fingerprint(), "study": study.to_json()}
@@ -247,6 +269,7 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
             raise ParameterError(f"{str(out)!r} holds another study (its sweep.json differs); resume needs the "
                                  "same one")
     designs = study.designs()
+    refuse_all_invalid(study.base, designs)
     out.mkdir(parents=True, exist_ok=True)
     results_file = ResultsFile(out / "results.csv", header_for(study), resume)
     meta.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")

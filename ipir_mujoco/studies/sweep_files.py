@@ -65,6 +65,47 @@ def _cell(value) -> str:
     return f"{value:.10g}" if isinstance(value, float) else " ".join(str(value).split())
 
 
+def _read_complete_lines(path: Path) -> list[str]:
+    """The lines of results.csv that end in a newline (a row cut by a crash is dropped); bytes that are not
+    UTF-8 are refused in one line naming the file and the line."""
+    data = path.read_bytes()
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise ParameterError(f"{str(path)!r} line {line} is not UTF-8 text (a corrupted file?); resume needs the "
+                             "results.csv a sweep wrote: remove the line, or run the sweep again in another --out")
+    return [ln for ln in text.splitlines(keepends=True) if ln.endswith("\n")]
+
+
+def _parse_rows(path: Path, lines: list[str]) -> list[list[str]]:
+    """The CSV rows of ``lines``, one per line (sweeps write no cell with a line break in it)."""
+    rows = []
+    for number, line in enumerate(lines, start=1):
+        try:
+            rows.extend(csv.reader([line]))
+        except csv.Error as exc:
+            raise ParameterError(f"{str(path)!r} line {number} is not a CSV row ({exc}); resume needs the "
+                                 "results.csv a sweep wrote: remove the line, or run again in another --out") from None
+    return rows
+
+
+def _done_designs(path: Path, rows: list[list[str]], width: int) -> set[int]:
+    """The design ids of the data rows, after checking that each has the header's ``width`` cells and a
+    whole-number id (a garbage line is refused in one line naming the file and the line)."""
+    done = set()
+    for number, row in enumerate(rows[1:], start=2):
+        if not row:
+            continue
+        if len(row) != width or not row[0].isdigit():
+            what = (f"has {len(row)} cells; the header has {width}" if len(row) != width
+                    else f"design_id {row[0][:20]!r} is not a whole number")
+            raise ParameterError(f"{str(path)!r} line {number} {what} (a corrupted row?); resume needs the "
+                                 "results.csv a sweep wrote: remove the line, or run again in another --out")
+        done.add(int(row[0]))
+    return done
+
+
 class ResultsFile:
     """results.csv: header once, one flushed row per finished design; sorted by design_id when complete."""
 
@@ -74,14 +115,12 @@ class ResultsFile:
         if path.exists():
             if not resume:
                 raise ParameterError(f"{str(path)!r} exists; use --resume to complete it, or another --out")
-            with path.open(newline="", encoding="utf-8") as fh:
-                lines = fh.read().splitlines(keepends=True)
-            complete = [ln for ln in lines if ln.endswith("\n")]  # a row cut by a crash is dropped
-            rows = list(csv.reader(complete))
+            complete = _read_complete_lines(path)
+            rows = _parse_rows(path, complete)
             if not rows or rows[0] != header:
                 raise ParameterError(f"{str(path)!r} was written for other engines, metrics or parameters; "
                                      "resume needs the same study and version")
-            self.done = {int(r[0]) for r in rows[1:] if r}
+            self.done = _done_designs(path, rows, len(header))
             path.write_text("".join(complete), encoding="utf-8")
         else:
             with path.open("w", newline="", encoding="utf-8") as fh:

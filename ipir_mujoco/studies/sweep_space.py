@@ -73,6 +73,8 @@ class Axis:
 
 def parse_vary(text: str) -> Axis:
     """Parse one ``--vary`` specification (see the module docstring)."""
+    if not isinstance(text, str):
+        raise ParameterError(f"vary={text!r} is not a string; allowed: NAME=START:STOP:N, NAME=A,B,C or NAME=LO:HI")
     name, sep, spec = text.partition("=")
     name = name.strip()
     if not sep or not spec:
@@ -151,6 +153,9 @@ class Study:
         if isinstance(self.engines, str):
             raise ParameterError(f"engines={self.engines!r} is a single string; allowed: a list of engine names, "
                                  f"e.g. [{self.engines!r}], from: {', '.join(ENGINES)}")
+        if not isinstance(self.engines, (list, tuple)):
+            raise ParameterError(f"engines={self.engines!r} is not a list; allowed: a list of engine names from: "
+                                 f"{', '.join(ENGINES)}")
         set_("engines", tuple(self.engines))
         if not self.engines:
             raise ParameterError(f"engines=[] names no engine; allowed: one or more of {', '.join(ENGINES)}")
