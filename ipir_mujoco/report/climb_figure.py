@@ -65,6 +65,9 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
         speed_handles.append(Line2D([], [], color=colour, label=label, **style))
         if np.isfinite(peak).any():  # MuJoCo's rigid clutches give none (module docstring)
             force_handles.append(Line2D([], [], color=colour, label=f"peak, {label}", **style))
+        if np.isfinite(_column(rows, engine, "mean_clutch_force_n")).any():  # drawn dashed in the engine's colour
+            force_handles.append(Line2D([], [], color=colour, lw=1.0, ls="--",
+                                        label=f"mean over the steady window, {label}"))
         limit = study["steady_climb"].get(engine, {}).get("incline_deg")
         if limit is not None:
             # dashes offset per engine: lines at one incline show both colours in turn
@@ -83,8 +86,7 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
     fine = np.linspace(min(x.min(), 0.0), x.max(), 200)
     mass = params.m1 + params.m2 + params.rod_mass
     force_ax.plot(fine, mass * params.g * np.sin(np.radians(fine)), color="grey", lw=2.5, alpha=0.5, gid="weight")
-    force_handles += [Line2D([], [], color="black", lw=1.0, ls="--", label="mean over the steady window"),
-                      Line2D([], [], color="grey", lw=2.5, alpha=0.5,
+    force_handles += [Line2D([], [], color="grey", lw=2.5, alpha=0.5,
                              label="weight along the pipe, (m1 + m2 + m_rod) g sin(incline)"),
                       Line2D([], [], ls="none", marker="x", mew=2, color="black",
                              label="stalled: peak over the run, then held at rest")]

@@ -87,7 +87,10 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
         ax.set_yscale("log")
         ax.set_xticks(list(decades) + [rigid_x], [f"$10^{{{int(np.log10(d))}}}$" for d in decades] + ["rigid"])
         ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
-        ax.yaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+        low, high = ax.get_ylim()
+        # a panel spanning less than a decade gets evenly stepped labels (a log locator would leave one or two)
+        ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]) if high < 10 * low
+                                   else matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
         ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set(xlabel="clutch stiffness seen at the module, k [N/m]", ylabel="peak clutch force [N]",

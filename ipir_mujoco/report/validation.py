@@ -72,16 +72,17 @@ def figure_lr_study(study: dict, path: Path) -> None:
     physics = np.array([abs(row["mujoco_vs_exact"]["revolutions"]) for row in study["rows"]])
     ax.plot(ratios, 100 * physics, "k:", lw=1.0, label="MuJoCo vs the exact equations of its linkage (with its "
                                                         "rod), revolutions")
-    for level in (1, 5):
+    for level in (1, 5):  # labelled at the left edge, clear of the curves (which fall to the right)
         ax.axhline(level, color="grey", lw=0.8, ls="--")
-        ax.text(ratios[-1], level * 1.08, f"{level} %", ha="right", va="bottom", fontsize="small", color="grey")
+        ax.text(0.005, level * 1.08, f"{level} %", transform=ax.get_yaxis_transform(), ha="left", va="bottom",
+                fontsize="small", color="dimgrey", bbox={"facecolor": "white", "edgecolor": "none", "pad": 1})
     ax.set(xscale="log", yscale="log", xlabel="L / r [-]", ylabel="|first order - exact| / |exact| [%]",
            title="where L >> r breaks down: divergence of the paper's first-order model")
     ticks = [x for x in (1.05, 1.5, 2, 3, 4, 6, 10, 15, 20) if ratios[0] <= x <= ratios[-1]]
     ax.set_xticks(ticks, [f"{x:g}" for x in ticks])
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize="x-small", loc="upper right")
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, fontsize="x-small")
     fig.savefig(path, dpi=120)
 
 
