@@ -108,13 +108,11 @@ def frame_times(run: RunResult, settings: VideoSettings, t_end: float | None = N
     return t[0] + settings.frame_interval * np.arange(count)
 
 
-def _render_model(params: RobotParams, settings: VideoSettings):
-    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size."""
+def checker_floor(spec) -> None:
+    """Give the pipe's floor 5 cm checker squares (and a softer light), so that the eye sees the robot advance
+    when the camera follows it: drawing only, for render and the viewer (an ``mujoco.MjSpec``, in place)."""
     import mujoco
 
-    from .engine.model import build_spec
-
-    spec = build_spec(params)
     spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
                      width=64, height=64, rgb1=[0.92, 0.92, 0.88], rgb2=[0.78, 0.78, 0.74])
     material = spec.add_material(name="grid", texrepeat=[10, 10], texuniform=True)  # 10 per metre: 5 cm squares
@@ -124,6 +122,26 @@ def _render_model(params: RobotParams, settings: VideoSettings):
     spec.geom("pipe_floor").size = [100.0, 1.0, 0.01]  # far beyond any run, and wider than the view
     spec.visual.headlight.ambient = [0.45, 0.45, 0.45]
     spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]
+
+
+def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: float,
+               held: tuple[bool, bool]) -> tuple[str, str]:
+    """The overlay's (labels, values) of the robot's state: crank speed and turns, each module's speed and
+    whether its clutch holds (times [s], angles [rad], speeds [rad/s, m/s])."""
+    words = ("holds (green)", "slides")
+    values = (f"{fixed(omega, 1)} rad/s, {fixed((phi - phi0) / (2 * math.pi), 2)} rev\n"
+              f"{fixed(v1, 2)} m/s, clutch {words[0] if held[0] else words[1]}\n"
+              f"{fixed(v2, 2)} m/s, clutch {words[0] if held[1] else words[1]}")
+    return "crank\nmodule 1 (rear)\nmodule 2 (front)", values
+
+
+def _render_model(params: RobotParams, settings: VideoSettings):
+    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size."""
+
+    from .engine.model import build_spec
+
+    spec = build_spec(params)
+    checker_floor(spec)
     spec.visual.global_.offwidth = settings.width
     spec.visual.global_.offheight = settings.height
     return spec.compile()
@@ -179,15 +197,16 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
             if settings.width < OVERLAY_MIN_WIDTH:  # the text would cover the robot
                 yield _read_frame(settings, viewport, renderer)
                 continue
-            words = ("holds (green)", "slides")
+            # the text on dark panels: white text alone is hard to read over the light floor
+            for y, height, width in ((0.80, 0.20, 0.80), (0.0, 0.25, 0.75)):  # fractions of the frame
+                mujoco.mjr_rectangle(mujoco.MjrRect(0, int(settings.height * y), int(settings.width * width),
+                                                    int(settings.height * height)), 0.1, 0.1, 0.12, 0.55)
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport,
                                f"{title}\nt = {when:.3f} s", f"\n{settings.speed:g}x real time", renderer)
-            state = (f"{fixed(np.interp(when, t, s['omega']), 1)} rad/s, "
-                     f"{fixed((phi - s['phi'][0]) / (2 * math.pi), 2)} rev\n"
-                     f"{fixed(np.interp(when, t, s['v1']), 2)} m/s, clutch {words[0] if held[0] else words[1]}\n"
-                     f"{fixed(np.interp(when, t, s['v2']), 2)} m/s, clutch {words[0] if held[1] else words[1]}")
-            mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport,
-                               "crank\nmodule 1 (rear)\nmodule 2 (front)", state, renderer)
+            labels, values = state_text(when, phi, float(s["phi"][0]), float(np.interp(when, t, s["omega"])),
+                                        float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held)
+            mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels,
+                               values, renderer)
             yield _read_frame(settings, viewport, renderer)
     finally:
         renderer.free()

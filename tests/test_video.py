@@ -215,3 +215,15 @@ def test_the_viewer_colours_the_housings_by_the_clutches():
     run = simulate_mujoco(RobotParams(), "unilateral", "ratchet", robot.data.time, dt_out=2.5e-3,
                           settings=robot.settings)
     assert robot.data.qpos[robot.model.joint("crank_hinge").qposadr[0]] == run.series["phi"][-1]
+
+
+def test_the_viewer_draws_the_checker_floor_and_says_time_and_speeds():
+    """So that the robot is seen to advance with the camera following it, and the state is read as in render."""
+    from ipir_mujoco.view import ViewedRobot
+
+    robot = ViewedRobot(RobotParams())
+    assert robot.model.ntex == 1 and robot.model.geom_matid[robot.model.geom("pipe_floor").id] >= 0
+    robot.step(2000)
+    labels, values = robot.overlay()
+    assert labels.startswith("t = 0.") and "module 2 (front)" in labels
+    assert values.count("m/s, clutch") == 2 and "rad/s" in values

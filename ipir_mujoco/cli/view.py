@@ -34,10 +34,11 @@ from ipir_mujoco.core.params import RobotParams
 
 from ..engine.clutches import clutch_controller
 from ..engine.common import check_clutch_options
-from ..engine.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
+from ..engine.model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control,
+                            set_closed_loop_state)
 from ..engine.stepper import loop_options, make_steps
 from ..engine.timestep import choose_settings
-from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS
+from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
 
@@ -56,7 +57,7 @@ class ViewedRobot:
         if settings is None:  # the step the engine would choose for a run of t_end [s]
             settings, _ = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
         self.settings = settings
-        self.model = build_model(params, settings, ratchet=self.implementation == "ratchet")
+        self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=checker_floor)
         self.data = mujoco.MjData(self.model)
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)
@@ -78,6 +79,15 @@ class ViewedRobot:
         housings take the clutches' colours (rewritten only when a clutch's state changed)."""
         self.steps.run(n)
         self._colour()
+
+    def overlay(self) -> tuple[str, str]:
+        """The viewer's text, as render's: the time and the playback, then the crank's and the modules' state."""
+        d, m = self.data, self.model
+        crank, rear, front = (m.joint(n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE))
+        labels, values = state_text(d.time, float(d.qpos[crank.qposadr[0]]), self.params.phi0,
+                                    float(d.qvel[crank.dofadr[0]]), float(d.qvel[rear.dofadr[0]]),
+                                    float(d.qvel[front.dofadr[0]]), self.held or (False, False))
+        return f"t = {d.time:.2f} s\n{labels}", f"\n{values}"
 
     def _colour(self) -> None:
         held = tuple(self.controller.reactions()[:2])
@@ -121,6 +131,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     import mujoco.viewer
 
     frame = 1.0 / 60.0  # wall-clock seconds between two viewer updates
+    print("python -m ipir_mujoco.view: drag to turn the camera, right-drag to move it, scroll to zoom; Space "
+          "pauses, Tab and Shift+Tab show the panels, Esc or closing the window ends it", file=sys.stderr)
     # the panels start hidden so the robot has the window (Tab and Shift+Tab show them)
     with mujoco.viewer.launch_passive(robot.model, robot.data, show_left_ui=False,
                                       show_right_ui=False) as viewer:
@@ -135,6 +147,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 robot.step(max(1, round(frame / args.slow / robot.settings.timestep)))
                 if robot.data.time >= args.t_end:
                     robot.reset()
+            viewer.set_texts((mujoco.mjtFontScale.mjFONTSCALE_150, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT,
+                              *robot.overlay()))
             viewer.sync()
             time.sleep(max(0.0, frame - (time.perf_counter() - started)))
     return EXIT_OK

@@ -308,9 +308,12 @@ def _write_solver(spec: mujoco.MjSpec, settings: SolverSettings, hint: str, ratc
 
 
 def build_model(params: RobotParams, settings: SolverSettings = SolverSettings(),
-                mjcf: str | Path | None = None, ratchet: bool = False) -> mujoco.MjModel:
-    """Compile the robot for ``params`` (see :func:`build_spec`)."""
+                mjcf: str | Path | None = None, ratchet: bool = False, decorate=None) -> mujoco.MjModel:
+    """Compile the robot for ``params`` (see :func:`build_spec`); ``decorate(spec)``, if given, adds what only
+    drawing needs (the viewer's floor texture) before compiling."""
     spec = build_spec(params, settings, mjcf, ratchet)
+    if decorate is not None:
+        decorate(spec)
     try:
         model = spec.compile()
     except ValueError as exc:
