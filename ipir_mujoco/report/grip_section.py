@@ -158,7 +158,12 @@ def verdict(metrics: dict) -> dict:
                      f"on G = {fmt(weakest['grip_n'], 3)} N (mu {weakest['mu']:g}, F_n {weakest['press_n']:g} N) "
                      f"the modules skid back {fmt(m['slip_m'], 3)} m and the speed changes {change}")
     answer = ("The one-way model: " + "; ".join(parts) + ".") if parts else "No finite-grip run completed."
+    needs = [case["unlimited"][ONE_WAY].get("peak_clutch_force_n") for case in metrics["cases"].values()]
+    needs = [n for n in needs if n is not None]
+    short = (f"up to {fmt(max(needs), 3)} N per module (the one-way model); less skids" if needs
+             else "no finite-grip run completed")
     return {"question": "How much wall grip does the robot need, and what does realistic grip cost?",
-            "answer": answer,
+            "answer": answer, "short": short,
+            "key": f"riser: F_n >= {fmt(max(metrics['riser']['needed_n']), 3)} N at mu {metrics['riser']['mu']:g}",
             "evidence": f"riser press at mu {metrics['riser']['mu']:g}: "
                         + " / ".join(fmt(f) for f in metrics["riser"]["needed_n"]) + " N per module"}
