@@ -152,6 +152,17 @@ static double upper_bound(double value, double margin) {
 }
 
 /* the clutch update before a step: Ratchet, Locks, CompliantClutches, GripRatchet.before_step */
+/* grip.GripRows' carriage update, for both grip controllers: module i's carriage at c may only move back, its
+   forward bound lowered to its running minimum; a carriage pushed forward again counts as excursion */
+static void carriage_ratchet(const int64_t *cfg, double *st, mjtNum *range, int i, double c) {
+  if (c < st[S_cmin0 + i]) {
+    st[S_cmin0 + i] = c;
+    range[2 * cfg[C_skid_j0 + i] + 1] = upper_bound(c, st[S_cmargin0 + i]);
+  } else if (c - st[S_cmin0 + i] > st[S_excursion]) {
+    st[S_excursion] = c - st[S_cmin0 + i];
+  }
+}
+
 static void before_step(const int64_t *cfg, double *st) {
   const mjtNum *qpos = DATA(cfg)->qpos, *qvel = DATA(cfg)->qvel;
   switch (cfg[C_clutch]) {
@@ -224,12 +235,7 @@ static void before_step(const int64_t *cfg, double *st) {
         } else if (st[S_lmax0 + i] - roll > st[S_excursion]) {
           st[S_excursion] = st[S_lmax0 + i] - roll;
         }
-        if (c < st[S_cmin0 + i]) {
-          st[S_cmin0 + i] = c;
-          range[2 * cfg[C_skid_j0 + i] + 1] = upper_bound(c, st[S_cmargin0 + i]);
-        } else if (c - st[S_cmin0 + i] > st[S_excursion]) {
-          st[S_excursion] = c - st[S_cmin0 + i];
-        }
+        carriage_ratchet(cfg, st, range, i, c);
       }
       break;
     }
@@ -252,12 +258,7 @@ static void before_step(const int64_t *cfg, double *st) {
           st[S_damped0 + i] = d > 0.0 ? 1.0 : 0.0;
           biasprm[act * mjNBIAS + 2] = d > 0.0 ? -st[S_c] : 0.0;
         }
-        if (c < st[S_cmin0 + i]) {
-          st[S_cmin0 + i] = c;
-          range[2 * cfg[C_skid_j0 + i] + 1] = upper_bound(c, st[S_cmargin0 + i]);
-        } else if (c - st[S_cmin0 + i] > st[S_excursion]) {
-          st[S_excursion] = c - st[S_cmin0 + i];
-        }
+        carriage_ratchet(cfg, st, range, i, c);
       }
       break;
     }

@@ -51,6 +51,20 @@ from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damp
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
 
 
+def clutch_actuators(model: mujoco.MjModel, act, params: RobotParams) -> tuple[float, float]:
+    """(k [N/m], c [N s/m]) of the compliant clutches' actuators ``act`` (ids), checked to be the spring k =
+    clutch_stiffness with the force range [0, ...]; their dampers set as built (a model that has run may hold
+    0). ValueError where the model was built from other parameters."""
+    k, c = params.clutch_stiffness, params.clutch_damping
+    for u in act:
+        if not (k is not None and model.actuator_gainprm[u, 0] == k and model.actuator_biasprm[u, 1] == -k
+                and model.actuator_forcelimited[u] and model.actuator_forcerange[u, 0] == 0.0):
+            raise ValueError("the clutch actuators need the spring k = clutch_stiffness and the force range "
+                             "[0, ...]: build the model from these parameters, with a finite clutch_stiffness")
+        model.actuator_biasprm[u, 2] = -c
+    return k, c
+
+
 class CompliantClutches:
     """The controller of the compliant clutches: moves the anchors, switches the dampers, counts their work.
 
@@ -79,13 +93,7 @@ class CompliantClutches:
             if (model.actuator_trntype[u] != joint_trn or model.actuator_trnid[u, 0] != model.joint(slide).id
                     or model.actuator_gear[u, 0] != 1.0):
                 raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {slide!r} with gear 1")
-        k, c = params.clutch_stiffness, params.clutch_damping
-        for u in self.act:
-            if not (k is not None and model.actuator_gainprm[u, 0] == k and model.actuator_biasprm[u, 1] == -k
-                    and model.actuator_forcelimited[u] and model.actuator_forcerange[u, 0] == 0.0):
-                raise ValueError("the clutch actuators need the spring k = clutch_stiffness and the force range "
-                                 "[0, ...]: build the model from these parameters, with a finite clutch_stiffness")
-            model.actuator_biasprm[u, 2] = -c  # the damper as built (a model that has run may hold 0)
+        k, c = clutch_actuators(model, self.act, params)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler does not
         self.implicit = implicit_damping(model)

@@ -30,7 +30,7 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 
 from .common import REST_SPEED
-from .compliant import CLUTCHES, CompliantClutches
+from .compliant import CLUTCHES, CompliantClutches, clutch_actuators
 from .grip import GripRows, upper_bound
 from .grip_model import ROLLS, SKIDS
 from .model import SLIDES, dof_address, implicit_damping, qpos_address
@@ -58,13 +58,7 @@ class CompliantGrip(CompliantClutches):
             if (model.actuator_trntype[u] != tendon_trn or model.actuator_trnid[u, 0] != model.tendon(roll).id
                     or model.actuator_gear[u, 0] != 1.0):
                 raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {roll!r} with gear 1")
-        k, c = params.clutch_stiffness, params.clutch_damping
-        for u in self.act:
-            if not (model.actuator_gainprm[u, 0] == k and model.actuator_biasprm[u, 1] == -k
-                    and model.actuator_forcelimited[u] and model.actuator_forcerange[u, 0] == 0.0):
-                raise ValueError("the clutch actuators need the spring k = clutch_stiffness and the force range "
-                                 "[0, ...]: build the model from these parameters")
-            model.actuator_biasprm[u, 2] = -c  # the damper as built (a model that has run may hold 0)
+        k, c = clutch_actuators(model, self.act, params)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         self.implicit = implicit_damping(model)
         self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm

@@ -78,53 +78,14 @@ class PythonSteps:
     def run(self, nstep: int, row: int = -1) -> None:
         """``nstep`` steps; the velocities before the last one go to ``qvel_before[row]`` (row >= 0).
 
-        The inner loop works on Python floats (one ``tolist`` per array read)."""
-        if self.grip is not None:
-            return self._run_grip(nstep, row)
+        The inner loop works on Python floats (one ``tolist`` per array read). The work against the
+        resistances (and, with finite grip, the grips' work against skidding) is the friction rows' force
+        times the speed they act at after the step (:meth:`_friction_power`)."""
         m, d, ctl = self.model, self.data, self.controller
         dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
         step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
         motor, cq, cv, slope = self.motor, self.crank_q, self.crank_v, self.slope
-        nfric = len(self.friction_dofs)
-        fa, fb = self.fric_a, self.fric_b
-        torque, wm, wf, omega_prev = self.torque, self.motor_work, self.friction_work, self.omega_prev
-        for j in range(nstep):
-            if servo is not None:
-                ctrl[motor] = servo.torque(d.time, qpos[cq], qvel[cv])
-            before()
-            if j == nstep - 1 and row >= 0:
-                self.qvel_before[row] = qvel
-            step(m, d)
-            if after is not None:
-                after()
-            v = qvel.tolist()
-            omega = v[cv]
-            torque = d.actuator_force.item(motor) + slope * (omega - omega_prev)
-            wm += torque * omega * dt
-            # the frictionloss rows follow the ne equality rows: read only if there (as _stepper.c)
-            if nfric and d.nf != nfric:
-                raise missing_rows(2, d.time)
-            if nfric == 2:
-                ne = d.ne
-                f0, f1 = d.efc_force[ne:ne + 2].tolist()
-                wf -= (f0 * v[fa] + f1 * v[fb]) * dt
-            elif nfric == 1:
-                wf -= d.efc_force.item(d.ne) * v[fa] * dt
-            omega_prev = omega
-        self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
-
-    def _run_grip(self, nstep: int, row: int = -1) -> None:
-        """:meth:`run` on a finite-grip model: the work against the rolling resistances from their rows
-        (at the roll's speed v_x - v_c with rigid clutches, the slide's v_x with compliant ones) and the
-        grips' work against skidding from the carriages' rows (at v_c), the friction rows' force times the
-        speed they act at after the step, as without grip."""
-        m, d, ctl = self.model, self.data, self.controller
-        dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
-        step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
-        motor, cq, cv, slope = self.motor, self.crank_q, self.crank_v, self.slope
-        g = self.grip
-        count, tendon = g["count"], g["rolling_tendon"]
-        per_module = tuple(zip(g["roll"], g["grip"], g["x_dof"], g["c_dof"]))
+        power = self._friction_power()
         torque, wm, wf, ws = self.torque, self.motor_work, self.friction_work, self.skid_work
         omega_prev = self.omega_prev
         for j in range(nstep):
@@ -140,19 +101,49 @@ class PythonSteps:
             omega = v[cv]
             torque = d.actuator_force.item(motor) + slope * (omega - omega_prev)
             wm += torque * omega * dt
-            if d.nf != count:
-                raise missing_rows(2, d.time)
-            ne, force, rolling, skidding = d.ne, d.efc_force, 0.0, 0.0  # the rows move in MuJoCo's arena each step
-            for roll, grip, x, c in per_module:
-                if roll >= 0:
-                    rolling += force.item(ne + roll) * ((v[x] - v[c]) if tendon else v[x])
-                if grip >= 0:
-                    skidding += force.item(ne + grip) * v[c]
+            rolling, skidding = power(v)
             wf -= rolling * dt
             ws -= skidding * dt
             omega_prev = omega
         self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
         self.skid_work = ws
+
+    def _friction_power(self):
+        """``power(v)`` after a step, ``v`` the velocities as a list: (the resistances' rows' force times their
+        speed, the grips' rows' force times the carriages' speed) [W], as _stepper.c sums them. Without grip
+        the frictionloss rows follow the ne equality rows, one per slide; with finite grip the rolling
+        resistance acts at the roll's speed v_x - v_c (rigid clutches: a tendon) or the slide's v_x
+        (compliant ones), the grip at the carriage's v_c. A missing row is an error, not a zero."""
+        d = self.data
+        if self.grip is not None:
+            g = self.grip
+            count, tendon = g["count"], g["rolling_tendon"]
+            per_module = tuple(zip(g["roll"], g["grip"], g["x_dof"], g["c_dof"]))
+
+            def with_grip(v):
+                if d.nf != count:
+                    raise missing_rows(2, d.time)
+                ne, force, rolling, skidding = d.ne, d.efc_force, 0.0, 0.0  # the rows move in MuJoCo's arena
+                for roll, grip, x, c in per_module:
+                    if roll >= 0:
+                        rolling += force.item(ne + roll) * ((v[x] - v[c]) if tendon else v[x])
+                    if grip >= 0:
+                        skidding += force.item(ne + grip) * v[c]
+                return rolling, skidding
+            return with_grip
+        nfric, fa, fb = len(self.friction_dofs), self.fric_a, self.fric_b
+
+        def slides(v):
+            if nfric and d.nf != nfric:
+                raise missing_rows(2, d.time)
+            if nfric == 2:
+                ne = d.ne
+                f0, f1 = d.efc_force[ne:ne + 2].tolist()
+                return f0 * v[fa] + f1 * v[fb], 0.0
+            if nfric == 1:
+                return d.efc_force.item(d.ne) * v[fa], 0.0
+            return 0.0, 0.0
+        return slides
 
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
                messages: list[str]) -> tuple[int, int]:

@@ -255,6 +255,13 @@ def steady_climb_limit(params: RobotParams, engine: str, low: float, high: float
         progress(f"{engine} at {incline:.4g} deg: {'climbs' if ok else 'does not climb'}")
         return ok
 
+    return bisect_incline(verdict, low, high, tolerance, runs)
+
+
+def bisect_incline(verdict: Callable[[float], bool], low: float, high: float, tolerance: float, runs: list) -> dict:
+    """The steepest incline [deg] in [low, high] where ``verdict(incline)`` holds, by bisection to ``tolerance``
+    [deg] (each end tried first): {"incline_deg" (None if not even ``low``), "bracket": [holds, does not],
+    "runs": ``runs``, which ``verdict`` fills}; a bracket of ``high`` twice means it holds up to ``high``."""
     if not verdict(low):
         return {"incline_deg": None, "bracket": [None, low], "runs": runs}
     if verdict(high):

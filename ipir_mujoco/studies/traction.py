@@ -191,18 +191,10 @@ def steady_limit(params: RobotParams, engine: str, high: float, tolerance: float
         progress(f"{engine} at {incline:.4g} deg: " + ("climbs, no skid" if ok else "skids or stalls"))
         return ok
 
-    low = 0.0
     try:
-        if not verdict(low):
-            return {"incline_deg": None, "bracket": [None, low], "runs": runs}
-        if verdict(high):
-            return {"incline_deg": high, "bracket": [high, high], "runs": runs}
-        while high - low > tolerance:
-            middle = 0.5 * (low + high)
-            low, high = (middle, high) if verdict(middle) else (low, middle)
+        return climbing.bisect_incline(verdict, 0.0, high, tolerance, runs)
     except _Refused as exc:
         return {"error": str(exc), "runs": runs}
-    return {"incline_deg": low, "bracket": [low, high], "runs": runs}
 
 
 class _Refused(Exception):
