@@ -7,8 +7,8 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ..studies.sweep_space import T_END_STEADY
 from .common import EXIT_OK, add_model_options, model_params
+from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
 def add_parser(commands) -> None:
@@ -28,35 +28,10 @@ def add_parser(commands) -> None:
     opt.add_argument("--engine", default=None, help="engine of the search (default analytic-unilateral)")
     opt.add_argument("--verify", default=None, metavar="ENGINE|none",
                      help="engine re-running the optimum / front (default mujoco-ratchet; none: skip)")
-    opt.add_argument("--seed", type=int, default=None, help="seed, >= 0 (default 0)")
-    opt.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
-                     help="simulated time per design (default 1 s; with --until-steady the cap, default 10 s)")
-    opt.add_argument("--until-steady", action="store_true", help="run every design to its periodic steady state")
+    add_design_run_options(opt)
     add_model_options(opt)
-    opt.add_argument("--out", metavar="DIR", default="optimize", help="results folder (default ./optimize)")
-    opt.add_argument("--resume", action="store_true", help="complete an interrupted optimization in DIR")
-    opt.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
-    add_scheduler_option(opt)
+    add_output_options(opt, "optimize", "optimization")
     opt.set_defaults(handler=run)
-
-
-def add_scheduler_option(parser) -> None:
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run on a Dask distributed scheduler (needs the 'dask' extra), e.g. tcp://host:8786")
-
-
-def connect(address: str | None):
-    """A Dask client of ``--scheduler`` (the caller closes it), or None; a one-line ParameterError otherwise."""
-    if not address:
-        return None
-    try:
-        from distributed import Client
-    except ImportError:
-        raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
-    try:
-        return Client(address, timeout="20s")
-    except (OSError, TimeoutError) as exc:
-        raise ParameterError(f"--scheduler {address!r} cannot be reached: {exc}") from None
 
 
 def problem_from_args(args: argparse.Namespace):
@@ -76,9 +51,8 @@ def problem_from_args(args: argparse.Namespace):
     objectives = tuple(parse_objective(o) for o in args.objective)
     constraints = tuple(parse_constraint(c) for c in args.constraint)
     verify = DEFAULT_VERIFY if args.verify is None else (None if args.verify.strip() == "none" else args.verify)
-    t_end = args.t_end if args.t_end is not None else (T_END_STEADY if args.until_steady else 1.0)
-    return Problem(axes, objectives, constraints, model_params(args), args.engine or DEFAULT_ENGINE, verify, t_end,
-                   bool(args.until_steady), DEFAULT_BUDGET if args.budget is None else args.budget,
+    return Problem(axes, objectives, constraints, model_params(args), args.engine or DEFAULT_ENGINE, verify,
+                   design_t_end(args), bool(args.until_steady), DEFAULT_BUDGET if args.budget is None else args.budget,
                    0 if args.seed is None else args.seed)
 
 
@@ -89,16 +63,12 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
-    client = connect(args.scheduler)
     try:
-        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers,
-                              executor=client.get_executor() if client else None)
+        with scheduler_executor(args.scheduler) as executor:
+            record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor)
     except StudyInterrupted as exc:
         print(f"ipir-mujoco optimize: {exc}", file=sys.stderr)
         return 130
-    finally:
-        if client is not None:
-            client.close()
     from ..report.optimize_plots import plot_pareto
 
     figure = plot_pareto(args.out, problem)

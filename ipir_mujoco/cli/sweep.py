@@ -13,6 +13,7 @@ from ..labels import significant
 from ..studies.sweep_metrics import METRICS, UNITS
 from ..studies.sweep_space import DEFAULT_ENGINES, ENGINES, T_END_STEADY
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
+from .design_runs import add_scheduler_option, scheduler_executor
 
 
 def add_parser(commands) -> None:
@@ -49,55 +50,8 @@ def add_parser(commands) -> None:
     swp.add_argument("--plot-metric", default=None, metavar="METRIC",
                      help="metric the heatmap colours (default: steady_speed_m_s with --until-steady, else "
                           "mean_speed_m_s); any of: " + ", ".join(METRICS))
-    swp.add_argument("--scheduler", metavar="ADDRESS",
-                     help="run on a Dask distributed scheduler (needs the 'dask' extra), e.g. tcp://host:8786")
+    add_scheduler_option(swp)
     swp.set_defaults(handler=run)
-
-
-
-
-SCHEMES = ("tcp", "tls", "ws", "wss")  # Dask's network transports
-CONNECT_TIMEOUT_S = 5.0  # s: a scheduler on the network answers in milliseconds; a wrong address is not waited on
-
-
-def scheduler_address(address: str) -> tuple[str, str, int]:
-    """(scheme, host, port) of a Dask scheduler address ``[SCHEME://]HOST:PORT``, or a one-line
-    ParameterError naming it and the allowed form."""
-    allowed = (f"allowed: SCHEME://HOST:PORT with SCHEME one of {', '.join(SCHEMES)} (e.g. tcp://host:8786), "
-               "or the inproc:// address of a cluster in this process")
-    scheme, _, rest = address.strip().rpartition("://")
-    scheme = scheme or "tcp"
-    if scheme == "inproc" and rest:  # a LocalCluster(processes=False) of this process: no socket to probe
-        return scheme, rest, 0
-    host, _, port = rest.rpartition(":")
-    host = host.strip("[]")
-    if scheme not in SCHEMES or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise ParameterError(f"--scheduler {address!r} is not a scheduler address; {allowed}")
-    return scheme, host, int(port)
-
-
-def connect_scheduler(address: str):
-    """A Dask ``Client`` of the scheduler at ``address``; an address that is malformed, or where nothing
-    answers within CONNECT_TIMEOUT_S, is a one-line ParameterError naming it (tried with a plain socket
-    first, so that the answer comes in seconds)."""
-    import socket
-
-    scheme, host, port = scheduler_address(address)
-    try:
-        from distributed import Client
-    except ImportError:
-        raise ParameterError("--scheduler needs Dask: pip install 'ipir-mujoco[dask]'") from None
-    try:
-        if scheme != "inproc":
-            socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
-    except OSError as exc:
-        raise ParameterError(f"--scheduler {address!r} cannot be reached ({exc.strerror or exc or 'timed out'}); "
-                             "allowed: the address of a running Dask scheduler") from None
-    try:
-        return Client(address if "://" in address else f"tcp://{address}", timeout=f"{CONNECT_TIMEOUT_S:g}s")
-    except Exception as exc:  # noqa: BLE001 (whatever Dask raises: a handshake that is not a scheduler's)
-        raise ParameterError(f"--scheduler {address!r} did not answer as a Dask scheduler "
-                             f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
 
 
 def study_from_args(args: argparse.Namespace):
@@ -136,17 +90,14 @@ def run(args: argparse.Namespace) -> int:
     if args.no_batch and args.batch_size is not None:
         raise ParameterError(f"--batch-size {args.batch_size} with --no-batch: the batch size is for mujoco.batch; "
                              "allowed: one of the two")
-    client = connect_scheduler(args.scheduler) if args.scheduler is not None else None
     try:
-        results = run_sweep(study, args.out, executor=client.get_executor() if client else None,
-                            batch_mujoco=False if args.no_batch else None, resume=args.resume, workers=args.workers,
-                            timeout_per_design=args.timeout_per_design, batch_size=args.batch_size)
+        with scheduler_executor(args.scheduler) as executor:
+            results = run_sweep(study, args.out, executor=executor, batch_mujoco=False if args.no_batch else None,
+                                resume=args.resume, workers=args.workers,
+                                timeout_per_design=args.timeout_per_design, batch_size=args.batch_size)
     except SweepInterrupted as exc:
         print(f"ipir-mujoco sweep: {exc}", file=sys.stderr)
         return 130
-    finally:
-        if client is not None:
-            client.close()
     axes = [a.name for a in study.axes]
     columns = read_results(results)
     errors = [e for e in columns["error"] if e]
