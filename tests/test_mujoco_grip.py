@@ -45,6 +45,18 @@ def skid_per_rev(run, first: int, last: int) -> list[float]:
 
 # --- the model ---------------------------------------------------------------------------------------------------
 
+def stepped_by_hand(p: RobotParams, dt: float):
+    """(model, data, clutch controller, the carriages' dof addresses) of the ratchet model at its closed-loop
+    start with the drive set, ready for mj_step by hand."""
+    model = build_model(p, SolverSettings(timestep=dt), ratchet=True)
+    data = mujoco.MjData(model)
+    set_closed_loop_state(model, data, p)
+    clutch = clutch_controller(model, data, p, "ratchet")
+    data.ctrl[model.actuator(MOTOR).id] = drive_control(p)
+    mujoco.mj_forward(model, data)
+    return model, data, clutch, [dof_address(model, n) for n in SKIDS]
+
+
 def test_unlimited_grip_builds_todays_model_and_finite_grip_adds_only_the_carriages():
     plain, grip = build_model(RobotParams(), ratchet=True), build_model(CRUISE, ratchet=True)
     assert (plain.nbody, plain.njnt, plain.ntendon) == (grip.nbody - 2, grip.njnt - 2, grip.ntendon - 2) == (5, 4, 0)
@@ -84,13 +96,7 @@ def test_mujocos_rows_hold_up_to_the_grip_and_skid_at_it():
     round-off of forces of ~10 N: 1e-9 N. While the carriage moves back the friction row sits at G_i
     exactly; at rest it creeps below 1e-6 m/s (the package's rest speed; measured 2.5e-7 m/s at most)."""
     p, dt = CRUISE, 1e-4
-    model = build_model(p, SolverSettings(timestep=dt), ratchet=True)
-    data = mujoco.MjData(model)
-    set_closed_loop_state(model, data, p)
-    clutch = clutch_controller(model, data, p, "ratchet")
-    data.ctrl[model.actuator(MOTOR).id] = drive_control(p)
-    mujoco.mj_forward(model, data)
-    c_dof = [dof_address(model, n) for n in SKIDS]
+    model, data, clutch, c_dof = stepped_by_hand(p, dt)
     rolls = [model.tendon(n).id for n in ROLLS]
     m_c = model.dof_armature[c_dof]
     skidding = [[], []]
@@ -278,13 +284,7 @@ def test_a_compliant_clutchs_force_is_capped_by_the_grip_and_its_anchor_slides()
     p = COMPLIANT
     settings = simulate_mujoco(p, "unilateral", "ratchet", 1e-3, dt_out=1e-3).settings
     dt = settings["timestep"]
-    model = build_model(p, SolverSettings(timestep=dt), ratchet=True)
-    data = mujoco.MjData(model)
-    set_closed_loop_state(model, data, p)
-    clutch = clutch_controller(model, data, p, "ratchet")
-    data.ctrl[model.actuator(MOTOR).id] = drive_control(p)
-    mujoco.mj_forward(model, data)
-    c_dof = [dof_address(model, n) for n in SKIDS]
+    model, data, clutch, c_dof = stepped_by_hand(p, dt)
     acts = clutch.act
     m_c = model.dof_armature[c_dof]
     sliding = [0, 0]

@@ -70,13 +70,14 @@ def draw(rng: np.random.Generator) -> RobotParams:
 
 
 def run_pair(params: RobotParams, t_end: float, budget_s: float | None = None) -> dict:
-    """Both engines on one design: {'analytic': (status, value), 'mujoco': ..., '<engine>_wall': s}.
+    """Both engines on one design: {'analytic': (status, value), 'mujoco': ..., '<engine>_wall': s,
+    '<engine>_summary': the run's summary dict, or None where it was refused or failed}.
 
     status 'ok' with (revolutions, travel [m]), or 'refused' / 'failed' with the engine's one-line reason.
     """
     row: dict = {"params": params}
     for name, variant in (("analytic", "analytic-unilateral"), ("mujoco", "mujoco-ratchet")):
-        started = time.perf_counter()
+        started, row[name + "_summary"] = time.perf_counter(), None
         try:
             run = registry.run(variant, params, t_end, dt_out=1e-3, wall_budget_s=budget_s)
         except ParameterError as exc:
@@ -84,7 +85,7 @@ def run_pair(params: RobotParams, t_end: float, budget_s: float | None = None) -
         except SimulationError as exc:
             row[name] = ("failed", str(exc))
         else:
-            s = run.summary
+            s = row[name + "_summary"] = run.summary
             row[name] = ("ok", (s["revolutions"], 0.5 * (s["x1_final"] + s["x2_final"])))
         row[name + "_wall"] = time.perf_counter() - started
     return row
