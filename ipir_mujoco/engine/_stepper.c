@@ -151,9 +151,9 @@ static double upper_bound(double value, double margin) {
   return bound;
 }
 
-/* the clutch update before a step: Ratchet, Locks, CompliantClutches, GripRatchet.before_step */
-/* grip.GripRows' carriage update, for both grip controllers: module i's carriage at c may only move back, its
-   forward bound lowered to its running minimum; a carriage pushed forward again counts as excursion */
+/* the carriage update of both grip controllers (GripRatchet and CompliantGrip.before_step): module i's carriage
+   at c may only move back, its forward bound lowered to its running minimum; a carriage pushed forward again
+   counts as excursion */
 static void carriage_ratchet(const int64_t *cfg, double *st, mjtNum *range, int i, double c) {
   if (c < st[S_cmin0 + i]) {
     st[S_cmin0 + i] = c;
@@ -163,6 +163,7 @@ static void carriage_ratchet(const int64_t *cfg, double *st, mjtNum *range, int 
   }
 }
 
+/* the clutch update before a step: Ratchet, Locks, CompliantClutches, GripRatchet, CompliantGrip.before_step */
 static void before_step(const int64_t *cfg, double *st) {
   const mjtNum *qpos = DATA(cfg)->qpos, *qvel = DATA(cfg)->qvel;
   switch (cfg[C_clutch]) {
@@ -322,7 +323,7 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
     torque = force[motor] + slope * (omega - omega_prev);
     wm += torque * omega * dt;
     /* the frictionloss rows follow the ne equality rows, one per dof with friction: read only if there */
-    if (grip) { /* PythonSteps._run_grip: the rolling resistances' rows and the grips' */
+    if (grip) { /* PythonSteps._friction_power: the rolling resistances' rows and the grips' */
       if (d->nf != nfric) return MISSING_FRICTION_ROWS;
       double rolling = 0.0, skidding = 0.0;
       for (int i = 0; i < 2; i++) {
