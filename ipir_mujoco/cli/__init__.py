@@ -36,7 +36,7 @@ try:
     import sys
     from typing import Sequence
 
-    from ipir_mujoco.core.errors import ParameterError, SimulationError
+    from ipir_mujoco.core.errors import ParameterError, SimulationError, StudyInterrupted
 
     from .. import __version__
     from ..resources import shipped
@@ -131,6 +131,8 @@ def _describe_failure(exc: BaseException) -> tuple[int, str]:
         return EXIT_FAILURE, f"simulation failed: {one_line(exc)}"
     if isinstance(exc, KeyboardInterrupt):
         return EXIT_INTERRUPTED, "interrupted"
+    if isinstance(exc, StudyInterrupted):  # a study's Ctrl-C: where its results so far are
+        return EXIT_INTERRUPTED, one_line(exc)
     if isinstance(exc, MemoryError):
         return EXIT_FAILURE, "out of memory (a smaller run: shorter --t-end, larger --dt-out, fewer designs)"
     if isinstance(exc, OSError):

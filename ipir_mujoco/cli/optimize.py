@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
@@ -57,18 +56,13 @@ def problem_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..studies.design_eval import StudyInterrupted
     from ..studies.optimize import run_optimize
 
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
-    try:
-        with scheduler_executor(args.scheduler) as executor:
-            record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor)
-    except StudyInterrupted as exc:
-        print(f"ipir-mujoco optimize: {exc}", file=sys.stderr)
-        return 130
+    with scheduler_executor(args.scheduler) as executor:
+        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor)
     from ..report.optimize_plots import plot_pareto
 
     figure = plot_pareto(args.out, problem)

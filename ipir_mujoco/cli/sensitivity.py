@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
@@ -29,7 +28,7 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..report.optimize_plots import plot_indices
-    from ..studies.design_eval import StudyInterrupted, check_key
+    from ..studies.design_eval import check_key
     from ..studies.sensitivity import run_sensitivity
     from ..studies.sweep_space import parse_vary
 
@@ -37,17 +36,13 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")
     axes = tuple(parse_vary(v) for v in args.vary)
     metrics = tuple(check_key(m, f"--metric {m!r}") for m in args.metric)
-    try:
-        with scheduler_executor(args.scheduler) as executor:
-            indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
-                                      engine=args.engine or "analytic-unilateral", t_end=design_t_end(args),
-                                      until_steady=bool(args.until_steady),
-                                      samples=64 if args.samples is None else args.samples,
-                                      seed=0 if args.seed is None else args.seed, resume=args.resume,
-                                      workers=args.workers, executor=executor)
-    except StudyInterrupted as exc:
-        print(f"ipir-mujoco sensitivity: {exc}", file=sys.stderr)
-        return 130
+    with scheduler_executor(args.scheduler) as executor:
+        indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
+                                  engine=args.engine or "analytic-unilateral", t_end=design_t_end(args),
+                                  until_steady=bool(args.until_steady),
+                                  samples=64 if args.samples is None else args.samples,
+                                  seed=0 if args.seed is None else args.seed, resume=args.resume,
+                                  workers=args.workers, executor=executor)
     figure = plot_indices(args.out, indices, list(metrics))
     for i in indices:
         print(f"  {i['metric']:22s} {i['parameter']:12s} S1 {i['S1']:+.3f} +- {i['S1_conf']:.3f}   "

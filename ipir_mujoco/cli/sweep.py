@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
@@ -80,7 +79,7 @@ def study_from_args(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     from ..report.sweep_plots import (LARGER_IS_BETTER, best_designs, check_plot_metric, plot_sweep, rankings,
                                       read_results)
-    from ..studies.sweep import SweepInterrupted, check_sweep_options, run_sweep
+    from ..studies.sweep import check_sweep_options, run_sweep
 
     if args.study is not None:
         check_input_file("--study", args.study)
@@ -90,14 +89,10 @@ def run(args: argparse.Namespace) -> int:
     if args.no_batch and args.batch_size is not None:
         raise ParameterError(f"--batch-size {args.batch_size} with --no-batch: the batch size is for mujoco.batch; "
                              "allowed: one of the two")
-    try:
-        with scheduler_executor(args.scheduler) as executor:
-            results = run_sweep(study, args.out, executor=executor, batch_mujoco=False if args.no_batch else None,
-                                resume=args.resume, workers=args.workers,
-                                timeout_per_design=args.timeout_per_design, batch_size=args.batch_size)
-    except SweepInterrupted as exc:
-        print(f"ipir-mujoco sweep: {exc}", file=sys.stderr)
-        return 130
+    with scheduler_executor(args.scheduler) as executor:
+        results = run_sweep(study, args.out, executor=executor, batch_mujoco=False if args.no_batch else None,
+                            resume=args.resume, workers=args.workers, timeout_per_design=args.timeout_per_design,
+                            batch_size=args.batch_size)
     axes = [a.name for a in study.axes]
     columns = read_results(results)
     errors = [e for e in columns["error"] if e]

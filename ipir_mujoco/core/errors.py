@@ -12,6 +12,11 @@ class ParameterError(ValueError):
     """
 
 
+class StudyInterrupted(RuntimeError):
+    """Ctrl-C (or SIGINT) stopped a study of many designs (sweep, optimize, sensitivity); the message says
+    where the results written so far are kept (the command line: exit status 130)."""
+
+
 class SimulationError(RuntimeError):
     """A simulation failed (solver failure, instability, chattering).
 

@@ -22,7 +22,7 @@ import os
 from concurrent import futures
 from pathlib import Path
 
-from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError, StudyInterrupted
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams
 
 from .pool import kill_workers, worker_init
@@ -31,10 +31,6 @@ from .sweep_files import Progress, ResultsFile, _cell
 from .sweep_metrics import METRICS
 
 KEYS = (*METRICS, *PARAMETER_NAMES)
-
-
-class StudyInterrupted(RuntimeError):
-    """Ctrl-C stopped the study; the evaluations written so far are kept."""
 
 
 def check_key(key: str, option: str) -> str:

@@ -56,7 +56,7 @@ from pathlib import Path
 from typing import Callable
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.errors import ParameterError, SimulationError, StudyInterrupted
 from ipir_mujoco.core.options import check_type
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
@@ -71,8 +71,7 @@ from .sweep_space import Study
 BATCH_SIZE = 64
 
 
-class SweepInterrupted(RuntimeError):
-    """Ctrl-C (or SIGINT) stopped the sweep; the rows written so far are kept."""
+SweepInterrupted = StudyInterrupted  # the sweep's name for it (Ctrl-C: the rows written so far are kept)
 
 
 class DesignTimeout(Exception):
