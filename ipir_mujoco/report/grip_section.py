@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ipir_mujoco.core.params import RobotParams
 
-from ..studies import traction
+from ..studies import climbing, traction
 from .document import Heading, Image, Paragraph, Table, fmt
 
 MU = {False: (0.3, 0.5, 0.8), True: (0.5,)}  # wheel-wall friction coefficients tried, full / quick
@@ -42,14 +42,14 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     """The demands, the runs on finite grip and the riser press (module docstring)."""
     out = {"quick": quick, "mu": list(MU[quick]), "press_n": list(PRESS), "cases": {}}
     for name, case in _cases(params).items():
-        unlimited = {engine: traction.measure(engine, case) for engine in (PAPER, ONE_WAY)}
+        unlimited = {engine: climbing.measure(engine, case) for engine in (PAPER, ONE_WAY)}
         rows = []
         for mu in MU[quick]:
             for press in PRESS:
                 grip = case.replace(mu_wall=mu, F_n1=press, F_n2=press)
-                row = {"mu": mu, "press_n": press, "grip_n": mu * press, ONE_WAY: traction.measure(ONE_WAY, grip)}
+                row = {"mu": mu, "press_n": press, "grip_n": mu * press, ONE_WAY: climbing.measure(ONE_WAY, grip)}
                 if not quick or not rows:  # quick: MuJoCo once per case, enough to show it accepts or refuses
-                    row[MUJOCO] = traction.measure(MUJOCO, grip)
+                    row[MUJOCO] = climbing.measure(MUJOCO, grip)
                 rows.append(row)
                 progress(f"finite grip, {name}, mu {mu:g}, F_n {press:g} N: " + (
                     row[ONE_WAY].get("error") or f"travel {row[ONE_WAY]['travel_m']:.4g} m"))

@@ -222,20 +222,49 @@ def climbs(metrics: dict, drive: str) -> bool:
     return bool(metrics["steady"] and metrics["steady_speed_m_s"] > 0) if drive == "motor" else True
 
 
-def measure(engine: str, params: RobotParams, t_end: float | None = None, every_step: bool = False) -> dict:
-    """:func:`run_metrics` of one run, or {"error": one line} for a run that fails (a runaway the paper's rule
-    cannot follow, MuJoCo's accuracy monitor, ...): a result of the study, not its end. ``every_step``: as
-    :func:`run_engine` (the curve's runs, whose mean clutch force is shown; the bisection only asks whether
-    a run climbs)."""
+def measure(engine: str, params: RobotParams, t_end: float | None = None, every_step: bool = False,
+            memo: dict | None = None) -> dict:
+    """:func:`run_metrics` of one run (with finite grip also "steady_slip_m", :func:`steady_skid`), or
+    {"error": one line} for a run that fails (a runaway the paper's rule cannot follow, MuJoCo's accuracy
+    monitor, ...): a result of the study, not its end; {"error", "refused": True} where the engine refuses the
+    parameters (MuJoCo's locks with finite grip). ``every_step``: as :func:`run_engine` (the curve's runs,
+    whose mean clutch force is shown; the bisection only asks whether a run climbs). ``memo``: a dict that
+    keeps each run's figures by (engine, params, t_end, every_step), so that two searches of one study (the
+    steady climb and its traction limit) run an incline once."""
+    t_end = default_t_end(params) if t_end is None else t_end
+    key = (engine, params, t_end, every_step)
+    if memo is not None and key in memo:
+        return memo[key]
     try:
-        return run_metrics(run_engine(engine, params, default_t_end(params) if t_end is None else t_end,
-                                      every_step=every_step))
-    except (ParameterError, SimulationError) as exc:
-        return {"error": " ".join(str(exc).split())}
+        run = run_engine(engine, params, t_end, every_step=every_step)
+    except ParameterError as exc:
+        out = {"error": " ".join(str(exc).split()), "refused": True}
+    except SimulationError as exc:
+        out = {"error": " ".join(str(exc).split())}
+    else:
+        out = run_metrics(run)
+        if run.params.grip is not None:
+            out["steady_slip_m"] = steady_skid(run)
+    if memo is not None:
+        memo[key] = out
+    return out
+
+
+def steady_skid(run: RunResult) -> float | None:
+    """[m] slip1 + slip2 gained over a run's steady window (its whole run if none), or None where the run has
+    no slip columns (an engine without grip: unlimited grip counts as no skid, see :func:`.traction.skids`)."""
+    s = run.series
+    if "slip1" not in s:
+        return None
+    t0, t1, _steady = steady_window(run)
+    inside = np.flatnonzero((s["t"] >= t0) & (s["t"] <= t1))
+    total = s["slip1"] + s["slip2"]
+    return float(total[inside[-1]] - total[inside[0]]) if inside.size else 0.0
 
 
 def steady_climb_limit(params: RobotParams, engine: str, low: float, high: float, tolerance: float = TOLERANCE_DEG,
-                       t_end: float | None = None, progress: Progress = lambda _m: None) -> dict:
+                       t_end: float | None = None, progress: Progress = lambda _m: None,
+                       memo: dict | None = None) -> dict:
     """Bisection on the incline [deg] for the steepest one the motor climbs from rest at phi0 (``engine``).
 
     ``low`` should climb and ``high`` not; each end is run first. {"incline_deg": the steepest incline
@@ -246,7 +275,7 @@ def steady_climb_limit(params: RobotParams, engine: str, low: float, high: float
     runs = []
 
     def verdict(incline: float) -> bool:
-        metrics = measure(engine, params.replace(incline=incline), t_end)
+        metrics = measure(engine, params.replace(incline=incline), t_end, memo=memo)
         ok = climbs(metrics, params.drive)
         note = metrics.get("error") or metrics.get("stall_reason") or (
             "" if ok else f"no steady state by t={metrics['t_end_s']:.3g} s")
@@ -308,17 +337,17 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
     restart = restart_limit(params)
     paper = restart_limit(params.replace(rod_mass=0.0, rod_inertia=0.0), "approx")
     bound = energy_bound(params)
-    limits = {}
+    limits, memo = {}, {}  # memo: the runs of the steady-climb search, read again by the traction search
     if params.drive == "motor":
         low = min(max(restart["incline_deg"] if restart["incline_deg"] is not None else -90.0, 0.0), 90.0)
         if params.grip is not None:  # a finite grip may skid below the restart limit: search from the level
             low = 0.0
         high = 90.0 if bound["incline_deg"] is None or bound["sin"] >= 1 else max(bound["incline_deg"], low)
         for engine in engines:
-            limits[engine] = steady_climb_limit(params, engine, low, high, tolerance, t_end, progress)
+            limits[engine] = steady_climb_limit(params, engine, low, high, tolerance, t_end, progress, memo)
     from .traction import traction_study
 
-    traction = traction_study(params, engines, limits, tolerance, t_end, progress)
+    traction = traction_study(params, engines, limits, tolerance, t_end, progress, memo)
     rows = incline_curve(params, inclines, engines, t_end, progress)
     return {"drive": params.drive, "torque_at_rest_n_m": restart["torque_at_rest_n_m"], "restart": restart,
             "restart_paper_model": paper, "energy_bound": bound,

@@ -138,35 +138,6 @@ def riser_press(params: RobotParams, geometry: str = "exact") -> dict:
     return out
 
 
-def steady_skid(metrics_run) -> float | None:
-    """[m] slip1 + slip2 gained over a run's steady window (its whole run if none), or None where the run has
-    no slip columns (an engine without grip: unlimited grip counts as no skid, see :func:`skids`)."""
-    s = metrics_run.series
-    if "slip1" not in s:
-        return None
-    t0, t1, _steady = climbing.steady_window(metrics_run)
-    inside = np.flatnonzero((s["t"] >= t0) & (s["t"] <= t1))
-    total = s["slip1"] + s["slip2"]
-    return float(total[inside[-1]] - total[inside[0]]) if inside.size else 0.0
-
-
-def measure(engine: str, params: RobotParams, t_end: float | None = None) -> dict:
-    """:func:`.climbing.run_metrics` of one run with "steady_slip_m" and "peak_grip_use", or {"error"} (with
-    "refused": True where the engine refuses the parameters, a ParameterError)."""
-    from ipir_mujoco.core.errors import ParameterError, SimulationError
-
-    try:
-        run = climbing.run_engine(engine, params, climbing.default_t_end(params) if t_end is None else t_end)
-    except ParameterError as exc:  # the engine refuses the design (MuJoCo without finite grip)
-        return {"error": " ".join(str(exc).split()), "refused": True}
-    except SimulationError as exc:  # a run that fails at this incline: a result, not the engine's refusal
-        return {"error": " ".join(str(exc).split())}
-    out = climbing.run_metrics(run)
-    out.update(steady_slip_m=steady_skid(run), peak_grip_use=run.summary.get("peak_grip_use"),
-               slips_m=[run.summary.get("slip1_m"), run.summary.get("slip2_m")])
-    return out
-
-
 def skids(metrics: dict) -> bool:
     """Whether a run skids in its steady window (slip columns), else whether its grip use reached 1."""
     if metrics.get("steady_slip_m") is not None:
@@ -175,14 +146,15 @@ def skids(metrics: dict) -> bool:
 
 
 def steady_limit(params: RobotParams, engine: str, high: float, tolerance: float = climbing.TOLERANCE_DEG,
-                 t_end: float | None = None, progress: Progress = lambda _m: None) -> dict:
+                 t_end: float | None = None, progress: Progress = lambda _m: None, memo: dict | None = None) -> dict:
     """Bisection on the incline [deg] in [0, ``high``] for the steepest one the motor climbs to a steady state
     from rest with no skid in the steady window. {"incline_deg" (None: not even on the level), "bracket",
-    "runs"}, or {"error": one line} where the engine refuses the design (MuJoCo without finite grip)."""
+    "runs"}, or {"error": one line} where the engine refuses the design (MuJoCo without finite grip). ``memo``:
+    as :func:`.climbing.measure` (runs the steady-climb search made are read, not run again)."""
     runs = []
 
     def verdict(incline: float) -> bool:
-        m = measure(engine, params.replace(incline=incline), t_end)
+        m = climbing.measure(engine, params.replace(incline=incline), t_end, memo=memo)
         if m.get("refused"):
             raise _Refused(m["error"])
         ok = climbing.climbs(m, params.drive) and not skids(m)
@@ -203,11 +175,12 @@ class _Refused(Exception):
 
 def traction_study(params: RobotParams, engines=climbing.ENGINES, steady_climb: dict | None = None,
                    tolerance: float = climbing.TOLERANCE_DEG, t_end: float | None = None,
-                   progress: Progress = lambda _m: None) -> dict:
+                   progress: Progress = lambda _m: None, memo: dict | None = None) -> dict:
     """The traction figures of ``params`` (JSON-ready): {"grip": None, "note": UNLIMITED} with unlimited grip,
     else {"grip": [G1, G2], "mu_wall", "F_n": [F_n1, F_n2], "rest": :func:`rest_limit`, "riser":
     :func:`riser_press`, "steady": {engine: :func:`steady_limit`} (motor only; ``steady_climb``, the
-    study's steady-climb limits, caps each engine's bracket)}."""
+    study's steady-climb limits, caps each engine's bracket; ``memo``: the runs already made,
+    :func:`.climbing.measure`)}."""
     if params.grip is None:
         return {"grip": None, "note": UNLIMITED}
     out = {"grip": list(params.grip), "mu_wall": params.mu_wall, "F_n": [params.F_n1, params.F_n2],
@@ -216,5 +189,5 @@ def traction_study(params: RobotParams, engines=climbing.ENGINES, steady_climb: 
         for engine in engines:
             cap = (steady_climb or {}).get(engine, {}).get("incline_deg")
             out["steady"][engine] = steady_limit(params, engine, 90.0 if cap is None else max(cap, 0.0),
-                                                 tolerance, t_end, progress)
+                                                 tolerance, t_end, progress, memo)
     return out
