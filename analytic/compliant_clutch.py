@@ -95,8 +95,10 @@ class Regime(NamedTuple):
 
     @property
     def mode(self) -> Mode:
-        """The rigid model's mode that best describes it: a module is held while stuck or pushed by its clutch."""
-        held = [s == 0 or c in (Clutch.ENGAGED, Clutch.SLIDING) for s, c in zip(self.slip, self.clutch)]
+        """The mode column's label: a module is held while its clutch pushes (ENGAGED, or SLIDING at the grip),
+        as in MuJoCo's compliant clutch; one standing in its play on its resistance, or sliding back into it,
+        is not (with rigid clutches a module that stands counts as held: there is no play to stand in)."""
+        held = [c in (Clutch.ENGAGED, Clutch.SLIDING) for c in self.clutch]
         return {(False, True): Mode.CONTRACTION, (True, False): Mode.EXPANSION,
                 (False, False): Mode.BOTH_MOVING, (True, True): Mode.BOTH_LOCKED}[tuple(held)]
 

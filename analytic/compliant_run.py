@@ -11,7 +11,7 @@ run exactly at the end of a revolution.
 
 Series columns (ndarrays of shape (n,)): the shared ``COLUMNS`` (``lambda1``/
 ``lambda2`` are the clutch forces [N], ``mode`` tells which modules are held,
-stuck or pushed by their clutch, see :attr:`.Regime.mode`), ``resistance1``/
+pushed by their clutch, see :attr:`.Regime.mode`), ``resistance1``/
 ``resistance2`` (the friction force on each module [N]: -F_ri sign(v_i) while
 it slides, the force keeping it at rest while stuck), ``clutch_overlap1``/
 ``clutch_overlap2`` (d_i [m]: > 0 the clutch is compressed, -backlash..0 inside

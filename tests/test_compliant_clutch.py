@@ -58,6 +58,29 @@ def damped_run():
     return compliant(params, 0.5, dt_out=1e-5)  # fine samples for the momentum balance
 
 
+def test_the_mode_says_held_exactly_where_a_clutch_pushes_in_both_engines():
+    """With compliant clutches a module counts as held only while its clutch pushes (docs/model.md, Modes).
+    Uphill with the play open at the start, module 1 stands on its resistance while module 2 slides back
+    into its play for 11 ms: neither clutch pushes, so the mode is 3, not 2 (rear held). Read against each
+    engine's own clutch forces at every sample: a module labelled unheld has a clutch force of exactly 0;
+    one whose clutch pushes by more than 1e-6 N (far above the engagement hysteresis, k x 1 pm = 1e-6 N
+    here, where a force starts from 0) is labelled held."""
+    from ipir_mujoco.engine import simulate_mujoco
+
+    p = RobotParams(M=0.4, incline=25, clutch_stiffness=1e6, clutch_damping=20, clutch_backlash=5e-4, phi0=0.7)
+    runs = (compliant(p, 0.06, dt_out=1e-4), simulate_mujoco(p, "unilateral", "ratchet", 0.06, dt_out=1e-4))
+    for run in runs:
+        s = run.series
+        mode = s["mode"].astype(int)
+        held = (np.isin(mode, [Mode.EXPANSION, Mode.BOTH_LOCKED]), np.isin(mode, [Mode.CONTRACTION, Mode.BOTH_LOCKED]))
+        for i, force in enumerate((s["lambda1"], s["lambda2"])):
+            assert np.all(force[~held[i]] == 0.0), (run.engine, i)
+            assert np.all(held[i][force > 1e-6]), (run.engine, i)
+        start = s["t"] < 0.011
+        assert np.all(mode[start] == Mode.BOTH_MOVING) and s["v2"][start][-1] < 0, run.engine
+        assert np.any(mode == Mode.CONTRACTION), run.engine  # module 2's clutch takes the load in the end
+
+
 def test_energy_audit_closes_with_the_clutch_spring_and_damper(damped_run):
     e, s = damped_run.energy, damped_run.series
     # the audit's terms are integrated states (rtol 1e-10) summed over ~1e3 steps and ~1e2 events:
@@ -249,7 +272,11 @@ def test_a_torque_too_small_stalls_for_good():
     s = run.series
     rest = s["t"] > 0.6  # it coasts to rest within 0.52 s
     assert np.ptp(s["x1"][rest]) == 0 and np.ptp(s["x2"][rest]) == 0 and np.all(s["omega"][rest] == 0)
-    assert np.all(s["mode"][rest] == int(Mode.BOTH_LOCKED))
+    # at rest the mode says which clutches push (a module standing in its play on its resistance is not held)
+    push1, push2 = s["lambda1"][rest] > 0, s["lambda2"][rest] > 0
+    expected = np.where(push1 & push2, Mode.BOTH_LOCKED, np.where(push2, Mode.CONTRACTION,
+                                                                  np.where(push1, Mode.EXPANSION, Mode.BOTH_MOVING)))
+    assert np.all(s["mode"][rest] == expected) and np.all(push2)
     assert abs(run.energy["residual_j"]) < 1e-7 * run.energy["friction_j"]
 
 
