@@ -71,18 +71,20 @@ from typing import Any
 import numpy as np
 
 from ipir_mujoco.core.cycles import cycle_summary, travel
+from ipir_mujoco.labels import SUMMARY
 
 LEGACY = {"mean_speed_mps": "mean_speed_m_s", "accel_jump_mps2": "accel_jump_m_s2"}  # old spelling -> new
-# metric: (in words, unit)
-DESCRIBED = {
-    "revolutions": ("crank revolutions", "rev"), "mean_speed_m_s": ("mean forward speed", "m/s"),
-    "steady": ("steady state reached", "0/1"), "t_steady_s": ("time to steady state", "s"),
-    "steady_speed_m_s": ("steady forward speed", "m/s"), "distance_per_rev_m": ("distance per revolution", "m"),
-    "energy_per_metre_j_m": ("energy per metre", "J/m"), "efficiency": ("efficiency", "-"),
-    "peak_clutch_force_n": ("peak clutch force", "N"), "peak_rod_force_n": ("peak rod force", "N"),
-    "accel_jump_m_s2": ("acceleration jump at a clutch switch", "m/s^2"), "stalled": ("stalled", "0/1"),
-    "residual_ratio": ("MuJoCo energy residual / motor work", "-"), "loop_gap_m": ("MuJoCo loop gap", "m"),
+# metric: (in words, unit): the summary's figures as ipir_mujoco.labels names them, and the sweep's own
+_SWEEP_ONLY = {
+    "mean_speed_m_s": ("mean forward speed", "m/s"), "steady": ("steady state reached", "0/1"),
+    "peak_rod_force_n": ("peak rod force", "N"), "accel_jump_m_s2": ("acceleration jump at a clutch switch", "m/s^2"),
+    "stalled": ("stalled", "0/1"), "residual_ratio": ("MuJoCo energy residual / motor work", "-"),
+    "loop_gap_m": ("MuJoCo loop gap", "m"),
 }
+DESCRIBED = {m: SUMMARY[m] if m in SUMMARY else _SWEEP_ONLY[m] for m in (  # in the order of the CSV's columns
+    "revolutions", "mean_speed_m_s", "steady", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m",
+    "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2", "stalled",
+    "residual_ratio", "loop_gap_m")}
 METRICS = (*DESCRIBED, *LEGACY)  # every column a row carries per engine, the legacy spellings last
 UNITS = {**{m: unit for m, (_, unit) in DESCRIBED.items()}, **{old: DESCRIBED[new][1] for old, new in LEGACY.items()}}
 PER_REVOLUTION = ("distance_per_rev_m", "energy_per_metre_j_m", "efficiency")  # empty for a stalled design
