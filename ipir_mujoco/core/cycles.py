@@ -40,6 +40,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import ParameterError
+from .params import as_real
+
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
 _WHOLE_TOL = 1e-9  # revolutions: see cycle_boundaries
@@ -200,6 +203,17 @@ def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) 
     return None if k is None else found[k - n + 1:k + 1]
 
 
+def check_steady_test(tol, n) -> tuple[float, int]:
+    """(tol, n) of the steady test as (float, int), or a one-line ParameterError naming the one out of range:
+    0 < steady_tol < 1 and steady_cycles a whole number >= 2."""
+    number = as_real(tol)
+    if number is None or isinstance(tol, bool) or not (math.isfinite(number) and 0 < number < 1):
+        raise ParameterError(f"steady_tol={tol!r} is out of range; allowed: 0 < steady_tol < 1")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+        raise ParameterError(f"steady_cycles={n!r} is out of range; allowed: a whole number >= 2")
+    return float(number), int(n)
+
+
 class SteadyWatch:
     """Tells an engine, sample by sample, when its run has reached the periodic steady state.
 
@@ -209,11 +223,8 @@ class SteadyWatch:
     """
 
     def __init__(self, phi0: float, tol: float = STEADY_TOL, n: int = STEADY_CYCLES):
-        if not (isinstance(n, int) and n >= 2):
-            raise ValueError(f"steady_cycles={n!r} is out of range; allowed: a whole number >= 2")
-        if not (math.isfinite(tol) and 0 < tol < 1):
-            raise ValueError(f"steady_tol={tol!r} is out of range; allowed: 0 < steady_tol < 1")
-        self.phi0, self.tol, self.n = float(phi0), float(tol), n
+        tol, n = check_steady_test(tol, n)
+        self.phi0, self.tol, self.n = float(phi0), tol, n
         self.reach = 0.0  # running maximum of phi - phi0
         self.last = None  # (t, reach, travel) of the previous sample
         self.boundary = None  # (t, travel) where the current revolution began

@@ -17,7 +17,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .cycles import STEADY_CYCLES, STEADY_TOL
+from .cycles import STEADY_CYCLES, STEADY_TOL, check_steady_test
 from .errors import ParameterError
 from .params import as_real, check_real, check_whole
 
@@ -100,14 +100,9 @@ class RunOptions:
         if not isinstance(self.until_steady, (bool, np.bool_)):
             raise ParameterError(f"until_steady={self.until_steady!r} is not a bool; allowed: True or False")
         set_(self, "until_steady", bool(self.until_steady))
-        tol = as_real(self.steady_tol)
-        if tol is None or not (math.isfinite(tol) and 0 < tol < 1):
-            raise ParameterError(f"steady_tol={self.steady_tol!r} is out of range; allowed: 0 < steady_tol < 1")
+        tol, cycles = check_steady_test(self.steady_tol, self.steady_cycles)
         set_(self, "steady_tol", tol)
-        cycles = self.steady_cycles
-        if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 2:
-            raise ParameterError(f"steady_cycles={cycles!r} is out of range; allowed: a whole number >= 2")
-        set_(self, "steady_cycles", int(cycles))
+        set_(self, "steady_cycles", cycles)
         if self.progress is not None and not callable(self.progress):
             raise ParameterError(f"progress={self.progress!r} is not callable; allowed: a function of the "
                                  "simulated time [s], or None")
