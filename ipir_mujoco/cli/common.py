@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+from typing import Callable
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import DRIVES, RobotParams, load_params
@@ -69,27 +70,27 @@ def check_input_file(option: str, path: str) -> None:
         raise ParameterError(f"{option} {path!r} is not a regular file (a device or pipe); give a file")
 
 
-def progress_printer(t_end: float):
-    """Progress on stderr for runs long enough to wait for (simulated time > 2 s); None otherwise.
+def tenths_printer(total: float, text: Callable[[float], str], final_within: float = 0.0) -> Callable[[float], None]:
+    """Progress on stderr, ``report(done)`` for ``done`` of ``total`` (any unit): on a terminal one line
+    (``text(done)``) rewritten in place, ended once ``done`` is within ``final_within`` of ``total``; in a log
+    file one line per tenth of the total."""
+    if sys.stderr.isatty():
+        def report(done: float) -> None:
+            print("\r" + text(done), end="\n" if done >= total - final_within else "", file=sys.stderr, flush=True)
+        return report
+    shown = [0]
 
-    On a terminal one line is rewritten in place; in a log file, one line per tenth of the run.
-    The returned callable takes the simulated time [s].
-    """
+    def report_lines(done: float) -> None:
+        tenth = min(int(10 * done / total + 1e-9), 10)
+        if tenth > shown[0]:
+            shown[0] = tenth
+            print(text(done), file=sys.stderr, flush=True)
+    return report_lines
+
+
+def progress_printer(t_end: float):
+    """Progress of a run on stderr (:func:`tenths_printer` of the simulated time [s], the callable's argument)
+    for runs long enough to wait for (simulated time > 2 s); None otherwise."""
     if t_end <= 2.0:
         return None
-
-    if sys.stderr.isatty():
-        def report(t: float) -> None:
-            print(f"\rsimulated {t:6.2f} / {t_end:g} s", end="" if t < t_end - 0.05 else "\n",
-                  file=sys.stderr, flush=True)
-        return report
-
-    milestones = iter([t_end * k / 10 for k in range(1, 11)])
-    state = {"next": next(milestones)}
-
-    def report_lines(t: float) -> None:
-        if t >= state["next"] - 1e-9:
-            print(f"simulated {t:.2f} / {t_end:g} s", file=sys.stderr, flush=True)
-            state["next"] = next(milestones, float("inf"))
-
-    return report_lines
+    return tenths_printer(t_end, lambda t: f"simulated {t:.2f} / {t_end:g} s", final_within=0.05)

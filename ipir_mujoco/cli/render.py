@@ -9,7 +9,7 @@ from pathlib import Path
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params, progress_printer
+from .common import EXIT_OK, add_model_options, model_params, progress_printer, tenths_printer
 
 
 def add_parser(commands) -> None:
@@ -64,16 +64,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def frame_printer():
-    """Progress of the rendering on stderr, ``report(done, total)``: on a terminal one line rewritten in place,
-    in a log one line per tenth of the frames."""
-    tty = sys.stderr.isatty()
-    shown = [0]
+    """Progress of the rendering on stderr, ``report(done, total)`` (:func:`.common.tenths_printer`)."""
+    printers = {}
 
     def report(done: int, total: int) -> None:
-        if tty:
-            print(f"\rrendered {done} / {total} frames", end="\n" if done == total else "", file=sys.stderr,
-                  flush=True)
-        elif done == total or done * 10 // total > shown[0]:
-            shown[0] = done * 10 // total
-            print(f"rendered {done} / {total} frames", file=sys.stderr, flush=True)
+        if total not in printers:
+            printers[total] = tenths_printer(total, lambda n: f"rendered {n:.0f} / {total} frames")
+        printers[total](done)
     return report
