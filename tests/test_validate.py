@@ -287,7 +287,8 @@ def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_valid
         return [Paragraph(f"twice L is {result['twice_L_m']:g} m"), Image("figures/toy.png", "toy figure")]
 
     toy = Section("toy", "toy study", lambda params, quick, progress: {"twice_L_m": 2 * params.L}, render,
-                  lambda result: {"question": "Is L positive?", "answer": "Yes", "evidence": "sections.toy"})
+                  lambda result: {"question": "Is L positive?", "answer": "Yes", "evidence": "sections.toy",
+                                  "short": "Yes", "key": f"L = {result['twice_L_m'] / 2:g} m"})
     metrics, rungs = copy.deepcopy(quick_validation)
     seen = []
     run_sections(metrics, RobotParams(L=0.3), True, seen.append, (toy,))
@@ -353,10 +354,12 @@ def test_the_report_opens_with_a_summary_table_that_links_each_verdict_to_its_se
     """One row per verdict (question, verdict, key figure, where), before the verdicts' paragraphs; each link
     goes to a heading the report has (in HTML, to that heading's id)."""
     from ipir_mujoco.report.document import Heading, Link, Table, anchor, to_html
-    from ipir_mujoco.report.validation import build_blocks, verdict_short
+    from ipir_mujoco.report.validation import build_blocks
 
-    assert verdict_short("Yes: MuJoCo matches to +0.02 % in revolutions") == ("Yes", "+0.02 %")
     metrics, _ = quick_validation
+    # every verdict states its own short form and key figure (nothing read back out of its prose)
+    assert all(v["short"] and isinstance(v["key"], str) for v in metrics["verdicts"])
+    assert all(v["key"] for v in metrics["verdicts"] if not v["short"].startswith("not checked"))
     figures = {name: f"figures/{name}" for name in ("mechanism.png", "fig2_crank.png", "fig3_modules.png",
                                                     "fig4_gap.png", "lr_study.png", "clutch_reactions.png",
                                                     "pull_per_stroke.png")}

@@ -264,9 +264,10 @@ def _physics(study: dict) -> str:
 def verdict(metrics: dict) -> dict:
     """The report's opening answer: each realistic clutch's peak force and acceleration at both points."""
     study, paper = metrics["study"], metrics["paper_model"]
-    answers = []
+    answers, key_figure = [], None
     for key, point in study["points"].items():
         cells = []
+        head = "at cruise" if point["until_steady"] else "at the paper's start-up"
         for pair in metrics["realistic"]:
             row = _row(study, key, pair)
             if row is None or "error" in row["analytic"]:
@@ -275,10 +276,11 @@ def verdict(metrics: dict) -> dict:
             an, div = row["analytic"], row["divergence"]["peak_clutch_force_n"]
             cells.append(f"{pair['name']} {an['peak_clutch_force_n']:.3g} N, {an['peak_acceleration_m_s2']:.3g} m/s^2"
                          + ("" if div is None else f" (MuJoCo {signed_percent(div, 2)})"))
+            if key_figure is None:
+                key_figure = f"{an['peak_clutch_force_n']:.3g} N peak ({pair['name']}, {head})"
         rigid = [f"{name} {ref['peak_clutch_force_n']:.3g} N, {ref['peak_acceleration_m_s2']:.3g} m/s^2"
                  for name, ref in (("analytic", study["rigid"][key]["analytic"]),
                                    ("MuJoCo", study["rigid"][key]["mujoco"])) if "error" not in ref]
-        head = "at cruise" if point["until_steady"] else "at the paper's start-up"
         answers.append(f"{head}: " + "; ".join(cells) + (" (rigid clutches: " + "; ".join(rigid) + ")"
                                                           if rigid else ""))
     ideal = "" if "error" in paper else (
@@ -290,4 +292,5 @@ def verdict(metrics: dict) -> dict:
                 "linkage unless the play makes a stiff clutch an impact (F ~ sqrt(k)); the force is set by the "
                 "clutch's stiffness and play.")
     return {"question": "What engagement loads does a real one-way clutch give, instead of the ideal clutch's "
-                        "spikes?", "answer": answer, "evidence": "sections.clutch_engagement"}
+                        "spikes?", "answer": answer, "evidence": "sections.clutch_engagement",
+            "short": "set by the clutch's stiffness and play", "key": key_figure or ""}

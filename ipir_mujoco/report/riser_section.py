@@ -244,4 +244,6 @@ def verdict(metrics: dict) -> dict:
               + " and ".join(f"{fmt(s, 4)} m/s" for s in speeds) + " (analytic, MuJoCo" + (
                   f": {_relative(speeds[0], speeds[1])})" if None not in speeds else ")") + ".")
     return {"question": "Can the robot climb a vertical riser with its motor, and does the paper's model tell?",
-            "answer": answer, "evidence": "sections.vertical_riser"}
+            "answer": answer, "evidence": "sections.vertical_riser",
+            "short": ("No, not" if stalls else "Yes,") + f" with M_stall {metrics['motor']['M_stall_n_m']:g} N m",
+            "key": f"{need['torque_n_m']:.4g} N m needed at rest"}

@@ -5,7 +5,8 @@ report it draws: ``compute`` returns a JSON-ready dict stored in
 ``metrics.json`` under ``sections.<key>``; ``render`` writes the section's
 figures into the report's figures folder and returns its blocks
 (:mod:`ipir_mujoco.report.document`); ``verdict``, if given, adds a
-{question, answer, evidence} to the report's opening verdicts.
+{question, answer, evidence, short, key} to the report's opening verdicts (``short``: the verdict in a few
+words, ``key``: its key figure with its unit, '' if none; the summary table shows both).
 :data:`SECTIONS` lists them in report order; ``ipir-mujoco validate`` runs
 them all.
 """

@@ -10,7 +10,6 @@ place and is otherwise complete.
 
 from __future__ import annotations
 
-import re
 
 import math
 from pathlib import Path
@@ -206,26 +205,6 @@ def _envelope_blocks(envelope: dict) -> list:
                    "worst energy residual / energy [-]", "worst loop gap [m]", "MuJoCo wall [s]"], rows)]
 
 
-# a figure with its unit as the verdicts state them: a signed percentage, a number with a unit, or a count
-_KEY_FIGURE = re.compile(r"[+-]?\d[\d.]*(?:e[+-]?\d+)? ?(?:%|N m|N|m/s|m|deg|s\b)|\d+ of the \d+")
-
-
-def verdict_short(answer: str) -> tuple[str, str]:
-    """(the verdict in a few words, its first figure) of a verdict's answer: the words before its first colon
-    (or its first sentence), and the first number with its unit in what follows ('' if none)."""
-    head, colon, rest = answer.partition(": ")
-    if not colon or len(head) > 80:
-        head, rest = answer.split(". ", 1)[0][:80], answer
-    found = _KEY_FIGURE.search(rest)
-    return head.rstrip("."), found.group(0) if found else ""
-
-
-def _short(verdict: dict) -> tuple[str, str]:
-    """(verdict in a few words, key figure): the verdict's own where it gives them, else read off its answer."""
-    head, key = verdict_short(verdict["answer"])
-    return verdict.get("short", head), verdict.get("key", key)
-
-
 def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | None = None,
                  animation: dict | None = None, extra: Sequence = ()) -> list:
     case = metrics["paper_case"]
@@ -237,7 +216,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                               f"(simulated {metrics['settings']['t_end_s']:g} s from rest).")]
     blocks.append(Heading("Summary"))
     blocks.append(Table(["question", "verdict", "key figure", "where"],
-                        [[v["question"], *_short(v),
+                        [[v["question"], v["short"], v["key"],
                           Link(v["section"], v["section"]) if v.get("section") else ""] for v in metrics["verdicts"]]))
     blocks.append(Heading("Verdicts"))
     for verdict in metrics["verdicts"]:

@@ -147,7 +147,8 @@ def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> di
         return {"question": question, "evidence": "paper_case", "section": "Not the paper's case",
                 "answer": "Not checked: this is not the paper's case (" + describe_differences(case["differences"])
                           + "), and the paper prints figures for its own case only. Every rung below is "
-                          "compared with the paper's model at this design instead (the ladder's first rung)."}
+                          "compared with the paper's model at this design instead (the ladder's first rung).",
+                "short": "not checked: not the paper's case", "key": ""}
     inside = [c for c in checks if c["status"] == "inside"]
     edge = [c for c in checks if c["status"] == "edge"]
     outside = [c for c in checks if c["status"] == "outside"]
@@ -173,7 +174,8 @@ def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> di
     answer += (". The paper's S_min = L - r and S_max = L + r " + ("hold" if held else "do NOT hold")
                + " by construction of the slider-crank and are not counted as reproduced figures.")
     return {"question": question, "answer": answer, "evidence": "paper_checks, identities",
-            "section": "The paper's figures, reproduced"}
+            "section": "The paper's figures, reproduced", "short": head,
+            "key": f"{len(inside)} of the {len(checks)} figures"}
 
 
 def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list[LadderRun], pull: dict, study: dict,
@@ -202,6 +204,8 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
                   f"{_percent(relative_change(locks['revolutions'], paper['revolutions']))} in revolutions: the cost "
                   "of L >> r and of the rod, not of the engine.",
         "evidence": "ladder, convergence", "section": "The model ladder",
+        "short": "Yes" if worst < 0.2 * smallest else "No",
+        "key": f"{_percent(relative_change(locks['revolutions'], rod['revolutions']))} in revolutions",
     }
     p = rungs[0].run.params
     ratio = (f"At the paper's L/r = {p.L / p.r:g}" if case["is_paper_case"]
@@ -242,6 +246,8 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
                   f"smallest modelling effect in the ladder ({smallest_name}) changes them by up to "
                   f"{100 * smallest:.2f} %.",
         "evidence": "convergence", "section": "Numerical convergence",
+        "short": "Yes" if numerical < 0.2 * smallest else "No",
+        "key": f"{100 * convergence['mujoco_default_error']:.3f} % (MuJoCo, timestep halved)",
     }
     return [_paper_verdict(checks, identities, case), engine, costs, trust]
 
@@ -321,6 +327,9 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
     return metrics, rungs
 
 
+VERDICT_KEYS = ("question", "answer", "evidence", "short", "key")  # what every verdict states
+
+
 def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Callable[[str], None],
                  sections: Sequence) -> None:
     """Compute each section into ``metrics["sections"]`` and add its verdict, if any (in place)."""
@@ -331,6 +340,9 @@ def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Call
         result = section.compute(params, quick, lambda m, s=section: progress(f"{s.title}: {m}"))
         metrics["sections"][section.key] = result
         if section.verdict is not None and (verdict := section.verdict(result)) is not None:
+            missing = [k for k in VERDICT_KEYS if k not in verdict]
+            if missing:  # a section written without them: a programming error, said where it is
+                raise ValueError(f"the verdict of section {section.key!r} lacks {', '.join(missing)}")
             metrics["verdicts"].append({**verdict, "section": section.title})
         progress(f"{section.title}: done ({time.perf_counter() - started:.1f} s)")
 
