@@ -224,14 +224,14 @@ class Recorder:
 
     def _wheel_columns(self, out: dict, sc: dict) -> dict[str, np.ndarray]:
         """The wheeled model's columns (``ipir_mujoco.core.results``): slip1/2 [m], each module's backward steps
-        while it skids (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip; the
+        (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip; the
         contacts' cumulative work skid_work [J] and the wheels' states wheels1/2."""
         from .wheels import wheel_slip
 
         cols = {}
         for k in (1, 2):
             wheels = sc[f"wheels{k}"]
-            cols[f"slip{k}"] = wheel_slip(out[f"x{k}"], wheels)
+            cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
             if self.params.grip is not None:
                 G = self.params.grip[k - 1]
                 cols[f"grip_use{k}"] = out[f"lambda{k}"] / G
