@@ -171,3 +171,20 @@ def test_a_riser_with_grip_below_the_weight_skids_down_as_the_analytic_model_doe
         assert fine.summary[f"x{k}_final"] < 0 and analytic.summary[f"x{k}_final"] < 0
         assert abs(s_w - s_a) <= abs(s_c - s_w)
     assert fine.accuracy["ok"]
+
+
+def test_render_and_the_viewer_draw_the_pipe_walls_and_the_wheels():
+    """What render and the viewer draw is the wheeled model itself: its walls and wheels are visible geoms, and
+    the viewer steps it with the engine's loop (no screen needed for either check)."""
+    from ipir_mujoco.cli.view import ViewedRobot
+    from ipir_mujoco.video import VideoSettings, _render_model
+
+    drawn = _render_model(CRUISE, VideoSettings(), wheeled=True)
+    for name in WALLS + tuple(n + "_wheel" for names in WHEEL_NAMES for n in names):
+        assert drawn.geom_rgba[drawn.geom(name).id][3] > 0  # drawn, not transparent
+    robot = ViewedRobot(CRUISE, model="wheels", settings=SolverSettings(timestep=1e-4))
+    assert isinstance(robot.controller, WheelRatchet)
+    robot.step(500)
+    assert robot.data.qpos[qpos_address(robot.model, "crank_hinge")] > 0.1  # the crank turns
+    with pytest.raises(ParameterError, match="wheels' hubs"):
+        ViewedRobot(CRUISE, "kinematic", model="wheels")

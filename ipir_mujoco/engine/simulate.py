@@ -120,8 +120,8 @@ def simulate_mujoco(
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
     check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
-    check_clutch_options(params, clutch, implementation)
     check_mujoco_model(model, params, implementation)
+    check_clutch_options(params, clutch, implementation)
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
     t_end, dt_out = run.t_end, run.dt_out
