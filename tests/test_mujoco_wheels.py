@@ -188,3 +188,18 @@ def test_render_and_the_viewer_draw_the_pipe_walls_and_the_wheels():
     assert robot.data.qpos[qpos_address(robot.model, "crank_hinge")] > 0.1  # the crank turns
     with pytest.raises(ParameterError, match="wheels' hubs"):
         ViewedRobot(CRUISE, "kinematic", model="wheels")
+
+
+def test_the_closed_form_bend_fit():
+    """l_max = 2 sqrt((R + D/2)^2 - (R - D/2 + w)^2), checked against its own geometry: the rectangle of that
+    length with its inner side on the inner wall's tangent has its outer corners exactly on the outer wall."""
+    from ipir_mujoco.core.pipe import bend_max_length
+
+    D, R, w = 0.16, 0.24, 0.06
+    length = bend_max_length(w, R, D)
+    corner = np.hypot(R - D / 2 + w, length / 2)  # distance of an outer corner from the bend's centre
+    assert corner == pytest.approx(R + D / 2, rel=1e-12)
+    assert bend_max_length(D, R, D) == 0.0  # a module as wide as the pipe never turns rigidly
+    assert bend_max_length(w, 100.0, D) > 10 * length  # a gentle bend passes long modules
+    with pytest.raises(ParameterError, match="radius"):
+        bend_max_length(w, 0.05, D)
