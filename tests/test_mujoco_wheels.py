@@ -203,3 +203,22 @@ def test_the_closed_form_bend_fit():
     assert bend_max_length(w, 100.0, D) > 10 * length  # a gentle bend passes long modules
     with pytest.raises(ParameterError, match="radius"):
         bend_max_length(w, 0.05, D)
+
+
+def test_simulate_runs_the_wheeled_model_and_refuses_what_it_does_not_have(capsys):
+    import json
+
+    from cli_run import run_cli
+
+    code, out, err = run_cli(capsys, "simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--drive", "motor",
+                             "--set", "mu_wall=0.8", "--t-end", "0.2", "--timestep", "1e-4", "--json")
+    assert code == 0 and err == ""
+    record = json.loads(out)
+    assert record["settings"]["mujoco_model"] == "wheels" and record["settings"]["cone"] == "elliptic"
+    assert record["summary"]["revolutions"] > 0.3 and record["summary"]["slip1_m"] == 0.0
+    for argv, word in ((("--mujoco-model", "wheels"), "--engine mujoco"),
+                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--mujoco-clutch", "lock"), "ratchet"),
+                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--set", "clutch_stiffness=1e5"), "rigid"),
+                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--set", "pipe_diameter=0.1"), "2 r")):
+        code, out, err = run_cli(capsys, "simulate", *argv)
+        assert code == 2 and word in err and len(err.strip().splitlines()) == 1

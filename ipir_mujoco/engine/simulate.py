@@ -111,10 +111,8 @@ def simulate_mujoco(
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
-    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``model``: 'slides' (the
-    modules on slides, their resistance joint friction) or 'wheels' (the modules free in the plane on wheels
-    pressed on the pipe's walls, a ratchet in every hub: :mod:`.wheels_model`, :mod:`.wheels`; the ratchet
-    with rigid clutches only, stepped in Python).
+    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``model``: 'slides' or 'wheels'
+    (on wheels in a pipe, a ratchet in every hub, stepped in Python: :mod:`.wheels_model`, :mod:`.wheels`).
     """
     params = require_params(params)
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
@@ -166,6 +164,7 @@ class _Run:
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
         self.compliant = params.clutch_stiffness is not None
         self.wheeled = wheeled  # the wheeled model (.wheels_model), else the slide model
+        self.model_settings = {"mujoco_model": "wheels", **ContactSettings().as_dict()} if wheeled else {}
         self.model = (build_wheels_model(params, settings, mjcf=mjcf) if wheeled
                       else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
         self.data = mujoco.MjData(self.model)
@@ -206,20 +205,16 @@ class _Run:
             settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch,
                       "clutch_model": "compliant" if self.compliant else "rigid", "dt_out": self.dt_out,
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
-                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles,
-                      **({"mujoco_model": "wheels", **ContactSettings().as_dict()} if self.wheeled else {})},
+                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.model_settings},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
         )
 
     def _setup(self):
         m, d, p = self.model, self.data, self.params
-        if self.wheeled:
-            set_wheels_state(m, d, p)
-            self.controller = controller = WheelRatchet(m, d, p)
-        else:
-            set_closed_loop_state(m, d, p)
-            self.controller = controller = clutch_controller(m, d, p, self.implementation, self.clutch)
+        (set_wheels_state if self.wheeled else set_closed_loop_state)(m, d, p)
+        self.controller = controller = (WheelRatchet(m, d, p) if self.wheeled
+                                        else clutch_controller(m, d, p, self.implementation, self.clutch))
         motor, crank = m.actuator(MOTOR).id, m.joint(CRANK_HINGE)
         d.ctrl[motor] = drive_control(p) if self.servo is None else self.servo.torque(
             0.0, d.qpos[crank.qposadr[0]], d.qvel[crank.dofadr[0]])
