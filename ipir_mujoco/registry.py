@@ -38,6 +38,7 @@ from .core.results import RunResult
 
 ENGINES = ("analytic", "mujoco")
 RULES = ("kinematic", "unilateral")
+MUJOCO_MODELS = ("slides", "wheels")  # MuJoCo's models: the modules on slides, or on wheels on the pipe walls
 
 
 @dataclass(frozen=True)
@@ -50,6 +51,7 @@ class Variant:
     geometry: str  # 'approx' | 'exact' (MuJoCo always models the exact linkage)
     clutch: str | None  # MuJoCo's clutch: 'ratchet' | 'lock'; None for the equations
     label: str  # in words, for figures and reports
+    model: str = "slides"  # MuJoCo's model of the robot: 'slides' | 'wheels' (the equations: 'slides')
 
     @property
     def is_mujoco(self) -> bool:
@@ -57,8 +59,11 @@ class Variant:
 
     def describe(self) -> dict[str, Any]:
         """The variant as a run's JSON records it: name, engine, geometry, clutch rule and MuJoCo's clutch."""
-        return {"variant": self.name, "engine": self.engine, "geometry": self.geometry, "clutch": self.rule,
-                "mujoco_clutch": self.clutch}
+        described = {"variant": self.name, "engine": self.engine, "geometry": self.geometry, "clutch": self.rule,
+                     "mujoco_clutch": self.clutch}
+        if self.model != "slides":
+            described["mujoco_model"] = self.model
+        return described
 
 
 VARIANTS: dict[str, Variant] = {v.name: v for v in (
@@ -70,6 +75,7 @@ VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("mujoco-lock", "mujoco", "kinematic", "exact", "lock", "MuJoCo, paper's rule"),
     Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
     Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
+    Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels"),
 )}
 ALIASES = {
     "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
@@ -98,11 +104,17 @@ def variant(name: str | Variant) -> Variant:
     raise ParameterError(f"engine {name!r} is unknown; allowed: {', '.join(NAMES)}")
 
 
-def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str = "kinematic",
-               clutch: str | None = None) -> Variant:
-    """The variant the command line's ``--engine``, ``--geometry``, ``--clutch`` and ``--mujoco-clutch`` name
-    (each refused in one line where it does not apply): the analytic geometry defaults to the paper's first
-    order, MuJoCo's clutch to the lock for the paper's rule and to the ratchet for one-way clutches."""
+def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str | None = "kinematic",
+               clutch: str | None = None, model: str = "slides") -> Variant:
+    """The variant the command line's ``--engine``, ``--geometry``, ``--clutch``, ``--mujoco-clutch`` and
+    ``--mujoco-model`` name (each refused in one line where it does not apply): the analytic geometry defaults
+    to the paper's first order, MuJoCo's clutch to the lock for the paper's rule and to the ratchet for one-way
+    clutches; ``rule`` None is the paper's rule, or one-way clutches on the wheeled model (its only ones)."""
+    if model not in MUJOCO_MODELS:
+        raise ParameterError(f"--mujoco-model {model!r} is unknown; allowed: {', '.join(MUJOCO_MODELS)}")
+    if model == "wheels":
+        return _wheels_from_flags(engine, geometry, rule, clutch)
+    rule = "kinematic" if rule is None else rule
     if engine not in ENGINES:
         raise ParameterError(f"--engine {engine!r} is unknown; allowed: {', '.join(ENGINES)}")
     if rule not in RULES:
@@ -126,9 +138,25 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     return _find(engine, rule, "exact", clutch)
 
 
+def _wheels_from_flags(engine: str, geometry: str | None, rule: str | None, clutch: str | None) -> Variant:
+    """``mujoco-wheels``, after refusing the flags it does not take (one line each)."""
+    if engine != "mujoco":
+        raise ParameterError("--mujoco-model wheels applies only to --engine mujoco")
+    if geometry == "approx":
+        raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real linkage; "
+                             "allowed: --geometry exact (or leave it out)")
+    if rule not in (None, "unilateral"):
+        raise ParameterError(f"--clutch {rule} with --mujoco-model wheels: its clutches are one-way ratchets in the "
+                             "wheels' hubs; allowed: --clutch unilateral (or leave it out)")
+    if clutch not in (None, "ratchet"):
+        raise ParameterError(f"--mujoco-clutch {clutch} with --mujoco-model wheels: its clutches are ratchets in the "
+                             "wheels' hubs; allowed: --mujoco-clutch ratchet (or leave it out)")
+    return VARIANTS["mujoco-wheels"]
+
+
 def _find(engine: str, rule: str, geometry: str, clutch: str | None) -> Variant:
     return next(v for v in VARIANTS.values()
-                if (v.engine, v.rule, v.geometry, v.clutch) == (engine, rule, geometry, clutch))
+                if (v.engine, v.rule, v.geometry, v.clutch, v.model) == (engine, rule, geometry, clutch, "slides"))
 
 
 def check_options(name: str | Variant, options: dict[str, Any], spelled: Callable[[str], str] = str) -> Variant:
@@ -194,6 +222,8 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         settings = options.get("settings")
         options["dt_out"] = settings.timestep if settings is not None else timestep(
             v, params, t_end, options.get("dt_out", 1e-4))
+    if v.model != "slides":
+        options["model"] = v.model
     return simulate_mujoco(params, v.rule, v.clutch, t_end, **options)
 
 

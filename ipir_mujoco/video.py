@@ -135,16 +135,28 @@ def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: f
     return "crank\nmodule 1 (rear)\nmodule 2 (front)", values
 
 
-def _render_model(params: RobotParams, settings: VideoSettings):
-    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size."""
+def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = False):
+    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
+    ``wheeled``: the wheeled model (its pipe walls and wheels drawn too)."""
 
     from .engine.model import build_spec
 
-    spec = build_spec(params)
+    if wheeled:
+        from .engine.wheels_model import build_wheels_spec
+
+        spec = build_wheels_spec(params)
+    else:
+        spec = build_spec(params)
     checker_floor(spec)
     spec.visual.global_.offwidth = settings.width
     spec.visual.global_.offheight = settings.height
     return spec.compile()
+
+
+def _wheel_names():
+    from .engine.wheels_model import WHEEL_NAMES
+
+    return WHEEL_NAMES
 
 
 def _held(mode: int) -> tuple[bool, bool]:
@@ -161,9 +173,12 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
 
     context = _open_context(settings.width, settings.height)
     params, s = run.params, run.series
-    model = _render_model(params, settings)
+    wheeled = run.settings.get("mujoco_model") == "wheels"
+    model = _render_model(params, settings, wheeled)
     data = mujoco.MjData(model)
     address = {name: qpos_address(model, name) for name in (REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE)}
+    # the wheeled model's hubs, drawn turning as they roll on each module's travel (the series holds no angles)
+    hubs = [[qpos_address(model, n + "_hub") for n in names] for names in _wheel_names()] if wheeled else []
     front0 = closed_loop_pose(params, float(s["phi"][0]))[FRONT_SLIDE]
     housings = [model.geom(name).id for name in HOUSINGS]
     scene = mujoco.MjvScene(model, maxgeom=200)
@@ -187,6 +202,8 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
             data.qpos[address[CRANK_HINGE]] = phi
             data.qpos[address[ROD_HINGE]] = pose[ROD_HINGE]
             data.qpos[address[FRONT_SLIDE]] = front0 + x2
+            for travel, module in zip((x1, x2), hubs):
+                data.qpos[module] = travel / params.wheel_radius
             mujoco.mj_kinematics(model, data)
             held = _held(int(s["mode"][i]))
             for geom, on in zip(housings, held):

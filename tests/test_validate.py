@@ -174,7 +174,7 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     out = tmp_path / "report"
     assert main(["validate", "--quick", "--out", str(out)]) == 0
     captured = capsys.readouterr()
-    assert "[6/6]" in captured.err  # progress shown
+    assert "[7/7]" in captured.err  # progress shown
     page = (out / "index.html").read_text()
     markdown = (out / "report.md").read_text()
     assert "<script" not in page and "http://" not in page and "https://" not in page
@@ -202,7 +202,7 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     assert "module 1 (rear) travel [m]" in markdown and "| x1_final" not in markdown
     assert "first_contraction_end_s" not in markdown
     metrics = json.loads((out / "metrics.json").read_text())
-    assert metrics["schema_version"] == 2 and len(metrics["ladder"]) == 6
+    assert metrics["schema_version"] == 2 and len(metrics["ladder"]) == 7
     for verdict in metrics["verdicts"]:
         assert html.escape(verdict["question"]) in page
     # parameters left to a rule are shown by the rule's word

@@ -24,6 +24,9 @@ def add_parser(commands) -> None:
                      help="unilateral: one-way clutches (default); kinematic: the paper's rule (locks)")
     ren.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
                      help="ratchet (default with unilateral) or lock (default with kinematic)")
+    ren.add_argument("--mujoco-model", choices=registry.MUJOCO_MODELS, default="slides",
+                     help="MuJoCo's model: slides (default) or wheels (the robot on wheels in its pipe, walls and "
+                          "wheels drawn)")
     ren.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS", help="simulated time (default 1 s)")
     ren.add_argument("--speed", type=float, default=0.1,
                      help="playback speed, video seconds per simulated second (default 0.1: ten times slower)")
@@ -46,11 +49,11 @@ def run(args: argparse.Namespace) -> int:
     if out.is_dir():
         raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
     params = model_params(args)
-    variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch)
+    variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch, args.mujoco_model)
     print(f"simulating {args.t_end:g} s in MuJoCo ...", file=sys.stderr, flush=True)
     result = registry.run(variant, params, args.t_end, progress=progress_printer(args.t_end))
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
-            f"({variant.clutch})"
+            f"({'wheels, hub ratchets' if variant.model == 'wheels' else variant.clutch})"
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial{out.suffix}")
     try:

@@ -26,12 +26,17 @@ def add_parser(commands) -> None:
     sim.add_argument("--geometry", choices=("approx", "exact"), default=None,
                      help="first-order kinematics as in the paper (approx; analytic default) or the exact "
                           "slider-crank (exact; MuJoCo always models it)")
-    sim.add_argument("--clutch", choices=registry.RULES, default="kinematic",
+    sim.add_argument("--clutch", choices=registry.RULES, default=None,
                      help="kinematic: the paper's rule, lock by the sign of S_dot (default); "
-                          "unilateral: one-way clutches that can only push")
+                          "unilateral: one-way clutches that can only push (the default and only choice with "
+                          "--mujoco-model wheels)")
     sim.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
                      help="MuJoCo clutch implementation: joint-limit ratchet (default with --clutch unilateral) "
                           "or velocity-triggered lock (default with --clutch kinematic)")
+    sim.add_argument("--mujoco-model", choices=registry.MUJOCO_MODELS, default="slides",
+                     help="MuJoCo's model of the robot: slides = the modules on slide joints, their resistance joint "
+                          "friction (default); wheels = the modules free in the plane on wheels pressed on the pipe's "
+                          "walls by springs, a ratchet in every hub, friction mu_wall at the contacts (mjcf/README.md)")
     sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
                      help="MuJoCo timestep [s] (default: chosen from the motion, by the rule in mjcf/README.md, "
                           "installed with the package: see 'ipir-mujoco --help')")
@@ -95,7 +100,7 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
                              "> 0, or inf (no limit)")
     if args.max_switches is not None:
         check_whole("--max-switches", args.max_switches, low=1)
-    variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch)
+    variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch, args.mujoco_model)
     engine_options = {"max_switches": args.max_switches, "mjcf": args.mjcf, "timestep": args.timestep,
                       "accuracy": None if args.accuracy == "stop" else args.accuracy}
     registry.check_options(variant, engine_options, FLAGS.get)

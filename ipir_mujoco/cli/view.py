@@ -16,7 +16,11 @@ camera follows module 1 (drag to turn it, scroll to zoom). Needs a screen (on ma
 one, use ``ipir-mujoco render`` for a video.
 
     python -m ipir_mujoco.view [--clutch unilateral|kinematic] [--mujoco-clutch ratchet|lock]
+                               [--mujoco-model slides|wheels]
                                [--set NAME=VALUE]... [--config FILE.toml] [--slow FACTOR] [--t-end SECONDS]
+
+With ``--mujoco-model wheels`` the robot on wheels in its pipe (walls and wheels drawn), its hub ratchets
+stepped by the engine's Python loop.
 """
 
 from __future__ import annotations
@@ -38,6 +42,8 @@ from ..engine.model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverS
                             set_closed_loop_state)
 from ..engine.stepper import loop_options, make_steps
 from ..engine.timestep import choose_settings
+from ..engine.wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
+from ..engine.wheels_model import build_wheels_model, set_wheels_state
 from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
@@ -50,14 +56,20 @@ class ViewedRobot:
     """
 
     def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,
-                 settings: SolverSettings | None = None, t_end: float = 4.0):
-        self.params, self.clutch = params, clutch
+                 settings: SolverSettings | None = None, t_end: float = 4.0, model: str = "slides"):
+        self.params, self.clutch, self.wheeled = params, clutch, model == "wheels"
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
+        check_mujoco_model(model, params, self.implementation)
         check_clutch_options(params, clutch, self.implementation)
         if settings is None:  # the step the engine would choose for a run of t_end [s]
-            settings, _ = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
+            settings, why = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
+            if self.wheeled:
+                settings, _ = wheels_settings(settings, why, params, 1e-3)
         self.settings = settings
-        self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=checker_floor)
+        if self.wheeled:
+            self.model = build_wheels_model(params, settings, decorate=checker_floor)
+        else:
+            self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=checker_floor)
         self.data = mujoco.MjData(self.model)
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)
@@ -66,11 +78,16 @@ class ViewedRobot:
     def reset(self) -> None:
         """Back to the start: the loop-consistent initial state, a fresh clutch controller."""
         m, d = self.model, self.data
-        set_closed_loop_state(m, d, self.params)
-        self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
+        if self.wheeled:
+            set_wheels_state(m, d, self.params)
+            self.controller = WheelRatchet(m, d, self.params)
+        else:
+            set_closed_loop_state(m, d, self.params)
+            self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
         d.ctrl[m.actuator(MOTOR).id] = drive_control(self.params)
         mujoco.mj_forward(m, d)
-        self.steps = make_steps(m, d, self.controller, self._qvel_before, **loop_options(m, d))
+        options = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
+        self.steps = make_steps(m, d, self.controller, self._qvel_before, **options)
         self.held: tuple[bool, bool] | None = None
         self._colour()
 
@@ -105,6 +122,8 @@ def build_parser() -> Parser:
                         help="unilateral: one-way clutches (default); kinematic: the paper's rule")
     parser.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
                         help="ratchet (default with unilateral) or lock (default with kinematic)")
+    parser.add_argument("--mujoco-model", choices=("slides", "wheels"), default="slides",
+                        help="slides: the modules on slide joints (default); wheels: on wheels in the pipe")
     parser.add_argument("--slow", type=float, default=1.0, metavar="FACTOR",
                         help="play FACTOR times slower than real time (default 1; the crank reaches ~10 rev/s "
                              "within a second)")
@@ -121,7 +140,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ParameterError(f"--slow {args.slow} is out of range; allowed: 1 <= FACTOR <= 1000")
         if not (0.0 < args.t_end <= 60.0):
             raise ParameterError(f"--t-end {args.t_end} is out of range; allowed: 0 < SECONDS <= 60")
-        robot = ViewedRobot(model_params(args), args.clutch, args.mujoco_clutch, t_end=args.t_end)
+        robot = ViewedRobot(model_params(args), args.clutch, args.mujoco_clutch, t_end=args.t_end,
+                            model=args.mujoco_model)
         if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
             raise ParameterError("the viewer needs a screen and none is set (no DISPLAY); "
                                  "write a video instead: ipir-mujoco render")

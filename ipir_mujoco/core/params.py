@@ -100,6 +100,11 @@ class RobotParams:
                           "polyurethane wheels on steel", 50.0, 0.0, 1e6)
     F_n2: float = _number("N", "wall-press normal force on module 2's wheels, all together (with finite mu_wall); "
                           "default as F_n1", 50.0, 0.0, 1e6)
+    pipe_diameter: float = _number("m", "inside diameter of the pipe (the wheeled MuJoCo model's walls; must exceed "
+                                   "2 r and 4 wheel_radius); the default fits the paper's design", 0.16, 0.0, 10.0,
+                                   low_open=True)
+    wheel_radius: float = _number("m", "radius of the wheeled MuJoCo model's wheels (below pipe_diameter / 4)", 0.015,
+                                  0.0, 1.0, low_open=True)
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):

@@ -88,14 +88,15 @@ class Recorder:
     ``mj_forward`` on the run's initial state."""
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int,
-                 clutch=None):
+                 clutch=None, wheeled: bool = False):
         self.model, self.data, self.params = model, data, params
         self.clutch = clutch  # the compliant clutches' controller (.compliant.CompliantClutches), or None
         self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
         # finite grip: the carriages' positions (their running minimum is the wheels' skid so far)
-        self.skid_q = None if params.grip is None else [qpos_address(model, n) for n in SKIDS]
+        self.skid_q = None if params.grip is None or wheeled else [qpos_address(model, n) for n in SKIDS]
+        self.wheeled = wheeled  # the wheeled model (.wheels_model): its wheels' columns
         # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
         self.site, self.front, offset = pin_offset(model, data)  # data: after mj_forward
         self.pin_offset = offset.tolist()
@@ -176,7 +177,7 @@ class Recorder:
         mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
                         np.where(held2, int(Mode.CONTRACTION),
                                  np.where(held1, int(Mode.EXPANSION), int(Mode.BOTH_MOVING))))
-        if self.clutch is None and self.skid_q is None:
+        if self.clutch is None and self.skid_q is None and not self.wheeled:
             mode = _dead_centre_passages(mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED)
         elif self.clutch is None:  # finite grip: the wheels' states pass through a dead centre with the mode
             mode, sc["wheels1"], sc["wheels2"] = _dead_centre_passages(
@@ -202,6 +203,8 @@ class Recorder:
                         "clutch_damper_work": sc["clutch_damper_work"].copy()})
         if self.skid_q is not None:
             out.update(self._grip_columns(q, sc, out))
+        elif self.wheeled:
+            out.update(self._wheel_columns(out, sc))
         assert set(COLUMNS) <= set(out)
         return out
 
@@ -215,6 +218,23 @@ class Recorder:
             wheels = sc[f"wheels{k}"]
             cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
             cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"wheels{k}"] = wheels.copy()
+        cols["skid_work"] = sc["skid_work"].copy()
+        return cols
+
+    def _wheel_columns(self, out: dict, sc: dict) -> dict[str, np.ndarray]:
+        """The wheeled model's columns (``ipir_mujoco.core.results``): slip1/2 [m], each module's backward steps
+        (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip; the
+        contacts' cumulative work skid_work [J] and the wheels' states wheels1/2."""
+        from .wheels import wheel_slip
+
+        cols = {}
+        for k in (1, 2):
+            wheels = sc[f"wheels{k}"]
+            cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
+            if self.params.grip is not None:
+                G = self.params.grip[k - 1]
+                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = sc["skid_work"].copy()
         return cols

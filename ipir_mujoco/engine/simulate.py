@@ -63,6 +63,8 @@ from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_
 from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
+from .wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
+from .wheels_model import ContactSettings, build_wheels_model, set_wheels_state
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK, _SKID_WORK = (SCALARS.index(n) for n in (
@@ -90,6 +92,7 @@ def simulate_mujoco(
     steady_tol: float = STEADY_TOL,
     steady_cycles: int = STEADY_CYCLES,
     wall_budget_s: float | None = None,
+    model: str = "slides",
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -108,12 +111,14 @@ def simulate_mujoco(
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
-    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
+    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``model``: 'slides' or 'wheels'
+    (on wheels in a pipe, a ratchet in every hub, stepped in Python: :mod:`.wheels_model`, :mod:`.wheels`).
     """
     params = require_params(params)
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
     check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
+    check_mujoco_model(model, params, implementation)
     check_clutch_options(params, clutch, implementation)
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
@@ -123,11 +128,14 @@ def simulate_mujoco(
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
-                   steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s)
+                   steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
+                   wheeled=model == "wheels")
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
     chosen, why = choose_settings(params, t_end, dt_out, servo, implementation)
+    if model == "wheels":
+        chosen, why = wheels_settings(chosen, why, params, dt_out)
     failures = []
     for attempt in range(REFINEMENTS + 1):
         try:
@@ -145,7 +153,7 @@ class _Run:
     """One MuJoCo run with fixed settings (the loop is in :meth:`_integrate`)."""
 
     def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
-                 until_steady, steady_tol, steady_cycles, wall_budget_s, started=None):
+                 until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
         self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
@@ -155,7 +163,10 @@ class _Run:
         self.steps_per_sample = steps_per_output(dt_out, dt)
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
         self.compliant = params.clutch_stiffness is not None
-        self.model = build_model(params, settings, mjcf, ratchet=implementation == "ratchet")
+        self.wheeled = wheeled  # the wheeled model (.wheels_model), else the slide model
+        self.model_settings = {"mujoco_model": "wheels", **ContactSettings().as_dict()} if wheeled else {}
+        self.model = (build_wheels_model(params, settings, mjcf=mjcf) if wheeled
+                      else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
         self.data = mujoco.MjData(self.model)
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
@@ -182,7 +193,7 @@ class _Run:
             damper = series["clutch_damper_work"][-1]
             energy["clutch_spring_j"], energy["clutch_damper_j"] = float(spring), float(damper)
         dissipated = wf + damper
-        if self.params.grip is not None:
+        if self.params.grip is not None or self.wheeled:
             energy["skid_j"] = float(series["skid_work"][-1])
             dissipated = dissipated + series["skid_work"][-1]
         residual, scale = energy_audit(wm, dissipated, kinetic, potential + spring, self.energy_floor)
@@ -194,22 +205,23 @@ class _Run:
             settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch,
                       "clutch_model": "compliant" if self.compliant else "rigid", "dt_out": self.dt_out,
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
-                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles},
+                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.model_settings},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
         )
 
     def _setup(self):
         m, d, p = self.model, self.data, self.params
-        set_closed_loop_state(m, d, p)
-        self.controller = controller = clutch_controller(m, d, p, self.implementation, self.clutch)
+        (set_wheels_state if self.wheeled else set_closed_loop_state)(m, d, p)
+        self.controller = controller = (WheelRatchet(m, d, p) if self.wheeled
+                                        else clutch_controller(m, d, p, self.implementation, self.clutch))
         motor, crank = m.actuator(MOTOR).id, m.joint(CRANK_HINGE)
         d.ctrl[motor] = drive_control(p) if self.servo is None else self.servo.torque(
             0.0, d.qpos[crank.qposadr[0]], d.qvel[crank.dofadr[0]])
         mujoco.mj_forward(m, d)
-        self.loop = loop_options(m, d)
+        self.loop = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
-                                 controller if self.compliant else None)
+                                 controller if self.compliant else None, wheeled=self.wheeled)
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
@@ -224,7 +236,7 @@ class _Run:
         torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
-        wheels = ctl.wheels() if self.params.grip is not None else NO_WHEELS
+        wheels = ctl.wheels() if self.params.grip is not None or self.wheeled else NO_WHEELS
         row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=wheels)
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
         kinetic, potential, spring = (rec.deferred.item(row, c) for c in (_KINETIC, _POTENTIAL, _SPRING))
@@ -307,7 +319,7 @@ class _Run:
         the clutch springs count with the potential energy, their dampers with the friction work."""
         sc, de = self.recorder.scalars[a:b], self.recorder.deferred[a:b]
         dissipated = sc[:, _FRICTION_WORK] + sc[:, _DAMPER_WORK]
-        if self.params.grip is not None:  # and the grips' work against skidding
+        if self.params.grip is not None or self.wheeled:  # and the grips' (the wheels' contacts') work
             dissipated = dissipated + sc[:, _SKID_WORK]
         return energy_audit(sc[:, _MOTOR_WORK], dissipated,
                             de[:, _KINETIC] - self.energy0[0], de[:, _POTENTIAL] + de[:, _SPRING] - self.energy0[1],

@@ -65,7 +65,7 @@ class PythonSteps:
     compiled = False
 
     def __init__(self, model, data, controller, qvel_before, *, motor, crank_q, crank_v, slope, friction_dofs,
-                 torque, servo=None, grip=None):
+                 torque, servo=None, grip=None, power=None):
         self.model, self.data, self.controller, self.qvel_before = model, data, controller, qvel_before
         self.motor, self.crank_q, self.crank_v, self.slope = motor, crank_q, crank_v, slope
         self.friction_dofs, self.servo = list(friction_dofs), servo
@@ -74,6 +74,9 @@ class PythonSteps:
         self.omega_prev = data.qvel.item(crank_v)
         self.grip = grip  # a finite-grip model's friction rows (grip_layout), or None
         self.skid_work = 0.0  # the grips' cumulative work against skidding [J] (finite grip)
+        # the wheeled model's work rates (.wheels.wheel_loop_options), in place of the slides' rows
+        self.power = power
+        self.reports_wheels = grip is not None or power is not None  # the controller reports wheels' states
 
     def run(self, nstep: int, row: int = -1) -> None:
         """``nstep`` steps; the velocities before the last one go to ``qvel_before[row]`` (row >= 0).
@@ -115,6 +118,8 @@ class PythonSteps:
         resistance acts at the roll's speed v_x - v_c (rigid clutches: a tendon) or the slide's v_x
         (compliant ones), the grip at the carriage's v_c. A missing row is an error, not a zero."""
         d = self.data
+        if self.power is not None:
+            return self.power
         if self.grip is not None:
             g = self.grip
             count, tendon = g["count"], g["rolling_tendon"]
@@ -169,7 +174,7 @@ class PythonSteps:
             if len(messages) != warned:  # the state may be MuJoCo's reset: nothing to record
                 return WARNED, taken
             pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(), ctl.damper_work,
-                                 ctl.excursion, self.skid_work, ctl.wheels() if self.grip is not None else NO_WHEELS)
+                                 ctl.excursion, self.skid_work, ctl.wheels() if self.reports_wheels else NO_WHEELS)
         return DONE, taken
 
 
@@ -187,6 +192,8 @@ class CompiledSteps(PythonSteps):
     def __init__(self, model, data, controller, qvel_before, **options):
         if options.get("servo") is not None:
             raise LayoutError("a crank servo is a Python function of time")
+        if options.get("power") is not None:
+            raise LayoutError("the wheeled model steps in Python")
         super().__init__(model, data, controller, qvel_before, **options)
         stepper = compiled()
         model_address, data_address = pointers(stepper, model, data)
