@@ -20,17 +20,16 @@ Build one from defaults, a TOML file and ``NAME=VALUE`` overrides with
 from __future__ import annotations
 
 import dataclasses
-import decimal
 import functools
 import math
-import numbers
 import os
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from .checks import as_real, check_real, check_whole  # noqa: F401  (re-exported: their home was here)
 from .errors import ParameterError
+from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401  (re-exported)
 
 DRIVES = ("torque", "motor")
 
@@ -185,22 +184,6 @@ PARAMETER_NAMES: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(Robo
 _FIELDS = {f.name: f for f in dataclasses.fields(RobotParams)}
 
 
-def as_real(value: Any) -> float | None:
-    """``value`` as a float if it is a real number of any numeric type (int, float, numpy scalar or
-    0-d array, Fraction, Decimal); None otherwise (bool, complex, strings, containers)."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, (numbers.Real, decimal.Decimal)):
-        try:
-            return float(value)
-        except (OverflowError, ValueError):
-            return math.inf
-    shape, kind = getattr(value, "shape", None), getattr(getattr(value, "dtype", None), "kind", None)
-    if shape == () and kind in ("i", "u", "f"):  # a 0-d numpy array
-        return float(value)
-    return None
-
-
 def _inside(x: float, meta: Mapping[str, Any]) -> bool:
     low_ok = x > meta["low"] if meta["low_open"] else x >= meta["low"]
     high_ok = x < meta["high"] if meta["high_open"] else x <= meta["high"]
@@ -288,50 +271,6 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     return values
 
 
-MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far past any real one, and a bound
-# on what /dev/zero or a mistyped multi-GB file would make the command read into memory
-
-
-def read_text_file(path: str | Path, what: str) -> str:
-    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
-    for a device or pipe, /dev/zero, and a file past MAX_TEXT_BYTES)."""
-    path = Path(path)
-    try:
-        if path.exists() and not path.is_dir() and not path.is_file():
-            raise ParameterError(f"{what} {str(path)!r} is not a regular file (a device or pipe); give a file")
-        with path.open("rb") as handle:
-            data = handle.read(MAX_TEXT_BYTES + 1)
-        if len(data) > MAX_TEXT_BYTES:
-            raise ParameterError(f"{what} {str(path)!r} is larger than {MAX_TEXT_BYTES / 1e6:g} MB; allowed: a "
-                                 "text file of at most that size")
-        return data.decode("utf-8")
-    except FileNotFoundError:
-        raise ParameterError(f"{what} {str(path)!r} does not exist") from None
-    except IsADirectoryError:
-        raise ParameterError(f"{what} {str(path)!r} is a folder; give a file") from None
-    except UnicodeDecodeError as exc:
-        raise ParameterError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}); "
-                             "save it as UTF-8") from None
-    except OSError as exc:
-        raise ParameterError(f"{what} {str(path)!r} cannot be read: {exc.strerror}") from None
-
-
-def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
-    """A TOML file as a dict, or a ParameterError naming the file and the problem in one line."""
-    text = read_text_file(path, what)
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
-    except ValueError as exc:  # an integer past Python's 4300-digit conversion limit
-        why = "an integer of more than 4300 digits" if "digits" in str(exc) else " ".join(str(exc).split())[:120]
-        raise ParameterError(f"{what} {str(path)!r} holds a value that cannot be read ({why}); allowed: numbers "
-                             "within the ranges 'ipir-mujoco params' lists") from None
-    except RecursionError:  # arrays or tables nested thousands deep
-        raise ParameterError(f"{what} {str(path)!r} nests arrays or tables too deep to read; allowed: the flat "
-                             "tables of a config or study file (docs/cli.md)") from None
-
-
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read parameter values from a TOML file.
 
@@ -377,42 +316,7 @@ def load_params(
 
 
 # ----------------------------------------------------------------------------------------------------
-# Value checks shared by the run options (:mod:`.options`), the study files and the Python API
-
-def check_real(name: str, value: Any, *, low: float = 0.0, high: float = math.inf, low_open: bool = True,
-               unit: str = "") -> float:
-    """``value`` as a float if it is a finite real number (any numeric type) inside the interval; else a
-    ParameterError naming ``name``, the value and the allowed range."""
-    unit_text = f" {unit}" if unit else ""
-    low_text = f"{low:g} {'<' if low_open else '<='} {name}"
-    allowed = low_text + (f" <= {high:g}{unit_text}" if math.isfinite(high) else unit_text)
-    number = as_real(value)
-    if number is None:
-        raise ParameterError(f"{name}={value!r} is not a number; allowed: {allowed}")
-    if not math.isfinite(number) or not (number > low if low_open else number >= low) or number > high:
-        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
-    return number
-
-
-def _shown(value: Any) -> str:
-    """A number as the message shows it: 1e+09 rather than 1000000000.0; -1.0 and 0.25 as written."""
-    if isinstance(value, float) and math.isfinite(value) and value != 0 and not 1e-4 <= abs(value) < 1e6:
-        return f"{value:g}"
-    return repr(value)
-
-
-def check_whole(name: str, value: Any, *, low: int = 0, high: int | None = None, why: str = "") -> int:
-    """``value`` as an int if it is a whole number (int, numpy integer, or an integral float) in
-    [low, high]; else a ParameterError naming it. ``why`` explains the upper limit."""
-    allowed = f"a whole number >= {low}" + (f" and <= {high}{why}" if high is not None else "")
-    number = as_real(value)
-    if number is None or not math.isfinite(number) or number != int(number):
-        raise ParameterError(f"{name}={value!r} is not a whole number; allowed: {allowed}")
-    whole = int(number)
-    if whole < low or (high is not None and whole > high):
-        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
-    return whole
-
+# Parameters that act only through another one (the numeric checks are in :mod:`.checks`)
 
 # (parameter, the parameters that act only through it when it is not None, what they need, its value that
 # leaves them idle, the unit the message gives them): refused together (refuse_idle_parameters)
