@@ -49,6 +49,7 @@ from typing import Callable
 
 import numpy as np
 
+from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
@@ -60,7 +61,7 @@ from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, missed_crossing,
-                             raw_piece, restart_step, spurious_start, steps_until, truncate)
+                             raw_piece, restart_step, spurious_start, steps_until, truncate, with_drive_u)
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
         Mode.BOTH_MOVING: (False, False), Mode.BOTH_LOCKED: (True, True)}
@@ -85,13 +86,19 @@ class UnilateralModel:
         self.linkage = self.dyn.linkage
         self.torque = torque  # (t, phi, omega) -> N m, or None for the drive of params
         self.constants = kernels.pack(self.dyn)  # the scalar kernels' copy of the constants
+        self.u = 1.0  # the motor's voltage fraction (drive = servo: the controller's, set by set_u)
+
+    def set_u(self, u: float) -> None:
+        """The speed controller's u from now on (drive = servo): the kernels' and the Python path's."""
+        self.u = float(u)
+        self.constants[kernels.P_U] = self.u
 
     def motor(self, t, phi, omega):
         """Motor torque [N m] at time t (array-friendly)."""
         if self.torque is None:
             if isinstance(phi, float):  # one state (the event loop): the same sum without a numpy call
-                return drive_torque(self.params, omega) + 0.0 * phi
-            return drive_torque(self.params, omega) + 0.0 * np.asarray(phi, dtype=float)
+                return drive_torque(self.params, omega, self.u) + 0.0 * phi
+            return drive_torque(self.params, omega, self.u) + 0.0 * np.asarray(phi, dtype=float)
         return self.torque(t, phi, omega)
 
     # --- the state in each mode: y = [phi, omega, x1, x2, v1] ---------------------------
@@ -287,7 +294,8 @@ class UnilateralModel:
 
 
 def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry.EXACT, t_end: float = 1.0, *,
-                        rtol: float = 1e-10, atol: float = 1e-12, torque: Callable | None = None, **run) -> RunResult:
+                        rtol: float = 1e-10, atol: float = 1e-12, torque: Callable | None = None,
+                        feedforward=None, **run) -> RunResult:
     """Simulate the robot with one-way clutches (see the module docstring).
 
     Initial module velocities from (phi0, omega0) follow the MuJoCo engine's
@@ -300,8 +308,14 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     ``steady_tol``, ``steady_cycles``, ``progress``, ``wall_budget_s``,
     ``max_switches``, default :data:`.solver_support.MAX_SWITCHES`), run by
     :class:`.solver_support.RunMonitor`. Each revolution's end is an exact sample.
+
+    ``drive = servo``: the speed controller (:class:`ipir_mujoco.core.control.SpeedController`, with the
+    ``feedforward`` table where ``params.feedforward`` is not 'none') ticks at exact times, each an end of
+    a segment: its u goes into the drive's torque (:meth:`UnilateralModel.set_u`) and the clutch mode is
+    chosen again for the new torque; the series then also has ``drive_u`` and ``motor_torque``.
     """
     options = RunOptions.given(t_end, run)
+    speed = SpeedController(params, feedforward) if params.drive == "servo" else None
     rtol, atol = check_tolerances(rtol, atol)
     t_end, dt_out = options.t_end, options.dt_out
     monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
@@ -317,10 +331,22 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     S_dot0 = K0 * params.omega0
     v1_0 = max(-S_dot0, 0.0)
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, v1_0, 0.0])
+    if speed is not None:  # the controller's tick at t = 0
+        model.set_u(speed.tick(params.phi0, params.omega0))
     mode = model.choose(0.0, y, (v1_0, v1_0 + S_dot0))
     y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
     t, pieces, switches, short_run, stall, h0 = 0.0, [], 0, 0, None, None
     while True:
+        stop = t_end if speed is None else min(t_end, speed.next_tick)  # a segment ends at the next tick
+        if mode == Mode.BOTH_LOCKED and speed is not None:  # at rest until the controller's next tick
+            pieces.append(with_drive_u(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, stop, grid),
+                                                 lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES),
+                                       model.u))
+            t = stop
+            if t >= t_end:
+                break
+            mode, y = _tick(model, speed, monitor, t, y, mode)
+            continue
         if mode == Mode.BOTH_LOCKED:
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
@@ -332,11 +358,11 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
                                     lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES))
             break
         events = model.events(mode)
-        sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0)
+        sol = _integrate(model, mode, events, t, stop, y, rtol, atol, h0)
         spurious = spurious_start(sol, lambda ts, ys: model.guards(ts, ys, mode))
         if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
             events = model.events(mode, quiet=dict([spurious]))
-            sol = _integrate(model, mode, events, t, t_end, y, rtol, atol, h0, dict([spurious]))
+            sol = _integrate(model, mode, events, t, stop, y, rtol, atol, h0, dict([spurious]))
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events],
                                  model.graze_scan(sol, mode))
@@ -344,8 +370,14 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
             t_stop, hit, y_grazed = grazed
         piece = raw_piece(mode, monitor.samples(t, t_stop, grid, steps_until(sol.t, t_stop), sol.sol), sol.sol,
                           _STATES)
+        if speed is not None:
+            piece = with_drive_u(piece, model.u)
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
+        if steady_at is None and grazed is None and sol.status == 0 and stop < t_end:  # at the next tick
+            t = stop
+            mode, y = _tick(model, speed, monitor, t, np.asarray(sol.y[:, -1], dtype=float), mode)
+            continue
         if steady_at is not None or grazed is None and sol.status != 1:
             break
         if grazed is None:
@@ -367,13 +399,25 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
         series.update(model.energy_columns(series))
         add_kinetostatics(series, model.dyn)
     monitor.report(float(series["t"][-1]), final=True)
-    del series["motor_torque"]  # folded into motor_power
+    if speed is None:
+        del series["motor_torque"]  # folded into motor_power (the servo's is kept beside its drive_u)
     check_finite(series)
     return RunResult(engine="analytic", geometry=model.dyn.geometry.value, clutch="unilateral", params=params,
                      t_end=float(series["t"][-1]), series=series, energy=model.energy_audit(series),
                      wall_time_s=time.perf_counter() - monitor.started, stall=stall,
                      settings={"method": "DOP853", "rtol": rtol, "atol": atol, "dt_out": dt_out,
                                "rod_modelled": model.dyn.include_rod, **monitor.settings})
+
+
+def _tick(model: UnilateralModel, speed, monitor: RunMonitor, t: float, y: np.ndarray, mode: Mode):
+    """The speed controller's tick at time t [s] in state ``y``: its u into the drive, then the clutch mode
+    for the new torque (a held module's margin moves with it) and the state projected onto it."""
+    model.set_u(speed.tick(float(y[0]), float(y[1])))
+    velocities = model.velocities(y, mode)
+    new = model.choose(t, y, velocities, previous=mode)
+    monitor.check_budget(t, float(y[0]))
+    monitor.report(t)
+    return new, model.project(y, new, velocities)
 
 
 def _integrate(model, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
@@ -409,7 +453,10 @@ def _columns(model: UnilateralModel, mode: Mode, rows: dict) -> dict[str, np.nda
     v1, v2 = model.velocities(y, mode)
     v1 = np.broadcast_to(v1, phi.shape).astype(float)
     v2 = np.broadcast_to(v2, phi.shape).astype(float)
-    M = np.broadcast_to(model.motor(times, phi, omega), phi.shape).astype(float)
+    if "drive_u" in rows:  # drive = servo: each sample's u, held between the controller's ticks
+        M = drive_torque(model.params, omega, rows["drive_u"]) + 0.0 * phi
+    else:
+        M = np.broadcast_to(model.motor(times, phi, omega), phi.shape).astype(float)
     m = model.motion(phi, omega, v1, mode, M)
     tr = model.linkage.transfer(phi)
     F = (model.params.F_r1, model.params.F_r2)
@@ -427,4 +474,6 @@ def _columns(model: UnilateralModel, mode: Mode, rows: dict) -> dict[str, np.nda
         "mode": rows["mode"], "resistance1": resistance[0], "resistance2": resistance[1],
         "motor_work": y[5], "motor_torque": M,
     }
+    if "drive_u" in rows:
+        piece["drive_u"] = rows["drive_u"]
     return piece

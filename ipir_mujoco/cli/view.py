@@ -29,6 +29,8 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
+from ipir_mujoco import registry
+from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
@@ -36,6 +38,7 @@ from ..engine.clutches import clutch_controller
 from ..engine.common import check_clutch_options
 from ..engine.model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control,
                             set_closed_loop_state)
+from ..engine.servo_drive import TickedDrive
 from ..engine.stepper import loop_options, make_steps
 from ..engine.timestep import choose_settings
 from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
@@ -68,9 +71,19 @@ class ViewedRobot:
         m, d = self.model, self.data
         set_closed_loop_state(m, d, self.params)
         self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
-        d.ctrl[m.actuator(MOTOR).id] = drive_control(self.params)
+        motor = m.actuator(MOTOR).id
+        d.ctrl[motor] = drive_control(self.params)
+        speed = None
+        if self.params.drive == "servo":  # the speed controller, its table computed as for a run
+            speed = SpeedController(self.params, registry.feedforward_table(self.params))
+            crank = m.joint(CRANK_HINGE)
+            d.ctrl[motor] = speed.tick(float(d.qpos[crank.qposadr[0]]), float(d.qvel[crank.dofadr[0]]))
         mujoco.mj_forward(m, d)
-        self.steps = make_steps(m, d, self.controller, self._qvel_before, **loop_options(m, d))
+        options = loop_options(m, d)
+        self.steps = make_steps(m, d, self.controller, self._qvel_before, **options)
+        if speed is not None:
+            TickedDrive(self.steps, speed, d, motor=motor, crank_q=options["crank_q"], crank_v=options["crank_v"],
+                        dt=m.opt.timestep)
         self.held: tuple[bool, bool] | None = None
         self._colour()
 

@@ -31,7 +31,9 @@ from .checks import as_real, check_real, check_whole  # noqa: F401  (re-exported
 from .errors import ParameterError
 from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401  (re-exported)
 
-DRIVES = ("torque", "motor")
+DRIVES = ("torque", "motor", "servo")
+FEEDFORWARDS = ("none", "paper", "exact")  # drive = servo: the feedforward table's model (core/control.py)
+SERVO_FIELDS = ("omega_target", "feedforward", "control_rate", "speed_kp", "speed_ki")  # act only with drive=servo
 
 
 def _number(units: str, text: str, default: float, low: float, high: float, *, low_open: bool = False,
@@ -77,9 +79,12 @@ class RobotParams:
                           -1e4, 1e4)
     omega0: float = _number("rad/s", "initial crank speed", 0.0, -1e4, 1e4)
     drive: str = _choice("what turns the crank: 'torque' = the constant M; 'motor' = a DC gearmotor, "
-                         "torque M_stall (1 - omega / omega_noload)", "torque", DRIVES)
-    M_stall: float = _number("N m", "motor stall torque at the crank (drive = motor)", 0.5, 0.0, 1e6, low_open=True)
-    omega_noload: float = _number("rad/s", "motor no-load crank speed (drive = motor)", 30.0, 0.0, 1e5,
+                         "torque M_stall (1 - omega / omega_noload); 'servo' = that motor at a voltage fraction u "
+                         "in [-1, 1] set by a speed controller, torque M_stall (u - omega / omega_noload)",
+                         "torque", DRIVES)
+    M_stall: float = _number("N m", "motor stall torque at the crank (drive = motor or servo)", 0.5, 0.0, 1e6,
+                             low_open=True)
+    omega_noload: float = _number("rad/s", "motor no-load crank speed (drive = motor or servo)", 30.0, 0.0, 1e5,
                                   low_open=True)
     clutch_stiffness: float | None = _number("N/m", "stiffness of each one-way clutch once engaged", None, 0.0,
                                              1e12, low_open=True, none_word="rigid",
@@ -99,6 +104,20 @@ class RobotParams:
                           "polyurethane wheels on steel", 50.0, 0.0, 1e6)
     F_n2: float = _number("N", "wall-press normal force on module 2's wheels, all together (with finite mu_wall); "
                           "default as F_n1", 50.0, 0.0, 1e6)
+
+    omega_target: float = _number("rad/s", "crank speed the speed controller holds (drive = servo; below "
+                                  "omega_noload)", 10.0, 0.0, 1e5, low_open=True)
+    feedforward: str = _choice("drive = servo: the torque table added to the PI controller, from inverse "
+                               "kinetostatics at omega_target: 'none' (PI alone), 'paper' (the paper's first-order "
+                               "geometry, L >> r), 'exact' (the exact slider-crank)", "none", FEEDFORWARDS)
+    control_rate: float = _number("Hz", "rate of the speed controller's ticks; u is held between them (drive = "
+                                  "servo)", 1000.0, 0.0, 1e5, low_open=True)
+    speed_kp: float | None = _number("s/rad", "speed controller's proportional gain, u per rad/s of speed error "
+                                     "(drive = servo)", None, 0.0, 1e4, none_word="model",
+                                     none_text="derived from the model, docs/control.md")
+    speed_ki: float | None = _number("1/rad", "speed controller's integral gain, u per rad of integrated speed "
+                                     "error (drive = servo)", None, 0.0, 1e8, none_word="model",
+                                     none_text="derived from the model, docs/control.md")
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -128,6 +147,10 @@ class RobotParams:
                     raise ParameterError(
                         f"{name}={getattr(self, name)!r} N with mu_wall={self.mu_wall!r}: a finite grip needs the "
                         f"wheels pressed on; allowed: 0 < {name} <= 1e+06 N, or mu_wall=unlimited")
+        if self.drive == "servo" and not self.omega_target < self.omega_noload:
+            raise ParameterError(
+                f"omega_target={self.omega_target:g} rad/s is out of range; allowed: 0 < omega_target < "
+                f"omega_noload = {self.omega_noload:g} rad/s (at full voltage the motor turns the crank no faster)")
         if not self.clutch_backlash <= 0.5 * self.r:
             raise ParameterError(
                 f"clutch_backlash={self.clutch_backlash} m is out of range; allowed: 0 <= clutch_backlash <= "
@@ -200,6 +223,8 @@ def allowed_text(name: str) -> str:
     text = f"{low}{name}{high}" + (f" {meta['units']}" if meta["units"] != "-" else "")  # no unit: a ratio
     if name == "L":
         text += ", and L > r"
+    if name == "omega_target":
+        text = f"0 < omega_target < omega_noload {meta['units']}"
     if name == "clutch_backlash":
         text = f"0 <= clutch_backlash <= r / 2 {meta['units']}"
     if name in ("F_n1", "F_n2"):
@@ -330,9 +355,16 @@ _ACTS_THROUGH = (
 
 def refuse_idle_parameters(params: RobotParams) -> None:
     """Parameters that act only through another one, given without it, refused in one line (never silently
-    ignored), for every engine: clutch damping and backlash need a clutch with a spring (a finite
+    ignored), for every engine: the speed controller's (SERVO_FIELDS) need drive=servo; clutch damping and backlash need a clutch with a spring (a finite
     ``clutch_stiffness``); the wheels' normal forces act only through a finite grip (``mu_wall``)."""
     defaults = RobotParams()
+    if params.drive != "servo":
+        for name in SERVO_FIELDS:
+            value, default = getattr(params, name), getattr(defaults, name)
+            if value != default:
+                shown = "model" if value is None else value
+                raise ParameterError(f"{name}={shown!r} sets the speed controller, which only drive=servo has; "
+                                     f"allowed: drive=servo, or leave {name} out (drive={params.drive!r})")
     for through, names, needs, idle, unit in _ACTS_THROUGH:
         if getattr(params, through) is not None:
             continue

@@ -49,7 +49,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
-from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
 from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
@@ -61,6 +61,7 @@ from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, 
 from .model import set_closed_loop_state
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
 from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
+from .servo_drive import TickedDrive, controller_for
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 
@@ -90,6 +91,7 @@ def simulate_mujoco(
     steady_tol: float = STEADY_TOL,
     steady_cycles: int = STEADY_CYCLES,
     wall_budget_s: float | None = None,
+    feedforward=None,
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -108,13 +110,18 @@ def simulate_mujoco(
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
-    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`).
+    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
+    ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
+    required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`).
     """
     params = require_params(params)
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
     check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
     check_clutch_options(params, clutch, implementation)
+    controller_for(params, feedforward)  # refused here, before any work, if the table does not fit
+    if servo is not None and params.drive == "servo":
+        raise ParameterError("a crank servo with drive='servo': one thing sets the crank's actuator; allowed: one")
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
     t_end, dt_out = run.t_end, run.dt_out
@@ -123,7 +130,8 @@ def simulate_mujoco(
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
-                   steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s)
+                   steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
+                   feedforward=feedforward)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
@@ -145,7 +153,7 @@ class _Run:
     """One MuJoCo run with fixed settings (the loop is in :meth:`_integrate`)."""
 
     def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
-                 until_steady, steady_tol, steady_cycles, wall_budget_s, started=None):
+                 until_steady, steady_tol, steady_cycles, wall_budget_s, feedforward=None, started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
         self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
@@ -160,6 +168,8 @@ class _Run:
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
         self.recorder: Recorder | None = None  # made by _setup
+        self.speed = controller_for(params, feedforward)  # drive = servo: this attempt's own controller
+        self.ticked: TickedDrive | None = None
 
     def result(self, extra_settings: dict) -> RunResult:
         with captured_warnings() as messages:
@@ -171,6 +181,8 @@ class _Run:
                 raise SimulationError(mujoco_failure(t, str(exc))) from None
         rec = self.recorder
         series = rec.series(last)
+        if self.ticked is not None:
+            series["drive_u"] = self.ticked.u_column(series["t"])
         wm, wf = series["motor_work"][-1], series["friction_work"][-1]
         kinetic = series["kinetic"][-1] - series["kinetic"][0]
         potential = series["potential"][-1]
@@ -206,6 +218,8 @@ class _Run:
         motor, crank = m.actuator(MOTOR).id, m.joint(CRANK_HINGE)
         d.ctrl[motor] = drive_control(p) if self.servo is None else self.servo.torque(
             0.0, d.qpos[crank.qposadr[0]], d.qvel[crank.dofadr[0]])
+        if self.speed is not None:  # the speed controller's tick at t = 0
+            d.ctrl[motor] = self.speed.tick(float(d.qpos[crank.qposadr[0]]), float(d.qvel[crank.dofadr[0]]))
         mujoco.mj_forward(m, d)
         self.loop = loop_options(m, d)
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
@@ -234,6 +248,9 @@ class _Run:
         self._check(messages, 0.0)
 
         steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, servo=self.servo, **self.loop)
+        if self.speed is not None:
+            self.ticked = TickedDrive(steps, self.speed, d, motor=self.loop["motor"], crank_q=self.loop["crank_q"],
+                                      crank_v=self.loop["crank_v"], dt=m.opt.timestep)
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
         checks = _BlockChecks(self)
@@ -355,7 +372,7 @@ class _BlockChecks:
         self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
             if run.until_steady else None
         # a stall is final only under constant loads: not with a servo's time-varying torque
-        self.stall_watch = run.servo is None
+        self.stall_watch = run.servo is None and run.params.drive != "servo"
 
     def check(self, newest: int, messages: list[str]) -> int | None:
         """Returns the row to end the run at (steady state or stall), or None to go on."""
