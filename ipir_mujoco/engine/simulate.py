@@ -59,7 +59,8 @@ from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captu
                      climb_energy, monotone, mujoco_failure, rest_since, stall_reason, steps_per_output)
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
-from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
+from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
+                      rising as _rising)
 from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
 from .servo_drive import TickedDrive, controller_for
 from .stepper import WARNED, loop_options, make_steps
@@ -285,7 +286,7 @@ class _Run:
         judged row i - 1 (residual ratio, then loop gap), then raised the energy floor to sample i's torque and
         reported its excursion; if MuJoCo warned in the interval after the last new sample (``warned``: it was
         not recorded, but it judged that sample), the run fails with the last good time. Of each figure only the
-        values that leave the monitor as feeding every one would are fed (:func:`_rising`: its first crossing
+        values that leave the monitor as feeding every one would are fed (:func:`.monitor.rising`: its first crossing
         of the tolerance and the block's worst), so a block costs a few array operations."""
         rec, mon = self.recorder, self.monitor
         tol = mon.tolerances
@@ -338,25 +339,6 @@ class _Run:
                                   "(a smaller --timestep may carry the run further)")
         if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
-
-
-def _rising(values: np.ndarray, worst: float, tolerance: float, offset: int) -> list[int]:
-    """Rows (index + ``offset``) of ``values`` the monitor must be fed to end as if fed each in turn (each
-    that beats the worst so far, starting from ``worst``): the first fed one beyond ``tolerance`` (it is
-    the first beyond both, and the one that stops a run or is recorded as its crossing), and the first of
-    the largest, if it beats ``worst`` (NaN never does). Every other value would only be overtaken."""
-    size = np.abs(values)
-    largest = np.fmax.reduce(size)
-    if not largest > abs(worst):  # the common case once a run is under way: nothing to feed
-        return []
-    rows = []
-    threshold = max(abs(worst), tolerance)
-    if largest > threshold:
-        rows.append(int(np.argmax(size > threshold)))
-    top = int(np.argmax(size == largest))
-    if not rows or top != rows[0]:
-        rows.append(top)
-    return [row + offset for row in rows]
 
 
 class _BlockChecks:
