@@ -210,8 +210,8 @@ FEEDFORWARD_REVOLUTIONS = 2  # the table is the last: the modules start at rest 
 
 
 def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
-    """The speed controller's feedforward (``params.feedforward``): the torque [N m] a crank turning at exactly
-    ``omega_target`` needs at each crank angle, by the package's inverse kinetostatics with one-way clutches
+    """The speed controller's feedforward (``params.feedforward``): the torque [N m] a crank following its speed
+    target exactly (``omega_target``, or the profile of ``speed_dip``) needs at each crank angle, by the package's inverse kinetostatics with one-way clutches
     (:func:`ipir_mujoco.analytic.inverse.inverse_kinetostatics`) on the paper's first-order geometry
     ('paper', L >> r) or the exact slider-crank ('exact'); None for 'none'. Computed above the engines and
     handed to each as data (the MuJoCo engine never runs the equations); cached per parameter set."""
@@ -223,15 +223,18 @@ def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
 @functools.lru_cache(maxsize=64)
 def _table(params: RobotParams) -> FeedforwardTable:
     from .analytic.inverse import CrankMotion, inverse_kinetostatics
-    from .core.control import TABLE_POINTS
+    from .core.control import TABLE_POINTS, reference_motion
 
-    omega = params.omega_target
-    motion = CrankMotion.constant_speed(omega, params.phi0, FEEDFORWARD_REVOLUTIONS)
+    omega, dip = params.omega_target, params.speed_dip
+    if dip == 0.0:
+        motion = CrankMotion.constant_speed(omega, params.phi0, FEEDFORWARD_REVOLUTIONS)
+    else:  # the profile through the dead centres: phi(t) sampled finely, a spline through it
+        motion = CrankMotion.from_samples(*reference_motion(omega, dip, params.phi0, FEEDFORWARD_REVOLUTIONS))
     run = inverse_kinetostatics(params, motion, FEEDFORWARD_MODELS[params.feedforward], "unilateral",
                                 dt_out=2 * math.pi / omega / TABLE_POINTS)
     s = run.series
     last = s["phi"] >= params.phi0 + 2 * math.pi * (FEEDFORWARD_REVOLUTIONS - 1)
-    return FeedforwardTable.from_samples(s["phi"][last], s["motor_torque"][last], params.feedforward, omega)
+    return FeedforwardTable.from_samples(s["phi"][last], s["motor_torque"][last], params.feedforward, omega, dip)
 
 
 def halved_settings(run: RunResult):

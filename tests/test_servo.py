@@ -158,3 +158,17 @@ def test_bad_servo_input_exits_2_with_one_line(capsys, argv, fragment):
     code, out, err = run_cli(capsys, "simulate", "--t-end", "0.01", *argv)
     assert code == 2 and out == ""
     assert fragment in err and err.count("\n") == 1
+
+
+def test_the_dead_centre_profile_keeps_the_mean_crank_speed():
+    from ipir_mujoco.core.control import reference_motion, reference_speed
+
+    for dip in (0.0, 0.3, 0.6):
+        t, phi = reference_motion(8.0, dip, 0.4, 2)
+        # two turns at a mean of 8 rad/s take 4 pi / 8 s; the closed form to roundoff
+        assert t[-1] == pytest.approx(4 * math.pi / 8.0, rel=1e-12)
+        # and it follows omega_ref: its slope, by central differences, to their O(h^2) error (h = 2 pi / 4000)
+        slope = (phi[2:] - phi[:-2]) / (t[2:] - t[:-2])
+        assert np.allclose(slope, reference_speed(8.0, dip, phi[1:-1]), rtol=1e-4)
+    # slowest at the dead centres (phi = 0, pi), fastest mid-stroke
+    assert reference_speed(8.0, 0.3, 0.0) < 8.0 < reference_speed(8.0, 0.3, math.pi / 2)

@@ -7,11 +7,15 @@ motor allows. This module decides u. It ticks at ``control_rate`` [Hz], at t_k =
 (k = 0, 1, ...), reads the crank angle phi [rad] and speed omega [rad/s] there, and holds its u until the
 next tick (a zero-order hold, as a microcontroller's PWM does):
 
-    e = omega_target - omega
+    e = omega_ref(phi) - omega
     u = clip(u_ff(phi) + kp e + ki I, -1, 1)
-    u_ff(phi) = tau_ff(phi) / M_stall + omega_target / omega_noload     (0 without feedforward)
+    u_ff(phi) = tau_ff(phi) / M_stall + omega_ref(phi) / omega_noload     (0 without feedforward)
 
-``tau_ff(phi)`` [N m] is the torque a chosen model says a crank turning at exactly omega_target needs at
+``omega_ref(phi)`` [rad/s] is omega_target, or with ``speed_dip`` = a > 0 a profile that slows through the
+dead centres (phi = 0, pi, where the modules hand over) and makes up mid-stroke,
+omega_ref = omega_0 (1 - a cos 2 phi), with omega_0 = omega_target / sqrt(1 - a^2) so that its mean crank
+speed, 2 pi over the revolution's time (the integral of dphi / omega_ref), is omega_target.
+``tau_ff(phi)`` [N m] is the torque a chosen model says a crank following omega_ref exactly needs at
 angle phi (:class:`FeedforwardTable`, computed above the engines from the package's inverse kinetostatics:
 ``ipir_mujoco.registry.feedforward_table``), and omega_target / omega_noload the voltage that cancels the
 motor's back-EMF at that speed. I is the integrated error, with anti-windup by conditional integration: a
@@ -46,28 +50,31 @@ TABLE_POINTS = 720  # crank angles of a feedforward table (every half degree)
 
 @dataclass(frozen=True)
 class FeedforwardTable:
-    """The torque tau_ff [N m] a crank at constant speed needs, at TABLE_POINTS equally spaced crank angles
-    ``phi0 + 2 pi j / n`` (j = 0..n-1, ``torque`` shape (n,)), periodic in phi; ``model`` says whose
-    ('paper' | 'exact'), ``omega`` [rad/s] at which speed."""
+    """The torque tau_ff [N m] a crank following the speed target needs, at TABLE_POINTS equally spaced crank
+    angles ``phi0 + 2 pi j / n`` (j = 0..n-1, ``torque`` shape (n,)), periodic in phi; ``model`` says whose
+    ('paper' | 'exact'), ``omega`` [rad/s] and ``dip`` which target (:func:`reference_speed`)."""
 
     phi0: float
     torque: tuple[float, ...]
     model: str
     omega: float
+    dip: float = 0.0
 
     def __post_init__(self) -> None:
         if len(self.torque) < 4 or not all(math.isfinite(v) for v in self.torque):
             raise ParameterError(f"a feedforward table needs at least 4 finite torques, got {len(self.torque)}")
 
     @classmethod
-    def from_samples(cls, phi, torque, model: str, omega: float, points: int = TABLE_POINTS) -> "FeedforwardTable":
+    def from_samples(cls, phi, torque, model: str, omega: float, dip: float = 0.0,
+                     points: int = TABLE_POINTS) -> "FeedforwardTable":
         """The table from one revolution's samples (phi (n,) ascending over 2 pi [rad], torque (n,) [N m]),
         resampled linearly onto ``points`` equally spaced angles from phi[0]."""
         phi, torque = np.asarray(phi, dtype=float), np.asarray(torque, dtype=float)
         keep = np.concatenate([np.diff(phi) > 0, [True]])  # of duplicated instants, the later sample
         phi, torque = phi[keep], torque[keep]
         grid = phi[0] + 2 * math.pi * np.arange(points) / points
-        return cls(float(phi[0]), tuple(float(v) for v in np.interp(grid, phi, torque)), model, float(omega))
+        return cls(float(phi[0]), tuple(float(v) for v in np.interp(grid, phi, torque)), model, float(omega),
+                   float(dip))
 
     def at(self, phi: float) -> float:
         """tau_ff [N m] at crank angle ``phi`` [rad] (linear between table angles, periodic)."""
@@ -76,6 +83,29 @@ class FeedforwardTable:
         j = int(x)
         w = x - j
         return (1.0 - w) * self.torque[j % n] + w * self.torque[(j + 1) % n]
+
+
+def reference_speed(omega_target: float, dip: float, phi):
+    """omega_ref(phi) [rad/s] (float or ndarray like phi [rad]): omega_target, or with ``dip`` = a > 0
+    omega_0 (1 - a cos 2 phi), omega_0 = omega_target / sqrt(1 - a^2) (the module docstring)."""
+    if dip == 0.0:
+        return omega_target + 0.0 * phi
+    return omega_target / math.sqrt(1.0 - dip * dip) * (1.0 - dip * np.cos(2.0 * phi))
+
+
+def reference_motion(omega_target: float, dip: float, phi0: float, revolutions: int, points: int = 4000):
+    """(t (n,) [s], phi (n,) [rad]): the crank following omega_ref from phi0 for ``revolutions`` turns, t = the
+    integral of dphi / omega_ref (closed form: omega_0 sqrt(1 - a^2) t = atan(sqrt((1 + a) / (1 - a)) tan
+    phi), unwrapped), ``points`` samples per revolution."""
+    phi = phi0 + 2 * math.pi * np.arange(revolutions * points + 1) / points
+    if dip == 0.0:
+        return (phi - phi0) / omega_target, phi
+    k = math.sqrt((1 + dip) / (1 - dip))
+
+    def clock(angle):  # omega_target t(angle) from angle 0, continuous: atan's branch plus a half turn per pi
+        turns = np.floor(angle / math.pi + 0.5)
+        return np.arctan(k * np.tan(angle - turns * math.pi)) + turns * math.pi
+    return (clock(phi) - clock(np.array(phi0))) / omega_target, phi
 
 
 def reference_inertia(params: RobotParams) -> float:
@@ -118,14 +148,15 @@ class SpeedController:
             if not isinstance(table, FeedforwardTable) or table.model != params.feedforward:
                 raise ParameterError(f"feedforward={params.feedforward!r} needs its table (a FeedforwardTable of "
                                      f"that model); run through ipir_mujoco.registry.run, which computes it")
-            if not math.isclose(table.omega, params.omega_target, rel_tol=1e-12):
-                raise ParameterError(f"the feedforward table is for {table.omega:g} rad/s, not omega_target="
-                                     f"{params.omega_target:g} rad/s")
+            if not (math.isclose(table.omega, params.omega_target, rel_tol=1e-12) and table.dip == params.speed_dip):
+                raise ParameterError(f"the feedforward table is for {table.omega:g} rad/s and speed_dip "
+                                     f"{table.dip:g}, not omega_target={params.omega_target:g} rad/s and speed_dip "
+                                     f"{params.speed_dip:g}")
         self.table = table
-        self.target = params.omega_target
+        self.target, self.dip = params.omega_target, params.speed_dip
         self.kp, self.ki = gains(params)
         self.m_stall, self.omega_noload = params.M_stall, params.omega_noload
-        self.bias = params.omega_target / params.omega_noload if table is not None else 0.0
+        self.with_ff = table is not None
         self.period = 1.0 / params.control_rate
         self.integral = 0.0  # rad
         self.ticks = 0
@@ -138,8 +169,9 @@ class SpeedController:
 
     def tick(self, phi: float, omega: float) -> float:
         """u in [-1, 1] from the crank angle phi [rad] and speed omega [rad/s] at this tick; held to the next."""
-        error = self.target - omega
-        ff = self.bias + (self.table.at(phi) / self.m_stall if self.table is not None else 0.0)
+        reference = self.target if self.dip == 0.0 else float(reference_speed(self.target, self.dip, phi))
+        error = reference - omega
+        ff = reference / self.omega_noload + self.table.at(phi) / self.m_stall if self.with_ff else 0.0
         trial = ff + self.kp * error + self.ki * (self.integral + error * self.period)
         if -1.0 <= trial <= 1.0 or (trial > 1.0) != (error > 0.0):  # anti-windup: no integration into the clip
             self.integral += error * self.period

@@ -33,7 +33,7 @@ from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401 
 
 DRIVES = ("torque", "motor", "servo")
 FEEDFORWARDS = ("none", "paper", "exact")  # drive = servo: the feedforward table's model (core/control.py)
-SERVO_FIELDS = ("omega_target", "feedforward", "control_rate", "speed_kp", "speed_ki")  # act only with drive=servo
+SERVO_FIELDS = ("omega_target", "speed_dip", "feedforward", "control_rate", "speed_kp", "speed_ki")  # act only with drive=servo
 
 
 def _number(units: str, text: str, default: float, low: float, high: float, *, low_open: bool = False,
@@ -107,6 +107,10 @@ class RobotParams:
 
     omega_target: float = _number("rad/s", "crank speed the speed controller holds (drive = servo; below "
                                   "omega_noload)", 10.0, 0.0, 1e5, low_open=True)
+    speed_dip: float = _number("-", "drive = servo: how far the speed target dips through the dead centres, where "
+                               "the modules hand over: omega_ref = omega_0 (1 - speed_dip cos 2 phi), omega_0 = "
+                               "omega_target / sqrt(1 - speed_dip^2), so the mean crank speed stays omega_target "
+                               "(0: constant speed)", 0.0, 0.0, 0.9)
     feedforward: str = _choice("drive = servo: the torque table added to the PI controller, from inverse "
                                "kinetostatics at omega_target: 'none' (PI alone), 'paper' (the paper's first-order "
                                "geometry, L >> r), 'exact' (the exact slider-crank)", "none", FEEDFORWARDS)
@@ -151,6 +155,13 @@ class RobotParams:
             raise ParameterError(
                 f"omega_target={self.omega_target:g} rad/s is out of range; allowed: 0 < omega_target < "
                 f"omega_noload = {self.omega_noload:g} rad/s (at full voltage the motor turns the crank no faster)")
+        if self.drive == "servo" and self.speed_dip > 0:
+            fastest = self.omega_target * math.sqrt((1 + self.speed_dip) / (1 - self.speed_dip))
+            if not fastest < self.omega_noload:
+                raise ParameterError(
+                    f"speed_dip={self.speed_dip:g} with omega_target={self.omega_target:g} rad/s is out of range: "
+                    f"the target's fastest, mid-stroke, is {fastest:.4g} rad/s; allowed: below omega_noload = "
+                    f"{self.omega_noload:g} rad/s (a smaller speed_dip or omega_target)")
         if not self.clutch_backlash <= 0.5 * self.r:
             raise ParameterError(
                 f"clutch_backlash={self.clutch_backlash} m is out of range; allowed: 0 <= clutch_backlash <= "
