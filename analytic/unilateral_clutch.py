@@ -61,7 +61,7 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, missed_crossing,
                              raw_piece, restart_step, spurious_start, steps_until, truncate, with_drive_u)
-from .unilateral_model import _STATES, UnilateralModel  # the model; the tests import it from here too
+from .unilateral_model import _STATES, _TOL_F, _TOL_V, HELD, UnilateralModel  # the tests import it from here too
 
 # more zero-length segments in a row than this is chatter, not motion
 _MAX_STALLED_SEGMENTS = 50
@@ -185,12 +185,21 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
 
 def _tick(model: UnilateralModel, speed, monitor: RunMonitor, t: float, y: np.ndarray, mode: Mode):
     """The speed controller's tick at time t [s] in state ``y``: its u into the drive, then the clutch mode
-    for the new torque (a held module's margin moves with it) and the state projected onto it."""
+    for the new torque (a held module's margin moves with it) and the state projected onto it. Where every
+    event function of the mode stays clearly positive under the new torque (each moving module moving, each
+    held one's margin above zero by the sign tests' tolerance), the mode's conditions hold strictly and it
+    is the complementarity problem's one solution: kept, without solving it again."""
     model.set_u(speed.tick(float(y[0]), float(y[1])))
-    velocities = model.velocities(y, mode)
-    new = model.choose(t, y, velocities, previous=mode)
     monitor.check_budget(t, float(y[0]))
     monitor.report(t)
+    if mode is not Mode.BOTH_LOCKED:
+        guards = model.guards(np.array([t]), y[:, None], mode)[:, 0]  # module i's: margin if held, else speed
+        p, r, omega = model.params, model.linkage.r, abs(float(y[1]))
+        clear = (_TOL_F * (p.F_r1 + p.F_r2 + (p.m1 + p.m2) * r * omega * omega), _TOL_V * r * omega)  # N, m/s
+        if all(g > clear[0 if held else 1] for g, held in zip(guards, HELD[mode])):
+            return mode, y
+    velocities = model.velocities(y, mode)
+    new = model.choose(t, y, velocities, previous=mode)
     return new, model.project(y, new, velocities)
 
 
