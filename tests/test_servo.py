@@ -172,3 +172,8 @@ def test_the_dead_centre_profile_keeps_the_mean_crank_speed():
         assert np.allclose(slope, reference_speed(8.0, dip, phi[1:-1]), rtol=1e-4)
     # slowest at the dead centres (phi = 0, pi), fastest mid-stroke
     assert reference_speed(8.0, 0.3, 0.0) < 8.0 < reference_speed(8.0, 0.3, math.pi / 2)
+
+
+def test_climb_refuses_the_servo_in_one_line(capsys, tmp_path):
+    code, out, err = run_cli(capsys, "climb", "--drive", "servo", "--out", str(tmp_path / "c"))
+    assert code == 2 and "drive='servo' in climb" in err and err.count("\n") == 1
