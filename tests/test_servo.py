@@ -177,3 +177,9 @@ def test_the_dead_centre_profile_keeps_the_mean_crank_speed():
 def test_climb_refuses_the_servo_in_one_line(capsys, tmp_path):
     code, out, err = run_cli(capsys, "climb", "--drive", "servo", "--out", str(tmp_path / "c"))
     assert code == 2 and "drive='servo' in climb" in err and err.count("\n") == 1
+
+
+def test_a_given_timestep_longer_than_the_controller_period_is_refused():
+    with pytest.raises(ParameterError, match="longer than the speed controller's period"):
+        registry.run("mujoco-ratchet", RobotParams(drive="servo", control_rate=5000.0), 0.01, dt_out=1e-3,
+                     timestep=5e-4)

@@ -62,7 +62,7 @@ class TickedDrive:
     def run(self, nstep: int, row: int = -1) -> None:
         d, ctl = self.data, self.controller
         while nstep > 0:
-            while self.done >= self.next_step:  # a tick is due at this step's start (several if dt > period)
+            while self.done >= self.next_step:  # a tick is due at this step's start (the timestep <= the period)
                 u = ctl.tick(d.qpos.item(self.crank_q), d.qvel.item(self.crank_v))
                 d.ctrl[self.motor] = u
                 self.log_steps.append(self.next_step)

@@ -128,6 +128,10 @@ def simulate_mujoco(
     t_end, dt_out = run.t_end, run.dt_out
     if settings is not None:  # bounded up front: a tiny given timestep is refused, not run for days
         check_step_count(t_end, settings.timestep)
+        if params.drive == "servo" and settings.timestep * params.control_rate > 1 + 1e-9:
+            raise ParameterError(f"timestep={settings.timestep:g} s is longer than the speed controller's period "
+                                 f"1 / control_rate = {1 / params.control_rate:g} s; allowed: a timestep of at most "
+                                 "that (or none: the engine then chooses one)")
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
