@@ -58,6 +58,12 @@ def test_the_engines_agree_on_every_servo_run(study):
         assert m["electrical_energy_per_metre_j_m"] == pytest.approx(a["electrical_energy_per_metre_j_m"], rel=3e-3)
 
 
+def test_mujoco_leaves_its_rigid_ratchets_peaks_out(study):
+    for r in study["rows"] + study["profile"]["rows"]:
+        missing = r["peak_clutch_force_n"] is None and r["peak_module_accel_m_s2"] is None
+        assert missing == (r["variant"] == "mujoco-ratchet")
+
+
 def test_the_energy_drawn_covers_the_work_at_the_crank(study):
     # the winding's loss tau^2 omega_noload / M_stall >= 0: what the motor draws is at least its work
     for r in study["rows"] + study["profile"]["rows"]:
@@ -74,7 +80,7 @@ def test_files_and_figure(study, tmp_path):
     fig = study_figure(study)
     gids = {a.get_gid() for ax in fig.axes for a in ax.get_children()}
     assert {"trace:pi", "trace:pi+exact", "ripple:mujoco-ratchet", "force:analytic-unilateral",
-            "profile-force:mujoco-ratchet"} <= gids
+            "profile-force:analytic-unilateral", "profile-energy:mujoco-ratchet"} <= gids
     assert all(ax.get_ylabel() for ax in fig.axes)
     text = format_table(study)
     assert "ripple [-]" in text and "dead-centre profile" in text

@@ -65,15 +65,18 @@ def study_figure(study: dict) -> Figure:
         ax_trace.set_ylabel("crank speed - target [% of target]")
         ax_trace.legend(fontsize=8, loc="upper right")
 
-    width = 0.8 / max(1, len(variants))
     groups = [(w, c) for w in speeds for c in controllers]
     x = np.arange(len(groups))
     for ax, key, title, unit, log in ((ax_ripple, "speed_ripple", "(b) speed ripple (peak-to-peak / mean)", "-", True),
                                       (ax_force, "peak_clutch_force_n", "(c) peak clutch force", "N", False)):
-        for j, v in enumerate(variants):
-            values = [_value(next((r for r in rows if r["speed_rad_s"] == w and r["controller"] == c
-                                   and r["variant"] == v), {"error": ""}), key) for w, c in groups]
-            bars = ax.bar(x + (j - (len(variants) - 1) / 2) * width, values, width,
+        table = {v: [_value(next((r for r in rows if r["speed_rad_s"] == w and r["controller"] == c
+                                  and r["variant"] == v), {"error": ""}), key) for w, c in groups] for v in variants}
+        shown = [v for v in variants if not all(math.isnan(value) for value in table[v])]
+        missing = [VARIANT_STYLE[v]["label"] for v in variants if v not in shown]
+        width = 0.8 / max(1, len(shown))
+        for j, v in enumerate(shown):
+            values = table[v]
+            bars = ax.bar(x + (j - (len(shown) - 1) / 2) * width, values, width,
                           color=[CONTROLLER_COLOURS[c] for _, c in groups], edgecolor="black", lw=0.6,
                           hatch=VARIANT_STYLE[v]["hatch"], label=VARIANT_STYLE[v]["label"])
             for bar in bars:
@@ -85,6 +88,9 @@ def study_figure(study: dict) -> Figure:
         ax.set_ylabel(f"{title.split(') ')[1].split(' (')[0]} [{unit}]")
         ax.set_xlabel("controller and mean crank speed")
         ax.legend(fontsize=8, title="bars: hatch = model", title_fontsize=8)
+        if missing:  # MuJoCo's rigid ratchet: its peaks measure its timestep (studies/control_study.py)
+            ax.set_xlabel(f"controller and mean crank speed\n({', '.join(missing)}: n/a, a rigid ratchet's sampled "
+                          "peak measures its timestep)")
 
     profile = study["profile"]
     prows = profile["rows"]
@@ -94,8 +100,10 @@ def study_figure(study: dict) -> Figure:
             chosen = sorted((r for r in prows if r["variant"] == v), key=lambda r: r["speed_dip"])
             dips = [r["speed_dip"] for r in chosen]
             style = LINE_STYLE.get(v, {})
-            ax_profile.plot(dips, [_value(r, "peak_clutch_force_n") for r in chosen], color="tab:red", **style,
-                            label=f"peak clutch force, {VARIANT_STYLE[v]['label']}", gid=f"profile-force:{v}")
+            force = [_value(r, "peak_clutch_force_n") for r in chosen]
+            if not all(math.isnan(f) for f in force):  # MuJoCo's: n/a (see panel c)
+                ax_profile.plot(dips, force, color="tab:red", **style,
+                                label=f"peak clutch force, {VARIANT_STYLE[v]['label']}", gid=f"profile-force:{v}")
             energy_ax.plot(dips, [_value(r, "electrical_energy_per_metre_j_m") for r in chosen], color="tab:purple",
                            **style, label=f"electrical energy, {VARIANT_STYLE[v]['label']}",
                            gid=f"profile-energy:{v}")

@@ -93,7 +93,9 @@ def render(metrics: dict, figures_dir) -> list:
         "gap rate K = -r sin(phi) (1 + r cos(phi) / D) makes the strokes asymmetric by up to r / L, and the inertia "
         "torque the feedforward must supply, 1/2 dJ/dphi omega^2, has another shape; the PI is left with that "
         "error. The open-loop motor's ripple at the same mean speed is over 50 % (ipir-mujoco control-study, "
-        "which also compares a speed profile that slows through the dead centres)."))
+        "which also compares a speed profile that slows through the dead centres). MuJoCo's peak clutch force is "
+        "n/a, as in a sweep: its rigid ratchet takes up each hand-over within a few steps of a soft constraint, "
+        "and a sampled peak measures the step (the section \"Real clutches\" has real clutches' loads)."))
     return blocks
 
 
