@@ -211,7 +211,8 @@ FEEDFORWARD_REVOLUTIONS = 2  # the table is the last: the modules start at rest 
 
 def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
     """The speed controller's feedforward (``params.feedforward``): the torque [N m] a crank following its speed
-    target exactly (``omega_target``, or the profile of ``speed_dip``) needs at each crank angle, by the package's inverse kinetostatics with one-way clutches
+    target exactly (``omega_target``, or the profile of ``speed_dip``) needs at each crank angle, by the
+    package's inverse kinetostatics with one-way clutches
     (:func:`ipir_mujoco.analytic.inverse.inverse_kinetostatics`) on the paper's first-order geometry
     ('paper', L >> r) or the exact slider-crank ('exact'); None for 'none'. Computed above the engines and
     handed to each as data (the MuJoCo engine never runs the equations); cached per parameter set."""

@@ -49,8 +49,8 @@ finally:
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "main"]
 
-COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study, climb,
-            control_study)
+COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
+            climb, control_study)
 
 
 def build_parser() -> Parser:

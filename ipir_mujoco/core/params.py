@@ -33,7 +33,8 @@ from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401 
 
 DRIVES = ("torque", "motor", "servo")
 FEEDFORWARDS = ("none", "paper", "exact")  # drive = servo: the feedforward table's model (core/control.py)
-SERVO_FIELDS = ("omega_target", "speed_dip", "feedforward", "control_rate", "speed_kp", "speed_ki")  # act only with drive=servo
+# the speed controller's parameters: they act only with drive=servo
+SERVO_FIELDS = ("omega_target", "speed_dip", "feedforward", "control_rate", "speed_kp", "speed_ki")
 
 
 def _number(units: str, text: str, default: float, low: float, high: float, *, low_open: bool = False,
@@ -366,8 +367,9 @@ _ACTS_THROUGH = (
 
 def refuse_idle_parameters(params: RobotParams) -> None:
     """Parameters that act only through another one, given without it, refused in one line (never silently
-    ignored), for every engine: the speed controller's (SERVO_FIELDS) need drive=servo; clutch damping and backlash need a clutch with a spring (a finite
-    ``clutch_stiffness``); the wheels' normal forces act only through a finite grip (``mu_wall``)."""
+    ignored), for every engine: the speed controller's (SERVO_FIELDS) need drive=servo; clutch damping and
+    backlash need a clutch with a spring (a finite ``clutch_stiffness``); the wheels' normal forces act only
+    through a finite grip (``mu_wall``)."""
     defaults = RobotParams()
     if params.drive != "servo":
         for name in SERVO_FIELDS:

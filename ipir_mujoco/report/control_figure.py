@@ -1,9 +1,10 @@
 """The control study's design-review figure (:mod:`ipir_mujoco.studies.control_study`).
 
 Four panels: (a) the crank speed's deviation from its target over one steady revolution at the fastest study
-speed, one curve per servo controller (MuJoCo; the open loop's tens of percent said in words); (b) the speed ripple per controller and variant at each speed (log
-scale); (c) the peak clutch force per controller and variant; (d) the dead-centre profile: peak clutch force
-and the electrical energy per metre against the speed target's dip, both engines. Each data line or bar group
+speed, one curve per servo controller (MuJoCo; the open loop's tens of percent said in words); (b) the speed
+ripple per controller and variant at each speed (log scale); (c) the peak clutch force per controller and
+variant (the equations'; MuJoCo's rigid ratchet's n/a); (d) the dead-centre profile: peak clutch force and the
+electrical energy per metre against the speed target's dip. Each data line or bar group
 carries a gid (``trace:CONTROLLER``, ``ripple:VARIANT``, ``force:VARIANT``, ``profile-force:VARIANT``,
 ``profile-energy:VARIANT``) so that a test can read the figure back.
 """

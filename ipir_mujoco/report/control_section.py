@@ -120,8 +120,9 @@ def write_figure(metrics: dict, path: Path) -> None:
             continue
         phi = np.degrees(np.mod(r["trace"]["phi_rad"], 2 * math.pi))
         order = np.argsort(phi)
-        ax.plot(phi[order], 100 * (np.asarray(r["trace"]["omega_rad_s"])[order] / w - 1), color=COLOURS[r["controller"]],
-                ls=STYLES[r["variant"]], lw=1.3, label=f"{r['controller']}, {LABELS[r['variant']]}")
+        deviation = 100 * (np.asarray(r["trace"]["omega_rad_s"])[order] / w - 1)
+        ax.plot(phi[order], deviation, color=COLOURS[r["controller"]], ls=STYLES[r["variant"]], lw=1.3,
+                label=f"{r['controller']}, {LABELS[r['variant']]}")
     ax.axhline(0.0, color="black", lw=0.8)
     ax.set_xlim(0, 360)
     ax.set_xticks(range(0, 361, 45))
@@ -143,7 +144,7 @@ def verdict(metrics: dict) -> dict | None:
                       f"{_ripple(metrics, 'pi+exact', EXACT)} peak to peak; with the paper's feedforward it is "
                       f"promised {_ripple(metrics, 'pi+paper', PROMISE)} and gets "
                       f"{_ripple(metrics, 'pi+paper', EXACT)} on the real linkage.",
-            "short": f"ripple {_ripple(metrics, 'pi+exact', EXACT)} (exact ff) vs {_ripple(metrics, 'pi+paper', EXACT)} "
-                     "(paper's ff)",
+            "short": f"ripple {_ripple(metrics, 'pi+exact', EXACT)} (exact ff) vs "
+                     f"{_ripple(metrics, 'pi+paper', EXACT)} (paper's ff)",
             "key": f"paper's ff promises {_ripple(metrics, 'pi+paper', PROMISE)}",
             "evidence": f"speed ripple at {w:g} rad/s, exact one-way equations"}
