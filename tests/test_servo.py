@@ -183,3 +183,10 @@ def test_a_given_timestep_longer_than_the_controller_period_is_refused():
     with pytest.raises(ParameterError, match="longer than the speed controller's period"):
         registry.run("mujoco-ratchet", RobotParams(drive="servo", control_rate=5000.0), 0.01, dt_out=1e-3,
                      timestep=5e-4)
+
+
+def test_leaving_the_servo_drive_drops_its_controller_settings():
+    servo = RobotParams(drive="servo", omega_target=12.0, feedforward="paper", speed_kp=1.0)
+    motor = servo.replace(drive="motor")
+    assert (motor.omega_target, motor.feedforward, motor.speed_kp) == (10.0, "none", None)
+    assert servo.replace(M_stall=0.6).omega_target == 12.0  # kept while the drive stays the servo

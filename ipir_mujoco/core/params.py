@@ -195,7 +195,12 @@ class RobotParams:
         return values
 
     def replace(self, **changes: Any) -> "RobotParams":
-        """A copy with some values changed (validated like a new set)."""
+        """A copy with some values changed (validated like a new set). A change of ``drive`` away from 'servo'
+        also returns the speed controller's parameters (SERVO_FIELDS) not given in ``changes`` to their
+        defaults: they belong to the servo, and another drive refuses them (:func:`refuse_idle_parameters`)."""
+        if self.drive == "servo" and changes.get("drive", "servo") != "servo":
+            for name in SERVO_FIELDS:
+                changes.setdefault(name, _FIELDS[name].default)
         return dataclasses.replace(self, **changes)
 
 

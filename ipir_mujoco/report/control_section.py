@@ -2,7 +2,8 @@
 costs a controller designed on it.
 
 The speed controller of ``drive = servo`` (:mod:`ipir_mujoco.core.control`) holds the crank at
-:data:`SPEED` rad/s (a third of the no-load speed where that is less), with the PI alone and with the
+:data:`SPEED` rad/s (a third of the no-load speed where that is less; the design's ``omega_target`` where its
+drive is the servo), with the PI alone and with the
 feedforward from the paper's first-order model and from the exact one, each run to its steady state in the
 paper's geometry (what the paper's model promises the controller), the exact one-way equations and MuJoCo:
 six runs, about two seconds. The full comparison, with the open-loop motor and a dead-centre profile, is
@@ -32,7 +33,7 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     over its last revolution), or an error."""
     from ..studies.control_study import Task, run_task
 
-    speed = min(SPEED, params.omega_noload / 3)
+    speed = params.omega_target if params.drive == "servo" else min(SPEED, params.omega_noload / 3)
     defaults = RobotParams()
     base = params.replace(drive=defaults.drive, clutch_stiffness=None, clutch_damping=0.0, clutch_backlash=0.0,
                           mu_wall=None, F_n1=defaults.F_n1, F_n2=defaults.F_n2)  # the study's: rigid clutches
