@@ -139,7 +139,7 @@ def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.
     switches, stall, h0 = 0, None, None
     while True:
         stop = t_end if speed is None else min(t_end, speed.next_tick)  # a segment ends at the next tick
-        if mode is Mode.BOTH_LOCKED and speed is not None:  # at rest until the controller's next tick
+        if mode is Mode.BOTH_LOCKED and speed is not None and constants[kernels.P_U] < 1.0:  # to the next tick
             pieces.append(with_drive_u(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, stop, grid),
                                                  lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES),
                                        constants[kernels.P_U]))
@@ -154,11 +154,13 @@ def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque at rest")
-            # Everything at rest under a torque that is constant at rest: nothing changes any more.
+            # Everything at rest under a torque that is constant at rest: nothing changes any more (the servo's
+            # too once it asks for full voltage: at rest its error is the whole target, none integrated in the clip)
             stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g != 0)
             # at rest for good: the run goes on REST_TIME at rest and ends, as every engine's does
-            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
-                                    lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES))
+            rest = raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
+                             lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES)
+            pieces.append(rest if speed is None else with_drive_u(rest, constants[kernels.P_U]))
             break
         sol = _integrate_mode(dyn, mode, t, stop, y, rtol, atol, torque, h0, constants)
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)

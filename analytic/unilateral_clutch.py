@@ -112,7 +112,7 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     t, pieces, switches, short_run, stall, h0 = 0.0, [], 0, 0, None, None
     while True:
         stop = t_end if speed is None else min(t_end, speed.next_tick)  # a segment ends at the next tick
-        if mode == Mode.BOTH_LOCKED and speed is not None:  # at rest until the controller's next tick
+        if mode == Mode.BOTH_LOCKED and speed is not None and model.u < 1.0:  # at rest until the next tick
             pieces.append(with_drive_u(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, stop, grid),
                                                  lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES),
                                        model.u))
@@ -125,11 +125,13 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque at rest")
-            # at rest, held by statics, under a torque that is constant at rest: final
+            # at rest, held by statics, under a torque that is constant at rest: final (the servo's too once it
+            # asks for full voltage: at rest its error is the whole target and it integrates none into the clip)
             stall = stall_reason(t, float(y[0]), float(model.motor(t, y[0], 0.0)), model.dyn.a_g != 0)
             # at rest for good: the run goes on REST_TIME at rest and ends, as every engine's does
-            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
-                                    lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES))
+            rest = raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
+                             lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES)
+            pieces.append(rest if speed is None else with_drive_u(rest, model.u))
             break
         events = model.events(mode)
         sol = _integrate(model, mode, events, t, stop, y, rtol, atol, h0)

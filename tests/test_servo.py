@@ -190,3 +190,14 @@ def test_leaving_the_servo_drive_drops_its_controller_settings():
     motor = servo.replace(drive="motor")
     assert (motor.omega_target, motor.feedforward, motor.speed_kp) == (10.0, "none", None)
     assert servo.replace(M_stall=0.6).omega_target == 12.0  # kept while the drive stays the servo
+
+
+def test_a_servo_that_cannot_climb_stalls_as_the_motor_does():
+    # a vertical riser under M_stall 0.3 N m: from rest the controller asks for full voltage and keeps it,
+    # so the drive is the motor line and both engines must report the motor's stall, word for word
+    riser = RobotParams(drive="servo", incline=90.0, M_stall=0.3)
+    for variant in PAIR:
+        servo = registry.run(variant, riser, 5.0, dt_out=1e-3)
+        motor = registry.run(variant, riser.replace(drive="motor"), 5.0, dt_out=1e-3)
+        assert servo.stall is not None and servo.stall == motor.stall
+        assert np.all(servo.series["drive_u"] == 1.0)

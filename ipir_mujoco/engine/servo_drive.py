@@ -73,6 +73,12 @@ class TickedDrive:
             self.done += n
             nstep -= n
 
+    def saturated_since(self, since: float) -> bool:
+        """Whether every u applied from time ``since`` [s] on was full voltage, 1: a robot at rest since then is
+        stalled for good (at rest the error is the whole target, and none is integrated into the clip)."""
+        first = np.searchsorted(np.asarray(self.log_steps), since / self.dt - 1e-9, side="right") - 1
+        return bool(np.all(np.asarray(self.log_u[max(first, 0):]) >= 1.0))
+
     def u_column(self, t: np.ndarray) -> np.ndarray:
         """u [-] over the step that ended at each sample time ``t`` (n,) [s] (at t = 0: the first tick's)."""
         steps = np.rint(np.asarray(t, dtype=float) / self.dt).astype(np.int64)

@@ -357,8 +357,9 @@ class _BlockChecks:
         self.v_adr = [rec.va[n] for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
         self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
             if run.until_steady else None
-        # a stall is final only under constant loads: not with a servo's time-varying torque
-        self.stall_watch = run.servo is None and run.params.drive != "servo"
+        # a stall is final only under constant loads: not with a crank servo's time-varying torque; the speed
+        # controller's only while it asks for full voltage (:meth:`_stall`)
+        self.stall_watch = run.servo is None
 
     def check(self, newest: int, messages: list[str]) -> int | None:
         """Returns the row to end the run at (steady state or stall), or None to go on."""
@@ -387,7 +388,7 @@ class _BlockChecks:
         v = rec.qvel[:newest + 1]
         since = rest_since(rec.t[:newest + 1], v[:, self.v_adr[0]], v[:, self.v_adr[1]], v[:, self.v_adr[2]],
                            self.run.params.r)
-        if since is None:
+        if since is None or (self.run.ticked is not None and not self.run.ticked.saturated_since(since)):
             return None
         self.run.stall = stall_reason(self.run.params, since, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
         return newest
