@@ -34,8 +34,9 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     grip the wall with at most mu_wall F_ni, and a held module may skid back).
     ``options``: ``dt_out``, ``rtol``, ``atol``, ``until_steady``, ``steady_tol``,
     ``steady_cycles``, ``progress``, ``max_switches``, ``wall_budget_s``, ``torque``
-    (see :func:`simulate_kinematic`, :func:`simulate_unilateral` and
-    :func:`simulate_compliant`).
+    (see :func:`simulate_kinematic`, :func:`simulate_unilateral` and :func:`simulate_compliant`), and with
+    ``drive = servo`` ``feedforward``, the speed controller's table (:mod:`ipir_mujoco.core.control`; the
+    rigid clutches with unlimited grip).
     """
     params = require_params(params)
     try:
@@ -48,6 +49,12 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"mu_wall={params.mu_wall!r} with clutch={clutch!r}: the paper's rule locks its "
                              "modules whatever the load; allowed: clutch='unilateral' or mu_wall=unlimited")
     refuse_idle_parameters(params)
+    if params.drive == "servo":
+        _check_servo(params, options)
+    elif options.get("feedforward") is not None:
+        raise ParameterError(f"a feedforward table with drive={params.drive!r}; allowed: drive='servo'")
+    else:
+        options.pop("feedforward", None)
     if options.get("torque") is not None:
         _check_torque(options["torque"], params)
     if params.clutch_stiffness is not None:
@@ -58,6 +65,16 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     if clutch == "unilateral":
         return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
+
+
+def _check_servo(params: RobotParams, options: dict) -> None:
+    """What the speed controller runs on, refused in one line elsewhere: rigid clutches (the paper's rule or
+    one-way) with unlimited grip, either geometry, without a torque profile (both would set the torque)."""
+    if params.clutch_stiffness is not None or params.mu_wall is not None:
+        raise ParameterError("drive='servo' runs on rigid clutches with unlimited grip in the analytic engine; "
+                             "allowed: clutch_stiffness=rigid and mu_wall=unlimited")
+    if options.get("torque") is not None:
+        raise ParameterError("a torque profile with drive='servo': one thing sets the crank's torque; allowed: one")
 
 
 def _check_torque(torque, params: RobotParams) -> None:

@@ -54,7 +54,7 @@ from ipir_mujoco.core.results import Mode
 
 from . import accel, dop853, kernels
 from .kinematics import Geometry
-from .unilateral_clutch import _REST_SPEED, _TINY, _TOL_A, _TOL_F, _TOL_V, UnilateralModel, _columns
+from .unilateral_model import _REST_SPEED, _TINY, _TOL_A, _TOL_F, _TOL_V, UnilateralModel, _columns
 
 _SKID1, _SKID2 = 4, 8  # GripMode bits: module 1 / 2 skids back
 # |K| below this fraction of r counts as a dead centre for the next-order decision (K = 0 up to roundoff

@@ -32,25 +32,28 @@ from .forces import gravity_along_pipe
 KINEMATIC, UNILATERAL = 0, 1  # COMPLIANT = 2 and GRIP = 3: see their sections below
 CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # Mode values (BOTH_LOCKED is never integrated)
 (P_M1, P_M2, P_R, P_L, P_JA, P_FR1, P_FR2, P_M, P_ROD_M, P_ROD_I, P_EXACT, P_ROD, P_MOTOR, P_MSTALL, P_WNL,
- P_AG) = range(16)
+ P_AG, P_U) = range(17)
 TINY = float(np.finfo(float).tiny)  # what a quiet guard reads at least (see unilateral_clutch.events)
 
 
 def pack(dyn: OneDofDynamics) -> np.ndarray:
-    """The constants of ``dyn`` (its parameters, geometry, rod and drive) as the kernels' float array (16,)."""
+    """The constants of ``dyn`` (its parameters, geometry, rod and drive) as the kernels' float array (17,).
+
+    P_U is the motor's voltage fraction u: 1 (full voltage) for ``drive = motor``; with ``drive = servo``
+    the run loop writes the speed controller's u there at each of its ticks (constant between them)."""
     p = dyn.params
-    motor = p.drive == "motor"
+    motor = p.drive in ("motor", "servo")
     return np.array([p.m1, p.m2, p.r, p.L, p.J_A, *dyn.resistance, p.M, p.rod_mass, p.rod_inertia_value,
                      float(dyn.geometry.value == "exact"), float(dyn.include_rod), float(motor),
-                     p.M_stall if motor else 0.0, p.omega_noload if motor else 1.0, gravity_along_pipe(p)],
+                     p.M_stall if motor else 0.0, p.omega_noload if motor else 1.0, gravity_along_pipe(p), 1.0],
                     dtype=float)
 
 
 @jit
 def drive_torque(p, omega):
-    """The drive's torque [N m] at crank speed omega (:func:`.forces.drive_torque`)."""
+    """The drive's torque [N m] at crank speed omega (:func:`.forces.drive_torque`; u = p[P_U])."""
     if p[P_MOTOR] != 0.0:
-        return p[P_MSTALL] * (1.0 - omega / p[P_WNL])
+        return p[P_MSTALL] * (p[P_U] - omega / p[P_WNL])
     return p[P_M]
 
 
@@ -223,11 +226,11 @@ def guard_table(model, mode, n_events, p, times, states, out):
 COMPLIANT = 2
 RAW, GUARDED = 0, 1
 TRACKING, FREE, ENGAGED, CLIPPED, SLIDING = 0, 1, 2, 3, 4  # .compliant_clutch.Clutch
-P_K, P_C, P_DELTA, P_S0, P_S1, P_S2, P_C1, P_C2, P_PK1, P_PK2, P_T0 = range(16, 27)
+P_K, P_C, P_DELTA, P_S0, P_S1, P_S2, P_C1, P_C2, P_PK1, P_PK2, P_T0 = range(17, 28)
 # finite grip (:mod:`.compliant_grip`): each module's grip [N] (inf: unlimited), and while its clutch's
 # anchor slides the slide's start [s] and the overlap then [m]
-P_GR1, P_GR2, P_TS1, P_DS1, P_TS2, P_DS2 = range(27, 33)
-P_EVENTS = 33  # then four numbers per event: kind, module, direction, offset
+P_GR1, P_GR2, P_TS1, P_DS1, P_TS2, P_DS2 = range(28, 34)
+P_EVENTS = 34  # then four numbers per event: kind, module, direction, offset
 EV_MARGIN, EV_VELOCITY, EV_OVERLAP, EV_TRACK, EV_PUSH, EV_PHI, EV_GRIP, EV_STICK = range(8)
 
 
@@ -344,7 +347,7 @@ def compliant_guard(guarded, k, t, y, p):
 # the one-way model's state and right-hand sides; ``p`` is :func:`pack` of the dynamics whose resistance of
 # a module skidding back is -G_i (its grip pushes it forward), then the grips and each module's state
 GRIP = 3
-P_G1, P_G2, P_DIR1, P_DIR2 = range(16, 20)  # grips [N]; per module +1 rolling forward, -1 skidding back, 0 held
+P_G1, P_G2, P_DIR1, P_DIR2 = range(17, 21)  # grips [N]; per module +1 rolling forward, -1 skidding back, 0 held
 
 
 @jit

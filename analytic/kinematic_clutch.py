@@ -40,6 +40,7 @@ from typing import Callable
 
 import numpy as np
 
+from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
@@ -51,7 +52,7 @@ from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, raw_piece,
-                             restart_step, truncate)
+                             restart_step, truncate, with_drive_u)
 
 # |S_ddot| below this fraction of r * (omega^2 + |alpha_c| + |alpha_e|) counts as
 # zero: roundoff in K near a dead centre (sin(k pi) ~ 1e-16 k) is far below it,
@@ -96,7 +97,8 @@ def choose_initial_mode(dyn: OneDofDynamics, phi: float, omega: float, M: float 
 
 
 def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.APPROX, t_end: float = 1.0, *,
-                       rtol: float = 1e-10, atol: float = 1e-12, torque: Callable | None = None, **run) -> RunResult:
+                       rtol: float = 1e-10, atol: float = 1e-12, torque: Callable | None = None,
+                       feedforward=None, **run) -> RunResult:
     """Simulate the robot with the paper's clutch rule.
 
     ``geometry`` 'approx' is the paper's model (rod ignored); 'exact' uses the
@@ -110,9 +112,14 @@ def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.
     ``steady_tol``, ``steady_cycles``, ``progress``, ``wall_budget_s``,
     ``max_switches``, default :data:`.solver_support.MAX_SWITCHES`), run by
     :class:`.solver_support.RunMonitor`. The output grid gets each mode-switch
-    instant (twice: once per mode) and each revolution's end.
+    instant (twice: once per mode) and each revolution's end. ``drive = servo``: the speed controller
+    (:class:`ipir_mujoco.core.control.SpeedController`, ``feedforward`` its table) ticks at exact times, each
+    a segment's end, its u held in the kernels' constants between ticks (the paper's rule picks the module
+    by S_dot, which a torque step does not change; at rest the mode is chosen again at each tick); the
+    series then also has ``drive_u`` and ``motor_torque``.
     """
     options = RunOptions.given(t_end, run)
+    speed = SpeedController(params, feedforward) if params.drive == "servo" else None
     rtol, atol = check_tolerances(rtol, atol)
     t_end, dt_out = options.t_end, options.dt_out
     monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
@@ -123,25 +130,51 @@ def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.
 
     t = 0.0
     y = np.array([params.phi0, params.omega0, 0.0, 0.0, 0.0])
-    mode = choose_initial_mode(dyn, params.phi0, params.omega0, _torque_at(torque, 0.0, y))
+    start_torque = _torque_at(torque, 0.0, y)
+    if speed is not None:  # the controller's tick at t = 0
+        constants[kernels.P_U] = speed.tick(params.phi0, params.omega0)
+        start_torque = float(drive_torque(params, params.omega0, constants[kernels.P_U]))
+    mode = choose_initial_mode(dyn, params.phi0, params.omega0, start_torque)
     pieces: list[dict[str, np.ndarray]] = []
     switches, stall, h0 = 0, None, None
     while True:
+        stop = t_end if speed is None else min(t_end, speed.next_tick)  # a segment ends at the next tick
+        if mode is Mode.BOTH_LOCKED and speed is not None and constants[kernels.P_U] < 1.0:  # to the next tick
+            pieces.append(with_drive_u(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, stop, grid),
+                                                 lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES),
+                                       constants[kernels.P_U]))
+            t = stop
+            if t >= t_end:
+                break
+            constants[kernels.P_U] = speed.tick(float(y[0]), float(y[1]))
+            mode = choose_initial_mode(dyn, float(y[0]), float(y[1]),
+                                       float(drive_torque(params, float(y[1]), constants[kernels.P_U])))
+            continue
         if mode is Mode.BOTH_LOCKED:
             if torque is not None:
                 raise SimulationError(f"the robot stalls at t={t:.6g} s under the given torque profile; "
                                       "restarting from a stall is modelled only for a constant torque at rest")
-            # Everything at rest under a torque that is constant at rest: nothing changes any more.
+            # Everything at rest under a torque that is constant at rest: nothing changes any more (the servo's
+            # too once it asks for full voltage: at rest its error is the whole target, none integrated in the clip)
             stall = stall_reason(t, float(y[0]), float(drive_torque(params, 0.0)), dyn.a_g != 0)
             # at rest for good: the run goes on REST_TIME at rest and ends, as every engine's does
-            pieces.append(raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
-                                    lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES))
+            rest = raw_piece(Mode.BOTH_LOCKED, monitor.samples(t, min(t + REST_TIME, t_end), grid),
+                             lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES)
+            pieces.append(rest if speed is None else with_drive_u(rest, constants[kernels.P_U]))
             break
-        sol = _integrate_mode(dyn, mode, t, t_end, y, rtol, atol, torque, h0, constants)
+        sol = _integrate_mode(dyn, mode, t, stop, y, rtol, atol, torque, h0, constants)
         t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
         piece = raw_piece(mode, monitor.samples(t, t_stop, grid, sol.t, sol.sol), sol.sol, _STATES)
+        if speed is not None:
+            piece = with_drive_u(piece, constants[kernels.P_U])
         steady_at = monitor.observe(piece)
         pieces.append(piece if steady_at is None else truncate(piece, steady_at))
+        if steady_at is None and sol.status == 0 and stop < t_end:  # the controller's tick: the mode stays
+            t, y = stop, np.array(sol.y[:, -1], dtype=float)
+            constants[kernels.P_U] = speed.tick(float(y[0]), float(y[1]))
+            monitor.check_budget(t, float(y[0]))
+            monitor.report(t)
+            continue
         if steady_at is not None or sol.status != 1:
             break
         t, y = float(sol.t_events[0][0]), sol.y_events[0][0].copy()
@@ -155,7 +188,8 @@ def simulate_kinematic(params: RobotParams, geometry: Geometry | str = Geometry.
     monitor.report(float(series["t"][-1]), final=True)
     series.update(dyn.energy_columns(series))
     add_kinetostatics(series, dyn)
-    del series["motor_torque"]  # folded into motor_power
+    if speed is None:
+        del series["motor_torque"]  # folded into motor_power (the servo's is kept beside its drive_u)
     check_finite(series)
     return RunResult(
         engine="analytic",
@@ -227,7 +261,10 @@ def _mode_columns(dyn, mode, rows, torque=None) -> dict[str, np.ndarray]:
     times, phi, omega = rows["t"], rows["phi"], rows["omega"]
     if mode is Mode.BOTH_LOCKED:
         return _stalled_columns(dyn, rows)
-    M = drive_torque(dyn.params, omega) if torque is None else torque(times, phi, omega)
+    if "drive_u" in rows:  # drive = servo: each sample's u, held between the controller's ticks
+        M = drive_torque(dyn.params, omega, rows["drive_u"])
+    else:
+        M = drive_torque(dyn.params, omega) if torque is None else torque(times, phi, omega)
     M = np.broadcast_to(M, times.shape).astype(float)
     st = dyn.state(phi, omega, mode, M)
     return {
@@ -238,7 +275,7 @@ def _mode_columns(dyn, mode, rows, torque=None) -> dict[str, np.ndarray]:
         # the paper's lock takes the whole holding force; a moving module feels -F_r
         "resistance1": np.zeros(times.shape) if mode is Mode.EXPANSION else np.full(times.shape, -dyn.params.F_r1),
         "resistance2": np.zeros(times.shape) if mode is Mode.CONTRACTION else np.full(times.shape, -dyn.params.F_r2),
-        "motor_work": rows["motor_work"], "motor_torque": M,
+        "motor_work": rows["motor_work"], "motor_torque": M, **_drive_u(rows),
     }
 
 
@@ -255,5 +292,12 @@ def _stalled_columns(dyn, rows) -> dict[str, np.ndarray]:
         "mode": rows["mode"],
         # a hold pulling a module back is its resistance's (see stalled_reactions)
         "resistance1": np.full(n, res1), "resistance2": np.full(n, res2),
-        "motor_work": rows["motor_work"], "motor_torque": np.full(n, float(drive_torque(dyn.params, 0.0))),
+        "motor_work": rows["motor_work"], **_drive_u(rows),
+        "motor_torque": (drive_torque(dyn.params, zeros, rows["drive_u"]) if "drive_u" in rows
+                         else np.full(n, float(drive_torque(dyn.params, 0.0)))),
     }
+
+
+def _drive_u(rows: dict) -> dict:
+    """The servo's ``drive_u`` column of ``rows`` where it has one (drive = servo), else nothing."""
+    return {"drive_u": rows["drive_u"]} if "drive_u" in rows else {}

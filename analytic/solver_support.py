@@ -312,6 +312,13 @@ def assemble(pieces: list[dict[str, np.ndarray]], columns) -> dict[str, np.ndarr
     return series
 
 
+def with_drive_u(piece: dict[str, np.ndarray], u: float) -> dict[str, np.ndarray]:
+    """``piece`` with the speed controller's u [-] over it (drive = servo; constant between its ticks, which
+    end segments) as the column ``drive_u``."""
+    piece["drive_u"] = np.full(np.shape(piece["t"]), float(u))
+    return piece
+
+
 def truncate(piece: dict[str, np.ndarray], t_stop: float) -> dict[str, np.ndarray]:
     """The samples of ``piece`` at or before t_stop [s]."""
     keep = piece["t"] <= t_stop

@@ -38,6 +38,7 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
 
 MOTOR = dict(drive="motor")
+SERVO_EXACT = RobotParams(drive="servo", feedforward="exact")  # the speed controller, 10 rad/s, exact feedforward
 # name: (params, geometry, clutch, t_end, options)
 ANALYTIC = {
     "paper model 1 s": (RobotParams(), "approx", "kinematic", 1.0, {}),
@@ -56,6 +57,8 @@ ANALYTIC = {
         "unilateral", 10.0, {"until_steady": True, "dt_out": 1e-3}),
     "compliant incline 25": (RobotParams(M=0.4, incline=25.0, clutch_stiffness=1e6, clutch_damping=20.0,
                                          clutch_backlash=5e-4, phi0=0.7), "exact", "unilateral", 0.5, {}),
+    "servo PI one-way 1 s": (RobotParams(drive="servo"), "exact", "unilateral", 1.0, {"dt_out": 1e-3}),
+    "servo exact ff paper rule 1 s": (SERVO_EXACT, "approx", "kinematic", 1.0, {"dt_out": 1e-3, "feedforward": True}),
 }
 # name: (params, clutch rule, implementation, t_end, options)
 MUJOCO = {
@@ -67,6 +70,7 @@ MUJOCO = {
     "mujoco compliant motor incline": (RobotParams(clutch_stiffness=1e5, clutch_damping=5.0, incline=20.0, **MOTOR),
                                        "unilateral", "ratchet", 1.0, {"dt_out": 1e-3}),
     "mujoco riser stall": (RobotParams(incline=90.0), "unilateral", "ratchet", 1.0, {"dt_out": 1e-3}),
+    "mujoco servo exact ff 1 s": (SERVO_EXACT, "unilateral", "ratchet", 1.0, {"dt_out": 1e-3, "feedforward": True}),
 }
 
 
@@ -103,6 +107,15 @@ def digest_run(run) -> str:
     return h.hexdigest()[:16]
 
 
+def _with_table(params, options: dict) -> dict:
+    """``options`` with ``feedforward: True`` replaced by the servo's table (computed as registry.run does)."""
+    if not options.get("feedforward"):
+        return options
+    from ipir_mujoco.registry import feedforward_table
+
+    return {**options, "feedforward": feedforward_table(params)}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--skip-studies", action="store_true")
@@ -113,8 +126,10 @@ def main() -> int:
     from ipir_mujoco.engine import simulate_mujoco
 
     for name, (params, geometry, clutch, t_end, options) in ANALYTIC.items():
+        options = _with_table(params, options)
         print(f"{name:45s} {digest_run(analytic.simulate(params, geometry, clutch, t_end, **options))}", flush=True)
     for name, (params, rule, implementation, t_end, options) in MUJOCO.items():
+        options = _with_table(params, options)
         print(f"{name:45s} {digest_run(simulate_mujoco(params, rule, implementation, t_end, **options))}", flush=True)
     if args.skip_studies:
         return 0

@@ -29,9 +29,12 @@ The MuJoCo engine is imported only when a MuJoCo variant runs (its import is slo
 
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
+from .core.control import FeedforwardTable
 from .core.errors import ParameterError
 from .core.params import RobotParams, check_real
 from .core.results import RunResult
@@ -203,8 +206,13 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
     ``every_step`` (sample at every step of the timestep MuJoCo chooses for ``dt_out``: where a sample holds
     its step's force, so that a mean over a window is the impulse, and no engagement peak falls between
     samples). An option the variant's engine does not take is refused in one line.
+
+    With ``params.drive = 'servo'`` the speed controller's feedforward table (:func:`feedforward_table`) is
+    computed here and handed to the engine as data (``feedforward``; give one to use another).
     """
     v = check_options(name, options)
+    if params.drive == "servo" and options.get("feedforward") is None:
+        options["feedforward"] = feedforward_table(params)
     foreign = MUJOCO_OPTIONS if not v.is_mujoco else ANALYTIC_OPTIONS  # given as None or False: not given
     options = {k: value for k, value in options.items() if value is not None and k not in foreign}
     if not v.is_mujoco:
@@ -225,6 +233,39 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
     if v.model != "slides":
         options["model"] = v.model
     return simulate_mujoco(params, v.rule, v.clutch, t_end, **options)
+
+
+FEEDFORWARD_MODELS = {"paper": "approx", "exact": "exact"}  # feedforward -> the inverse kinetostatics' geometry
+FEEDFORWARD_REVOLUTIONS = 2  # the table is the last: the modules start at rest and settle within the first
+
+
+def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
+    """The speed controller's feedforward (``params.feedforward``): the torque [N m] a crank following its speed
+    target exactly (``omega_target``, or the profile of ``speed_dip``) needs at each crank angle, by the
+    package's inverse kinetostatics with one-way clutches
+    (:func:`ipir_mujoco.analytic.inverse.inverse_kinetostatics`) on the paper's first-order geometry
+    ('paper', L >> r) or the exact slider-crank ('exact'); None for 'none'. Computed above the engines and
+    handed to each as data (the MuJoCo engine never runs the equations); cached per parameter set."""
+    if params.drive != "servo" or params.feedforward == "none":
+        return None
+    return _table(params)
+
+
+@functools.lru_cache(maxsize=64)
+def _table(params: RobotParams) -> FeedforwardTable:
+    from .analytic.inverse import CrankMotion, inverse_kinetostatics
+    from .core.control import TABLE_POINTS, reference_motion
+
+    omega, dip = params.omega_target, params.speed_dip
+    if dip == 0.0:
+        motion = CrankMotion.constant_speed(omega, params.phi0, FEEDFORWARD_REVOLUTIONS)
+    else:  # the profile through the dead centres: phi(t) sampled finely, a spline through it
+        motion = CrankMotion.from_samples(*reference_motion(omega, dip, params.phi0, FEEDFORWARD_REVOLUTIONS))
+    run = inverse_kinetostatics(params, motion, FEEDFORWARD_MODELS[params.feedforward], "unilateral",
+                                dt_out=2 * math.pi / omega / TABLE_POINTS)
+    s = run.series
+    last = s["phi"] >= params.phi0 + 2 * math.pi * (FEEDFORWARD_REVOLUTIONS - 1)
+    return FeedforwardTable.from_samples(s["phi"][last], s["motor_torque"][last], params.feedforward, omega, dip)
 
 
 def halved_settings(run: RunResult):

@@ -131,7 +131,7 @@ def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
 
 
 def test_drive_option_is_checked(capsys):
-    assert exit_code(["simulate", "--drive", "servo"]) == 2
+    assert exit_code(["simulate", "--drive", "wheel"]) == 2
 
 
 def test_dt_out_defaults_to_whole_timesteps_of_a_given_timestep(capsys):

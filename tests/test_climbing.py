@@ -220,7 +220,6 @@ def test_efficiency_counts_the_lift_as_useful(side_by_side):
             t0, t1, steady = climbing.steady_window(run)
             motor, kinetic, lifted, friction = (np.diff(np.interp([t0, t1], run.series["t"], run.series[c]))[0]
                                                 for c in ("motor_work", "kinetic", "potential", "friction_work"))
-            put_in = motor + max(-lifted, 0.0)
             bound = 1e-6 if run.engine == "analytic" else 2 * RESIDUAL_TOL * run.series["motor_work"][-1] / motor
             assert steady and abs(run.summary["efficiency"] - 1) < bound, (case, run.engine)
             if p.incline > 0:  # the resistances' share alone is far from 1 on a climb

@@ -16,7 +16,8 @@ from ipir_mujoco.analytic import ParameterError, RobotParams, load_params
 from ipir_mujoco.core.params import PARAMETER_NAMES, describe_parameters, parse_overrides, read_toml
 
 CONTRACT_NAMES = ("m1 m2 r L J_A F_r1 F_r2 M rod_mass rod_inertia phi0 omega0 drive M_stall omega_noload "
-                  "clutch_stiffness clutch_damping clutch_backlash incline g mu_wall F_n1 F_n2 pipe_diameter wheel_radius").split()
+                  "clutch_stiffness clutch_damping clutch_backlash incline g mu_wall F_n1 F_n2 pipe_diameter wheel_radius "
+                  "omega_target speed_dip feedforward control_rate speed_kp speed_ki").split()
 
 
 def test_contract_names_and_the_papers_defaults():
@@ -44,7 +45,7 @@ def test_default_rod_inertia_follows_the_rod_and_an_explicit_one_is_kept():
     ("rod_inertia", -1e-6, "0 <= rod_inertia"),
     ("omega0", 1e300, "omega0=1e+300 is out of range; allowed: -10000 <= omega0 <= 10000 rad/s"),
     ("incline", 91.0, "-90 <= incline <= 90 deg"),
-    ("drive", "servo", "drive='servo' is unknown; allowed: torque, motor"),
+    ("drive", "wheel", "drive='wheel' is unknown; allowed: torque, motor, servo"),
     ("clutch_stiffness", -1.0, "0 < clutch_stiffness <= 1e+12 N/m, or 'rigid'"),
     ("clutch_backlash", 0.03, "clutch_backlash <= r / 2 = 0.025 m"),
     ("M", math.nan, "M=nan is not finite"),

@@ -8,7 +8,7 @@ import sys
 from typing import Callable
 
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import DRIVES, RobotParams, load_params
+from ipir_mujoco.core.params import DRIVES, FEEDFORWARDS, RobotParams, load_params
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -45,15 +45,27 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
                         help="TOML file of parameters (top level or a [params] table); --set wins over it")
     parser.add_argument("--drive", choices=DRIVES, default=None,
                         help="what turns the crank: torque = the constant M (the paper's case, default); "
-                             "motor = a DC gearmotor, M_stall (1 - omega / omega_noload); wins over --set and "
-                             "the config file")
+                             "motor = a DC gearmotor, M_stall (1 - omega / omega_noload); servo = that motor under "
+                             "a speed controller holding omega_target (--set omega_target=RAD_S; docs/control.md); "
+                             "wins over --set and the config file")
+    parser.add_argument("--feedforward", choices=FEEDFORWARDS, default=None,
+                        help="--drive servo only: the torque table the speed controller adds to its PI, from "
+                             "inverse kinetostatics at omega_target: none (PI alone, default), paper (the paper's "
+                             "first-order geometry, L >> r) or exact (the exact slider-crank); wins over --set")
 
 
 def model_params(args: argparse.Namespace) -> RobotParams:
-    """The parameter set a command's options describe: defaults, --config, --set, then --drive."""
+    """The parameter set a command's options describe: defaults, --config, --set, then --drive and
+    --feedforward (refused in one line with a drive other than servo)."""
     params = load_params(args.config, args.overrides)
     if getattr(args, "drive", None) is not None:
         params = params.replace(drive=args.drive)
+    feedforward = getattr(args, "feedforward", None)
+    if feedforward is not None:
+        if params.drive != "servo":
+            raise ParameterError(f"--feedforward {feedforward} applies only to --drive servo (the drive here is "
+                                 f"{params.drive!r}); allowed: --drive servo, or leave --feedforward out")
+        params = params.replace(feedforward=feedforward)
     return params
 
 

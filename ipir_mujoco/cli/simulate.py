@@ -149,6 +149,13 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      f"{significant(s['energy_per_metre_j_m'], 5)} J/m, efficiency {significant(s['efficiency'], 5)}")
     elif until_steady:
         lines.append(f"  steady state            not reached by {run.t_end:g} s")
+    if s["mean_omega_rad_s"] is not None:
+        over = "over the steady revolutions" if s["steady"] else "over the run"
+        drive = "" if s["peak_drive_u"] is None else (f", peak torque {significant(s['peak_motor_torque_n_m'], 4)} "
+                                                      f"N m, peak |u| {significant(s['peak_drive_u'], 4)}")
+        ripple = "n/a" if s["speed_ripple"] is None else significant(s["speed_ripple"], 4)
+        lines.append(f"  crank speed {over}: mean {significant(s['mean_omega_rad_s'], 6)} rad/s, "
+                     f"ripple {ripple}{drive}")
     if run.params.grip is not None:
         use = s.get("peak_grip_use")
         lines.append(f"  wheels' grip {run.params.grip[0]:.4g} N / {run.params.grip[1]:.4g} N: skidded back "

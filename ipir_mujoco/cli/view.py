@@ -33,6 +33,8 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
+from ipir_mujoco import registry
+from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
@@ -40,6 +42,7 @@ from ..engine.clutches import clutch_controller
 from ..engine.common import check_clutch_options
 from ..engine.model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control,
                             set_closed_loop_state)
+from ..engine.servo_drive import TickedDrive
 from ..engine.stepper import loop_options, make_steps
 from ..engine.timestep import choose_settings
 from ..engine.wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
@@ -84,10 +87,19 @@ class ViewedRobot:
         else:
             set_closed_loop_state(m, d, self.params)
             self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
-        d.ctrl[m.actuator(MOTOR).id] = drive_control(self.params)
+        motor = m.actuator(MOTOR).id
+        d.ctrl[motor] = drive_control(self.params)
+        speed = None
+        if self.params.drive == "servo":  # the speed controller, its table computed as for a run
+            speed = SpeedController(self.params, registry.feedforward_table(self.params))
+            crank = m.joint(CRANK_HINGE)
+            d.ctrl[motor] = speed.tick(float(d.qpos[crank.qposadr[0]]), float(d.qvel[crank.dofadr[0]]))
         mujoco.mj_forward(m, d)
         options = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
         self.steps = make_steps(m, d, self.controller, self._qvel_before, **options)
+        if speed is not None:
+            TickedDrive(self.steps, speed, d, motor=motor, crank_q=options["crank_q"], crank_v=options["crank_v"],
+                        dt=m.opt.timestep)
         self.held: tuple[bool, bool] | None = None
         self._colour()
 

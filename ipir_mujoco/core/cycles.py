@@ -345,6 +345,26 @@ def limit_motion(last: list[Cycle]) -> tuple[float, float]:
     return sum(distances) / time, sum(distances) / len(last)
 
 
+def speed_figures(series: dict[str, np.ndarray], t0: float, t1: float) -> dict:
+    """The crank-speed and drive figures over the times t0..t1 [s] of a run (the steady window, or the whole
+    run): ``mean_omega_rad_s`` (the crank's turn over the stretch divided by its time), ``speed_ripple``
+    (the samples' peak-to-peak crank speed over that mean [-]; None unless the mean is > 0),
+    ``peak_motor_torque_n_m`` (largest |motor_torque|, None without that column) and ``peak_drive_u``
+    (largest |drive_u|, the servo's voltage fraction; None without it). Samples on the stretch's ends count;
+    a series without ``omega`` has no ripple (None)."""
+    t = np.asarray(series["t"], dtype=float)
+    inside = (t >= t0) & (t <= t1)
+    phi = _at(t, series["phi"], np.array([t0, t1]))
+    mean = float(phi[1] - phi[0]) / (t1 - t0) if t1 > t0 else None
+    omega = np.asarray(series["omega"], dtype=float)[inside] if "omega" in series else np.zeros(0)
+    out = {"mean_omega_rad_s": mean,
+           "speed_ripple": float(omega.max() - omega.min()) / mean if mean and mean > 0 and omega.size else None}
+    for key, column in (("peak_motor_torque_n_m", "motor_torque"), ("peak_drive_u", "drive_u")):
+        values = np.asarray(series[column], dtype=float)[inside] if column in series else np.zeros(0)
+        out[key] = float(np.abs(values).max()) if values.size else None
+    return out
+
+
 def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> dict:
     """The summary's per-revolution keys.
 
@@ -355,7 +375,8 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     :func:`transit_free_energy`; the peak over the steady window) when steady,
     else over the whole run (None where the run lacks the columns); ``cycles``: whole
     revolutions; ``cycle_energy_residual_j``: the largest |audit residual| of a
-    revolution (None without energy columns).
+    revolution (None without energy columns); the crank-speed figures of :func:`speed_figures` over the
+    steady window when steady, else over the whole run.
     """
     found = cycles(series)
     k = steady_index([c.mean_speed_m_s for c in found], tol, n)
@@ -371,6 +392,7 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
         out["energy_per_metre_j_m"], out["efficiency"] = energy["energy_per_metre"], energy["efficiency"]
         peaks = [c.peak_clutch_force_n for c in window if c.peak_clutch_force_n is not None]
         out["peak_clutch_force_n"] = max(peaks) if peaks else None
+        out.update(speed_figures(series, window[0].t_start, window[-1].t_end))
         return out
     revolutions = float((series["phi"][-1] - series["phi"][0]) / (2 * math.pi))
     moved = float(travel(series)[-1] - travel(series)[0])
@@ -379,4 +401,5 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     out["efficiency"] = _stretch_efficiency(series, float(t[0]), float(t[-1]))
     lambdas = [series[c] for c in ("lambda1", "lambda2") if c in series]
     out["peak_clutch_force_n"] = float(max(v.max() for v in lambdas)) if lambdas else None
+    out.update(speed_figures(series, float(t[0]), float(t[-1])))
     return out

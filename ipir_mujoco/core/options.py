@@ -66,8 +66,8 @@ def refuse_steady_without_motor(drive: str, until_steady: bool) -> None:
     speeds up for ever or comes to rest): refused in one line, with what has a steady state."""
     if until_steady and drive == "torque":
         raise ParameterError("until_steady with drive=torque: a constant torque has no periodic steady state (the "
-                             "crank speeds up for ever, or comes to rest); allowed: drive=motor (--drive motor), or "
-                             "a run of fixed length without until_steady")
+                             "crank speeds up for ever, or comes to rest); allowed: drive=motor or servo (--drive "
+                             "motor), or a run of fixed length without until_steady")
 
 
 @dataclass(frozen=True)

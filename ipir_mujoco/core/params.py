@@ -20,19 +20,21 @@ Build one from defaults, a TOML file and ``NAME=VALUE`` overrides with
 from __future__ import annotations
 
 import dataclasses
-import decimal
 import functools
 import math
-import numbers
 import os
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from .checks import as_real, check_real, check_whole  # noqa: F401  (re-exported: their home was here)
 from .errors import ParameterError
+from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401  (re-exported)
 
-DRIVES = ("torque", "motor")
+DRIVES = ("torque", "motor", "servo")
+FEEDFORWARDS = ("none", "paper", "exact")  # drive = servo: the feedforward table's model (core/control.py)
+# the speed controller's parameters: they act only with drive=servo
+SERVO_FIELDS = ("omega_target", "speed_dip", "feedforward", "control_rate", "speed_kp", "speed_ki")
 
 
 def _number(units: str, text: str, default: float, low: float, high: float, *, low_open: bool = False,
@@ -78,9 +80,12 @@ class RobotParams:
                           -1e4, 1e4)
     omega0: float = _number("rad/s", "initial crank speed", 0.0, -1e4, 1e4)
     drive: str = _choice("what turns the crank: 'torque' = the constant M; 'motor' = a DC gearmotor, "
-                         "torque M_stall (1 - omega / omega_noload)", "torque", DRIVES)
-    M_stall: float = _number("N m", "motor stall torque at the crank (drive = motor)", 0.5, 0.0, 1e6, low_open=True)
-    omega_noload: float = _number("rad/s", "motor no-load crank speed (drive = motor)", 30.0, 0.0, 1e5,
+                         "torque M_stall (1 - omega / omega_noload); 'servo' = that motor at a voltage fraction u "
+                         "in [-1, 1] set by a speed controller, torque M_stall (u - omega / omega_noload)",
+                         "torque", DRIVES)
+    M_stall: float = _number("N m", "motor stall torque at the crank (drive = motor or servo)", 0.5, 0.0, 1e6,
+                             low_open=True)
+    omega_noload: float = _number("rad/s", "motor no-load crank speed (drive = motor or servo)", 30.0, 0.0, 1e5,
                                   low_open=True)
     clutch_stiffness: float | None = _number("N/m", "stiffness of each one-way clutch once engaged", None, 0.0,
                                              1e12, low_open=True, none_word="rigid",
@@ -105,6 +110,24 @@ class RobotParams:
                                    low_open=True)
     wheel_radius: float = _number("m", "radius of the wheeled MuJoCo model's wheels (below pipe_diameter / 4)", 0.015,
                                   0.0, 1.0, low_open=True)
+
+    omega_target: float = _number("rad/s", "crank speed the speed controller holds (drive = servo; below "
+                                  "omega_noload)", 10.0, 0.0, 1e5, low_open=True)
+    speed_dip: float = _number("-", "drive = servo: how far the speed target dips through the dead centres, where "
+                               "the modules hand over: omega_ref = omega_0 (1 - speed_dip cos 2 phi), omega_0 = "
+                               "omega_target / sqrt(1 - speed_dip^2), so the mean crank speed stays omega_target "
+                               "(0: constant speed)", 0.0, 0.0, 0.9)
+    feedforward: str = _choice("drive = servo: the torque table added to the PI controller, from inverse "
+                               "kinetostatics at omega_target: 'none' (PI alone), 'paper' (the paper's first-order "
+                               "geometry, L >> r), 'exact' (the exact slider-crank)", "none", FEEDFORWARDS)
+    control_rate: float = _number("Hz", "rate of the speed controller's ticks; u is held between them (drive = "
+                                  "servo)", 1000.0, 0.0, 1e5, low_open=True)
+    speed_kp: float | None = _number("s/rad", "speed controller's proportional gain, u per rad/s of speed error "
+                                     "(drive = servo)", None, 0.0, 1e4, none_word="model",
+                                     none_text="derived from the model, docs/control.md")
+    speed_ki: float | None = _number("1/rad", "speed controller's integral gain, u per rad of integrated speed "
+                                     "error (drive = servo)", None, 0.0, 1e8, none_word="model",
+                                     none_text="derived from the model, docs/control.md")
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -134,6 +157,17 @@ class RobotParams:
                     raise ParameterError(
                         f"{name}={getattr(self, name)!r} N with mu_wall={self.mu_wall!r}: a finite grip needs the "
                         f"wheels pressed on; allowed: 0 < {name} <= 1e+06 N, or mu_wall=unlimited")
+        if self.drive == "servo" and not self.omega_target < self.omega_noload:
+            raise ParameterError(
+                f"omega_target={self.omega_target:g} rad/s is out of range; allowed: 0 < omega_target < "
+                f"omega_noload = {self.omega_noload:g} rad/s (at full voltage the motor turns the crank no faster)")
+        if self.drive == "servo" and self.speed_dip > 0:
+            fastest = self.omega_target * math.sqrt((1 + self.speed_dip) / (1 - self.speed_dip))
+            if not fastest < self.omega_noload:
+                raise ParameterError(
+                    f"speed_dip={self.speed_dip:g} with omega_target={self.omega_target:g} rad/s is out of range: "
+                    f"the target's fastest, mid-stroke, is {fastest:.4g} rad/s; allowed: below omega_noload = "
+                    f"{self.omega_noload:g} rad/s (a smaller speed_dip or omega_target)")
         if not self.clutch_backlash <= 0.5 * self.r:
             raise ParameterError(
                 f"clutch_backlash={self.clutch_backlash} m is out of range; allowed: 0 <= clutch_backlash <= "
@@ -166,7 +200,12 @@ class RobotParams:
         return values
 
     def replace(self, **changes: Any) -> "RobotParams":
-        """A copy with some values changed (validated like a new set)."""
+        """A copy with some values changed (validated like a new set). A change of ``drive`` away from 'servo'
+        also returns the speed controller's parameters (SERVO_FIELDS) not given in ``changes`` to their
+        defaults: they belong to the servo, and another drive refuses them (:func:`refuse_idle_parameters`)."""
+        if self.drive == "servo" and changes.get("drive", "servo") != "servo":
+            for name in SERVO_FIELDS:
+                changes.setdefault(name, _FIELDS[name].default)
         return dataclasses.replace(self, **changes)
 
 
@@ -190,22 +229,6 @@ PARAMETER_NAMES: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(Robo
 _FIELDS = {f.name: f for f in dataclasses.fields(RobotParams)}
 
 
-def as_real(value: Any) -> float | None:
-    """``value`` as a float if it is a real number of any numeric type (int, float, numpy scalar or
-    0-d array, Fraction, Decimal); None otherwise (bool, complex, strings, containers)."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, (numbers.Real, decimal.Decimal)):
-        try:
-            return float(value)
-        except (OverflowError, ValueError):
-            return math.inf
-    shape, kind = getattr(value, "shape", None), getattr(getattr(value, "dtype", None), "kind", None)
-    if shape == () and kind in ("i", "u", "f"):  # a 0-d numpy array
-        return float(value)
-    return None
-
-
 def _inside(x: float, meta: Mapping[str, Any]) -> bool:
     low_ok = x > meta["low"] if meta["low_open"] else x >= meta["low"]
     high_ok = x < meta["high"] if meta["high_open"] else x <= meta["high"]
@@ -222,6 +245,8 @@ def allowed_text(name: str) -> str:
     text = f"{low}{name}{high}" + (f" {meta['units']}" if meta["units"] != "-" else "")  # no unit: a ratio
     if name == "L":
         text += ", and L > r"
+    if name == "omega_target":
+        text = f"0 < omega_target < omega_noload {meta['units']}"
     if name == "clutch_backlash":
         text = f"0 <= clutch_backlash <= r / 2 {meta['units']}"
     if name in ("F_n1", "F_n2"):
@@ -293,50 +318,6 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     return values
 
 
-MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far past any real one, and a bound
-# on what /dev/zero or a mistyped multi-GB file would make the command read into memory
-
-
-def read_text_file(path: str | Path, what: str) -> str:
-    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
-    for a device or pipe, /dev/zero, and a file past MAX_TEXT_BYTES)."""
-    path = Path(path)
-    try:
-        if path.exists() and not path.is_dir() and not path.is_file():
-            raise ParameterError(f"{what} {str(path)!r} is not a regular file (a device or pipe); give a file")
-        with path.open("rb") as handle:
-            data = handle.read(MAX_TEXT_BYTES + 1)
-        if len(data) > MAX_TEXT_BYTES:
-            raise ParameterError(f"{what} {str(path)!r} is larger than {MAX_TEXT_BYTES / 1e6:g} MB; allowed: a "
-                                 "text file of at most that size")
-        return data.decode("utf-8")
-    except FileNotFoundError:
-        raise ParameterError(f"{what} {str(path)!r} does not exist") from None
-    except IsADirectoryError:
-        raise ParameterError(f"{what} {str(path)!r} is a folder; give a file") from None
-    except UnicodeDecodeError as exc:
-        raise ParameterError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}); "
-                             "save it as UTF-8") from None
-    except OSError as exc:
-        raise ParameterError(f"{what} {str(path)!r} cannot be read: {exc.strerror}") from None
-
-
-def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
-    """A TOML file as a dict, or a ParameterError naming the file and the problem in one line."""
-    text = read_text_file(path, what)
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
-    except ValueError as exc:  # an integer past Python's 4300-digit conversion limit
-        why = "an integer of more than 4300 digits" if "digits" in str(exc) else " ".join(str(exc).split())[:120]
-        raise ParameterError(f"{what} {str(path)!r} holds a value that cannot be read ({why}); allowed: numbers "
-                             "within the ranges 'ipir-mujoco params' lists") from None
-    except RecursionError:  # arrays or tables nested thousands deep
-        raise ParameterError(f"{what} {str(path)!r} nests arrays or tables too deep to read; allowed: the flat "
-                             "tables of a config or study file (docs/cli.md)") from None
-
-
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read parameter values from a TOML file.
 
@@ -382,42 +363,7 @@ def load_params(
 
 
 # ----------------------------------------------------------------------------------------------------
-# Value checks shared by the run options (:mod:`.options`), the study files and the Python API
-
-def check_real(name: str, value: Any, *, low: float = 0.0, high: float = math.inf, low_open: bool = True,
-               unit: str = "") -> float:
-    """``value`` as a float if it is a finite real number (any numeric type) inside the interval; else a
-    ParameterError naming ``name``, the value and the allowed range."""
-    unit_text = f" {unit}" if unit else ""
-    low_text = f"{low:g} {'<' if low_open else '<='} {name}"
-    allowed = low_text + (f" <= {high:g}{unit_text}" if math.isfinite(high) else unit_text)
-    number = as_real(value)
-    if number is None:
-        raise ParameterError(f"{name}={value!r} is not a number; allowed: {allowed}")
-    if not math.isfinite(number) or not (number > low if low_open else number >= low) or number > high:
-        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
-    return number
-
-
-def _shown(value: Any) -> str:
-    """A number as the message shows it: 1e+09 rather than 1000000000.0; -1.0 and 0.25 as written."""
-    if isinstance(value, float) and math.isfinite(value) and value != 0 and not 1e-4 <= abs(value) < 1e6:
-        return f"{value:g}"
-    return repr(value)
-
-
-def check_whole(name: str, value: Any, *, low: int = 0, high: int | None = None, why: str = "") -> int:
-    """``value`` as an int if it is a whole number (int, numpy integer, or an integral float) in
-    [low, high]; else a ParameterError naming it. ``why`` explains the upper limit."""
-    allowed = f"a whole number >= {low}" + (f" and <= {high}{why}" if high is not None else "")
-    number = as_real(value)
-    if number is None or not math.isfinite(number) or number != int(number):
-        raise ParameterError(f"{name}={value!r} is not a whole number; allowed: {allowed}")
-    whole = int(number)
-    if whole < low or (high is not None and whole > high):
-        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
-    return whole
-
+# Parameters that act only through another one (the numeric checks are in :mod:`.checks`)
 
 # (parameter, the parameters that act only through it when it is not None, what they need, its value that
 # leaves them idle, the unit the message gives them): refused together (refuse_idle_parameters)
@@ -431,9 +377,17 @@ _ACTS_THROUGH = (
 
 def refuse_idle_parameters(params: RobotParams) -> None:
     """Parameters that act only through another one, given without it, refused in one line (never silently
-    ignored), for every engine: clutch damping and backlash need a clutch with a spring (a finite
-    ``clutch_stiffness``); the wheels' normal forces act only through a finite grip (``mu_wall``)."""
+    ignored), for every engine: the speed controller's (SERVO_FIELDS) need drive=servo; clutch damping and
+    backlash need a clutch with a spring (a finite ``clutch_stiffness``); the wheels' normal forces act only
+    through a finite grip (``mu_wall``)."""
     defaults = RobotParams()
+    if params.drive != "servo":
+        for name in SERVO_FIELDS:
+            value, default = getattr(params, name), getattr(defaults, name)
+            if value != default:
+                shown = "model" if value is None else value
+                raise ParameterError(f"{name}={shown!r} sets the speed controller, which only drive=servo has; "
+                                     f"allowed: drive=servo, or leave {name} out (drive={params.drive!r})")
     for through, names, needs, idle, unit in _ACTS_THROUGH:
         if getattr(params, through) is not None:
             continue

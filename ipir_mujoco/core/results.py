@@ -88,7 +88,7 @@ SERIES_UNITS: dict[str, str] = {
     "clutch_damper_work": "J", "skid_work": "J", "motor_torque": "N m", "motor_power": "W", "rod_force": "N",
     "crank_pin_force": "N", "resistance1": "N", "resistance2": "N", "clutch_overlap1": "m", "clutch_overlap2": "m",
     "slip1": "m", "slip2": "m", "grip_use1": "-", "grip_use2": "-", "wheels1": "-", "wheels2": "-",
-    "loop_gap": "m", "momentum": "kg m/s",
+    "loop_gap": "m", "momentum": "kg m/s", "drive_u": "-",
 }
 
 

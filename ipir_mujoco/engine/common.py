@@ -1,7 +1,8 @@
 """What serial and batched MuJoCo runs (and the viewer) share: the clutch check, warnings, the crank servo, stalls.
 
 Stall: under a constant torque or the motor (loads that do not change with
-time), a robot whose crank pin and modules have all been slower than
+time; the speed controller's motor once it asks for full voltage, u = 1, which
+at rest it keeps), a robot whose crank pin and modules have all been slower than
 REST_SPEED for REST_TIME is in a static equilibrium it will not leave; the run
 ends there (REST_TIME after the rest began, as every engine's run does), with a
 one-line reason (:func:`stall_reason`), not an error.
@@ -128,7 +129,7 @@ def stall_reason(params: RobotParams, since: float, phi: float) -> str:
     """The one-line RunResult.stall (core.results.stall_reason: the same words as every engine's) of a robot
     at rest from ``since`` [s] with the crank at ``phi`` [rad]; the drive's torque at rest is its actuator's
     at zero speed (M, or the motor's M_stall)."""
-    torque = params.M_stall if params.drive == "motor" else params.M
+    torque = params.M_stall if params.drive in ("motor", "servo") else params.M  # the servo stalls at u = 1
     return core_stall_reason(since, phi, torque, params.incline != 0 and params.g != 0)
 
 

@@ -200,8 +200,9 @@ def _write_drive(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
     ctrl = M. ``drive='motor'``: gain M_stall, bias -(M_stall / omega_noload) omega,
     ctrl = 1 (full voltage), so the torque is M_stall (1 - omega / omega_noload) on
     both sides of the no-load speed, computed by MuJoCo itself every step (and
-    integrated implicitly in omega by the implicit integrators). See
-    :func:`drive_control` for the ctrl value.
+    integrated implicitly in omega by the implicit integrators). ``drive='servo'``: the
+    same motor, ctrl = u in [-1, 1] written by the speed controller at its ticks
+    (:mod:`.servo_drive`). See :func:`drive_control` for the ctrl value.
     """
     act = _element(spec.actuator, MOTOR, hint)
     act.gear[0] = 1.0
@@ -210,7 +211,7 @@ def _write_drive(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
     act.dyntype = mujoco.mjtDyn.mjDYN_NONE
     act.gainprm[:] = 0.0
     act.biasprm[:] = 0.0
-    if params.drive == "motor":
+    if params.drive in ("motor", "servo"):
         act.gainprm[0] = params.M_stall
         act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
         act.biasprm[2] = -params.M_stall / params.omega_noload
@@ -240,7 +241,10 @@ def drive_torque_slope(model: mujoco.MjModel) -> float:
 
 
 def drive_control(params: RobotParams) -> float:
-    """The ctrl value of the crank actuator: M [N m] for a constant torque, 1 (full voltage) for the motor."""
+    """The ctrl value of the crank actuator: M [N m] for a constant torque, 1 (full voltage) for the motor;
+    for the servo 0 until its controller's first tick sets u (:mod:`.servo_drive`)."""
+    if params.drive == "servo":
+        return 0.0
     return 1.0 if params.drive == "motor" else params.M
 
 

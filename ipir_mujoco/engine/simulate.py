@@ -49,7 +49,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
-from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
 from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
@@ -59,8 +59,10 @@ from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captu
                      climb_energy, monotone, mujoco_failure, rest_since, stall_reason, steps_per_output)
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
-from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
+from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
+                      rising as _rising)
 from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
+from .servo_drive import TickedDrive, controller_for
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 from .wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
@@ -93,6 +95,7 @@ def simulate_mujoco(
     steady_cycles: int = STEADY_CYCLES,
     wall_budget_s: float | None = None,
     model: str = "slides",
+    feedforward=None,
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -111,7 +114,9 @@ def simulate_mujoco(
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
-    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``model``: 'slides' or 'wheels'
+    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
+    ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
+    required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`). ``model``: 'slides' or 'wheels'
     (on wheels in a pipe, a ratchet in every hub, stepped in Python: :mod:`.wheels_model`, :mod:`.wheels`).
     """
     params = require_params(params)
@@ -120,16 +125,23 @@ def simulate_mujoco(
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
     check_mujoco_model(model, params, implementation)
     check_clutch_options(params, clutch, implementation)
+    controller_for(params, feedforward)  # refused here, before any work, if the table does not fit
+    if servo is not None and params.drive == "servo":
+        raise ParameterError("a crank servo with drive='servo': one thing sets the crank's actuator; allowed: one")
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
     t_end, dt_out = run.t_end, run.dt_out
     if settings is not None:  # bounded up front: a tiny given timestep is refused, not run for days
         check_step_count(t_end, settings.timestep)
+        if params.drive == "servo" and settings.timestep * params.control_rate > 1 + 1e-9:
+            raise ParameterError(f"timestep={settings.timestep:g} s is longer than the speed controller's period "
+                                 f"1 / control_rate = {1 / params.control_rate:g} s; allowed: a timestep of at most "
+                                 "that (or none: the engine then chooses one)")
 
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
-                   wheeled=model == "wheels")
+                   wheeled=model == "wheels", feedforward=feedforward)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
@@ -153,7 +165,8 @@ class _Run:
     """One MuJoCo run with fixed settings (the loop is in :meth:`_integrate`)."""
 
     def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
-                 until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, started=None):
+                 until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, feedforward=None,
+                 started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
         self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
@@ -171,6 +184,8 @@ class _Run:
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
         self.recorder: Recorder | None = None  # made by _setup
+        self.speed = controller_for(params, feedforward)  # drive = servo: this attempt's own controller
+        self.ticked: TickedDrive | None = None
 
     def result(self, extra_settings: dict) -> RunResult:
         with captured_warnings() as messages:
@@ -182,6 +197,8 @@ class _Run:
                 raise SimulationError(mujoco_failure(t, str(exc))) from None
         rec = self.recorder
         series = rec.series(last)
+        if self.ticked is not None:
+            series["drive_u"] = self.ticked.u_column(series["t"])
         wm, wf = series["motor_work"][-1], series["friction_work"][-1]
         kinetic = series["kinetic"][-1] - series["kinetic"][0]
         potential = series["potential"][-1]
@@ -218,6 +235,8 @@ class _Run:
         motor, crank = m.actuator(MOTOR).id, m.joint(CRANK_HINGE)
         d.ctrl[motor] = drive_control(p) if self.servo is None else self.servo.torque(
             0.0, d.qpos[crank.qposadr[0]], d.qvel[crank.dofadr[0]])
+        if self.speed is not None:  # the speed controller's tick at t = 0
+            d.ctrl[motor] = self.speed.tick(float(d.qpos[crank.qposadr[0]]), float(d.qvel[crank.dofadr[0]]))
         mujoco.mj_forward(m, d)
         self.loop = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
@@ -246,6 +265,9 @@ class _Run:
         self._check(messages, 0.0)
 
         steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, servo=self.servo, **self.loop)
+        if self.speed is not None:
+            self.ticked = TickedDrive(steps, self.speed, d, motor=self.loop["motor"], crank_q=self.loop["crank_q"],
+                                      crank_v=self.loop["crank_v"], dt=m.opt.timestep)
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
         checks = _BlockChecks(self)
@@ -280,7 +302,7 @@ class _Run:
         judged row i - 1 (residual ratio, then loop gap), then raised the energy floor to sample i's torque and
         reported its excursion; if MuJoCo warned in the interval after the last new sample (``warned``: it was
         not recorded, but it judged that sample), the run fails with the last good time. Of each figure only the
-        values that leave the monitor as feeding every one would are fed (:func:`_rising`: its first crossing
+        values that leave the monitor as feeding every one would are fed (:func:`.monitor.rising`: its first crossing
         of the tolerance and the block's worst), so a block costs a few array operations."""
         rec, mon = self.recorder, self.monitor
         tol = mon.tolerances
@@ -335,25 +357,6 @@ class _Run:
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
 
 
-def _rising(values: np.ndarray, worst: float, tolerance: float, offset: int) -> list[int]:
-    """Rows (index + ``offset``) of ``values`` the monitor must be fed to end as if fed each in turn (each
-    that beats the worst so far, starting from ``worst``): the first fed one beyond ``tolerance`` (it is
-    the first beyond both, and the one that stops a run or is recorded as its crossing), and the first of
-    the largest, if it beats ``worst`` (NaN never does). Every other value would only be overtaken."""
-    size = np.abs(values)
-    largest = np.fmax.reduce(size)
-    if not largest > abs(worst):  # the common case once a run is under way: nothing to feed
-        return []
-    rows = []
-    threshold = max(abs(worst), tolerance)
-    if largest > threshold:
-        rows.append(int(np.argmax(size > threshold)))
-    top = int(np.argmax(size == largest))
-    if not rows or top != rows[0]:
-        rows.append(top)
-    return [row + offset for row in rows]
-
-
 class _BlockChecks:
     """What the run checks every BLOCK_TIME of simulated time: progress, budget, steady state, stall."""
 
@@ -366,7 +369,8 @@ class _BlockChecks:
         self.v_adr = [rec.va[n] for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
         self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
             if run.until_steady else None
-        # a stall is final only under constant loads: not with a servo's time-varying torque
+        # a stall is final only under constant loads: not with a crank servo's time-varying torque; the speed
+        # controller's only while it asks for full voltage (:meth:`_stall`)
         self.stall_watch = run.servo is None
 
     def check(self, newest: int, messages: list[str]) -> int | None:
@@ -396,7 +400,7 @@ class _BlockChecks:
         v = rec.qvel[:newest + 1]
         since = rest_since(rec.t[:newest + 1], v[:, self.v_adr[0]], v[:, self.v_adr[1]], v[:, self.v_adr[2]],
                            self.run.params.r)
-        if since is None:
+        if since is None or (self.run.ticked is not None and not self.run.ticked.saturated_since(since)):
             return None
         self.run.stall = stall_reason(self.run.params, since, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
         return newest

@@ -24,6 +24,8 @@ interval. Further limits:
   sqrt(LEAK_RATIO / ratio);
 - a crank servo: 0.2 / max(sqrt(kp / J_A), kv / J_A), a tenth of the explicit
   stability limit of its stiffness and damping;
+- the speed controller (drive = servo): dt <= 1 / control_rate, at least one
+  step per tick (ticks then fall on steps where the step divides the period);
 - compliant clutches: MuJoCo steps a spring explicitly, so its period must be
   resolved: dt <= CLUTCH_SHARE / omega_c with omega_c = sqrt(k / min(m1, m2)),
   an upper bound of every clutch frequency (the robot's kinetic energy is at
@@ -93,7 +95,7 @@ def crank_bounds(params: RobotParams, t_end: float) -> tuple[float, float]:
     mass = p.m1 + p.m2 + p.rod_mass
     j_start = p.J_A + mass * lever**2 + p.rod_inertia_value * rod_turn**2
     omega_start = abs(p.omega0) * math.sqrt(j_start / p.J_A)
-    if p.drive == "motor":
+    if p.drive in ("motor", "servo"):  # the servo's torque stays in the motor's band (|u| <= 1)
         omega_b = max(p.omega_noload, omega_start)
         return omega_b, omega_b * t_end / (2 * math.pi)
     omega_b = omega_start + abs(p.M) * t_end / p.J_A
@@ -141,6 +143,8 @@ def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None
     if servo is not None:
         rate = max(math.sqrt(servo.kp / params.J_A), servo.kv / params.J_A)
         limits["servo_s"] = SERVO_SHARE / rate
+    if params.drive == "servo":
+        limits["control_s"] = 1.0 / params.control_rate
     if params.clutch_stiffness is not None:
         limits["clutch_s"] = CLUTCH_SHARE / clutch_rate(params)
     needed = min(limits.values())

@@ -19,7 +19,7 @@ from typing import Callable
 
 from ipir_mujoco.core.params import RobotParams
 
-from . import clutch_section, cruise_section, grip_section, riser_section
+from . import clutch_section, control_section, cruise_section, grip_section, riser_section
 
 Progress = Callable[[str], None]
 
@@ -39,4 +39,6 @@ SECTIONS: tuple[Section, ...] = (
     Section("cruise", "Under a real motor", cruise_section.compute, cruise_section.render, cruise_section.verdict),
     Section("vertical_riser", "Vertical riser", riser_section.compute, riser_section.render, riser_section.verdict),
     Section("finite_grip", "Finite grip", grip_section.compute, grip_section.render, grip_section.verdict),
+    Section("speed_control", "Speed control", control_section.compute, control_section.render,
+            control_section.verdict),
 )

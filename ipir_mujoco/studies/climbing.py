@@ -329,6 +329,10 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
     (motor only; empty for a constant torque), "traction": :func:`.traction.traction_study` (finite grip:
     the wheels' limits; unlimited: a note), "rows": :func:`incline_curve`, "engines", "wall_s"}.
     """
+    if params.drive == "servo":  # its torque at rest depends on the controller's history: no restart limit
+        raise ParameterError("drive='servo' in climb: the study's restart limit and steady climb are the constant "
+                             "torque's and the motor's (a fixed torque at rest); allowed: --drive torque or motor "
+                             "(the servo's climb: simulate --drive servo --set incline=DEG)")
     started = time.perf_counter()
     t_end = default_t_end(params) if t_end is None else t_end
     for engine in engines:

@@ -1,0 +1,63 @@
+"""Checks of single values shared by the parameter set (:mod:`.params`), the run options (:mod:`.options`),
+the study files and the Python API: is it a real number, inside an interval, a whole number. Each refuses
+bad input with a :class:`ParameterError` naming the value and the allowed range in one line."""
+
+from __future__ import annotations
+
+import decimal
+import math
+import numbers
+from typing import Any
+
+from .errors import ParameterError
+
+
+def as_real(value: Any) -> float | None:
+    """``value`` as a float if it is a real number of any numeric type (int, float, numpy scalar or
+    0-d array, Fraction, Decimal); None otherwise (bool, complex, strings, containers)."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (numbers.Real, decimal.Decimal)):
+        try:
+            return float(value)
+        except (OverflowError, ValueError):
+            return math.inf
+    shape, kind = getattr(value, "shape", None), getattr(getattr(value, "dtype", None), "kind", None)
+    if shape == () and kind in ("i", "u", "f"):  # a 0-d numpy array
+        return float(value)
+    return None
+
+
+def check_real(name: str, value: Any, *, low: float = 0.0, high: float = math.inf, low_open: bool = True,
+               unit: str = "") -> float:
+    """``value`` as a float if it is a finite real number (any numeric type) inside the interval; else a
+    ParameterError naming ``name``, the value and the allowed range."""
+    unit_text = f" {unit}" if unit else ""
+    low_text = f"{low:g} {'<' if low_open else '<='} {name}"
+    allowed = low_text + (f" <= {high:g}{unit_text}" if math.isfinite(high) else unit_text)
+    number = as_real(value)
+    if number is None:
+        raise ParameterError(f"{name}={value!r} is not a number; allowed: {allowed}")
+    if not math.isfinite(number) or not (number > low if low_open else number >= low) or number > high:
+        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
+    return number
+
+
+def _shown(value: Any) -> str:
+    """A number as the message shows it: 1e+09 rather than 1000000000.0; -1.0 and 0.25 as written."""
+    if isinstance(value, float) and math.isfinite(value) and value != 0 and not 1e-4 <= abs(value) < 1e6:
+        return f"{value:g}"
+    return repr(value)
+
+
+def check_whole(name: str, value: Any, *, low: int = 0, high: int | None = None, why: str = "") -> int:
+    """``value`` as an int if it is a whole number (int, numpy integer, or an integral float) in
+    [low, high]; else a ParameterError naming it. ``why`` explains the upper limit."""
+    allowed = f"a whole number >= {low}" + (f" and <= {high}{why}" if high is not None else "")
+    number = as_real(value)
+    if number is None or not math.isfinite(number) or number != int(number):
+        raise ParameterError(f"{name}={value!r} is not a whole number; allowed: {allowed}")
+    whole = int(number)
+    if whole < low or (high is not None and whole > high):
+        raise ParameterError(f"{name}={_shown(value)} is out of range; allowed: {allowed}")
+    return whole

@@ -1,0 +1,53 @@
+"""Reading the text and TOML files users give (configs, study files, samples): one line saying why a file
+cannot be read, never a traceback."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from .errors import ParameterError
+
+MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far past any real one, and a bound
+# on what /dev/zero or a mistyped multi-GB file would make the command read into memory
+
+
+def read_text_file(path: str | Path, what: str) -> str:
+    """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
+    for a device or pipe, /dev/zero, and a file past MAX_TEXT_BYTES)."""
+    path = Path(path)
+    try:
+        if path.exists() and not path.is_dir() and not path.is_file():
+            raise ParameterError(f"{what} {str(path)!r} is not a regular file (a device or pipe); give a file")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_TEXT_BYTES + 1)
+        if len(data) > MAX_TEXT_BYTES:
+            raise ParameterError(f"{what} {str(path)!r} is larger than {MAX_TEXT_BYTES / 1e6:g} MB; allowed: a "
+                                 "text file of at most that size")
+        return data.decode("utf-8")
+    except FileNotFoundError:
+        raise ParameterError(f"{what} {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise ParameterError(f"{what} {str(path)!r} is a folder; give a file") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}); "
+                             "save it as UTF-8") from None
+    except OSError as exc:
+        raise ParameterError(f"{what} {str(path)!r} cannot be read: {exc.strerror}") from None
+
+
+def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
+    """A TOML file as a dict, or a ParameterError naming the file and the problem in one line."""
+    text = read_text_file(path, what)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
+    except ValueError as exc:  # an integer past Python's 4300-digit conversion limit
+        why = "an integer of more than 4300 digits" if "digits" in str(exc) else " ".join(str(exc).split())[:120]
+        raise ParameterError(f"{what} {str(path)!r} holds a value that cannot be read ({why}); allowed: numbers "
+                             "within the ranges 'ipir-mujoco params' lists") from None
+    except RecursionError:  # arrays or tables nested thousands deep
+        raise ParameterError(f"{what} {str(path)!r} nests arrays or tables too deep to read; allowed: the flat "
+                             "tables of a config or study file (docs/cli.md)") from None
