@@ -173,3 +173,17 @@ def test_scheduler_gives_the_local_pool_s_files(tmp_path, capsys):
     assert code == 0, err
     for name in ("evaluations.csv", "pareto.csv"):
         assert (tmp_path / "dask" / name).read_bytes() == (tmp_path / "local" / name).read_bytes()
+
+
+def test_an_objective_that_cannot_tell_designs_apart_is_said(tmp_path, capsys):
+    """0.05 s is a fifth of the first crank revolution: the mean speed over the last whole revolutions is 0
+    in every design, so the 'best' is arbitrary; the command says so on stderr (and optimize.json lists it),
+    and a run long enough to tell the designs apart says nothing."""
+    argv = ("optimize", "--vary", "m2=0.5:2", "--objective", "max:mean_speed_m_s", "--budget", "4",
+            "--engine", "analytic-unilateral", "--verify", "none", "--workers", "1")
+    code, _, err = run_cli(capsys, *argv, "--t-end", "0.05", "--out", tmp_path / "short")
+    assert code == 0 and "note: mean_speed_m_s is the same in every feasible design" in err
+    assert json.loads((tmp_path / "short" / "optimize.json").read_text())["flat_objectives"] == ["mean_speed_m_s"]
+    code, _, err = run_cli(capsys, *argv, "--t-end", "0.6", "--out", tmp_path / "long")
+    assert code == 0 and "note:" not in err
+    assert json.loads((tmp_path / "long" / "optimize.json").read_text())["flat_objectives"] == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
@@ -83,6 +84,10 @@ def run(args: argparse.Namespace) -> int:
             div = "; divergence " + ", ".join(f"{k} {_fmt(v)}" for k, v in divs.items())
         print(f"  {'best' if 'best' in record else 'front'}: {where}{': ' + objs if objs else ''}{div}")
     print(f"  files: {args.out}/evaluations.csv, pareto.csv, optimize.json, {figure}")
+    for key in record["flat_objectives"]:
+        print(f"ipir-mujoco optimize: note: {key} is the same in every feasible design, so the search could not "
+              f"tell them apart (a run too short for a whole crank revolution? --t-end is {problem.t_end:g} s)",
+              file=sys.stderr)
     return EXIT_OK
 
 

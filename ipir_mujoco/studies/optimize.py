@@ -295,7 +295,8 @@ def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, wor
                             problem.t_end, problem.study.dt_out, options, workers, executor)
     _write_front(out / "pareto.csv", front, problem, keys)
     record = {"fingerprint": problem.fingerprint(), "settings": settings, "status": "done",
-              "evaluations": len(rows), "feasible": len(feasible), "reused_on_resume": reused}
+              "evaluations": len(rows), "feasible": len(feasible), "reused_on_resume": reused,
+              "flat_objectives": flat_objectives(problem, feasible)}
     summary = [_summary(r, problem, keys) for r in front]
     if len(problem.objectives) == 1:
         record["best"] = summary[0] if summary else None
@@ -303,6 +304,16 @@ def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, wor
         record["front"] = summary
     write_json(out / "optimize.json", _finite(record))
     return record
+
+
+def flat_objectives(problem: Problem, feasible: list[dict]) -> list[str]:
+    """The objectives whose value is the same in every feasible design (of two or more): a search that
+    cannot tell its designs apart, which the command line says rather than naming an arbitrary best (the
+    usual cause: a run too short to complete a revolution, whose per-revolution figures read 0 or empty)."""
+    if len(feasible) < 2:
+        return []
+    columns = np.array([problem.objective_values(r) for r in feasible])
+    return [o.key for o, column in zip(problem.objectives, columns.T) if np.all(column == column[0])]
 
 
 def _finite(data):
