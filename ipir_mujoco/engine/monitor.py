@@ -177,3 +177,22 @@ class AccuracyMonitor:
         out["ok"] = not self.violations
         out["violations"] = list(self.violations)
         return out
+
+
+def rising(values: np.ndarray, worst: float, tolerance: float, offset: int) -> list[int]:
+    """Rows (index + ``offset``) of ``values`` the monitor must be fed to end as if fed each in turn (each
+    that beats the worst so far, starting from ``worst``): the first fed one beyond ``tolerance`` (it is
+    the first beyond both, and the one that stops a run or is recorded as its crossing), and the first of
+    the largest, if it beats ``worst`` (NaN never does). Every other value would only be overtaken."""
+    size = np.abs(values)
+    largest = np.fmax.reduce(size)
+    if not largest > abs(worst):  # the common case once a run is under way: nothing to feed
+        return []
+    rows = []
+    threshold = max(abs(worst), tolerance)
+    if largest > threshold:
+        rows.append(int(np.argmax(size > threshold)))
+    top = int(np.argmax(size == largest))
+    if not rows or top != rows[0]:
+        rows.append(top)
+    return [row + offset for row in rows]

@@ -59,10 +59,12 @@ from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captu
                      climb_energy, monotone, mujoco_failure, rest_since, stall_reason, steps_per_output)
 from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
-from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
+from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
+                      rising as _rising)
 from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
+from .route_watch import check_route, route_decorator, route_watch
 from .wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
 from .wheels_model import ContactSettings, build_wheels_model, set_wheels_state
 
@@ -93,6 +95,7 @@ def simulate_mujoco(
     steady_cycles: int = STEADY_CYCLES,
     wall_budget_s: float | None = None,
     model: str = "slides",
+    route=None,
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -113,12 +116,15 @@ def simulate_mujoco(
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``model``: 'slides' or 'wheels'
     (on wheels in a pipe, a ratchet in every hub, stepped in Python: :mod:`.wheels_model`, :mod:`.wheels`).
+    ``route``: a :class:`ipir_mujoco.core.route.Route` (the wheeled model only): the walls along it, the run
+    ended at its end or where the robot jams (:mod:`.route_watch`).
     """
     params = require_params(params)
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
     check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
     check_mujoco_model(model, params, implementation)
+    params = check_route(route, model, params, until_steady)
     check_clutch_options(params, clutch, implementation)
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
     check_accuracy_mode(accuracy)
@@ -129,7 +135,7 @@ def simulate_mujoco(
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
-                   wheeled=model == "wheels")
+                   wheeled=model == "wheels", route=route)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
@@ -153,7 +159,7 @@ class _Run:
     """One MuJoCo run with fixed settings (the loop is in :meth:`_integrate`)."""
 
     def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
-                 until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, started=None):
+                 until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, route=None, started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
         self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
@@ -165,8 +171,9 @@ class _Run:
         self.compliant = params.clutch_stiffness is not None
         self.wheeled = wheeled  # the wheeled model (.wheels_model), else the slide model
         self.model_settings = {"mujoco_model": "wheels", **ContactSettings().as_dict()} if wheeled else {}
-        self.model = (build_wheels_model(params, settings, mjcf=mjcf) if wheeled
-                      else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
+        self.route = route
+        self.model = (build_wheels_model(params, settings, mjcf=mjcf, decorate=route_decorator(params, route))
+                      if wheeled else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
         self.data = mujoco.MjData(self.model)
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
@@ -208,6 +215,7 @@ class _Run:
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.model_settings},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
+            route=self.route_watch and self.route_watch.record(self.t_end, self.stall),
         )
 
     def _setup(self):
@@ -222,6 +230,7 @@ class _Run:
         self.loop = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
                                  controller if self.compliant else None, wheeled=self.wheeled)
+        self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out)  # None without a route
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
@@ -335,25 +344,6 @@ class _Run:
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
 
 
-def _rising(values: np.ndarray, worst: float, tolerance: float, offset: int) -> list[int]:
-    """Rows (index + ``offset``) of ``values`` the monitor must be fed to end as if fed each in turn (each
-    that beats the worst so far, starting from ``worst``): the first fed one beyond ``tolerance`` (it is
-    the first beyond both, and the one that stops a run or is recorded as its crossing), and the first of
-    the largest, if it beats ``worst`` (NaN never does). Every other value would only be overtaken."""
-    size = np.abs(values)
-    largest = np.fmax.reduce(size)
-    if not largest > abs(worst):  # the common case once a run is under way: nothing to feed
-        return []
-    rows = []
-    threshold = max(abs(worst), tolerance)
-    if largest > threshold:
-        rows.append(int(np.argmax(size > threshold)))
-    top = int(np.argmax(size == largest))
-    if not rows or top != rows[0]:
-        rows.append(top)
-    return [row + offset for row in rows]
-
-
 class _BlockChecks:
     """What the run checks every BLOCK_TIME of simulated time: progress, budget, steady state, stall."""
 
@@ -387,6 +377,8 @@ class _BlockChecks:
             self.fed = newest + 1
             if steady:
                 return int(np.searchsorted(rec.t[:newest + 1], self.watch.steady_at - 1e-12, side="left"))
+        if run.route_watch is not None and (stop := run.route_watch.check(newest)) is not None:
+            return stop
         if self.stall_watch:
             return self._stall(newest, t)
         return None
