@@ -13,7 +13,7 @@ import pytest
 
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams
-from ipir_mujoco.core.pipe import bend_max_length, bend_wheel_spread
+from ipir_mujoco.core.pipe import bend_max_length, bend_rod_clearance, bend_wheel_spread
 from ipir_mujoco.core.route import read_route, route_from_tables
 
 CRUISE = RobotParams(drive="motor", mu_wall=0.8)
@@ -69,6 +69,10 @@ def test_the_closed_form_fits_against_hand_cases():
     assert bend_max_length(0.1, 0.15, 0.2) == pytest.approx(0.4, abs=1e-15)
     with pytest.raises(ParameterError, match="radius"):
         bend_wheel_spread(0.025, 0.015, 0.07, 0.16)
+    # a rod of 0.6 m as a chord of a 0.5 m centreline: its middle 0.4 m from the centre, where the inner wall of a
+    # 0.2 m pipe is; a rod 0.01 m thick crosses it by that much
+    assert bend_rod_clearance(0.6, 0.01, 0.5, 0.2) == pytest.approx(-0.01, abs=1e-15)
+    assert bend_rod_clearance(1.2, 0.0, 0.5, 0.2) == -math.inf  # longer than the centreline's diameter
 
 
 def test_a_straight_route_runs_as_the_straight_pipe_and_ends_at_its_end():

@@ -26,7 +26,7 @@ def add_parser(commands) -> None:
                     "straight-pipe prediction over that length. Writes DIR/bend_study.csv, DIR/bend_study.json and "
                     "the figure DIR/bend_study.png; prints the table.")
     cmd.add_argument("--ratios", metavar="LIST", default=None,
-                     help="bend radius over pipe diameter, R/D: a comma-separated list (default 1,1.5,2,3,5,7.5,10)")
+                     help="bend radius over pipe diameter, R/D: a comma-separated list (default 0.6,1,1.5,2,3,5,7.5,10)")
     cmd.add_argument("--quick", action="store_true", help="R/D 2 and 5 only, for a first look")
     cmd.add_argument("--workers", type=int, default=None, help="processes to use (default: all cores)")
     cmd.add_argument("--out", metavar="DIR", default="bend-study", help="results folder (default ./bend-study)")
@@ -93,6 +93,15 @@ def write_csv(path: Path, study: dict) -> None:
                              for c in COLUMNS])
 
 
+def _short(predicted: str) -> str:
+    """The closed-form fit's line in a word or two."""
+    for start, word in (("passes", "passes"), ("jams", "housing jams"), ("the linkage", "rod binds"),
+                        ("a wheel", "wall lost")):
+        if predicted.startswith(start):
+            return word
+    return predicted
+
+
 def format_table(study: dict) -> str:
     """The study as text: per R/D the passage's time and energy, MuJoCo in the bend / in a straight / the analytic
     model's straight prediction, and how the run ended."""
@@ -108,7 +117,7 @@ def format_table(study: dict) -> str:
                      f"{num(f['bend_time_s'])} / {num(f['straight_time_s'])} / {num(f['analytic_time_s'])}",
                      f"{num(f['bend_energy_j'])} / {num(f['straight_energy_j'])} / {num(f['analytic_energy_j'])}",
                      num(f["bend_wheel_off_s"], 3),
-                     "passes" if (f["predicted"] or "").startswith("passes") else "wall lost",
+                     _short(f["predicted"] or ""),
                      "passed" if f["bend_passed"] else f"stopped: {f['bend_route_stop']}"])
     widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
     lines = ["  ".join(str(x).ljust(w) for x, w in zip(r, widths)) for r in [header] + rows]

@@ -12,8 +12,9 @@ A straight pipe of inside diameter D holds the planar mechanism when
   arm from the module's centreline, so 2 R < D / 2 (R < D / 4).
 
 The rod length L does not enter a straight pipe's fit (the rod swings inside the crank pin's band, |y| <= r).
-A bend's fit has two closed forms here, both reported beside MuJoCo's outcome of a route (``route_fit``): a
-rigid box's (:func:`bend_max_length`) and the spread sprung wheels need (:func:`bend_wheel_spread`).
+A bend's fit has three closed forms here, all reported beside MuJoCo's outcome of a route (``route_fit``): a
+rigid box's (:func:`bend_max_length`), the spread sprung wheels need (:func:`bend_wheel_spread`) and the rod's
+clearance from the inner wall (:func:`bend_rod_clearance`).
 """
 
 from __future__ import annotations
@@ -83,3 +84,20 @@ def bend_wheel_spread(half_base: float, wheel_radius: float, radius: float, diam
         return math.inf
     return (outer * outer - half_base * half_base) ** 0.5 - (inner * inner - half_base * half_base) ** 0.5 \
         - (diameter - 2 * wheel_radius)
+
+
+def bend_rod_clearance(length: float, rod_radius: float, radius: float, diameter: float) -> float:
+    """How far [m] a rod of ``length`` [m] and radius ``rod_radius`` [m], as a chord with both ends on a bend's
+    centreline (radius ``radius`` [m], pipe diameter ``diameter`` [m]), clears the bend's inner wall; negative where
+    it would cross it:
+
+        clearance = sqrt(R^2 - (L/2)^2) - (R - D/2) - rod_radius
+
+    (the chord's middle is nearest the bend's centre). The linkage's two ends ride near the pipe's axis, so a
+    negative clearance says the rod must push them outward or bind."""
+    if not (length > 0 and rod_radius >= 0 and radius > diameter / 2 and diameter > 0):
+        raise ParameterError(f"bend rod clearance: length={length!r} m, rod_radius={rod_radius!r} m, radius={radius!r}"
+                             f" m, diameter={diameter!r} m; allowed: length > 0, rod_radius >= 0, radius > diameter / 2")
+    if length / 2 >= radius:
+        return -math.inf
+    return (radius * radius - length * length / 4) ** 0.5 - (radius - diameter / 2) - rod_radius

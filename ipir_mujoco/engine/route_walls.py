@@ -11,6 +11,8 @@ condim:
 - a bend's inner wall (convex towards the pipe): one capsule with its axis along z, radius R - D/2, at the
   bend's centre: a smooth circle, no seams (capsule-capsule contacts are MuJoCo's exact ones). It collides
   only (group 3, not drawn); a cylinder of the same radius, colliding with nothing, draws it;
+- the housings, the crank and the rod collide with the route's walls too (in the straight model they never
+  reach the planes and collide with nothing), so that a bend too tight for the linkage binds it;
 - a bend's outer wall (concave towards the pipe): N boxes, each with its inner face tangent to the circle of
   radius R + D/2 at angles (k + 1/2) angle / N, overlapping their neighbours: the pipe sees a polygon with
   no edge of a box in it (every box's end lies behind its neighbours' faces), whose corners stand at most
@@ -29,7 +31,7 @@ import math
 import mujoco
 
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.pipe import bend_max_length, bend_wheel_spread
+from ipir_mujoco.core.pipe import bend_max_length, bend_rod_clearance, bend_wheel_spread
 from ipir_mujoco.core.route import Piece, Route
 
 THICKNESS = 0.02  # m: a wall box's thickness (outward from its inner face)
@@ -37,7 +39,9 @@ HEIGHT = 0.05  # m: a wall's half-height along z (as the planes are drawn); the 
 SAGITTA = 2e-6  # m: how far a bend's outer polygon's corners stand out of the circle (2 % of the spring travel)
 LEAD_IN = 0.3  # m: the walls behind the route's start and beyond the robot at its end
 HOUSING_HALF = 0.03  # m: the housing's half-size (inchworm_wheels.xml), the module's rigid part
+ROD_RADIUS = 0.004  # m: the rod's capsule radius (inchworm_wheels.xml)
 WALL_RGBA = (0.35, 0.4, 0.5, 0.8)
+COLLIDING = ("rear_housing", "front_housing", "crank_arm", "rod_bar")  # besides the wheels, along a route
 
 
 def _quat(heading: float) -> list[float]:
@@ -102,6 +106,10 @@ def write_route_walls(spec: mujoco.MjSpec, params: RobotParams, route: Route) ->
                  solref=list(template.solref), solimp=list(template.solimp), margin=float(template.margin))
     for name in ("wall_top", "wall_bottom"):
         spec.delete(spec.geom(name))
+    for name in COLLIDING:  # the rigid parts meet the route's walls (each other and the wheels never)
+        geom = spec.geom(name)
+        geom.contype, geom.conaffinity, geom.condim = 1, 0, style["condim"]
+        geom.friction, geom.solref, geom.solimp = style["friction"], style["solref"], style["solimp"]
     world = spec.worldbody
     robot_length = params.L + params.r + 0.1  # A to the front module's fore wheels and beyond
     half = D / 2
@@ -163,16 +171,24 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
         rigid = bend_max_length(2 * HOUSING_HALF, bend.radius, D)
         spread = bend_wheel_spread(half_base, Rw, bend.radius, D)
         press = 1.0 - spread / (2 * spring_travel)
+        clearance = bend_rod_clearance(params.L, ROD_RADIUS, bend.radius, D)
         bends.append({"bend": k + 1, "radius_m": bend.radius, "R_over_D": bend.radius / D,
                       "housing_max_length_m": rigid, "housing_fits": rigid >= 2 * HOUSING_HALF,
                       "wheel_spread_m": spread, "spring_reach_m": 2 * spring_travel,
-                      "wall_press_share": press, "wheels_keep_wall": press > 0})
+                      "wall_press_share": press, "wheels_keep_wall": press > 0,
+                      "rod_clearance_m": clearance, "rod_clears": clearance > 0})
         if worst is None or press < worst["wall_press_share"]:
             worst = bends[-1]
+    tightest = min(bends, key=lambda b: b["rod_clearance_m"]) if bends else None
     if worst is None:
         predicted = "no bend: the straight pipe's fit"
     elif not worst["housing_fits"]:
         predicted = f"jams: the housing does not pass bend {worst['bend']}"
+    elif not tightest["rod_clears"]:
+        by = ("it is longer than the centreline's diameter" if math.isinf(tightest["rod_clearance_m"]) else
+              f"as a chord of the centreline it would cross the inner wall by "
+              f"{-tightest['rod_clearance_m'] * 1e3:.3g} mm")
+        predicted = f"the linkage may bind in bend {tightest['bend']} (R/D {tightest['R_over_D']:.3g}): the rod {by}"
     elif not worst["wheels_keep_wall"]:
         predicted = (f"a wheel leaves the wall in bend {worst['bend']} (R/D {worst['R_over_D']:.3g}): the wheels "
                      f"need {worst['wheel_spread_m'] * 1e3:.3g} mm more spread, their springs reach "

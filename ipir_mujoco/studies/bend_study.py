@@ -33,7 +33,7 @@ from ipir_mujoco.core.route import route_from_tables
 
 from .pool import map_unordered
 
-RATIOS = (1.0, 1.5, 2.0, 3.0, 5.0, 7.5, 10.0)  # R/D, the default
+RATIOS = (0.6, 1.0, 1.5, 2.0, 3.0, 5.0, 7.5, 10.0)  # R/D, the default
 RATIOS_QUICK = (2.0, 5.0)
 LEAD_IN = 0.6  # m: straight before the passage's window (the default motor reaches its cruise in ~1 s)
 EXIT = 0.05  # m: straight after the bend
