@@ -17,7 +17,7 @@ from ipir_mujoco.core.pipe import bend_max_length, bend_rod_clearance, bend_whee
 from ipir_mujoco.core.route import read_route, route_from_tables
 
 CRUISE = RobotParams(drive="motor", mu_wall=0.8)
-BEND = [dict(kind="straight", length=0.3), dict(kind="bend", radius=1.0, angle=90.0),
+BEND = [dict(kind="straight", length=0.4), dict(kind="bend", radius=1.0, angle=90.0),
         dict(kind="straight", length=0.5, incline=0.0)]
 
 
@@ -80,18 +80,18 @@ def test_a_straight_route_runs_as_the_straight_pipe_and_ends_at_its_end():
     normal), so the motion is the plane model's to round-off (1e-9 of the travel is far above round-off,
     far below the monitor's 1e-3); a route shorter than the run ends where the plane model's rear module
     crossed its length, to one output interval."""
-    dt_out, t_end, length = 1e-3, 0.4, 0.1
+    dt_out, t_end, length = 1e-3, 1.0, 0.35
     plain = registry.run("mujoco-wheels", CRUISE, t_end, dt_out=dt_out, timestep=1e-4)
     long = registry.run("mujoco-wheels", CRUISE, t_end, dt_out=dt_out, timestep=1e-4,
-                        route=route_from_tables([dict(kind="straight", length=0.2), dict(kind="straight", length=4.8)]))
+                        route=route_from_tables([dict(kind="straight", length=0.35), dict(kind="straight", length=4.65)]))
     for key in ("x1_final", "x2_final", "revolutions"):
         assert long.summary[key] == pytest.approx(plain.summary[key], rel=1e-9)
     s = long.summary
-    # the robot's centre, midway between A (x1) and C (x2 + the gap S at the start), reached 0.2 m when the plane
+    # the robot's centre, midway between A (x1) and C (x2 + the gap S at the start), reached 0.35 m when the plane
     # model's did, to one output interval
     series = plain.series
     centre = 0.5 * (series["x1"] + series["x2"] + series["S"][0])
-    crossed = series["t"][centre >= 0.2][0]
+    crossed = series["t"][centre >= 0.35][0]
     assert crossed - dt_out <= s["route_piece_times_s"][1] <= crossed + 1e-12
     assert s["route_done"] is False and s["route_time_s"] is None and "t_end" in s["route_stop"]
     assert s["route_s_m"] == pytest.approx(plain.series["x1"].max(), rel=1e-9)  # the rear module, along x
@@ -111,7 +111,7 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
     from cli_run import run_cli
 
     path = tmp_path / "bend.toml"
-    path.write_text('[[segment]]\nkind = "straight"\nlength = 0.05\n[[segment]]\nkind = "bend"\nradius = 0.32\n'
+    path.write_text('[[segment]]\nkind = "straight"\nlength = 0.35\n[[segment]]\nkind = "bend"\nradius = 0.32\n'
                     'angle = 30\n[[segment]]\nkind = "straight"\nlength = 0.05\n')
     argv = ("simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--drive", "motor", "--set", "mu_wall=0.8",
             "--route", path, "--timestep", "5e-5", "--dt-out", "1e-3", "--t-end", "3")
@@ -131,18 +131,26 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
     assert ("route done in" in printed) == s["route_done"] and "closed-form fit" in printed
 
 
-def test_a_robot_that_makes_no_progress_stops_with_the_reason(monkeypatch):
-    """A riser with a grip of a quarter of the weight: the robot slides down and never progresses; the run
-    stops after the watch's window (shortened here to keep the test fast) with the reason in one line."""
+def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monkeypatch):
+    """A horizontal pipe with a grip of half the rolling resistance (mu_wall 0.01: 0.5 N against F_r = 1 N): the
+    held module cannot hold the other's resistance, the crank turns and the robot gets nowhere; the run stops
+    after the watch's window (shortened here to keep the test fast) with the reason in one line. A riser with a
+    grip of a quarter of the weight: the robot slides down and out of the pipe behind the route's start."""
     from ipir_mujoco.engine import route_watch
 
     monkeypatch.setattr(route_watch, "PROGRESS_S", 0.3)
-    p = RobotParams(drive="motor", mu_wall=0.05)  # grip 2.5 N per module, weight 9.8 N
-    route = route_from_tables([dict(kind="straight", length=1.0, incline=90.0)])
-    run = registry.run("mujoco-wheels", p, 2.0, dt_out=1e-3, timestep=5e-5, route=route, accuracy="warn")
+    route = route_from_tables([dict(kind="straight", length=1.0)])
+    run = registry.run("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.01), 2.0, dt_out=1e-3, timestep=5e-5,
+                       route=route, accuracy="warn")
     s = run.summary
-    assert s["route_done"] is False and s["route_stop"].startswith("stalled") and "\n" not in s["route_stop"]
-    assert run.t_end < 1.0 and run.params.incline == 90.0
+    assert s["route_done"] is False and s["route_stop"].startswith("stalled") and "crank turned" in s["route_stop"]
+    assert "\n" not in s["route_stop"] and run.t_end < 1.0 and s["route_s_m"] < 0.1
+    riser = route_from_tables([dict(kind="straight", length=1.0, incline=90.0)])
+    run = registry.run("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.05), 2.0, dt_out=1e-3, timestep=5e-5,
+                       route=riser, accuracy="warn")
+    s = run.summary
+    assert s["route_done"] is False and s["route_stop"].startswith("slid back out of the pipe")
+    assert run.params.incline == 90.0 and run.series["x1"][-1] < -route_watch.BACK_OUT + 1e-12
 
 
 def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
@@ -155,6 +163,9 @@ def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
     tight = tmp_path / "tight.toml"
     tight.write_text('[[segment]]\nkind = "straight"\nlength = 1\n[[segment]]\nkind = "bend"\nradius = 0.05\n'
                      'angle = 90\n')
+    short = tmp_path / "short.toml"
+    short.write_text('[[segment]]\nkind = "straight"\nlength = 0.1\n[[segment]]\nkind = "bend"\nradius = 1\n'
+                     'angle = 90\n')
     wheels = ("--engine", "mujoco", "--mujoco-model", "wheels")
     for argv, word in ((("--engine", "mujoco", "--route", good), "--mujoco-model wheels"),
                        (("--route", good), "--mujoco-model wheels"),
@@ -162,7 +173,8 @@ def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
                        ((*wheels, "--route", tight), "radius > pipe_diameter / 2"),
                        ((*wheels, "--route", tmp_path / "none.toml"), "does not exist"),
                        ((*wheels, "--route", good, "--until-steady", "--drive", "motor"), "--until-steady"),
-                       ((*wheels, "--route", good, "--set", "incline=10"), "incline")):
+                       ((*wheels, "--route", good, "--set", "incline=10"), "incline"),
+                       ((*wheels, "--route", short), "length >= 0.325 m")):
         code, out, err = run_cli(capsys, "simulate", *argv)
         assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (argv, err)
     with pytest.raises(ParameterError, match="wheeled"):

@@ -7,6 +7,7 @@ furthest so far). The run stops, with one line in ``route_stop``, when
 
 - the rear module reaches the route's end (``route_done`` true, ``route_time_s`` the time it did,
   interpolated between samples);
+- the robot slid back out of the pipe behind the route's start (the walls reach LEAD_IN behind it);
 - no progress: the distance along the route grew by less than PROGRESS_M in PROGRESS_S (the crank turns
   and the robot skids or rocks in place, or the crank stands: the message says which);
 - or the run's own ends: t_end, a stall (the robot at rest for good), a failure.
@@ -29,12 +30,15 @@ import numpy as np
 from ipir_mujoco.core.route import Route
 
 from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, qpos_address
+from .route_walls import LEAD_IN
 from .wheels_model import ARMS, LATERALS, SPRING_TRAVEL
 
 WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
 PROGRESS_M = 0.01  # m: the least progress along the route in PROGRESS_S (a tenth of a stroke, 2 r)
 PROGRESS_S = 2.0  # s: (the default motor makes ~7 revolutions in it)
+BACK_OUT = LEAD_IN - 0.1  # m: the rear module this far behind the start has its aft wheels (0.075 m back) at the
+# walls' end
 
 
 class RouteWatch:
@@ -91,6 +95,10 @@ class RouteWatch:
                 self.s_last = self.s_max = s
                 self.stop = f"reached the route's end ({length:.3f} m) at t = {self.done_at:.4f} s"
                 return i
+            if s < -BACK_OUT:
+                self.stop = (f"slid back out of the pipe: the rear module {-s:.3f} m behind the route's start at "
+                             f"t = {ti:.4f} s (the walls end {LEAD_IN:g} m behind it)")
+                return i
             self.s_last = s
             self.s_max = max(self.s_max, s)
             if self.s_max - self.progress_at[1] >= PROGRESS_M:
@@ -130,8 +138,12 @@ class RouteWatch:
             self.off_since[k] = None
 
     def _along(self, x: float, y: float, near: float) -> float:
-        """A point's distance along the route [m] (near ``near`` [m]), beyond its end along the exit straight."""
+        """A point's distance along the route [m] (near ``near`` [m]), beyond its end along the exit straight and
+        before its start (negative) along the first straight."""
         s = self.route.project(x, y, near=near)
+        if s <= 0.0:  # behind the start: along the first straight, backwards
+            first = self.route.pieces[0]
+            return min(0.0, (x - first.x) * math.cos(first.heading) + (y - first.y) * math.sin(first.heading))
         if s >= self.route.length:
             ex, ey, heading = self.route.at(self.route.length)
             s = self.route.length + max(0.0, (x - ex) * math.cos(heading) + (y - ey) * math.sin(heading))
@@ -162,8 +174,8 @@ class RouteWatch:
 
 def check_route(route, model: str, params, until_steady: bool):
     """``params`` for a run along ``route`` (None: as they are): its incline the route's first straight's;
-    ParameterError (one line) for a route on the slide model, with --until-steady, or with an incline set
-    apart from the route's."""
+    ParameterError (one line) for a route on the slide model, with --until-steady, with an incline set apart
+    from the route's, or whose first straight is shorter than the robot (it starts in it)."""
     from ipir_mujoco.core.errors import ParameterError
 
     if route is None:
@@ -179,6 +191,14 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
+    from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
+
+    reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
+    first = route.pieces[0]
+    if first.length < reach:
+        raise ParameterError(f"{route.source}: segment 1: length={first.length:g} m; the robot starts in it and "
+                             f"reaches L + r + {reach - params.L - params.r:g} m ahead of its rear module; allowed: "
+                             f"length >= {reach:g} m")
     return params.replace(incline=route.incline)
 
 
