@@ -90,7 +90,7 @@ NAMES = tuple(VARIANTS)
 # the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
 ANALYTIC_OPTIONS = ("rtol", "atol", "max_switches", "method", "torque")
-MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step")
+MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step", "route")
 _WHY_NOT = {"analytic": "the analytic engines hold their solver tolerance and have no timestep, clutch "
                         "implementation or MJCF",
             "mujoco": "MuJoCo's cost is its step count, t_end / timestep, and its accuracy its own monitor's"}

@@ -18,7 +18,7 @@ from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.engine.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
 from ipir_mujoco.engine.monitor import RESIDUAL_TOL
 from ipir_mujoco.engine.wheels import WheelRatchet
-from ipir_mujoco.engine.wheels_model import (ARMS, HUBS, WALLS, WHEEL_NAMES, WHEEL_SHARE, WHEELS_PER_MODULE,
+from ipir_mujoco.engine.wheels_model import (HUBS, WALLS, WHEEL_NAMES, WHEEL_SHARE, WHEELS_PER_MODULE,
                                              build_wheels_model, set_wheels_state)
 
 CRUISE = RobotParams(drive="motor", mu_wall=0.8)  # the acceptance case: F_n = 50 N, grip 40 N per module

@@ -37,12 +37,18 @@ def add_parser(commands) -> None:
                      help="MuJoCo's model of the robot: slides = the modules on slide joints, their resistance joint "
                           "friction (default); wheels = the modules free in the plane on wheels pressed on the pipe's "
                           "walls by springs, a ratchet in every hub, friction mu_wall at the contacts (mjcf/README.md)")
+    sim.add_argument("--route", metavar="FILE.toml", default=None,
+                     help="with --mujoco-model wheels: a pipeline of [[segment]] tables (straights and bends, "
+                          "docs/cli.md); the run ends at the route's end or where the robot stops (default --t-end "
+                          f"{T_END_ROUTE:g} s then)")
     sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
                      help="MuJoCo timestep [s] (default: chosen from the motion, by the rule in mjcf/README.md, "
                           "installed with the package: see 'ipir-mujoco --help')")
-    sim.add_argument("--accuracy", choices=("stop", "warn"), default="stop",
+    sim.add_argument("--accuracy", choices=("stop", "warn"), default=None,
                      help="MuJoCo accuracy monitor: stop the run when the energy residual or the loop gap "
-                          "exceeds its tolerance (default), or warn, record it in the summary and go on")
+                          "exceeds its tolerance (default), or warn, record it in the summary and go on (the "
+                          "default with --route: in tight bends the wheels' contacts take work the audit does not "
+                          "count, mjcf/README.md)")
     sim.add_argument("--mjcf", metavar="FILE.xml", default=None,
                      help="MJCF template for --engine mujoco (default: the shipped inchworm.xml)")
     add_model_options(sim)
@@ -79,6 +85,7 @@ def output_interval(args: argparse.Namespace) -> float:
 
 
 T_END, T_END_STEADY = 1.0, 30.0  # s: the default run, and the default cap of a run to steady state
+T_END_ROUTE = 60.0  # s: the default cap of a run along a route
 
 
 FLAGS = {"max_switches": "--max-switches", "mjcf": "--mjcf", "timestep": "--timestep", "accuracy": "--accuracy"}
@@ -87,8 +94,16 @@ FLAGS = {"max_switches": "--max-switches", "mjcf": "--mjcf", "timestep": "--time
 def check_options(args: argparse.Namespace) -> registry.Variant:
     """Every option of ``simulate`` that the engines do not check themselves, before any work; the variant
     the flags name (:func:`ipir_mujoco.registry.from_flags`)."""
+    if args.route is not None and args.mujoco_model != "wheels":
+        raise ParameterError(f"--route {args.route}: only the wheeled model runs along a route; allowed: --engine "
+                             "mujoco --mujoco-model wheels")
+    if args.route is not None and args.until_steady:
+        raise ParameterError("--until-steady with --route: a run along a route ends at the route's end; allowed: "
+                             "one of them")
+    if args.accuracy is None:
+        args.accuracy = "warn" if args.route is not None else "stop"
     if args.t_end is None:
-        args.t_end = T_END_STEADY if args.until_steady else T_END
+        args.t_end = T_END_STEADY if args.until_steady else T_END_ROUTE if args.route is not None else T_END
     if args.timestep is not None:  # before the output interval is derived from it
         check_real("--timestep", args.timestep, high=1e-2, unit="s")
     args.dt_out = output_interval(args)
@@ -106,6 +121,11 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
     registry.check_options(variant, engine_options, FLAGS.get)
     if args.mjcf is not None:
         check_input_file("--mjcf", args.mjcf)
+    if args.route is not None:
+        from ipir_mujoco.core.route import read_route
+
+        check_input_file("--route", args.route)
+        args.route_parsed = read_route(args.route)
     return variant
 
 
@@ -118,7 +138,8 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
     try:
         return registry.run(variant, params, args.t_end, dt_out=args.dt_out, until_steady=args.until_steady or None,
                             progress=progress, max_switches=args.max_switches, timestep=args.timestep,
-                            mjcf=args.mjcf, accuracy=accuracy, wall_budget_s=args.wall_budget)
+                            mjcf=args.mjcf, accuracy=accuracy, wall_budget_s=args.wall_budget,
+                            route=getattr(args, "route_parsed", None))
     except SimulationError as exc:
         if "budget" in str(exc) and "wall" in str(exc):  # say which option raises it
             raise SimulationError(f"{exc} (--wall-budget {args.wall_budget:g} s; raise it, or 'inf')") from None
@@ -163,6 +184,8 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      + ("none" if use is None else f"{use:.3g} of the grip"))
     if s["stalled"]:
         lines.append(f"  stalled: {s['stall_reason']}")
+    if "route_done" in s:
+        lines += route_lines(s)
     accuracy = s.get("accuracy") or {}
     if "loop_gap_m" in accuracy:
         lines.append(f"  accuracy: energy residual {accuracy['residual_ratio']:.1e} of the energy, loop gap "
@@ -171,6 +194,18 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                                                               f"{v['figure']} {v['value']:.3g} (tolerance {v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
                                                               for v in accuracy.get("violations", []))))
     return "\n".join(lines)
+
+
+def route_lines(s: dict) -> list[str]:
+    """A run along a route in words: done or not and why, the closed-form fit beside it."""
+    done = (f"route done in {s['route_time_s']:.4f} s" if s["route_done"] else
+            f"route NOT done: {s['route_s_m']:.3f} of {s['route_length_m']:.3f} m")
+    lines = [f"  {done}: {s['route_stop']}"]
+    if s["route_wall_loss"] is not None:
+        lines.append(f"  wheels off their walls {s['route_wheel_off_s']:.3f} s in all (a whole module "
+                     f"{s['route_module_off_s']:.3f} s); first: {s['route_wall_loss']}")
+    lines.append(f"  closed-form fit: {s['route_fit']['predicted']}")
+    return lines
 
 
 def _energy_line(e: dict) -> str:

@@ -59,7 +59,10 @@ class ViewedRobot:
     """
 
     def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,
-                 settings: SolverSettings | None = None, t_end: float = 4.0, model: str = "slides"):
+                 settings: SolverSettings | None = None, t_end: float = 4.0, model: str = "slides", route=None):
+        from ..engine.route_watch import check_route, route_decorator
+
+        params = check_route(route, model, params, False)  # the route's incline
         self.params, self.clutch, self.wheeled = params, clutch, model == "wheels"
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
         check_mujoco_model(model, params, self.implementation)
@@ -70,7 +73,13 @@ class ViewedRobot:
                 settings, _ = wheels_settings(settings, why, params, 1e-3)
         self.settings = settings
         if self.wheeled:
-            self.model = build_wheels_model(params, settings, decorate=checker_floor)
+            walls = route_decorator(params, route)
+
+            def decorate(spec):
+                if walls is not None:
+                    walls(spec)
+                checker_floor(spec)
+            self.model = build_wheels_model(params, settings, decorate=decorate)
         else:
             self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=checker_floor)
         self.data = mujoco.MjData(self.model)
@@ -136,6 +145,8 @@ def build_parser() -> Parser:
                         help="ratchet (default with unilateral) or lock (default with kinematic)")
     parser.add_argument("--mujoco-model", choices=("slides", "wheels"), default="slides",
                         help="slides: the modules on slide joints (default); wheels: on wheels in the pipe")
+    parser.add_argument("--route", metavar="FILE.toml", default=None,
+                        help="with --mujoco-model wheels: the pipe along a route of straights and bends (docs/cli.md)")
     parser.add_argument("--slow", type=float, default=1.0, metavar="FACTOR",
                         help="play FACTOR times slower than real time (default 1; the crank reaches ~10 rev/s "
                              "within a second)")
@@ -152,8 +163,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ParameterError(f"--slow {args.slow} is out of range; allowed: 1 <= FACTOR <= 1000")
         if not (0.0 < args.t_end <= 60.0):
             raise ParameterError(f"--t-end {args.t_end} is out of range; allowed: 0 < SECONDS <= 60")
+        route = None
+        if args.route is not None:
+            from ipir_mujoco.core.route import read_route
+
+            from .common import check_input_file
+
+            check_input_file("--route", args.route)
+            route = read_route(args.route)
         robot = ViewedRobot(model_params(args), args.clutch, args.mujoco_clutch, t_end=args.t_end,
-                            model=args.mujoco_model)
+                            model=args.mujoco_model, route=route)
         if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
             raise ParameterError("the viewer needs a screen and none is set (no DISPLAY); "
                                  "write a video instead: ipir-mujoco render")

@@ -11,11 +11,15 @@ A straight pipe of inside diameter D holds the planar mechanism when
 - each wheel fits between the axis and its wall: the wheel's centre sits at D / 2 - R from the axis, on an
   arm from the module's centreline, so 2 R < D / 2 (R < D / 4).
 
-The rod length L does not enter a straight pipe's fit (the rod swings inside the crank pin's band, |y| <= r);
-a bend's fit is another matter.
+The rod length L does not enter a straight pipe's fit (the rod swings inside the crank pin's band, |y| <= r).
+A bend's fit has three closed forms here, all reported beside MuJoCo's outcome of a route (``route_fit``): a
+rigid box's (:func:`bend_max_length`), the spread sprung wheels need (:func:`bend_wheel_spread`) and the rod's
+clearance from the inner wall (:func:`bend_rod_clearance`).
 """
 
 from __future__ import annotations
+
+import math
 
 from .errors import ParameterError
 
@@ -42,8 +46,9 @@ def bend_max_length(width: float, radius: float, diameter: float) -> float:
 
         l_max = 2 sqrt((R + D/2)^2 - (R - D/2 + w)^2)
 
-    (for a straight pipe, R -> infinity, any length passes). Not yet checked against MuJoCo: the route with
-    bends is not built.
+    (for a straight pipe, R -> infinity, any length passes). A run along a route reports it for the wheeled
+    model's rigid housing beside MuJoCo's outcome (``route_fit``); the housing is far from binding there, the
+    wheels' springs bind first (:func:`bend_wheel_spread`).
     """
     if not (width >= 0 and radius > 0 and diameter > 0):
         raise ParameterError(f"bend fit: width={width!r} m, radius={radius!r} m, diameter={diameter!r} m; allowed: "
@@ -55,3 +60,44 @@ def bend_max_length(width: float, radius: float, diameter: float) -> float:
         return 0.0
     outer, inner = radius + diameter / 2, radius - diameter / 2 + width
     return 2.0 * (outer * outer - inner * inner) ** 0.5
+
+
+def bend_wheel_spread(half_base: float, wheel_radius: float, radius: float, diameter: float) -> float:
+    """How much farther apart [m] the two wheels of a station must reach in a bend than in a straight pipe: a
+    module tangent to the bend's centreline (radius ``radius`` [m], pipe diameter ``diameter`` [m]) with its
+    stations ``half_base`` [m] either side of its middle and wheels of radius ``wheel_radius`` [m] on both walls.
+
+    Closed form: the wheels' centres lie on the circles R + D/2 - R_w (outer wall) and R - D/2 + R_w (inner
+    wall), on the station's line across the module, a distance b = half_base from the tangent point along the
+    module, so
+
+        spread = sqrt((R + D/2 - R_w)^2 - b^2) - sqrt((R - D/2 + R_w)^2 - b^2) - (D - 2 R_w)
+
+    about b^2 D / (2 (R - D/2) (R + D/2)) for b << R - D/2: the pipe, measured across the module off its
+    middle, is wider than D. Sprung wheels keep their wall while their springs reach that far."""
+    if not (half_base >= 0 and wheel_radius > 0 and diameter > 4 * wheel_radius and radius > diameter / 2):
+        raise ParameterError(f"bend wheel spread: half_base={half_base!r} m, wheel_radius={wheel_radius!r} m, "
+                             f"radius={radius!r} m, diameter={diameter!r} m; allowed: half_base >= 0, "
+                             "0 < 4 wheel_radius < diameter < 2 radius")
+    outer, inner = radius + diameter / 2 - wheel_radius, radius - diameter / 2 + wheel_radius
+    if half_base >= inner:
+        return math.inf
+    return (outer * outer - half_base * half_base) ** 0.5 - (inner * inner - half_base * half_base) ** 0.5 \
+        - (diameter - 2 * wheel_radius)
+
+
+def bend_rod_clearance(length: float, rod_radius: float, radius: float, diameter: float) -> float:
+    """How far [m] a rod of ``length`` [m] and radius ``rod_radius`` [m], as a chord with both ends on a bend's
+    centreline (radius ``radius`` [m], pipe diameter ``diameter`` [m]), clears the bend's inner wall; negative where
+    it would cross it:
+
+        clearance = sqrt(R^2 - (L/2)^2) - (R - D/2) - rod_radius
+
+    (the chord's middle is nearest the bend's centre). The linkage's two ends ride near the pipe's axis, so a
+    negative clearance says the rod must push them outward or bind."""
+    if not (length > 0 and rod_radius >= 0 and radius > diameter / 2 and diameter > 0):
+        raise ParameterError(f"bend rod clearance: length={length!r} m, rod_radius={rod_radius!r} m, radius={radius!r}"
+                             f" m, diameter={diameter!r} m; allowed: length > 0, rod_radius >= 0, radius > diameter / 2")
+    if length / 2 >= radius:
+        return -math.inf
+    return (radius * radius - length * length / 4) ** 0.5 - (radius - diameter / 2) - rod_radius

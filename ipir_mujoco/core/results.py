@@ -125,7 +125,9 @@ class RunResult:
     given, ``steady_tol`` and ``steady_cycles`` for the steady-state test).
     ``stall`` is None, or why the robot ended at rest for good (with the time).
     ``accuracy`` is the engine's own accuracy record (MuJoCo: at least
-    ``residual_ratio`` and ``loop_gap_m``), or None.
+    ``residual_ratio`` and ``loop_gap_m``), or None. ``route`` is None, or a
+    run along a route's summary keys (``route_done``, ``route_time_s``,
+    ``route_stop``, ...: ``ipir_mujoco.engine.route_watch``).
     """
 
     engine: str
@@ -139,6 +141,7 @@ class RunResult:
     settings: dict[str, Any] = field(default_factory=dict)
     stall: str | None = None
     accuracy: dict[str, Any] | None = None
+    route: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         missing = [c for c in COLUMNS if c not in self.series]
@@ -179,6 +182,8 @@ class RunResult:
             if scale > 0:
                 accuracy["residual_ratio"] = e["residual_j"] / scale
         summary["accuracy"] = accuracy
+        if self.route is not None:  # a run along a route: route_done, route_time_s, route_stop, ...
+            summary.update(self.route)
         return summary
 
     def to_json_dict(self) -> dict[str, Any]:

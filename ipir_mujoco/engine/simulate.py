@@ -48,16 +48,17 @@ from typing import Callable
 import mujoco
 import numpy as np
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
 from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
+from .block_checks import BlockChecks
 from .clutches import clutch_controller
 from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_clutch_options,
-                     climb_energy, monotone, mujoco_failure, rest_since, stall_reason, steps_per_output)
-from .model import CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control
+                     climb_energy, monotone, mujoco_failure, steps_per_output)
+from .model import CRANK_HINGE, MOTOR, SolverSettings, build_model, drive_control
 from .model import set_closed_loop_state
 from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
@@ -65,6 +66,7 @@ from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
 from .servo_drive import TickedDrive, controller_for
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
+from .route_watch import check_route, route_decorator, route_watch
 from .wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
 from .wheels_model import ContactSettings, build_wheels_model, set_wheels_state
 
@@ -96,6 +98,7 @@ def simulate_mujoco(
     wall_budget_s: float | None = None,
     model: str = "slides",
     feedforward=None,
+    route=None,
 ) -> RunResult:
     """Run MuJoCo on the real linkage.
 
@@ -118,12 +121,15 @@ def simulate_mujoco(
     ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
     required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`). ``model``: 'slides' or 'wheels'
     (on wheels in a pipe, a ratchet in every hub, stepped in Python: :mod:`.wheels_model`, :mod:`.wheels`).
+    ``route``: a :class:`ipir_mujoco.core.route.Route` (the wheeled model only): the walls along it, the run
+    ended at its end or where the robot jams (:mod:`.route_watch`).
     """
     params = require_params(params)
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
     check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
     check_mujoco_model(model, params, implementation)
+    params = check_route(route, model, params, until_steady)
     check_clutch_options(params, clutch, implementation)
     controller_for(params, feedforward)  # refused here, before any work, if the table does not fit
     if servo is not None and params.drive == "servo":
@@ -141,7 +147,7 @@ def simulate_mujoco(
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
-                   wheeled=model == "wheels", feedforward=feedforward)
+                   wheeled=model == "wheels", feedforward=feedforward, route=route)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
@@ -166,7 +172,7 @@ class _Run:
 
     def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
                  until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, feedforward=None,
-                 started=None):
+                 route=None, started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
         self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
@@ -178,8 +184,9 @@ class _Run:
         self.compliant = params.clutch_stiffness is not None
         self.wheeled = wheeled  # the wheeled model (.wheels_model), else the slide model
         self.model_settings = {"mujoco_model": "wheels", **ContactSettings().as_dict()} if wheeled else {}
-        self.model = (build_wheels_model(params, settings, mjcf=mjcf) if wheeled
-                      else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
+        self.route = route
+        self.model = (build_wheels_model(params, settings, mjcf=mjcf, decorate=route_decorator(params, route))
+                      if wheeled else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
         self.data = mujoco.MjData(self.model)
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
@@ -225,6 +232,7 @@ class _Run:
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.model_settings},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
+            route=self.route_watch and self.route_watch.record(self.t_end, self.stall),
         )
 
     def _setup(self):
@@ -241,6 +249,7 @@ class _Run:
         self.loop = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
                                  controller if self.compliant else None, wheeled=self.wheeled)
+        self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out)  # None without a route
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
@@ -270,7 +279,7 @@ class _Run:
                                       crank_v=self.loop["crank_v"], dt=m.opt.timestep)
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
-        checks = _BlockChecks(self)
+        checks = BlockChecks(self)
         pending, last = -1, None  # the first interval has no sample before it to fill in
         while done < n_steps:
             first = rec.count
@@ -355,52 +364,3 @@ class _Run:
                                   "(a smaller --timestep may carry the run further)")
         if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
             raise SimulationError(f"non-finite state after t={t_good:.6g} s")
-
-
-class _BlockChecks:
-    """What the run checks every BLOCK_TIME of simulated time: progress, budget, steady state, stall."""
-
-    def __init__(self, run: _Run):
-        self.run = run
-        self.next_report = 0.1
-        self.fed = 0  # samples given to the steady-state watch so far
-        rec = run.recorder
-        self.r1, self.f2 = rec.qa[REAR_SLIDE], rec.qa[FRONT_SLIDE]
-        self.v_adr = [rec.va[n] for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
-        self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
-            if run.until_steady else None
-        # a stall is final only under constant loads: not with a crank servo's time-varying torque; the speed
-        # controller's only while it asks for full voltage (:meth:`_stall`)
-        self.stall_watch = run.servo is None
-
-    def check(self, newest: int, messages: list[str]) -> int | None:
-        """Returns the row to end the run at (steady state or stall), or None to go on."""
-        run, rec = self.run, self.run.recorder
-        t = float(rec.t[newest])
-        run._check(messages, float(rec.t[max(newest - 1, 0)]))
-        if run.progress is not None and t >= self.next_report - 1e-12:
-            run.progress(t)
-            self.next_report = 0.1 * (math.floor(t / 0.1 + 1e-9) + 1)
-        if run.wall_budget_s is not None and time.perf_counter() - run.started > run.wall_budget_s:
-            raise SimulationError(f"the run exceeded its wall-time budget of {run.wall_budget_s:g} s at "
-                                  f"t={t:.6g} s (simulated)")
-        if self.watch is not None:
-            q = rec.qpos[self.fed:newest + 1]
-            travel = 0.5 * (q[:, self.r1] - rec.qpos[0, self.r1] + q[:, self.f2] - rec.qpos[0, self.f2])
-            steady = self.watch.update(rec.t[self.fed:newest + 1], q[:, rec.qa[CRANK_HINGE]], travel)
-            self.fed = newest + 1
-            if steady:
-                return int(np.searchsorted(rec.t[:newest + 1], self.watch.steady_at - 1e-12, side="left"))
-        if self.stall_watch:
-            return self._stall(newest, t)
-        return None
-
-    def _stall(self, newest: int, t: float) -> int | None:
-        rec = self.run.recorder
-        v = rec.qvel[:newest + 1]
-        since = rest_since(rec.t[:newest + 1], v[:, self.v_adr[0]], v[:, self.v_adr[1]], v[:, self.v_adr[2]],
-                           self.run.params.r)
-        if since is None or (self.run.ticked is not None and not self.run.ticked.saturated_since(since)):
-            return None
-        self.run.stall = stall_reason(self.run.params, since, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
-        return newest

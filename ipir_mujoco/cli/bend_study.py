@@ -1,0 +1,126 @@
+"""``ipir-mujoco bend-study``: time and energy for the wheeled robot to pass a 90-degree bend, against R/D."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import sys
+from pathlib import Path
+
+from ipir_mujoco.core.params import check_whole
+from ipir_mujoco.core.results import write_json
+
+from ..output import check_output_dir, staged_output
+from .common import EXIT_OK, model_params
+
+FILES = ("bend_study.csv", "bend_study.json", "bend_study.png")
+
+
+def add_parser(commands) -> None:
+    cmd = commands.add_parser(
+        "bend-study", help="the wheeled MuJoCo robot through a 90-degree bend: time and energy against R/D",
+        description="Run the wheeled MuJoCo model (--mujoco-model wheels) along a route with a 90-degree bend for "
+                    "each R/D, and the same length of straight pipe; time and motor work from the front module "
+                    "entering the bend to the rear module leaving it, beside the analytic finite-grip model's "
+                    "straight-pipe prediction over that length. Writes DIR/bend_study.csv, DIR/bend_study.json and "
+                    "the figure DIR/bend_study.png; prints the table.")
+    cmd.add_argument("--ratios", metavar="LIST", default=None,
+                     help="bend radius over pipe diameter, R/D: a comma-separated list (default 0.6,1,1.5,2,3,5,7.5,10)")
+    cmd.add_argument("--quick", action="store_true", help="R/D 2 and 5 only, for a first look")
+    cmd.add_argument("--workers", type=int, default=None, help="processes to use (default: all cores)")
+    cmd.add_argument("--out", metavar="DIR", default="bend-study", help="results folder (default ./bend-study)")
+    cmd.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                     help="a robot parameter (SI units), e.g. pipe_diameter=0.2; the study runs the default motor "
+                          "and, unless given, mu_wall 0.8")
+    cmd.add_argument("--config", metavar="FILE.toml", help="TOML file of robot parameters; --set wins over it")
+    cmd.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..report.bend_figure import write_bend_figure
+    from ..studies import bend_study as bs
+    from ..studies.clutch_study import parse_values
+
+    params = bs.study_params(model_params(args))
+    ratios = parse_values("--ratios", args.ratios, log=False) if args.ratios is not None else \
+        (bs.RATIOS_QUICK if args.quick else bs.RATIOS)
+    bs.check_ratios(ratios, params)
+    workers = (os.cpu_count() or 1) if args.workers is None else check_whole("workers", args.workers, low=1, high=1024)
+    check_output_dir(args.out, files=FILES)
+
+    def progress(message: str) -> None:
+        print(f"bend-study: {message}", file=sys.stderr, flush=True)
+
+    progress(f"{len(ratios)} bends and their straight twins on {workers} processes (each ~2 s of wall time per "
+             "simulated second)")
+    study = bs.run_study(params, ratios, workers=workers, progress=progress)
+    with staged_output(args.out) as staging:
+        write_csv(staging / FILES[0], study)
+        write_json(staging / FILES[1], study)
+        write_bend_figure(study, staging / FILES[2])
+    print(format_table(study))
+    print(f"{len(study['rows'])} bends in {study['wall_s']:.1f} s; results: "
+          + ", ".join(str(Path(args.out) / f) for f in FILES))
+    return EXIT_OK
+
+
+COLUMNS = ("R_over_D", "radius_m", "window_m", "analytic_time_s", "analytic_energy_j", "straight_time_s",
+           "straight_energy_j", "bend_time_s", "bend_energy_j", "bend_passed", "bend_route_stop",
+           "bend_wheel_off_s", "bend_module_off_s", "bend_arm_reach", "bend_residual_ratio", "bend_skid_j",
+           "predicted")
+
+
+def _flat(row: dict) -> dict:
+    b, s, a = row["bend"], row["straight"], row["analytic"]
+    return {"R_over_D": row["R_over_D"], "radius_m": row["radius_m"], "window_m": row["window_m"],
+            "analytic_time_s": a["time_s"], "analytic_energy_j": a["energy_j"], "straight_time_s": s.get("time_s"),
+            "straight_energy_j": s.get("energy_j"), "bend_time_s": b.get("time_s"), "bend_energy_j": b.get("energy_j"),
+            "bend_passed": b.get("passed"), "bend_route_stop": b.get("error", b.get("route_stop")),
+            "bend_wheel_off_s": b.get("route_wheel_off_s"), "bend_module_off_s": b.get("route_module_off_s"),
+            "bend_arm_reach": b.get("route_arm_reach"), "bend_residual_ratio": b.get("residual_ratio"),
+            "bend_skid_j": b.get("skid_j"), "predicted": b.get("predicted")}
+
+
+def write_csv(path: Path, study: dict) -> None:
+    """One row per R/D, the columns of COLUMNS (units in their names)."""
+    with open(path, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(COLUMNS)
+        for row in study["rows"]:
+            flat = _flat(row)
+            writer.writerow(["" if flat[c] is None else repr(flat[c]) if isinstance(flat[c], float) else flat[c]
+                             for c in COLUMNS])
+
+
+def _short(predicted: str) -> str:
+    """The closed-form fit's line in a word or two."""
+    for start, word in (("passes", "passes"), ("jams", "housing jams"), ("the linkage", "rod binds"),
+                        ("a wheel", "wall lost")):
+        if predicted.startswith(start):
+            return word
+    return predicted
+
+
+def format_table(study: dict) -> str:
+    """The study as text: per R/D the passage's time and energy, MuJoCo in the bend / in a straight / the analytic
+    model's straight prediction, and how the run ended."""
+    def num(v, digits=4):
+        return "n/a" if v is None else f"{v:.{digits}g}"
+
+    header = ["R/D", "window [m]", "time [s] bend / straight / analytic", "energy [J] bend / straight / analytic",
+              "wheels off [s]", "closed form", "outcome"]
+    rows = []
+    for row in study["rows"]:
+        f = _flat(row)
+        rows.append([f"{f['R_over_D']:g}", f"{f['window_m']:.3f}",
+                     f"{num(f['bend_time_s'])} / {num(f['straight_time_s'])} / {num(f['analytic_time_s'])}",
+                     f"{num(f['bend_energy_j'])} / {num(f['straight_energy_j'])} / {num(f['analytic_energy_j'])}",
+                     num(f["bend_wheel_off_s"], 3),
+                     _short(f["predicted"] or ""),
+                     "passed" if f["bend_passed"] else f"stopped: {f['bend_route_stop']}"])
+    widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
+    lines = ["  ".join(str(x).ljust(w) for x, w in zip(r, widths)) for r in [header] + rows]
+    ref = study["reference"]
+    lines.append(f"analytic straight pipe: {ref['steady_speed_m_s']:.5g} m/s, {ref['energy_per_metre_j_m']:.5g} J/m")
+    return "\n".join(lines)

@@ -1,0 +1,66 @@
+"""What a MuJoCo run checks every BLOCK_TIME of simulated time (:mod:`.simulate`'s loop): progress, the
+wall-time budget, the periodic steady state, a route's end or jam, and a stall."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ipir_mujoco.core.cycles import SteadyWatch
+from ipir_mujoco.core.errors import SimulationError
+
+from .common import rest_since, stall_reason
+from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
+
+
+class BlockChecks:
+    """What the run checks every BLOCK_TIME of simulated time: progress, budget, steady state, stall."""
+
+    def __init__(self, run):
+        self.run = run
+        self.next_report = 0.1
+        self.fed = 0  # samples given to the steady-state watch so far
+        rec = run.recorder
+        self.r1, self.f2 = rec.qa[REAR_SLIDE], rec.qa[FRONT_SLIDE]
+        self.v_adr = [rec.va[n] for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
+        self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
+            if run.until_steady else None
+        # a stall is final only under constant loads: not with a crank servo's time-varying torque; the speed
+        # controller's only while it asks for full voltage (:meth:`_stall`)
+        self.stall_watch = run.servo is None
+
+    def check(self, newest: int, messages: list[str]) -> int | None:
+        """Returns the row to end the run at (steady state or stall), or None to go on."""
+        run, rec = self.run, self.run.recorder
+        t = float(rec.t[newest])
+        run._check(messages, float(rec.t[max(newest - 1, 0)]))
+        if run.progress is not None and t >= self.next_report - 1e-12:
+            run.progress(t)
+            self.next_report = 0.1 * (math.floor(t / 0.1 + 1e-9) + 1)
+        if run.wall_budget_s is not None and time.perf_counter() - run.started > run.wall_budget_s:
+            raise SimulationError(f"the run exceeded its wall-time budget of {run.wall_budget_s:g} s at "
+                                  f"t={t:.6g} s (simulated)")
+        if self.watch is not None:
+            q = rec.qpos[self.fed:newest + 1]
+            travel = 0.5 * (q[:, self.r1] - rec.qpos[0, self.r1] + q[:, self.f2] - rec.qpos[0, self.f2])
+            steady = self.watch.update(rec.t[self.fed:newest + 1], q[:, rec.qa[CRANK_HINGE]], travel)
+            self.fed = newest + 1
+            if steady:
+                return int(np.searchsorted(rec.t[:newest + 1], self.watch.steady_at - 1e-12, side="left"))
+        if run.route_watch is not None and (stop := run.route_watch.check(newest)) is not None:
+            return stop
+        if self.stall_watch:
+            return self._stall(newest, t)
+        return None
+
+    def _stall(self, newest: int, t: float) -> int | None:
+        rec = self.run.recorder
+        v = rec.qvel[:newest + 1]
+        since = rest_since(rec.t[:newest + 1], v[:, self.v_adr[0]], v[:, self.v_adr[1]], v[:, self.v_adr[2]],
+                           self.run.params.r)
+        if since is None or (self.run.ticked is not None and not self.run.ticked.saturated_since(since)):
+            return None
+        self.run.stall = stall_reason(self.run.params, since, float(rec.qpos[newest, rec.qa[CRANK_HINGE]]))
+        return newest

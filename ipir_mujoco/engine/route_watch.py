@@ -1,0 +1,223 @@
+"""A wheeled run along a route (``--route``): where the robot is along it, and why the run stops.
+
+:class:`RouteWatch` reads the recorded samples every block of the run loop (:mod:`.simulate`): the rear
+module's point A (its x and y slides: the crank's axis) projected on the route's centreline
+(:meth:`ipir_mujoco.core.route.Route.project`) is the robot's distance along the route, ``route_s_m`` (the
+furthest so far). The run stops, with one line in ``route_stop``, when
+
+- the rear module reaches the route's end (``route_done`` true, ``route_time_s`` the time it did,
+  interpolated between samples);
+- the robot slid back out of the pipe behind the route's start (the walls reach LEAD_IN behind it);
+- no progress: the distance along the route grew by less than PROGRESS_M in PROGRESS_S (the crank turns
+  and the robot skids or rocks in place, or the crank stands: the message says which);
+- or the run's own ends: t_end, a stall (the robot at rest for good), a failure.
+
+A wheel that lost its wall (its spring pressing with less than LOST_SHARE of its preload, for WALL_LOSS_S
+without a break) is reported (``route_wall_loss``, with how long wheels and whole modules were off their
+walls) but does not stop the run: in tight bends the modules ride on two diagonal wheels, or float on the
+linkage for a moment, and still get through (measured: R/D = 2, mjcf/README.md), so a lost wall alone is no
+jam. A robot that no longer progresses is one, and its stop line says whether a wheel had lost its wall.
+
+Every check reads recorded samples, so its times are good to one output interval.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ipir_mujoco.core.route import Route
+
+from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, qpos_address
+from .route_walls import LEAD_IN
+from .wheels_model import ARMS, LATERALS, SPRING_TRAVEL
+
+WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
+LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
+PROGRESS_M = 0.01  # m: the least progress along the route in PROGRESS_S (a tenth of a stroke, 2 r)
+PROGRESS_S = 2.0  # s: (the default motor makes ~7 revolutions in it)
+BACK_OUT = LEAD_IN - 0.1  # m: the rear module this far behind the start has its aft wheels (0.075 m back) at the
+# walls' end
+
+
+class RouteWatch:
+    """The route's checks on one run (module docstring); ``model`` the compiled wheeled model with the route's
+    walls, ``recorder`` the run's :class:`.recorder.Recorder`."""
+
+    def __init__(self, route: Route, model, recorder, prediction: dict, dt_out: float):
+        self.route, self.rec, self.prediction = route, recorder, prediction
+        self.x, self.y = qpos_address(model, REAR_SLIDE), qpos_address(model, LATERALS[0])
+        # the front module's point C: its body's place in the template plus its slides (both in the world's axes)
+        self.fx, self.fy = qpos_address(model, FRONT_SLIDE), qpos_address(model, LATERALS[1])
+        self.front0 = [float(v) for v in model.body("front_module").pos[:2]]
+        self.s_front = 0.0
+        self.crank = qpos_address(model, CRANK_HINGE)
+        self.arms = [qpos_address(model, n) for n in ARMS]
+        self.free = SPRING_TRAVEL  # the arm slide's springref: the spring's free length
+        self.fed = 0
+        self.s_max = 0.0
+        self.s_last = 0.0
+        self.progress_at = (0.0, 0.0, 0.0)  # (t, s, crank angle) when progress last passed PROGRESS_M
+        self.off_since: list[float | None] = [None] * len(self.arms)
+        self.done_at: float | None = None
+        self.off_time = 0.0  # s: samples' time with some wheel off its wall (below LOST_SHARE of its preload)
+        self.module_off_time = 0.0  # s: samples' time with every wheel of a module off its wall
+        self.lost: str | None = None  # the first wheel off its wall for WALL_LOSS_S, in words
+        self.reach = 0.0  # the largest arm slide over the spring's free length (1: a spring unloaded)
+        self.dt = dt_out
+        self.marks = [p.s0 for p in route.pieces] + [route.length]
+        self.mark_times: list[float | None] = [None] * len(self.marks)
+        self.stop: str | None = None
+
+    def check(self, newest: int) -> int | None:
+        """Feed the samples up to row ``newest``; the row to end the run at, or None to go on."""
+        rec = self.rec
+        rows = range(self.fed, newest + 1)
+        self.fed = newest + 1
+        q, t = rec.qpos, rec.t
+        length = self.route.length
+        for i in rows:
+            ti = float(t[i])
+            s = self._along(float(q[i, self.x]), float(q[i, self.y]), self.s_last)
+            t0 = float(t[i - 1]) if i > 0 else ti
+            front = self._along(self.front0[0] + float(q[i, self.fx]), self.front0[1] + float(q[i, self.fy]),
+                                self.s_front)
+            centre, before = 0.5 * (s + front), 0.5 * (self.s_last + self.s_front)
+            self.s_front = front
+            for k, mark in enumerate(self.marks):  # when the robot's centre first reached each piece's start
+                if self.mark_times[k] is None and centre >= mark:
+                    share = (mark - before) / (centre - before) if centre > before else 1.0
+                    self.mark_times[k] = t0 + share * (ti - t0)
+            if s >= length and self.done_at is None:
+                share = (length - self.s_last) / (s - self.s_last) if s > self.s_last else 1.0
+                self.done_at = t0 + share * (ti - t0)
+                self.s_last = self.s_max = s
+                self.stop = f"reached the route's end ({length:.3f} m) at t = {self.done_at:.4f} s"
+                return i
+            if s < -BACK_OUT:
+                self.stop = (f"slid back out of the pipe: the rear module {-s:.3f} m behind the route's start at "
+                             f"t = {ti:.4f} s (the walls end {LEAD_IN:g} m behind it)")
+                return i
+            self.s_last = s
+            self.s_max = max(self.s_max, s)
+            if self.s_max - self.progress_at[1] >= PROGRESS_M:
+                self.progress_at = (ti, self.s_max, float(q[i, self.crank]))
+            elif ti - self.progress_at[0] >= PROGRESS_S:
+                turns = (float(q[i, self.crank]) - self.progress_at[2]) / (2 * math.pi)
+                why = (f"the crank turned {turns:.2f} revolutions" if abs(turns) >= 0.05
+                       else "the crank stood: the linkage bound, or the drive too weak")
+                if self.lost is not None:
+                    why += f"; {self.lost}"
+                self.stop = (f"stalled: less than {PROGRESS_M * 1e3:g} mm of progress in {PROGRESS_S:g} s "
+                             f"({why}), at {self.route.where(self.s_max)}, t = {ti:.4f} s")
+                return i
+            self._wheels(q[i, self.arms], ti)
+        return None
+
+    def _wheels(self, arms: np.ndarray, t: float) -> None:
+        """Note which wheels press with less than LOST_SHARE of their preload at one sample (``arms``: the arm
+        slides [m]; the spring presses with 1 - q / SPRING_TRAVEL of its preload, the light arm's contact with
+        as much but for the arm's inertia)."""
+        self.reach = max(self.reach, float(arms.max()) / self.free)
+        off = arms > (1.0 - LOST_SHARE) * self.free
+        if off.any():
+            self.off_time += self.dt
+        half = len(self.arms) // 2
+        if off[:half].all() or off[half:].all():
+            self.module_off_time += self.dt
+        for k in np.flatnonzero(off):
+            since = self.off_since[k]
+            if since is None:
+                self.off_since[k] = t
+            elif self.lost is None and t - since >= WALL_LOSS_S:
+                self.lost = (f"wheel {ARMS[k][:-4]} lost its wall (pressing with < {100 * LOST_SHARE:g} % of its "
+                             f"preload for {WALL_LOSS_S:g} s) from t = {since:.4f} s, at "
+                             f"{self.route.where(self.s_max)}")
+        for k in np.flatnonzero(~off):
+            self.off_since[k] = None
+
+    def _along(self, x: float, y: float, near: float) -> float:
+        """A point's distance along the route [m] (near ``near`` [m]), beyond its end along the exit straight and
+        before its start (negative) along the first straight."""
+        s = self.route.project(x, y, near=near)
+        if s <= 0.0:  # behind the start: along the first straight, backwards
+            first = self.route.pieces[0]
+            return min(0.0, (x - first.x) * math.cos(first.heading) + (y - first.y) * math.sin(first.heading))
+        if s >= self.route.length:
+            ex, ey, heading = self.route.at(self.route.length)
+            s = self.route.length + max(0.0, (x - ex) * math.cos(heading) + (y - ey) * math.sin(heading))
+        return s
+
+    def record(self, t_end: float, stall: str | None) -> dict:
+        """The summary's route keys: ``route_done``, ``route_time_s`` [s] or None, ``route_s_m`` [m] (the furthest the
+        rear module got along the route), ``route_length_m``, ``route_stop`` (one line), ``route_wall_loss`` (the
+        first wheel that lost its wall, in words, or None), ``route_wheel_off_s`` [s] (how long some wheel was off
+        its wall), ``route_module_off_s`` [s] (every wheel of a module), ``route_arm_reach`` (the largest arm
+        extension over the spring's free length: 1 unloads a spring), ``route_piece_times_s`` (when the robot's
+        centre, midway along the route between the rear module's A and the front module's C, first reached each
+        segment's start and the route's end [s], or None: it starts about L / 2 into the route), and ``route_fit``
+        (the closed-form prediction, :func:`.route_walls.fit_prediction`)."""
+        stop = self.stop
+        if stop is None:
+            where = self.route.where(self.s_max)
+            if stall is not None:
+                stop = f"stalled: {stall}, at {where}"
+            else:
+                stop = f"t_end {t_end:g} s reached before the route's end, at {where}"
+        return {"route_done": self.done_at is not None, "route_time_s": self.done_at, "route_s_m": self.s_max,
+                "route_length_m": self.route.length, "route_stop": stop, "route_fit": self.prediction,
+                "route_wall_loss": self.lost, "route_wheel_off_s": self.off_time,
+                "route_module_off_s": self.module_off_time, "route_arm_reach": self.reach,
+                "route_piece_times_s": list(self.mark_times)}
+
+
+def check_route(route, model: str, params, until_steady: bool):
+    """``params`` for a run along ``route`` (None: as they are): its incline the route's first straight's;
+    ParameterError (one line) for a route on the slide model, with --until-steady, with an incline set apart
+    from the route's, or whose first straight is shorter than the robot (it starts in it)."""
+    from ipir_mujoco.core.errors import ParameterError
+
+    if route is None:
+        return params
+    if not isinstance(route, Route):
+        raise ParameterError(f"route={route!r}; allowed: a Route (ipir_mujoco.core.route.read_route), or None")
+    if model != "wheels":
+        raise ParameterError("--route applies only to the wheeled model; allowed: --mujoco-model wheels")
+    if until_steady:
+        raise ParameterError("--until-steady with --route: a run along a route ends at the route's end; "
+                             "allowed: one of them")
+    if params.incline != 0.0 and params.incline != route.incline:
+        raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
+                             "incline; allowed: incline=0 (give it in the route)")
+    route.check_pipe(params.pipe_diameter)
+    from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
+
+    reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
+    first = route.pieces[0]
+    if first.length < reach:
+        raise ParameterError(f"{route.source}: segment 1: length={first.length:g} m; the robot starts in it and "
+                             f"reaches L + r + {reach - params.L - params.r:g} m ahead of its rear module; allowed: "
+                             f"length >= {reach:g} m")
+    return params.replace(incline=route.incline)
+
+
+def route_decorator(params, route):
+    """``build_wheels_model``'s decorate for the route's walls (:func:`.route_walls.write_route_walls`), or
+    None without a route."""
+    if route is None:
+        return None
+    from .route_walls import write_route_walls
+
+    return lambda spec: write_route_walls(spec, params, route)
+
+
+def route_watch(route: Route | None, model, recorder, params, dt_out: float) -> RouteWatch | None:
+    """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
+    geometry (:func:`.route_walls.fit_prediction`)."""
+    if route is None:
+        return None
+    from .route_walls import fit_prediction
+    from .wheels_model import STATION_OFFSET
+
+    return RouteWatch(route, model, recorder, fit_prediction(route, params, STATION_OFFSET, SPRING_TRAVEL), dt_out)

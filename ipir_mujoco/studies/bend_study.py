@@ -1,0 +1,160 @@
+"""The bend study (``ipir-mujoco bend-study``): time and energy for the wheeled robot to pass a 90-degree bend,
+against the bend's R/D, beside the straight-pipe predictions over the same centreline length.
+
+Each case is a route (:mod:`ipir_mujoco.core.route`): a lead-in straight of LEAD_IN + L / 2 (the robot reaches its
+cruise before the bend: L is the rod, about the distance from the rear module's crank axis A to the front module's
+C), a 90-degree bend of centreline radius R = (R/D) D, L / 2 + EXIT after it. The *passage* is the window from the
+robot's centre (midway between A and C along the route) L / 2 before the bend (the front module entering it) to L /
+2 after it (the rear module leaving it): a centreline length L + pi R / 2. (The centre moves more evenly than either
+module, which stands half of each revolution; its crossing times still carry about r / 2 / v, 0.05 s, of the
+stroke's ripple.) Its time and the motor's work over it come from the wheeled MuJoCo run (``mujoco-wheels`` with the
+route, the rear module's progress along the centreline, :mod:`ipir_mujoco.engine.route_watch`), with how it ended
+(done, or where and why it stopped), the closed-form fit beside it, and how long wheels were off their walls.
+
+The references over the same length: the analytic finite-grip model's (``analytic-unilateral``) periodic
+steady state in a straight pipe, speed v and energy per metre e: time length / v, energy e x length; and the
+wheeled model's own straight pipe (the same route with the bend straightened: its marks at the same
+distances), so that what the bend costs is told apart from what the wheels cost in any pipe.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ipir_mujoco import registry
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.route import route_from_tables
+
+from .pool import map_unordered
+
+RATIOS = (0.6, 1.0, 1.5, 2.0, 3.0, 5.0, 7.5, 10.0)  # R/D, the default
+RATIOS_QUICK = (2.0, 5.0)
+LEAD_IN = 0.6  # m: straight before the passage's window (the default motor reaches its cruise in ~1 s)
+EXIT = 0.05  # m: straight after the bend
+DT_OUT = 1e-3  # s: the samples the progress is read from (the passage's times are good to this)
+T_CAP_PER_M = 20.0  # s per metre of route: the run's cap (the default motor cruises at ~0.53 m/s: 1.9 s/m)
+MU_WALL = 0.8  # the study's wall friction unless --set gives one: the straight-pipe acceptance case
+
+
+def study_params(base: RobotParams) -> RobotParams:
+    """The study's parameters: ``base`` with the motor, and mu_wall MU_WALL where it is unlimited."""
+    if base.incline != 0.0:
+        raise ParameterError(f"incline={base.incline:g} deg: the bend study's bends are horizontal; allowed: "
+                             "incline=0")
+    return base.replace(drive="motor", mu_wall=MU_WALL if base.mu_wall is None else base.mu_wall)
+
+
+def case_route(params: RobotParams, ratio: float):
+    """The route of one case: the lead-in, a 90-degree bend of R/D ``ratio``, the exit."""
+    half = dict(kind="straight", length=params.L / 2)
+    return route_from_tables([dict(kind="straight", length=LEAD_IN), half,
+                              dict(kind="bend", radius=ratio * params.pipe_diameter, angle=90.0), half,
+                              dict(kind="straight", length=EXIT)], "bend study")
+
+
+def straight_route(params: RobotParams, length: float):
+    """The straightened route: the same marks as a bend's of centreline length ``length`` [m]."""
+    half = dict(kind="straight", length=params.L / 2)
+    return route_from_tables([dict(kind="straight", length=LEAD_IN), half, dict(kind="straight", length=length),
+                              half, dict(kind="straight", length=EXIT)], "bend study")
+
+
+def check_ratios(ratios: Sequence[float], params: RobotParams) -> None:
+    """ParameterError (one line) for an R/D the pipe cannot have: above 1/2 (the inner wall), at most 100."""
+    if not ratios:
+        raise ParameterError("--ratios is empty; allowed: one or more R/D values, 0.5 < R/D <= 100")
+    for r in ratios:
+        if not (isinstance(r, (int, float)) and math.isfinite(r) and 0.5 < r <= 100):
+            raise ParameterError(f"--ratios {r!r} is out of range; allowed: R/D > 0.5 and <= 100")
+        if r * params.pipe_diameter > 100:
+            raise ParameterError(f"--ratios {r:g}: radius {r * params.pipe_diameter:g} m; allowed: radius <= 100 m")
+
+
+def _passage(run, route, first: int, last: int) -> dict:
+    """The window from the robot's centre at mark ``first`` to mark ``last`` (route pieces' starts): time [s]
+    and the energy the robot used [J] (the motor's work less the kinetic energy gained: the window's ends fall
+    at any phase of a revolution, whose kinetic energy swings by tenths of a joule), or None where the run did
+    not get there."""
+    s = run.summary
+    times = s["route_piece_times_s"]
+    t_a, t_b = times[first], times[last]
+    out = {"route_done": s["route_done"], "route_stop": s["route_stop"], "route_s_m": s["route_s_m"],
+           "route_length_m": s["route_length_m"], "route_wall_loss": s["route_wall_loss"],
+           "route_wheel_off_s": s["route_wheel_off_s"], "route_module_off_s": s["route_module_off_s"],
+           "route_arm_reach": s["route_arm_reach"], "predicted": s["route_fit"]["predicted"],
+           "wheels_keep_wall": all(b["wheels_keep_wall"] for b in s["route_fit"]["bends"]),
+           "timestep_s": run.settings["timestep"], "residual_ratio": s["accuracy"].get("residual_ratio"),
+           "skid_j": run.energy.get("skid_j"), "passed": t_b is not None, "time_s": None, "energy_j": None}
+    if t_a is not None and t_b is not None:
+        work = np.interp([t_a, t_b], run.series["t"], run.series["motor_work"])
+        kinetic = np.interp([t_a, t_b], run.series["t"], run.series["kinetic"])
+        out.update(time_s=t_b - t_a, energy_j=float(work[1] - work[0] - (kinetic[1] - kinetic[0])))
+    return out
+
+
+def run_case(params: RobotParams, item: tuple[str, float]) -> dict:
+    """One case in a worker: ('bend', R/D) or ('straight', R/D: its bend's length straightened)."""
+    kind, ratio = item
+    started = time.perf_counter()
+    arc = math.pi / 2 * ratio * params.pipe_diameter
+    route = straight_route(params, arc) if kind == "straight" else case_route(params, ratio)
+    t_cap = T_CAP_PER_M * route.length
+    try:
+        run = registry.run("mujoco-wheels", params, t_cap, dt_out=DT_OUT, route=route, accuracy="warn")
+    except SimulationError as exc:
+        return {"kind": kind, "R_over_D": ratio, "error": str(exc), "passed": False,
+                "wall_s": time.perf_counter() - started}
+    out = _passage(run, route, 1, 4)
+    out.update(kind=kind, R_over_D=ratio, radius_m=ratio * params.pipe_diameter, window_m=params.L + arc,
+               wall_s=time.perf_counter() - started)
+    return out
+
+
+def reference(params: RobotParams) -> dict:
+    """The analytic finite-grip model's straight-pipe steady state: speed [m/s], energy per metre [J/m]."""
+    run = registry.run("analytic-unilateral", params, 30.0, dt_out=1e-3, until_steady=True)
+    s = run.summary
+    if not s["steady"]:
+        raise SimulationError("bend study: the analytic straight-pipe reference reached no steady state in 30 s")
+    return {"steady_speed_m_s": s["steady_speed_m_s"], "energy_per_metre_j_m": s["energy_per_metre_j_m"]}
+
+
+def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: int = 1,
+              progress: Callable[[str], None] = lambda _m: None) -> dict:
+    """The study (module docstring) as a JSON-ready dict: ``rows`` (one per R/D: the bend's passage, its
+    straightened twin's, the analytic reference over the same length), ``reference``, ``settings``,
+    ``wall_s``."""
+    started = time.perf_counter()
+    params = study_params(base)
+    check_ratios(ratios, params)
+    ref = reference(params)
+    items = [(kind, r) for r in sorted(ratios, reverse=True) for kind in ("bend", "straight")]  # longest first
+    results: dict[tuple[str, float], dict] = {}
+
+    def done(item, result) -> None:
+        results[item] = result
+        kind, r = item
+        status = (result["error"] if "error" in result else
+                  f"passage {result['time_s']:.3f} s, {result['energy_j']:.3f} J" if result["passed"] else
+                  f"did not pass: {result['route_stop']}")
+        progress(f"[{len(results)}/{len(items)}] R/D {r:g} {kind}: {status} ({result['wall_s']:.1f} s wall)")
+
+    map_unordered(functools.partial(run_case, params), items, workers, done)
+    rows = []
+    for r in sorted(ratios):
+        bend, straight = results[("bend", r)], results[("straight", r)]
+        window = params.L + math.pi / 2 * r * params.pipe_diameter
+        analytic = {"time_s": window / ref["steady_speed_m_s"], "energy_j": window * ref["energy_per_metre_j_m"]}
+        rows.append({"R_over_D": r, "radius_m": r * params.pipe_diameter, "window_m": window, "bend": bend,
+                     "straight": straight, "analytic": analytic})
+    return {"rows": rows, "reference": ref,
+            "settings": {"lead_in_m": LEAD_IN, "exit_m": EXIT, "dt_out_s": DT_OUT, "angle_deg": 90.0,
+                         "params": params.as_dict(), "window": "front module entering (A at the bend's start - L) "
+                                                              "to rear module leaving (A at its end)"},
+            "wall_s": time.perf_counter() - started}

@@ -1,0 +1,229 @@
+"""Routes for the wheeled MuJoCo model (``--route``): parsing and bad input, the centreline, the closed-form fit
+against hand cases, a straight route against the straight pipe, a bend that ends with a reason.
+
+Tolerances are derived where they are used (the centreline's round-off, one output interval, the contact
+geometry's round-off)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from ipir_mujoco import registry
+from ipir_mujoco.analytic import ParameterError, RobotParams
+from ipir_mujoco.core.pipe import bend_max_length, bend_rod_clearance, bend_wheel_spread
+from ipir_mujoco.core.route import read_route, route_from_tables
+
+CRUISE = RobotParams(drive="motor", mu_wall=0.8)
+BEND = [dict(kind="straight", length=0.4), dict(kind="bend", radius=1.0, angle=90.0),
+        dict(kind="straight", length=0.5, incline=0.0)]
+
+
+def test_a_route_file_is_read_into_its_centreline(tmp_path):
+    path = tmp_path / "route.toml"
+    path.write_text('[[segment]]\nkind = "straight"\nlength = 0.3\n\n[[segment]]\nkind = "bend"\nradius = 1.0\n'
+                    'angle = 90\n\n[[segment]]\nkind = "straight"\nlength = 0.5\n')
+    route = read_route(path)
+    assert route.length == pytest.approx(0.3 + math.pi / 2 + 0.5, rel=1e-15)
+    # the bend turns towards +y about a centre at (0.3, 1): it ends at (1.3, 1) heading +y, the exit at (1.3, 1.5)
+    x, y, heading = route.at(route.length)
+    assert (x, y, heading) == pytest.approx((1.3, 1.5, math.pi / 2), abs=1e-12)
+    # a point on the arc's 45-degree radius, 0.05 m off the centreline, projects to the arc's middle
+    c = math.cos(math.pi / 4)
+    s = route.project(0.3 + 1.05 * c, 1.0 - 1.05 * c)
+    assert s == pytest.approx(0.3 + math.pi / 4, abs=1e-12)
+    assert "bend 1" in route.where(s)
+
+
+@pytest.mark.parametrize("tables, word", [
+    ([dict(kind="bend", radius=1.0, angle=90)], "a straight first"),
+    ([dict(kind="straight", length=-1.0)], "length > 0"),
+    ([dict(kind="straight", length=1.0), dict(kind="bend", radius=1.0, angle=0)], "not 0"),
+    ([dict(kind="straight", length=1.0), dict(kind="bend", radius=1.0, angle=200)], "<= 180"),
+    ([dict(kind="straight", length=1.0), dict(kind="bend", angle=90)], "radius"),
+    ([dict(kind="straight", length=1.0, incline=95)], "incline"),
+    ([dict(kind="straight", length=1.0, width=2)], "'width' is unknown"),
+    ([dict(kind="elbow", length=1.0)], "kind"),
+    ([], "1..100 segments"),
+    # a plane tilted by 30 degrees: after a 90-degree bend the pipe runs level, not still at 30 degrees
+    ([dict(kind="straight", length=1.0, incline=30), dict(kind="bend", radius=1.0, angle=90),
+      dict(kind="straight", length=1.0, incline=30)], "allowed: incline = 0"),
+])
+def test_a_bad_route_is_refused_in_one_line(tables, word):
+    with pytest.raises(ParameterError, match=word) as info:
+        route_from_tables(tables, "r.toml")
+    assert "\n" not in str(info.value) and "allowed" in str(info.value)
+
+
+def test_the_closed_form_fits_against_hand_cases():
+    """Numbers chosen so that the square roots are exact: a station b = 0.3 m off the module's middle, wheel
+    centres on circles of 0.5 m (outer: R + D/2 - R_w) and 0.34 m (inner: R - D/2 + R_w), so 0.4 m and
+    0.16 m from the tangent along the station's line: 0.24 m apart where a straight pipe holds them
+    D - 2 R_w = 0.16 m apart."""
+    assert bend_wheel_spread(0.3, 0.01, 0.42, 0.18) == pytest.approx(0.08, abs=1e-15)
+    assert bend_wheel_spread(0.0, 0.01, 0.42, 0.18) == pytest.approx(0.0, abs=1e-15)  # on the radius: D
+    # a rectangle 0.1 m wide with its inner side on the inner wall's tangent (0.05 m from the centre, a bend of
+    # 0.15 m in a 0.2 m pipe) reaches the outer wall (0.25 m) at a half-length sqrt(0.25^2 - 0.15^2) = 0.2 m
+    assert bend_max_length(0.1, 0.15, 0.2) == pytest.approx(0.4, abs=1e-15)
+    with pytest.raises(ParameterError, match="radius"):
+        bend_wheel_spread(0.025, 0.015, 0.07, 0.16)
+    # a rod of 0.6 m as a chord of a 0.5 m centreline: its middle 0.4 m from the centre, where the inner wall of a
+    # 0.2 m pipe is; a rod 0.01 m thick crosses it by that much
+    assert bend_rod_clearance(0.6, 0.01, 0.5, 0.2) == pytest.approx(-0.01, abs=1e-15)
+    assert bend_rod_clearance(1.2, 0.0, 0.5, 0.2) == -math.inf  # longer than the centreline's diameter
+
+
+def test_a_straight_route_runs_as_the_straight_pipe_and_ends_at_its_end():
+    """Box walls in place of the planes: the same contacts (capsule against a face at the same distance and
+    normal), so the motion is the plane model's to round-off (1e-9 of the travel is far above round-off,
+    far below the monitor's 1e-3); a route shorter than the run ends where the plane model's rear module
+    crossed its length, to one output interval."""
+    dt_out, t_end, length = 1e-3, 1.0, 0.35
+    plain = registry.run("mujoco-wheels", CRUISE, t_end, dt_out=dt_out, timestep=1e-4)
+    long = registry.run("mujoco-wheels", CRUISE, t_end, dt_out=dt_out, timestep=1e-4,
+                        route=route_from_tables([dict(kind="straight", length=0.35), dict(kind="straight", length=4.65)]))
+    for key in ("x1_final", "x2_final", "revolutions"):
+        assert long.summary[key] == pytest.approx(plain.summary[key], rel=1e-9)
+    s = long.summary
+    # the robot's centre, midway between A (x1) and C (x2 + the gap S at the start), reached 0.35 m when the plane
+    # model's did, to one output interval
+    series = plain.series
+    centre = 0.5 * (series["x1"] + series["x2"] + series["S"][0])
+    crossed = series["t"][centre >= 0.35][0]
+    assert crossed - dt_out <= s["route_piece_times_s"][1] <= crossed + 1e-12
+    assert s["route_done"] is False and s["route_time_s"] is None and "t_end" in s["route_stop"]
+    assert s["route_s_m"] == pytest.approx(plain.series["x1"].max(), rel=1e-9)  # the rear module, along x
+    short = registry.run("mujoco-wheels", CRUISE, t_end, dt_out=dt_out, timestep=1e-4,
+                         route=route_from_tables([dict(kind="straight", length=length)]))
+    s = short.summary
+    crossed = plain.series["t"][plain.series["x1"] >= length][0]
+    assert s["route_done"] is True and "end" in s["route_stop"]
+    assert crossed - dt_out <= s["route_time_s"] <= crossed + 1e-12
+    assert short.t_end < t_end
+
+
+def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(capsys, tmp_path):
+    """A tight bend (R/D 2, 30 degrees): the closed form says the wheels need more spread than their springs
+    reach, and MuJoCo's wheels are indeed off their walls for a while; the run either reaches the end or
+    stops with one line, and the summary (JSON, and the lines printed without --json) says which."""
+    from cli_run import run_cli
+
+    path = tmp_path / "bend.toml"
+    path.write_text('[[segment]]\nkind = "straight"\nlength = 0.35\n[[segment]]\nkind = "bend"\nradius = 0.32\n'
+                    'angle = 30\n[[segment]]\nkind = "straight"\nlength = 0.05\n')
+    argv = ("simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--drive", "motor", "--set", "mu_wall=0.8",
+            "--route", path, "--timestep", "5e-5", "--dt-out", "1e-3", "--t-end", "3")
+    code, out, err = run_cli(capsys, *argv, "--json")
+    assert code == 0 and err == ""
+    s = json.loads(out)["summary"]
+    assert isinstance(s["route_done"], bool) and s["route_stop"] and "\n" not in s["route_stop"]
+    if s["route_done"]:
+        assert s["route_time_s"] > 0 and s["route_s_m"] >= s["route_length_m"]
+    else:
+        assert s["route_time_s"] is None and s["route_s_m"] < s["route_length_m"]
+    assert "leaves the wall" in s["route_fit"]["predicted"] and not s["route_fit"]["bends"][0]["wheels_keep_wall"]
+    assert s["route_wheel_off_s"] > 0
+    from ipir_mujoco.cli.simulate import route_lines  # what simulate prints without --json
+
+    printed = "\n".join(route_lines(s))
+    assert ("route done in" in printed) == s["route_done"] and "closed-form fit" in printed
+
+
+def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monkeypatch):
+    """A horizontal pipe with a grip of half the rolling resistance (mu_wall 0.01: 0.5 N against F_r = 1 N): the
+    held module cannot hold the other's resistance, the crank turns and the robot gets nowhere; the run stops
+    after the watch's window (shortened here to keep the test fast) with the reason in one line. A riser with a
+    grip of a quarter of the weight: the robot slides down and out of the pipe behind the route's start."""
+    from ipir_mujoco.engine import route_watch
+
+    monkeypatch.setattr(route_watch, "PROGRESS_S", 0.3)
+    route = route_from_tables([dict(kind="straight", length=1.0)])
+    run = registry.run("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.01), 2.0, dt_out=1e-3, timestep=5e-5,
+                       route=route, accuracy="warn")
+    s = run.summary
+    assert s["route_done"] is False and s["route_stop"].startswith("stalled") and "crank turned" in s["route_stop"]
+    assert "\n" not in s["route_stop"] and run.t_end < 1.0 and s["route_s_m"] < 0.1
+    riser = route_from_tables([dict(kind="straight", length=1.0, incline=90.0)])
+    run = registry.run("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.05), 2.0, dt_out=1e-3, timestep=5e-5,
+                       route=riser, accuracy="warn")
+    s = run.summary
+    assert s["route_done"] is False and s["route_stop"].startswith("slid back out of the pipe")
+    assert run.params.incline == 90.0 and run.series["x1"][-1] < -route_watch.BACK_OUT + 1e-12
+
+
+def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
+    from cli_run import run_cli
+
+    good = tmp_path / "r.toml"
+    good.write_text('[[segment]]\nkind = "straight"\nlength = 1\n')
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[segment]]\nkind = "bend"\nradius = 1\nangle = 90\n')
+    tight = tmp_path / "tight.toml"
+    tight.write_text('[[segment]]\nkind = "straight"\nlength = 1\n[[segment]]\nkind = "bend"\nradius = 0.05\n'
+                     'angle = 90\n')
+    short = tmp_path / "short.toml"
+    short.write_text('[[segment]]\nkind = "straight"\nlength = 0.1\n[[segment]]\nkind = "bend"\nradius = 1\n'
+                     'angle = 90\n')
+    wheels = ("--engine", "mujoco", "--mujoco-model", "wheels")
+    for argv, word in ((("--engine", "mujoco", "--route", good), "--mujoco-model wheels"),
+                       (("--route", good), "--mujoco-model wheels"),
+                       ((*wheels, "--route", bad), "a straight first"),
+                       ((*wheels, "--route", tight), "radius > pipe_diameter / 2"),
+                       ((*wheels, "--route", tmp_path / "none.toml"), "does not exist"),
+                       ((*wheels, "--route", good, "--until-steady", "--drive", "motor"), "--until-steady"),
+                       ((*wheels, "--route", good, "--set", "incline=10"), "incline"),
+                       ((*wheels, "--route", short), "length >= 0.325 m")):
+        code, out, err = run_cli(capsys, "simulate", *argv)
+        assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (argv, err)
+    with pytest.raises(ParameterError, match="wheeled"):
+        registry.run("mujoco-ratchet", CRUISE, 0.1, route=route_from_tables(BEND))
+
+
+def test_the_viewer_builds_the_route_walls():
+    """The interactive viewer's robot (no screen needed to build and step it) carries the route's walls."""
+    from ipir_mujoco.cli.view import ViewedRobot
+    from ipir_mujoco.engine.model import SolverSettings
+
+    robot = ViewedRobot(CRUISE, model="wheels", route=route_from_tables(BEND), settings=SolverSettings(timestep=1e-4))
+    names = {robot.model.geom(i).name for i in range(robot.model.ngeom)}
+    assert {"route_straight1_top", "route_bend1_inner", "route_bend1_outer1"} <= names
+    assert "wall_top" not in names  # the planes are gone
+    robot.step(200)
+
+
+def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsys, tmp_path):
+    """From a study record (the shape run_study gives): the CSV's columns, the table's rows and the figure's
+    points, each the record's numbers over the analytic prediction; bad R/D values are refused in one line."""
+    import csv
+
+    from cli_run import run_cli
+    from matplotlib.figure import Figure
+
+    from ipir_mujoco.cli.bend_study import COLUMNS, format_table, write_csv
+    from ipir_mujoco.report.bend_figure import bend_figure
+
+    def passage(time_s, energy_j, keeps):
+        return {"time_s": time_s, "energy_j": energy_j, "passed": True, "route_stop": "reached the route's end",
+                "route_wheel_off_s": 0.0, "route_module_off_s": 0.0, "route_arm_reach": 0.5, "residual_ratio": 1e-4,
+                "skid_j": 0.0, "predicted": "passes" if keeps else "a wheel leaves the wall", "wheels_keep_wall": keeps}
+
+    rows = [{"R_over_D": r, "radius_m": 0.16 * r, "window_m": w, "bend": passage(tb, eb, r > 2),
+             "straight": passage(ts, es, True), "analytic": {"time_s": ta, "energy_j": ea}}
+            for r, w, tb, eb, ts, es, ta, ea in ((2.0, 0.7, 1.2, 0.9, 1.3, 1.4, 1.32, 1.41),
+                                                 (5.0, 1.46, 2.74, 2.91, 2.73, 2.91, 2.735, 2.913))]
+    study = {"rows": rows, "reference": {"steady_speed_m_s": 0.53, "energy_per_metre_j_m": 2.0},
+             "settings": {"params": RobotParams(mu_wall=0.8).as_dict()}}
+    write_csv(tmp_path / "s.csv", study)
+    with open(tmp_path / "s.csv") as f:
+        read = list(csv.DictReader(f))
+    assert tuple(read[0]) == COLUMNS and float(read[1]["bend_time_s"]) == 2.74
+    assert "2.74 / 2.73 / 2.735" in format_table(study)
+    fig = bend_figure(study)
+    assert isinstance(fig, Figure)
+    bend = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "bend:time"][0]
+    assert list(bend.get_ydata()) == pytest.approx([1.2 / 1.32, 2.74 / 2.735], rel=1e-12)
+    for ratios in ("0.4", "1,abc"):
+        code, out, err = run_cli(capsys, "bend-study", "--ratios", ratios, "--out", tmp_path / "o")
+        assert code == 2 and "--ratios" in err and len(err.strip().splitlines()) == 1
