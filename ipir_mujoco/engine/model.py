@@ -358,21 +358,31 @@ def set_closed_loop_state(model: mujoco.MjModel, data: mujoco.MjData, params: Ro
     clutch rule would free (module 1 if the gap shrinks, module 2 if it grows);
     the gap rate is read from MuJoCo's own kinematics (the rod end's velocity).
     """
+    start_closed_loop(model, data, params)
+    mujoco.mj_forward(model, data)
+
+
+def start_closed_loop(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> tuple[str, float] | None:
+    """Reset ``data`` to the loop-consistent pose at phi0 and, with omega0 != 0, the crank, rod and freed
+    module's velocities (:func:`set_closed_loop_state`; the slide and the wheeled models share it). Returns
+    (the freed module's slide, its speed [m/s]) where omega0 != 0, else None; ``data`` is left before its
+    final ``mj_forward``."""
     mujoco.mj_resetData(model, data)
     for name, value in closed_loop_pose(params, params.phi0).items():
         data.qpos[qpos_address(model, name)] = value
-    if params.omega0 != 0.0:
-        r, L, phi = params.r, params.L, params.phi0
-        beta = math.asin(-r * math.sin(phi) / L)
-        beta_rate = -r * math.cos(phi) * params.omega0 / (L * math.cos(beta))
-        data.qvel[dof_address(model, CRANK_HINGE)] = params.omega0
-        data.qvel[dof_address(model, ROD_HINGE)] = beta_rate - params.omega0
-        mujoco.mj_forward(model, data)
-        gap_rate = site_velocity_x(model, data, ROD_END)  # module 1 at rest: C's speed is the gap rate
-        target = REAR_SLIDE if gap_rate < 0 else FRONT_SLIDE
-        # freeing module 1 at -gap_rate carries A forward and leaves C (module 2) at rest
-        data.qvel[dof_address(model, target)] = abs(gap_rate)
+    if params.omega0 == 0.0:
+        return None
+    r, L, phi = params.r, params.L, params.phi0
+    beta = math.asin(-r * math.sin(phi) / L)
+    beta_rate = -r * math.cos(phi) * params.omega0 / (L * math.cos(beta))
+    data.qvel[dof_address(model, CRANK_HINGE)] = params.omega0
+    data.qvel[dof_address(model, ROD_HINGE)] = beta_rate - params.omega0
     mujoco.mj_forward(model, data)
+    gap_rate = site_velocity_x(model, data, ROD_END)  # module 1 at rest: C's speed is the gap rate
+    target = REAR_SLIDE if gap_rate < 0 else FRONT_SLIDE
+    # freeing module 1 at -gap_rate carries A forward and leaves C (module 2) at rest
+    data.qvel[dof_address(model, target)] = abs(gap_rate)
+    return target, abs(gap_rate)
 
 
 def pin_offset(model: mujoco.MjModel, data: mujoco.MjData | None = None) -> tuple[int, int, np.ndarray]:

@@ -39,9 +39,8 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.pipe import check_fit
 
 from ..resources import mjcf_dir
-from .model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, SolverSettings, _element,
-                    _write_drive, _write_gravity, _write_mechanism, check_params, closed_loop_pose, load_spec,
-                    qpos_address)
+from .model import (FRONT_SLIDE, LOOP, REAR_SLIDE, SolverSettings, _element,
+                    _write_drive, _write_gravity, _write_mechanism, check_params, load_spec)
 
 MODULES = ("rear", "front")
 SIDES = ("top", "bottom")  # the wall at +D/2, the wall at -D/2
@@ -216,23 +215,11 @@ def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotPa
     """The loop closed at ``phi0`` with module 1 at 0, both modules on the pipe's axis, every wheel on its wall
     (arm slides at 0), at rest or with the crank at ``omega0`` (the slide model's rule: the gap rate goes to
     the module the paper's clutch rule frees, :func:`.model.set_closed_loop_state`)."""
-    from .model import dof_address, site_velocity_x
-    from .model import ROD_END
+    from .model import dof_address, start_closed_loop
 
-    mujoco.mj_resetData(model, data)
-    for name, value in closed_loop_pose(params, params.phi0).items():
-        data.qpos[qpos_address(model, name)] = value
-    if params.omega0 != 0.0:
-        r, L, phi = params.r, params.L, params.phi0
-        beta = math.asin(-r * math.sin(phi) / L)
-        beta_rate = -r * math.cos(phi) * params.omega0 / (L * math.cos(beta))
-        data.qvel[dof_address(model, CRANK_HINGE)] = params.omega0
-        data.qvel[dof_address(model, ROD_HINGE)] = beta_rate - params.omega0
-        mujoco.mj_forward(model, data)
-        gap_rate = site_velocity_x(model, data, ROD_END)
-        target = REAR_SLIDE if gap_rate < 0 else FRONT_SLIDE
-        data.qvel[dof_address(model, target)] = abs(gap_rate)
-        # the wheels of the moving module roll with it
+    freed = start_closed_loop(model, data, params)
+    if freed is not None:  # the wheels of the moving module roll with it
+        target, speed = freed
         for prefix in WHEEL_NAMES[0 if target == REAR_SLIDE else 1]:
-            data.qvel[dof_address(model, prefix + "_hub")] = abs(gap_rate) / params.wheel_radius
+            data.qvel[dof_address(model, prefix + "_hub")] = speed / params.wheel_radius
     mujoco.mj_forward(model, data)
