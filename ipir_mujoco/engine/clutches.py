@@ -55,20 +55,37 @@ def missing_rows(code: int, t: float) -> SimulationError:
                            "resistances")
 
 
-class FrictionRows:
-    """The resistances of the modules on ``dofs``: ``resistance`` [N] (F_r1, F_r2) and where their
-    frictionloss rows sit. MuJoCo puts the rows after the equality rows, one per dof with friction, in dof
-    order, so each dof's offset among them is fixed by the model; read once per sample at those rows."""
+FRICTION_DOF, FRICTION_TENDON = (int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF),
+                                 int(mujoco.mjtConstraint.mjCNSTR_FRICTION_TENDON))
 
-    def __init__(self, model: mujoco.MjModel, dofs: list[int]):
-        with_friction = [i for i in range(model.nv) if model.dof_frictionloss[i] > 0]
-        self.resistance = [float(model.dof_frictionloss[dof]) for dof in dofs]
-        self.offsets = [with_friction.index(dof) if dof in with_friction else -1 for dof in dofs]
-        self.count = len(with_friction)
+
+class FrictionRows:
+    """Where the frictionloss rows of some of a model's dofs and tendons sit, and their bounds.
+
+    ``elements``: (kind, index) pairs, kind FRICTION_DOF (index a dof) or FRICTION_TENDON (a tendon), in the
+    order :meth:`forces` returns them. MuJoCo puts the friction rows after the equality rows, the dofs' in
+    dof order, then the tendons' in tendon order, one per element with friction, so each element's offset
+    among them is fixed by the model; read once per sample at those rows. ``resistance`` [N]: each element's
+    frictionloss; ``offsets``: its offset among the friction rows (-1: it has none); ``count``: how many
+    friction rows the model has.
+    """
+
+    def __init__(self, model: mujoco.MjModel, elements: list[tuple[int, int]]):
+        order = [(FRICTION_DOF, i) for i in range(model.nv) if model.dof_frictionloss[i] > 0]
+        order += [(FRICTION_TENDON, i) for i in range(model.ntendon) if model.tendon_frictionloss[i] > 0]
+        self.resistance = [float((model.dof_frictionloss if kind == FRICTION_DOF else model.tendon_frictionloss)[i])
+                           for kind, i in elements]
+        self.offsets = [order.index(e) if e in order else -1 for e in elements]
+        self.count = len(order)
+
+    @classmethod
+    def of_dofs(cls, model: mujoco.MjModel, dofs: list[int]) -> "FrictionRows":
+        """The rows of the dofs ``dofs`` (the slides' resistances)."""
+        return cls(model, [(FRICTION_DOF, dof) for dof in dofs])
 
     def forces(self, data: mujoco.MjData) -> list[float]:
-        """The rows' forces [N] of the last step on ``dofs`` (0.0 for a dof without a row)."""
-        if data.nf != self.count:  # as the stepping loops: never a row that is not this dof's
+        """The rows' forces [N] of the last step, per element (0.0 for one without a row)."""
+        if data.nf != self.count:  # as the stepping loops: never a row that is not this element's
             raise missing_rows(2, data.time)
         ne, force = data.ne, data.efc_force
         return [force.item(ne + k) if k >= 0 else 0.0 for k in self.offsets]
@@ -128,7 +145,7 @@ class Ratchet:
         self._qpos = data.qpos
         self._slides = tuple(zip(self.qpos_adr, self.joint_ids))  # (qpos address, joint id) per module
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
-        self.friction = FrictionRows(model, self.dof_adr)  # and F_r1, F_r2 [N]
+        self.friction = FrictionRows.of_dofs(model, self.dof_adr)  # and F_r1, F_r2 [N]
 
     def before_step(self) -> None:
         """Raise each module's bound to its running maximum, or note how far it is below it."""
@@ -200,7 +217,7 @@ class Locks:
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
         self.crank_q, self.rod_q = qpos_address(model, CRANK_HINGE), qpos_address(model, ROD_HINGE)
         self.crank_v, self.rod_v = dof_address(model, CRANK_HINGE), dof_address(model, ROD_HINGE)
-        self.friction = FrictionRows(model, self.dof_adr)  # and F_r1, F_r2 [N]
+        self.friction = FrictionRows.of_dofs(model, self.dof_adr)  # and F_r1, F_r2 [N]
         self.held = [False, False]
         self.forces = [0.0, 0.0]
         self.excursion = 0.0

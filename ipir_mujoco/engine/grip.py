@@ -40,13 +40,11 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
-from .clutches import clutch_share, missing_rows
+from .clutches import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
 from .common import REST_SPEED
 from .grip_model import ROLLS, SKIDS
 from .model import SLIDES, dof_address, qpos_address
 
-FRICTION_DOF, FRICTION_TENDON = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF), int(
-    mujoco.mjtConstraint.mjCNSTR_FRICTION_TENDON)
 LIMIT_TENDON = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON)
 
 
@@ -70,43 +68,25 @@ def upper_bound(value: float, margin: float) -> float:
 
 
 class GripRows:
-    """Where each module's friction rows sit among MuJoCo's friction rows: the carriage's (the grip) and the
-    rolling resistance's (the roll tendon with rigid clutches, the module slide with compliant ones).
-
-    MuJoCo puts the friction rows after the equality rows, the dofs' in dof order, then the tendons' in
-    tendon order, one per element with friction: fixed by the model. ``grip``, ``roll``: offsets among them
-    per module (-1: no row, a zero grip or resistance); ``count``: how many; ``grips``, ``resistances`` [N].
+    """Where each module's friction rows sit among MuJoCo's friction rows (:class:`.clutches.FrictionRows`): the
+    carriage's (the grip) and the rolling resistance's (the roll tendon with rigid clutches, the module slide
+    with compliant ones). ``grip``, ``roll``: offsets among them per module (-1: no row, a zero grip or
+    resistance); ``count``: how many; ``grips``, ``resistances`` [N].
     """
 
     def __init__(self, model: mujoco.MjModel, roll_on_tendon: bool):
-        dofs = [i for i in range(model.nv) if model.dof_frictionloss[i] > 0]
-        tendons = [i for i in range(model.ntendon) if model.tendon_frictionloss[i] > 0]
-        order = [(FRICTION_DOF, i) for i in dofs] + [(FRICTION_TENDON, i) for i in tendons]
-        self.count = len(order)
-
-        def offset(kind, index):
-            return order.index((kind, index)) if (kind, index) in order else -1
-
-        skid_dofs = [dof_address(model, n) for n in SKIDS]
-        self.grip = [offset(FRICTION_DOF, dof) for dof in skid_dofs]
-        self.grips = [float(model.dof_frictionloss[dof]) for dof in skid_dofs]
-        if roll_on_tendon:
-            rolls = [model.tendon(n).id for n in ROLLS]
-            self.roll = [offset(FRICTION_TENDON, t) for t in rolls]
-            self.resistances = [float(model.tendon_frictionloss[t]) for t in rolls]
-        else:
-            slides = [dof_address(model, n) for n in SLIDES]
-            self.roll = [offset(FRICTION_DOF, dof) for dof in slides]
-            self.resistances = [float(model.dof_frictionloss[dof]) for dof in slides]
+        skids = [(FRICTION_DOF, dof_address(model, n)) for n in SKIDS]
+        rolls = ([(FRICTION_TENDON, model.tendon(n).id) for n in ROLLS] if roll_on_tendon
+                 else [(FRICTION_DOF, dof_address(model, n)) for n in SLIDES])
+        self.rows = FrictionRows(model, skids + rolls)
+        self.count = self.rows.count
+        self.grip, self.roll = self.rows.offsets[:2], self.rows.offsets[2:]
+        self.grips, self.resistances = self.rows.resistance[:2], self.rows.resistance[2:]
 
     def forces(self, data: mujoco.MjData) -> tuple[list[float], list[float]]:
         """(grip rows, roll rows) [N] of the last step, per module (0.0 where a module has no row)."""
-        if data.nf != self.count:
-            raise missing_rows(2, data.time)
-        ne, force = data.ne, data.efc_force
-        grip = [force.item(ne + k) if k >= 0 else 0.0 for k in self.grip]
-        roll = [force.item(ne + k) if k >= 0 else 0.0 for k in self.roll]
-        return grip, roll
+        forces = self.rows.forces(data)
+        return forces[:2], forces[2:]
 
 
 class GripRatchet:

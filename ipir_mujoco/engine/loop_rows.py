@@ -13,11 +13,11 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .grip import FRICTION_TENDON, GripRows
+from .clutches import FRICTION_DOF as FRICTION_ROW, FRICTION_TENDON
+from .grip import GripRows
 from .grip_model import ROLLS, SKIDS
 from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
 
-FRICTION_ROW = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
 
 
 def loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:

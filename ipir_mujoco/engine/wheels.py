@@ -40,7 +40,6 @@ from .wheels_model import WHEEL_NAMES, contact_friction
 
 LIMIT_JOINT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 SLIDING_SHARE = 1e-6  # a module's contacts slide where their tangential force is within this share of the cone
-FRICTION_DOF = int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
 
 
 class WheelRatchet:
