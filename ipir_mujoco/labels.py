@@ -27,6 +27,8 @@ SUMMARY: dict[str, tuple[str, str]] = {
     "efficiency": ("efficiency", "-"),
     "peak_clutch_force_n": ("peak clutch force", "N"),
     "t_steady_s": ("time to steady state", "s"),
+    "mean_omega_rad_s": ("mean crank speed", "rad/s"),
+    "speed_ripple": ("crank speed ripple, peak-to-peak / mean", "-"),
 }
 
 # time-series column -> (name, unit); the units are the result container's (core.results.SERIES_UNITS)

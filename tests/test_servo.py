@@ -201,3 +201,22 @@ def test_a_servo_that_cannot_climb_stalls_as_the_motor_does():
         motor = registry.run(variant, riser.replace(drive="motor"), 5.0, dt_out=1e-3)
         assert servo.stall is not None and servo.stall == motor.stall
         assert np.all(servo.series["drive_u"] == 1.0)
+
+
+def test_a_sweep_row_carries_the_runs_crank_speed_figures(tmp_path, capsys):
+    """sweep (and so optimize and sensitivity) reads the servo's figures: each design's speed_ripple and
+    mean_omega_rad_s columns are the registry run's summary values (written with 10 significant digits)."""
+    import csv
+
+    code, _, err = run_cli(capsys, "sweep", "--vary", "control_rate=500,1000", "--engines", "analytic-unilateral",
+                           "--drive", "servo", "--set", "omega_target=10", "--t-end", "0.3", "--workers", "1",
+                           "--out", tmp_path / "s")
+    assert code == 0, err
+    with (tmp_path / "s" / "results.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    for row in rows:
+        rate = float(row["control_rate"])
+        summary = registry.run("analytic-unilateral", RobotParams(drive="servo", omega_target=10.0,
+                                                                  control_rate=rate), 0.3).summary
+        for key in ("speed_ripple", "mean_omega_rad_s"):
+            assert float(row[f"analytic-unilateral:{key}"]) == pytest.approx(summary[key], rel=1e-9), (rate, key)

@@ -467,7 +467,7 @@ def test_the_line_plot_does_not_draw_a_stalled_design_as_a_point_of_the_curve():
     for metric in ("mean_speed_m_s", "distance_per_rev_m"):
         columns[f"a:{metric}"] = np.array([0.06, 0.11, 0.12, 0.125])
     for metric in ("steady_speed_m_s", "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n",
-                   "peak_rod_force_n", "accel_jump_m_s2"):
+                   "peak_rod_force_n", "accel_jump_m_s2", "mean_omega_rad_s", "speed_ripple"):
         columns[f"a:{metric}"] = np.full(4, np.nan)
     fig = lines_figure(columns, SimpleNamespace(name="M_stall", log=False), ["a"])
     lines = {line.get_gid(): line for ax in fig.axes for line in ax.get_lines() if line.get_gid()}
@@ -484,7 +484,7 @@ def test_a_metric_equal_in_every_design_names_no_best_design():
     columns = {"design_id": np.arange(3.0), "L": np.array([0.1, 0.2, 0.3]), "a:revolutions": np.ones(3),
                "a:stalled": np.zeros(3)}
     for metric in ("mean_speed_m_s", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m",
-                   "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2"):
+                   "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2", "mean_omega_rad_s", "speed_ripple"):
         columns[f"a:{metric}"] = np.full(3, np.nan)
     columns["a:mean_speed_m_s"] = np.zeros(3)
     columns["a:efficiency"] = np.array([0.1, 0.3, 0.2])
@@ -607,7 +607,7 @@ def test_a_panel_flat_within_what_the_runs_resolve_says_so_and_names_no_best():
     x = np.array([0.1, 0.2, 0.3, 0.4])
     columns = {"design_id": np.arange(4.0), "L": x, "a:stalled": np.zeros(4), "a:revolutions": np.ones(4)}
     for metric in ("mean_speed_m_s", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m", "efficiency",
-                   "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2"):
+                   "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2", "mean_omega_rad_s", "speed_ripple"):
         columns[f"a:{metric}"] = np.full(4, np.nan)
     columns["a:energy_per_metre_j_m"] = 2.0 * (1 + np.array([1e-4, -2e-4, 3e-4, 0.0]))  # within RESOLVED
     columns["a:steady_speed_m_s"] = np.array([0.55, 0.54, 0.53, 0.53])

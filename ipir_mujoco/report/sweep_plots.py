@@ -29,7 +29,7 @@ from .plots import new_figure
 
 # metrics where larger is better; the rest (energy per metre, forces, jumps, time to settle) are better small
 LARGER_IS_BETTER = ("mean_speed_m_s", "steady_speed_m_s", "distance_per_rev_m", "efficiency")
-NOT_RANKED = ("revolutions", "steady", "stalled", "residual_ratio", "loop_gap_m", *LEGACY)
+NOT_RANKED = ("revolutions", "steady", "stalled", "residual_ratio", "loop_gap_m", "mean_omega_rad_s", *LEGACY)
 # a panel whose values all lie within this relative band of their mean is drawn flat across that band: MuJoCo's
 # accuracy monitor holds its runs' energy to 1e-3 of what the robot is given (mjcf/README.md), and an engine's
 # steady figures lie within 1e-4 to 1e-3 of the periodic limit, so a design-to-design wiggle inside it is

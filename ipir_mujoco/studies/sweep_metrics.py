@@ -84,7 +84,7 @@ _SWEEP_ONLY = {
 DESCRIBED = {m: SUMMARY[m] if m in SUMMARY else _SWEEP_ONLY[m] for m in (  # in the order of the CSV's columns
     "revolutions", "mean_speed_m_s", "steady", "t_steady_s", "steady_speed_m_s", "distance_per_rev_m",
     "energy_per_metre_j_m", "efficiency", "peak_clutch_force_n", "peak_rod_force_n", "accel_jump_m_s2", "stalled",
-    "residual_ratio", "loop_gap_m")}
+    "residual_ratio", "loop_gap_m", "mean_omega_rad_s", "speed_ripple")}
 METRICS = (*DESCRIBED, *LEGACY)  # every column a row carries per engine, the legacy spellings last
 UNITS = {**{m: unit for m, (_, unit) in DESCRIBED.items()}, **{old: DESCRIBED[new][1] for old, new in LEGACY.items()}}
 PER_REVOLUTION = ("distance_per_rev_m", "energy_per_metre_j_m", "efficiency")  # empty for a stalled design
@@ -170,6 +170,8 @@ def design_metrics(series: dict[str, np.ndarray], summary: dict[str, Any], energ
         "stalled": float(stalled),
         "residual_ratio": _number(accuracy.get("residual_ratio")),
         "loop_gap_m": _number(accuracy.get("loop_gap_m")),
+        "mean_omega_rad_s": _number(summary.get("mean_omega_rad_s")),
+        "speed_ripple": _number(summary.get("speed_ripple")),
     }
     if stalled:  # a robot at rest for good: no revolution to be per (module docstring)
         metrics.update({m: math.nan for m in PER_REVOLUTION})
