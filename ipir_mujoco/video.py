@@ -1,13 +1,16 @@
 """See the robot move: a MuJoCo run replayed through MuJoCo's offscreen renderer, headless.
 
 A run's recorded state (crank angle and module positions, from any engine's
-series) is put back into the MuJoCo model frame by frame (the rod's angle
-follows from the crank's, closing the loop), drawn with MuJoCo's own
-renderer and written as a GIF (Pillow) or an MP4 (the optional ``video``
-extra, imageio-ffmpeg). Each frame shows the modules, crank and rod, each
-module's clutch state by its colour (green: the clutch holds the module;
-grey-blue: the module moves), and the time, playback speed and speeds as text
-(in frames at least 320 px wide; in narrower ones the text would hide the robot).
+series; a wheeled run's modules also at their recorded pose in the plane) is
+put back into the MuJoCo model frame by frame (:mod:`ipir_mujoco.replay`: the
+rod's angle closes the loop), drawn with MuJoCo's own renderer and written as
+a GIF (Pillow) or an MP4 (the optional ``video`` extra, imageio-ffmpeg). A
+wheeled run along a route is drawn among the route's walls, built as the run
+built them, seen from above by a camera that follows the robot. Each frame
+shows the modules, crank and rod, each module's clutch state by its colour
+(green: the clutch holds the module; grey-blue: the module moves), and the
+time, playback speed and speeds as text (in frames at least 320 px wide; in
+narrower ones the text would hide the robot).
 
 Rendering needs an OpenGL library that works without a screen: EGL (Debian:
 libegl1) or OSMesa (libosmesa6). ``MUJOCO_GL=egl`` or ``osmesa`` picks one;
@@ -37,6 +40,8 @@ HELD_RGBA = (0.15, 0.7, 0.3, 1.0)  # the clutch holds the module to the pipe
 FREE_RGBA = (0.6, 0.68, 0.85, 1.0)  # the module slides forward (grey-blue)
 HOUSINGS = ("rear_housing", "front_housing")
 OVERLAY_MIN_WIDTH = 320  # px: narrower frames show the robot without the text
+ROUTE_VIEW_DISTANCE = 0.9  # m: the camera above the plane along a route (fovy 45 deg: 0.75 m of it in a frame's
+# height, 0.41 m between the texts: the robot, 0.4 m long, and its pipe, 0.16 m wide by default, fit there)
 LIBRARIES = {"egl": ("EGL", "EGL (Debian: apt-get install libegl1)"),
              "osmesa": ("OSMesa", "OSMesa (Debian: apt-get install libosmesa6)")}
 
@@ -117,9 +122,10 @@ def checker_floor(spec) -> None:
                      width=64, height=64, rgb1=[0.92, 0.92, 0.88], rgb2=[0.78, 0.78, 0.74])
     material = spec.add_material(name="grid", texrepeat=[10, 10], texuniform=True)  # 10 per metre: 5 cm squares
     material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
-    spec.geom("pipe_floor").material = "grid"
-    spec.geom("pipe_floor").rgba = [1, 1, 1, 1]
-    spec.geom("pipe_floor").size = [100.0, 1.0, 0.01]  # far beyond any run, and wider than the view
+    floor = spec.geom("pipe_floor")
+    floor.material, floor.rgba = "grid", [1, 1, 1, 1]
+    # far beyond any run, and wider than the view; a route's floor (route_walls: under it all) stays as large
+    floor.size = [max(100.0, floor.size[0]), max(1.0, floor.size[1]), 0.01]
     spec.visual.headlight.ambient = [0.45, 0.45, 0.45]
     spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]
 
@@ -135,16 +141,20 @@ def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: f
     return "crank\nmodule 1 (rear)\nmodule 2 (front)", values
 
 
-def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = False):
+def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = False, route=None):
     """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
-    ``wheeled``: the wheeled model (its pipe walls and wheels drawn too)."""
+    ``wheeled``: the wheeled model (its pipe walls and wheels drawn too); ``route``: its walls along the route,
+    built as the run built them (:func:`ipir_mujoco.engine.route_watch.route_decorator`)."""
 
     from .engine.model import build_spec
 
     if wheeled:
+        from .engine.route_watch import route_decorator
         from .engine.wheels_model import build_wheels_spec
 
         spec = build_wheels_spec(params)
+        if route is not None:
+            route_decorator(params, route)(spec)
     else:
         spec = build_spec(params)
     checker_floor(spec)
@@ -153,38 +163,48 @@ def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = 
     return spec.compile()
 
 
-def _wheel_names():
-    from .engine.wheels_model import WHEEL_NAMES
-
-    return WHEEL_NAMES
-
-
 def _held(mode: int) -> tuple[bool, bool]:
     """(rear held, front held) for a Mode value."""
     return (mode in (Mode.BOTH_LOCKED, Mode.EXPANSION), mode in (Mode.BOTH_LOCKED, Mode.CONTRACTION))
 
 
+def check_route_run(run: RunResult, route) -> None:
+    """ParameterError (one line) unless ``route`` (a :class:`ipir_mujoco.core.route.Route`, or None) is the one
+    ``run`` ran along: a route for a run of the wheeled model along one, of its length; none for any other run."""
+    ran = run.route
+    if route is None and ran is not None:
+        raise ParameterError(f"the run went along a route of {ran['route_length_m']:.6g} m; allowed: its route "
+                             "(route=...), so that its walls are drawn")
+    if route is not None and (ran is None or abs(route.length - ran["route_length_m"]) > 1e-12 * route.length):
+        went = "along no route" if ran is None else f"along a route of {ran['route_length_m']:.6g} m"
+        raise ParameterError(f"route {route.source} ({route.length:.6g} m): the run went {went}; allowed: the "
+                             "route the run ran along")
+
+
 def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_end: float | None = None,
-                  title: str | None = None):
-    """Yield the frames of ``run`` as uint8 arrays of shape (height, width, 3), one per frame time."""
+                  title: str | None = None, route=None):
+    """Yield the frames of ``run`` as uint8 arrays of shape (height, width, 3), one per frame time; ``route``:
+    the route a wheeled run ran along (:func:`check_route_run`), its walls drawn and the camera above the
+    plane, following the robot through the bends."""
     import mujoco
 
-    from .engine.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, ROD_HINGE, closed_loop_pose, qpos_address
+    from .replay import replay_for
 
+    check_route_run(run, route)
     context = _open_context(settings.width, settings.height)
     params, s = run.params, run.series
     wheeled = run.settings.get("mujoco_model") == "wheels"
-    model = _render_model(params, settings, wheeled)
+    model = _render_model(params, settings, wheeled, route)
     data = mujoco.MjData(model)
-    address = {name: qpos_address(model, name) for name in (REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE)}
-    # the wheeled model's hubs, drawn turning as they roll on each module's travel (the series holds no angles)
-    hubs = [[qpos_address(model, n + "_hub") for n in names] for names in _wheel_names()] if wheeled else []
-    front0 = closed_loop_pose(params, float(s["phi"][0]))[FRONT_SLIDE]
+    replay = replay_for(model, run)
     housings = [model.geom(name).id for name in HOUSINGS]
-    scene = mujoco.MjvScene(model, maxgeom=200)
+    scene = mujoco.MjvScene(model, maxgeom=200 if route is None else model.ngeom + 200)  # a bend: ~200-500 boxes
     camera = mujoco.MjvCamera()
     camera.type = mujoco.mjtCamera.mjCAMERA_FREE
-    camera.distance, camera.azimuth, camera.elevation = 0.5, 90.0, -50.0
+    if route is None:
+        camera.distance, camera.azimuth, camera.elevation = 0.5, 90.0, -50.0
+    else:  # from above: a route's near wall would hide the robot seen from the side; +x right, +y up
+        camera.distance, camera.azimuth, camera.elevation = ROUTE_VIEW_DISTANCE, 90.0, -90.0
     option, perturb = mujoco.MjvOption(), mujoco.MjvPerturb()
     font = mujoco.mjtFontScale.mjFONTSCALE_150 if settings.width >= 600 else mujoco.mjtFontScale.mjFONTSCALE_100
     renderer = mujoco.MjrContext(model, font)
@@ -192,23 +212,16 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
     viewport = mujoco.MjrRect(0, 0, settings.width, settings.height)
     t = s["t"]
     title = title or f"{run.engine}, {run.clutch} clutches"
+    along = "" if route is None else f" along {Path(route.source).name}"
     try:
         for when in frame_times(run, settings, t_end):
             i = max(0, int(np.searchsorted(t, when, side="right")) - 1)  # the sample in force at this time
             phi = float(np.interp(when, t, s["phi"]))
-            x1, x2 = float(np.interp(when, t, s["x1"])), float(np.interp(when, t, s["x2"]))
-            pose = closed_loop_pose(params, phi)
-            data.qpos[address[REAR_SLIDE]] = x1
-            data.qpos[address[CRANK_HINGE]] = phi
-            data.qpos[address[ROD_HINGE]] = pose[ROD_HINGE]
-            data.qpos[address[FRONT_SLIDE]] = front0 + x2
-            for travel, module in zip((x1, x2), hubs):
-                data.qpos[module] = travel / params.wheel_radius
-            mujoco.mj_kinematics(model, data)
+            replay.pose(data, when)
             held = _held(int(s["mode"][i]))
             for geom, on in zip(housings, held):
                 model.geom_rgba[geom] = HELD_RGBA if on else FREE_RGBA
-            camera.lookat[:] = [0.5 * (x1 + front0 + x2 + params.r + params.L), 0.0, -0.02]
+            camera.lookat[:] = replay.lookat(data)
             mujoco.mjv_updateScene(model, data, option, perturb, camera, mujoco.mjtCatBit.mjCAT_ALL, scene)
             mujoco.mjr_render(viewport, scene, renderer)
             if settings.width < OVERLAY_MIN_WIDTH:  # the text would cover the robot
@@ -219,7 +232,7 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
                 mujoco.mjr_rectangle(mujoco.MjrRect(0, int(settings.height * y), int(settings.width * width),
                                                     int(settings.height * height)), 0.1, 0.1, 0.12, 0.55)
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport,
-                               f"{title}\nt = {when:.3f} s", f"\n{settings.speed:g}x real time", renderer)
+                               f"{title}\nt = {when:.3f} s{along}", f"\n{settings.speed:g}x real time", renderer)
             labels, values = state_text(when, phi, float(s["phi"][0]), float(np.interp(when, t, s["omega"])),
                                         float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held)
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels,
@@ -263,12 +276,14 @@ def check_writer(path: str | Path) -> str:
 
 def write_video(run: RunResult, path: str | Path, settings: VideoSettings = VideoSettings(),
                 t_end: float | None = None, title: str | None = None,
-                progress: Callable[[int, int], None] | None = None) -> int:
+                progress: Callable[[int, int], None] | None = None, route=None) -> int:
     """Render ``run`` up to ``t_end`` [s] into ``path`` (.gif or .mp4); returns the number of frames.
-    ``progress(done, total)`` is called with the frames rendered so far, after each frame."""
+    ``progress(done, total)`` is called with the frames rendered so far, after each frame; ``route``: the route
+    the run ran along (:func:`render_frames`)."""
     path = Path(path)
     kind = check_writer(path)
-    frames = render_frames(run, settings, t_end, title)
+    check_route_run(run, route)  # before the file is opened
+    frames = render_frames(run, settings, t_end, title, route)
     if progress is not None:
         frames = _counted(frames, len(frame_times(run, settings, t_end)), progress)
     if kind == "gif":

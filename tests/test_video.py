@@ -11,6 +11,7 @@ import pytest
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
+from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.video import RenderUnavailable, VideoSettings, frame_times, write_video
 
 
@@ -109,6 +110,117 @@ def test_render_refuses_bad_video_settings(tmp_path, capsys):
     assert ".avi" in capsys.readouterr().err
     assert main(["render", "--out", str(tmp_path / "x.gif"), "--width", "63"]) == 2
     assert "width=63" in capsys.readouterr().err
+
+
+# a 90-degree bend of R/D 2.5 right after the first straight: in 0.6 s from rest the motor drives the front
+# module into the bend, where it turns by ~29 degrees and moves ~33 mm across the first straight's axis
+BEND = [dict(kind="straight", length=0.33), dict(kind="bend", radius=0.4, angle=90.0),
+        dict(kind="straight", length=0.3)]
+
+
+@pytest.fixture(scope="module")
+def bend_run():
+    from ipir_mujoco import registry
+    from ipir_mujoco.core.route import route_from_tables
+
+    route = route_from_tables(BEND, "bend.toml")
+    run = registry.run("mujoco-wheels", RobotParams(drive="motor"), 0.6, route=route, accuracy="warn", dt_out=1e-3)
+    return run, route
+
+
+def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_run):
+    """Without OpenGL: the drawing model carries the walls the run's model had, and at every frame time (each a
+    sample time here, so nothing is interpolated) each module stands at its recorded pose in the plane and the
+    rod closes the loop as the run's did.
+
+    Tolerances: the poses are the recorded joint values through MuJoCo's kinematics (a few additions and
+    products of numbers of order 1 m): round-off, 1e-12 m and rad. The replayed rod points at module 2's pin,
+    so its end misses it by | |BC| - L |, which the run's own gap |end - C| bounds (its rod has length L too).
+    """
+    import mujoco
+
+    from ipir_mujoco.engine.model import FRONT_SLIDE, ROD_END, closed_loop_pose
+    from ipir_mujoco.engine.route_watch import route_decorator
+    from ipir_mujoco.engine.wheels_model import build_wheels_model
+    from ipir_mujoco.replay import WheeledReplay, replay_for
+    from ipir_mujoco.video import _render_model
+
+    run, route = bend_run
+    settings = VideoSettings(width=96, height=64, fps=10.0, speed=0.1)  # a frame every 0.01 s: every 10th sample
+    model = _render_model(run.params, settings, wheeled=True, route=route)
+    ran = build_wheels_model(run.params, decorate=route_decorator(run.params, route))
+    walls = [ran.geom(i).name for i in range(ran.ngeom) if ran.geom(i).name.startswith("route_")]
+    assert {"route_straight1_top", "route_bend1_inner_drawn", "route_bend1_outer1"} <= set(walls)
+    for name in walls:
+        for field in ("pos", "quat", "size", "rgba"):
+            np.testing.assert_array_equal(getattr(model.geom(name), field), getattr(ran.geom(name), field))
+    replay = replay_for(model, run)
+    assert isinstance(replay, WheeledReplay)
+    data = mujoco.MjData(model)
+    s = run.series
+    rear, front = model.body("rear_module").id, model.body("front_module").id
+    c0 = model.body_pos[front][0] + closed_loop_pose(run.params, run.params.phi0)[FRONT_SLIDE]  # C at the start
+    pin = model.eq_data[model.equality("rod_to_front").id, 3:6]
+    times = frame_times(run, settings)
+    rows = np.searchsorted(s["t"], times - 1e-9)
+    np.testing.assert_allclose(s["t"][rows], times, rtol=0, atol=1e-12)
+    for i in rows:
+        replay.pose(data, float(s["t"][i]))
+        for body, x, k in ((rear, s["x1"][i], 1), (front, c0 + s["x2"][i], 2)):
+            np.testing.assert_allclose(data.xpos[body][:2], [x, s[f"y{k}"][i]], rtol=0, atol=1e-12)
+            yaw = math.atan2(data.xmat[body][3], data.xmat[body][0])
+            assert yaw == pytest.approx(s[f"yaw{k}"][i], abs=1e-12)
+        c = data.xpos[front] + data.xmat[front].reshape(3, 3) @ pin
+        assert np.linalg.norm(data.site_xpos[model.site(ROD_END).id] - c) <= s["loop_gap"][i] + 1e-12
+    # the poses checked include the robot turning in the bend
+    assert math.degrees(s["yaw2"][rows[-1]]) > 20 and s["y2"][rows[-1]] > 0.02
+
+
+def test_route_frames_draw_the_robot_turning_where_a_straight_replay_does_not(bend_run):
+    """The frames follow the recorded planar pose: at t = 0 (on the axis, unturned) a frame is the frame of a
+    replay with y and yaw zeroed, pixel for pixel; at 0.6 s, the front module 33 mm across and turned ~29 deg
+    (about 3 px and a third of its 5 px housing's width in these frames: 0.75 m of the plane in 64 px), they
+    differ in more than the housing's 25 pixels."""
+    _require_gl()
+    from dataclasses import replace
+
+    from ipir_mujoco.video import render_frames
+
+    run, route = bend_run
+    settings = VideoSettings(width=96, height=64, fps=10.0, speed=3.0)  # a frame every 0.3 s: 0, 0.3, 0.6 s
+    planar = ("y1", "y2", "yaw1", "yaw2")
+    assert all(run.series[c][0] == 0.0 for c in planar)
+    straight = replace(run, series={**run.series, **{c: np.zeros_like(run.series[c]) for c in planar}})
+    turned = list(render_frames(run, settings, route=route))
+    flat = list(render_frames(straight, settings, route=route))
+    assert len(turned) == len(flat) == 3
+    assert np.array_equal(turned[0], flat[0])
+    assert np.count_nonzero(np.any(turned[-1] != flat[-1], axis=2)) > 25
+    with pytest.raises(ParameterError, match="its route"):  # the walls are the run's: a route run needs its route
+        next(render_frames(run, settings))
+
+
+def test_render_takes_a_route_for_the_wheeled_model_only(tmp_path, capsys):
+    good = tmp_path / "bend.toml"
+    good.write_text("".join(f"[[segment]]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in seg.items())
+                            for seg in BEND))
+    out = tmp_path / "x.gif"
+    for argv, word in ((["--route", str(good)], "--mujoco-model wheels"),
+                       (["--mujoco-model", "wheels", "--route", str(tmp_path / "none.toml")], "does not exist")):
+        assert main(["render", *argv, "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and word in err
+    assert not out.exists()
+    _require_gl()
+    from PIL import Image
+
+    assert main(["render", "--mujoco-model", "wheels", "--route", str(good), "--drive", "motor", "--t-end", "0.3",
+                 "--fps", "10", "--speed", "1", "--width", "80", "--height", "64", "--out", str(out)]) == 0
+    with Image.open(out) as gif:
+        assert gif.n_frames == 4 and gif.size == (80, 64)  # t = 0, 0.1, 0.2, 0.3 s
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].startswith(f"wrote {out}: 4 frames")
+    assert printed[1].startswith("route NOT done: t_end 0.3 s reached before the route's end")
 
 
 def test_viewer_loop_steps_the_robot_as_the_engine_does():

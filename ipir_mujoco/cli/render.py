@@ -9,7 +9,8 @@ from pathlib import Path
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params, progress_printer, tenths_printer
+from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer, tenths_printer
+from .simulate import T_END, T_END_ROUTE
 
 
 def add_parser(commands) -> None:
@@ -27,7 +28,11 @@ def add_parser(commands) -> None:
     ren.add_argument("--mujoco-model", choices=registry.MUJOCO_MODELS, default="slides",
                      help="MuJoCo's model: slides (default) or wheels (the robot on wheels in its pipe, walls and "
                           "wheels drawn)")
-    ren.add_argument("--t-end", type=float, default=1.0, metavar="SECONDS", help="simulated time (default 1 s)")
+    ren.add_argument("--route", metavar="FILE.toml", default=None,
+                     help="with --mujoco-model wheels: the robot along a route of straights and bends (docs/cli.md), "
+                          "its walls drawn, seen from above; the run ends at the route's end (--t-end caps it)")
+    ren.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+                     help="simulated time (default 1 s; with --route the cap, default 60 s)")
     ren.add_argument("--speed", type=float, default=0.1,
                      help="playback speed, video seconds per simulated second (default 0.1: ten times slower)")
     ren.add_argument("--fps", type=float, default=25.0, help="frames per second of the video (default 25)")
@@ -43,26 +48,41 @@ def run(args: argparse.Namespace) -> int:
     settings = VideoSettings(width=args.width, height=args.height, fps=args.fps, speed=args.speed)
     out = Path(args.out)
     # before any work, and before MuJoCo is imported (MUJOCO_GL naming a missing library breaks that import):
-    # the suffix and its writer, the OpenGL library, the output path, the parameters
+    # the suffix and its writer, the route, the OpenGL library, the output path, the parameters
     check_writer(out)
+    route = None
+    if args.route is not None:
+        if args.mujoco_model != "wheels":
+            raise ParameterError(f"--route {args.route}: only the wheeled model runs along a route; allowed: "
+                                 "--mujoco-model wheels")
+        from ipir_mujoco.core.route import read_route
+
+        check_input_file("--route", args.route)
+        route = read_route(args.route)
     gl_backend()
     if out.is_dir():
         raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
     params = model_params(args)
     variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch, args.mujoco_model)
-    print(f"simulating {args.t_end:g} s in MuJoCo ...", file=sys.stderr, flush=True)
-    result = registry.run(variant, params, args.t_end, progress=progress_printer(args.t_end))
+    t_end = args.t_end if args.t_end is not None else T_END_ROUTE if route is not None else T_END
+    options = {} if route is None else {"route": route, "accuracy": "warn"}  # as simulate's defaults with --route
+    until = " (or to the route's end)" if route is not None else ""
+    print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
+    result = registry.run(variant, params, t_end, progress=progress_printer(t_end), **options)
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
             f"({'wheels, hub ratchets' if variant.model == 'wheels' else variant.clutch})"
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial{out.suffix}")
     try:
-        count = write_video(result, partial, settings, title=title, progress=frame_printer())
+        count = write_video(result, partial, settings, title=title, progress=frame_printer(), route=route)
         partial.replace(out)
     finally:
         partial.unlink(missing_ok=True)
     print(f"wrote {out}: {count} frames of {settings.width} x {settings.height} px at {settings.fps:g} fps, "
           f"{result.t_end:g} s simulated shown in {count / settings.fps:.1f} s ({settings.speed:g}x real time)")
+    if route is not None:
+        s = result.summary
+        print(f"route {'done' if s['route_done'] else 'NOT done'}: {s['route_stop']}")
     return EXIT_OK
 
 

@@ -48,6 +48,12 @@ wheels1/2    -     optional: each module's state, +1 rolling forward, 0
                    standing, -1 skidding back (mode_switches counts its
                    changes as mode changes)
 ===========  ====  ====================================================
+
+MuJoCo's wheeled model (``mujoco-wheels``) also writes each module's pose in
+the mechanism's plane beside its x: ``y1``, ``y2`` [m] (module 1's A, module
+2's C across the first straight's axis, 0 on it) and ``yaw1``, ``yaw2`` [rad]
+(its turn about the plane's normal, 0 along x, positive towards +y), so that
+``render`` can replay a run along a route with bends.
 """
 
 from __future__ import annotations
@@ -88,7 +94,7 @@ SERIES_UNITS: dict[str, str] = {
     "clutch_damper_work": "J", "skid_work": "J", "motor_torque": "N m", "motor_power": "W", "rod_force": "N",
     "crank_pin_force": "N", "resistance1": "N", "resistance2": "N", "clutch_overlap1": "m", "clutch_overlap2": "m",
     "slip1": "m", "slip2": "m", "grip_use1": "-", "grip_use2": "-", "wheels1": "-", "wheels2": "-",
-    "loop_gap": "m", "momentum": "kg m/s", "drive_u": "-",
+    "loop_gap": "m", "momentum": "kg m/s", "drive_u": "-", "y1": "m", "y2": "m", "yaw1": "rad", "yaw2": "rad",
 }
 
 

@@ -41,7 +41,8 @@ from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_ad
 # loop-closure gap [m]; and the cumulative energy columns every driving engine writes [J].
 # With compliant clutches also: overlaps clutch_overlap1/2 d_i [m] (> 0: the spring is compressed), the springs'
 # stored energy clutch_spring_energy and the dampers' cumulative dissipation clutch_damper_work [J]. With finite
-# grip also: slip1/2, grip_use1/2, skid_work, wheels1/2 (ipir_mujoco.core.results).
+# grip also: slip1/2, grip_use1/2, skid_work, wheels1/2 (ipir_mujoco.core.results). The wheeled model also: its
+# modules' planar pose y1/2 [m], yaw1/2 [rad] (Recorder._planar_pose).
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
 # the per-sample scalars, in their order in Recorder.scalars (the compiled loop writes them too: native.py checks
 # the order against _stepper.c's)
@@ -205,6 +206,7 @@ class Recorder:
             out.update(self._grip_columns(q, sc, out))
         elif self.wheeled:
             out.update(self._wheel_columns(out, sc))
+            out.update(self._planar_pose(q))
         assert set(COLUMNS) <= set(out)
         return out
 
@@ -221,6 +223,15 @@ class Recorder:
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = sc["skid_work"].copy()
         return cols
+
+    def _planar_pose(self, q: np.ndarray) -> dict[str, np.ndarray]:
+        """The wheeled model's modules' pose in the plane beside x1, x2: y1, y2 [m], each module's lateral slide
+        (its point A, C across the first straight's axis: 0 on it) and yaw1, yaw2 [rad], its hinge about z
+        (0 along +x, positive towards +y). With x1, x2, phi they pose the robot for a replay (render)."""
+        from .wheels_model import LATERALS, YAWS
+
+        return {name: q[:, qpos_address(self.model, joint)].copy()
+                for name, joint in zip(("y1", "y2", "yaw1", "yaw2"), (*LATERALS, *YAWS))}
 
     def _wheel_columns(self, out: dict, sc: dict) -> dict[str, np.ndarray]:
         """The wheeled model's columns (``ipir_mujoco.core.results``): slip1/2 [m], each module's backward steps

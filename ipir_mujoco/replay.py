@@ -1,0 +1,119 @@
+"""A recorded MuJoCo run put back into a drawing model, at any time of its series (for ``render``).
+
+The series holds what poses the robot: the crank angle ``phi`` and the modules' travel ``x1``, ``x2``; the
+wheeled model's runs (``mujoco-wheels``) also each module's pose in the plane, ``y1``, ``y2``, ``yaw1``,
+``yaw2`` (:mod:`ipir_mujoco.engine.recorder`). Values between samples are interpolated linearly. What the
+series does not hold follows from it:
+
+- the rod's hinge closes the loop: the rod points from its pin on the crank (B) at module 2's pin (C),
+  as MuJoCo's loop constraint holds it to within the run's ``loop_gap`` (a few micrometres: far below a pixel);
+- the wheeled model's wheels turn by their module's travel along its own axis over the wheel radius (the
+  run records no hub angles), and their arms stand at the springs' preload (arm slide 0: the springs'
+  whole travel, SPRING_TRAVEL = 0.1 mm, is below a pixel in any frame ``render`` draws).
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.results import RunResult
+
+from .engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, closed_loop_pose,
+                           qpos_address)
+
+PLANAR = ("y1", "y2", "yaw1", "yaw2")  # the wheeled model's columns beside x1, x2
+
+
+class SlideReplay:
+    """The slide model's pose at a time of ``run`` (``model``: the drawing model, compiled from the run's
+    parameters): module 1 at x1, module 2 at its start plus x2, the crank at phi, the rod closing the loop
+    (:func:`ipir_mujoco.engine.model.closed_loop_pose`: the modules stay on the pipe's axis)."""
+
+    def __init__(self, model: mujoco.MjModel, run: RunResult):
+        self.model, self.params, self.series = model, run.params, run.series
+        self.address = {name: qpos_address(model, name) for name in (REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE)}
+        self.front0 = closed_loop_pose(self.params, float(self.series["phi"][0]))[FRONT_SLIDE]
+
+    def value(self, name: str, when: float) -> float:
+        """Column ``name`` at time ``when`` [s], interpolated linearly between samples."""
+        return float(np.interp(when, self.series["t"], self.series[name]))
+
+    def pose(self, data: mujoco.MjData, when: float) -> None:
+        """Set ``data``'s joints for time ``when`` [s] and compute its kinematics."""
+        a, p = self.address, self.params
+        phi = self.value("phi", when)
+        x1, x2 = self.value("x1", when), self.value("x2", when)
+        data.qpos[a[REAR_SLIDE]] = x1
+        data.qpos[a[CRANK_HINGE]] = phi
+        data.qpos[a[ROD_HINGE]] = closed_loop_pose(p, phi)[ROD_HINGE]
+        data.qpos[a[FRONT_SLIDE]] = self.front0 + x2
+        mujoco.mj_kinematics(self.model, data)
+        self._travel = (x1, x2)
+
+    def lookat(self, data: mujoco.MjData) -> list[float]:
+        """Where the camera looks after :meth:`pose` [m, (3,)]: midway between A and C on the pipe's axis,
+        below the plane."""
+        x1, x2 = self._travel
+        return [0.5 * (x1 + self.front0 + x2 + self.params.r + self.params.L), 0.0, -0.02]
+
+
+class WheeledReplay(SlideReplay):
+    """The wheeled model's pose at a time of ``run``: each module at its recorded (x, y, yaw), the crank at phi,
+    the rod closing the loop between the modules as they stand, the wheels turned by their travel (module
+    docstring). ParameterError if the run lacks the planar columns (not a wheeled MuJoCo run)."""
+
+    def __init__(self, model: mujoco.MjModel, run: RunResult):
+        from .engine.wheels_model import LATERALS, WHEEL_NAMES, YAWS
+
+        missing = [c for c in PLANAR if c not in run.series]
+        if missing:
+            raise ParameterError(f"the run's series lacks {', '.join(missing)}; allowed: a run of the wheeled MuJoCo "
+                                 "model (mujoco-wheels), which records each module's pose in the plane")
+        super().__init__(model, run)
+        self.address.update({name: qpos_address(model, joint) for name, joint in zip(PLANAR, (*LATERALS, *YAWS))})
+        self.hubs = [[qpos_address(model, n + "_hub") for n in names] for names in WHEEL_NAMES]
+        s = self.series
+        self.travel = [_axial_travel(s[f"x{k}"], s[f"y{k}"], s[f"yaw{k}"]) for k in (1, 2)]
+        self.crank, self.rod = model.body("crank").id, model.body("rod").id
+        self.front, self.end = model.body("front_module").id, model.site(ROD_END).id
+        self.pin = model.eq_data[model.equality(LOOP).id, 3:6].copy()  # C in module 2's frame
+
+    def pose(self, data: mujoco.MjData, when: float) -> None:
+        a, m = self.address, self.model
+        data.qpos[a[REAR_SLIDE]] = self.value("x1", when)
+        data.qpos[a[FRONT_SLIDE]] = self.front0 + self.value("x2", when)
+        for name in PLANAR:
+            data.qpos[a[name]] = self.value(name, when)
+        data.qpos[a[CRANK_HINGE]] = self.value("phi", when)
+        data.qpos[a[ROD_HINGE]] = 0.0
+        for travel, module in zip(self.travel, self.hubs):
+            data.qpos[module] = float(np.interp(when, self.series["t"], travel)) / self.params.wheel_radius
+        mujoco.mj_kinematics(m, data)
+        # the rod along the crank (hinge 0) now; turn it to point from B at C
+        b, tip = data.xpos[self.rod], data.site_xpos[self.end]
+        c = data.xpos[self.front] + data.xmat[self.front].reshape(3, 3) @ self.pin
+        turn = math.atan2(c[1] - b[1], c[0] - b[0]) - math.atan2(tip[1] - b[1], tip[0] - b[0])
+        data.qpos[a[ROD_HINGE]] = math.remainder(turn, 2 * math.pi)
+        mujoco.mj_kinematics(m, data)
+
+    def lookat(self, data: mujoco.MjData) -> list[float]:
+        """Midway between the modules' frames (A and C) in the plane, below it."""
+        rear, front = data.xpos[self.model.body("rear_module").id], data.xpos[self.front]
+        return [0.5 * float(rear[0] + front[0]), 0.5 * float(rear[1] + front[1]), -0.02]
+
+
+def _axial_travel(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """A module's cumulative travel along its own axis [m], shape (n,): each sample's step (dx, dy) on its
+    heading, midway between the samples' yaws [rad]."""
+    heading = 0.5 * (yaw[1:] + yaw[:-1])
+    steps = np.diff(x) * np.cos(heading) + np.diff(y) * np.sin(heading)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def replay_for(model: mujoco.MjModel, run: RunResult) -> SlideReplay:
+    """The replay of ``run`` on its drawing model: :class:`WheeledReplay` for the wheeled model's runs."""
+    return (WheeledReplay if run.settings.get("mujoco_model") == "wheels" else SlideReplay)(model, run)
