@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     params = model_params(args)
     variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch, args.mujoco_model)
     t_end = args.t_end if args.t_end is not None else T_END_ROUTE if route is not None else T_END
-    options = {} if route is None else {"route": route, "accuracy": "warn"}  # as simulate's defaults with --route
+    options = {} if route is None else {"route": route}  # the wheeled model's accuracy monitor warns by default
     until = " (or to the route's end)" if route is not None else ""
     print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
     result = registry.run(variant, params, t_end, progress=progress_printer(t_end), **options)

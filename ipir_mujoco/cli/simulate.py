@@ -46,9 +46,9 @@ def add_parser(commands) -> None:
                           "installed with the package: see 'ipir-mujoco --help')")
     sim.add_argument("--accuracy", choices=("stop", "warn"), default=None,
                      help="MuJoCo accuracy monitor: stop the run when the energy residual or the loop gap "
-                          "exceeds its tolerance (default), or warn, record it in the summary and go on (the "
-                          "default with --route: in tight bends the wheels' contacts take work the audit does not "
-                          "count, mjcf/README.md)")
+                          "exceeds its tolerance (the default on the slides), or warn, record it in the summary and "
+                          "go on (the default with --mujoco-model wheels: the wheels' soft contacts take work the "
+                          "audit does not count, mjcf/README.md)")
     sim.add_argument("--mjcf", metavar="FILE.xml", default=None,
                      help="MJCF template for --engine mujoco (default: the shipped inchworm.xml)")
     add_model_options(sim)
@@ -100,8 +100,6 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
     if args.route is not None and args.until_steady:
         raise ParameterError("--until-steady with --route: a run along a route ends at the route's end; allowed: "
                              "one of them")
-    if args.accuracy is None:
-        args.accuracy = "warn" if args.route is not None else "stop"
     if args.t_end is None:
         args.t_end = T_END_STEADY if args.until_steady else T_END_ROUTE if args.route is not None else T_END
     if args.timestep is not None:  # before the output interval is derived from it
@@ -117,7 +115,7 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
         check_whole("--max-switches", args.max_switches, low=1)
     variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch, args.mujoco_model)
     engine_options = {"max_switches": args.max_switches, "mjcf": args.mjcf, "timestep": args.timestep,
-                      "accuracy": None if args.accuracy == "stop" else args.accuracy}
+                      "accuracy": None if args.accuracy in (None, "stop") else args.accuracy}
     registry.check_options(variant, engine_options, FLAGS.get)
     if args.mjcf is not None:
         check_input_file("--mjcf", args.mjcf)
@@ -134,7 +132,7 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
     variant = check_options(args)
     params = model_params(args)
     progress = progress_printer(args.t_end) if not args.json else None
-    accuracy = None if args.accuracy == "stop" else args.accuracy
+    accuracy = args.accuracy if variant.is_mujoco else None  # None: the model's own (stop; warn on wheels)
     try:
         return registry.run(variant, params, args.t_end, dt_out=args.dt_out, until_steady=args.until_steady or None,
                             progress=progress, max_switches=args.max_switches, timestep=args.timestep,

@@ -67,7 +67,7 @@ from .servo_drive import TickedDrive, controller_for
 from .stepper import WARNED, loop_options, make_steps
 from .timestep import DT_MIN, choose_settings
 from .route_watch import check_route, route_decorator, route_watch
-from .wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
+from .wheels import WheelRatchet, check_mujoco_model, default_accuracy, wheel_loop_options, wheels_settings
 from .wheels_model import ContactSettings, build_wheels_model, set_wheels_state
 
 # columns of the recorder's arrays the monitor reads
@@ -91,7 +91,7 @@ def simulate_mujoco(
     mjcf=None,
     progress: Callable[[float], None] | None = None,
     servo: CrankServo | None = None,
-    accuracy: str = "stop",
+    accuracy: str | None = None,
     until_steady: bool = False,
     steady_tol: float = STEADY_TOL,
     steady_cycles: int = STEADY_CYCLES,
@@ -113,7 +113,8 @@ def simulate_mujoco(
     None chooses the timestep from the motion (:func:`.timestep.choose_settings`)
     and halves it (at most twice) if the accuracy monitor fails; given settings
     are used as they are. ``accuracy``: 'stop' (a failed accuracy check is a
-    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``).
+    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``); None: the model's own,
+    :func:`.wheels.default_accuracy` ('stop' on the slides, 'warn' on wheels).
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
@@ -135,7 +136,7 @@ def simulate_mujoco(
     if servo is not None and params.drive == "servo":
         raise ParameterError("a crank servo with drive='servo': one thing sets the crank's actuator; allowed: one")
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
-    check_accuracy_mode(accuracy)
+    accuracy = check_accuracy_mode(default_accuracy(model) if accuracy is None else accuracy)
     t_end, dt_out = run.t_end, run.dt_out
     if settings is not None:  # bounded up front: a tiny given timestep is refused, not run for days
         check_step_count(t_end, settings.timestep)

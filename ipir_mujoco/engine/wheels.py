@@ -227,6 +227,15 @@ def wheel_slip(x: np.ndarray) -> np.ndarray:
 MODELS = ("slides", "wheels")  # the MuJoCo models of the robot (simulate_mujoco's ``model``)
 
 
+def default_accuracy(model: str) -> str:
+    """The accuracy monitor's mode where a run does not choose one: 'stop' on the slides; 'warn' on wheels,
+    whose modules rock on their springs and whose soft contacts dissipate work the energy audit (the contacts'
+    tangential rows only) cannot attribute, ~0.1-0.3 % of the motor's whatever the step (mjcf/README.md,
+    "Wheels in contact"): a term of the model, not the stepping's error, so the residual is recorded and
+    shown rather than stopping the run (or halving its step, which does not lower it)."""
+    return "warn" if model == "wheels" else "stop"
+
+
 def check_mujoco_model(model: str, params: RobotParams, implementation: str) -> None:
     """ParameterError (one line) for an unknown MuJoCo ``model`` or a clutch the wheeled model does not have: it
     has the hubs' rigid ratchets only."""
