@@ -131,10 +131,11 @@ def checker_floor(spec) -> None:
 
 
 def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: float,
-               held: tuple[bool, bool]) -> tuple[str, str]:
+               held: tuple[bool, bool], wheeled: bool = False) -> tuple[str, str]:
     """The overlay's (labels, values) of the robot's state: crank speed and turns, each module's speed and
-    whether its clutch holds (times [s], angles [rad], speeds [rad/s, m/s])."""
-    words = ("holds (green)", "slides")
+    whether its clutch holds (times [s], angles [rad], speeds [rad/s, m/s]); a module not held slides on its
+    slide, or with ``wheeled`` rolls on its wheels."""
+    words = ("holds (green)", "free, rolls" if wheeled else "slides")
     values = (f"{fixed(omega, 1)} rad/s, {fixed((phi - phi0) / (2 * math.pi), 2)} rev\n"
               f"{fixed(v1, 2)} m/s, clutch {words[0] if held[0] else words[1]}\n"
               f"{fixed(v2, 2)} m/s, clutch {words[0] if held[1] else words[1]}")
@@ -234,7 +235,8 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport,
                                f"{title}\nt = {when:.3f} s{along}", f"\n{settings.speed:g}x real time", renderer)
             labels, values = state_text(when, phi, float(s["phi"][0]), float(np.interp(when, t, s["omega"])),
-                                        float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held)
+                                        float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held,
+                                        wheeled)
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels,
                                values, renderer)
             yield _read_frame(settings, viewport, renderer)

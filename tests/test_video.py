@@ -339,3 +339,14 @@ def test_the_viewer_draws_the_checker_floor_and_says_time_and_speeds():
     labels, values = robot.overlay()
     assert labels.startswith("t = 0.") and "module 2 (front)" in labels
     assert values.count("m/s, clutch") == 2 and "rad/s" in values
+
+
+def test_the_overlay_says_a_free_wheeled_module_rolls():
+    """A module whose clutch does not hold slides on its slide, but rolls on its wheels: the overlay's word
+    follows the model (render and the viewer share state_text)."""
+    from ipir_mujoco.video import state_text
+
+    _, slides = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True))
+    _, wheels = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True), wheeled=True)
+    assert slides.splitlines()[1].endswith("clutch slides") and wheels.splitlines()[1].endswith("clutch free, rolls")
+    assert slides.splitlines()[2] == wheels.splitlines()[2] == "0.00 m/s, clutch holds (green)"

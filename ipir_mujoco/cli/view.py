@@ -124,7 +124,7 @@ class ViewedRobot:
         crank, rear, front = (m.joint(n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE))
         labels, values = state_text(d.time, float(d.qpos[crank.qposadr[0]]), self.params.phi0,
                                     float(d.qvel[crank.dofadr[0]]), float(d.qvel[rear.dofadr[0]]),
-                                    float(d.qvel[front.dofadr[0]]), self.held or (False, False))
+                                    float(d.qvel[front.dofadr[0]]), self.held or (False, False), self.wheeled)
         return f"t = {d.time:.2f} s\n{labels}", f"\n{values}"
 
     def _colour(self) -> None:
