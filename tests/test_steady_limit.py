@@ -96,12 +96,13 @@ def _cycle(t0: float, period: float, distance: float) -> Cycle:
 
 
 def test_limit_motion_recovers_a_geometric_approach_exactly():
-    """Revolutions whose speed and distance approach their limits as c rho^k: the extrapolation returns the
+    """Revolutions whose speed and distance approach their limits as c rho^k, from as far as a run the steady
+    test stops can be (its last revolution within STEADY_TOL of the limit): the extrapolation returns the
     limits to rounding, for a monotone (rho 0.8) and an alternating (rho -0.5) approach."""
     for rho in (0.8, -0.5):
         u_lim, d_lim = 0.5, 0.05
-        speeds = [u_lim * (1 - 0.01 * rho ** k) for k in range(3)]
-        distances = [d_lim * (1 - 0.02 * rho ** k) for k in range(3)]
+        speeds = [u_lim * (1 - 1e-4 * rho ** k) for k in range(3)]
+        distances = [d_lim * (1 - 2e-4 * rho ** k) for k in range(3)]
         revolutions = [_cycle(float(k), d / u, d) for k, (u, d) in enumerate(zip(speeds, distances))]
         speed, distance = limit_motion(revolutions)
         assert speed == pytest.approx(u_lim, rel=1e-12) and distance == pytest.approx(d_lim, rel=1e-12)
@@ -130,3 +131,17 @@ def test_no_sawtooth_across_designs():
         assert run.summary["energy_per_metre_j_m"] == pytest.approx(params.F_r1 + params.F_r2,
                                                                     rel=LIMIT_ACCURACY["analytic"]), J_A
         assert run.summary["efficiency"] == pytest.approx(1.0, abs=LIMIT_ACCURACY["analytic"]), J_A
+
+
+def test_limit_motion_caps_its_correction_at_the_steady_tolerance():
+    """Two nearly equal last changes (rho = 0.9999: a wobble the stop accepts because its last change is
+    below a thousandth of the tolerance) would extrapolate by 9999 times that change; the correction is held
+    to the steady tolerance of the speed, the distance's scaled alike."""
+    u, d = 0.5, 0.05
+    speeds = [u, u * (1 + 5e-8), u * (1 + 5e-8 + 0.9999 * 5e-8)]
+    revolutions = [_cycle(float(k), d / u, d * s / u) for k, s in enumerate(speeds)]  # speed s, distance ~ s
+    speed, distance = limit_motion(revolutions, tol=STEADY_TOL)
+    assert abs(speed / speeds[2] - 1) == pytest.approx(STEADY_TOL, rel=1e-6)
+    assert abs(distance / revolutions[2].distance_m - 1) <= STEADY_TOL * (1 + 1e-6)
+    uncapped = speeds[2] + (speeds[2] - speeds[1]) * 0.9999 / (1 - 0.9999)
+    assert abs(uncapped / speeds[2] - 1) > 4 * STEADY_TOL  # the cap acts here

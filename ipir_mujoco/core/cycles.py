@@ -323,7 +323,7 @@ def transit_free_energy(window: list[Cycle]) -> dict[str, float | None]:
     return out
 
 
-def limit_motion(last: list[Cycle]) -> tuple[float, float]:
+def limit_motion(last: list[Cycle], tol: float = STEADY_TOL) -> tuple[float, float]:
     """The periodic limit of the mean speed [m/s] and the distance per revolution [m], from the last three
     revolutions of a run at its steady state (``last``, in order; with fewer, their mean).
 
@@ -331,8 +331,10 @@ def limit_motion(last: list[Cycle]) -> tuple[float, float]:
     speed's ratio rho = (u_3 - u_2) / (u_2 - u_1). So f_lim = f_3 + (f_3 - f_2) rho / (1 - rho) (Aitken's
     extrapolation), the distance with the speed's rho too (the one the steady test watches). Where
     |rho| >= 1 the revolutions show no such approach (a wobble from revolution to revolution, as MuJoCo's
-    steps give): then the mean over the revolutions. The correction is bounded by the steady test, which
-    stops only once the speed's extrapolated remaining drift is below its tolerance.
+    steps give): then the mean over the revolutions. The speed's correction is at most ``tol`` (the steady
+    test's tolerance) of it, the distance's scaled alike: the steady test stops once the speed's extrapolated
+    remaining drift is below ``tol``, or once its last change is a thousandth of that whatever its trend, and
+    there a rho just below 1 (two equal wobbles) would make the factor rho / (1 - rho) unbounded.
     """
     speeds = [c.mean_speed_m_s for c in last]
     distances = [c.distance_m for c in last]
@@ -340,7 +342,11 @@ def limit_motion(last: list[Cycle]) -> tuple[float, float]:
     if len(last) == 3 and speeds[1] != speeds[0]:
         rho = (speeds[2] - speeds[1]) / (speeds[1] - speeds[0])
     if abs(rho) < 1:
-        return tuple(f[2] + (f[2] - f[1]) * rho / (1.0 - rho) for f in (speeds, distances))
+        factor = rho / (1.0 - rho)
+        step = abs(speeds[2] - speeds[1]) * abs(factor)
+        if step > tol * abs(speeds[2]):
+            factor *= tol * abs(speeds[2]) / step
+        return tuple(f[2] + (f[2] - f[1]) * factor for f in (speeds, distances))
     time = sum(c.period_s for c in last)
     return sum(distances) / time, sum(distances) / len(last)
 
@@ -387,7 +393,7 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     out["cycle_energy_residual_j"] = max(residuals) if residuals else None
     if window is not None:
         out["t_steady_s"] = window[-1].t_end
-        out["steady_speed_m_s"], out["distance_per_rev_m"] = limit_motion(found[max(k - 2, 0):k + 1])
+        out["steady_speed_m_s"], out["distance_per_rev_m"] = limit_motion(found[max(k - 2, 0):k + 1], tol)
         energy = transit_free_energy(window)
         out["energy_per_metre_j_m"], out["efficiency"] = energy["energy_per_metre"], energy["efficiency"]
         peaks = [c.peak_clutch_force_n for c in window if c.peak_clutch_force_n is not None]
