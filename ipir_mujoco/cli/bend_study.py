@@ -5,14 +5,12 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import sys
 from pathlib import Path
 
 from ipir_mujoco.core.params import check_whole
-from ipir_mujoco.core.results import write_json
 
-from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, model_params
+from ..output import check_output_dir
+from .common import EXIT_OK, model_params, study_progress, write_study_files
 
 FILES = ("bend_study.csv", "bend_study.json", "bend_study.png")
 
@@ -49,19 +47,12 @@ def run(args: argparse.Namespace) -> int:
     workers = (os.cpu_count() or 1) if args.workers is None else check_whole("workers", args.workers, low=1, high=1024)
     check_output_dir(args.out, files=FILES)
 
-    def progress(message: str) -> None:
-        print(f"bend-study: {message}", file=sys.stderr, flush=True)
-
+    progress = study_progress("bend-study")
     progress(f"{len(ratios)} bends and their straight twins on {workers} processes (each ~2 s of wall time per "
              "simulated second)")
     study = bs.run_study(params, ratios, workers=workers, progress=progress)
-    with staged_output(args.out) as staging:
-        write_csv(staging / FILES[0], study)
-        write_json(staging / FILES[1], study)
-        write_bend_figure(study, staging / FILES[2])
-    print(format_table(study))
-    print(f"{len(study['rows'])} bends in {study['wall_s']:.1f} s; results: "
-          + ", ".join(str(Path(args.out) / f) for f in FILES))
+    write_study_files(args.out, FILES, study, write_csv, lambda path: write_bend_figure(study, path),
+                      format_table(study), f"{len(study['rows'])} bends")
     return EXIT_OK
 
 

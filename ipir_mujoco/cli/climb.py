@@ -5,18 +5,16 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import sys
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco import registry
 from ipir_mujoco.core.options import check_run_options
 from ipir_mujoco.core.params import check_real
-from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
-from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, model_params
+from ..output import check_output_dir
+from .common import EXIT_OK, add_model_options, model_params, study_progress, write_study_files
 
 FILES = ("climb.csv", "climb.json", "climb.png")
 KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
@@ -89,17 +87,9 @@ def run(args: argparse.Namespace) -> int:
     check_run_options(t_end, climbing.DT_OUT)
     check_output_dir(args.out, files=FILES)
 
-    def progress(message: str) -> None:
-        print(f"climb: {message}", file=sys.stderr, flush=True)
-
-    study = climbing.climb_study(params, inclines, engines, tolerance, t_end, progress)
-    with staged_output(args.out) as staging:
-        write_csv(staging / FILES[0], study)
-        write_json(staging / FILES[1], study)
-        write_figure(study, params, staging / FILES[2])
-    print(format_study(study, params))
-    print(f"{len(inclines)} inclines x {len(engines)} engines in {study['wall_s']:.1f} s; results: "
-          + ", ".join(str(Path(args.out) / f) for f in FILES))
+    study = climbing.climb_study(params, inclines, engines, tolerance, t_end, study_progress("climb"))
+    write_study_files(args.out, FILES, study, write_csv, lambda path: write_figure(study, params, path),
+                      format_study(study, params), f"{len(inclines)} inclines x {len(engines)} engines")
     return EXIT_OK
 
 

@@ -5,16 +5,14 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import sys
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import check_whole
-from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
-from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, model_params
+from ..output import check_output_dir
+from .common import EXIT_OK, model_params, study_progress, write_study_files
 
 FILES = ("clutch_study.csv", "clutch_study.json", "clutch_study.png")
 
@@ -66,17 +64,10 @@ def run(args: argparse.Namespace) -> int:
     cs.plan(base, designs, points)  # every value checked before anything is written or run
     check_output_dir(args.out, files=FILES)
 
-    def progress(message: str) -> None:
-        print(f"clutch-study: {message}", file=sys.stderr, flush=True)
-
-    study = cs.run_study(base, designs=designs, points=points, workers=args.workers, progress=progress)
-    with staged_output(args.out) as staging:
-        write_csv(staging / FILES[0], study)
-        write_json(staging / FILES[1], study)
-        write_study_figure(study, staging / FILES[2])
-    print(format_table(study))
-    print(f"{len(study['rows'])} designs x 2 engines in {study['wall_s']:.1f} s; results: "
-          + ", ".join(str(Path(args.out) / f) for f in FILES))
+    study = cs.run_study(base, designs=designs, points=points, workers=args.workers,
+                         progress=study_progress("clutch-study"))
+    write_study_files(args.out, FILES, study, write_csv, lambda path: write_study_figure(study, path),
+                      format_table(study), f"{len(study['rows'])} designs x 2 engines")
     return EXIT_OK
 
 

@@ -106,3 +106,29 @@ def progress_printer(t_end: float):
     if t_end <= 2.0:
         return None
     return tenths_printer(t_end, lambda t: f"simulated {t:.2f} / {t_end:g} s", final_within=0.05)
+
+
+def study_progress(command: str) -> Callable[[str], None]:
+    """A study's progress on stderr, one line per message, prefixed with the command's name."""
+    def progress(message: str) -> None:
+        print(f"{command}: {message}", file=sys.stderr, flush=True)
+    return progress
+
+
+def write_study_files(out, files: tuple[str, str, str], study: dict, write_csv, write_figure, table: str,
+                      counted: str) -> None:
+    """A study command's ending: ``files`` (CSV, JSON, figure) written into ``out`` all or nothing
+    (``write_csv(path, study)``, the study as JSON, ``write_figure(path)``), then the ``table`` and one line
+    '``counted`` in S s; results: ...' on stdout."""
+    from pathlib import Path
+
+    from ipir_mujoco.core.results import write_json
+
+    from ..output import staged_output
+
+    with staged_output(out) as staging:
+        write_csv(staging / files[0], study)
+        write_json(staging / files[1], study)
+        write_figure(staging / files[2])
+    print(table)
+    print(f"{counted} in {study['wall_s']:.1f} s; results: " + ", ".join(str(Path(out) / f) for f in files))

@@ -6,16 +6,14 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import sys
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import check_real, check_whole
-from ipir_mujoco.core.results import write_json
 
 from ..labels import significant
-from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, model_params
+from ..output import check_output_dir
+from .common import EXIT_OK, model_params, study_progress, write_study_files
 
 FILES = ("control_study.csv", "control_study.json", "control_study.png")
 METRICS = ("mean_omega_rad_s", "speed_ripple", "peak_clutch_force_n", "peak_module_accel_m_s2",
@@ -81,17 +79,10 @@ def run(args: argparse.Namespace) -> int:
     cs.check_speeds(base, speeds, dips, profile_speed)  # every value checked before anything is written or run
     check_output_dir(args.out, files=FILES)
 
-    def progress(message: str) -> None:
-        print(f"control-study: {message}", file=sys.stderr, flush=True)
-
-    study = cs.run_study(base, speeds, dips, profile_speed, workers=args.workers, progress=progress)
-    with staged_output(args.out) as staging:
-        write_csv(staging / FILES[0], study)
-        write_json(staging / FILES[1], study)
-        write_study_figure(study, staging / FILES[2])
-    print(format_table(study))
-    print(f"{len(study['rows']) + len(study['profile']['rows'])} runs in {study['wall_s']:.1f} s; results: "
-          + ", ".join(str(Path(args.out) / f) for f in FILES))
+    study = cs.run_study(base, speeds, dips, profile_speed, workers=args.workers,
+                         progress=study_progress("control-study"))
+    write_study_files(args.out, FILES, study, write_csv, lambda path: write_study_figure(study, path),
+                      format_table(study), f"{len(study['rows']) + len(study['profile']['rows'])} runs")
     return EXIT_OK
 
 
