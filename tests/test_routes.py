@@ -224,6 +224,8 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
     assert isinstance(fig, Figure)
     bend = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "bend:time"][0]
     assert list(bend.get_ydata()) == pytest.approx([1.2 / 1.32, 2.74 / 2.735], rel=1e-12)
-    for ratios in ("0.4", "1,abc"):
-        code, out, err = run_cli(capsys, "bend-study", "--ratios", ratios, "--out", tmp_path / "o")
-        assert code == 2 and "--ratios" in err and len(err.strip().splitlines()) == 1
+    for argv, word in ((("--ratios", "0.4"), "--ratios"), (("--ratios", "1,abc"), "--ratios"),
+                       (("--set", "pipe_diameter=0.05"), "pipe_diameter")):  # refused before any run or progress
+        code, out, err = run_cli(capsys, "bend-study", *argv, "--out", tmp_path / "o")
+        assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (argv, err)
+    assert not (tmp_path / "o").exists()

@@ -29,6 +29,7 @@ import numpy as np
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
 
 from .pool import map_unordered
@@ -43,10 +44,12 @@ MU_WALL = 0.8  # the study's wall friction unless --set gives one: the straight-
 
 
 def study_params(base: RobotParams) -> RobotParams:
-    """The study's parameters: ``base`` with the motor, and mu_wall MU_WALL where it is unlimited."""
+    """The study's parameters: ``base`` with the motor, and mu_wall MU_WALL where it is unlimited; ParameterError
+    (one line) for an incline or a robot that does not fit its pipe (:func:`ipir_mujoco.core.pipe.check_fit`)."""
     if base.incline != 0.0:
         raise ParameterError(f"incline={base.incline:g} deg: the bend study's bends are horizontal; allowed: "
                              "incline=0")
+    check_fit(base)  # the robot fits its pipe: refused here, before any run
     return base.replace(drive="motor", mu_wall=MU_WALL if base.mu_wall is None else base.mu_wall)
 
 
