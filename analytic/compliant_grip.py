@@ -34,8 +34,8 @@ import math
 import numpy as np
 
 from . import kernels
+from .compliant_state import _HYSTERESIS_FORCE, _HYSTERESIS_OVERLAP, NO_SLIDE, Clutch
 
-NO_SLIDE = (math.nan, math.nan)  # (t_s, d0) of a clutch whose anchor holds
 
 
 def slide_overlap(t, slide: tuple[float, float], k: float, c: float, G: float):
@@ -75,8 +75,6 @@ def grip_hysteresis(model, G: float) -> float:
     twice the force of the overlap hysteresis (k * 1 pm, at which a clutch engages), what the positions
     resolve (a float overlap of a module 1 m along is known to 1e-16 m, k times that in force), whichever is
     larger: so that on no grip (G = 0) a clutch that engages is not beyond its grip at once."""
-    from .compliant_clutch import _HYSTERESIS_FORCE, _HYSTERESIS_OVERLAP
-
     return max(_HYSTERESIS_FORCE * max(1.0, G), 2.0 * model.k * _HYSTERESIS_OVERLAP)
 
 
@@ -84,8 +82,6 @@ def add_events(model, regime, i: int, add, hysteresis_speed: float) -> None:
     """The grip's events of module i in ``regime`` through ``add`` (:meth:`.CompliantModel.events`): 'grip' (an
     engaged clutch's force reaches G_i plus :func:`grip_hysteresis`: its anchor slides) and 'stick' (a sliding
     anchor's backward speed falls below minus a hysteresis: it stops)."""
-    from .compliant_clutch import Clutch
-
     G = model.grip[i]
     if regime.clutch[i] is Clutch.ENGAGED and math.isfinite(G) and regime.slip[i] != 0:  # stuck: k d stays
         offset = G + grip_hysteresis(model, G)
@@ -100,10 +96,6 @@ def add_events(model, regime, i: int, add, hysteresis_speed: float) -> None:
 def transitions(model, t: float, y: np.ndarray, fired, clutch: list, peak: list, slide: list) -> None:
     """What a 'grip' or 'stick' event changes, in place: the clutch's state, its slide, its anchor (``peak`` =
     anchor + backlash) and, at a slide's end, the damper work its slide dissipated, into y[6] (J)."""
-    from .compliant_clutch import Clutch
-
-    from .compliant_clutch import _HYSTERESIS_OVERLAP
-
     if fired is None or fired[0] not in ("grip", "stick"):
         return
     kind, i = fired
@@ -127,8 +119,6 @@ def start_slides(model, t: float, y: np.ndarray, regime, fired):
     """``regime`` with every engaged clutch whose force at state ``y`` (projected) exceeds its grip (beyond the
     hysteresis) sliding from t (an engagement at speed with a damper, which pushes with c |v| at once), but the
     one whose slide just ended (``fired``: its force is the grip); ``regime`` itself if none."""
-    from .compliant_clutch import Clutch
-
     clutch, slide = list(regime.clutch), list(regime.slide)
     for i in (0, 1):
         G = model.grip[i]
@@ -145,8 +135,6 @@ def piece_columns(model, regime, times: np.ndarray, columns: dict) -> None:
     """Correct one segment's ``columns`` (:func:`.compliant_run._piece`) for its sliding anchors, in place: the
     overlap d(t), the spring energy, the damper work so far (with the slide's); and with finite grip add
     ``grip_use1/2`` and ``wheels1/2`` (-1 anchor sliding, +1 rolling forward at its running maximum, 0 standing)."""
-    from .compliant_clutch import Clutch
-
     finite = [math.isfinite(G) for G in model.grip]
     for i in (0, 1):
         if regime.clutch[i] is Clutch.SLIDING:

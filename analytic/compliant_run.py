@@ -37,7 +37,8 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_TIME, RunResult, stall_reason
 
 from . import accel, compliant_grip, dop853, kernels
-from .compliant_clutch import Clutch, CompliantModel, Regime
+from .compliant_clutch import CompliantModel
+from .compliant_state import Clutch, Regime
 from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics

@@ -225,7 +225,7 @@ def guard_table(model, mode, n_events, p, times, states, out):
 # of rhs/guard says whether an event reads its raw value (RAW) or what the root search sees (GUARDED).
 COMPLIANT = 2
 RAW, GUARDED = 0, 1
-TRACKING, FREE, ENGAGED, CLIPPED, SLIDING = 0, 1, 2, 3, 4  # .compliant_clutch.Clutch
+TRACKING, FREE, ENGAGED, CLIPPED, SLIDING = 0, 1, 2, 3, 4  # .compliant_state.Clutch
 P_K, P_C, P_DELTA, P_S0, P_S1, P_S2, P_C1, P_C2, P_PK1, P_PK2, P_T0 = range(17, 28)
 # finite grip (:mod:`.compliant_grip`): each module's grip [N] (inf: unlimited), and while its clutch's
 # anchor slides the slide's start [s] and the overlap then [m]

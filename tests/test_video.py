@@ -202,7 +202,7 @@ def test_route_frames_draw_the_robot_turning_where_a_straight_replay_does_not(be
 
 def test_render_takes_a_route_for_the_wheeled_model_only(tmp_path, capsys):
     good = tmp_path / "bend.toml"
-    good.write_text("".join(f"[[segment]]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in seg.items())
+    good.write_text("".join("[[segment]]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in seg.items())
                             for seg in BEND))
     out = tmp_path / "x.gif"
     for argv, word in ((["--route", str(good)], "--mujoco-model wheels"),
