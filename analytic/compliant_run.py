@@ -6,7 +6,7 @@ the output grid (with every segment's ends: an instant where the regime
 changes appears twice; a damped clutch's force maxima are sampled too, so a
 peak force does not depend on the grid), and the next regime is decided. A whole turn of the
 crank's running maximum also ends a segment, so every revolution boundary is
-a sample and the steady-state test (:class:`.cycles.SteadyWatch`) stops the
+a sample and the steady-state test (:class:`ipir_mujoco.core.steady_watch.SteadyWatch`) stops the
 run exactly at the end of a revolution.
 
 Series columns (ndarrays of shape (n,)): the shared ``COLUMNS`` (``lambda1``/

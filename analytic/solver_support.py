@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from ipir_mujoco.core.cycles import SteadyWatch
+from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import check_real

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from ipir_mujoco.core.cycles import SteadyWatch, cycle_boundaries, cycle_summary, cycles, steady_index
+from ipir_mujoco.core.cycles import cycle_boundaries, cycle_summary, cycles, steady_index
+from ipir_mujoco.core.steady_watch import SteadyWatch
 
 
 def settling_run(t_end=6.0, n=60001, tau=0.5, omega_ss=20.0, per_rev=0.05):

@@ -16,7 +16,7 @@ import pytest
 
 from ipir_mujoco.analytic import RobotParams, dop853, kernels
 from ipir_mujoco.analytic import accel
-from ipir_mujoco.core.cycles import SteadyWatch
+from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.analytic.dense import DenseSolution, component_at, dense_table, graze_scan
 from ipir_mujoco.analytic.kinematics import Linkage
 from ipir_mujoco.core.results import Mode

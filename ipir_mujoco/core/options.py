@@ -17,7 +17,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .cycles import STEADY_CYCLES, STEADY_TOL, check_steady_test
+from .cycles import STEADY_CYCLES, STEADY_TOL
+from .steady_watch import check_steady_test
 from .errors import ParameterError
 from .params import as_real, check_real, check_whole
 
@@ -76,7 +77,7 @@ class RunOptions:
 
     ``t_end`` [s]: the simulated time (with ``until_steady``, the cap); ``dt_out`` [s]: the output interval;
     ``until_steady``: stop at the end of the revolution where the periodic steady state is reached
-    (:class:`.cycles.SteadyWatch` with ``steady_tol`` and ``steady_cycles``); ``progress(t)``: called with
+    (:class:`.steady_watch.SteadyWatch` with ``steady_tol`` and ``steady_cycles``); ``progress(t)``: called with
     the simulated time [s] now and then (about every 0.1 s of it), or None; ``wall_budget_s`` [s]: the most
     wall-clock time a run may take (None: :data:`DEFAULT_WALL_BUDGET_S`, so that no run left alone goes on
     for hours; ``math.inf``: no limit, stored as None); ``max_switches``: the most mode switches an

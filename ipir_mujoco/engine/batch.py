@@ -39,7 +39,8 @@ import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
 
-from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL, SteadyWatch
+from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
+from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams

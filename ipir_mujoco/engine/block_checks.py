@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 
-from ipir_mujoco.core.cycles import SteadyWatch
+from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import SimulationError
 
 from .common import rest_since, stall_reason
