@@ -10,7 +10,7 @@ from pathlib import Path
 from ipir_mujoco.core.params import check_whole
 
 from ..output import check_output_dir
-from .common import EXIT_OK, model_params, study_progress, write_study_files
+from .common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
 
 FILES = ("bend_study.csv", "bend_study.json", "bend_study.png")
 
@@ -26,12 +26,8 @@ def add_parser(commands) -> None:
     cmd.add_argument("--ratios", metavar="LIST", default=None,
                      help="bend radius over pipe diameter, R/D: a comma-separated list (default 0.6,1,1.5,2,3,5,7.5,10)")
     cmd.add_argument("--quick", action="store_true", help="R/D 2 and 5 only, for a first look")
-    cmd.add_argument("--workers", type=int, default=None, help="processes to use (default: all cores)")
-    cmd.add_argument("--out", metavar="DIR", default="bend-study", help="results folder (default ./bend-study)")
-    cmd.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
-                     help="a robot parameter (SI units), e.g. pipe_diameter=0.2; the study runs the default motor "
-                          "and, unless given, mu_wall 0.8")
-    cmd.add_argument("--config", metavar="FILE.toml", help="TOML file of robot parameters; --set wins over it")
+    add_study_options(cmd, "bend-study", "e.g. pipe_diameter=0.2; "
+                                       "the study runs the default motor and, unless given, mu_wall 0.8")
     cmd.set_defaults(handler=run)
 
 

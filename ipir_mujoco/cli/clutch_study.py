@@ -12,7 +12,7 @@ from ipir_mujoco.core.params import check_whole
 
 from ..labels import significant
 from ..output import check_output_dir
-from .common import EXIT_OK, model_params, study_progress, write_study_files
+from .common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
 
 FILES = ("clutch_study.csv", "clutch_study.json", "clutch_study.png")
 
@@ -32,12 +32,8 @@ def add_parser(commands) -> None:
     cmd.add_argument("--points", metavar="LIST", default="cruise,startup",
                      help="operating points, from: cruise (the default motor, to its periodic steady state), "
                           "startup (the paper's constant torque, 1 s from rest); default both")
-    cmd.add_argument("--workers", type=int, default=None, help="processes to use (default: all cores)")
-    cmd.add_argument("--out", metavar="DIR", default="clutch-study", help="results folder (default ./clutch-study)")
-    cmd.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
-                     help="a robot parameter (SI units), e.g. clutch_damping=50; the study sets drive, "
-                          "clutch_stiffness and clutch_backlash itself")
-    cmd.add_argument("--config", metavar="FILE.toml", help="TOML file of robot parameters; --set wins over it")
+    add_study_options(cmd, "clutch-study", "e.g. clutch_damping=50; "
+                                       "the study sets drive, clutch_stiffness and clutch_backlash itself")
     cmd.add_argument("--quick", action="store_true",
                      help="a small grid (1e4,1e5,1e6 N/m x 0,1e-3 m) for a first look; --stiffness/--backlash win")
     cmd.set_defaults(handler=run)

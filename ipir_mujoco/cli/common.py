@@ -54,6 +54,16 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
                              "first-order geometry, L >> r) or exact (the exact slider-crank); wins over --set")
 
 
+def add_study_options(parser: argparse.ArgumentParser, command: str, set_help: str) -> None:
+    """The options every study command (clutch-study, control-study, bend-study) shares: --workers, --out
+    (default ./COMMAND), and --set (``set_help`` says what the study sets itself) and --config for the robot."""
+    parser.add_argument("--workers", type=int, default=None, help="processes to use (default: all cores)")
+    parser.add_argument("--out", metavar="DIR", default=command, help=f"results folder (default ./{command})")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                        help=f"a robot parameter (SI units), {set_help}")
+    parser.add_argument("--config", metavar="FILE.toml", help="TOML file of robot parameters; --set wins over it")
+
+
 def model_params(args: argparse.Namespace) -> RobotParams:
     """The parameter set a command's options describe: defaults, --config, --set, then --drive and
     --feedforward (refused in one line with a drive other than servo)."""

@@ -13,7 +13,7 @@ from ipir_mujoco.core.params import check_real, check_whole
 
 from ..labels import significant
 from ..output import check_output_dir
-from .common import EXIT_OK, model_params, study_progress, write_study_files
+from .common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
 
 FILES = ("control_study.csv", "control_study.json", "control_study.png")
 METRICS = ("mean_omega_rad_s", "speed_ripple", "peak_clutch_force_n", "peak_module_accel_m_s2",
@@ -38,12 +38,8 @@ def add_parser(commands) -> None:
     cmd.add_argument("--profile-speed", type=float, default=None, metavar="RAD_S",
                      help="the profile comparison's mean crank speed [rad/s] (default 8)")
     cmd.add_argument("--quick", action="store_true", help="10 rad/s and dips 0, 0.2 only; --speeds/--dips win")
-    cmd.add_argument("--workers", type=int, default=None, help="processes to use (default: all cores)")
-    cmd.add_argument("--out", metavar="DIR", default="control-study", help="results folder (default ./control-study)")
-    cmd.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
-                     help="a robot parameter (SI units), e.g. control_rate=500; the study sets drive, omega_target, "
-                          "speed_dip and feedforward itself")
-    cmd.add_argument("--config", metavar="FILE.toml", help="TOML file of robot parameters; --set wins over it")
+    add_study_options(cmd, "control-study", "e.g. control_rate=500; "
+                                       "the study sets drive, omega_target, speed_dip and feedforward itself")
     cmd.set_defaults(handler=run)
 
 
