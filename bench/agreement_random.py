@@ -13,11 +13,10 @@ from __future__ import annotations
 
 import argparse
 import time
-from concurrent import futures
 
 import numpy as np
 
-from ipir_mujoco.studies.agreement import describe, draw, judge, run_pair
+from ipir_mujoco.studies.agreement import describe, draw, judged, run_pair
 
 
 def run_one(index: int, params, t_end: float, budget: float) -> dict:
@@ -36,16 +35,12 @@ def main() -> None:
     designs = [draw(rng) for _ in range(args.designs)]
     counts: dict[str, int] = {}
     started = time.perf_counter()
-    with futures.ProcessPoolExecutor(args.workers) as pool:
-        jobs = [pool.submit(run_one, i, p, args.t_end, args.budget) for i, p in enumerate(designs)]
-        for job in futures.as_completed(jobs):
-            row = job.result()
-            verdict, detail, _ = judge(row)
-            counts[verdict] = counts.get(verdict, 0) + 1
-            print(f"[{row['design']:3d}] {verdict:9s} {detail}  (wall {row['analytic_wall']:.2f} / "
-                  f"{row['mujoco_wall']:.2f} s)", flush=True)
-            if verdict != "agree":
-                print(f"      {describe(row['params'])}", flush=True)
+    for row, verdict, detail in judged(designs, run_one, args.t_end, args.budget, args.workers):
+        counts[verdict] = counts.get(verdict, 0) + 1
+        print(f"[{row['design']:3d}] {verdict:9s} {detail}  (wall {row['analytic_wall']:.2f} / "
+              f"{row['mujoco_wall']:.2f} s)", flush=True)
+        if verdict != "agree":
+            print(f"      {describe(row['params'])}", flush=True)
     print(f"\n{args.designs} designs, {time.perf_counter() - started:.0f} s wall: "
           + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
 

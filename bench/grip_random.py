@@ -18,12 +18,11 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from concurrent import futures
 from dataclasses import replace
 
 import numpy as np
 
-from ipir_mujoco.studies.agreement import describe, draw, judge, run_pair
+from ipir_mujoco.studies.agreement import describe, draw, judged, run_pair
 
 
 def grip_design(rng: np.random.Generator):
@@ -53,24 +52,20 @@ def main() -> None:
     counts: dict[str, int] = {}
     worst = 0.0
     started = time.perf_counter()
-    with futures.ProcessPoolExecutor(args.workers) as pool:
-        jobs = [pool.submit(run_one, i, p, args.t_end, args.budget) for i, p in enumerate(designs)]
-        for job in futures.as_completed(jobs):
-            row = job.result()
-            verdict, detail, _ = judge(row)
-            counts[verdict] = counts.get(verdict, 0) + 1
-            skid = ""
-            a, m = row["slips"]["analytic"], row["slips"]["mujoco"]
-            if a is not None and m is not None:
-                floor = 1e-2 * 2 * row["params"].r
-                rel = max(abs(mj - an) / max(an, floor) for an, mj in zip(a, m))
-                worst = max(worst, rel)
-                skid = f", skids {1e3 * a[0]:.3g} / {1e3 * a[1]:.3g} mm, worst difference {rel:.1e}"
-            print(f"[{row['design']:3d}] {verdict:9s} {detail}{skid}  (wall {row['analytic_wall']:.2f} / "
-                  f"{row['mujoco_wall']:.2f} s)", flush=True)
-            if verdict != "agree":
-                p = row["params"]
-                print(f"      {describe(p)}, mu_wall {p.mu_wall:.3g}, F_n {p.F_n1:.3g} / {p.F_n2:.3g} N", flush=True)
+    for row, verdict, detail in judged(designs, run_one, args.t_end, args.budget, args.workers):
+        counts[verdict] = counts.get(verdict, 0) + 1
+        skid = ""
+        a, m = row["slips"]["analytic"], row["slips"]["mujoco"]
+        if a is not None and m is not None:
+            floor = 1e-2 * 2 * row["params"].r
+            rel = max(abs(mj - an) / max(an, floor) for an, mj in zip(a, m))
+            worst = max(worst, rel)
+            skid = f", skids {1e3 * a[0]:.3g} / {1e3 * a[1]:.3g} mm, worst difference {rel:.1e}"
+        print(f"[{row['design']:3d}] {verdict:9s} {detail}{skid}  (wall {row['analytic_wall']:.2f} / "
+              f"{row['mujoco_wall']:.2f} s)", flush=True)
+        if verdict != "agree":
+            p = row["params"]
+            print(f"      {describe(p)}, mu_wall {p.mu_wall:.3g}, F_n {p.F_n1:.3g} / {p.F_n2:.3g} N", flush=True)
     print(f"\n{args.designs} designs, {time.perf_counter() - started:.0f} s wall: "
           + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + f"; worst skid difference {worst:.1e}")
 

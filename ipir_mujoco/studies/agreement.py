@@ -115,3 +115,17 @@ def describe(p: RobotParams) -> str:
         f"k={p.clutch_stiffness:.3g} c={p.clutch_damping:.3g} backlash={p.clutch_backlash:.3g}")
     return (f"m1={p.m1:.3g} m2={p.m2:.3g} r={p.r:.3g} L={p.L:.3g} J_A={p.J_A:.3g} rod_mass={p.rod_mass:.3g} "
             f"F_r1={p.F_r1:.3g} F_r2={p.F_r2:.3g} phi0={p.phi0:.3g} {drive} incline={p.incline:.3g} {clutch}")
+
+
+def judged(designs: list[RobotParams], run_one, t_end: float, budget_s: float, workers: int):
+    """Each design's (row, verdict, detail) as it finishes: ``run_one(index, params, t_end, budget_s)`` (a
+    module-level function returning :func:`run_pair`'s row with its ``design`` index) on a process pool of
+    ``workers``, judged by :func:`judge`. The loop the random-design benchmarks share."""
+    from concurrent import futures
+
+    with futures.ProcessPoolExecutor(workers) as pool:
+        jobs = [pool.submit(run_one, i, p, t_end, budget_s) for i, p in enumerate(designs)]
+        for job in futures.as_completed(jobs):
+            row = job.result()
+            verdict, detail, _ = judge(row)
+            yield row, verdict, detail
