@@ -51,6 +51,15 @@ from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damp
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
 
 
+def check_transmissions(model: mujoco.MjModel, act: list[int], trn, targets: list[int], names) -> None:
+    """ValueError unless each clutch actuator of ``act`` acts through transmission ``trn`` (an mjtTrn) on its
+    element of ``targets`` (ids; ``names`` for the message) with gear 1."""
+    for u, target, name in zip(act, targets, names):
+        if (model.actuator_trntype[u] != int(trn) or model.actuator_trnid[u, 0] != target
+                or model.actuator_gear[u, 0] != 1.0):
+            raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {name!r} with gear 1")
+
+
 def clutch_actuators(model: mujoco.MjModel, act, params: RobotParams) -> tuple[float, float]:
     """(k [N/m], c [N s/m]) of the compliant clutches' actuators ``act`` (ids), checked to be the spring k =
     clutch_stiffness with the force range [0, ...]; their dampers set as built (a model that has run may hold
@@ -88,11 +97,7 @@ class CompliantClutches:
         self.act = [model.actuator(n).id for n in CLUTCHES]
         self.qpos_adr = [qpos_address(model, n) for n in SLIDES]
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
-        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
-        for u, slide in zip(self.act, SLIDES):
-            if (model.actuator_trntype[u] != joint_trn or model.actuator_trnid[u, 0] != model.joint(slide).id
-                    or model.actuator_gear[u, 0] != 1.0):
-                raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {slide!r} with gear 1")
+        check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_JOINT, [model.joint(n).id for n in SLIDES], SLIDES)
         k, c = clutch_actuators(model, self.act, params)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler does not

@@ -30,7 +30,7 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 
 from .common import REST_SPEED
-from .compliant import CLUTCHES, CompliantClutches, clutch_actuators
+from .compliant import CLUTCHES, CompliantClutches, check_transmissions, clutch_actuators
 from .grip import GripRows, upper_bound
 from .grip_model import ROLLS, SKIDS
 from .model import SLIDES, dof_address, implicit_damping, qpos_address
@@ -53,11 +53,7 @@ class CompliantGrip(CompliantClutches):
         self.c_adr = [qpos_address(model, n) for n in SKIDS]
         self.c_dof = [dof_address(model, n) for n in SKIDS]
         self.skid_ids = [model.joint(n).id for n in SKIDS]
-        tendon_trn = int(mujoco.mjtTrn.mjTRN_TENDON)
-        for u, roll in zip(self.act, ROLLS):
-            if (model.actuator_trntype[u] != tendon_trn or model.actuator_trnid[u, 0] != model.tendon(roll).id
-                    or model.actuator_gear[u, 0] != 1.0):
-                raise ValueError(f"clutch actuator {model.actuator(u).name!r} must act on {roll!r} with gear 1")
+        check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_TENDON, [model.tendon(n).id for n in ROLLS], ROLLS)
         k, c = clutch_actuators(model, self.act, params)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         self.implicit = implicit_damping(model)
