@@ -292,13 +292,30 @@ def _write_clutches(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None
             act.biasprm[2] = -params.clutch_damping
 
 
+def write_step_options(spec: mujoco.MjSpec, settings: SolverSettings) -> tuple[list[float], list[float]]:
+    """Write the timestep and integrator of ``settings`` into ``spec``; return the (solref, solimp) every
+    constraint row of the model gets (the slide and the wheeled models alike)."""
+    spec.option.timestep = settings.timestep
+    spec.option.integrator = INTEGRATORS[settings.integrator]
+    return [settings.time_constant, 1.0], [*settings.solimp, 0.5, 2.0]
+
+
+def compile_spec(spec: mujoco.MjSpec, decorate, what: str) -> mujoco.MjModel:
+    """``spec`` compiled, after ``decorate(spec)`` if given (what only drawing needs: a floor texture, a
+    route's walls); a compiler error is a one-line ParameterError naming ``what`` was built."""
+    if decorate is not None:
+        decorate(spec)
+    try:
+        return spec.compile()
+    except ValueError as exc:
+        message = " ".join(str(exc).split())
+        raise ParameterError(f"the {what} does not compile for these parameters: {message}") from None
+
+
 def _write_solver(spec: mujoco.MjSpec, settings: SolverSettings, hint: str, ratchet: bool) -> None:
     """Timestep, integrator and the soft-constraint parameters of every constraint row."""
     joint = lambda name: _element(spec.joint, name, hint)  # noqa: E731
-    spec.option.timestep = settings.timestep
-    spec.option.integrator = INTEGRATORS[settings.integrator]
-    solref = [settings.time_constant, 1.0]
-    solimp = [*settings.solimp, 0.5, 2.0]
+    solref, solimp = write_step_options(spec, settings)
     for name in (REAR_SLIDE, FRONT_SLIDE):
         j = joint(name)
         if ratchet:
@@ -315,14 +332,7 @@ def build_model(params: RobotParams, settings: SolverSettings = SolverSettings()
                 mjcf: str | Path | None = None, ratchet: bool = False, decorate=None) -> mujoco.MjModel:
     """Compile the robot for ``params`` (see :func:`build_spec`); ``decorate(spec)``, if given, adds what only
     drawing needs (the viewer's floor texture) before compiling."""
-    spec = build_spec(params, settings, mjcf, ratchet)
-    if decorate is not None:
-        decorate(spec)
-    try:
-        model = spec.compile()
-    except ValueError as exc:
-        message = " ".join(str(exc).split())
-        raise ParameterError(f"the MuJoCo model does not compile for these parameters: {message}") from None
+    model = compile_spec(build_spec(params, settings, mjcf, ratchet), decorate, "MuJoCo model")
     if params.grip is not None:
         scale_grip_rows(model, SLIDES)
     return model

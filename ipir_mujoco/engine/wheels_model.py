@@ -39,8 +39,8 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.pipe import check_fit
 
 from ..resources import mjcf_dir
-from .model import (FRONT_SLIDE, LOOP, REAR_SLIDE, SolverSettings, _element,
-                    _write_drive, _write_gravity, _write_mechanism, check_params, load_spec)
+from .model import (FRONT_SLIDE, LOOP, REAR_SLIDE, SolverSettings, _element, _write_drive, _write_gravity,
+                    _write_mechanism, check_params, compile_spec, load_spec, write_step_options)
 
 MODULES = ("rear", "front")
 SIDES = ("top", "bottom")  # the wall at +D/2, the wall at -D/2
@@ -170,16 +170,11 @@ def _write_wheels(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
 def _write_contact_solver(spec: mujoco.MjSpec, settings: SolverSettings, contact: ContactSettings,
                           hint: str) -> None:
     """Timestep, integrator, cone, impratio, noslip and every row's solref and solimp (the slide model's)."""
-    from .model import INTEGRATORS
-
-    spec.option.timestep = settings.timestep
-    spec.option.integrator = INTEGRATORS[settings.integrator]
+    solref, solimp = write_step_options(spec, settings)
     spec.option.cone = (mujoco.mjtCone.mjCONE_ELLIPTIC if contact.cone == "elliptic"
                         else mujoco.mjtCone.mjCONE_PYRAMIDAL)
     spec.option.impratio = contact.impratio
     spec.option.noslip_iterations = contact.noslip_iterations
-    solref = [settings.time_constant, 1.0]
-    solimp = [*settings.solimp, 0.5, 2.0]
     for name in HUBS:
         j = _element(spec.joint, name, hint)
         j.solref_limit, j.solimp_limit = solref, solimp
@@ -196,14 +191,7 @@ def build_wheels_model(params: RobotParams, settings: SolverSettings = SolverSet
                        decorate=None) -> mujoco.MjModel:
     """Compile the wheeled robot for ``params`` (:func:`build_wheels_spec`); ``decorate(spec)`` as for
     :func:`.model.build_model`."""
-    spec = build_wheels_spec(params, settings, contact, mjcf)
-    if decorate is not None:
-        decorate(spec)
-    try:
-        return spec.compile()
-    except ValueError as exc:
-        message = " ".join(str(exc).split())
-        raise ParameterError(f"the wheeled MuJoCo model does not compile for these parameters: {message}") from None
+    return compile_spec(build_wheels_spec(params, settings, contact, mjcf), decorate, "wheeled MuJoCo model")
 
 
 def is_wheeled(model: mujoco.MjModel) -> bool:
