@@ -104,6 +104,7 @@ class GripRatchet:
         if params.grip is None or params.clutch_stiffness is not None:
             raise ValueError("GripRatchet needs a model built with a finite mu_wall and rigid clutches")
         self.model, self.data = model, data
+        self._states = (math.nan, None)  # (data.time, states()) of the last step read
         self.x_adr = [qpos_address(model, n) for n in SLIDES]
         self.c_adr = [qpos_address(model, n) for n in SKIDS]
         self.c_dof = [dof_address(model, n) for n in SKIDS]
@@ -161,7 +162,10 @@ class GripRatchet:
 
     def states(self) -> tuple[list[int], list[float]]:
         """Per module, its wheels' state (+1 rolling, 0 standing, -1 skidding) and its clutch's share of
-        the hold [N], of the last step (module docstring)."""
+        the hold [N], of the last step (module docstring). Computed once per step: a sample reads it twice
+        (:meth:`reactions`, :meth:`wheels`)."""
+        if self._states[0] == self.data.time:
+            return self._states[1]
         clutch = self._clutch_rows()
         grip_force, roll_force = self.rows.forces(self.data)
         states, shares = [], []
@@ -175,6 +179,7 @@ class GripRatchet:
             skids = grip_force[k] >= G if G > 0.0 else self._qvel.item(self.c_dof[k]) < -REST_SPEED
             states.append(-1 if skids else 0)
             shares.append(clutch_share(hold, F))
+        self._states = (self.data.time, (states, shares))
         return states, shares
 
     def reactions(self) -> tuple[bool, bool, float, float]:

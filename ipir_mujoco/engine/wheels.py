@@ -52,6 +52,7 @@ class WheelRatchet:
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
         self.model, self.data, self.radius = model, data, params.wheel_radius
+        self._states = (math.nan, None)  # (data.time, states()) of the last step read
         names = [n + "_hub" for module in WHEEL_NAMES for n in module]
         self.module_of = {}
         self.joint_ids = [model.joint(n).id for n in names]
@@ -141,7 +142,10 @@ class WheelRatchet:
 
     def states(self) -> tuple[list[int], list[float]]:
         """Per module its wheels' state (+1 rolling, 0 standing, -1 skidding) and its clutch's share of the
-        hold [N], of the last step (module docstring)."""
+        hold [N], of the last step (module docstring). Computed once per step: a sample reads it twice
+        (:meth:`reactions`, :meth:`wheels`)."""
+        if self._states[0] == self.data.time:
+            return self._states[1]
         limits, friction, sticks = self._rows()
         normal, tangential = self._contacts()
         states, shares = [], []
@@ -157,6 +161,7 @@ class WheelRatchet:
                 skids = self._qvel.item(self.x_dof[i]) < -REST_SPEED
             states.append(-1 if skids else 0)
             shares.append(clutch_share(hold, self.resistance[i]))
+        self._states = (self.data.time, (states, shares))
         return states, shares
 
     def reactions(self) -> tuple[bool, bool, float, float]:
