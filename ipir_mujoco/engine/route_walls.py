@@ -56,6 +56,13 @@ def outer_boxes(radius: float, diameter: float, angle: float) -> int:
     return max(4, math.ceil(abs(angle) / step))
 
 
+def outer_box_width(radius: float, diameter: float, angle: float) -> tuple[int, float]:
+    """(how many boxes, each one's face length [m]) of a bend's outer wall (centreline radius [m], pipe
+    diameter [m], ``angle`` [rad]): the face between its neighbours' tangent points on radius + diameter / 2."""
+    n = outer_boxes(radius, diameter, angle)
+    return n, 2 * (radius + diameter / 2) * math.tan(abs(angle) / n / 2)
+
+
 def _wall_straights(route: Route, robot_length: float, diameter: float) -> list[dict]:
     """The straights the walls need: merged collinear route straights, the exit straight; each with its
     start (x, y, heading), length, and per side ('top' +1, 'bottom' -1) how far it reaches into a bend on that
@@ -85,9 +92,7 @@ def _wall_straights(route: Route, robot_length: float, diameter: float) -> list[
                 if 0 <= neighbour < len(pieces) and pieces[neighbour].kind == "bend":
                     bend = pieces[neighbour]
                     if (1.0 if bend.angle > 0 else -1.0) == -side:  # this side is the bend's outer wall
-                        outer = bend.radius + diameter / 2
-                        n = outer_boxes(bend.radius, diameter, bend.angle)
-                        box = 2 * outer * math.tan(abs(bend.angle) / n / 2)
+                        _, box = outer_box_width(bend.radius, diameter, bend.angle)
                         if which == "before":
                             before = box
                         else:
@@ -132,9 +137,8 @@ def write_route_walls(spec: mujoco.MjSpec, params: RobotParams, route: Route) ->
         world.add_geom(name=f"route_bend{k + 1}_inner_drawn", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
                        size=[inner, HEIGHT, 0], pos=[cx, cy, 0.0], contype=0, conaffinity=0, group=1,
                        rgba=list(WALL_RGBA))
-        n = outer_boxes(bend.radius, D, bend.angle)
+        n, box = outer_box_width(bend.radius, D, bend.angle)
         step = bend.angle / n
-        box = 2 * outer * math.tan(abs(step) / 2)  # the face between the neighbours' tangent points
         side = 1.0 if bend.angle > 0 else -1.0
         start = math.atan2(bend.y - cy, bend.x - cx)  # the bend's start, seen from its centre
         for j in range(n):
