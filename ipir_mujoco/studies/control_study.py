@@ -22,7 +22,8 @@ T_CAP is flagged ``steady`` false and read over its last STEADY_CYCLES whole rev
 ``peak_module_accel_m_s2`` (the largest |a1|, |a2|) [m/s^2], ``energy_per_metre_j_m`` (the motor's work at the
 crank per metre) [J/m], ``electrical_energy_per_metre_j_m`` [J/m] (what the motor draws: u tau omega_noload,
 as V I for the DC motor with omega_noload = V / k_t, so the winding's loss tau^2 omega_noload / M_stall is
-in it), ``steady_speed_m_s`` [m/s], ``peak_drive_u``, ``peak_motor_torque_n_m`` [N m], ``wall_s`` [s]. The
+in it), ``steady_speed_m_s`` [m/s] (with ``energy_per_metre_j_m``: the run summary's periodic limit when
+steady, :mod:`ipir_mujoco.core.cycles`; else the window's totals), ``peak_drive_u``, ``peak_motor_torque_n_m`` [N m], ``wall_s`` [s]. The
 equations' peaks are exact (their reactions and accelerations peak at mode switches, which are samples).
 MuJoCo's peak clutch force and module acceleration are left None, as the sweep leaves them
 (:mod:`.sweep_metrics`): its rigid ratchet is a soft constraint that takes up each hand-over within a few steps
@@ -138,9 +139,13 @@ def run_metrics(run, params: RobotParams) -> dict:
     edges = np.array([t0, t1])
     position = np.interp(edges, t, travel(s))
     distance = float(position[1] - position[0])
-    work = np.diff(np.interp(edges, t, s["motor_work"]))[0]
-    out["steady_speed_m_s"] = distance / (t1 - t0)
-    out["energy_per_metre_j_m"] = float(work) / distance if distance > 0 else None
+    if steady:  # the summary's, the periodic limit's (core.cycles: the stated accuracy)
+        out["steady_speed_m_s"] = run.summary["steady_speed_m_s"]
+        out["energy_per_metre_j_m"] = run.summary["energy_per_metre_j_m"]
+    else:  # no steady state: the window's own totals
+        work = np.diff(np.interp(edges, t, s["motor_work"]))[0]
+        out["steady_speed_m_s"] = distance / (t1 - t0)
+        out["energy_per_metre_j_m"] = float(work) / distance if distance > 0 else None
     tt, omega = t[inside], s["omega"][inside]
     if "drive_u" in s:
         u, torque = s["drive_u"][inside], s["motor_torque"][inside]
