@@ -121,17 +121,20 @@ def main() -> int:
     parser.add_argument("--skip-studies", action="store_true")
     parser.add_argument("--leave-out", default="", metavar="NAME,...",
                         help="summary keys and parameters to leave out (names added since the fingerprint compared)")
+    parser.add_argument("--smoke", action="store_true", help="the first two runs only, in seconds (a check that "
+                        "it runs; compare smoke fingerprints only with smoke fingerprints)")
     args = parser.parse_args()
     LEFT_OUT.update(name for name in args.leave_out.split(",") if name)
     from ipir_mujoco.engine import simulate_mujoco
 
-    for name, (params, geometry, clutch, t_end, options) in ANALYTIC.items():
+    smoke = slice(0, 2 if args.smoke else None)
+    for name, (params, geometry, clutch, t_end, options) in list(ANALYTIC.items())[smoke]:
         options = _with_table(params, options)
         print(f"{name:45s} {digest_run(analytic.simulate(params, geometry, clutch, t_end, **options))}", flush=True)
-    for name, (params, rule, implementation, t_end, options) in MUJOCO.items():
+    for name, (params, rule, implementation, t_end, options) in list(MUJOCO.items())[smoke]:
         options = _with_table(params, options)
         print(f"{name:45s} {digest_run(simulate_mujoco(params, rule, implementation, t_end, **options))}", flush=True)
-    if args.skip_studies:
+    if args.skip_studies or args.smoke:
         return 0
     from ipir_mujoco.studies.climbing import climb_study
     from ipir_mujoco.studies.cruise import cruise_study

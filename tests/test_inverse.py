@@ -121,3 +121,13 @@ def test_on_a_slope_the_inverse_torque_drives_the_forward_model_the_same_way(clu
     assert np.max(np.abs(forward["phi"] - OMEGA * forward["t"])) < 1e-5
     for column in ("x1", "x2"):
         assert forward[column][-1] == pytest.approx(s[column][-1], rel=1e-4, abs=1e-9)
+
+
+def test_progress_reports_the_simulated_time_up_to_the_end():
+    """progress(t) at every clutch-mode change: increasing simulated times [s], the last the run's end, so
+    that the command line can say where a long prescribed motion is (kinetostatics --samples)."""
+    reached = []
+    run = inverse_kinetostatics(RobotParams(), CrankMotion.constant_speed(20.0, 0.0, 2.0), "exact", "unilateral",
+                                progress=reached.append)
+    assert len(reached) >= 4 and np.all(np.diff(reached) > 0)  # two mode changes a revolution at least
+    assert reached[-1] == pytest.approx(run.t_end, rel=1e-12)

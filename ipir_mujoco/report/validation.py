@@ -20,7 +20,7 @@ import numpy as np
 
 from ipir_mujoco.core.results import Mode
 
-from ..labels import summary_label
+from ..labels import SUMMARY, summary_label
 from ..resources import shipped
 from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Link, Paragraph, Table, fmt, pct, to_html, to_markdown
@@ -228,13 +228,15 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     blocks.append(Paragraph("Each rung removes one idealization; the change against the rung before (in brackets) "
                             "is what that idealization costs."))
     header = ["rung", "removes"] + [summary_label(k) for k in LADDER_FIGURES]
-    rows = []
+    rows, previous = [], None
     for rung in metrics["ladder"]:
         cells = [rung["name"], rung["isolates"]]
         for key in LADDER_FIGURES:
-            change = pct(rung["change_vs_previous"][key])
+            change = ladder_change(rung["summary"][key], None if previous is None else previous["summary"][key],
+                                   rung["change_vs_previous"][key], key)
             cells.append(fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
+        previous = rung
     blocks.append(Table(header, rows))
 
     from ..studies.lr_study import FIGURES as LR_FIGURES, describe_threshold
@@ -282,10 +284,14 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     blocks.append(Paragraph("For the equations the residual is the integration error; for MuJoCo it is what "
                             "the soft constraints and the time stepping took."))
     blocks.append(Table(["rung", "motor work [J]", "kinetic [J]", "friction [J]", "residual [J]",
-                         "residual / motor work [-]"],
+                         "residual / motor work [-]", "MuJoCo's accuracy monitor"],
                         [[r["name"], fmt(e["motor_work_j"], 8), fmt(e["kinetic_j"], 8), fmt(e["friction_j"], 8),
-                          f"{e['residual_j']:.2e}", f"{e['residual_j'] / e['motor_work_j']:.1e}"]
+                          f"{e['residual_j']:.2e}", f"{e['residual_j'] / e['motor_work_j']:.1e}",
+                          monitor_verdict(r["summary"].get("accuracy"))]
                          for r in metrics["ladder"] for e in [r["summary"]["energy"]]]))
+    flagged = [flag for r in metrics["ladder"] if (flag := accuracy_flag(r["name"], r["summary"].get("accuracy")))]
+    if flagged:
+        blocks.append(Paragraph("**Flagged:** " + " ".join(flagged)))
 
     blocks += list(extra)
 
@@ -340,6 +346,45 @@ def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | Non
     except RenderUnavailable as exc:
         return str(exc), settings
     return None, settings
+
+
+def monitor_verdict(accuracy: dict | None) -> str:
+    """The energy-audit table's cell for a rung's accuracy record: '' for the equations (no monitor),
+    'within' or 'ABOVE (figure)' against MuJoCo's tolerances."""
+    if not accuracy or "tolerances" not in accuracy:
+        return ""
+    if accuracy.get("ok", True) and not accuracy.get("violations"):
+        return "within its tolerances"
+    return "ABOVE: " + ", ".join(sorted({v["figure"] for v in accuracy.get("violations", [])})) + " (see below)"
+
+
+def accuracy_flag(name: str, accuracy: dict | None) -> str:
+    """A sentence for a MuJoCo rung whose run went beyond the accuracy monitor's tolerances (a rung run with
+    accuracy='warn' finishes and is reported, and its figures carry that error), or ''."""
+    if not accuracy or "tolerances" not in accuracy or (accuracy.get("ok", True) and not accuracy.get("violations")):
+        return ""
+    parts = []
+    for figure, tolerance in accuracy["tolerances"].items():
+        worst = accuracy.get(figure)
+        first = next((v for v in accuracy.get("violations", []) if v["figure"] == figure), None)
+        if first is not None and worst is not None:
+            parts.append(f"{figure} {abs(worst):.1e} against the tolerance {tolerance:g} (first above it at "
+                         f"t = {first['t_s']:.3g} s)")
+    return (f"{name}: " + "; ".join(parts) + ". The monitor warned instead of stopping this rung (accuracy="
+            f"'{accuracy.get('mode', 'warn')}'), so its figures carry that error; compare its changes with it "
+            "before drawing conclusions.")
+
+
+def ladder_change(value, before, relative, key: str) -> str:
+    """The change of a ladder figure against the rung before: a signed percentage, or, where the figure
+    reaches zero or changes sign (a clutch reaction from -1371 N, a pull, to 0: '+100 %' would read as a
+    doubling), the difference in the figure's unit ('+1371 N'); '' for the first rung."""
+    if relative is None or before is None or value is None:
+        return ""
+    if value == 0 or before == 0 or (value > 0) != (before > 0):
+        unit = SUMMARY.get(key, (key, ""))[1]
+        return f"{value - before:+.4g}" + (f" {unit}" if unit and unit != "-" else "")
+    return pct(relative)
 
 
 def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: Sequence = ()) -> None:

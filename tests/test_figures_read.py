@@ -1,0 +1,104 @@
+"""The report's and the studies' figures read right (tests/figure_checks.py): legend entries drawn, axes with
+units and without raw keys, no text over data; and each figure's own fault fixed. Built from small
+synthetic records in the shape the studies write, so that these tests take a second."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import figure_checks
+from ipir_mujoco.report import cruise_section
+
+
+def _cruise_metrics(same: bool = True) -> dict:
+    """Rungs as cruise_study writes them: the three equation rungs on one curve, the locks on it too, the
+    one-way rungs on another, the one-way rungs running longer (they settle later)."""
+    rungs = []
+    for name, t_end, level in ((cruise_section.PAPER, 1.75, 0.43), (cruise_section.EXACT, 1.75, 0.43),
+                               (cruise_section.ROD, 1.75, 0.43), (cruise_section.LOCKS, 1.75, 0.43),
+                               (cruise_section.ONE_WAY, 2.2, 0.53), (cruise_section.RATCHET, 2.2, 0.53)):
+        t = np.linspace(0.0, t_end, 400)
+        ends = np.linspace(0.35, t_end, 8)
+        rungs.append({"name": name, "steady": True, "steady_speed_m_s": level,
+                      "history": {"t": t.tolist(), "omega": (30 * level * (1 + 0.2 * np.sin(40 * t))).tolist(),
+                                  "speed": (level * (1 + 0.5 * np.sin(40 * t))).tolist()},
+                      "revolutions_end": {"t": ends.tolist(), "speed": (level * (1 - np.exp(-5 * ends))).tolist()}})
+    return {"rungs": rungs, "params": {"omega_noload": 30.0}}
+
+
+def test_cruise_histories_show_every_series_on_one_time_axis():
+    fig = cruise_section.history_figure(_cruise_metrics())
+    assert not figure_checks.undrawn_legend_entries(fig)
+    assert not figure_checks.bad_axis_labels(fig)
+    assert not figure_checks.texts_over_data(fig)
+    assert "[s]" in fig.axes[-1].get_xlabel()
+    # one time axis: the three panels span the same times (panel (c) used to start at its first revolution)
+    assert len({ax.get_xlim() for ax in fig.axes}) == 1 and fig.axes[0].get_xlim()[0] == 0.0
+    # a series drawn over an identical one is thinner, so the one under it shows as a rim
+    for ax in fig.axes:
+        lines = [line for line in ax.lines if len(line.get_xdata()) > 2]
+        for i, upper in enumerate(lines):
+            for lower in lines[:i]:
+                if np.array_equal(lower.get_xdata(), upper.get_xdata()) and \
+                        np.allclose(lower.get_ydata(), upper.get_ydata()):
+                    assert upper.get_linewidth() < lower.get_linewidth(), (lower.get_label(), upper.get_label())
+
+
+def _grip_metrics() -> dict:
+    """The finite-grip section's record: per case the unlimited-grip runs and the finite-grip rows (the
+    cruise runs to their steady states, each as long as it needs)."""
+    from ipir_mujoco.report.grip_section import ONE_WAY, PAPER
+
+    def run(travel, t_end, speed, peak=12.0, slip=0.0):
+        return {"travel_m": travel, "t_end_s": t_end, "steady_speed_m_s": speed, "peak_clutch_force_n": peak,
+                "slip_m": slip}
+    cases = {}
+    for key, drive in (("startup", "torque"), ("cruise", "motor")):
+        rows = [{"mu": mu, "press_n": press, "grip_n": mu * press,
+                 ONE_WAY: run(1.3 - 0.1 * (mu == 0.1), 2.6 + (mu == 0.1), 0.53 - 0.01 * (mu == 0.1), slip=0.01)}
+                for mu in (0.1, 0.5) for press in (50.0,)]
+        cases[key] = {"drive": drive, "unlimited": {PAPER: run(1.2, 2.4, 0.43, 77.0), ONE_WAY: run(1.25, 2.5, 0.533)},
+                      "rows": rows}
+    return {"quick": True, "mu": [0.1, 0.5], "press_n": [50.0], "cases": cases,
+            "riser": {"mu": 0.5, "needed_n": [41.4, 41.4], "press_n": {"drive_off": [19.6, 19.9]}}}
+
+
+def test_finite_grip_figure_labels_its_log_axis_and_its_table_says_each_runs_time(tmp_path):
+    from ipir_mujoco.report import grip_section
+    from ipir_mujoco.report.document import Table
+
+    metrics = _grip_metrics()
+    fig = grip_section.grip_figure(metrics)
+    assert not figure_checks.undrawn_legend_entries(fig)
+    assert not figure_checks.bad_axis_labels(fig)
+    assert not figure_checks.texts_over_data(fig)
+    for ax in fig.axes:
+        fig.canvas.draw()
+        shown = [t.get_text() for t in ax.get_xticklabels() if t.get_text() and
+                 ax.get_xlim()[0] <= t.get_position()[0] <= ax.get_xlim()[1]]
+        assert len(shown) >= 2, shown  # a log axis over 5-25 N used to show one label ("10^1")
+        assert "mu_wall" not in ax.get_xlabel() and "F_n" not in ax.get_xlabel()
+    # the table: the speed is the figure to compare; a travel comes with the time it took
+    (table,) = [b for b in grip_section.render(metrics, tmp_path) if isinstance(b, Table)][1:]
+    travel = table.header.index("travel [m] in the run's time [s]")
+    assert table.rows[0][travel] == "1.250 in 2.50 s" and table.rows[1][travel] == "1.200 in 3.60 s"
+    assert table.header.index("speed [m/s] (steady, or mean over 1 s)") < travel
+
+
+def test_the_ladder_shows_a_change_through_zero_in_its_unit_and_flags_an_inaccurate_rung():
+    from ipir_mujoco.report.validation import accuracy_flag, ladder_change, monitor_verdict
+
+    # a reaction from -1371 N (a pull) to 0: not '+100.00 %'
+    assert ladder_change(0.0, -1371.2, 1.0, "min_clutch_reaction_n") == "+1371 N"
+    assert ladder_change(5.0, -2.0, -3.5, "x1_final") == "+7 m"
+    assert ladder_change(8.289, 8.3223, -0.004, "revolutions") == "-0.40 %"
+    assert ladder_change(8.3, None, None, "revolutions") == ""
+    accuracy = {"residual_ratio": 3.78e-3, "tolerances": {"residual_ratio": 1e-3, "loop_gap_m": 5e-5}, "mode": "warn",
+                "ok": False, "violations": [{"figure": "residual_ratio", "t_s": 0.819, "value": 1.04e-3,
+                                             "tolerance": 1e-3}], "loop_gap_m": 1.4e-5}
+    flag = accuracy_flag("wheels in contact", accuracy)
+    assert flag.startswith("wheels in contact: residual_ratio 3.8e-03 against the tolerance 0.001 (first above it "
+                           "at t = 0.819 s)") and "loop_gap_m" not in flag
+    assert monitor_verdict(accuracy) == "ABOVE: residual_ratio (see below)"
+    assert accuracy_flag("MuJoCo ratchet", {**accuracy, "ok": True, "violations": []}) == ""
+    assert monitor_verdict({"residual_ratio": 1e-9}) == ""  # the equations: no monitor
