@@ -102,3 +102,58 @@ def test_the_ladder_shows_a_change_through_zero_in_its_unit_and_flags_an_inaccur
     assert monitor_verdict(accuracy) == "ABOVE: residual_ratio (see below)"
     assert accuracy_flag("MuJoCo ratchet", {**accuracy, "ok": True, "violations": []}) == ""
     assert monitor_verdict({"residual_ratio": 1e-9}) == ""  # the equations: no monitor
+
+
+def _optimize_folder(tmp_path, infeasible: bool):
+    """evaluations.csv and pareto.csv of a one-objective search (min M_stall with steady speed >= 0.5 m/s)
+    as run_optimize writes them, with or without infeasible designs."""
+    from ipir_mujoco.core.params import RobotParams
+    from ipir_mujoco.studies.optimize import Problem, parse_constraint, parse_objective
+    from ipir_mujoco.studies.sweep_space import parse_vary
+
+    problem = Problem((parse_vary("M_stall=0.1:1"),), (parse_objective("min:M_stall"),),
+                      (parse_constraint("steady_speed_m_s>=0.5"),), RobotParams(drive="motor"), verify=None,
+                      t_end=10.0, until_steady=True, budget=20)
+    stall = np.linspace(0.32 if not infeasible else 0.1, 1.0, 12)
+    speed = 0.5 + 0.28 * (stall - 0.316)
+    header = "eval_id,M_stall,steady_speed_m_s,notes,error\n"
+    rows = [f"{i},{m:.6g},{v:.6g},," for i, (m, v) in enumerate(zip(stall, speed))]
+    (tmp_path / "evaluations.csv").write_text(header + "\n".join(rows) + "\n")
+    best = int(np.argmin(np.where(speed >= 0.5, stall, np.inf)))
+    (tmp_path / "pareto.csv").write_text(header + rows[best] + "\n")
+    return problem
+
+
+def test_pareto_figure_names_its_axes_in_words_with_units_and_lists_only_what_it_drew(tmp_path):
+    from ipir_mujoco.report.optimize_plots import pareto_figure
+
+    for infeasible in (False, True):
+        fig = pareto_figure(tmp_path, _optimize_folder(tmp_path, infeasible))
+        assert not figure_checks.undrawn_legend_entries(fig)
+        assert not figure_checks.bad_axis_labels(fig)
+        assert not figure_checks.texts_over_data(fig)
+        labels = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert any(label.startswith("infeasible") for label in labels) is infeasible, labels
+        assert fig.axes[0].get_ylabel() == "steady forward speed [m/s]" and fig.axes[0].get_xlabel() == "M_stall [N m]"
+        assert "constraint: steady forward speed >= 0.5" in labels
+
+
+def test_sensitivity_figure_labels_units_and_says_why_s1_exceeds_st():
+    from ipir_mujoco.report.optimize_plots import indices_figure
+
+    indices = [{"metric": "energy_per_metre_j_m", "parameter": "F_r1", "S1": 0.522, "S1_conf": 0.18, "ST": 0.473,
+                "ST_conf": 0.156},
+               {"metric": "energy_per_metre_j_m", "parameter": "F_r2", "S1": 0.501, "S1_conf": 0.244, "ST": 0.499,
+                "ST_conf": 0.129},
+               {"metric": "energy_per_metre_j_m", "parameter": "L", "S1": 0.0, "S1_conf": 0.0, "ST": 0.0,
+                "ST_conf": 0.0}]
+    fig = indices_figure(indices, ["energy_per_metre_j_m"])
+    assert not figure_checks.undrawn_legend_entries(fig)
+    assert not figure_checks.bad_axis_labels(fig)
+    assert not figure_checks.texts_over_data(fig)
+    (ax,) = fig.axes
+    assert ax.get_ylabel() == "Sobol index [-]" and "energy per metre [J/m]" in ax.get_title()
+    # F_r1's S1 is 0.05 above its ST (shown); F_r2's 0.002 (not visible on the bars: not commented)
+    assert "S1 > ST for F_r1: within the 95 % intervals" in ax.get_title()
+    agreeing = [dict(i, S1=min(i["S1"], i["ST"])) for i in indices]
+    assert "S1 > ST" not in indices_figure(agreeing, ["energy_per_metre_j_m"]).axes[0].get_title()
