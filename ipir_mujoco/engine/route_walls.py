@@ -106,6 +106,11 @@ def write_route_walls(spec: mujoco.MjSpec, params: RobotParams, route: Route) ->
     friction, condim, solref and solimp carry over."""
     D = params.pipe_diameter
     route.check_pipe(D)
+    if not route.planar:
+        from ipir_mujoco.core.errors import ParameterError
+
+        raise ParameterError(f"{route.source}: a bend turns out of the mechanism's plane (plane not 0 or 180 deg), "
+                             "which the planar walls cannot build; allowed: plane = 0 or 180 on this model")
     template = spec.geom("wall_top")
     style = dict(contype=0, conaffinity=1, condim=int(template.condim), friction=list(template.friction),
                  solref=list(template.solref), solimp=list(template.solimp), margin=float(template.margin))
