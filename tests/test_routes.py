@@ -121,6 +121,9 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
     assert isinstance(s["route_done"], bool) and s["route_stop"] and "\n" not in s["route_stop"]
     if s["route_done"]:
         assert s["route_time_s"] > 0 and s["route_s_m"] >= s["route_length_m"]
+        # the travel is read along the route: the rear module's A from its start (0) to the route's end, to one
+        # sample's step of the run's end (its last samples' speed, below 1.2 m/s, times the 1e-3 s interval)
+        assert s["x1_final"] == pytest.approx(s["route_s_m"], abs=1.2e-3)
     else:
         assert s["route_time_s"] is None and s["route_s_m"] < s["route_length_m"]
     assert "leaves the wall" in s["route_fit"]["predicted"] and not s["route_fit"]["bends"][0]["wheels_keep_wall"]
@@ -129,6 +132,8 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
 
     printed = "\n".join(route_lines(s))
     assert ("route done in" in printed) == s["route_done"] and "closed-form fit" in printed
+    code, out, err = run_cli(capsys, *argv)
+    assert code == 0 and "module 1 (rear) moved" in out and "m along the route" in out
 
 
 def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monkeypatch):

@@ -198,15 +198,17 @@ class WheelsKind(ModelKind):
 
     def columns(self, model, params, q, scalars, out):
         """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i
-        with finite grip; the contacts' cumulative work skid_work [J], the wheels' states wheels1/2; the
-        modules' planar pose y1/2 [m] (lateral slides), yaw1/2 [rad] (hinges about z), which with x1, x2,
-        phi pose the robot for a replay."""
+        with finite grip (1 while skidding where G_i = 0); the contacts' cumulative work skid_work [J], the
+        wheels' states wheels1/2; the modules' planar pose y1/2 [m] (lateral slides), yaw1/2 [rad] (hinges about
+        z), which with x1, x2, phi pose the robot for a replay."""
         cols = {}
         for k in (1, 2):
+            wheels = scalars[f"wheels{k}"]
             cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
-            if params.grip is not None:
-                cols[f"grip_use{k}"] = out[f"lambda{k}"] / params.grip[k - 1]
-            cols[f"wheels{k}"] = scalars[f"wheels{k}"].copy()
+            if params.grip is not None:  # as the slide model's: 1 while skidding where G_i = 0 (mu_wall = 0)
+                G = params.grip[k - 1]
+                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = scalars["skid_work"].copy()
         cols.update({name: q[:, qpos_address(model, joint)].copy()
                      for name, joint in zip(("y1", "y2", "yaw1", "yaw2"), (*LATERALS, *YAWS))})

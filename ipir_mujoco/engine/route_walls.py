@@ -106,6 +106,11 @@ def write_route_walls(spec: mujoco.MjSpec, params: RobotParams, route: Route) ->
     friction, condim, solref and solimp carry over."""
     D = params.pipe_diameter
     route.check_pipe(D)
+    if not route.planar:
+        from ipir_mujoco.core.errors import ParameterError
+
+        raise ParameterError(f"{route.source}: a bend turns out of the mechanism's plane (plane not 0 or 180 deg), "
+                             "which the planar walls cannot build; allowed: plane = 0 or 180 on this model")
     template = spec.geom("wall_top")
     style = dict(contype=0, conaffinity=1, condim=int(template.condim), friction=list(template.friction),
                  solref=list(template.solref), solimp=list(template.solimp), margin=float(template.margin))
@@ -168,7 +173,8 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
     against :func:`.pipe.bend_max_length`, and the spread the wheels of a station (``half_base`` [m] either side
     of the module's middle) need against their springs' reach (2 ``spring_travel`` [m] per pair: each of the
     pair's springs reaches its free length), :func:`.pipe.bend_wheel_spread`. Returns ``{"bends": [...],
-    "predicted": one line}``."""
+    "predicted": one line}``; a figure with no finite value (the rod's clearance where it is longer than the
+    centreline's diameter) is None."""
     D, Rw = params.pipe_diameter, params.wheel_radius
     bends, worst = [], None
     for k, bend in enumerate(route.bends):
@@ -200,4 +206,6 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
     else:
         predicted = (f"passes: in bend {worst['bend']} (R/D {worst['R_over_D']:.3g}) the wheels press with "
                      f"{100 * worst['wall_press_share']:.0f} % of their preload")
+    for b in bends:  # JSON has no infinity: a rod longer than the centreline's diameter has no clearance (None)
+        b.update({key: None for key, value in b.items() if isinstance(value, float) and not math.isfinite(value)})
     return {"bends": bends, "predicted": predicted}
