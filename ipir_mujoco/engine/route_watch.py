@@ -246,6 +246,9 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
+    from .route_walls import check_wall_count
+
+    check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
     from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
 
     reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
