@@ -248,4 +248,5 @@ def test_a_route_whose_planar_walls_would_be_too_large_is_refused_before_buildin
     assert "\n" not in str(info.value)
     assert check_wall_count(route_from_tables(BEND), 0.16) < MAX_WALL_BOXES  # a bend of R/D 6 is built
     with pytest.raises(ParameterError, match="out of the mechanism's plane"):
-        check_wall_count(route_from_tables([BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.5)]), 0.16)
+        across = [BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.5)]
+        check_wall_count(route_from_tables(across), 0.16)
