@@ -60,8 +60,8 @@ def test_a_ball_touches_the_wall_at_its_exact_distance_from_the_centreline(table
 
 @pytest.mark.parametrize("tables", [None, OUT_OF_PLANE])
 def test_a_wheel_carried_along_the_pipe_presses_with_a_constant_force(tables):
-    """The rig's three sprung wheels (10 N preload, 3 mm travel) carried at 2 m/s through straights and bends: the normal force
-    stays constant (the wall is round; its construction adds no ripple), one contact per wheel."""
+    """The rig's three sprung wheels (10 N preload, 3 mm travel) carried at 2 m/s through straights and bends: the
+    normal force stays constant (the wall is round; its construction adds no ripple), one contact per wheel."""
     route = None if tables is None else route_from_tables(tables)
     model = build_rig(route)
     run = roll(model, route, speed=2.0, distance=0.3 if route is None else route.length)

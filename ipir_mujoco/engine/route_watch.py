@@ -4,7 +4,8 @@
 module's point A (the crank's axis, :class:`ModulePoints`, in 3-D) projected on the route's centreline
 (:meth:`ipir_mujoco.core.route.Route.along`) is the robot's distance along the route, ``route_s_m`` (the
 furthest so far). At the run's end the series' x and v columns are read along the route
-(:meth:`RouteWatch.along_series`), so the summary's travel and every figure of x and v are along the centreline. The run stops, with one line in ``route_stop``, when
+(:meth:`RouteWatch.along_series`), so the summary's travel and every figure of x and v are along the centreline.
+The run stops, with one line in ``route_stop``, when
 
 - the rear module reaches the route's end (``route_done`` true, ``route_time_s`` the time it did,
   interpolated between samples);
@@ -198,8 +199,8 @@ class RouteWatch:
             if since is None:
                 self.off_since[k] = t
             elif self.lost is None and t - since >= WALL_LOSS_S:
-                self.lost = (f"wheel {self.arm_names[k][:-4]} lost its wall (pressing with < {100 * LOST_SHARE:g} % of its "
-                             f"preload for {WALL_LOSS_S:g} s) from t = {since:.4f} s, at "
+                self.lost = (f"wheel {self.arm_names[k][:-4]} lost its wall (pressing with < {100 * LOST_SHARE:g} % of "
+                             f"its preload for {WALL_LOSS_S:g} s) from t = {since:.4f} s, at "
                              f"{self.route.where(self.s_max)}")
         for k in np.flatnonzero(~off):
             self.off_since[k] = None
@@ -246,6 +247,9 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
+    from .route_walls import check_wall_count
+
+    check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
     from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
 
     reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
