@@ -42,15 +42,17 @@ def _measure(result: dict, name: str) -> tuple[str, dict]:
 
 def plot_atlas(result: dict, atlas, out: str | Path) -> list[Path]:
     out = Path(out)
-    paths = [plot_safe(result, atlas, out / "atlas_safe.png")]
+    paths = [plot_safe(result["idealizations"], atlas.axes, out / "atlas_safe.png")]
     d = len(atlas.axes)
     draw = {1: plot_1d, 2: plot_map}.get(d, plot_partial)
     paths.append(draw(result, atlas, out / {1: "atlas_1d.png", 2: "atlas_map.png"}.get(d, "atlas_partial.png")))
     return paths
 
 
-def plot_safe(result: dict, atlas, path: Path) -> Path:
-    rows = [(name, metric, item, entry["measured_by"]) for name, per in result["idealizations"].items()
+def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the paper's model holds") -> Path:
+    """Bars: each idealization's safe share per metric and threshold with its interval (``idealizations``:
+    atlas.json's; ``axes``: the varied ranges, sweep_space.Axis)."""
+    rows = [(name, metric, item, entry["measured_by"]) for name, per in idealizations.items()
             for metric, entry in per.items() for item in entry["by_threshold"]]
     fig = _figure(8.0, 1.2 + 0.32 * len(rows))
     ax = fig.add_subplot()
@@ -66,8 +68,8 @@ def plot_safe(result: dict, atlas, path: Path) -> Path:
                   fontsize="small")
     ax.invert_yaxis()
     ax.set(xlim=(0, 100), xlabel="share of the box where the idealization is safe [%] (95 % interval)",
-           title="Where the paper's model holds: " + ", ".join(
-               f"{a.name} {a.low:g}..{a.high:g}" for a in atlas.axes))
+           title=title + ": " + ", ".join(f"{a.name} {a.low:.3g}..{a.high:.3g}" for a in axes))
+    ax.title.set_fontsize("small")
     ax.barh([], [], color="tab:blue", alpha=0.55, label="measured by the equations (dense sample)")
     ax.barh([], [], color="tab:red", alpha=0.55, label="measured by MuJoCo (surrogate)")
     ax.legend(fontsize="x-small", loc="lower right")
