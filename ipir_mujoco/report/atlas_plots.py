@@ -99,7 +99,8 @@ def plot_1d(result: dict, atlas, path: Path) -> Path:
             U, rows = result["_measured"][(name, fidelity)]
             cost = np.array([np.nan if r["cost"].get(metric) is None else abs(r["cost"][metric]) for r in rows])
             ax.plot(atlas.values(U)[:, 0], 100 * np.maximum(cost, 1e-6), marker, color=colour, ms=3 if marker == "." else 5,
-                    label=f"{'equations' if fidelity == 'equations' else 'MuJoCo'} ({len(rows)} designs)")
+                    label=f"{'equations' if fidelity == 'equations' else 'MuJoCo'} "
+                          f"({len({tuple(v) for v in np.round(U, 12)})} designs)")
             s = result["_surrogates"].get((name, fidelity), {}).get(metric)
             if fidelity == "mujoco" and s is not None:
                 mean, lo, hi = s.cost(u[:, None])

@@ -108,7 +108,8 @@ class Samples:
             if key not in self.cache and key not in todo:
                 todo[key] = {n: float(v) for n, v in zip(self.names, key[2:])}
         if todo:
-            bar = Progress(len(todo), 0, self.progress and len(todo) > 1, what=f"atlas {label or name} ({fidelity})")
+            # a bar for batches worth waiting for (MuJoCo's adaptive batches of a few designs have their own lines)
+            bar = Progress(len(todo), 0, self.progress and len(todo) >= 8, what=f"atlas {label or name} ({fidelity})")
             chunk = CHUNK if fidelity == "equations" else 1
             items = list(todo.items())
             groups = [items[k:k + chunk] for k in range(0, len(items), chunk)]
