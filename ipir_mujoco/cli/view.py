@@ -47,7 +47,7 @@ from ..engine.stepper import loop_options, make_steps
 from ..engine.timestep import choose_settings
 from ..engine.wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
 from ..engine.wheels_model import build_wheels_model, set_wheels_state
-from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
+from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
 
@@ -81,7 +81,11 @@ class ViewedRobot:
                 checker_floor(spec)
             self.model = build_wheels_model(params, settings, decorate=decorate)
         else:
-            self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=checker_floor)
+            def decorate(spec):
+                in_pipe(spec, params)  # the whole pipe, translucent: the viewer's camera turns
+                checker_floor(spec)
+
+            self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=decorate)
         self.data = mujoco.MjData(self.model)
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)
