@@ -42,13 +42,18 @@ def _rings(piece: dict, diameter: float) -> list[tuple[np.ndarray, np.ndarray]]:
     return rings
 
 
+def _quat(rotation: np.ndarray) -> list[float]:
+    """The quaternion of a rotation matrix (3, 3) whose columns are the geom's axes in the world."""
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(rotation, dtype=float).ravel())
+    return [float(v) for v in q]
+
+
 def draw_pipe(spec: mujoco.MjSpec, pieces: list[dict], diameter: float, prefix: str = "pipe", facing=None,
               rgba=RGBA) -> list[str]:
     """Add a translucent tube per wall piece (``pieces`` from :func:`.pipe_walls.wall_pieces`) to ``spec``;
     ``facing``: the camera's view direction (3,) in the world, to draw only the far half (module docstring);
     returns the drawing geoms' names (``{prefix}_drawn{k}``)."""
-    from .pipe_walls import _quat
-
     names = []
     for k, piece in enumerate(pieces):
         rings = _rings(piece, diameter)
