@@ -29,7 +29,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.results import COLUMNS, Mode
+from ipir_mujoco.core.results import COLUMNS, Mode, grip_use
 
 from .clutches import equality_row
 from .grip_model import SKIDS
@@ -213,13 +213,13 @@ class Recorder:
     def _grip_columns(self, q: np.ndarray, sc: dict, out: dict) -> dict[str, np.ndarray]:
         """The finite-grip columns (``ipir_mujoco.core.results``): slip1/2 [m], each carriage's backward travel
         below its start (its running minimum over the samples: the carriage only skids back, its limit holds
-        it from going forward), grip_use1/2 = lambda_i / G_i (1 while skidding where G_i = 0), the grips'
+        it from going forward), grip_use1/2 (:func:`~ipir_mujoco.core.results.grip_use`), the grips'
         cumulative work skid_work [J] and the wheels' states wheels1/2."""
         cols = {}
         for k, (adr, G) in enumerate(zip(self.skid_q, self.params.grip), start=1):
             wheels = sc[f"wheels{k}"]
             cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
-            cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = sc["skid_work"].copy()
         return cols
@@ -235,7 +235,7 @@ class Recorder:
 
     def _wheel_columns(self, out: dict, sc: dict) -> dict[str, np.ndarray]:
         """The wheeled model's columns (``ipir_mujoco.core.results``): slip1/2 [m], each module's backward steps
-        (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip; the
+        (:func:`.wheels.wheel_slip`); grip_use1/2 (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the
         contacts' cumulative work skid_work [J] and the wheels' states wheels1/2."""
         from .wheels import wheel_slip
 
@@ -245,7 +245,7 @@ class Recorder:
             cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
             if self.params.grip is not None:
                 G = self.params.grip[k - 1]
-                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G
+                cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = sc["skid_work"].copy()
         return cols
