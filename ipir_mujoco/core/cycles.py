@@ -40,7 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .steady_test import LIMIT_ACCURACY, Steady, find_steady, window_uncertainty  # noqa: F401 (LIMIT_ACCURACY: its old home)
+# LIMIT_ACCURACY's old home: studies and benchmarks import it from here
+from .steady_test import LIMIT_ACCURACY, Steady, find_steady, window_uncertainty  # noqa: F401
 
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
@@ -195,7 +196,8 @@ def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: i
     return None
 
 
-def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES, target: float | None = None) -> list | None:
+def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES,
+                  target: float | None = None) -> list | None:
     """The whole revolutions (of :func:`cycles`) at whose end the run first is at steady state, or None: the
     window every steady-state figure is taken over. ``target``: the statistical test's (None: the exact test
     alone, :func:`steady_index`'s ``n`` revolutions); see :mod:`.steady_test`."""
