@@ -237,14 +237,13 @@ class RunResult:
 
     def plot(self, *others: "RunResult", path: str | Path | None = None):
         """The paper's figures (crank, modules, gap against time) of this run and any ``others`` drawn over it:
-        a list of three matplotlib figures; with ``path`` (a folder) also written there as fig2-4 PNG."""
-        from ipir_mujoco.report import plots  # drawing only: the one import of a layer above, kept lazy
+        a list of three matplotlib figures; with ``path`` (a folder) also written there as fig2-4 PNG.
 
-        runs = [self, *others]
-        if path is not None:
-            Path(path).mkdir(parents=True, exist_ok=True)
-            plots.write_paper_figures(runs, path)
-        return [plots.figure_crank(runs), plots.figure_modules(runs), plots.figure_gap(runs)]
+        A thin call of :func:`ipir_mujoco.report.plots.plot_runs` (the drawing lives in the report layer, which
+        imports nothing of this module: no import cycle)."""
+        from ipir_mujoco.report.plots import plot_runs  # matplotlib is loaded only when a run is drawn
+
+        return plot_runs([self, *others], path)
 
     def write_csv(self, path: str | Path) -> None:
         """Write the time series as CSV with a header row of :data:`COLUMNS`."""
