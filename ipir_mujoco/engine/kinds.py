@@ -35,7 +35,7 @@ from .grip_compliant import CompliantGrip
 from .grip_model import SKIDS
 from .loop_rows import loop_options
 from .model import SolverSettings, build_model, qpos_address, set_closed_loop_state
-from .route_watch import check_route, route_decorator
+from .route_watch import check_route, planar_fit, route_decorator
 from .slide_clutches import refuse_grip, slide_controller
 from .timestep import choose_settings
 from .wheels import WheelRatchet, refuse_clutches, wheel_loop_options, wheel_slip, wheels_settings
@@ -126,6 +126,11 @@ class ModelKind:
         per-sample ``scalars`` (name: (n,)) and the shared columns ``out``."""
         return {}
 
+    def route_fit(self, route, params: RobotParams) -> dict:
+        """The closed-form fit of a route's bends reported beside MuJoCo's outcome (``route_fit``: ``{"bends":
+        [...], "predicted": one line}``), for the kinds that take a route (:meth:`check` refuses it here)."""
+        raise NotImplementedError(f"the {self.name} model takes no route")
+
 
 class GripSlidesKind(ModelKind):
     """The slide model on wheels of finite grip: a carriage per module on the wall, held by friction G_i."""
@@ -190,6 +195,9 @@ class WheelsKind(ModelKind):
 
     def initial_state(self, model, data, params):
         set_wheels_state(model, data, params)
+
+    def route_fit(self, route, params):
+        return planar_fit(route, params)
 
     def controller(self, model, data, params, implementation, rule="unilateral"):
         return WheelRatchet(model, data, params)

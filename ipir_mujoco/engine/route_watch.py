@@ -228,10 +228,14 @@ class RouteWatch:
                 "route_piece_times_s": list(self.mark_times)}
 
 
-def check_route(route, model: str, params, until_steady: bool):
+def check_route(route, model: str, params, until_steady: bool, planar: bool = True, reach: float | None = None):
     """``params`` for a run along ``route`` (None: as they are): its incline the route's first straight's;
     ParameterError (one line) for a route on the slide model, with --until-steady, with an incline set apart
-    from the route's, or whose first straight is shorter than the robot (it starts in it)."""
+    from the route's, or whose first straight is shorter than the robot (it starts in it: ``reach`` [m], how far
+    the robot reaches ahead of its rear module's point A; the planar model's by default); with ``planar`` (the
+    planar model's box walls) one out of the mechanism's plane or whose walls would be too large
+    (:func:`.route_walls.check_wall_count`). The round pipe's walls (:mod:`.pipe_walls`) take any route: at most
+    MAX_SEGMENTS + 2 pieces."""
     from ipir_mujoco.core.errors import ParameterError
 
     if route is None:
@@ -247,12 +251,14 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
-    from .route_walls import check_wall_count
+    if planar:
+        from .route_walls import check_wall_count
 
-    check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
-    from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
+        check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
+    if reach is None:
+        from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
 
-    reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
+        reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
     first = route.pieces[0]
     if first.length < reach:
         raise ParameterError(f"{route.source}: segment 1: length={first.length:g} m; the robot starts in it and "
@@ -271,12 +277,17 @@ def route_decorator(params, route):
     return lambda spec: write_route_walls(spec, params, route)
 
 
-def route_watch(route: Route | None, model, recorder, params, dt_out: float) -> RouteWatch | None:
-    """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
-    geometry (:func:`.route_walls.fit_prediction`)."""
-    if route is None:
-        return None
+def planar_fit(route: Route, params) -> dict:
+    """The planar wheeled model's closed-form fit of the route's bends (:func:`.route_walls.fit_prediction`)."""
     from .route_walls import fit_prediction
     from .wheels_model import STATION_OFFSET
 
-    return RouteWatch(route, model, recorder, fit_prediction(route, params, STATION_OFFSET, SPRING_TRAVEL), dt_out)
+    return fit_prediction(route, params, STATION_OFFSET, SPRING_TRAVEL)
+
+
+def route_watch(route: Route | None, model, recorder, params, dt_out: float, fit=planar_fit) -> RouteWatch | None:
+    """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
+    geometry, ``fit(route, params) -> {"bends": [...], "predicted": one line}`` (the model kind's ``route_fit``)."""
+    if route is None:
+        return None
+    return RouteWatch(route, model, recorder, fit(route, params), dt_out)
