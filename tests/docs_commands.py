@@ -17,6 +17,9 @@ What a command is:
 - ``$ COMMAND`` followed, in the same block, by lines that are not commands: those lines are the quoted
   output, which the command's output must hold, line for line (a line of ``...`` stands for lines left out;
   wall times, ``(0.26 s wall)``, are not compared);
+- a command named in running text or a heading without arguments (```ipir-mujoco clutch-study```: the
+  engagement loads ...; ``python -m ipir_mujoco.studies.convergence``) is a name: its ``--help`` runs
+  (the command's synopsis and examples in code blocks run where they stand); a benchmark named so runs;
 - anything else runs as written, with these shortenings (said so in docs/cli.md, "Every documented command
   is tested"): a benchmark (``python bench/NAME.py``) gets ``--smoke``, a command that takes ``--quick``
   gets it; a shortened command's output is not compared.
@@ -48,6 +51,7 @@ class Command:
     output: list[str] = field(default_factory=list)   # the quoted output lines (after a "$ " prompt)
     inline: bool = False
     group: str = ""                   # its code block or paragraph: commands of one group run in order
+    heading: bool = False             # shown in a heading ('## `ipir-mujoco sweep`'): the command's name
 
     @property
     def synopsis(self) -> bool:
@@ -142,8 +146,10 @@ def parse(text: str, source: str, first_line: int = 1, double_ticks: bool = Fals
         number = first_line + text.count("\n", 0, match.start())
         paragraph = first_line + text.count("\n", 0, max(text.rfind("\n\n", 0, match.start()), 0))
         command = " ".join(match.group(1).replace("\\|", "|").split())
+        line = text[text.rfind("\n", 0, match.start()) + 1:match.start()]
         for part in _commands_in_line(command):
-            found.append(Command(f"{source}:{number}", part, inline=True, group=f"{source}:{paragraph}p"))
+            found.append(Command(f"{source}:{number}", part, inline=True, group=f"{source}:{paragraph}p",
+                                 heading=line.startswith("#")))
     return found
 
 
@@ -222,6 +228,8 @@ def shortened(command: str, takes_quick) -> tuple[str, str]:
     """(the command as the test runs it, how it was shortened or ''): benchmarks get --smoke, a command
     whose program takes --quick (``takes_quick(program(command))``) gets it."""
     if re.search(r"python3? bench/\w+\.py", command):
+        if "--smoke" in command.split():
+            return command, "--smoke"
         new = re.sub(r"(python3? bench/\w+\.py(?:\s+(?![|>&])\S+)*)", r"\1 --smoke", command)
         return new, "--smoke"
     if "--quick" not in command.split() and not re.search(r"[|>&]", command) and takes_quick(program(command)):

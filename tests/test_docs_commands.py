@@ -42,9 +42,15 @@ def _subcommands() -> dict[str, argparse.ArgumentParser]:
 
 
 def needs_arguments(command: dc.Command) -> bool:
-    """A bare ``ipir-mujoco NAME`` of a subcommand that cannot run without arguments: the name of the
-    command, as in a heading, whose --help the test runs."""
+    """A command named, not shown: an inline ``ipir-mujoco NAME`` or ``python -m MODULE`` with no arguments
+    in running text or a heading ('## `ipir-mujoco sweep`', '`ipir-mujoco clutch-study`: the engagement
+    loads ...'), or a bare subcommand that cannot run without arguments. The test runs its --help (the
+    command's examples and synopsis, shown in code blocks, are run and checked where they stand)."""
     words = command.text.split()
+    if command.inline and not command.screen and (
+            (words[0] == "ipir-mujoco" and len(words) <= 2) or (words[0].startswith("python") and len(words) == 3
+                                                                and words[1] == "-m")):
+        return True
     if words[0] != "ipir-mujoco" or len(words) != 2 or words[1] not in _subcommands():
         return False
     return any(a.required or not a.option_strings for a in _subcommands()[words[1]]._actions
