@@ -103,6 +103,11 @@ def bad_axis_labels(fig) -> list[str]:
             continue
         for name, label, ticks in (("x", ax.get_xlabel(), ax.get_xticks()), ("y", ax.get_ylabel(), ax.get_yticks())):
             shown = [t.get_text() for t in (ax.get_xticklabels() if name == "x" else ax.get_yticklabels())]
+            axis = ax.xaxis if name == "x" else ax.yaxis
+            if not label and not any(t.get_visible() and t.get_text() for t in axis.get_ticklabels()) and \
+                    len(axis.get_shared_axes() if hasattr(axis, "get_shared_axes") else
+                        (ax.get_shared_x_axes() if name == "x" else ax.get_shared_y_axes()).get_siblings(ax)) > 1:
+                continue  # an axis shared with a labelled panel, its tick labels hidden
             categorical = shown and all(t and not re.fullmatch(r"[-−+0-9.e$^{}\\mathrm]+", t) for t in shown)
             if categorical:  # names on the axis (bars): the names must not be raw keys
                 bad += [f"{ax.get_title()!r} {name} tick {t!r}" for t in shown if RAW_KEY.search(t)]

@@ -5,6 +5,7 @@ synthetic records in the shape the studies write, so that these tests take a sec
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import figure_checks
 from ipir_mujoco.report import cruise_section
@@ -157,3 +158,56 @@ def test_sensitivity_figure_labels_units_and_says_why_s1_exceeds_st():
     assert "S1 > ST for F_r1: within the 95 % intervals" in ax.get_title()
     agreeing = [dict(i, S1=min(i["S1"], i["ST"])) for i in indices]
     assert "S1 > ST" not in indices_figure(agreeing, ["energy_per_metre_j_m"]).axes[0].get_title()
+
+
+def _report_metrics() -> dict:
+    """A metrics record's ladder (the first second) and cruise section, as validate writes them."""
+    ladder = {"paper model": (8.435, 0.8959, 0.8), "exact geometry": (8.322, 0.8770, 0.8),
+              "with rod mass": (8.289, 0.8682, 0.8), "MuJoCo, paper's rule": (8.290, 0.8683, 0.79995),
+              "one-way clutches": (7.587, 0.9907, 0.8964), "MuJoCo ratchet": (7.589, 0.9907, 0.8966),
+              "wheels in contact": (7.475, 1.0048, 0.9053)}
+    cruise = {"paper model": 0.4270, "exact geometry": 0.4255, "with rod mass": 0.4256,
+              "MuJoCo, paper's rule": 0.42561, "one-way clutches": 0.5326, "MuJoCo ratchet": 0.53265}
+    return {"ladder": [{"name": n, "summary": {"revolutions": r, "x1_final": x1, "x2_final": x2}}
+                       for n, (r, x1, x2) in ladder.items()],
+            "sections": {"cruise": {"rungs": [{"name": n, "steady_speed_m_s": v} for n, v in cruise.items()]}}}
+
+
+def test_the_report_opens_with_each_idealizations_cost_beside_the_numerical_error():
+    from ipir_mujoco.report.overview import idealization_costs, overview_figure
+
+    metrics = _report_metrics()
+    data = idealization_costs(metrics)
+    costs = dict(data["costs"])
+    # the paper's first-order geometry against the exact one: (8.435 - 8.322) / 8.322
+    assert costs["first-order geometry"]["revolutions"] == pytest.approx(8.435 / 8.322 - 1, rel=1e-12)
+    assert costs["locks that pull (not one-way)"]["cruise"] == pytest.approx(0.4256 / 0.5326 - 1, rel=1e-12)
+    assert "cruise" not in costs["slides (not wheels on the wall)"]  # no wheeled cruise: n/a, not 0
+    # the band: the engines' worst disagreement on one linkage
+    assert data["error"]["revolutions"] == pytest.approx(max(8.290 / 8.289 - 1, 7.589 / 7.587 - 1), rel=1e-12)
+    fig = overview_figure(metrics)
+    assert not figure_checks.undrawn_legend_entries(fig)
+    assert not figure_checks.bad_axis_labels(fig)
+    assert not figure_checks.texts_over_data(fig)
+    bars = [p for p in fig.axes[0].patches if p.get_height() == pytest.approx(0.6)]
+    assert len(bars) == 4 and all("numerical error" in ax.get_title() for ax in fig.axes)
+    assert [t.get_text() for t in fig.axes[2].texts].count("n/a") == 1
+
+
+def test_verdicts_stay_short_and_their_detail_opens_their_section():
+    from ipir_mujoco.report.document import Heading, Paragraph
+    from ipir_mujoco.report.overview import VERDICT_WORDS, place_moved, short_verdict, verdict_blocks
+
+    long = ("Under a gearmotor the paper's model cruises at 0.427 m/s where the robot does 0.533 m/s. "
+            + "Its locks stop each module instead of letting it coast, " * 8 + "so it is slow. The end.")
+    text, cut = short_verdict(long)
+    assert cut and text == "Under a gearmotor the paper's model cruises at 0.427 m/s where the robot does 0.533 m/s."
+    one = "Yes, to the precision the paper states them: " + "5 of 6 figures land in their intervals, " * 10 + "ok."
+    assert short_verdict(one) == ("Yes, to the precision the paper states them.", True)
+    verdicts = [{"question": "Q1?", "answer": long, "section": "Under a real motor"},
+                {"question": "Q2?", "answer": "Yes.", "section": "Energy audit"}]
+    blocks, moved = verdict_blocks(verdicts)
+    assert all(len(b.text.split()) <= VERDICT_WORDS + 12 for b in blocks if isinstance(b, Paragraph))
+    assert blocks[1].text.endswith('(More in "Under a real motor".)') and list(moved) == ["Under a real motor"]
+    placed = place_moved([Heading("Under a real motor"), Paragraph("table")], moved)
+    assert placed[1].text == f"**Q1?** {long}" and placed[2].text == "table"

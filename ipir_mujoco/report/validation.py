@@ -20,7 +20,10 @@ import numpy as np
 
 from ipir_mujoco.core.results import Mode
 
-from ..labels import SUMMARY, summary_label
+from ..labels import summary_label
+from .overview import FIGURE as OVERVIEW
+from .overview import (accuracy_flag, ladder_change, monitor_verdict, overview_caption, overview_figure,
+                       place_moved, verdict_blocks)
 from ..resources import shipped
 from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Link, Paragraph, Table, fmt, pct, to_html, to_markdown
@@ -214,13 +217,14 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                     Paragraph("The paper's analytic model of the two-module inchworm robot, reproduced and "
                               f"taken apart one idealization at a time {where} "
                               f"(simulated {metrics['settings']['t_end_s']:g} s from rest).")]
+    if OVERVIEW in figures:  # the picture a reader grasps first (report/overview.py)
+        blocks.append(Image(figures[OVERVIEW], overview_caption(metrics)))
     blocks.append(Heading("Summary"))
     blocks.append(Table(["question", "verdict", "key figure", "where"],
                         [[v["question"], v["short"], v["key"],
                           Link(v["section"], v["section"]) if v.get("section") else ""] for v in metrics["verdicts"]]))
-    blocks.append(Heading("Verdicts"))
-    for verdict in metrics["verdicts"]:
-        blocks.append(Paragraph(f"**{verdict['question']}** {verdict['answer']}"))
+    verdicts, moved = verdict_blocks(metrics["verdicts"])  # short; the full answers open their sections
+    blocks += verdicts
     blocks += _mechanism_section(figures, animation_note, animation or ANIMATION)
     blocks += _paper_section(metrics, figures)
 
@@ -332,7 +336,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                             "the model and its conventions are in docs/model.md. The documents this report names "
                             f"are installed with the package: docs/model.md as {shipped('docs/model.md')}, "
                             f"mjcf/README.md as {shipped('mjcf/README.md')}."))
-    return blocks
+    return place_moved(blocks, moved)
 
 
 def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | None, dict]:
@@ -346,45 +350,6 @@ def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | Non
     except RenderUnavailable as exc:
         return str(exc), settings
     return None, settings
-
-
-def monitor_verdict(accuracy: dict | None) -> str:
-    """The energy-audit table's cell for a rung's accuracy record: '' for the equations (no monitor),
-    'within' or 'ABOVE (figure)' against MuJoCo's tolerances."""
-    if not accuracy or "tolerances" not in accuracy:
-        return ""
-    if accuracy.get("ok", True) and not accuracy.get("violations"):
-        return "within its tolerances"
-    return "ABOVE: " + ", ".join(sorted({v["figure"] for v in accuracy.get("violations", [])})) + " (see below)"
-
-
-def accuracy_flag(name: str, accuracy: dict | None) -> str:
-    """A sentence for a MuJoCo rung whose run went beyond the accuracy monitor's tolerances (a rung run with
-    accuracy='warn' finishes and is reported, and its figures carry that error), or ''."""
-    if not accuracy or "tolerances" not in accuracy or (accuracy.get("ok", True) and not accuracy.get("violations")):
-        return ""
-    parts = []
-    for figure, tolerance in accuracy["tolerances"].items():
-        worst = accuracy.get(figure)
-        first = next((v for v in accuracy.get("violations", []) if v["figure"] == figure), None)
-        if first is not None and worst is not None:
-            parts.append(f"{figure} {abs(worst):.1e} against the tolerance {tolerance:g} (first above it at "
-                         f"t = {first['t_s']:.3g} s)")
-    return (f"{name}: " + "; ".join(parts) + ". The monitor warned instead of stopping this rung (accuracy="
-            f"'{accuracy.get('mode', 'warn')}'), so its figures carry that error; compare its changes with it "
-            "before drawing conclusions.")
-
-
-def ladder_change(value, before, relative, key: str) -> str:
-    """The change of a ladder figure against the rung before: a signed percentage, or, where the figure
-    reaches zero or changes sign (a clutch reaction from -1371 N, a pull, to 0: '+100 %' would read as a
-    doubling), the difference in the figure's unit ('+1371 N'); '' for the first rung."""
-    if relative is None or before is None or value is None:
-        return ""
-    if value == 0 or before == 0 or (value > 0) != (before > 0):
-        unit = SUMMARY.get(key, (key, ""))[1]
-        return f"{value - before:+.4g}" + (f" {unit}" if unit and unit != "-" else "")
-    return pct(relative)
 
 
 def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: Sequence = ()) -> None:
@@ -401,6 +366,7 @@ def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: 
     figure_clutch_reactions(rungs[0], figures_dir / "clutch_reactions.png")
     figure_lr_study(metrics["lr_study"], figures_dir / "lr_study.png")
     figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
+    overview_figure(metrics).savefig(figures_dir / OVERVIEW, dpi=110)
     physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
     note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
     extra = []
