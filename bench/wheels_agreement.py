@@ -1,6 +1,6 @@
 """The wheeled MuJoCo model against the analytic finite-grip model in straight pipes, measured in one run.
 
-Run on demand from the repository root (about 40 s):
+Run on demand from the repository root (about 40 s on 2 idle cores, several times that on a loaded machine):
 
     python bench/wheels_agreement.py [--smoke]
 

@@ -1,6 +1,6 @@
 """The wheeled MuJoCo model's settings, by a convergence study: cone, impratio, noslip, solref/solimp, timestep.
 
-Run on demand from the repository root (about a minute on 2 cores):
+Run on demand from the repository root (about a minute on 2 idle cores, several on a loaded machine):
 
     python bench/wheels_convergence.py [--quick] [--smoke]
 
