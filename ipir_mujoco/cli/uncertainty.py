@@ -95,9 +95,14 @@ def format_result(result: dict) -> str:
         if e.get("missing"):
             lines.append(f"    ({e['missing']} sample runs give no value: left out)")
     for text, e in result["events"].items():
-        extra = f"; MuJoCo alone {e['mujoco_mc']['count']}/{e['mujoco_mc']['samples']}" if "mujoco_mc" in e else ""
         lines.append(f"  P({text}) = {e['probability']:.4g}  {_interval(e['interval'])}  "
-                     f"[{e['estimator']}, {e['count']}/{e['samples']} samples{extra}]")
+                     f"[{e['estimator']}, {e['count']}/{e['samples']} samples]")
+        if "mujoco_mc" in e:
+            eq, mj = e["equations_mc"], e["mujoco_mc"]
+            lines.append(f"    equations alone {eq['count']}/{eq['samples']}: {eq['probability']:.4g} "
+                         f"{_interval(eq['interval'])}; MuJoCo alone {mj['count']}/{mj['samples']}: "
+                         f"{mj['probability']:.4g} {_interval(mj['interval'])}; the pairs disagree "
+                         f"{e['disagreements'][0]} + {e['disagreements'][1]} times")
         if not e.get("resolved", True):
             lines.append(f"    {e['note']}")
     failures = result["failures"]

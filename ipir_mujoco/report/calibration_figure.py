@@ -42,7 +42,7 @@ def plot_calibration(path: str | Path, result: dict, measured) -> Path:
         res.grid(True, alpha=0.3)
         if k == len(columns) - 1:
             res.set_xlabel("t [s]")
-    fitted = ", ".join(f"{n} = {e['value']:.4g} [{e['interval'][0]:.4g}, {e['interval'][1]:.4g}]"
+    fitted = ", ".join(f"{n} = {e['value']:.5g} [{e['interval'][0]:.5g}, {e['interval'][1]:.5g}]"
                        for n, e in result["estimates"].items())
     weak = result["not_identifiable"]
     fig.suptitle(f"Calibration to {Path(result['data']).name}: {fitted} (95 %)"

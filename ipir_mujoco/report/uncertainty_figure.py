@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..studies.sweep_metrics import UNITS
+from ..studies.uncertainty import KEY_UNITS as UNITS
 
 EQUATIONS, MUJOCO = "#1f77b4", "#d62728"
 
@@ -40,9 +40,11 @@ def plot_uncertainty(path: str | Path, result: dict) -> Path:
     metrics, events = list(result["metrics"]), list(result["events"])
     cheap, faithful = study["engine"], study["mujoco_engine"]
     n_rows = len(metrics) + (1 if events else 0)
-    fig = Figure(figsize=(11, 0.9 + 3.4 * n_rows), layout="constrained")
+    event_height = 0.5 + 0.45 * len(events)  # inches: a line per event
+    heights = [3.4] * len(metrics) + ([event_height] if events else [])
+    fig = Figure(figsize=(11, 0.9 + sum(heights)), layout="constrained")
     FigureCanvasAgg(fig)
-    grid = fig.add_gridspec(n_rows, 2)
+    grid = fig.add_gridspec(n_rows, 2, height_ratios=heights)
     for k, key in enumerate(metrics):
         entry = result["metrics"][key]
         g, f = _values(rows, cheap, key), _values(rows, faithful, key)
@@ -94,7 +96,13 @@ def plot_uncertainty(path: str | Path, result: dict) -> Path:
             resolved = result["events"][e].get("resolved", True)
             left = max(lo, 1e-6) if small else lo
             shown = max(p, 1e-6) if small else p
-            ax.plot([left, hi], [k, k], color="black", linewidth=2)
+            ax.plot([left, hi], [k, k], color="black", linewidth=2,
+                    label="estimate and 95 % interval" if k == 0 else None)
+            alone = result["events"][e].get("equations_mc")
+            if alone is not None:  # the equations' own Monte Carlo, for comparison
+                a_lo, a_hi = alone["interval"]
+                ax.plot([max(a_lo, 1e-6) if small else a_lo, a_hi], [k - 0.18, k - 0.18], color=EQUATIONS,
+                        linewidth=1.5, label=f"{cheap} alone" if k == 0 else None)
             ax.plot([shown], [k], "o", color="black", markerfacecolor="black" if resolved else "white",
                     markersize=7)
             ax.annotate(f"{p:.3g}  [{lo:.3g}, {hi:.3g}]" + ("" if resolved else "  (not resolved)"), (hi, k),
@@ -109,6 +117,7 @@ def plot_uncertainty(path: str | Path, result: dict) -> Path:
         ax.set_xlabel("probability (dot: estimate; line: 95 % interval; hollow: not resolved by the samples)")
         ax.grid(True, axis="x", alpha=0.3)
         ax.set_title("events", fontsize=10)
+        ax.legend(fontsize=7, loc="lower right")
     mf = f", {faithful} on the first {study['mujoco_samples']} (paired)" if study["mujoco_samples"] else ""
     fig.suptitle(f"Uncertainty: {', '.join(study['dists'])}\n{cheap} on {study['samples']} samples{mf}",
                  fontsize=10)

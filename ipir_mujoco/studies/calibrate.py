@@ -175,6 +175,7 @@ def calibrate(measured: Measured, fits: list[FitRange], *, base: RobotParams | N
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     corr = np.where(np.isfinite(corr), corr, 0.0)
+    corr = 0.5 * (corr + corr.T)  # exactly symmetric (the round-off of the two products differs)
     np.fill_diagonal(corr, 1.0)
     fitted = model.series(fit.x)
     residuals = {c: (fitted[c] - v) / model.noise[c] for c, v in measured.columns.items()}

@@ -40,7 +40,8 @@ from ipir_mujoco.core.results import write_json
 
 from . import uq_stats
 from .sweep_files import Progress
-from .sweep_metrics import METRICS, run_metrics
+from ..labels import SUMMARY
+from .sweep_metrics import METRICS, UNITS, run_metrics
 from .uq_dists import Dist, sample
 
 # a run's number beside its summary's and the sweep metrics: [unit] meaning
@@ -51,6 +52,10 @@ SUMMARY_KEYS = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "firs
                 "motor_work_j", "kinetic_j", "friction_j", "residual_j", "wheel_off_s", "press1_n", "press2_n",
                 "route_done", "route_time_s")
 KEYS = tuple(dict.fromkeys((*METRICS, *SUMMARY_KEYS, *DERIVED)))
+KEY_UNITS = {**{k: u for k, (_, u) in SUMMARY.items()}, **UNITS, "x1_final": "m", "x2_final": "m", "v1_max": "m/s",
+             "v2_max": "m/s", "slip1_m": "m", "slip2_m": "m", "peak_grip_use": "-", "motor_work_j": "J",
+             "kinetic_j": "J", "friction_j": "J", "residual_j": "J", "wheel_off_s": "s", "press1_n": "N",
+             "press2_n": "N", "route_time_s": "s", "travel_m": "m", "skid_m": "m"}
 NAMED_EVENTS = {"stall": ("stalled", ">", 0.5), "no-steady-state": ("steady", "<", 0.5),
                 "slides-back": ("travel_m", "<", 0.0)}
 OPERATORS = {">=": operator.ge, "<=": operator.le, ">": operator.gt, "<": operator.lt}
@@ -272,6 +277,7 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
             g_pair = _column(cheap_rows, event.key)[:m]
             entry = uq_stats.multi_fidelity_event(event.hits(f[ok_pair]), event.hits(g_pair[ok_pair]), event.hits(g))
             entry["mujoco_mc"] = uq_stats.event_probability(event.hits(f[ok_pair]))
+            entry["equations_mc"] = uq_stats.event_probability(event.hits(g))
         else:
             entry = uq_stats.event_probability(event.hits(g))
         out["events"][event.text] = _finite(entry)
