@@ -111,8 +111,8 @@ def simulate_mujoco(
     None chooses the timestep from the motion (:func:`.timestep.choose_settings`)
     and halves it (at most twice) if the accuracy monitor fails; given settings
     are used as they are. ``accuracy``: 'stop' (a failed accuracy check is a
-    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``); None: the model's own,
-    :func:`.wheels.default_accuracy` ('stop' on the slides, 'warn' on wheels).
+    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``); None: the model kind's own
+    (:attr:`.kinds.ModelKind.accuracy`: 'stop' on the slides, 'warn' on wheels).
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
