@@ -127,3 +127,18 @@ def test_a_route_file_that_cannot_be_read_is_refused_in_one_line(tmp_path, conte
     with pytest.raises(ParameterError, match=word) as info:
         read_route(path)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("radius", [None, 0.2])
+def test_wheels_rolling_with_friction_see_a_round_wall(radius):
+    """The rig on joints, wheels rolling with friction 0.5 at 0.5 m/s along a straight and inside a bend of
+    R/D 1.25: each wheel's force holds constant to 1e-6 of it (the contact solver's convergence, as above), and
+    its mean is the preload but for the wheel's own centripetal load in the bend, m v^2 / R = 0.02 x 0.25 / 0.2 =
+    0.025 N spread over the legs by their directions (at most that much off 10 N), and the contact's sinking
+    (the spring's 0.1 % of travel at most)."""
+    from ipir_mujoco.engine.pipe_rig import WHEEL_MASS, roll_on_joints, rolling_rig
+
+    run = roll_on_joints(rolling_rig(bend_radius=radius), 0.5, 0.1, settle=0.2)
+    assert run.contacts == 1 and ripple(run) < 1e-6
+    centripetal = 0.0 if radius is None else WHEEL_MASS * 0.5 ** 2 / radius
+    assert np.all(np.abs(run.force.mean(axis=0) - 10.0) <= centripetal + 0.01)
