@@ -27,6 +27,7 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import grip_use
 
 from .common import check_clutch_options
 from .grip import GripRatchet
@@ -145,15 +146,15 @@ class GripSlidesKind(ModelKind):
 
     def columns(self, model, params, q, scalars, out):
         """slip1/2 [m], each carriage's backward travel below its start (its running minimum over the samples:
-        the carriage only skids back, its limit holds it from going forward), grip_use1/2 = lambda_i / G_i (1
-        while skidding where G_i = 0), the grips' cumulative work skid_work [J] and the wheels' states
-        wheels1/2."""
+        the carriage only skids back, its limit holds it from going forward), grip_use1/2
+        (:func:`~ipir_mujoco.core.results.grip_use`), the grips' cumulative work skid_work [J] and the wheels'
+        states wheels1/2."""
         cols = {}
         for k, (name, G) in enumerate(zip(SKIDS, params.grip), start=1):
             adr = qpos_address(model, name)
             wheels = scalars[f"wheels{k}"]
             cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
-            cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = scalars["skid_work"].copy()
         return cols
@@ -205,17 +206,17 @@ class WheelsKind(ModelKind):
         return wheel_loop_options(model, data)
 
     def columns(self, model, params, q, scalars, out):
-        """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i
-        with finite grip (1 while skidding where G_i = 0); the contacts' cumulative work skid_work [J], the
+        """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2
+        (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J], the
         wheels' states wheels1/2; the modules' planar pose y1/2 [m] (lateral slides), yaw1/2 [rad] (hinges about
         z), which with x1, x2, phi pose the robot for a replay."""
         cols = {}
         for k in (1, 2):
             wheels = scalars[f"wheels{k}"]
             cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
-            if params.grip is not None:  # as the slide model's: 1 while skidding where G_i = 0 (mu_wall = 0)
+            if params.grip is not None:
                 G = params.grip[k - 1]
-                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+                cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = scalars["skid_work"].copy()
         cols.update({name: q[:, qpos_address(model, joint)].copy()

@@ -160,7 +160,7 @@ def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = D
 
 def steady_window(run: RunResult) -> tuple[float, float, bool]:
     """(t0, t1) [s] of the steady window (the revolutions the steady test used), else the whole run; steady?"""
-    window = settled_cycles(cycles(run.series), *run.steady_test)
+    window = settled_cycles(cycles(run.series), *run.steady_test, run.steady_target)
     if window is None:
         return float(run.series["t"][0]), float(run.series["t"][-1]), False
     return window[0].t_start, window[-1].t_end, True
