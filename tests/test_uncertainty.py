@@ -214,3 +214,34 @@ def test_multi_fidelity_study_runs_mujoco_on_the_first_samples(capsys, tmp_path)
     assert len(pairs) == 6
     for a, m in pairs:
         assert m == pytest.approx(a, rel=1e-3)  # the engines' cruise speeds agree to 0.01 % (docs): 10x margin
+
+
+def test_every_numeric_parameter_takes_a_distribution_inside_its_range_or_is_refused_by_name():
+    """Across the whole parameter table: a normal about each default (SD 10 %) is accepted and drawn inside the
+    allowed range, or refused naming the parameter and its range (a default at a bound, e.g. incline = 0 is not
+    one; omega0 = 0 and phi0 = 0 are inside open ranges)."""
+    from ipir_mujoco.core.params import describe_parameters
+    from ipir_mujoco.studies.uq_dists import inside
+
+    for row in describe_parameters():
+        name, default = row["name"], row["default"]
+        if not isinstance(default, float):
+            continue
+        spec = f"{name}=normal:{default!r}:{max(abs(default) * 0.1, 1e-3)!r}"
+        try:
+            d = parse_dist(spec)
+        except ParameterError as exc:
+            assert f"outside {name}'s allowed range" in str(exc), spec
+            continue
+        x = sample([d], 2000, seed=4)[:, 0]
+        assert all(inside(name, v) for v in x), spec
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--dist", "F_r1=normal:1:0.1", "--metric", "revolutions", "--until-steady"], "no periodic steady state"),
+    (["--dist", "F_n1=normal:50:5", "--metric", "revolutions"], "needs a finite mu_wall"),
+    (["--dist", "F_r1=normal:1:0.1", "--metric", "revolutions", "--t-end", "-1"], "t_end"),
+])
+def test_options_no_run_could_take_are_refused_before_any_run(capsys, tmp_path, argv, words):
+    code, out, err = run_cli(capsys, "uncertainty", *argv, "--samples", "10", "--out", tmp_path / "u")
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1

@@ -12,7 +12,7 @@ def add_parser(commands) -> None:
     cal = commands.add_parser(
         "calibrate", help="fit parameters to a measured run (CSV of t and any of x1 x2 phi omega v1 v2)",
         description="Fit the --fit parameters within their ranges so that the model's run matches the measured "
-                    "columns (least squares, each column weighed by its noise), with 95 %% confidence intervals, "
+                    "columns (least squares, each column weighed by its noise), with 95 % confidence intervals, "
                     "their correlation, and a warning for a parameter the data cannot identify. Writes "
                     "DIR/calibration.json, posterior.toml (for 'uncertainty --dist-file'), calibration.png "
                     "(docs/uncertainty.md).")

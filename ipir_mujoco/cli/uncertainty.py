@@ -13,7 +13,7 @@ def add_parser(commands) -> None:
         "uncertainty", help="metrics and event probabilities under uncertain parameters (equations + MuJoCo)",
         description="Draw --samples parameter sets from the --dist distributions, run the equations on all of "
                     "them and MuJoCo on the first --mujoco-samples (the same draws), and give each metric's mean, "
-                    "standard deviation and 5/50/95 %% quantiles with 95 %% confidence intervals, and each event's "
+                    "standard deviation and 5/50/95 % quantiles with 95 % confidence intervals, and each event's "
                     "probability with its interval. With MuJoCo samples the estimate is multi-fidelity (the "
                     "equations as a control variate of MuJoCo), shown beside MuJoCo's plain Monte Carlo with the "
                     "variance reduction. Writes DIR/uncertainty.json, samples.csv, uncertainty.png "

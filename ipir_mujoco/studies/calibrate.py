@@ -80,8 +80,9 @@ def parse_fit(text: str) -> FitRange:
 class _Model:
     """The engine's run at parameter vector ``x``, interpolated onto the measured times: residuals / noise."""
 
-    def __init__(self, measured: Measured, fits: list[FitRange], base: RobotParams, engine: str):
+    def __init__(self, measured: Measured, fits: list[FitRange], base: RobotParams, engine: str, progress=None):
         self.measured, self.fits, self.base, self.engine = measured, fits, base, engine
+        self.progress = progress
         self.t_end = float(measured.t[-1])
         self.dt_out = min(1e-3, self.t_end / 200)
         self.scale = {c: max(float(np.ptp(v)), float(np.max(np.abs(v))), 1e-12) for c, v in measured.columns.items()}
@@ -93,6 +94,8 @@ class _Model:
 
     def series(self, x) -> dict[str, np.ndarray]:
         self.runs += 1
+        if self.progress is not None and self.runs % 10 == 0:
+            self.progress(f"{self.runs} runs of the model")
         try:
             run = registry.run(self.engine, self.params(x), self.t_end, dt_out=self.dt_out)
         except (ParameterError, ValueError) as exc:
@@ -101,8 +104,7 @@ class _Model:
         s = run.series
         t = np.asarray(s["t"], dtype=float)
         keep = np.concatenate([[True], np.diff(t) > 0])  # an event instant is written twice: keep one
-        if t[-1] < self.t_end * (1 - 1e-9):  # a stall ends a run early: the robot stays where it stopped
-            pass
+        # a stall ends a run early, at rest for good: np.interp holds its last sample, where the robot stays
         return {c: np.interp(self.measured.t, t[keep], np.asarray(s[c], dtype=float)[keep])
                 for c in self.measured.columns}
 
@@ -127,7 +129,7 @@ def calibrate(measured: Measured, fits: list[FitRange], *, base: RobotParams | N
     if len(set(names)) != len(names):
         raise ParameterError(f"--fit names a parameter twice: {names}")
     registry.variant(engine)
-    model = _Model(measured, fits, base, engine)
+    model = _Model(measured, fits, base, engine, progress)
     low = np.array([f.low for f in fits])
     high = np.array([f.high for f in fits])
     x0 = np.array([min(max(getattr(base, f.name) if getattr(base, f.name) is not None else 0.5 * (f.low + f.high),

@@ -35,7 +35,8 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.params import RobotParams, check_whole
+from ipir_mujoco.core.options import MAX_T_END, refuse_steady_without_motor
+from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse_idle_parameters
 from ipir_mujoco.core.results import write_json
 
 from . import uq_stats
@@ -157,7 +158,9 @@ class SampleTask:
         try:
             params = self.base.replace(**design)
             run = registry.run(self.engine, params, self.t_end, dt_out=self.dt_out, until_steady=self.until_steady)
-        except (ParameterError, ValueError, SimulationError) as exc:
+        except (ParameterError, ValueError) as exc:  # this draw is not a valid design, or not for this engine
+            return index, {"error": " ".join(str(exc).split()), "bad_input": True}
+        except SimulationError as exc:
             return index, {"error": " ".join(str(exc).split())}
         values = sample_values(run)
         return index, {k: values[k] for k in self.keys}
@@ -193,13 +196,19 @@ def run_uncertainty(dists: list[Dist], metrics: tuple[str, ...], events: tuple[E
         raise ParameterError(f"--mujoco-samples {mujoco_samples}: allowed: 0, or {MIN_MUJOCO} to --samples "
                              f"({samples}) (the pairs give the correlation the estimate uses)")
     seed = check_whole("seed", seed, low=0)
+    t_end = check_real("t_end", t_end, high=MAX_T_END, unit="s")
+    refuse_steady_without_motor(base.drive, until_steady)
     workers = check_whole("workers", workers, low=1, high=1024) if workers is not None else (os.cpu_count() or 1)
     cheap, faithful = engine_pair(engine)
     names = [d.name for d in dists]
     draws = sample(dists, samples, seed, correlation)
     designs = [dict(zip(names, map(float, row))) for row in draws]
-    if not any(_valid(base, d) for d in designs[:50]):
+    first = next((d for d in designs[:50] if _valid(base, d)), None)
+    if first is None:
         base.replace(**designs[0])  # every draw invalid (say L <= r against the base): refuse, naming the first
+    # a parameter that acts only through another the base leaves idle (F_n1 with unlimited grip): every run
+    # would refuse it; refused here, once
+    refuse_idle_parameters(base.replace(**first))
     keys = tuple(dict.fromkeys((*metrics, *(e.key for e in events))))
     dt_out = min(1e-3, t_end)
     started = time.perf_counter()
@@ -244,6 +253,8 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
     failures = {"equations": int((~ok_cheap).sum()), "mujoco": int(m - ok_pair.sum()) if m else 0,
                 "first_error": next((r["error"] for r in [*cheap_rows, *faithful_rows] if "error" in r), None)}
     if not ok_cheap.any():
+        if all(r.get("bad_input") for r in cheap_rows):
+            raise ParameterError(f"every sample was refused by the equations; the first: {failures['first_error']}")
         raise SimulationError(f"every sample failed in the equations; the first: {failures['first_error']}")
     out: dict = {"metrics": {}, "events": {}, "failures": failures}
     for key in metrics:
