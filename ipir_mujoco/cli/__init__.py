@@ -40,8 +40,8 @@ try:
 
     from .. import __version__
     from ..resources import shipped
-    from . import (bend_study, climb, clutch_study, compare, control_study, kinetostatics, optimize, params, render,
-                   sensitivity, simulate, sweep, validate)
+    from . import (bend_study, calibrate, climb, clutch_study, compare, control_study, kinetostatics, optimize,
+                   params, render, sensitivity, simulate, sweep, uncertainty, validate)
     from . import atlas
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
@@ -51,7 +51,7 @@ finally:
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "main"]
 
 COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
-            climb, control_study, bend_study, atlas)
+            climb, control_study, bend_study, atlas, uncertainty, calibrate)
 
 
 def build_parser() -> Parser:

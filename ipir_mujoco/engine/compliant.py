@@ -47,6 +47,7 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 
 from .controller import ControllerBase
+from .native import LayoutError
 from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
@@ -165,6 +166,25 @@ class CompliantClutches(ControllerBase):
     def forces(self) -> tuple[float, float]:
         """The clutch forces [N] MuJoCo computed at the last step's start (or the last mj_forward)."""
         return self._force.item(self.act[0]), self._force.item(self.act[1])
+
+    def load_compiled(self, loop):
+        """Its layout in the compiled loop (:mod:`.controller`): the slides, the clutch actuators, the anchors."""
+        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], slide_v0=self.dof_adr[0],
+                        slide_v1=self.dof_adr[1], act0=self.act[0], act1=self.act[1], implicit=self.implicit)
+        loop.set_state(anchor0=self.anchor[0], anchor1=self.anchor[1], overlap0=self.overlap[0],
+                       overlap1=self.overlap[1], v_before0=self.v_before[0], v_before1=self.v_before[1],
+                       damped0=self.damped[0], damped1=self.damped[1], damper_work=self.damper_work, k=self.k,
+                       c=self.c, backlash=self.backlash)
+        if self.dt != loop.model.opt.timestep:
+            raise LayoutError("the compliant clutches' timestep is not the model's")
+        get = loop.getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
+                          "damped1", "damper_work")
+
+        def sync(state) -> None:
+            a0, a1, d0, d1, v0, v1, damped0, damped1, self.damper_work = get(state)
+            self.anchor, self.overlap, self.v_before = [a0, a1], [d0, d1], [v0, v1]
+            self.damped = [damped0 != 0.0, damped1 != 0.0]
+        return "compliant", sync
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear force [N], front force [N]): held while its clutch pushes."""

@@ -31,6 +31,7 @@ from ipir_mujoco.core.params import RobotParams
 
 from ipir_mujoco.core.results import REST_SPEED
 
+from .compiled_grip import load_compliant_grip
 from .compliant import CLUTCHES, CompliantClutches, check_transmissions, clutch_actuators
 from .controller import ROLLING, SKIDDING, STANDING, RunningBound
 from .grip import GripRows
@@ -114,6 +115,10 @@ class CompliantGrip(CompliantClutches):
                 applied -= self.c * (speed - self.v_before[i])
             work += ((self.k * d if d > 0.0 else 0.0) - applied) * speed
         self.damper_work += work * self.dt
+
+    def load_compiled(self, loop):
+        """Its layout in the compiled loop (:func:`.compiled_grip.load_compliant_grip`)."""
+        return load_compliant_grip(self, loop)
 
     def wheels(self) -> tuple[float, float]:
         """Each module's wheels' state of the last step: +1.0 rolling, 0.0 standing, -1.0 skidding."""
