@@ -20,6 +20,9 @@ check that it changed nothing else, leave the new names out of the later fingerp
 
 (every dictionary key and sweep column of those names is dropped before hashing; a name that does
 not occur changes nothing, so the earlier fingerprint compares as it is).
+
+``--smoke`` fingerprints the first two runs of each kind only, in seconds (a check that the bench runs;
+compare smoke fingerprints only with smoke fingerprints).
 """
 
 from __future__ import annotations

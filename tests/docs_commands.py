@@ -20,9 +20,11 @@ What a command is:
 - a command named in running text or a heading without arguments (```ipir-mujoco clutch-study```: the
   engagement loads ...; ``python -m ipir_mujoco.studies.convergence``) is a name: its ``--help`` runs
   (the command's synopsis and examples in code blocks run where they stand); a benchmark named so runs;
+- a command that reads a file the pages do not make (``--data run.csv``) runs its ``--help``;
 - anything else runs as written, with these shortenings (said so in docs/cli.md, "Every documented command
   is tested"): a benchmark (``python bench/NAME.py``) gets ``--smoke``, a command that takes ``--quick``
-  gets it; a shortened command's output is not compared.
+  gets it, ``--samples`` above 64 and ``--mujoco-samples`` above 2 are cut to that; a shortened command's
+  output is not compared.
 
 Commands of one file run in their order in one scratch folder holding copies of mjcf/ and docs/ and the
 bench/ and tests/ folders (so that ``--out sizing`` then ``python -c ... open('sizing/results.csv')``
@@ -224,17 +226,43 @@ def program(command: str) -> list[str]:
     return words[:2]
 
 
+# counts of draws a command's options set, capped by the test: (option, largest value run)
+CAPS = (("--samples", 64), ("--mujoco-samples", 2))
+
+
 def shortened(command: str, takes_quick) -> tuple[str, str]:
     """(the command as the test runs it, how it was shortened or ''): benchmarks get --smoke, a command
-    whose program takes --quick (``takes_quick(program(command))``) gets it."""
+    whose program takes --quick (``takes_quick(program(command))``) gets it, and a count of random draws
+    (``--samples N``, ``--mujoco-samples M``) is capped (:data:`CAPS`)."""
     if re.search(r"python3? bench/\w+\.py", command):
         if "--smoke" in command.split():
             return command, "--smoke"
         new = re.sub(r"(python3? bench/\w+\.py(?:\s+(?![|>&])\S+)*)", r"\1 --smoke", command)
         return new, "--smoke"
+    how = []
+    for option, cap in CAPS:
+        match = re.search(rf"{option} (\d+)\b", command)
+        if match and int(match.group(1)) > cap and command.startswith("ipir-mujoco "):
+            command = command[:match.start(1)] + str(cap) + command[match.end(1):]
+            how.append(f"{option} {cap}")
     if "--quick" not in command.split() and not re.search(r"[|>&]", command) and takes_quick(program(command)):
-        return command + " --quick", "--quick"
-    return command, ""
+        command += " --quick"
+        how.append("--quick")
+    return command, ", ".join(how)
+
+
+INPUTS = re.compile(r"(?<!--out )(?<!--save-mjcf )(?<![\w/.-])((?:[\w.-]+/)*[\w.-]+\.(?:csv|toml|xml|json))\b")
+
+
+def missing_inputs(command: str, folder) -> list[str]:
+    """The files a command reads (a .csv, .toml, .xml or .json argument, not one it writes: --out,
+    --save-mjcf, a redirection) that are not in ``folder``: an example's own data the docs do not make."""
+    from pathlib import Path
+
+    head = re.split(r"\s[>|]", command)[0]
+    if head.startswith("python -c"):
+        return []
+    return [name for name in INPUTS.findall(head) if not (Path(folder) / name).exists()]
 
 
 WALL = re.compile(r"\(?[\d.]+ (?:ms|s) wall\)?")
