@@ -14,13 +14,15 @@ Layers, bottom up:
 - :mod:`ipir_mujoco.cli`: the ``ipir-mujoco`` command.
 """
 
-from pathlib import Path as _Path
+import os as _os  # loaded with the interpreter: this file imports nothing that takes time (a Ctrl-C while the
+# command line starts is caught from its first statement on: ipir_mujoco.interrupts)
 
 __version__ = "0.2.0"
 
 # Installed, the repository's analytic/ and mjcf/ folders are ipir_mujoco/analytic and
 # ipir_mujoco/mjcf. In a source checkout run without installing, they sit beside this
 # package: let the subpackage import find them there.
-_here = _Path(__file__).resolve().parent
-if not (_here / "analytic").is_dir() and (_here.parent / "analytic" / "__init__.py").is_file():
-    __path__.append(str(_here.parent))  # noqa: F821 (a package's own __path__)
+_here = _os.path.dirname(_os.path.realpath(__file__))
+if (not _os.path.isdir(_os.path.join(_here, "analytic"))
+        and _os.path.isfile(_os.path.join(_here, "..", "analytic", "__init__.py"))):
+    __path__.append(_os.path.dirname(_here))  # noqa: F821 (a package's own __path__)
