@@ -77,9 +77,14 @@ def _main_thread() -> bool:
 
 def guard_loading() -> bool:
     """Install :func:`handler` in loading mode if Python's default handler is in place (never over a
-    handler the caller set; main thread only); True if installed. End it with :func:`loaded`."""
+    handler the caller set; main thread only), or put it back in loading mode where it is installed; True if
+    so. End it with :func:`loaded`."""
     try:
-        if _sig.getsignal(_sig.SIGINT) is not _sig.default_int_handler:
+        current = _sig.getsignal(_sig.SIGINT)
+        if current is handler:  # installed already (the package's __init__ as the command starts): loading again
+            state.loading = True
+            return True
+        if current is not _sig.default_int_handler:
             return False
         state.loading = True
         _sig.signal(_sig.SIGINT, handler)

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ipir_mujoco.core.results import RunResult
+if TYPE_CHECKING:  # annotations only: RunResult.plot calls plot_runs here, so nothing here imports core.results
+    from ipir_mujoco.core.results import RunResult
 
 REAR, FRONT = "black", "tab:red"  # the paper's colours: module 1 black, module 2 red
 STYLES = ("-", "--", ":", "-.")
@@ -73,18 +74,26 @@ def figure_crank(runs: Sequence[RunResult], labels: Sequence[str] | None = None)
 
 
 def figure_modules(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -> Figure:
-    """Paper's Fig. 3: module displacements (a), velocities (b), accelerations (c)."""
+    """Paper's Fig. 3: module displacements (a), velocities (b), accelerations (c); along the route's
+    centreline (s) for runs along a route (their x and v columns are, :meth:`ipir_mujoco.engine.route_watch.RouteWatch.along_series`)."""
     fig, axes = new_figure(3)
-    quantities = (("x", "displacement from start [m]", "(a) displacements"),
-                  ("v", "velocity [m/s]", "(b) velocities"),
-                  ("a", "acceleration [m/s^2]", "(c) accelerations"))
+    along = any(run.route is not None for run in runs)
+    if along:
+        quantities = (("x", "distance along the route s [m]", "(a) distances along the route"),
+                      ("v", "speed along the route ds/dt [m/s]", "(b) speeds along the route"),
+                      ("a", "rate of ds/dt [m/s^2]", "(c) accelerations along the route"))
+    else:
+        quantities = (("x", "displacement from start [m]", "(a) displacements"),
+                      ("v", "velocity [m/s]", "(b) velocities"),
+                      ("a", "acceleration [m/s^2]", "(c) accelerations"))
     for ax, (key, ylabel, title) in zip(axes, quantities):
         for i, (style, run) in enumerate(zip(STYLES, runs)):
             t = run.series["t"]
+            name = "s" if along and key == "x" else key
             ax.plot(t, run.series[key + "1"], style, color=REAR, lw=0.9,
-                    label=_legend_label(runs, labels, i, f"module 1 (rear) {key}1"))
+                    label=_legend_label(runs, labels, i, f"module 1 (rear) {name}1"))
             ax.plot(t, run.series[key + "2"], style, color=FRONT, lw=0.9,
-                    label=_legend_label(runs, labels, i, f"module 2 (front) {key}2"))
+                    label=_legend_label(runs, labels, i, f"module 2 (front) {name}2"))
         ax.set(ylabel=ylabel, title=title)
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
@@ -117,6 +126,28 @@ PAPER_FIGURES = {
     "fig3_modules.png": figure_modules,
     "fig4_gap.png": figure_gap,
 }
+
+
+def plot_runs(runs: Sequence[RunResult], path: str | Path | None = None) -> list[Figure]:
+    """The paper's figures (crank, modules, gap against time) of ``runs``, the first solid, the others dashed
+    over it.
+
+    Parameters
+    ----------
+    runs : sequence of RunResult
+    path : str or Path or None
+        A folder to write them in as fig2-4 PNG (made if missing); None: not written.
+
+    Returns
+    -------
+    list of matplotlib.figure.Figure
+        The three figures.
+    """
+    runs = list(runs)
+    if path is not None:
+        Path(path).mkdir(parents=True, exist_ok=True)
+        write_paper_figures(runs, path)
+    return [figure_crank(runs), figure_modules(runs), figure_gap(runs)]
 
 
 def write_paper_figures(runs: Sequence[RunResult], directory: str | Path, labels: Sequence[str] | None = None,
