@@ -239,14 +239,16 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         An unknown name, an option the variant's engine does not take, or parameters it refuses (one line).
     SimulationError
         A run that cannot go on (one line with the time and the reason).
+    KeyboardInterrupt
+        Ctrl-C during the run, wherever it landed (compiled code included), never another exception or a result.
     """
     v = check_options(name, options)
     require_params(params)
     unknown = [k for k in options if k not in (*COMMON_OPTIONS, *ANALYTIC_OPTIONS, *MUJOCO_OPTIONS)]
     if unknown:  # (an option of the other engine given as None or False counts as not given: check_options)
         known = (*COMMON_OPTIONS, *(MUJOCO_OPTIONS if v.is_mujoco else ANALYTIC_OPTIONS))
-        raise ParameterTypeError(f"option {unknown[0]}={options[unknown[0]]!r} is unknown to {v.name}; allowed: "
-                             f"{', '.join(known)}")
+        raise ParameterTypeError(f"option {unknown[0]}={options[unknown[0]]!r} is unknown to {v.name}; "
+                                 f"allowed: {', '.join(known)}")
     if not isinstance(options.get("every_step", False), (bool, type(None))):
         raise ParameterTypeError(f"every_step={options['every_step']!r} is not a bool; allowed: True or False")
     # Ctrl-C during the run is KeyboardInterrupt, whatever the code it landed in made of it (ipir_mujoco.interrupts)

@@ -119,7 +119,7 @@ CASES = [
     (["compare", "{f}/run", "{f}/header_only"], 2, "0 sample row(s)"),
     (["compare", "{f}/run", "{f}/torn"], 2, "1 sample row(s)"),
     (["compare", "--json", "{f}/run", "{f}/nan"], 2, "x1=nan is not a finite number"),
-    (["compare", "{f}/run", "{f}/afile"], 2, "is not a run folder"),
+    (["compare", "{f}/run", "{f}/afile"], 2, "has no column 't' in its header row"),
     (["compare", "{f}/run", "{f}/run", "--tolerance", "nan"], 2, "tolerance=nan"),
     (["kinetostatics", "--samples", "{f}/k_empty.csv", "--out", "{f}/k"], 2, "is empty"),
     (["kinetostatics", "--samples", "{f}/k_semicolon.csv", "--out", "{f}/k"], 2, "not ';'"),
