@@ -256,8 +256,10 @@ def run_atlas(atlas: Atlas, out: str | Path, *, resume: bool = False, workers: i
 
         mj_names = atlas.mujoco_names()
         if mj_names:
-            def evaluate(name: str, Um: np.ndarray) -> list[dict]:
-                return store.evaluate(name, "mujoco", atlas.designs(Um))
+            def evaluate(asked: dict) -> dict:
+                names = list(asked)
+                rows = store.evaluate_many([(n, "mujoco", atlas.designs(asked[n])) for n in names])
+                return dict(zip(names, rows))
 
             state = explore(mj_names, evaluate, lambda n, Um, rows: fit(n, "mujoco", Um, rows),
                             lambda n, s: unit_sobol(n, d, s), atlas.budget, d, atlas.thresholds, atlas.tolerance,
