@@ -21,8 +21,9 @@ Files: ``OUT/samples.csv`` (:mod:`.atlas_eval`: every pair, streamed, resumable)
         "crossings": {PARAM: [values]}, "crossings_interval": {PARAM: [[value, lo, hi]]} (one varied
         parameter only), "sensitivity": {PARAM: {S1, S1_conf, ST, ST_conf}}, "runs", "measured_by":
         "equations" | "mujoco", "designs", "runs_by_region": {safe, unsafe, boundary} (MuJoCo),
-        "by_threshold": [{threshold, safe_fraction, safe_fraction_interval, crossings...}] (every threshold;
-        the top level repeats the first), "equations": {...} (where MuJoCo measured it too)}}},
+        "by_threshold": [{threshold, safe_fraction, safe_fraction_interval, crossings...}] (every
+        threshold, smallest first; the top level repeats the smallest), "equations": {...} (where MuJoCo
+        measured it too)}}},
      "settings": ..., "fingerprint", "status", "wall_s", "runs": {equations, mujoco}, "stopped": {NAME: why}}
 """
 
