@@ -45,7 +45,6 @@ __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep
 
 ENGINES = ("analytic", "mujoco")
 RULES = ("kinematic", "unilateral")
-MUJOCO_MODELS = ("slides", "wheels")  # MuJoCo's models: the modules on slides, or on wheels on the pipe walls
 
 
 @dataclass(frozen=True)
@@ -59,6 +58,7 @@ class Variant:
     clutch: str | None  # MuJoCo's clutch: 'ratchet' | 'lock'; None for the equations
     label: str  # in words, for figures and reports
     model: str = "slides"  # MuJoCo's model of the robot: 'slides' | 'wheels' (the equations: 'slides')
+    clutches: str = ""  # its clutches in words, where its model has only those (for a refused flag's message)
 
     @property
     def is_mujoco(self) -> bool:
@@ -83,7 +83,8 @@ VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("mujoco-lock", "mujoco", "kinematic", "exact", "lock", "MuJoCo, paper's rule"),
     Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
     Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
-    Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels"),
+    Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels",
+            "one-way ratchets in the wheels' hubs"),
 )}
 ALIASES = {
     "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
@@ -91,6 +92,8 @@ ALIASES = {
     "mujoco-lock-kinematic": "mujoco-lock",
 }
 NAMES = tuple(VARIANTS)
+# MuJoCo's models of the robot (``--mujoco-model``): the modules on slides, or on wheels on the pipe walls, ...
+MUJOCO_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.engine == "mujoco"))
 
 # the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
@@ -120,8 +123,8 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     clutches; ``rule`` None is the paper's rule, or one-way clutches on the wheeled model (its only ones)."""
     if model not in MUJOCO_MODELS:
         raise ParameterError(f"--mujoco-model {model!r} is unknown; allowed: {', '.join(MUJOCO_MODELS)}")
-    if model == "wheels":
-        return _wheels_from_flags(engine, geometry, rule, clutch)
+    if model != "slides":
+        return _model_from_flags(engine, geometry, rule, clutch, model)
     rule = "kinematic" if rule is None else rule
     if engine not in ENGINES:
         raise ParameterError(f"--engine {engine!r} is unknown; allowed: {', '.join(ENGINES)}")
@@ -146,20 +149,23 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     return _find(engine, rule, "exact", clutch)
 
 
-def _wheels_from_flags(engine: str, geometry: str | None, rule: str | None, clutch: str | None) -> Variant:
-    """``mujoco-wheels``, after refusing the flags it does not take (one line each)."""
+def _model_from_flags(engine: str, geometry: str | None, rule: str | None, clutch: str | None,
+                      model: str) -> Variant:
+    """The one variant of MuJoCo's model ``model`` (not the slides: ``mujoco-wheels`` for 'wheels'), after
+    refusing the flags it does not take (one line each)."""
+    v = next(v for v in VARIANTS.values() if v.model == model)
     if engine != "mujoco":
-        raise ParameterError("--mujoco-model wheels applies only to --engine mujoco")
+        raise ParameterError(f"--mujoco-model {model} applies only to --engine mujoco")
     if geometry == "approx":
         raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real linkage; "
                              "allowed: --geometry exact (or leave it out)")
-    if rule not in (None, "unilateral"):
-        raise ParameterError(f"--clutch {rule} with --mujoco-model wheels: its clutches are one-way ratchets in the "
-                             "wheels' hubs; allowed: --clutch unilateral (or leave it out)")
-    if clutch not in (None, "ratchet"):
-        raise ParameterError(f"--mujoco-clutch {clutch} with --mujoco-model wheels: its clutches are ratchets in the "
-                             "wheels' hubs; allowed: --mujoco-clutch ratchet (or leave it out)")
-    return VARIANTS["mujoco-wheels"]
+    if rule not in (None, v.rule):
+        raise ParameterError(f"--clutch {rule} with --mujoco-model {model}: its clutches are {v.clutches}; "
+                             f"allowed: --clutch {v.rule} (or leave it out)")
+    if clutch not in (None, v.clutch):
+        raise ParameterError(f"--mujoco-clutch {clutch} with --mujoco-model {model}: its clutches are {v.clutches}; "
+                             f"allowed: --mujoco-clutch {v.clutch} (or leave it out)")
+    return v
 
 
 def _find(engine: str, rule: str, geometry: str, clutch: str | None) -> Variant:

@@ -73,13 +73,16 @@ def _interval(pair) -> str:
 def format_result(result: dict) -> str:
     """The study's estimates as text: per metric a line per statistic with its 95 % interval; per event its
     probability and interval; the failures."""
+    from ..studies.uq_stats import BCA_MAX
+
     study = result["study"]
     lines = [f"{study['engine']} on {study['samples']} samples"
              + (f", {study['mujoco_engine']} on the first {study['mujoco_samples']}" if study["mujoco_samples"] else "")
              + f" ({study['wall_s']:.1f} s); 95 % confidence intervals"]
     for key, e in result["metrics"].items():
         how = ("multi-fidelity (control variate)" if e["estimator"] == "multi-fidelity"
-               else "Monte Carlo: mean Student t, SD BCa bootstrap, quantiles order statistics")
+               else f"Monte Carlo: mean Student t, SD {'BCa' if e['samples'] <= BCA_MAX else 'percentile'} bootstrap, "
+                    "quantiles order statistics")
         lines.append(f"  {key}  [{how}]")
         lines.append(f"    mean {e['mean']:.6g}  {_interval(e['mean_interval'])}")
         lines.append(f"    std  {e['std']:.4g}  {_interval(e['std_interval'])}")
@@ -87,11 +90,11 @@ def format_result(result: dict) -> str:
             lines.append(f"    q{q:<3} {v:.6g}  {_interval(e['quantile_intervals'][q])}")
         if e["estimator"] == "multi-fidelity":
             mc = e["mujoco_mc"]
-            lines.append(f"    MuJoCo alone ({mc['samples']} runs): mean {mc['mean']:.6g} {_interval(mc['mean_interval'])}"
-                         f", std {mc['std']:.4g} {_interval(mc['std_interval'])}")
+            lines.append(f"    MuJoCo alone ({mc['samples']} runs): mean {mc['mean']:.6g} "
+                         f"{_interval(mc['mean_interval'])}, std {mc['std']:.4g} {_interval(mc['std_interval'])}")
+            worth = e["variance_reduction"] * mc["samples"]
             lines.append(f"    correlation {e['correlation']:.5f}, coefficient {e['coefficient']:.4g}: variance "
-                         f"reduction {e['variance_reduction']:.3g}x, worth {e['variance_reduction'] * mc['samples']:.0f}"
-                         " plain MuJoCo runs")
+                         f"reduction {e['variance_reduction']:.3g}x, worth {worth:.0f} plain MuJoCo runs")
         if e.get("missing"):
             lines.append(f"    ({e['missing']} sample runs give no value: left out)")
     for text, e in result["events"].items():

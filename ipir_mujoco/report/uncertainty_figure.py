@@ -16,7 +16,6 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..studies.uncertainty import KEY_UNITS as UNITS
 
 EQUATIONS, MUJOCO = "#1f77b4", "#d62728"
 
@@ -29,13 +28,16 @@ def _values(rows: list[dict], engine: str | None, key: str) -> np.ndarray:
     return v[np.isfinite(v)]
 
 
-def _label(key: str) -> str:
-    unit = UNITS.get(key)
+def _label(key: str, units: dict) -> str:
+    unit = units.get(key)
     return f"{key} [{unit}]" if unit and unit != "-" else key
 
 
-def plot_uncertainty(path: str | Path, result: dict) -> Path:
-    """Draw the figure of :func:`ipir_mujoco.studies.uncertainty.run_uncertainty`'s ``result`` at ``path``."""
+def plot_uncertainty(path: str | Path, result: dict, units: dict | None = None) -> Path:
+    """Draw the figure of :func:`ipir_mujoco.studies.uncertainty.run_uncertainty`'s ``result`` at ``path``;
+    ``units``: {metric: unit} for the axes (the study's ``KEY_UNITS``, handed in: this module imports no study,
+    which calls it)."""
+    units = {} if units is None else units
     study, rows = result["study"], result["rows"]
     metrics, events = list(result["metrics"]), list(result["events"])
     cheap, faithful = study["engine"], study["mujoco_engine"]
@@ -62,7 +64,7 @@ def plot_uncertainty(path: str | Path, result: dict) -> Path:
         for q in ("5", "95"):
             _band(hist, entry["quantiles"][q], entry["quantile_intervals"][q], "#2ca02c",
                   "5 and 95 % quantiles, 95 % intervals" if q == "5" else None)
-        hist.set_xlabel(_label(key))
+        hist.set_xlabel(_label(key, units))
         hist.set_ylabel("probability density")
         std = entry["std"]
         hist.set_title(f"{key}: mean {entry['mean']:.4g}, SD {std:.3g}" if std is not None else key, fontsize=10)
@@ -78,7 +80,7 @@ def plot_uncertainty(path: str | Path, result: dict) -> Path:
             lo_q, hi_q = (v if v is not None else est for v in interval)
             ecdf.errorbar([est], [int(q) / 100], xerr=[[est - lo_q], [hi_q - est]], fmt="o", color="black",
                           capsize=4, markersize=4, label="quantile estimate, 95 % interval" if q == "5" else None)
-        ecdf.set_xlabel(_label(key))
+        ecdf.set_xlabel(_label(key, units))
         ecdf.set_ylabel("P(metric <= x)")
         ecdf.set_ylim(-0.02, 1.02)
         ecdf.grid(True, alpha=0.3)

@@ -18,8 +18,9 @@ distances), so that what the bend costs is told apart from what the wheels cost 
 
 ``planes`` [deg]: the bend's plane turned about the pipe's axis (:mod:`ipir_mujoco.core.route`): 0 turns it in the
 horizontal plane, across gravity (the default); 90 turns it up, in the plane of gravity, so that the route leaves
-the bend as a riser. The energy over the window is then the motor's work less the kinetic *and potential* energy
-gained (what the robot dissipates, comparable with its level twin's), and the time includes climbing, which the
+the bend as a riser. The energy over the window is the motor's work less the kinetic *and potential* energy gained
+(MuJoCo's potential energy: the height, and the springs of the wheels' legs; what is left is what the robot
+dissipates, comparable with its level twin's); a bend that turns up also climbs, which its time includes and the
 level twin and the analytic level reference do not: the row says how much potential energy the window gained.
 Each plane's bends share their straight twins (a straight has no plane).
 

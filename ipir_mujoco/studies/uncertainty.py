@@ -332,7 +332,7 @@ def write_files(out: str | Path, result: dict) -> Path:
             writer.writeheader()
             writer.writerows({k: _cell(v) for k, v in r.items()} for r in rows)
         write_json(staging / "uncertainty.json", {k: v for k, v in result.items() if k != "rows"})
-        plot_uncertainty(staging / "uncertainty.png", result)
+        plot_uncertainty(staging / "uncertainty.png", result, KEY_UNITS)
     return Path(out) / "uncertainty.png"
 
 

@@ -4,7 +4,8 @@ Plain Monte Carlo (one engine, n independent samples; :func:`mc_statistics`):
 
 * mean: the sample mean, interval Student's t (n - 1 degrees of freedom; the central limit theorem);
 * standard deviation: the sample SD (n - 1), interval by the bias-corrected and accelerated (BCa) bootstrap
-  (``scipy.stats.bootstrap``, 2000 resamples, seeded): no normality assumed;
+  (``scipy.stats.bootstrap``, 2000 resamples, seeded; the percentile bootstrap beyond :data:`BCA_MAX` samples):
+  no normality assumed;
 * quantiles (5, 50, 95 %): the sample quantile, interval distribution-free from order statistics (the ranks
   j < k with P(X_(j) <= q_p <= X_(k)) >= 95 % under Binomial(n, p), exact for any continuous metric).
 
@@ -19,7 +20,8 @@ over this one's, 1 / (1 - (1 - M/N) rho^2): the multi-fidelity estimate is worth
 runs. Its interval: Student's t with M - 2 degrees of freedom (alpha is estimated from the pairs). The standard
 deviation is estimated the same way from the second moment (control variate g^2), the quantiles by inverting the
 control-variate CDF F_N^g(y) + F_M^f(y) - F_M^g(y) (coefficient 1: unbiased whatever the coefficient, and
-near-optimal where f and g nearly agree; made monotone by isotonic regression, ``scipy.optimize``), both with percentile-bootstrap intervals (the M pairs and the N - M
+near-optimal where f and g nearly agree; made monotone by isotonic regression, ``scipy.optimize``), both with
+percentile-bootstrap intervals (the M pairs and the N - M
 other equations' samples resampled separately, 2000 times).
 
 Event probabilities (:func:`event_probability`): one engine, k of n samples: k / n with the Clopper-Pearson
@@ -41,6 +43,8 @@ import numpy as np
 LEVEL = 0.95
 BOOTSTRAP = 2000
 QUANTILES = (5, 50, 95)
+BCA_MAX = 5000  # samples up to which the SD's interval is BCa: its jackknife costs n^2; beyond, the percentile
+# bootstrap (where the two agree: the SD's sampling distribution is close to normal by then)
 RARE_COUNT = 10  # events seen fewer times than this: the probability is not resolved (its upper bound is)
 
 
@@ -77,14 +81,17 @@ def mc_statistics(x: np.ndarray, seed: int = 0) -> dict:
     mean = float(np.mean(x))
     std = float(np.std(x, ddof=1)) if n > 1 else math.nan
     half = _t(n - 1) * std / math.sqrt(n) if n > 1 else math.inf
-    if n > 2 and std > 0:
+    if 2 < n <= BCA_MAX and std > 0:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
             boot = stats.bootstrap((x,), lambda s, axis: np.std(s, ddof=1, axis=axis), n_resamples=BOOTSTRAP,
-                                   confidence_level=LEVEL, method="BCa", rng=np.random.default_rng(seed))
+                                   confidence_level=LEVEL, method="BCa", rng=np.random.default_rng(seed),
+                                   batch=max(1, int(4e6 // n)))  # resamples at once: bounded memory
         std_interval = [float(boot.confidence_interval.low), float(boot.confidence_interval.high)]
         if not all(math.isfinite(v) for v in std_interval):
             std_interval = _percentile_std(x, seed)
+    elif n > BCA_MAX and std > 0:
+        std_interval = _percentile_std(x, seed)
     else:
         std_interval = [std, std] if n > 1 else [math.nan, math.nan]
     quantiles = {str(q): float(np.quantile(x, q / 100)) for q in QUANTILES}
@@ -95,7 +102,7 @@ def mc_statistics(x: np.ndarray, seed: int = 0) -> dict:
 
 def _percentile_std(x: np.ndarray, seed: int) -> list[float]:
     rng = np.random.default_rng(seed)
-    stds = np.std(x[rng.integers(0, len(x), (BOOTSTRAP, len(x)))], ddof=1, axis=1)
+    stds = np.array([np.std(x[rng.integers(0, len(x), len(x))], ddof=1) for _ in range(BOOTSTRAP)])
     return [float(np.quantile(stds, (1 - LEVEL) / 2)), float(np.quantile(stds, (1 + LEVEL) / 2))]
 
 
