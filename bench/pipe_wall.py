@@ -22,6 +22,7 @@ the cost here includes the Python loop's contact reading): the ripple with rolli
 from __future__ import annotations
 
 import argparse
+import math
 import time
 
 import mujoco
@@ -68,7 +69,8 @@ def main() -> None:
     duration = 0.2 if args.smoke else 1.0
     for label, radius in (("rolling (mu 0.5), straight", None), ("rolling (mu 0.5), in a bend of R/D 2.5", 0.4),
                           ("rolling (mu 0.5), in a bend of R/D 1.25", 0.2)):
-        run = roll_on_joints(rolling_rig(bend_radius=radius), 0.5, duration)
+        within = duration if radius is None else min(duration, 0.8 * (math.pi * radius - 0.3 * 0.5) / 0.5)
+        run = roll_on_joints(rolling_rig(bend_radius=radius), 0.5, within)  # the carriage stays in the half turn
         ptp = max(np.ptp(run.force[:, k]) / np.mean(run.force[:, k]) for k in range(run.force.shape[1]))
         means = ", ".join(f"{v:.4f}" for v in run.force.mean(axis=0))
         print(f"{label:44s} {ripple(run):16.2e} {ptp:15.2e} {run.us_per_step:8.2f} {run.contacts:15d}   "

@@ -245,3 +245,21 @@ def test_every_numeric_parameter_takes_a_distribution_inside_its_range_or_is_ref
 def test_options_no_run_could_take_are_refused_before_any_run(capsys, tmp_path, argv, words):
     code, out, err = run_cli(capsys, "uncertainty", *argv, "--samples", "10", "--out", tmp_path / "u")
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_metric_mujoco_leaves_empty_falls_back_to_the_equations_with_a_note():
+    """MuJoCo gives no peak force of a rigid clutch: that metric is the equations' Monte Carlo, said in a note,
+    while a metric both give is multi-fidelity."""
+    from ipir_mujoco.studies.uncertainty import estimate
+
+    rng = np.random.default_rng(0)
+    g = rng.normal(1.0, 0.1, 50)
+    cheap = [{"peak_clutch_force_n": 10 * v, "revolutions": v} for v in g]
+    faithful = [{"peak_clutch_force_n": math.nan, "revolutions": v * 1.0001} for v in g[:5]]
+    out = estimate(cheap, faithful, ("peak_clutch_force_n", "revolutions"), ())
+    peak, rev = out["metrics"]["peak_clutch_force_n"], out["metrics"]["revolutions"]
+    assert peak["estimator"] == "mc" and "only 0 of the 5 MuJoCo runs" in peak["note"]
+    assert peak["mean"] == pytest.approx(10 * g.mean(), rel=1e-12)
+    assert rev["estimator"] == "multi-fidelity" and rev["correlation"] == pytest.approx(1.0, abs=1e-9)
+    # f = 1.0001 g exactly: the control variate recovers 1.0001 x the mean of all 50 equations' samples
+    assert rev["mean"] == pytest.approx(1.0001 * g.mean(), rel=1e-12)

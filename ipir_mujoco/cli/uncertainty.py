@@ -95,6 +95,8 @@ def format_result(result: dict) -> str:
             worth = e["variance_reduction"] * mc["samples"]
             lines.append(f"    correlation {e['correlation']:.5f}, coefficient {e['coefficient']:.4g}: variance "
                          f"reduction {e['variance_reduction']:.3g}x, worth {worth:.0f} plain MuJoCo runs")
+        if e.get("note"):
+            lines.append(f"    note: {e['note']}")
         if e.get("missing"):
             lines.append(f"    ({e['missing']} sample runs give no value: left out)")
     for text, e in result["events"].items():

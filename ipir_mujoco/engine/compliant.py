@@ -99,46 +99,65 @@ class CompliantClutches(ControllerBase):
         self.act = [model.actuator(n).id for n in CLUTCHES]
         self.qpos_adr = [qpos_address(model, n) for n in SLIDES]
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
-        check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_JOINT, [model.joint(n).id for n in SLIDES], SLIDES)
+        self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
+        self.attach(model, data, params)
         k, c = clutch_actuators(model, self.act, params)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler does not
         self.implicit = implicit_damping(model)
         self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm
-        self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
-        self.anchor = [float(data.qpos[a]) - self.backlash for a in self.qpos_adr]  # running maximum - backlash
+        self.anchor = [self.coordinate(i) - self.backlash for i in (0, 1)]  # running maximum - backlash
         for u, a in zip(self.act, self.anchor):
             data.ctrl[u] = a
-        self._per_module = tuple(zip((0, 1), self.qpos_adr, self.dof_adr, self.act))
+        self._modules = tuple(zip((0, 1), self.act))
         self.damped = [True, True]  # as built: biasprm[2] = -c
         self.overlap = [0.0, 0.0]
         self.v_before = [0.0, 0.0]
+        self.tracking = [False, False]  # whether each module was at its running maximum at the last step's start
         self.damper_work = 0.0
         self.before_step()
 
+    # the pieces a compliant clutch on another coordinate replaces (.grip_compliant.CompliantGrip: the roll)
+    def attach(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
+        """Check that the clutch actuators act on the slides (and set up what else the coordinate needs)."""
+        check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_JOINT, [model.joint(n).id for n in SLIDES], SLIDES)
+
+    def coordinate(self, i: int) -> float:
+        """Module ``i``'s coordinate the clutch acts along [m]: its slide x_i."""
+        return self._qpos.item(self.qpos_adr[i])
+
+    def speed(self, i: int) -> float:
+        """Its rate [m/s]."""
+        return self._qvel.item(self.dof_adr[i])
+
+    def after_module(self, i: int) -> None:
+        """What else a step's start does for module ``i`` (nothing here)."""
+
     def before_step(self) -> None:
-        """Raise each anchor to (x - backlash) if the module went further; damper on while d > 0."""
-        q, v, backlash, anchor, overlap = self._qpos, self._qvel, self.backlash, self.anchor, self.overlap
-        for i, adr, dof, act in self._per_module:  # this runs before every step: plain floats only
-            x = q.item(adr)
-            if x - backlash > anchor[i]:
+        """Raise each anchor to (coordinate - backlash) if the module went further; damper on while d > 0."""
+        backlash, anchor, overlap = self.backlash, self.anchor, self.overlap
+        for i, act in self._modules:  # this runs before every step: plain floats only
+            x = self.coordinate(i)
+            self.tracking[i] = tracking = x - backlash > anchor[i]
+            if tracking:
                 anchor[i] = x - backlash
                 self._ctrl[act] = anchor[i]
             d = anchor[i] - x
             overlap[i] = d
-            self.v_before[i] = v.item(dof)
+            self.v_before[i] = self.speed(i)
             if (d > 0.0) != self.damped[i]:
                 self.damped[i] = d > 0.0
                 self._biasprm[act, 2] = -self.c if d > 0.0 else 0.0
+            self.after_module(i)
 
     def after_step(self) -> None:
-        """Add the step's damper dissipation: (spring force - applied force) * v_{n+1} * dt, both modules."""
+        """Add the step's damper dissipation: (spring force - applied force) * speed_{n+1} * dt, both modules."""
         work = 0.0
-        for i, _, dof, act in self._per_module:
+        for i, act in self._modules:
             d, applied = self.overlap[i], self._force.item(act)
             if d <= 0.0 and applied == 0.0:
                 continue  # inside the play: no force, nothing dissipated (the common case)
-            speed = self._qvel.item(dof)
+            speed = self.speed(i)
             if applied > 0.0 and self.damped[i] and self.implicit:
                 applied -= self.c * (speed - self.v_before[i])  # the implicit integrators' damping over the step
             work += ((self.k * d if d > 0.0 else 0.0) - applied) * speed

@@ -185,6 +185,10 @@ class _Run:
         self.setup = RunSetup(kind, params, settings, implementation=implementation, rule=clutch, mjcf=mjcf,
                               route=route, servo=servo)
         self.model, self.data = self.setup.model, self.setup.data
+        built = time.perf_counter() - self.started
+        if wall_budget_s is not None and built > wall_budget_s:  # the budget covers building, not only stepping
+            raise SimulationError(f"the run exceeded its wall-time budget of {wall_budget_s:g} s while building its "
+                                  f"model ({built:.3g} s), before the first step")
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
         self.recorder: Recorder | None = None  # made by _setup

@@ -21,6 +21,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter
 
 from ..studies.atlas_surrogate import CONFIDENT
 
@@ -68,8 +69,8 @@ def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the pap
         if frac is None:
             continue
         ax.barh(k, 100 * frac, color=colours[by], alpha=0.55)
-        ax.errorbar(100 * frac, k, xerr=[[100 * (frac - interval[0])], [100 * (interval[1] - frac)]], color="black",
-                    capsize=3, lw=1)
+        ax.errorbar(100 * frac, k, xerr=[[100 * max(0.0, frac - interval[0])], [100 * max(0.0, interval[1] - frac)]],
+                    color="black", capsize=3, lw=1)
         ax.text(min(100 * interval[1] + 1, 88), k, f"{100 * frac:.1f} %", va="center", fontsize="x-small")
     ax.set_yticks(range(len(rows)), [label for label, _i, _b in rows], fontsize="small")
     ax.invert_yaxis()
@@ -82,6 +83,12 @@ def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the pap
     ax.grid(alpha=0.3, axis="x")
     fig.savefig(path, dpi=110)
     return path
+
+
+def _plain_log_ticks(axis) -> None:
+    """Log-axis labels as plain numbers (0.5, 2, 10), not powers of ten."""
+    axis.set_major_formatter(FuncFormatter(lambda v, _p: f"{v:g}"))
+    axis.set_minor_formatter(FuncFormatter(lambda v, _p: f"{v:g}" if str(f"{v:g}")[0] in "25" else ""))
 
 
 def _panels(result: dict, atlas):
@@ -123,6 +130,7 @@ def plot_1d(result: dict, atlas, path: Path) -> Path:
         ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=f"{axis.name}",
                ylabel=f"|cost| of {metric} [%]", title=f"{name}\n(measured by {entry['measured_by']})")
         ax.title.set_fontsize("small")
+        _plain_log_ticks(ax.yaxis)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize="xx-small")
     fig.savefig(path, dpi=110)
@@ -197,6 +205,7 @@ def plot_partial(result: dict, atlas, path: Path) -> Path:
             for t in atlas.thresholds:
                 ax.axhline(100 * t, color="grey", ls="--", lw=0.9)
             ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=axis.name)
+            _plain_log_ticks(ax.yaxis)
             if c == 0:
                 ax.set_ylabel(f"{name}\n|cost| [%] ({'MuJoCo' if fidelity == 'mujoco' else 'equations'})",
                               fontsize="small")

@@ -16,6 +16,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..output import write_atomically
 from ..studies.design_eval import key_value
 from ..studies.sweep_metrics import DESCRIBED, LEGACY, described
 
@@ -60,7 +61,8 @@ def _values(rows, key, problem) -> np.ndarray:
 def plot_pareto(out: str | Path, problem) -> Path:
     """Draw OUT/pareto.png from OUT/evaluations.csv and OUT/pareto.csv; return its path."""
     path = Path(out) / "pareto.png"
-    pareto_figure(out, problem).savefig(path, dpi=110)
+    fig = pareto_figure(out, problem)
+    write_atomically(path, lambda staged: fig.savefig(staged, dpi=110))
     return path
 
 
@@ -123,7 +125,8 @@ def pareto_figure(out: str | Path, problem) -> Figure:
 def plot_indices(out: str | Path, indices: list[dict], metrics: list[str]) -> Path:
     """Draw OUT/sensitivity.png: S1 and ST per parameter with their confidence intervals, a panel per metric."""
     path = Path(out) / "sensitivity.png"
-    indices_figure(indices, metrics).savefig(path, dpi=110)
+    fig = indices_figure(indices, metrics)
+    write_atomically(path, lambda staged: fig.savefig(staged, dpi=110))
     return path
 
 

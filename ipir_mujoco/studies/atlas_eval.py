@@ -16,6 +16,7 @@ import csv
 import os
 from pathlib import Path
 
+from ipir_mujoco.core.errors import StudyInterrupted
 from ipir_mujoco.core.params import RobotParams
 
 from .atlas_space import IDEALIZATIONS, measure
@@ -88,6 +89,9 @@ class Samples:
         self.file.close()
         if kind is None:
             self.file.sort()
+        if kind is KeyboardInterrupt:
+            raise StudyInterrupted(f"interrupted; the {len(self.cache)} pairs so far are in {self.file.path}; run "
+                                   "again with --resume to complete it") from None
         return False
 
     def count(self, name: str, fidelity: str) -> int:

@@ -261,14 +261,11 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
         g = _column(cheap_rows, key)
         usable_g = np.isfinite(g)
         entry: dict
-        if m:
-            f = _column(faithful_rows, key)
-            pair = np.isfinite(f) & usable_g[:m]
+        f = _column(faithful_rows, key) if m else np.array([])
+        pair = np.isfinite(f) & usable_g[:m] if m else np.array([], dtype=bool)
+        if m and pair.sum() >= MIN_MUJOCO:
             rest = usable_g.copy()
             rest[:m] = False
-            if pair.sum() < MIN_MUJOCO:
-                raise SimulationError(f"{key}: only {int(pair.sum())} of the {m} MuJoCo samples give it (stalled or "
-                                      f"failed runs); the multi-fidelity estimate needs {MIN_MUJOCO}")
             entry = uq_stats.multi_fidelity(f[pair], g[:m][pair], g[rest], seed)
             entry["estimator"] = "multi-fidelity"
             entry["mujoco_mc"] = uq_stats.mc_statistics(f[pair], seed)
@@ -280,6 +277,10 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
                                       "or failed runs); statistics need 2")
             entry = uq_stats.mc_statistics(g[usable_g], seed)
             entry.update(estimator="mc", variance_reduction=None, missing=int((~usable_g).sum()))
+            if m:  # MuJoCo ran but gives too few values of this metric to pair (a rigid clutch's peak force: none)
+                entry["note"] = (f"only {int(pair.sum())} of the {m} MuJoCo runs give {key} (MuJoCo leaves some "
+                                 "metrics empty, e.g. a rigid clutch's peak force; or they stalled or failed): the "
+                                 f"equations' Monte Carlo alone (multi-fidelity needs {MIN_MUJOCO} pairs)")
         out["metrics"][key] = _finite(entry)
     for event in events:
         g = _column(cheap_rows, event.key)[ok_cheap]
