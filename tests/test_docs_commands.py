@@ -147,7 +147,7 @@ def test_every_benchmark_has_a_smoke_mode():
     which runs each bench with it) and says so in its usage."""
     for bench in sorted((dc.ROOT / "bench").glob("*.py")):
         source = bench.read_text()
-        assert re.search(r"add_argument\(\s*\"--smoke\"", source), bench.name
+        assert '"--smoke"' in source, bench.name  # the option in its code (argparse or by hand)
         assert "--smoke" in (ast.get_docstring(ast.parse(source)) or ""), bench.name
 
 
