@@ -28,7 +28,7 @@ So a held module stands while the whole ground force g on it satisfies
 limits are MuJoCo's friction rows' bounds, by construction.
 
 The carriage's inertia, :func:`carriage_share` of its module's mass
-(CARRIAGE_SHARE = 1e-4 with rigid clutches, COMPLIANT_CARRIAGE_SHARE = 1e-3
+(CARRIAGE_SHARE = 3e-4 with rigid clutches, COMPLIANT_CARRIAGE_SHARE = 1e-3
 with compliant ones, whose spring acts on it and whose step must resolve
 that), is its slide's ``armature`` (an inertia without weight, so it adds no load in a riser and no
 potential energy; its body has the nominal BODY_MASS MuJoCo requires of a
@@ -53,9 +53,10 @@ from ipir_mujoco.core.params import RobotParams
 CARRIAGES = ("rear_carriage", "front_carriage")  # bodies
 SKIDS = ("rear_skid", "front_skid")  # the carriages' slides: c_i
 ROLLS = ("rear_roll", "front_roll")  # tendons L_i = x_i - c_i
-# carriage inertia over its module's mass: rigid clutches (a skid's bias of about 0.85 of it; the solver's
-# rare unconverged steps, ~2e-4 N for one step, were as frequent at 1e-3, 1e-4 and 1e-5: mjcf/README.md)
-CARRIAGE_SHARE = 1e-4
+# carriage inertia over its module's mass: rigid clutches (a skid's bias of about 0.85 of it). Lighter let the
+# one-way limits give: at 1e-4 a 40 deg design's limits gave 3.3e-3 m at 1e-4 s (1.2e-10 m at 3e-4 and 1e-3);
+# the solver's rare unconverged steps, ~2e-4 N for one step, were as frequent at 1e-3, 1e-4 and 1e-5
+CARRIAGE_SHARE = 3e-4
 COMPLIANT_CARRIAGE_SHARE = 1e-3  # compliant clutches: the spring on it sets the step (timestep.clutch_rate)
 BODY_MASS = 1e-12  # kg, inertia 1e-12 kg m^2: the carriage body's own (MuJoCo needs > 1e-15 on a moving body)
 MARGIN = 1e-9  # m: the one-way limits' margin, as the ratchet's (clutches.Ratchet)

@@ -33,6 +33,7 @@ import math
 from ipir_mujoco.core.results import RunResult
 from ipir_mujoco.core.steady_test import LIMIT_ACCURACY
 
+from .grip_model import carriage_share
 from .monitor import RESIDUAL_TOL, AccuracyError
 
 HALVINGS = 3  # the most halvings of the step a skid check makes (1e-4 s down to 1.25e-5 s)
@@ -60,8 +61,11 @@ def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, floa
     speed and energy per metre where both reached the steady state (inf where only one did; where the finer run
     was found steady by the statistical test, its figure's own uncertainty U is added: what is left to trust
     is the difference and U together), else revolutions and x1_final, x2_final (travel relative to at least
-    TRAVEL_FLOOR strokes)."""
+    TRAVEL_FLOOR strokes). To each travel and steady figure the bias no halving shows is added: the carriage's
+    inertia shortens a skid by about its share of the module's mass (:func:`.grip_model.carriage_share`), so a
+    module's travel by that share of its slip (the steady figures: of both slips over both travels)."""
     a, b = coarse.summary, fine.summary
+    share = carriage_share(fine.params)  # the carriages' inertia: a skid short by about this share of itself
     if a["steady"] or b["steady"]:
         if not (a["steady"] and b["steady"]):
             return "steady", {"steady": math.inf}
@@ -71,13 +75,15 @@ def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, floa
             if a[key] is not None and b[key] is not None:
                 scale = max(abs(a[key]), abs(b[key]), 1e-300)
                 own = (b[spread] or 0.0) if b["steady_test"] == "statistical" else 0.0
-                out[key] = (abs(a[key] - b[key]) + own) / scale
+                moved = abs(b["x1_final"]) + abs(b["x2_final"])
+                bias = share * (b["slip1_m"] + b["slip2_m"]) / moved if moved > 0 else math.inf
+                out[key] = (abs(a[key] - b[key]) + own) / scale + bias
         return "steady", out
     floor = TRAVEL_FLOOR * 2 * fine.params.r
     out = {"revolutions": abs(a["revolutions"] - b["revolutions"]) / max(abs(a["revolutions"]), abs(b["revolutions"]),
                                                                         TRAVEL_FLOOR)}
-    for key in ("x1_final", "x2_final"):
-        out[key] = abs(a[key] - b[key]) / max(abs(a[key]), abs(b[key]), floor)
+    for k, key in ((1, "x1_final"), (2, "x2_final")):
+        out[key] = (abs(a[key] - b[key]) + share * b[f"slip{k}_m"]) / max(abs(a[key]), abs(b[key]), floor)
     return "fixed", out
 
 
