@@ -70,6 +70,21 @@ def view_direction(azimuth: float, elevation: float) -> np.ndarray:
     return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
 
 
+def route_view(route) -> tuple[float, float]:
+    """(azimuth, elevation) [deg] of a camera square to the plane a route lies in (the normal of least spread of
+    its centreline's points), from the side where the route starts towards the frame's right (and, for a plane
+    near the horizontal, from above): a route in the horizontal plane is seen from straight above (+x right, +y
+    up), one that turns up into a riser from its side."""
+    if route.planar:
+        return 90.0, -90.0
+    points = np.array([route.at3(route.length * i / 100)[0] for i in range(101)])
+    normal = np.linalg.svd(points - points.mean(axis=0))[2][2]
+    d = normal if normal[2] <= 0 else -normal  # the view direction, downward or level
+    if abs(d[2]) < 0.99 and float(np.cross(d, [0.0, 0.0, 1.0]) @ route.pieces[0].frame[0]) < 0:
+        d = -d  # the route's start runs to the right of the frame, as it does seen from above
+    return math.degrees(math.atan2(d[1], d[0])), math.degrees(math.asin(max(-1.0, min(1.0, d[2]))))
+
+
 def _open_context(width: int, height: int):
     """A current offscreen OpenGL context of the chosen backend."""
     backend = gl_backend()
@@ -226,8 +241,8 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
     camera.type = mujoco.mjtCamera.mjCAMERA_FREE
     if route is None:
         camera.distance, (camera.azimuth, camera.elevation) = 0.5, SIDE_VIEW
-    else:  # from above: a route's near wall would hide the robot seen from the side; +x right, +y up
-        camera.distance, camera.azimuth, camera.elevation = ROUTE_VIEW_DISTANCE, 90.0, -90.0
+    else:  # square to the route's plane: a route's near wall would hide the robot seen along it
+        camera.distance, (camera.azimuth, camera.elevation) = ROUTE_VIEW_DISTANCE, route_view(route)
     option, perturb = mujoco.MjvOption(), mujoco.MjvPerturb()
     font = mujoco.mjtFontScale.mjFONTSCALE_150 if settings.width >= 600 else mujoco.mjtFontScale.mjFONTSCALE_100
     renderer = mujoco.MjrContext(model, font)

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from .checks import as_real, check_real, check_whole  # noqa: F401  (re-exported: their home was here)
-from .errors import ParameterError
+from .errors import ParameterError, ParameterTypeError
 from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401  (re-exported)
 
 DRIVES = ("torque", "motor", "servo")
@@ -271,6 +271,23 @@ def describe_parameters() -> list[dict[str, Any]]:
     return rows
 
 
+def _parameters_section() -> str:
+    """RobotParams' numpydoc ``Parameters`` section, written from the fields' own metadata (one definition)."""
+    import textwrap
+
+    lines = ["", "", "    Parameters", "    ----------"]
+    for row in describe_parameters():
+        lines.append(f"    {row['name']} : {row['units']}")
+        text = f"{row['meaning']}. Default {row['default_text']}; allowed {row['allowed']}."
+        lines += textwrap.wrap(text, 110, initial_indent=" " * 8, subsequent_indent=" " * 8)
+    lines += ["", "    Raises", "    ------", "    ParameterError",
+              "        A value out of its range, an unknown choice, or fields that do not fit together (one line).", ""]
+    return "\n".join(lines)
+
+
+RobotParams.__doc__ = RobotParams.__doc__.rstrip() + _parameters_section()
+
+
 def parameter_units(name: str) -> str:
     """The unit of parameter ``name`` ('-' for a choice)."""
     return _FIELDS[name].metadata["units"]
@@ -401,6 +418,6 @@ def refuse_idle_parameters(params: RobotParams) -> None:
 def require_params(params: Any) -> RobotParams:
     """``params`` if it is a :class:`RobotParams`, else a ParameterError (for the Python API's entry points)."""
     if not isinstance(params, RobotParams):
-        raise ParameterError(f"params={params!r} is not a RobotParams; build one with RobotParams(...) "
+        raise ParameterTypeError(f"params={params!r} is not a RobotParams; build one with RobotParams(...) "
                              "or load_params(...)")
     return params

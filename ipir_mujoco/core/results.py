@@ -143,6 +143,35 @@ class RunResult:
     ``residual_ratio`` and ``loop_gap_m``), or None. ``route`` is None, or a
     run along a route's summary keys (``route_done``, ``route_time_s``,
     ``route_stop``, ...: ``ipir_mujoco.engine.route_watch``).
+
+    Parameters
+    ----------
+    engine : str
+        'analytic' or 'mujoco'.
+    geometry : str
+        'approx' (the paper's first order) or 'exact'.
+    clutch : str
+        The clutch rule: 'kinematic', 'unilateral' (or 'none').
+    params : RobotParams
+        The parameter set the run used.
+    t_end : float
+        The last sample's time [s].
+    series : dict of str to ndarray
+        Every column of :data:`COLUMNS` (and engine-specific ones), each of shape (n,), in SI units
+        (:data:`SERIES_UNITS`).
+    energy : dict of str to float
+        The energy audit [J].
+    wall_time_s : float
+        Wall time of the run [s].
+    settings : dict
+        Solver settings and what chose them.
+    stall, accuracy, route
+        As above.
+
+    Attributes
+    ----------
+    summary : dict
+        Figures every engine's run gets (revolutions, speeds, peak forces, steady state, efficiency, ...).
     """
 
     engine: str
@@ -382,5 +411,17 @@ def stall_reason(t: float, phi: float, torque: float, gravity: bool) -> str:
 
 
 def write_json(path: str | Path, data: dict[str, Any]) -> None:
-    """Write ``data`` as indented JSON (NaN is not valid JSON: refuse it)."""
-    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
+    """Write ``data`` as indented JSON (NaN is not valid JSON: refuse it), through a temporary file renamed into
+    place: a failed write (a full disk) leaves the earlier file, or none, never a cut one."""
+    import os
+
+    text = json.dumps(data, indent=2, allow_nan=False) + "\n"
+    path = Path(path)
+    staged = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")  # umask permissions (mkstemp: 0600)
+    try:
+        staged.write_text(text, encoding="utf-8")
+        os.replace(staged, path)
+    except BaseException:
+        if os.path.exists(staged):
+            os.unlink(staged)
+        raise
