@@ -105,6 +105,8 @@ def summary_lines(result: dict, atlas) -> list[str]:
                 top = ", ".join(f"{p} ST {v['ST']:.2f}" for p, v in sorted(
                     ((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict) and
                      v.get("ST") is not None), key=lambda pv: -pv[1]["ST"])[:2])
+                if entry.get("missing"):
+                    spent += f"; {entry['missing']} designs gave no value (samples.csv: notes, error)"
                 equations = entry.get("equations")
                 if equations is not None:  # MuJoCo measured it: the equations' answer beside it
                     eq = next(i for i in equations["by_threshold"] if i["threshold"] == item["threshold"])
