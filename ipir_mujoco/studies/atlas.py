@@ -194,6 +194,15 @@ def wilson(safe: int, n: int) -> list[float]:
     return [max(0.0, min(p, centre - half)), min(1.0, max(p, centre + half))]  # p inside it, whatever the rounding
 
 
+def top_drivers(entry: dict, count: int = 2) -> str:
+    """'L (ST 0.95 +- 0.10), m2 (...)': the parameters of largest total Sobol index whose 95 % interval
+    excludes 0 ('-' if none: too few samples to tell, or a cost that does not vary)."""
+    ranked = sorted(((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict)
+                     and v.get("ST") is not None and v.get("ST_conf") is not None and v["ST"] - v["ST_conf"] > 0),
+                    key=lambda pv: -pv[1]["ST"])
+    return ", ".join(f"{p} (ST {v['ST']:.2f} +- {v['ST_conf']:.2f})" for p, v in ranked[:count]) or "-"
+
+
 def _costs(rows: list[dict], metric: str) -> np.ndarray:
     return np.array([np.nan if r["cost"].get(metric) is None else r["cost"][metric] for r in rows], dtype=float)
 
