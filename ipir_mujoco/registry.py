@@ -34,9 +34,11 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
+from . import interrupts
 from .core.control import FeedforwardTable
-from .core.errors import ParameterError
-from .core.params import RobotParams, check_real
+from .core.errors import ParameterError, ParameterTypeError
+from .core.options import check_type
+from .core.params import RobotParams, check_real, check_whole, require_params
 from .core.results import RunResult
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
@@ -99,6 +101,8 @@ MUJOCO_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.engi
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
 ANALYTIC_OPTIONS = ("rtol", "atol", "max_switches", "method", "torque")
 MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step", "route")
+# what every engine takes: RunOptions' fields but t_end and max_switches (analytic), and the servo's table
+COMMON_OPTIONS = ("dt_out", "until_steady", "steady_tol", "steady_cycles", "progress", "wall_budget_s", "feedforward")
 _WHY_NOT = {"analytic": "the analytic engines hold their solver tolerance and have no timestep, clutch "
                         "implementation or MJCF",
             "mujoco": "MuJoCo's cost is its step count, t_end / timestep, and its accuracy its own monitor's"}
@@ -241,8 +245,32 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         An unknown name, an option the variant's engine does not take, or parameters it refuses (one line).
     SimulationError
         A run that cannot go on (one line with the time and the reason).
+    KeyboardInterrupt
+        Ctrl-C during the run, wherever it landed (compiled code included), never another exception or a result.
     """
     v = check_options(name, options)
+    require_params(params)
+    unknown = [k for k in options if k not in (*COMMON_OPTIONS, *ANALYTIC_OPTIONS, *MUJOCO_OPTIONS)]
+    if unknown:  # (an option of the other engine given as None or False counts as not given: check_options)
+        known = (*COMMON_OPTIONS, *(MUJOCO_OPTIONS if v.is_mujoco else ANALYTIC_OPTIONS))
+        raise ParameterTypeError(f"option {unknown[0]}={options[unknown[0]]!r} is unknown to {v.name}; "
+                                 f"allowed: {', '.join(known)}")
+    if not isinstance(options.get("every_step", False), (bool, type(None))):
+        raise ParameterTypeError(f"every_step={options['every_step']!r} is not a bool; allowed: True or False")
+    # Ctrl-C during the run is KeyboardInterrupt, whatever the code it landed in made of it (ipir_mujoco.interrupts)
+    with interrupts.watching() as since:
+        try:
+            result = _run(v, params, t_end, options)
+        except BaseException:
+            if interrupts.interrupted_since(since):
+                raise KeyboardInterrupt from None
+            raise
+        if interrupts.interrupted_since(since):
+            raise KeyboardInterrupt
+    return result
+
+
+def _run(v: Variant, params: RobotParams, t_end: float, options: dict[str, Any]) -> RunResult:
     if params.drive == "servo" and options.get("feedforward") is None:
         options["feedforward"] = feedforward_table(params)
     foreign = MUJOCO_OPTIONS if not v.is_mujoco else ANALYTIC_OPTIONS  # given as None or False: not given
@@ -327,10 +355,25 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
     outcome per design, as :func:`ipir_mujoco.engine.batch.run_ratchet_batch` gives them."""
     if not batched(name):
         raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
+    if not isinstance(designs, (list, tuple)):
+        raise ParameterTypeError(f"designs={designs!r} is not a list of RobotParams")
+    for params in designs:
+        require_params(params)
+    check_whole("nthread", nthread, low=1, high=1024)
+    check_type("until_steady", until_steady, bool, "True or False")
     from .engine import batch
 
     steady = {"until_steady": True} if until_steady else {}
-    return batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
+    with interrupts.watching() as since:  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design
+        try:
+            outcomes = batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
+        except BaseException:
+            if interrupts.interrupted_since(since):
+                raise KeyboardInterrupt from None
+            raise
+        if interrupts.interrupted_since(since):
+            raise KeyboardInterrupt
+    return outcomes
 
 
 def batch_models(params: RobotParams) -> bool:

@@ -40,8 +40,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError
+from ipir_mujoco.core.params import RobotParams, check_whole, require_params
 from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
 
@@ -197,6 +197,10 @@ def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: i
     """The study (module docstring) as a JSON-ready dict: ``rows`` (one per plane and R/D: the bend's passage,
     its straightened twin's, the analytic reference over the same length, ``note`` where the bend was faster
     than its twin), ``reference``, ``settings``, ``wall_s``."""
+    require_params(base)
+    check_whole("workers", workers, low=1, high=1024)
+    if not callable(progress):
+        raise ParameterTypeError(f"progress={progress!r} is not callable; allowed: a function of one message")
     started = time.perf_counter()
     params = study_params(base)
     check_ratios(ratios, params)
