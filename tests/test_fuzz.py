@@ -207,6 +207,7 @@ CASES = [
 
 
 @pytest.mark.parametrize("argv,code,fragment", CASES, ids=[" ".join(c[0])[:60] for c in CASES])
+@pytest.mark.slow
 def test_bad_input_is_one_line_with_the_right_exit_status_and_creates_nothing(capsys, files, argv, code, fragment):
     before = sorted(p.name for p in files.iterdir())
     got, _, err, caught = run_cli(capsys, [a.format(f=files) for a in argv])
@@ -253,6 +254,7 @@ def test_a_run_killed_while_staging_is_cleaned_by_the_next_run(capsys, tmp_path)
     assert not stale.exists() and live.is_dir() and (tmp_path / "out" / "summary.json").is_file()
 
 
+@pytest.mark.slow
 def test_an_existing_output_folder_keeps_what_the_command_did_not_write(capsys, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
@@ -382,6 +384,7 @@ def test_mujoco_never_runs_past_t_end_by_a_sample_interval_it_was_not_given():
 
 @settings(max_examples=EXAMPLES)
 @given(st.text(max_size=40))
+@pytest.mark.slow
 def test_vary_parser_accepts_or_refuses_cleanly(text):
     try:
         axis = parse_vary(text)
