@@ -87,6 +87,8 @@ def run(args: argparse.Namespace) -> int:
 
 def summary_lines(result: dict, atlas) -> list[str]:
     """One line per idealization, metric and threshold: the safe fraction, its interval, crossings, runs."""
+    from ..studies.atlas import top_drivers
+
     lines = []
     for name, per_metric in result["idealizations"].items():
         for metric, entry in per_metric.items():
@@ -102,13 +104,7 @@ def summary_lines(result: dict, atlas) -> list[str]:
                 spent = (f"; {entry['runs']} {entry['measured_by']} runs"
                          + (f" (safe {regions['safe']}, unsafe {regions['unsafe']}, boundary {regions['boundary']})"
                             if regions else ""))
-                top = ", ".join(f"{p} ST {v['ST']:.2f}" for p, v in sorted(
-                    ((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict) and
-                     v.get("ST") is not None), key=lambda pv: -pv[1]["ST"])[:2])
-                equations = entry.get("equations")
-                if equations is not None:  # MuJoCo measured it: the equations' answer beside it
-                    eq = next(i for i in equations["by_threshold"] if i["threshold"] == item["threshold"])
-                    spent += f"; the equations: safe in {100 * eq['safe_fraction']:.1f} %"
+                top = top_drivers(entry)
                 lines.append(f"{name:24s} {metric:22s} |cost| < {item['threshold']:g}: {where}{cross}{spent}"
-                             + (f"; driven by {top}" if top else ""))
+                             + (f"; driven by {top}" if top != "-" else ""))
     return lines

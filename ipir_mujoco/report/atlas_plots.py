@@ -184,6 +184,7 @@ def plot_partial(result: dict, atlas, path: Path) -> Path:
     fig = _figure(2.9 * d, 0.8 + 2.5 * len(names))
     C = result["_candidates"]
     bins = np.linspace(0, 1, 13)
+    floor = min(atlas.thresholds)  # [%]: costs below 1/100 of the smallest threshold are drawn on the axis's floor
     centres = 0.5 * (bins[1:] + bins[:-1])
     for r, name in enumerate(names):
         fidelity, fitted = _measure(result, name)
@@ -200,8 +201,8 @@ def plot_partial(result: dict, atlas, path: Path) -> Path:
                 low = np.array([np.percentile(cost[which == b], 10) for b in range(len(centres))])
                 high = np.array([np.percentile(cost[which == b], 90) for b in range(len(centres))])
                 colour = COLOURS[j % len(COLOURS)]
-                ax.plot(x, np.maximum(mean, 1e-4), color=colour, lw=1.4, label=metric)
-                ax.fill_between(x, np.maximum(low, 1e-4), np.maximum(high, 1e-4), color=colour, alpha=0.15)
+                ax.plot(x, np.maximum(mean, floor), color=colour, lw=1.4, label=metric)
+                ax.fill_between(x, np.maximum(low, floor), np.maximum(high, floor), color=colour, alpha=0.15)
             for t in atlas.thresholds:
                 ax.axhline(100 * t, color="grey", ls="--", lw=0.9)
             ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=axis.name)
