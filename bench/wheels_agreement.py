@@ -1,8 +1,10 @@
 """The wheeled MuJoCo model against the analytic finite-grip model in straight pipes, measured in one run.
 
-Run on demand from the repository root (about 40 s):
+Run on demand from the repository root (about 40 s on 2 idle cores, several times that on a loaded machine):
 
-    python bench/wheels_agreement.py
+    python bench/wheels_agreement.py [--smoke]
+
+``--smoke``: the first case over 0.02 s, no steady state (a check that it runs, not a measurement).
 
 Horizontal and inclined pipes, ample and finite grip, the default motor from rest for 1 s (and, where the
 grip is ample, to the periodic steady state): each module's travel and skid, the crank's revolutions, the
@@ -13,6 +15,7 @@ mjcf/README.md ("Wheels in contact", how far to trust it) is this script's outpu
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 
@@ -35,18 +38,22 @@ def relative(a: float, b: float) -> str:
 
 
 def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
+    smoke = parser.parse_args().smoke
+    cases, t_end = (dict(list(CASES.items())[:1]), 0.02) if smoke else (CASES, 1.0)
     print("| case | figure | analytic | MuJoCo wheels | difference |")
     print("|---|---|---|---|---|")
-    for name, params in CASES.items():
-        analytic = registry.run("analytic-unilateral", params, 1.0, dt_out=1e-3)
+    for name, params in cases.items():
+        analytic = registry.run("analytic-unilateral", params, t_end, dt_out=1e-3)
         started = time.perf_counter()
-        wheels = registry.run("mujoco-wheels", params, 1.0, dt_out=1e-3)
+        wheels = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3)
         wall = time.perf_counter() - started
         for key in FIGURES:
             a, w = analytic.summary[key], wheels.summary[key]
-            print(f"| {name} | {key} (1 s) | {a:.5f} | {w:.5f} | {relative(a, w)} |")
+            print(f"| {name} | {key} ({t_end:g} s) | {a:.5f} | {w:.5f} | {relative(a, w)} |")
         print(f"| {name} | MuJoCo step, wall time | | {wheels.settings['timestep']:g} s, {wall:.1f} s | |")
-        if name in STEADY:
+        if name in STEADY and not smoke:
             a = registry.run("analytic-unilateral", params, 30.0, dt_out=1e-3, until_steady=True)
             w = registry.run("mujoco-wheels", params, 30.0, dt_out=1e-3, until_steady=True, timestep=1e-4)
             va, vw = a.summary["steady_speed_m_s"], w.summary["steady_speed_m_s"]

@@ -2,7 +2,7 @@
 
 Run on demand from the repository root:
 
-    python bench/wheels_cost.py [--t-end SECONDS] [--repeat N]
+    python bench/wheels_cost.py [--t-end SECONDS] [--repeat N] [--smoke]
 
 The default motor on the default design (mu_wall 0.8, F_n 50 N for the wheels; the slide model with
 unlimited grip, its default) for ``--t-end`` simulated seconds, each run ``--repeat`` times, the best kept:
@@ -49,7 +49,10 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args(argv)
+    if args.smoke:
+        args.t_end, args.repeat = 0.01, 1
     slides, wheels = RobotParams(drive="motor"), RobotParams(drive="motor", mu_wall=0.8)
     rows = [
         ("slide model, C loop, 1e-4 s", cost("mujoco-ratchet", slides, args.t_end, args.repeat, timestep=1e-4)),
