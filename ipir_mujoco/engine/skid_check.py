@@ -109,34 +109,45 @@ def verify_skids(result: RunResult, rerun, mode: str, dt_min: float) -> RunResul
                         "difference": worst, "differences": diff})
         # two halvings at least, each within ACCEPT of the tolerance: one pair of runs can agree by chance
         if len(history) >= 2 and max(h["difference"] for h in history[-2:]) <= ACCEPT * tolerance:
-            return _verified(fine, history, tolerance, None)
+            return _verified(fine, history, ACCEPT * tolerance, None)
         coarse = fine
-    if len(history) < 2:  # the step cannot be halved twice above the smallest a run may take
-        fine.accuracy["skid_check"] = f"not verified: the timestep cannot be halved twice above {dt_min:g} s"
-        return fine
-    step = history[-1]
+    if len(history) < 2:  # the step cannot be halved twice above the smallest a run may take: unverifiable
+        message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and their error under "
+                   f"the step cannot be checked: the timestep {result.settings['timestep']:.3g} s cannot be halved "
+                   f"twice above {dt_min:g} s; use --accuracy warn to finish the run and record it")
+        if mode == "stop":
+            raise AccuracyError(message)
+        history = history or [{"timestep": result.settings["timestep"], "half": result.settings["timestep"],
+                               "figure": "none", "difference": math.inf, "differences": {}}]
+        return _verified(fine, history, ACCEPT * SKID_TOL["fixed"], message)
+    step = max(history[-2:], key=lambda h: h["difference"])  # the halving that kept the check from passing
     message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and halving the timestep "
-               f"from {step['timestep']:.3g} s to {step['half']:.3g} s still moved {step['figure']} by "
-               f"{step['difference']:.2e} of it (the last two halvings: more than {ACCEPT:g} of the tolerance "
-               f"{tolerance:.3g}; the skids' error under the step); use a smaller --timestep (e.g. "
-               f"{step['half'] / 2:.3g}), or --accuracy warn to finish the run and record it")
+               f"from {step['timestep']:.3g} s to {step['half']:.3g} s moved {step['figure']} by "
+               f"{step['difference']:.2e} of it, more than {ACCEPT:g} of the tolerance {tolerance:.3g} (each of the "
+               f"last two halvings must stay within it; the skids' error under the step); use a smaller --timestep "
+               f"(e.g. {history[-1]['half'] / 2:.3g}), or --accuracy warn to finish the run and record it")
     if mode == "stop":
         raise AccuracyError(message)
-    return _verified(fine, history, tolerance, message)
+    return _verified(fine, history, ACCEPT * tolerance, message)
 
 
 def _verified(run: RunResult, history: list, tolerance: float, failed: str | None) -> RunResult:
     """``run`` with the check recorded: ``settings['skid_check']`` (each halving's differences) and, in its
-    accuracy record, ``skid_difference`` (the last one) and, where it stayed above ``tolerance``, a violation."""
+    accuracy record, ``skid_difference`` (the last one), its ``tolerance`` (the share ACCEPT of the stated
+    accuracy a halving may move the figures by) and, where the check ``failed`` (its one-line reason), a
+    violation."""
+    finite = lambda x: float(x) if math.isfinite(x) else None  # noqa: E731  (JSON has no inf: None, not compared)
+    history = [{**h, "difference": finite(h["difference"]),
+                "differences": {k: finite(v) for k, v in h["differences"].items()}} for h in history]
     last = history[-1]
     run.settings["skid_check"] = history
     record = run.accuracy
     record["skid_check"] = "verified" if failed is None else "failed"
-    record["skid_difference"] = float(last["difference"])
+    record["skid_difference"] = last["difference"]
     record.setdefault("tolerances", {})["skid_difference"] = float(tolerance)
     if failed is not None:
         record["ok"] = False
         record.setdefault("violations", []).append({"figure": "skid_difference", "t_s": float(run.t_end),
-                                                    "value": float(last["difference"]),
+                                                    "value": last["difference"],
                                                     "tolerance": float(tolerance), "reason": failed})
     return run
