@@ -374,6 +374,9 @@ def test_numbers_of_every_numeric_type_are_numbers(value):
      "workers=0"),
     (lambda: _bend_study().run_study(RobotParams(), workers=0), "workers=0"),
     (lambda: _bend_study().run_study(None), "params=None"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", resume="no"), "resume='no'"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", workers=0), "workers=0"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", on_row=3), "on_row=3 is not callable"),
 ])
 def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # a call that wrongly went ahead would write here, and be seen below
