@@ -190,3 +190,17 @@ def test_a_folder_another_run_is_writing_is_refused(tmp_path):
         assert not (out / "samples.csv").exists()
     finally:
         lock.release()
+
+
+def test_command_prints_one_line_per_idealization_metric_and_threshold(tmp_path, capsys):
+    out = tmp_path / "cli"
+    assert main(["atlas", "--vary", "L=0.1:0.3", "--idealization", "first-order-kinematics", "--threshold", "0.01",
+                 "--threshold", "0.02", "--samples", "2", "--budget", "0", "--workers", "1", "--out", str(out)]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("first-order-kinematics")]
+    assert len(lines) == 2 * 2  # metrics (revolutions, travel_m) x thresholds
+    saved = json.loads((out / "atlas.json").read_text())["idealizations"]["first-order-kinematics"]
+    for line, (metric, k) in zip(lines, [(m, k) for m in ("revolutions", "travel_m") for k in (0, 1)]):
+        item = saved[metric]["by_threshold"][k]
+        assert metric in line and f"safe in {100 * item['safe_fraction']:.1f} %" in line
+        assert all(f"L={v:.5g}" in line for v in item["crossings"]["L"])
+    assert (out / "atlas_1d.png").is_file() and (out / "atlas_safe.png").is_file()
