@@ -319,6 +319,17 @@ def peak_grip_use(series: dict[str, np.ndarray]) -> float | None:
     return float(max(c.max() for c in columns)) if columns else None
 
 
+def wheel_keys(series: dict[str, np.ndarray]) -> dict[str, float]:
+    """The wheeled MuJoCo model's wall figures (a run with the ``press1/2`` and ``wheels_off`` columns; {} for
+    others): ``press1_n``, ``press2_n`` [N], each module's mean total wall press over the run's samples;
+    ``wheel_off_s`` [s], how long any wheel was off its wall (the sample intervals that start with one off)."""
+    if "press1" not in series:
+        return {}
+    t, off = np.asarray(series["t"], dtype=float), np.asarray(series["wheels_off"], dtype=float)
+    return {"press1_n": float(np.mean(series["press1"])), "press2_n": float(np.mean(series["press2"])),
+            "wheel_off_s": float(np.sum(np.diff(t)[off[:-1] > 0]))}
+
+
 def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[str, Any]:
     """The summary figures of a run, computed from its time series."""
     t, phi = series["t"], series["phi"]
@@ -334,6 +345,7 @@ def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[s
         "slip1_m": slip(series, 1),
         "slip2_m": slip(series, 2),
         "peak_grip_use": peak_grip_use(series),
+        **wheel_keys(series),
         "energy": dict(energy),
     }
 
