@@ -1,4 +1,5 @@
-"""The one compiled piece: the serial MuJoCo engine's stepping loop (ipir_mujoco/engine/_stepper.c).
+"""The compiled pieces: the serial MuJoCo engine's stepping loop (ipir_mujoco/engine/_stepper.c) and the round
+pipe's exact wall contacts (ipir_mujoco/engine/_pipewall.c, which the round pipe needs).
 
 All package metadata is in pyproject.toml. The extension is compiled against the headers of the mujoco
 installed where it builds (a build requirement: in pip's isolated build environment, the newest mujoco the
@@ -52,6 +53,7 @@ class BuildExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("ipir_mujoco.engine._stepper", ["ipir_mujoco/engine/_stepper.c"], optional=True)],
+    ext_modules=[Extension("ipir_mujoco.engine._stepper", ["ipir_mujoco/engine/_stepper.c"], optional=True),
+                 Extension("ipir_mujoco.engine._pipewall", ["ipir_mujoco/engine/_pipewall.c"], optional=True)],
     cmdclass={"build_ext": BuildExt},
 )

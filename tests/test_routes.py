@@ -121,6 +121,9 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
     assert isinstance(s["route_done"], bool) and s["route_stop"] and "\n" not in s["route_stop"]
     if s["route_done"]:
         assert s["route_time_s"] > 0 and s["route_s_m"] >= s["route_length_m"]
+        # the travel is read along the route: the rear module's A from its start (0) to the route's end, to one
+        # sample's step of the run's end (its last samples' speed, below 1.2 m/s, times the 1e-3 s interval)
+        assert s["x1_final"] == pytest.approx(s["route_s_m"], abs=1.2e-3)
     else:
         assert s["route_time_s"] is None and s["route_s_m"] < s["route_length_m"]
     assert "leaves the wall" in s["route_fit"]["predicted"] and not s["route_fit"]["bends"][0]["wheels_keep_wall"]
@@ -129,6 +132,8 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
 
     printed = "\n".join(route_lines(s))
     assert ("route done in" in printed) == s["route_done"] and "closed-form fit" in printed
+    code, out, err = run_cli(capsys, *argv)
+    assert code == 0 and "module 1 (rear) moved" in out and "m along the route" in out
 
 
 def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monkeypatch):
@@ -229,3 +234,19 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
         code, out, err = run_cli(capsys, "bend-study", *argv, "--out", tmp_path / "o")
         assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (argv, err)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_route_whose_planar_walls_would_be_too_large_is_refused_before_building():
+    """40 half turns of 100 m radius: each bend's outer polygon needs ~7,860 boxes (corners within 2e-6 m of
+    the circle); refused up front with the count, before any wall is built (the check is the closed-form count)."""
+    from ipir_mujoco.engine.route_walls import MAX_WALL_BOXES, check_wall_count
+
+    tables = [dict(kind="straight", length=0.5)] + [dict(kind="bend", radius=100.0, angle=(-1) ** k * 180.0)
+                                                     for k in range(40)]
+    with pytest.raises(ParameterError, match=f"need 3[0-9]{{5}} boxes .*allowed: at most {MAX_WALL_BOXES}") as info:
+        registry.run("mujoco-wheels", CRUISE, 1.0, route=route_from_tables(tables, "r.toml"))
+    assert "\n" not in str(info.value)
+    assert check_wall_count(route_from_tables(BEND), 0.16) < MAX_WALL_BOXES  # a bend of R/D 6 is built
+    with pytest.raises(ParameterError, match="out of the mechanism's plane"):
+        across = [BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.5)]
+        check_wall_count(route_from_tables(across), 0.16)

@@ -150,12 +150,13 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
     e = s["energy"]
     first = s["first_contraction_end_s"]
     reaction = s["min_clutch_reaction_n"]
+    along = " along the route" if "route_done" in s else ""
     lines = [
         f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
         f"({run.wall_time_s:.2f} s wall)",
         f"  crank revolutions        {s['revolutions']:.4f}",
-        f"  module 1 (rear) moved    {fixed(s['x1_final'], 4)} m   peak speed {fixed(s['v1_max'], 3)} m/s",
-        f"  module 2 (front) moved   {fixed(s['x2_final'], 4)} m   peak speed {fixed(s['v2_max'], 3)} m/s",
+        f"  module 1 (rear) moved    {fixed(s['x1_final'], 4)} m{along}   peak speed {fixed(s['v1_max'], 3)} m/s",
+        f"  module 2 (front) moved   {fixed(s['x2_final'], 4)} m{along}   peak speed {fixed(s['v2_max'], 3)} m/s",
         "  first minimum of S       " + ("none" if first is None else f"{first:.4f} s"),
         f"  mode switches            {s['mode_switches']}",
         "  min clutch reaction      " + ("none (no clutch held)" if reaction is None else f"{reaction:.4g} N"

@@ -13,17 +13,18 @@ MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far pa
 # on what /dev/zero or a mistyped multi-GB file would make the command read into memory
 
 
-def read_text_file(path: str | Path, what: str) -> str:
+def read_text_file(path: str | Path, what: str, max_bytes: int = MAX_TEXT_BYTES) -> str:
     """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
-    for a device or pipe, /dev/zero, and a file past MAX_TEXT_BYTES)."""
+    for a device or pipe, /dev/zero, and a file past ``max_bytes``, MAX_TEXT_BYTES unless a kind of file has a
+    smaller bound; only max_bytes + 1 bytes are ever read)."""
     path = Path(path)
     try:
         if path.exists() and not path.is_dir() and not path.is_file():
             raise ParameterError(f"{what} {str(path)!r} is not a regular file (a device or pipe); give a file")
         with path.open("rb") as handle:
-            data = handle.read(MAX_TEXT_BYTES + 1)
-        if len(data) > MAX_TEXT_BYTES:
-            raise ParameterError(f"{what} {str(path)!r} is larger than {MAX_TEXT_BYTES / 1e6:g} MB; allowed: a "
+            data = handle.read(max_bytes + 1)
+        if len(data) > max_bytes:
+            raise ParameterError(f"{what} {str(path)!r} is larger than {max_bytes / 1e6:g} MB; allowed: a "
                                  "text file of at most that size")
         return data.decode("utf-8")
     except FileNotFoundError:
@@ -37,9 +38,10 @@ def read_text_file(path: str | Path, what: str) -> str:
         raise ParameterError(f"{what} {str(path)!r} cannot be read: {exc.strerror}") from None
 
 
-def read_toml_file(path: str | Path, what: str) -> dict[str, Any]:
-    """A TOML file as a dict, or a ParameterError naming the file and the problem in one line."""
-    text = read_text_file(path, what)
+def read_toml_file(path: str | Path, what: str, max_bytes: int = MAX_TEXT_BYTES) -> dict[str, Any]:
+    """A TOML file as a dict, or a ParameterError naming the file and the problem in one line (``max_bytes``:
+    :func:`read_text_file`'s)."""
+    text = read_text_file(path, what, max_bytes)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -1,93 +1,157 @@
-"""A pipeline route for the wheeled MuJoCo model (``--route FILE.toml``): parsing, checking and its centreline.
+"""A pipeline route (``--route FILE.toml``): parsing, checking and its centreline in 3-D.
 
 Shared and free of physics: what the route is, where its centreline runs, how far along it a point is; the
-walls MuJoCo builds along it are the engine's (:mod:`ipir_mujoco.engine.route_walls`).
+walls MuJoCo builds along it are the engine's (:mod:`ipir_mujoco.engine.pipe_walls`).
 
 A route is a list of ``[[segment]]`` tables, in order:
 
-- ``kind = "straight"``: ``length`` [m] (0 < length <= 100), ``incline`` [deg] (optional);
+- ``kind = "straight"``: ``length`` [m] (0 < length <= 100), ``incline`` [deg] (optional, see below);
 - ``kind = "bend"``: ``radius`` [m] of the centreline (pipe_diameter / 2 < radius <= 100), ``angle`` [deg]
-  (-180 <= angle <= 180, not 0; positive turns towards the top wall, +y, negative towards the bottom one).
+  (-180 <= angle <= 180, not 0), ``plane`` [deg] (optional, -180..180, default 0): the bend's plane turned
+  about the pipe's axis. With ``plane = 0`` a positive angle turns towards the route's left (+y at the start,
+  the mechanism's top wall), a negative one towards its right; ``plane = 90`` turns a positive angle
+  towards the route's up side (+z at the start: out of the mechanism's plane), and so on. The side a bend
+  turns to is carried along the pipe (parallel transport), so ``plane`` is always relative to the pipe as it
+  arrives at the bend.
 
-The model is planar, so the whole route lies in the mechanism's plane and every bend turns in it. Gravity
-keeps today's convention: the plane is tilted about its across-the-pipe axis (y) so that the first
-segment (a straight, where the robot starts) rises at its ``incline`` (default 0: the plane horizontal,
-gravity normal to it, the bends horizontal; 90: the plane vertical, the route starts as a riser and a bend of
-+-90 degrees turns it horizontal). A later straight's incline follows from the bends before it, asin(sin
-theta_0 cos psi) with psi its heading in the plane; it may be given, and must then equal that (else the route
-would need a kink). Coordinates: the plane's x along the first straight, y across it, the route starting
-at the origin.
+Coordinates: the route starts at the origin with its first straight along +x, its left +y and its up +z.
+Gravity keeps the package's convention: the first straight (where the robot starts) rises at its ``incline``
+(default 0: level, gravity along -z; 90: a riser). A later straight's incline follows from the bends before
+it, asin(t . up) with t its direction and up = (sin theta_0, 0, cos theta_0) the world's up in route
+coordinates; it may be given, and must then equal that (else the route would need a kink). A vertical leg is
+a straight whose direction is +-up: for a level start, a bend of ``angle = 90, plane = 90``.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from .errors import ParameterError
 
 MAX_SEGMENTS = 100
 MAX_LENGTH = 100.0  # m: a straight's length and a bend's radius at most
 INCLINE_MATCH = 1e-6  # deg: how closely a later straight's given incline must match its heading's
+MAX_ROUTE_BYTES = 1_000_000  # bytes of a route file: 100 segments take ~10 kB; a bound on what is read
+MAX_ROUTE_DEPTH = 8  # how deep a route file's tables and arrays may nest ([[segment]] tables are 2 deep)
 
 
-@dataclass(frozen=True)
+def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
+    """``v`` turned by ``angle`` [rad] about the unit ``axis`` (Rodrigues)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return v * c + np.cross(axis, v) * s + axis * float(axis @ v) * (1 - c)
+
+
+@dataclass(frozen=True, eq=False)
 class Piece:
-    """One segment placed in the plane: ``kind`` 'straight' | 'bend', its start ``s0`` [m] along the
-    centreline, ``length`` [m] along it, start point ``x``, ``y`` [m] and ``heading`` [rad] (from +x towards +y);
-    a bend's ``radius`` [m] and signed ``angle`` [rad]; ``incline`` [deg] of a straight (its slope)."""
+    """One segment placed in 3-D: ``kind`` 'straight' | 'bend', its start ``s0`` [m] along the centreline,
+    ``length`` [m] along it, start ``point`` [m] (3,), ``frame`` (3, 3): rows the pipe's direction t, its left
+    n and its up b at the start; a bend's ``radius`` [m], ``angle`` [rad] as given (signed) and ``plane``
+    [rad]; ``incline`` [deg] of a straight (its slope)."""
 
     kind: str
     s0: float
     length: float
-    x: float
-    y: float
-    heading: float
+    point: np.ndarray
+    frame: np.ndarray
     radius: float = 0.0
     angle: float = 0.0
+    plane: float = 0.0
     incline: float = 0.0
 
     @property
+    def toward(self) -> np.ndarray:
+        """A bend's unit direction from its start to its centre (3,): where it turns."""
+        _, n, b = self.frame
+        d = math.cos(self.plane) * n + math.sin(self.plane) * b
+        return d if self.angle > 0 else -d
+
+    @property
+    def centre3(self) -> np.ndarray:
+        """A bend's centre [m] (3,)."""
+        return self.point + self.radius * self.toward
+
+    @property
+    def axis(self) -> np.ndarray:
+        """A bend's turning axis (3,): t x toward; the pipe turns positively about it."""
+        return np.cross(self.frame[0], self.toward)
+
+    def at3(self, u: float) -> tuple[np.ndarray, np.ndarray]:
+        """(point [m] (3,), unit direction (3,)) a distance ``u`` [m] (0..length) along the piece."""
+        t = self.frame[0]
+        if self.kind == "straight":
+            return self.point + u * t, t.copy()
+        phi, d = u / self.radius, self.toward
+        return (self.point + self.radius * (math.sin(phi) * t + (1 - math.cos(phi)) * d),
+                math.cos(phi) * t + math.sin(phi) * d)
+
+    def frame_at(self, u: float) -> np.ndarray:
+        """The pipe's frame (rows t, n, b) ``u`` [m] along the piece (transported along a bend)."""
+        if self.kind == "straight":
+            return self.frame.copy()
+        axis, phi = self.axis, u / self.radius
+        return np.array([_rotate(row, axis, phi) for row in self.frame])
+
+    def nearest3(self, p: np.ndarray) -> tuple[float, float]:
+        """(distance [m] from the point ``p`` (3,) to the piece's centreline, u [m] along it of the nearest
+        point)."""
+        t = self.frame[0]
+        if self.kind == "straight":
+            u = min(max(float((p - self.point) @ t), 0.0), self.length)
+        else:
+            c, d, axis = self.centre3, self.toward, self.axis
+            v = p - c
+            v = v - axis * float(v @ axis)  # into the bend's plane
+            turned = math.atan2(float(v @ t), float(v @ -d)) % (2 * math.pi)
+            a = abs(self.angle)
+            if turned > a:  # beyond the bend's end: clamp to the nearer end
+                turned = a if turned - a < 2 * math.pi - turned else 0.0
+            u = turned * self.radius
+        q, _ = self.at3(u)
+        return float(np.linalg.norm(p - q)), u
+
+    # the mechanism's plane (z = 0), for the planar model's walls: valid while every bend turns in it
+    @property
+    def x(self) -> float:
+        return float(self.point[0])
+
+    @property
+    def y(self) -> float:
+        return float(self.point[1])
+
+    @property
+    def heading(self) -> float:
+        """[rad] the direction in the xy plane, from +x towards +y."""
+        return math.atan2(float(self.frame[0][1]), float(self.frame[0][0]))
+
+    @property
+    def in_plane(self) -> bool:
+        """Whether the piece lies in the xy plane (a straight along it, a bend turning in it)."""
+        return abs(float(self.frame[0][2])) < 1e-9 and (self.kind == "straight" or abs(float(self.axis[2])) > 1 - 1e-9)
+
+    @property
     def centre(self) -> tuple[float, float]:
-        """A bend's centre [m]: radius to the left (+angle) or right (-angle) of its start heading."""
-        side = 1.0 if self.angle > 0 else -1.0
-        return (self.x - side * self.radius * math.sin(self.heading),
-                self.y + side * self.radius * math.cos(self.heading))
+        """A bend's centre [m] in the xy plane."""
+        c = self.centre3
+        return float(c[0]), float(c[1])
 
     def at(self, u: float) -> tuple[float, float, float]:
-        """(x, y, heading) [m, m, rad] a distance ``u`` [m] (0..length) along the piece."""
-        if self.kind == "straight":
-            return (self.x + u * math.cos(self.heading), self.y + u * math.sin(self.heading), self.heading)
-        cx, cy = self.centre
-        side = 1.0 if self.angle > 0 else -1.0
-        turned = self.heading + side * u / self.radius
-        return (cx + side * self.radius * math.sin(turned), cy - side * self.radius * math.cos(turned), turned)
+        """(x, y, heading) [m, m, rad] a distance ``u`` [m] (0..length) along the piece, in the xy plane."""
+        p, t = self.at3(u)
+        return float(p[0]), float(p[1]), math.atan2(float(t[1]), float(t[0]))
 
     def nearest(self, px: float, py: float) -> tuple[float, float]:
-        """(distance [m] from the point to the piece's centreline, u [m] along it of the nearest point)."""
-        if self.kind == "straight":
-            c, s = math.cos(self.heading), math.sin(self.heading)
-            u = min(max((px - self.x) * c + (py - self.y) * s, 0.0), self.length)
-        else:
-            cx, cy = self.centre
-            side = 1.0 if self.angle > 0 else -1.0
-            start = math.atan2(self.y - cy, self.x - cx)
-            turned = math.atan2(py - cy, px - cx) - start
-            turned = side * ((side * turned) % (2 * math.pi))  # 0..2 pi in the bend's sense
-            if abs(turned) > abs(self.angle):  # beyond the bend's end: clamp to the nearer end
-                over = abs(turned) - abs(self.angle)
-                turned = self.angle if over < (2 * math.pi - abs(turned)) else 0.0
-            u = abs(turned) * self.radius
-        x, y, _ = self.at(u)
-        return math.hypot(px - x, py - y), u
+        """:meth:`nearest3` of the point (px, py, 0)."""
+        return self.nearest3(np.array([px, py, 0.0]))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Route:
     """A checked route (module docstring): its pieces in order, the first straight's ``incline`` [deg]
-    (the plane's tilt) and where it came from (``source``, for messages)."""
+    (the gravity's tilt) and where it came from (``source``, for messages)."""
 
     pieces: tuple[Piece, ...]
     incline: float
@@ -103,25 +167,68 @@ class Route:
     def bends(self) -> tuple[Piece, ...]:
         return tuple(p for p in self.pieces if p.kind == "bend")
 
-    def at(self, s: float) -> tuple[float, float, float]:
-        """(x, y, heading) [m, m, rad] of the centreline at ``s`` [m] (clamped to 0..length)."""
+    @property
+    def planar(self) -> bool:
+        """Whether the whole route lies in the xy plane (the planar model's mechanism plane)."""
+        return all(p.in_plane for p in self.pieces)
+
+    @property
+    def up(self) -> np.ndarray:
+        """The world's up in route coordinates (3,): the first straight rises at ``incline``."""
+        th = math.radians(self.incline)
+        return np.array([math.sin(th), 0.0, math.cos(th)])
+
+    def _piece(self, s: float) -> tuple[Piece, float]:
         s = min(max(s, 0.0), self.length)
         for piece in self.pieces:
             if s <= piece.s0 + piece.length:
-                return piece.at(s - piece.s0)
-        return self.pieces[-1].at(self.pieces[-1].length)  # pragma: no cover (round-off at the end)
+                return piece, s - piece.s0
+        return self.pieces[-1], self.pieces[-1].length  # pragma: no cover (round-off at the end)
 
-    def project(self, x: float, y: float, near: float | None = None) -> float:
-        """How far along the centreline [m] the point (x, y) [m] is: its nearest centreline point's s; with
+    def at3(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """(point [m] (3,), unit direction (3,)) of the centreline at ``s`` [m] (clamped to 0..length)."""
+        piece, u = self._piece(s)
+        return piece.at3(u)
+
+    def frame_at(self, s: float) -> np.ndarray:
+        """The pipe's frame (3, 3), rows its direction t, left n and up b, at ``s`` [m] (clamped)."""
+        piece, u = self._piece(s)
+        return piece.frame_at(u)
+
+    def at(self, s: float) -> tuple[float, float, float]:
+        """(x, y, heading) [m, m, rad] of the centreline at ``s`` [m] in the xy plane (clamped to 0..length)."""
+        piece, u = self._piece(s)
+        return piece.at(u)
+
+    def project3(self, p, near: float | None = None) -> float:
+        """How far along the centreline [m] the point ``p`` [m] (3,) is: its nearest centreline point's s; with
         ``near`` [m], of the pieces within 0.5 m of that s only (a route that passes near itself)."""
+        p = np.asarray(p, dtype=float)
         best = (math.inf, 0.0)
         for piece in self.pieces:
             if near is not None and not (piece.s0 - 0.5 <= near <= piece.s0 + piece.length + 0.5):
                 continue
-            distance, u = piece.nearest(x, y)
+            distance, u = piece.nearest3(p)
             if distance < best[0]:
                 best = (distance, piece.s0 + u)
         return best[1]
+
+    def project(self, x: float, y: float, near: float | None = None) -> float:
+        """:meth:`project3` of the point (x, y, 0)."""
+        return self.project3(np.array([x, y, 0.0]), near)
+
+    def along(self, p, near: float) -> float:
+        """A point's distance along the route [m] (near ``near`` [m]), beyond its end along the exit straight
+        and before its start (negative) along the first straight."""
+        p = np.asarray(p, dtype=float)
+        s = self.project3(p, near=near)
+        if s <= 0.0:  # behind the start: along the first straight, backwards
+            first = self.pieces[0]
+            return min(0.0, float((p - first.point) @ first.frame[0]))
+        if s >= self.length:
+            end, t = self.at3(self.length)
+            s = self.length + max(0.0, float((p - end) @ t))
+        return s
 
     def piece_at(self, s: float) -> int:
         """Index of the piece at ``s`` [m] (the last for s beyond the end)."""
@@ -153,7 +260,8 @@ class Route:
             if p.kind == "straight":
                 segments.append({"kind": "straight", "length": p.length, "incline": p.incline})
             else:
-                segments.append({"kind": "bend", "radius": p.radius, "angle": math.degrees(p.angle)})
+                segments.append({"kind": "bend", "radius": p.radius, "angle": math.degrees(p.angle),
+                                 "plane": math.degrees(p.plane)})
         return {"segments": segments, "length_m": self.length, "incline_deg": self.incline}
 
 
@@ -182,13 +290,17 @@ def route_from_tables(tables: list, source: str = "route") -> Route:
     if not isinstance(tables, list) or not 1 <= len(tables) <= MAX_SEGMENTS:
         raise ParameterError(f"{source}: needs [[segment]] tables; allowed: 1..{MAX_SEGMENTS} segments")
     pieces: list[Piece] = []
-    s = x = y = heading = 0.0
+    s = 0.0
+    point, frame = np.zeros(3), np.eye(3)
+    point.setflags(write=False)
+    frame.setflags(write=False)
     incline0 = 0.0
+    up = np.array([0.0, 0.0, 1.0])
     for k, table in enumerate(tables):
         if not isinstance(table, dict):
             raise ParameterError(f"{source}: segment {k + 1} is not a table; allowed: [[segment]] tables")
         kind = table.get("kind")
-        allowed = {"straight": {"kind", "length", "incline"}, "bend": {"kind", "radius", "angle"}}
+        allowed = {"straight": {"kind", "length", "incline"}, "bend": {"kind", "radius", "angle", "plane"}}
         if kind not in allowed:
             raise ParameterError(f"{source}: segment {k + 1}: kind={kind!r} is unknown; allowed: kind = "
                                  "\"straight\" or \"bend\"")
@@ -204,8 +316,10 @@ def route_from_tables(tables: list, source: str = "route") -> Route:
             if k == 0:
                 incline0 = _value(source, k, table, "incline", -90.0, 90.0, "deg", low_open=False, default=0.0)
                 incline = incline0
+                th = math.radians(incline0)
+                up = np.array([math.sin(th), 0.0, math.cos(th)])
             else:
-                slope = math.sin(math.radians(incline0)) * math.cos(heading)
+                slope = float(frame[0] @ up)
                 # to 1e-9 deg: the bends' round-off (a level pipe is 0, not 1.8e-15)
                 incline = round(math.degrees(math.asin(max(-1.0, min(1.0, slope)))), 9) + 0.0
                 if "incline" in table:
@@ -214,28 +328,32 @@ def route_from_tables(tables: list, source: str = "route") -> Route:
                         raise ParameterError(f"{source}: segment {k + 1}: incline={given:g} deg, but the bends "
                                              f"before it leave the pipe at {incline:.6g} deg; allowed: incline = "
                                              f"{incline:.6g} (or leave it out)")
-            pieces.append(Piece("straight", s, length, x, y, heading, incline=incline))
+            pieces.append(Piece("straight", s, length, point, frame, incline=incline))
         else:
             radius = _value(source, k, table, "radius", 0.0, MAX_LENGTH, "m")
             angle = math.radians(_value(source, k, table, "angle", -180.0, 180.0, "deg", low_open=False,
                                         nonzero=True))
+            plane = math.radians(_value(source, k, table, "plane", -180.0, 180.0, "deg", low_open=False,
+                                        default=0.0))
             length = abs(angle) * radius
-            pieces.append(Piece("bend", s, length, x, y, heading, radius=radius, angle=angle))
-        x, y, heading = pieces[-1].at(pieces[-1].length)
+            pieces.append(Piece("bend", s, length, point, frame, radius=radius, angle=angle, plane=plane))
+        last = pieces[-1]
+        point, _ = last.at3(last.length)
+        frame = last.frame_at(last.length)
+        frame.setflags(write=False)
+        point.setflags(write=False)
         s += length
     return Route(tuple(pieces), incline0, source)
 
 
 def read_route(path: str | Path) -> Route:
-    """The route in the TOML file ``path`` (module docstring); ParameterError (one line) on bad input."""
+    """The route in the TOML file ``path`` (module docstring); ParameterError (one line) on bad input. Read as
+    every file the package takes (:func:`.files.read_toml_file`: UTF-8 only, no device, nesting bounded), with a
+    cap of MAX_ROUTE_BYTES: a route's 100 segments take a few kB."""
+    from .files import read_toml_file
+
     source = str(path)
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise ParameterError(f"--route {source}: no such file") from None
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise ParameterError(f"--route {source}: not a readable TOML file ({' '.join(str(exc).split())})") from None
+    data = read_toml_file(path, "--route", max_bytes=MAX_ROUTE_BYTES)
     extra = sorted(set(data) - {"segment"})
     if extra:
         raise ParameterError(f"{source}: {extra[0]!r} is unknown; allowed: [[segment]] tables only")

@@ -235,7 +235,7 @@ class Recorder:
 
     def _wheel_columns(self, out: dict, sc: dict) -> dict[str, np.ndarray]:
         """The wheeled model's columns (``ipir_mujoco.core.results``): slip1/2 [m], each module's backward steps
-        (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip; the
+        (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip (1 while skidding where G_i = 0); the
         contacts' cumulative work skid_work [J] and the wheels' states wheels1/2."""
         from .wheels import wheel_slip
 
@@ -243,9 +243,9 @@ class Recorder:
         for k in (1, 2):
             wheels = sc[f"wheels{k}"]
             cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
-            if self.params.grip is not None:
+            if self.params.grip is not None:  # as the slide model's: 1 while skidding where G_i = 0 (mu_wall = 0)
                 G = self.params.grip[k - 1]
-                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G
+                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = sc["skid_work"].copy()
         return cols

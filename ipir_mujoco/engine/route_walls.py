@@ -30,6 +30,7 @@ import math
 
 import mujoco
 
+from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.pipe import bend_max_length, bend_rod_clearance, bend_wheel_spread
 from ipir_mujoco.core.route import Piece, Route
@@ -63,14 +64,37 @@ def outer_box_width(radius: float, diameter: float, angle: float) -> tuple[int, 
     return n, 2 * (radius + diameter / 2) * math.tan(abs(angle) / n / 2)
 
 
+MAX_WALL_BOXES = 10_000  # the planar walls' boxes a route may need (measured: one 100 m half turn, 7,860 boxes,
+# builds in 1.2 s to 91 MB of the process and steps in 0.8 ms; cost grows faster than the count beyond)
+BOX_BYTES = 6_000  # bytes per wall box in the compiled model and its data (measured: 137 MB at 15,720 boxes)
+
+
+def check_wall_count(route: Route, diameter: float) -> int:
+    """How many boxes the planar walls of ``route`` need (two per merged straight, the outer polygon of each
+    bend); ParameterError (one line) for a route out of the mechanism's plane, or (with the count and the memory
+    it would take) one above MAX_WALL_BOXES, before anything is built."""
+    if not route.planar:
+        raise ParameterError(f"{route.source}: a bend turns out of the mechanism's plane (plane not 0 or 180 deg), "
+                             "which the planar walls cannot build; allowed: plane = 0 or 180 on this model")
+    count = 2 * (len(route.pieces) + 1) + sum(outer_boxes(b.radius, diameter, b.angle) for b in route.bends)
+    if count > MAX_WALL_BOXES:
+        worst = max(route.bends, key=lambda b: outer_boxes(b.radius, diameter, b.angle))
+        raise ParameterError(f"{route.source}: the planar walls of this route need {count} boxes (about "
+                             f"{count * BOX_BYTES / 1e6:.0f} MB, each bend's outer wall a polygon within {SAGITTA:g} m "
+                             f"of its circle; the largest, radius {worst.radius:g} m, "
+                             f"{outer_boxes(worst.radius, diameter, worst.angle)}); allowed: at most {MAX_WALL_BOXES} "
+                             "boxes: fewer, shorter or tighter bends")
+    return count
+
+
 def _wall_straights(route: Route, robot_length: float, diameter: float) -> list[dict]:
     """The straights the walls need: merged collinear route straights, the exit straight; each with its
     start (x, y, heading), length, and per side ('top' +1, 'bottom' -1) how far it reaches into a bend on that
     side's outer wall before and after it [m]."""
     pieces = list(route.pieces)
     last = pieces[-1]
-    x, y, heading = last.at(last.length)
-    pieces.append(Piece("straight", route.length, robot_length + LEAD_IN, x, y, heading))
+    end, _ = last.at3(last.length)
+    pieces.append(Piece("straight", route.length, robot_length + LEAD_IN, end, last.frame_at(last.length)))
     walls: list[dict] = []
     for k, piece in enumerate(pieces):
         if piece.kind != "straight":
@@ -106,6 +130,7 @@ def write_route_walls(spec: mujoco.MjSpec, params: RobotParams, route: Route) ->
     friction, condim, solref and solimp carry over."""
     D = params.pipe_diameter
     route.check_pipe(D)
+    check_wall_count(route, D)
     template = spec.geom("wall_top")
     style = dict(contype=0, conaffinity=1, condim=int(template.condim), friction=list(template.friction),
                  solref=list(template.solref), solimp=list(template.solimp), margin=float(template.margin))
@@ -168,7 +193,8 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
     against :func:`.pipe.bend_max_length`, and the spread the wheels of a station (``half_base`` [m] either side
     of the module's middle) need against their springs' reach (2 ``spring_travel`` [m] per pair: each of the
     pair's springs reaches its free length), :func:`.pipe.bend_wheel_spread`. Returns ``{"bends": [...],
-    "predicted": one line}``."""
+    "predicted": one line}``; a figure with no finite value (the rod's clearance where it is longer than the
+    centreline's diameter) is None."""
     D, Rw = params.pipe_diameter, params.wheel_radius
     bends, worst = [], None
     for k, bend in enumerate(route.bends):
@@ -200,4 +226,6 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
     else:
         predicted = (f"passes: in bend {worst['bend']} (R/D {worst['R_over_D']:.3g}) the wheels press with "
                      f"{100 * worst['wall_press_share']:.0f} % of their preload")
+    for b in bends:  # JSON has no infinity: a rod longer than the centreline's diameter has no clearance (None)
+        b.update({key: None for key, value in b.items() if isinstance(value, float) and not math.isfinite(value)})
     return {"bends": bends, "predicted": predicted}

@@ -1,9 +1,11 @@
 """A wheeled run along a route (``--route``): where the robot is along it, and why the run stops.
 
 :class:`RouteWatch` reads the recorded samples every block of the run loop (:mod:`.simulate`): the rear
-module's point A (its x and y slides: the crank's axis) projected on the route's centreline
-(:meth:`ipir_mujoco.core.route.Route.project`) is the robot's distance along the route, ``route_s_m`` (the
-furthest so far). The run stops, with one line in ``route_stop``, when
+module's point A (the crank's axis, :class:`ModulePoints`, in 3-D) projected on the route's centreline
+(:meth:`ipir_mujoco.core.route.Route.along`) is the robot's distance along the route, ``route_s_m`` (the
+furthest so far). At the run's end the series' x and v columns are read along the route
+(:meth:`RouteWatch.along_series`), so the summary's travel and every figure of x and v are along the centreline.
+The run stops, with one line in ``route_stop``, when
 
 - the rear module reaches the route's end (``route_done`` true, ``route_time_s`` the time it did,
   interpolated between samples);
@@ -25,13 +27,14 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numpy as np
 
 from ipir_mujoco.core.route import Route
 
-from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, qpos_address
+from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, dof_address, qpos_address
 from .route_walls import LEAD_IN
-from .wheels_model import ARMS, LATERALS, SPRING_TRAVEL
+from .wheels_model import SPRING_TRAVEL
 
 WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
@@ -41,23 +44,59 @@ BACK_OUT = LEAD_IN - 0.1  # m: the rear module this far behind the start has its
 # walls' end
 
 
+class ModulePoints:
+    """Where the wheeled models' reference points are, in route coordinates (the world's): the rear module's point
+    A (the crank's axis) and the front module's C, each its module body's place in the template plus its slides
+    along x, y (``*_lateral``) and, in the round-pipe model, z (``*_vertical``; the planar model has none: z = 0),
+    and their velocities (the slides' rates): ``positions(qpos) -> (A, C)``, ``velocities(qvel) -> (vA, vC)``,
+    each (3,) [m], [m/s]. A module's tilt (a ball joint at its point) does not move the point."""
+
+    def __init__(self, model):
+        names = ((REAR_SLIDE, "rear_lateral", "rear_vertical"), (FRONT_SLIDE, "front_lateral", "front_vertical"))
+        self.q, self.v, self.base = [], [], []
+        for module, slides in zip(("rear_module", "front_module"), names):
+            present = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) >= 0 for n in slides]
+            self.q.append([qpos_address(model, n) if ok else None for n, ok in zip(slides, present)])
+            self.v.append([dof_address(model, n) if ok else None for n, ok in zip(slides, present)])
+            self.base.append(np.array(model.body(module).pos, dtype=float))
+
+    @staticmethod
+    def _read(values, addresses, base) -> np.ndarray:
+        return base + np.array([0.0 if a is None else float(values[a]) for a in addresses])
+
+    def positions(self, q) -> tuple[np.ndarray, np.ndarray]:
+        return self._read(q, self.q[0], self.base[0]), self._read(q, self.q[1], self.base[1])
+
+    def velocities(self, v) -> tuple[np.ndarray, np.ndarray]:
+        zero = np.zeros(3)
+        return self._read(v, self.v[0], zero), self._read(v, self.v[1], zero)
+
+
+def arm_slides(model) -> tuple[list[int], list[float]]:
+    """The wheels' arm slides (joints named ``*_arm``, the rear module's first, as the models build them): their
+    qpos addresses and their springs' free lengths [m] (``qpos_spring``: the slide where a spring is unloaded)."""
+    joints = [j for j in range(model.njnt) if model.joint(j).name.endswith("_arm")]
+    addresses = [int(model.jnt_qposadr[j]) for j in joints]
+    return addresses, [float(model.qpos_spring[a]) for a in addresses]
+
+
 class RouteWatch:
     """The route's checks on one run (module docstring); ``model`` the compiled wheeled model with the route's
-    walls, ``recorder`` the run's :class:`.recorder.Recorder`."""
+    walls, ``recorder`` the run's :class:`.recorder.Recorder`, ``points`` where the modules' reference points
+    are (default :class:`ModulePoints`)."""
 
-    def __init__(self, route: Route, model, recorder, prediction: dict, dt_out: float):
+    def __init__(self, route: Route, model, recorder, prediction: dict, dt_out: float, points=None):
         self.route, self.rec, self.prediction = route, recorder, prediction
-        self.x, self.y = qpos_address(model, REAR_SLIDE), qpos_address(model, LATERALS[0])
-        # the front module's point C: its body's place in the template plus its slides (both in the world's axes)
-        self.fx, self.fy = qpos_address(model, FRONT_SLIDE), qpos_address(model, LATERALS[1])
-        self.front0 = [float(v) for v in model.body("front_module").pos[:2]]
+        self.points = ModulePoints(model) if points is None else points
         self.s_front = 0.0
         self.crank = qpos_address(model, CRANK_HINGE)
-        self.arms = [qpos_address(model, n) for n in ARMS]
-        self.free = SPRING_TRAVEL  # the arm slide's springref: the spring's free length
+        self.arms, free = arm_slides(model)
+        self.free = np.array(free)  # the arm slides' springref: the springs' free lengths [m]
+        self.arm_names = [model.joint(j).name for j in range(model.njnt) if model.joint(j).name.endswith("_arm")]
         self.fed = 0
         self.s_max = 0.0
         self.s_last = 0.0
+        self.along: list[tuple[float, float]] = []  # (rear A's s, front C's s) [m] per sample fed
         self.progress_at = (0.0, 0.0, 0.0)  # (t, s, crank angle) when progress last passed PROGRESS_M
         self.off_since: list[float | None] = [None] * len(self.arms)
         self.done_at: float | None = None
@@ -79,10 +118,11 @@ class RouteWatch:
         length = self.route.length
         for i in rows:
             ti = float(t[i])
-            s = self._along(float(q[i, self.x]), float(q[i, self.y]), self.s_last)
+            rear, ahead = self.points.positions(q[i])
+            s = self.route.along(rear, self.s_last)
             t0 = float(t[i - 1]) if i > 0 else ti
-            front = self._along(self.front0[0] + float(q[i, self.fx]), self.front0[1] + float(q[i, self.fy]),
-                                self.s_front)
+            front = self.route.along(ahead, self.s_front)
+            self.along.append((s, front))
             centre, before = 0.5 * (s + front), 0.5 * (self.s_last + self.s_front)
             self.s_front = front
             for k, mark in enumerate(self.marks):  # when the robot's centre first reached each piece's start
@@ -115,11 +155,39 @@ class RouteWatch:
             self._wheels(q[i, self.arms], ti)
         return None
 
+    def along_series(self, series: dict) -> dict:
+        """The run's series read along the route: ``x1``, ``x2`` become the rear module's A and the front
+        module's C distances along the centreline from where they started [m] (as x1, x2 are in a straight
+        pipe), ``v1``, ``v2`` their velocities along it (the velocity's component along the centreline's
+        direction there) [m/s] and ``a1``, ``a2`` the rates of those [m/s^2]; the world positions stay as
+        ``x1_world``, ``y1_world``, ``z1_world`` (and 2) [m]. Every figure and summary figure drawn from x and v
+        then reads along the route."""
+        n = len(series["t"])
+        rec = self.rec
+        out = dict(series)
+        along = list(self.along[:n])
+        world = np.array([np.concatenate(self.points.positions(rec.qpos[i])) for i in range(n)])
+        for i in range(len(along), n):  # samples after the last check (the run's end)
+            before = along[-1] if along else (0.0, 0.0)
+            along.append((self.route.along(world[i, :3], before[0]), self.route.along(world[i, 3:], before[1])))
+        along = np.array(along).reshape(n, 2)
+        for k, column in ((0, "1"), (1, "2")):
+            s = along[:, k]
+            out[f"x{column}_world"], out[f"y{column}_world"], out[f"z{column}_world"] = world[:, 3 * k:3 * k + 3].T
+            out[f"x{column}"] = s - s[0]
+            speed = np.empty(n)
+            for i in range(n):
+                _, direction = self.route.at3(float(s[i]))
+                speed[i] = float(self.points.velocities(rec.qvel[i])[k] @ direction)
+            out[f"v{column}"] = speed
+            out[f"a{column}"] = np.gradient(speed, series["t"]) if n > 1 else np.zeros(n)
+        return out
+
     def _wheels(self, arms: np.ndarray, t: float) -> None:
         """Note which wheels press with less than LOST_SHARE of their preload at one sample (``arms``: the arm
-        slides [m]; the spring presses with 1 - q / SPRING_TRAVEL of its preload, the light arm's contact with
-        as much but for the arm's inertia)."""
-        self.reach = max(self.reach, float(arms.max()) / self.free)
+        slides [m]; the spring presses with 1 - q / free of its preload, the light arm's contact with as much but
+        for the arm's inertia)."""
+        self.reach = max(self.reach, float((arms / self.free).max()))
         off = arms > (1.0 - LOST_SHARE) * self.free
         if off.any():
             self.off_time += self.dt
@@ -131,23 +199,11 @@ class RouteWatch:
             if since is None:
                 self.off_since[k] = t
             elif self.lost is None and t - since >= WALL_LOSS_S:
-                self.lost = (f"wheel {ARMS[k][:-4]} lost its wall (pressing with < {100 * LOST_SHARE:g} % of its "
-                             f"preload for {WALL_LOSS_S:g} s) from t = {since:.4f} s, at "
+                self.lost = (f"wheel {self.arm_names[k][:-4]} lost its wall (pressing with < {100 * LOST_SHARE:g} % of "
+                             f"its preload for {WALL_LOSS_S:g} s) from t = {since:.4f} s, at "
                              f"{self.route.where(self.s_max)}")
         for k in np.flatnonzero(~off):
             self.off_since[k] = None
-
-    def _along(self, x: float, y: float, near: float) -> float:
-        """A point's distance along the route [m] (near ``near`` [m]), beyond its end along the exit straight and
-        before its start (negative) along the first straight."""
-        s = self.route.project(x, y, near=near)
-        if s <= 0.0:  # behind the start: along the first straight, backwards
-            first = self.route.pieces[0]
-            return min(0.0, (x - first.x) * math.cos(first.heading) + (y - first.y) * math.sin(first.heading))
-        if s >= self.route.length:
-            ex, ey, heading = self.route.at(self.route.length)
-            s = self.route.length + max(0.0, (x - ex) * math.cos(heading) + (y - ey) * math.sin(heading))
-        return s
 
     def record(self, t_end: float, stall: str | None) -> dict:
         """The summary's route keys: ``route_done``, ``route_time_s`` [s] or None, ``route_s_m`` [m] (the furthest the
@@ -191,6 +247,9 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
+    from .route_walls import check_wall_count
+
+    check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
     from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
 
     reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels

@@ -205,6 +205,8 @@ class _Run:
                 raise SimulationError(mujoco_failure(t, str(exc))) from None
         rec = self.recorder
         series = rec.series(last)
+        if self.route_watch is not None:  # x and v along the route's centreline (world positions kept)
+            series = self.route_watch.along_series(series)
         if self.ticked is not None:
             series["drive_u"] = self.ticked.u_column(series["t"])
         wm, wf = series["motor_work"][-1], series["friction_work"][-1]

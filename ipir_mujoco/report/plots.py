@@ -73,18 +73,26 @@ def figure_crank(runs: Sequence[RunResult], labels: Sequence[str] | None = None)
 
 
 def figure_modules(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -> Figure:
-    """Paper's Fig. 3: module displacements (a), velocities (b), accelerations (c)."""
+    """Paper's Fig. 3: module displacements (a), velocities (b), accelerations (c); along the route's
+    centreline (s) for runs along a route (their x and v columns are, :meth:`ipir_mujoco.engine.route_watch.RouteWatch.along_series`)."""
     fig, axes = new_figure(3)
-    quantities = (("x", "displacement from start [m]", "(a) displacements"),
-                  ("v", "velocity [m/s]", "(b) velocities"),
-                  ("a", "acceleration [m/s^2]", "(c) accelerations"))
+    along = any(run.route is not None for run in runs)
+    if along:
+        quantities = (("x", "distance along the route s [m]", "(a) distances along the route"),
+                      ("v", "speed along the route ds/dt [m/s]", "(b) speeds along the route"),
+                      ("a", "rate of ds/dt [m/s^2]", "(c) accelerations along the route"))
+    else:
+        quantities = (("x", "displacement from start [m]", "(a) displacements"),
+                      ("v", "velocity [m/s]", "(b) velocities"),
+                      ("a", "acceleration [m/s^2]", "(c) accelerations"))
     for ax, (key, ylabel, title) in zip(axes, quantities):
         for i, (style, run) in enumerate(zip(STYLES, runs)):
             t = run.series["t"]
+            name = "s" if along and key == "x" else key
             ax.plot(t, run.series[key + "1"], style, color=REAR, lw=0.9,
-                    label=_legend_label(runs, labels, i, f"module 1 (rear) {key}1"))
+                    label=_legend_label(runs, labels, i, f"module 1 (rear) {name}1"))
             ax.plot(t, run.series[key + "2"], style, color=FRONT, lw=0.9,
-                    label=_legend_label(runs, labels, i, f"module 2 (front) {key}2"))
+                    label=_legend_label(runs, labels, i, f"module 2 (front) {name}2"))
         ax.set(ylabel=ylabel, title=title)
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
