@@ -26,7 +26,8 @@ the arms' stops and a wheel off its wall end that (:mod:`ipir_mujoco.core.pipe_l
 
 Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i, inside m_i; the module's
 inertia is a solid cylinder of its mass, as long as its ring spacing, of the radius inside its wheels. The pipe's
-wall: :func:`write_straight_wall` (a plane along each leg's track, tangent to the pipe's circle at the leg).
+wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat walls along each leg's track let a
+skidding module roll off them: a rolled wheel's normal on a plane has a moment about the axis that rolls it on).
 Every row's time constant is a property of the model in seconds (:class:`RowTimes`), not a multiple of the step.
 """
 
@@ -65,7 +66,6 @@ STOP_COMPRESSION = 4.0  # the arm's inner stop, in suspension travels of compres
 # crank, is 30 times a 5 N press); mu 10 let such a module skid
 MU_UNLIMITED = 100.0
 NOSLIP_ITERATIONS = 0  # MuJoCo's no-slip pass: off (a held robot creeps ~3e-6 m/s without it; it doubles the cost)
-WALL_LENGTH = 3.0  # m: a straight wall's half-length as drawn (its plane is infinite for collisions)
 IMPEDANCE = (0.9999, 0.9999, 0.001, 0.5, 2.0)  # every row's solimp: MuJoCo's largest impedance, as the slides'
 
 
@@ -160,10 +160,10 @@ def check_pipe_params(params: RobotParams) -> None:
 
 
 def build_pipe_spec(params: RobotParams, settings: SolverSettings | None = None, times: RowTimes = ROW_TIMES,
-                    mjcf: str | Path | None = None, wall=None) -> mujoco.MjSpec:
-    """The template with ``params`` written in and the legs added (not compiled); ``wall(spec, params)`` adds the
-    pipe's wall (default :func:`write_straight_wall`). ``settings``: the step and integrator (default
-    :func:`pipe_timestep`, implicitfast); the rows' softness is ``times``."""
+                    mjcf: str | Path | None = None, route=None) -> mujoco.MjSpec:
+    """The template with ``params`` written in, the legs added and the pipe's wall (:func:`write_pipe_wall`, a
+    straight pipe or along ``route``, a :class:`ipir_mujoco.core.route.Route`), not compiled. ``settings``: the
+    step and integrator (default :func:`pipe_timestep`, implicitfast); the rows' softness is ``times``."""
     check_pipe_params(params)
     settings = settings or SolverSettings(timestep=pipe_timestep(times))
     if settings.timestep > 0.5 * times.shortest() * (1 + 1e-12):
@@ -177,7 +177,7 @@ def build_pipe_spec(params: RobotParams, settings: SolverSettings | None = None,
     for name in (REAR_SLIDE, FRONT_SLIDE):
         _element(spec.joint, name, hint).frictionloss = 0.0  # the resistance is the hubs'
     _write_legs(spec, params, times, hint)
-    (wall or write_straight_wall)(spec, params)
+    write_pipe_wall(spec, params, route, times)
     spec.option.timestep = settings.timestep
     spec.option.integrator = INTEGRATORS[settings.integrator]
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
@@ -253,29 +253,23 @@ def _write_legs(spec: mujoco.MjSpec, params: RobotParams, times: RowTimes, hint:
         housing.contype, housing.conaffinity, housing.condim = 1, 0, 3
 
 
-def write_straight_wall(spec: mujoco.MjSpec, params: RobotParams) -> None:
-    """The straight pipe's wall: per leg direction u a plane tangent to the pipe's circle at u (normal -u, at
-    D/2), friction mu_wall. Each wheel rolls on its own plane, which is the round wall along its track while the
-    module keeps its roll (a rolled wheel sees the plane 1 - cos(roll) farther than the circle: 0.4 mm at 0.1 rad
-    with the defaults); the other planes are beyond reach."""
-    n, half = leg_count(params), 0.5 * params.pipe_diameter
-    mu = contact_friction(params)
-    times = ROW_TIMES
-    for k in range(n):
-        u = leg_direction(k, n)
-        quat = np.zeros(4)
-        mujoco.mju_quatZ2Vec(quat, -u)
-        spec.worldbody.add_geom(name=f"wall_{k}", type=mujoco.mjtGeom.mjGEOM_PLANE, pos=(half * u).tolist(),
-                                quat=quat.tolist(), size=[WALL_LENGTH, 0.02, 0.01], contype=0, conaffinity=1,
-                                condim=3, friction=[mu, 0.0, 0.0], group=3, rgba=[0.35, 0.4, 0.5, 0.3],
-                                solref=[times.contact, 1.0], solimp=list(IMPEDANCE))
+def write_pipe_wall(spec: mujoco.MjSpec, params: RobotParams, route=None, times: RowTimes = ROW_TIMES) -> list[str]:
+    """The pipe's round wall (:func:`.pipe_walls.add_pipe_walls`: exact contacts with the wheels' spheres and the
+    housings' capsules, no seams or facets), a straight pipe along x or along ``route``, with the wheels'
+    friction (:func:`contact_friction`), the contact time constant and the rows' impedance; returns its geoms'
+    names."""
+    from .pipe_walls import WallContact, add_pipe_walls
+
+    reach = params.r + params.L + 0.5 * params.ring_spacing + 2.0 * params.wheel_radius
+    return add_pipe_walls(spec, route, params.pipe_diameter,
+                          WallContact(contact_friction(params), (times.contact, 1.0), IMPEDANCE), robot_length=reach)
 
 
 def build_pipe_model(params: RobotParams, settings: SolverSettings | None = None, times: RowTimes = ROW_TIMES,
-                     mjcf: str | Path | None = None, wall=None, decorate=None) -> mujoco.MjModel:
+                     mjcf: str | Path | None = None, route=None, decorate=None) -> mujoco.MjModel:
     """Compile the round-pipe robot for ``params`` (:func:`build_pipe_spec`); ``decorate(spec)`` as for
     :func:`.model.build_model`."""
-    return compile_spec(build_pipe_spec(params, settings, times, mjcf, wall), decorate, "wheeled MuJoCo model")
+    return compile_spec(build_pipe_spec(params, settings, times, mjcf, route), decorate, "wheeled MuJoCo model")
 
 
 def sag(params: RobotParams, module: int) -> float:
