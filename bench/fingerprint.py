@@ -71,6 +71,21 @@ MUJOCO = {
                                        "unilateral", "ratchet", 1.0, {"dt_out": 1e-3}),
     "mujoco riser stall": (RobotParams(incline=90.0), "unilateral", "ratchet", 1.0, {"dt_out": 1e-3}),
     "mujoco servo exact ff 1 s": (SERVO_EXACT, "unilateral", "ratchet", 1.0, {"dt_out": 1e-3, "feedforward": True}),
+    "mujoco grip ratchet motor": (RobotParams(mu_wall=0.5, F_n1=10.0, F_n2=10.0, **MOTOR), "unilateral", "ratchet",
+                                  0.3, {"dt_out": 1e-3}),
+    "mujoco compliant grip motor": (RobotParams(clutch_stiffness=1e6, mu_wall=0.5, F_n1=10.0, F_n2=10.0, **MOTOR),
+                                    "unilateral", "ratchet", 0.3, {"dt_out": 1e-3}),
+    "mujoco wheels motor": (RobotParams(mu_wall=0.8, **MOTOR), "unilateral", "ratchet", 0.2,
+                            {"dt_out": 1e-3, "model": "wheels", "settings": "1e-4"}),
+}
+# name: (variant, params, t_end, options): through registry.run (what it adds: every_step, the variant's kind)
+REGISTRY = {
+    "wheels riser skids every step": ("mujoco-wheels", RobotParams(mu_wall=0.18, incline=90.0, **MOTOR), 0.04,
+                                      {"every_step": True}),
+    "wheels skid 1e-4 s": ("mujoco-wheels", RobotParams(mu_wall=0.18, incline=90.0, **MOTOR), 0.1,
+                           {"dt_out": 1e-3, "timestep": 1e-4}),
+    "grip riser skids every step": ("mujoco-ratchet", RobotParams(M_stall=1.0, incline=90.0, mu_wall=0.3, F_n1=20.0,
+                                                                  F_n2=20.0, **MOTOR), 0.1, {"every_step": True}),
 }
 
 
@@ -130,7 +145,15 @@ def main() -> int:
         print(f"{name:45s} {digest_run(analytic.simulate(params, geometry, clutch, t_end, **options))}", flush=True)
     for name, (params, rule, implementation, t_end, options) in MUJOCO.items():
         options = _with_table(params, options)
+        if options.get("settings") is not None:
+            from ipir_mujoco.engine import SolverSettings
+
+            options = {**options, "settings": SolverSettings(timestep=float(options["settings"]))}
         print(f"{name:45s} {digest_run(simulate_mujoco(params, rule, implementation, t_end, **options))}", flush=True)
+    from ipir_mujoco import registry
+
+    for name, (variant, params, t_end, options) in REGISTRY.items():
+        print(f"{name:45s} {digest_run(registry.run(variant, params, t_end, **options))}", flush=True)
     if args.skip_studies:
         return 0
     from ipir_mujoco.studies.climbing import climb_study

@@ -185,14 +185,15 @@ def prepare_for_many(names) -> None:
 
 
 def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float) -> float | None:
-    """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s]
-    (:func:`ipir_mujoco.engine.timestep.choose_settings`); None for the analytic engines."""
+    """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s]: the
+    variant's model kind's (:meth:`ipir_mujoco.engine.kinds.ModelKind.settings`), the step every such run
+    takes; None for the analytic engines."""
     v = variant(name)
     if not v.is_mujoco:
         return None
-    from .engine.timestep import choose_settings
+    from .engine.kinds import kind_for
 
-    return choose_settings(params, t_end, dt_out, clutch=v.clutch)[0].timestep
+    return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch)[0].timestep
 
 
 def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options) -> RunResult:

@@ -77,15 +77,23 @@ class WheeledReplay(SlideReplay):
         self.address.update({name: qpos_address(model, joint) for name, joint in zip(PLANAR, (*LATERALS, *YAWS))})
         self.hubs = [[qpos_address(model, n + "_hub") for n in names] for names in WHEEL_NAMES]
         s = self.series
-        self.travel = [_axial_travel(s[f"x{k}"], s[f"y{k}"], s[f"yaw{k}"]) for k in (1, 2)]
+        # the x slides' values: a run along a route reads x1, x2 along the route and keeps the modules' world
+        # positions (x1_world, x2_world: the module body's place in the template plus its slide)
+        if "x1_world" in s:
+            self.slides = [s[f"x{k}_world"] - float(model.body(name).pos[0])
+                           for k, name in ((1, "rear_module"), (2, "front_module"))]
+        else:
+            self.slides = [s["x1"], self.front0 + s["x2"]]
+        self.travel = [_axial_travel(x, s[f"y{k}"], s[f"yaw{k}"]) for k, x in zip((1, 2), self.slides)]
         self.crank, self.rod = model.body("crank").id, model.body("rod").id
         self.front, self.end = model.body("front_module").id, model.site(ROD_END).id
         self.pin = model.eq_data[model.equality(LOOP).id, 3:6].copy()  # C in module 2's frame
 
     def pose(self, data: mujoco.MjData, when: float) -> None:
         a, m = self.address, self.model
-        data.qpos[a[REAR_SLIDE]] = self.value("x1", when)
-        data.qpos[a[FRONT_SLIDE]] = self.front0 + self.value("x2", when)
+        t = self.series["t"]
+        data.qpos[a[REAR_SLIDE]] = float(np.interp(when, t, self.slides[0]))
+        data.qpos[a[FRONT_SLIDE]] = float(np.interp(when, t, self.slides[1]))
         for name in PLANAR:
             data.qpos[a[name]] = self.value(name, when)
         data.qpos[a[CRANK_HINGE]] = self.value("phi", when)

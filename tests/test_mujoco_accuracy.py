@@ -13,6 +13,7 @@ from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
 from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
+from ipir_mujoco.engine import kinds
 from ipir_mujoco.engine import simulate as engine_simulate
 from ipir_mujoco.engine.model import SolverSettings
 from ipir_mujoco.engine.monitor import RESIDUAL_TOL
@@ -92,8 +93,8 @@ def test_the_monitor_stops_a_coarse_run_and_warn_records_it(capsys, tmp_path, mo
 def test_an_automatic_step_that_fails_the_monitor_is_halved(monkeypatch):
     """Whatever the motion bounds miss is caught: a step of 4e-4 s (residual -5e-3 at the paper's case)
     fails, and the engine repeats the run at half the step until it passes."""
-    chosen = engine_simulate.choose_settings
-    monkeypatch.setattr(engine_simulate, "choose_settings",
+    chosen = kinds.choose_settings  # the slide kind's timestep rule, which every run asks
+    monkeypatch.setattr(kinds, "choose_settings",
                         lambda *args: (SolverSettings(timestep=4e-4), chosen(*args)[1]))
     run = simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.8, dt_out=4e-4)
     failed = run.settings["refinements"]
@@ -210,8 +211,8 @@ def test_progress_every_tenth_of_a_second_and_the_wall_budget():
 def test_progress_never_goes_back_across_a_halved_step(monkeypatch):
     """The first attempt at 4e-4 s reports progress until the monitor stops it; the repeat at half the
     step reports again only past that point, so a user's progress is increasing, and still reaches the end."""
-    chosen = engine_simulate.choose_settings
-    monkeypatch.setattr(engine_simulate, "choose_settings",
+    chosen = kinds.choose_settings  # the slide kind's timestep rule, which every run asks
+    monkeypatch.setattr(kinds, "choose_settings",
                         lambda *args: (SolverSettings(timestep=4e-4), chosen(*args)[1]))
     attempts, seen = [], []
     real = engine_simulate._Run

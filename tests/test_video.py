@@ -160,13 +160,15 @@ def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_ru
     s = run.series
     rear, front = model.body("rear_module").id, model.body("front_module").id
     c0 = model.body_pos[front][0] + closed_loop_pose(run.params, run.params.phi0)[FRONT_SLIDE]  # C at the start
+    assert s["x2_world"][0] == pytest.approx(c0, abs=1e-12) and s["x1_world"][0] == 0.0 and s["x1"][0] == 0.0
     pin = model.eq_data[model.equality("rod_to_front").id, 3:6]
     times = frame_times(run, settings)
     rows = np.searchsorted(s["t"], times - 1e-9)
     np.testing.assert_allclose(s["t"][rows], times, rtol=0, atol=1e-12)
     for i in rows:
         replay.pose(data, float(s["t"][i]))
-        for body, x, k in ((rear, s["x1"][i], 1), (front, c0 + s["x2"][i], 2)):
+        # along a route x1, x2 are read along its centreline; the world's x stays in x1_world, x2_world
+        for body, x, k in ((rear, s["x1_world"][i], 1), (front, s["x2_world"][i], 2)):
             np.testing.assert_allclose(data.xpos[body][:2], [x, s[f"y{k}"][i]], rtol=0, atol=1e-12)
             yaw = math.atan2(data.xmat[body][3], data.xmat[body][0])
             assert yaw == pytest.approx(s[f"yaw{k}"][i], abs=1e-12)

@@ -38,15 +38,9 @@ from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from ..engine.clutches import clutch_controller
-from ..engine.common import check_clutch_options
-from ..engine.model import (CRANK_HINGE, FRONT_SLIDE, MOTOR, REAR_SLIDE, SolverSettings, build_model, drive_control,
-                            set_closed_loop_state)
-from ..engine.servo_drive import TickedDrive
-from ..engine.stepper import loop_options, make_steps
-from ..engine.timestep import choose_settings
-from ..engine.wheels import WheelRatchet, check_mujoco_model, wheel_loop_options, wheels_settings
-from ..engine.wheels_model import build_wheels_model, set_wheels_state
+from ..engine.kinds import kind_for
+from ..engine.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
+from ..engine.run_setup import RunSetup
 from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
@@ -55,60 +49,35 @@ class ViewedRobot:
     """The model, its data and the engine's clutch controller, stepped by the engine's stepping loop.
 
     Refuses (ParameterError, one line) exactly the parameters and clutch choices ``simulate_mujoco``
-    refuses (:func:`ipir_mujoco.engine.common.check_clutch_options`).
+    refuses (the model kind's :meth:`ipir_mujoco.engine.kinds.ModelKind.check`), and builds and starts the
+    robot as a run does (:class:`ipir_mujoco.engine.run_setup.RunSetup`).
     """
 
     def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,
                  settings: SolverSettings | None = None, t_end: float = 4.0, model: str = "slides", route=None):
-        from ..engine.route_watch import check_route, route_decorator
-
-        params = check_route(route, model, params, False)  # the route's incline
-        self.params, self.clutch, self.wheeled = params, clutch, model == "wheels"
+        self.clutch = clutch
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
-        check_mujoco_model(model, params, self.implementation)
-        check_clutch_options(params, clutch, self.implementation)
+        kind = kind_for(model, params)
+        params = kind.check(params, self.implementation, clutch, route)  # the route's incline
+        self.params, self.wheeled = params, kind.model == "wheels"
         if settings is None:  # the step the engine would choose for a run of t_end [s]
-            settings, why = choose_settings(params, t_end, 1e-3, clutch=self.implementation)
-            if self.wheeled:
-                settings, _ = wheels_settings(settings, why, params, 1e-3)
+            settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation)
         self.settings = settings
-        if self.wheeled:
-            walls = route_decorator(params, route)
-
-            def decorate(spec):
-                if walls is not None:
-                    walls(spec)
-                checker_floor(spec)
-            self.model = build_wheels_model(params, settings, decorate=decorate)
-        else:
-            self.model = build_model(params, settings, ratchet=self.implementation == "ratchet", decorate=checker_floor)
-        self.data = mujoco.MjData(self.model)
+        self.setup = RunSetup(kind, params, settings, implementation=self.implementation, rule=clutch, route=route,
+                              decorate=checker_floor)
+        self.model, self.data = self.setup.model, self.setup.data
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)
         self.reset()
 
     def reset(self) -> None:
         """Back to the start: the loop-consistent initial state, a fresh clutch controller."""
-        m, d = self.model, self.data
-        if self.wheeled:
-            set_wheels_state(m, d, self.params)
-            self.controller = WheelRatchet(m, d, self.params)
-        else:
-            set_closed_loop_state(m, d, self.params)
-            self.controller = clutch_controller(m, d, self.params, self.implementation, self.clutch)
-        motor = m.actuator(MOTOR).id
-        d.ctrl[motor] = drive_control(self.params)
         speed = None
         if self.params.drive == "servo":  # the speed controller, its table computed as for a run
             speed = SpeedController(self.params, registry.feedforward_table(self.params))
-            crank = m.joint(CRANK_HINGE)
-            d.ctrl[motor] = speed.tick(float(d.qpos[crank.qposadr[0]]), float(d.qvel[crank.dofadr[0]]))
-        mujoco.mj_forward(m, d)
-        options = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
-        self.steps = make_steps(m, d, self.controller, self._qvel_before, **options)
-        if speed is not None:
-            TickedDrive(self.steps, speed, d, motor=motor, crank_q=options["crank_q"], crank_v=options["crank_v"],
-                        dt=m.opt.timestep)
+        self.setup.start(speed)
+        self.controller = self.setup.controller
+        self.steps, _ = self.setup.steps(self._qvel_before, speed)
         self.held: tuple[bool, bool] | None = None
         self._colour()
 

@@ -1,9 +1,8 @@
 """Many ratcheted MuJoCo designs at once, stepped by ``mujoco.batch`` on C threads.
 
-Each design's model is compiled by the same builder as a single run
-(:func:`ipir_mujoco.engine.model.build_model`), with the timestep chosen for
-that design (:func:`ipir_mujoco.engine.timestep.choose_settings`) unless
-settings are given; the batch runs one model with per-simulation copies of
+Each design's model is checked, compiled and started by the slide model's kind as a single run
+(:data:`ipir_mujoco.engine.kinds.SLIDES`: its checks, build and initial state), with the timestep it
+chooses for that design unless settings are given; the batch runs one model with per-simulation copies of
 every field in which the designs differ (timestep, gravity, drive included),
 so the builder stays the only place that turns parameters into a model. All
 designs share the output times (multiples of ``dt_out``); a design with a
@@ -45,12 +44,13 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 
-from .model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
-                    drive_torque_slope, pin_offset, qpos_address, set_closed_loop_state)
+from .kinds import SLIDES as SLIDE_KIND
+from .model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_control, drive_torque_slope,
+                    pin_offset, qpos_address)
 from .monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, check_clutch_options, climb_energy, mujoco_failure,
+from .common import (BLOCK_TIME, REFINEMENTS, captured_warnings, climb_energy, mujoco_failure,
                      rest_since, stall_reason, steps_per_output)
-from .timestep import DT_MIN, choose_settings
+from .timestep import DT_MIN
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
 MODELLED_DRIVES = ("torque", "motor")  # each design's own actuator gain and bias (checked against the serial engine)
@@ -104,7 +104,7 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
     chosen: dict[int, SolverSettings] = {}
     for i, params in enumerate(designs):
         try:
-            check_clutch_options(params)
+            SLIDE_KIND.check(params, "ratchet", "unilateral")
             if params.clutch_stiffness is not None:
                 raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m: batched runs have rigid "
                                      "ratchets only; allowed: clutch_stiffness=rigid (run compliant clutches "
@@ -113,7 +113,7 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
                 raise ParameterError(f"mu_wall={params.mu_wall!r}: batched runs have unlimited grip only (a batch "
                                      "cannot read the carriages' friction rows per simulation); allowed: "
                                      "mu_wall=unlimited (run finite grip serially, with simulate_mujoco)")
-            chosen[i] = settings if settings is not None else choose_settings(params, t_end, dt_out)[0]
+            chosen[i] = settings if settings is not None else SLIDE_KIND.settings(params, t_end, dt_out)[0]
         except ValueError as exc:
             results[i] = {"error": str(exc)}
     halvings = {i: [] for i in chosen}
@@ -122,7 +122,7 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
         for i, own in chosen.items():
             try:
                 steps_per_output(dt_out, own.timestep)
-                models.append(build_model(designs[i], own, ratchet=True))
+                models.append(SLIDE_KIND.build(designs[i], own, implementation="ratchet"))
                 index.append(i)
             except ValueError as exc:
                 results[i] = {"error": str(exc)}
@@ -180,7 +180,7 @@ class _Batch:
         self.motor = motor
         for k, (model, params) in enumerate(zip(self.models, self.designs)):
             data = mujoco.MjData(model)
-            set_closed_loop_state(model, data, params)
+            SLIDE_KIND.initial_state(model, data, params)
             self.qpos[k], self.qvel[k] = data.qpos, data.qvel
             ctrl[k, motor] = drive_control(params)
         self.record = {c: np.full((self.n_samples + 1, n), np.nan) for c in COLUMNS}

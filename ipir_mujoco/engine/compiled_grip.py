@@ -7,7 +7,8 @@ on finite grip, :class:`.grip.GripRatchet` and :class:`.grip_compliant.Compliant
 
 from __future__ import annotations
 
-from .common import REST_SPEED
+from ipir_mujoco.core.results import REST_SPEED
+
 from .grip import GripRatchet
 from .native import LayoutError
 
@@ -50,4 +51,5 @@ def _sync_ratchet(ctl, values) -> None:
 def _sync_compliant(ctl, values) -> None:
     a0, a1, d0, d1, v0, v1, damped0, damped1, ctl.damper_work, t0, t1, c0, c1, ctl.excursion = values
     ctl.anchor, ctl.overlap, ctl.v_before = [a0, a1], [d0, d1], [v0, v1]
-    ctl.damped, ctl.tracking, ctl.lowest = [damped0 != 0.0, damped1 != 0.0], [t0 != 0.0, t1 != 0.0], [c0, c1]
+    ctl.damped, ctl.tracking = [damped0 != 0.0, damped1 != 0.0], [t0 != 0.0, t1 != 0.0]
+    ctl.lowest[0], ctl.lowest[1] = c0, c1  # in place: the wall's running bound holds this list

@@ -46,6 +46,7 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
+from .controller import ControllerBase
 from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
@@ -74,7 +75,7 @@ def clutch_actuators(model: mujoco.MjModel, act, params: RobotParams) -> tuple[f
     return k, c
 
 
-class CompliantClutches:
+class CompliantClutches(ControllerBase):
     """The controller of the compliant clutches: moves the anchors, switches the dampers, counts their work.
 
     ``params``: the parameter set the model was built from; its
@@ -90,7 +91,7 @@ class CompliantClutches:
     """
 
     name = "compliant"
-    excursion = 0.0
+    deferred = True  # its forces are MuJoCo's at the sample's own state, a step later (the recorder reads them)
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
         self.model, self.data = model, data

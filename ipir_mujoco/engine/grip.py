@@ -39,32 +39,16 @@ import math
 import mujoco
 
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import REST_SPEED
 
-from .clutches import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
-from .common import REST_SPEED
+from .controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
 from .grip_model import ROLLS, SKIDS
 from .model import SLIDES, dof_address, qpos_address
+from .rows import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
+
+__all__ = ["LIMIT_TENDON", "GripRatchet", "GripRows", "lower_bound", "upper_bound"]
 
 LIMIT_TENDON = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON)
-
-
-def lower_bound(value: float, margin: float) -> float:
-    """The lower bound [m] one margin [m] below ``value``, raised by the last ulps until MuJoCo's distance to it,
-    value - bound, is below the margin: so the limit row exists at the running extreme itself (MuJoCo adds a
-    row while the distance is below the margin, and its soft limit pulls the distance to the margin, the
-    row's own edge)."""
-    bound = value - margin
-    while value - bound >= margin:
-        bound = math.nextafter(bound, math.inf)
-    return bound
-
-
-def upper_bound(value: float, margin: float) -> float:
-    """As :func:`lower_bound`, the upper bound one margin above ``value`` (MuJoCo's distance: bound - value)."""
-    bound = value + margin
-    while bound - value >= margin:
-        bound = math.nextafter(bound, -math.inf)
-    return bound
 
 
 class GripRows:
@@ -89,7 +73,7 @@ class GripRows:
         return forces[:2], forces[2:]
 
 
-class GripRatchet:
+class GripRatchet(ControllerBase):
     """The rigid one-way clutches on finite grip (module docstring): moves the clutch's and the wall's bounds.
 
     ``model`` built with a finite ``params.grip`` and rigid clutches; call it after the initial state is set.
@@ -97,8 +81,6 @@ class GripRatchet:
     """
 
     name = "grip ratchet"
-    after_step = None
-    damper_work = 0.0
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
         if params.grip is None or params.clutch_stiffness is not None:
@@ -118,35 +100,30 @@ class GripRatchet:
         self.roll_margins = [float(model.tendon_margin[t]) for t in self.roll_ids]
         self.skid_margins = [float(model.jnt_margin[j]) for j in self.skid_ids]
         q = data.qpos
-        self.bounds = [float(q[x]) - float(q[c]) for x, c in zip(self.x_adr, self.c_adr)]
-        self.lowest = [float(q[c]) for c in self.c_adr]
-        self._tendon_range, self._jnt_range = model.tendon_range, model.jnt_range
-        for k in (0, 1):
-            self._tendon_range[self.roll_ids[k], 0] = lower_bound(self.bounds[k], self.roll_margins[k])
-            self._jnt_range[self.skid_ids[k], 1] = upper_bound(self.lowest[k], self.skid_margins[k])
+        self.roll_limit = RunningBound(model.tendon_range, self.roll_ids,
+                                   [float(q[x]) - float(q[c]) for x, c in zip(self.x_adr, self.c_adr)],
+                                   self.roll_margins)
+        self.wall_limit = RunningBound(model.jnt_range, self.skid_ids, [float(q[c]) for c in self.c_adr],
+                                 self.skid_margins, upper=True)
+        self.bounds, self.lowest = self.roll_limit.extremes, self.wall_limit.extremes
         self.excursion = 0.0
         self._qpos, self._qvel = q, data.qvel
-        self._per_module = tuple(zip((0, 1), self.x_adr, self.c_adr, self.roll_ids, self.skid_ids))
+        self._per_module = tuple(zip((0, 1), self.x_adr, self.c_adr))
         self.rows = GripRows(model, roll_on_tendon=True)
         self.grip, self.resistance = self.rows.grips, self.rows.resistances  # G_i, F_ri [N]
 
     def before_step(self) -> None:
         """Raise each roll's bound to its running maximum and lower each carriage's to its running minimum,
         or note how far either has given."""
-        q, bounds, lowest = self._qpos, self.bounds, self.lowest
-        for k, xa, ca, t, j in self._per_module:
+        q, clutch, wall = self._qpos, self.roll_limit.follow, self.wall_limit.follow
+        for k, xa, ca in self._per_module:
             c = q.item(ca)
-            roll = q.item(xa) - c
-            if roll > bounds[k]:
-                bounds[k] = roll
-                self._tendon_range[t, 0] = lower_bound(roll, self.roll_margins[k])
-            elif bounds[k] - roll > self.excursion:
-                self.excursion = bounds[k] - roll
-            if c < lowest[k]:
-                lowest[k] = c
-                self._jnt_range[j, 1] = upper_bound(c, self.skid_margins[k])
-            elif c - lowest[k] > self.excursion:
-                self.excursion = c - lowest[k]
+            give = clutch(k, q.item(xa) - c)
+            if give > self.excursion:
+                self.excursion = give
+            give = wall(k, c)
+            if give > self.excursion:
+                self.excursion = give
 
     def _clutch_rows(self) -> list[float]:
         """The rolls' limit rows [N] of the last step (0.0 for a roll without one): the limit rows follow the
@@ -173,11 +150,11 @@ class GripRatchet:
             hold = clutch[k] + roll_force[k]
             F, G = self.resistance[k], self.grip[k]
             if not (clutch[k] > 0.0 or roll_force[k] > -F):
-                states.append(1)
+                states.append(ROLLING)
                 shares.append(0.0)
                 continue
             skids = grip_force[k] >= G if G > 0.0 else self._qvel.item(self.c_dof[k]) < -REST_SPEED
-            states.append(-1 if skids else 0)
+            states.append(SKIDDING if skids else STANDING)
             shares.append(clutch_share(hold, F))
         self._states = (self.data.time, (states, shares))
         return states, shares
@@ -186,7 +163,7 @@ class GripRatchet:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step: held while it
         stands."""
         states, shares = self.states()
-        return states[0] == 0, states[1] == 0, shares[0], shares[1]
+        return held(True, states[0]), held(True, states[1]), shares[0], shares[1]
 
     def wheels(self) -> tuple[float, float]:
         """Each module's wheels' state of the last step: +1.0 rolling, 0.0 standing, -1.0 skidding."""

@@ -29,9 +29,11 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
-from .common import REST_SPEED
+from ipir_mujoco.core.results import REST_SPEED
+
 from .compliant import CLUTCHES, CompliantClutches, check_transmissions, clutch_actuators
-from .grip import GripRows, upper_bound
+from .controller import ROLLING, SKIDDING, STANDING, RunningBound
+from .grip import GripRows
 from .grip_model import ROLLS, SKIDS
 from .model import SLIDES, dof_address, implicit_damping, qpos_address
 
@@ -59,15 +61,14 @@ class CompliantGrip(CompliantClutches):
         self.implicit = implicit_damping(model)
         self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm
         self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
-        self._jnt_range = model.jnt_range
         q = data.qpos
         self.anchor = [float(q[x]) - float(q[c]) - self.backlash for x, c in zip(self.qpos_adr, self.c_adr)]
         for u, a in zip(self.act, self.anchor):
             data.ctrl[u] = a
         self.skid_margins = [float(model.jnt_margin[j]) for j in self.skid_ids]
-        self.lowest = [float(q[c]) for c in self.c_adr]
-        for j, low, margin in zip(self.skid_ids, self.lowest, self.skid_margins):
-            self._jnt_range[j, 1] = upper_bound(low, margin)
+        self.wall_limit = RunningBound(model.jnt_range, self.skid_ids, [float(q[c]) for c in self.c_adr],
+                                       self.skid_margins, upper=True)
+        self.lowest = self.wall_limit.extremes  # each carriage's running minimum
         self._per_module = tuple(zip((0, 1), self.qpos_adr, self.dof_adr, self.act))
         self._carriages = tuple(zip(self.c_adr, self.c_dof, self.skid_ids))
         self.damped = [True, True]
@@ -97,11 +98,9 @@ class CompliantGrip(CompliantClutches):
             if (d > 0.0) != self.damped[i]:
                 self.damped[i] = d > 0.0
                 self._biasprm[act, 2] = -self.c if d > 0.0 else 0.0
-            if c < self.lowest[i]:
-                self.lowest[i] = c
-                self._jnt_range[j, 1] = upper_bound(c, self.skid_margins[i])
-            elif c - self.lowest[i] > self.excursion:
-                self.excursion = c - self.lowest[i]
+            give = self.wall_limit.follow(i, c)
+            if give > self.excursion:
+                self.excursion = give
 
     def after_step(self) -> None:
         """Add the step's damper dissipation at the roll's speed (:meth:`.CompliantClutches.after_step`)."""
@@ -125,9 +124,9 @@ class CompliantGrip(CompliantClutches):
             G = self.grip[i]
             skids = grip_force[i] >= G if G > 0.0 else v.item(cv) < -REST_SPEED
             if skids:
-                out.append(-1.0)
+                out.append(float(SKIDDING))
             elif self.tracking[i] and v.item(dof) - v.item(cv) > REST_SPEED:
-                out.append(1.0)
+                out.append(float(ROLLING))
             else:
-                out.append(0.0)
+                out.append(float(STANDING))
         return out[0], out[1]

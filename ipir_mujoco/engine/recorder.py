@@ -31,10 +31,11 @@ import numpy as np
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import COLUMNS, Mode
 
-from .clutches import equality_row
-from .grip_model import SKIDS
-from .common import REST_SPEED
+from ipir_mujoco.core.results import REST_SPEED
+
+from .controller import NO_WHEELS, held_where
 from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
+from .rows import equality_row
 
 # Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C
 # along the rod), motor power [W], total momentum along x [kg m/s], motor torque [N m],
@@ -48,7 +49,6 @@ EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_g
 # the order against _stepper.c's)
 SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
            "friction_work", "clutch_damper_work", "skid_work", "wheels1", "wheels2")
-NO_WHEELS = (0.0, 0.0)  # the wheels' states of a sample without grip (none are written)
 _NO_REACTIONS = (0.0, 0.0, 0.0, 0.0)  # a compliant clutch's sample, until its deferred forces (as _stepper.c)
 # MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
 DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
@@ -89,15 +89,14 @@ class Recorder:
     ``mj_forward`` on the run's initial state."""
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int,
-                 clutch=None, wheeled: bool = False):
+                 controller, kind):
         self.model, self.data, self.params = model, data, params
-        self.clutch = clutch  # the compliant clutches' controller (.compliant.CompliantClutches), or None
+        # a controller whose forces are MuJoCo's at the sample's own state (the compliant clutches), or None
+        self.clutch = controller if controller.deferred else None
+        self.kind = kind  # the model kind (.kinds): its own columns
         self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
-        # finite grip: the carriages' positions (their running minimum is the wheels' skid so far)
-        self.skid_q = None if params.grip is None or wheeled else [qpos_address(model, n) for n in SKIDS]
-        self.wheeled = wheeled  # the wheeled model (.wheels_model): its wheels' columns
         # module 2's pin in the world, relative to its body frame: fixed, as the body only slides
         self.site, self.front, offset = pin_offset(model, data)  # data: after mj_forward
         self.pin_offset = offset.tolist()
@@ -171,16 +170,15 @@ class Recorder:
         accel = (v - vb) / dt
         phi, omega = q[:, c], v[:, cv]
         beta = phi + q[:, rod]
-        if self.clutch is not None:  # a compliant clutch holds while it pushes, at the sample's own state
+        if self.clutch is not None:  # a compliant clutch carries while it pushes, at the sample's own state
             sc["lambda1"], sc["lambda2"] = de["clutch_force1"], de["clutch_force2"]
-            sc["held1"], sc["held2"] = (de["clutch_force1"] > 0).astype(float), (de["clutch_force2"] > 0).astype(float)
+            for k in ("1", "2"):  # held: carried and not skidding (.controller.held)
+                sc["held" + k] = held_where(de["clutch_force" + k] > 0, sc["wheels" + k]).astype(float)
         held1, held2 = sc["held1"] > 0.5, sc["held2"] > 0.5
         mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
                         np.where(held2, int(Mode.CONTRACTION),
                                  np.where(held1, int(Mode.EXPANSION), int(Mode.BOTH_MOVING))))
-        if self.clutch is None and self.skid_q is None and not self.wheeled:
-            mode = _dead_centre_passages(mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED)
-        elif self.clutch is None:  # finite grip: the wheels' states pass through a dead centre with the mode
+        if self.clutch is None:  # rigid clutches: the wheels' states pass through a dead centre with the mode
             mode, sc["wheels1"], sc["wheels2"] = _dead_centre_passages(
                 mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED, sc["wheels1"], sc["wheels2"])
         out = {
@@ -202,50 +200,6 @@ class Recorder:
                         "clutch_spring_energy": 0.5 * self.clutch.k * (np.maximum(d1, 0.0) ** 2
                                                                        + np.maximum(d2, 0.0) ** 2),
                         "clutch_damper_work": sc["clutch_damper_work"].copy()})
-        if self.skid_q is not None:
-            out.update(self._grip_columns(q, sc, out))
-        elif self.wheeled:
-            out.update(self._wheel_columns(out, sc))
-            out.update(self._planar_pose(q))
+        out.update(self.kind.columns(self.model, p, q, sc, out))
         assert set(COLUMNS) <= set(out)
         return out
-
-    def _grip_columns(self, q: np.ndarray, sc: dict, out: dict) -> dict[str, np.ndarray]:
-        """The finite-grip columns (``ipir_mujoco.core.results``): slip1/2 [m], each carriage's backward travel
-        below its start (its running minimum over the samples: the carriage only skids back, its limit holds
-        it from going forward), grip_use1/2 = lambda_i / G_i (1 while skidding where G_i = 0), the grips'
-        cumulative work skid_work [J] and the wheels' states wheels1/2."""
-        cols = {}
-        for k, (adr, G) in enumerate(zip(self.skid_q, self.params.grip), start=1):
-            wheels = sc[f"wheels{k}"]
-            cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
-            cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
-            cols[f"wheels{k}"] = wheels.copy()
-        cols["skid_work"] = sc["skid_work"].copy()
-        return cols
-
-    def _planar_pose(self, q: np.ndarray) -> dict[str, np.ndarray]:
-        """The wheeled model's modules' pose in the plane beside x1, x2: y1, y2 [m], each module's lateral slide
-        (its point A, C across the first straight's axis: 0 on it) and yaw1, yaw2 [rad], its hinge about z
-        (0 along +x, positive towards +y). With x1, x2, phi they pose the robot for a replay (render)."""
-        from .wheels_model import LATERALS, YAWS
-
-        return {name: q[:, qpos_address(self.model, joint)].copy()
-                for name, joint in zip(("y1", "y2", "yaw1", "yaw2"), (*LATERALS, *YAWS))}
-
-    def _wheel_columns(self, out: dict, sc: dict) -> dict[str, np.ndarray]:
-        """The wheeled model's columns (``ipir_mujoco.core.results``): slip1/2 [m], each module's backward steps
-        (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i with finite grip (1 while skidding where G_i = 0); the
-        contacts' cumulative work skid_work [J] and the wheels' states wheels1/2."""
-        from .wheels import wheel_slip
-
-        cols = {}
-        for k in (1, 2):
-            wheels = sc[f"wheels{k}"]
-            cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
-            if self.params.grip is not None:  # as the slide model's: 1 while skidding where G_i = 0 (mu_wall = 0)
-                G = self.params.grip[k - 1]
-                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
-            cols[f"wheels{k}"] = wheels.copy()
-        cols["skid_work"] = sc["skid_work"].copy()
-        return cols

@@ -55,20 +55,18 @@ from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
 from .block_checks import BlockChecks
-from .clutches import clutch_controller
-from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, check_clutch_options,
-                     climb_energy, monotone, mujoco_failure, steps_per_output)
-from .model import CRANK_HINGE, MOTOR, SolverSettings, build_model, drive_control
-from .model import set_closed_loop_state
+from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, climb_energy, monotone,
+                     mujoco_failure, steps_per_output)
+from .kinds import ModelKind, kind_for
+from .model import SolverSettings
 from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
-from .recorder import DEFERRED, EXTRA_COLUMNS, NO_WHEELS, SCALARS, Recorder
+from .recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
+from .route_watch import route_watch
+from .run_setup import RunSetup
 from .servo_drive import TickedDrive, controller_for
-from .stepper import WARNED, loop_options, make_steps
-from .timestep import DT_MIN, choose_settings
-from .route_watch import check_route, route_decorator, route_watch
-from .wheels import WheelRatchet, check_mujoco_model, default_accuracy, wheel_loop_options, wheels_settings
-from .wheels_model import ContactSettings, build_wheels_model, set_wheels_state
+from .stepper import WARNED
+from .timestep import DT_MIN
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK, _SKID_WORK = (SCALARS.index(n) for n in (
@@ -129,14 +127,13 @@ def simulate_mujoco(
     check_type("settings", settings, (SolverSettings, type(None)), "a SolverSettings, or None (chosen from the motion)")
     check_type("mjcf", mjcf, (str, os.PathLike, type(None)), "a path to an MJCF file, or None (the shipped one)")
     check_type("servo", servo, (CrankServo, type(None)), "a CrankServo, or None (the drive)")
-    check_mujoco_model(model, params, implementation)
-    params = check_route(route, model, params, until_steady)
-    check_clutch_options(params, clutch, implementation)
+    kind = kind_for(model, params)
+    params = kind.check(params, implementation, clutch, route, until_steady)
     controller_for(params, feedforward)  # refused here, before any work, if the table does not fit
     if servo is not None and params.drive == "servo":
         raise ParameterError("a crank servo with drive='servo': one thing sets the crank's actuator; allowed: one")
     run = RunOptions(t_end, dt_out, until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
-    accuracy = check_accuracy_mode(default_accuracy(model) if accuracy is None else accuracy)
+    accuracy = check_accuracy_mode(kind.accuracy if accuracy is None else accuracy)
     t_end, dt_out = run.t_end, run.dt_out
     if settings is not None:  # bounded up front: a tiny given timestep is refused, not run for days
         check_step_count(t_end, settings.timestep)
@@ -148,13 +145,11 @@ def simulate_mujoco(
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
                    progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
-                   wheeled=model == "wheels", feedforward=feedforward, route=route)
+                   kind=kind, feedforward=feedforward, route=route)
     if settings is not None:
         return _Run(params, settings, **options).result({"timestep_source": "given"})
     started = time.perf_counter()
-    chosen, why = choose_settings(params, t_end, dt_out, servo, implementation)
-    if model == "wheels":
-        chosen, why = wheels_settings(chosen, why, params, dt_out)
+    chosen, why = kind.settings(params, t_end, dt_out, servo, implementation)
     failures = []
     for attempt in range(REFINEMENTS + 1):
         try:
@@ -172,7 +167,7 @@ class _Run:
     """One MuJoCo run with fixed settings (the loop is in :meth:`_integrate`)."""
 
     def __init__(self, params, settings, *, clutch, implementation, t_end, dt_out, mjcf, progress, servo, accuracy,
-                 until_steady, steady_tol, steady_cycles, wall_budget_s, wheeled=False, feedforward=None,
+                 until_steady, steady_tol, steady_cycles, wall_budget_s, kind: ModelKind, feedforward=None,
                  route=None, started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
@@ -183,12 +178,11 @@ class _Run:
         self.steps_per_sample = steps_per_output(dt_out, dt)
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
         self.compliant = params.clutch_stiffness is not None
-        self.wheeled = wheeled  # the wheeled model (.wheels_model), else the slide model
-        self.model_settings = {"mujoco_model": "wheels", **ContactSettings().as_dict()} if wheeled else {}
+        self.kind = kind
         self.route = route
-        self.model = (build_wheels_model(params, settings, mjcf=mjcf, decorate=route_decorator(params, route))
-                      if wheeled else build_model(params, settings, mjcf, ratchet=implementation == "ratchet"))
-        self.data = mujoco.MjData(self.model)
+        self.setup = RunSetup(kind, params, settings, implementation=implementation, rule=clutch, mjcf=mjcf,
+                              route=route, servo=servo)
+        self.model, self.data = self.setup.model, self.setup.data
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
         self.recorder: Recorder | None = None  # made by _setup
@@ -220,7 +214,7 @@ class _Run:
             damper = series["clutch_damper_work"][-1]
             energy["clutch_spring_j"], energy["clutch_damper_j"] = float(spring), float(damper)
         dissipated = wf + damper
-        if self.params.grip is not None or self.wheeled:
+        if self.kind.skid:
             energy["skid_j"] = float(series["skid_work"][-1])
             dissipated = dissipated + series["skid_work"][-1]
         residual, scale = energy_audit(wm, dissipated, kinetic, potential + spring, self.energy_floor)
@@ -232,26 +226,18 @@ class _Run:
             settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch,
                       "clutch_model": "compliant" if self.compliant else "rigid", "dt_out": self.dt_out,
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
-                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.model_settings},
+                      "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.kind.recorded_settings()},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
             route=self.route_watch and self.route_watch.record(self.t_end, self.stall),
         )
 
     def _setup(self):
-        m, d, p = self.model, self.data, self.params
-        (set_wheels_state if self.wheeled else set_closed_loop_state)(m, d, p)
-        self.controller = controller = (WheelRatchet(m, d, p) if self.wheeled
-                                        else clutch_controller(m, d, p, self.implementation, self.clutch))
-        motor, crank = m.actuator(MOTOR).id, m.joint(CRANK_HINGE)
-        d.ctrl[motor] = drive_control(p) if self.servo is None else self.servo.torque(
-            0.0, d.qpos[crank.qposadr[0]], d.qvel[crank.dofadr[0]])
-        if self.speed is not None:  # the speed controller's tick at t = 0
-            d.ctrl[motor] = self.speed.tick(float(d.qpos[crank.qposadr[0]]), float(d.qvel[crank.dofadr[0]]))
-        mujoco.mj_forward(m, d)
-        self.loop = wheel_loop_options(m, d) if self.wheeled else loop_options(m, d)
-        self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2,
-                                 controller if self.compliant else None, wheeled=self.wheeled)
+        setup, p = self.setup, self.params
+        setup.start(self.speed)
+        m, d = self.model, self.data
+        self.controller, self.loop = setup.controller, setup.loop
+        self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2, self.controller, self.kind)
         self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out)  # None without a route
 
     def _integrate(self, messages: list[str]) -> int:
@@ -267,8 +253,7 @@ class _Run:
         torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
-        wheels = ctl.wheels() if self.params.grip is not None or self.wheeled else NO_WHEELS
-        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=wheels)
+        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=ctl.wheels())
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
         kinetic, potential, spring = (rec.deferred.item(row, c) for c in (_KINETIC, _POTENTIAL, _SPRING))
         self.energy0 = (kinetic, potential + spring)  # kinetic; potential with the clutch springs
@@ -276,10 +261,8 @@ class _Run:
         self._replay((0, 1), (0, 1))
         self._check(messages, 0.0)
 
-        steps = self.steps = make_steps(m, d, ctl, rec.qvel_before, servo=self.servo, **self.loop)
-        if self.speed is not None:
-            self.ticked = TickedDrive(steps, self.speed, d, motor=self.loop["motor"], crank_q=self.loop["crank_q"],
-                                      crank_v=self.loop["crank_v"], dt=m.opt.timestep)
+        steps, self.ticked = self.setup.steps(rec.qvel_before, self.speed)
+        self.steps = steps
         sps, n_steps, done, samples = self.steps_per_sample, self.n_steps, 0, 0
         block = max(1, round(BLOCK_TIME / self.dt_out))
         checks = BlockChecks(self)
@@ -353,7 +336,7 @@ class _Run:
         the clutch springs count with the potential energy, their dampers with the friction work."""
         sc, de = self.recorder.scalars[a:b], self.recorder.deferred[a:b]
         dissipated = sc[:, _FRICTION_WORK] + sc[:, _DAMPER_WORK]
-        if self.params.grip is not None or self.wheeled:  # and the grips' (the wheels' contacts') work
+        if self.kind.skid:  # and the grips' (the wheels' contacts') work
             dissipated = dissipated + sc[:, _SKID_WORK]
         return energy_audit(sc[:, _MOTOR_WORK], dissipated,
                             de[:, _KINETIC] - self.energy0[0], de[:, _POTENTIAL] + de[:, _SPRING] - self.energy0[1],

@@ -37,7 +37,6 @@ from operator import itemgetter
 import mujoco
 import numpy as np
 
-from .clutches import EQUALITY_ROWS, Locks, NoClutch, Ratchet, missing_rows
 from .compiled_grip import load_grip
 from .compliant import CompliantClutches
 from .grip import GripRatchet
@@ -45,7 +44,9 @@ from .grip_compliant import CompliantGrip
 from .loop_rows import loop_options  # noqa: F401  (make_steps' options: the viewer imports it from here)
 from .native import LayoutError, compiled, pointers
 from .native import address as array_address
-from .recorder import NO_WHEELS, Recorder
+from .recorder import Recorder
+from .rows import EQUALITY_ROWS, missing_rows
+from .slide_clutches import Locks, NoClutch, Ratchet
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
@@ -76,7 +77,6 @@ class PythonSteps:
         self.skid_work = 0.0  # the grips' cumulative work against skidding [J] (finite grip)
         # the wheeled model's work rates (.wheels.wheel_loop_options), in place of the slides' rows
         self.power = power
-        self.reports_wheels = grip is not None or power is not None  # the controller reports wheels' states
 
     def run(self, nstep: int, row: int = -1) -> None:
         """``nstep`` steps; the velocities before the last one go to ``qvel_before[row]`` (row >= 0).
@@ -174,7 +174,7 @@ class PythonSteps:
             if len(messages) != warned:  # the state may be MuJoCo's reset: nothing to record
                 return WARNED, taken
             pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(), ctl.damper_work,
-                                 ctl.excursion, self.skid_work, ctl.wheels() if self.reports_wheels else NO_WHEELS)
+                                 ctl.excursion, self.skid_work, ctl.wheels())
         return DONE, taken
 
 

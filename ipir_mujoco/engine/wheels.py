@@ -25,6 +25,7 @@ J v_{n+1} of its tangential directions: the friction's work against skidding).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -32,23 +33,22 @@ import numpy as np
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from .clutches import clutch_share, missing_rows
-from .common import REST_SPEED
-from .grip import lower_bound
-from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
+from ipir_mujoco.core.results import REST_SPEED
+
+from .controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
+from .model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
+from .rows import clutch_share, missing_rows
 from .wheels_model import WHEEL_NAMES, contact_friction
 
 LIMIT_JOINT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 SLIDING_SHARE = 1e-6  # a module's contacts slide where their tangential force is within this share of the cone
 
 
-class WheelRatchet:
+class WheelRatchet(ControllerBase):
     """The hubs' ratchets (module docstring); ``model`` built by :func:`.wheels_model.build_wheels_model`, called
     after the initial state is set. ``bounds`` [rad]: each hub's running maximum, rear module's hubs first."""
 
     name = "wheel ratchet"
-    after_step = None
-    damper_work = 0.0
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
         self.model, self.data, self.radius = model, data, params.wheel_radius
@@ -65,12 +65,12 @@ class WheelRatchet:
             raise ValueError("the wheel ratchet needs the hubs, and only them, limited: build the wheeled model")
         self.margins = [float(model.jnt_margin[j]) for j in self.joint_ids]
         self.range = model.jnt_range
-        self.bounds = [float(data.qpos[a]) for a in self.qpos_adr]
-        for j, b, margin in zip(self.joint_ids, self.bounds, self.margins):
-            self.range[j, 0] = lower_bound(b, margin)
+        self.limit = RunningBound(self.range, self.joint_ids, [float(data.qpos[a]) for a in self.qpos_adr],
+                                  self.margins)
+        self.bounds = self.limit.extremes
         self.excursion = 0.0
         self._qpos, self._qvel = data.qpos, data.qvel
-        self._hubs = tuple(zip(range(len(names)), self.qpos_adr, self.joint_ids, self.margins))
+        self._hubs = tuple(enumerate(self.qpos_adr))
         self.x_dof = [dof_address(model, n) for n in SLIDES]
         # the friction rows follow the equality rows, one per dof with friction, in dof order: the hubs' only
         with_friction = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
@@ -91,16 +91,11 @@ class WheelRatchet:
 
     def before_step(self) -> None:
         """Raise each hub's bound to its running maximum, or note how far (on the wall) it has given."""
-        q, bounds, rng = self._qpos, self.bounds, self.range
-        for k, a, j, margin in self._hubs:
-            angle = q.item(a)
-            if angle > bounds[k]:
-                bounds[k] = angle
-                rng[j, 0] = lower_bound(angle, margin)
-            else:
-                give = (bounds[k] - angle) * self.radius
-                if give > self.excursion:
-                    self.excursion = give
+        q, follow = self._qpos, self.limit.follow
+        for k, a in self._hubs:
+            give = follow(k, q.item(a)) * self.radius
+            if give > self.excursion:
+                self.excursion = give
 
     def _rows(self) -> tuple[list[float], list[float], list[bool]]:
         """Per module of the last step: its hubs' limit rows summed [N m], their friction rows summed [N m], and
@@ -151,7 +146,7 @@ class WheelRatchet:
         states, shares = [], []
         for i in (0, 1):
             if not (limits[i] > 0.0 or sticks[i]):
-                states.append(1)
+                states.append(ROLLING)
                 shares.append(0.0)
                 continue
             hold = (limits[i] + friction[i]) / self.radius
@@ -159,16 +154,16 @@ class WheelRatchet:
                 skids = tangential[i] >= (1.0 - SLIDING_SHARE) * self.mu * normal[i]
             else:
                 skids = self._qvel.item(self.x_dof[i]) < -REST_SPEED
-            states.append(-1 if skids else 0)
+            states.append(SKIDDING if skids else STANDING)
             shares.append(clutch_share(hold, self.resistance[i]))
         self._states = (self.data.time, (states, shares))
         return states, shares
 
     def reactions(self) -> tuple[bool, bool, float, float]:
-        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step: held while not
-        rolling."""
+        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step: held while it
+        stands (:func:`.controller.held`: neither rolling nor skidding)."""
         states, shares = self.states()
-        return states[0] != 1, states[1] != 1, shares[0], shares[1]
+        return held(True, states[0]), held(True, states[1]), shares[0], shares[1]
 
     def wheels(self) -> tuple[float, float]:
         """Each module's wheels' state of the last step: +1.0 rolling, 0.0 standing, -1.0 skidding."""
@@ -229,25 +224,9 @@ def wheel_slip(x: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(back)])
 
 
-MODELS = ("slides", "wheels")  # the MuJoCo models of the robot (simulate_mujoco's ``model``)
-
-
-def default_accuracy(model: str) -> str:
-    """The accuracy monitor's mode where a run does not choose one: 'stop' on the slides; 'warn' on wheels,
-    whose modules rock on their springs and whose soft contacts dissipate work the energy audit (the contacts'
-    tangential rows only) cannot attribute, ~0.1-0.3 % of the motor's whatever the step (mjcf/README.md,
-    "Wheels in contact"): a term of the model, not the stepping's error, so the residual is recorded and
-    shown rather than stopping the run (or halving its step, which does not lower it)."""
-    return "warn" if model == "wheels" else "stop"
-
-
-def check_mujoco_model(model: str, params: RobotParams, implementation: str) -> None:
-    """ParameterError (one line) for an unknown MuJoCo ``model`` or a clutch the wheeled model does not have: it
-    has the hubs' rigid ratchets only."""
-    if model not in MODELS:
-        raise ParameterError(f"mujoco model {model!r} is unknown; allowed: {', '.join(MODELS)}")
-    if model != "wheels":
-        return
+def refuse_clutches(params: RobotParams, implementation: str) -> None:
+    """ParameterError (one line) for a clutch the wheeled model does not have: it has the hubs' rigid
+    ratchets only."""
     if implementation != "ratchet":
         raise ParameterError(f"the MuJoCo {implementation!r} clutch on the wheeled model: its clutches are ratchets "
                              "in the wheels' hubs; allowed: --mujoco-clutch ratchet (--clutch unilateral)")
@@ -261,12 +240,10 @@ def check_mujoco_model(model: str, params: RobotParams, implementation: str) -> 
 DT_SKID = 2.5e-5
 
 
-def wheels_settings(chosen, why: dict, params: RobotParams, dt_out: float):
+def wheels_settings(chosen: SolverSettings, why: dict, params: RobotParams, dt_out: float):
     """The automatic settings of a wheeled run: ``chosen`` (:func:`.timestep.choose_settings`' SolverSettings
     and ``why``, its limits [s]) with the step capped at DT_SKID where the grip is finite, a whole fraction
     of ``dt_out`` [s]; returns (settings, why)."""
-    from dataclasses import replace
-
     if params.grip is None or chosen.timestep <= DT_SKID:
         return chosen, why
     steps = math.ceil(dt_out / DT_SKID * (1 - 1e-12))

@@ -1,0 +1,263 @@
+"""MuJoCo's models of the robot, each one object: a *model kind* owns what differs between them.
+
+A kind is chosen once per run (:func:`kind_for`, from ``simulate_mujoco``'s ``model`` and the parameter set)
+and owns its checks (which clutches, options and parameters it takes), its settings (the automatic timestep,
+the contact settings a run records), its build (MJCF template to ``MjModel``), its initial state, its clutch
+controller (:mod:`.controller`'s protocol), its stepping loop's options, its extra series columns and energy
+terms and its default accuracy mode. Everything else, the run loop (:mod:`.stepper`), the recorder, the
+accuracy monitor, the run's setup (:mod:`.run_setup`), is shared and names no kind.
+
+The kinds:
+
+- ``slides`` (:data:`SLIDES`): the modules on two slides, the clutches a joint-limit ratchet (rigid or
+  compliant, :mod:`.slide_clutches`, :mod:`.compliant`) or velocity-triggered locks; unlimited grip.
+- ``slides`` with a finite ``mu_wall`` (:data:`GRIP_SLIDES`): a carriage per module on the wall, held by
+  friction G_i, carries the clutch (:mod:`.grip_model`, :mod:`.grip`, :mod:`.grip_compliant`).
+- ``wheels`` (:data:`WHEELS`): the modules on wheels in a pipe, a ratchet in every hub (:mod:`.wheels_model`,
+  :mod:`.wheels`); routes of straights and bends (:mod:`.route_watch`).
+
+Adding a kind: subclass :class:`ModelKind`, give it a ``name`` and the methods below that differ from the
+base's, and list it in :data:`KINDS` (``docs/architecture.md``, "Adding a model kind").
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.params import RobotParams
+
+from .common import check_clutch_options
+from .grip import GripRatchet
+from .grip_compliant import CompliantGrip
+from .grip_model import SKIDS
+from .loop_rows import loop_options
+from .model import SolverSettings, build_model, qpos_address, set_closed_loop_state
+from .route_watch import check_route, route_decorator
+from .slide_clutches import refuse_grip, slide_controller
+from .timestep import choose_settings
+from .wheels import WheelRatchet, refuse_clutches, wheel_loop_options, wheel_slip, wheels_settings
+from .wheels_model import LATERALS, YAWS, ContactSettings, build_wheels_model, set_wheels_state
+
+
+class ModelKind:
+    """One MuJoCo model of the robot: its checks, settings, build, initial state, controller, loop options,
+    extra columns and energy terms, default accuracy mode. The base is the slide model's; a kind overrides
+    what differs.
+
+    Attributes
+    ----------
+    name : str
+        The kind's name (:data:`KINDS`' key).
+    model : str
+        The user's word for its MuJoCo model, ``simulate_mujoco``'s ``model`` ('slides' | 'wheels').
+    accuracy : str
+        The accuracy monitor's mode where a run does not choose one ('stop' | 'warn').
+    skid : bool
+        Whether the energy audit books the grips' (or the contacts') work against skidding, ``skid_j``.
+    """
+
+    name = "slides"
+    model = "slides"
+    accuracy = "stop"
+    skid = False
+
+    def check(self, params: RobotParams, implementation: str, rule: str, route=None,
+              until_steady: bool = False) -> RobotParams:
+        """The parameters for a run (a route may set its incline), after refusing (ParameterError, one line)
+        what this kind does not take.
+
+        Parameters
+        ----------
+        params : RobotParams
+        implementation : str
+            The MuJoCo clutch: 'ratchet' | 'lock' | 'none'.
+        rule : str
+            The clutch rule: 'kinematic' | 'unilateral'.
+        route : ipir_mujoco.core.route.Route or None
+        until_steady : bool
+
+        Returns
+        -------
+        RobotParams
+
+        Raises
+        ------
+        ParameterError
+        """
+        if route is not None:
+            raise ParameterError("--route applies only to the wheeled model; allowed: --mujoco-model wheels")
+        check_clutch_options(params, rule, implementation)
+        return params
+
+    def settings(self, params: RobotParams, t_end: float, dt_out: float, servo=None,
+                 implementation: str = "ratchet") -> tuple[SolverSettings, dict]:
+        """The automatic settings of a run of ``t_end`` [s] sampled every ``dt_out`` [s], and why: (settings,
+        {each limit [s]}) (:func:`.timestep.choose_settings`); every run and ``registry.timestep`` ask this."""
+        return choose_settings(params, t_end, dt_out, servo, implementation)
+
+    def recorded_settings(self) -> dict:
+        """What a run's ``RunResult.settings`` records of the kind beside the solver's settings."""
+        return {}
+
+    def build(self, params: RobotParams, settings: SolverSettings, *, mjcf=None, implementation: str = "ratchet",
+              route=None, decorate=None) -> mujoco.MjModel:
+        """The compiled model for ``params``; ``decorate(spec)`` adds what only drawing needs."""
+        return build_model(params, settings, mjcf, ratchet=implementation == "ratchet", decorate=decorate)
+
+    def initial_state(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
+        """The run's initial state (the loop closed at ``phi0``, at rest or at ``omega0``)."""
+        set_closed_loop_state(model, data, params)
+
+    def controller(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, implementation: str,
+                   rule: str = "unilateral"):
+        """The run's clutch controller (:class:`.controller.ClutchController`), after the initial state."""
+        return slide_controller(model, data, params, implementation, rule)
+
+    def loop_options(self, model: mujoco.MjModel, data: mujoco.MjData) -> dict:
+        """:func:`.stepper.make_steps`' keyword arguments after ``mj_forward`` on the initial state."""
+        return loop_options(model, data)
+
+    def columns(self, model: mujoco.MjModel, params: RobotParams, q: np.ndarray, scalars: dict,
+                out: dict) -> dict[str, np.ndarray]:
+        """The kind's series columns beyond the shared ones, from the samples' ``q`` (n, nq), the recorder's
+        per-sample ``scalars`` (name: (n,)) and the shared columns ``out``."""
+        return {}
+
+
+class GripSlidesKind(ModelKind):
+    """The slide model on wheels of finite grip: a carriage per module on the wall, held by friction G_i."""
+
+    name = "slides-grip"
+    skid = True
+
+    def controller(self, model, data, params, implementation, rule="unilateral"):
+        refuse_grip(params, implementation)
+        if params.clutch_stiffness is None:
+            return GripRatchet(model, data, params)
+        return CompliantGrip(model, data, params)
+
+    def columns(self, model, params, q, scalars, out):
+        """slip1/2 [m], each carriage's backward travel below its start (its running minimum over the samples:
+        the carriage only skids back, its limit holds it from going forward), grip_use1/2 = lambda_i / G_i (1
+        while skidding where G_i = 0), the grips' cumulative work skid_work [J] and the wheels' states
+        wheels1/2."""
+        cols = {}
+        for k, (name, G) in enumerate(zip(SKIDS, params.grip), start=1):
+            adr = qpos_address(model, name)
+            wheels = scalars[f"wheels{k}"]
+            cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
+            cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"wheels{k}"] = wheels.copy()
+        cols["skid_work"] = scalars["skid_work"].copy()
+        return cols
+
+
+class WheelsKind(ModelKind):
+    """The modules on wheels in a pipe, a ratchet in every hub, stepped in Python."""
+
+    name = "wheels"
+    model = "wheels"
+    # 'warn': its modules rock on their springs and its soft contacts dissipate work the energy audit (the
+    # contacts' tangential rows only) cannot attribute, ~0.1-0.3 % of the motor's whatever the step
+    # (mjcf/README.md, "Wheels in contact"): a term of the model, not the stepping's error, so the residual is
+    # recorded and shown rather than stopping the run (or halving its step, which does not lower it)
+    accuracy = "warn"
+    skid = True
+
+    def check(self, params, implementation, rule, route=None, until_steady=False):
+        refuse_clutches(params, implementation)
+        params = check_route(route, self.model, params, until_steady)
+        check_clutch_options(params, rule, implementation)
+        return params
+
+    def settings(self, params, t_end, dt_out, servo=None, implementation="ratchet"):
+        chosen, why = super().settings(params, t_end, dt_out, servo, implementation)
+        return wheels_settings(chosen, why, params, dt_out)
+
+    def recorded_settings(self):
+        return {"mujoco_model": self.model, **ContactSettings().as_dict()}
+
+    def build(self, params, settings, *, mjcf=None, implementation="ratchet", route=None, decorate=None):
+        walls = route_decorator(params, route)
+        if walls is not None and decorate is not None:
+            both = lambda spec: (walls(spec), decorate(spec))  # noqa: E731
+        else:
+            both = walls or decorate
+        return build_wheels_model(params, settings, mjcf=mjcf, decorate=both)
+
+    def initial_state(self, model, data, params):
+        set_wheels_state(model, data, params)
+
+    def controller(self, model, data, params, implementation, rule="unilateral"):
+        return WheelRatchet(model, data, params)
+
+    def loop_options(self, model, data):
+        return wheel_loop_options(model, data)
+
+    def columns(self, model, params, q, scalars, out):
+        """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i
+        with finite grip (1 while skidding where G_i = 0); the contacts' cumulative work skid_work [J], the
+        wheels' states wheels1/2; the modules' planar pose y1/2 [m] (lateral slides), yaw1/2 [rad] (hinges about
+        z), which with x1, x2, phi pose the robot for a replay."""
+        cols = {}
+        for k in (1, 2):
+            wheels = scalars[f"wheels{k}"]
+            cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
+            if params.grip is not None:  # as the slide model's: 1 while skidding where G_i = 0 (mu_wall = 0)
+                G = params.grip[k - 1]
+                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"wheels{k}"] = wheels.copy()
+        cols["skid_work"] = scalars["skid_work"].copy()
+        cols.update({name: q[:, qpos_address(model, joint)].copy()
+                     for name, joint in zip(("y1", "y2", "yaw1", "yaw2"), (*LATERALS, *YAWS))})
+        return cols
+
+
+SLIDES, GRIP_SLIDES, WHEELS = ModelKind(), GripSlidesKind(), WheelsKind()
+KINDS = {kind.name: kind for kind in (SLIDES, GRIP_SLIDES, WHEELS)}
+MODELS = ("slides", "wheels")  # the MuJoCo models a user names (simulate_mujoco's ``model``)
+
+
+def kind_for(model: str, params: RobotParams) -> ModelKind:
+    """The model kind of a run of MuJoCo's model ``model`` ('slides' | 'wheels') on ``params``: on the slides a
+    finite ``mu_wall`` chooses the carriages' model.
+
+    Parameters
+    ----------
+    model : str
+    params : RobotParams
+
+    Returns
+    -------
+    ModelKind
+
+    Raises
+    ------
+    ParameterError
+        For an unknown ``model``.
+    """
+    if model == "wheels":
+        return WHEELS
+    if model == "slides":
+        return SLIDES if params.grip is None else GRIP_SLIDES
+    raise ParameterError(f"mujoco model {model!r} is unknown; allowed: {', '.join(MODELS)}")
+
+
+def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, implementation: str,
+                      rule: str = "unilateral"):
+    """The slide model's clutch controller of a run (the slide kinds' :meth:`ModelKind.controller`): kept for
+    scripts that built the slide model themselves."""
+    return kind_for("slides", params).controller(model, data, params, implementation, rule)
+
+
+def check_mujoco_model(model: str, params: RobotParams, implementation: str) -> None:
+    """ParameterError (one line) for an unknown MuJoCo ``model`` or a clutch the wheeled model does not have."""
+    if kind_for(model, params) is WHEELS:
+        refuse_clutches(params, implementation)
+
+
+def default_accuracy(model: str) -> str:
+    """The accuracy monitor's mode where a run does not choose one: the kind's (:attr:`ModelKind.accuracy`)."""
+    return kind_for(model, RobotParams()).accuracy
