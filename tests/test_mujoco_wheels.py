@@ -24,9 +24,9 @@ from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.core.pipe import leg_direction, lift_check
 from ipir_mujoco.engine.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
 from ipir_mujoco.engine.monitor import RESIDUAL_TOL
-from ipir_mujoco.engine.pipe_model import (ROW_TIMES, WHEEL_SHARE, build_pipe_model, leg_names, leg_preload,
-                                           leg_stiffness, sag, set_pipe_state)
-from ipir_mujoco.engine.pipe_wheels import HubRatchet, leg_press
+from ipir_mujoco.engine.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
+                                            leg_stiffness, sag, set_wheels_state)
+from ipir_mujoco.engine.wheels import WheelRatchet, leg_press
 
 from cli_run import run_cli
 
@@ -35,12 +35,12 @@ RISER = RobotParams(drive="motor", mu_wall=0.18, incline=90.0)  # grip 9 N per m
 
 
 def by_hand(p: RobotParams, dt: float | None = None):
-    model = build_pipe_model(p, None if dt is None else SolverSettings(timestep=dt))
+    model = build_wheels_model(p, None if dt is None else SolverSettings(timestep=dt))
     data = mujoco.MjData(model)
-    set_pipe_state(model, data, p)
+    set_wheels_state(model, data, p)
     data.ctrl[model.actuator(MOTOR).id] = drive_control(p)
     mujoco.mj_forward(model, data)
-    return model, data, HubRatchet(model, data, p)
+    return model, data, WheelRatchet(model, data, p)
 
 
 def contact_forces(model, data, p) -> np.ndarray:
@@ -61,7 +61,7 @@ def contact_forces(model, data, p) -> np.ndarray:
 def test_the_compiled_model_holds_the_parameters():
     p = RobotParams(F_n1=40.0, F_n2=60.0, F_r1=1.0, F_r2=2.0, mu_wall=0.6, wheel_radius=0.02, pipe_diameter=0.2,
                     wheel_legs=4, suspension_travel=0.004, ring_spacing=0.12)
-    m = build_pipe_model(p)
+    m = build_wheels_model(p)
     legs = leg_names(p)
     for i, names in enumerate(legs):
         assert len(names) == 2 * 4  # two rings of wheel_legs
@@ -84,12 +84,12 @@ def test_the_compiled_model_holds_the_parameters():
     assert m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
     # the rows' time constants are seconds of the model, the same whatever the step
     for dt in (ROW_TIMES.shortest() / 2, ROW_TIMES.shortest() / 8):
-        m = build_pipe_model(p, SolverSettings(timestep=dt))
+        m = build_wheels_model(p, SolverSettings(timestep=dt))
         assert m.eq_solref[m.equality("rod_to_front").id][0] == ROW_TIMES.loop
         assert m.jnt_solref[m.joint(legs[0][0] + "_hub").id][0] == ROW_TIMES.limit
         assert m.geom_solref[m.geom(legs[0][0] + "_wheel").id][0] == ROW_TIMES.contact
     with pytest.raises(ParameterError, match="timestep"):  # MuJoCo's floor: two steps per time constant
-        build_pipe_model(p, SolverSettings(timestep=ROW_TIMES.shortest()))
+        build_wheels_model(p, SolverSettings(timestep=ROW_TIMES.shortest()))
     # only the hubs have friction
     assert set(np.flatnonzero(m.dof_frictionloss)) == {dof_address(m, n + "_hub") for names in legs for n in names}
 
@@ -101,7 +101,7 @@ def test_the_compiled_model_holds_the_parameters():
 ])
 def test_a_robot_that_does_not_fit_its_pipe_is_refused(bad, word):
     with pytest.raises(ParameterError, match=word) as caught:
-        build_pipe_model(RobotParams(**bad))
+        build_wheels_model(RobotParams(**bad))
     assert "\n" not in str(caught.value)
 
 

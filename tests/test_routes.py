@@ -126,8 +126,13 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
         assert s["x1_final"] == pytest.approx(s["route_s_m"], abs=1.2e-3)
     else:
         assert s["route_time_s"] is None and s["route_s_m"] < s["route_length_m"]
-    assert "leaves the wall" in s["route_fit"]["predicted"] and not s["route_fit"]["bends"][0]["wheels_keep_wall"]
-    assert s["route_wheel_off_s"] > 0
+    # the closed form for a module tangent to the bend: its legs reach the spread (83 % of the preload left)
+    assert "passes" in s["route_fit"]["predicted"] and s["route_fit"]["bends"][0]["wheels_keep_wall"]
+    # but the linkage holds module 2's pin C on a chord L of the bend from A: L^2 / (8 R) = 15.6 mm off the
+    # centreline, three times the legs' travel beyond their preload (5 mm), so its wheels on one side lift in
+    # the bend, as MuJoCo shows (the closed form does not model the linkage's offset)
+    assert 0.2 ** 2 / (8 * 0.32) > 3 * RobotParams().suspension_travel
+    assert s["route_wheel_off_s"] > 0 and s["wheel_off_s"] > 0
     from ipir_mujoco.cli.simulate import route_lines  # what simulate prints without --json
 
     printed = "\n".join(route_lines(s))
@@ -179,7 +184,7 @@ def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
                        ((*wheels, "--route", tmp_path / "none.toml"), "does not exist"),
                        ((*wheels, "--route", good, "--until-steady", "--drive", "motor"), "--until-steady"),
                        ((*wheels, "--route", good, "--set", "incline=10"), "incline"),
-                       ((*wheels, "--route", short), "length >= 0.325 m")):
+                       ((*wheels, "--route", short), "length >= 0.315 m")):  # L + r + ring_spacing / 2 + R
         code, out, err = run_cli(capsys, "simulate", *argv)
         assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (argv, err)
     with pytest.raises(ParameterError, match="wheeled"):

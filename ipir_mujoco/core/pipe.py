@@ -156,3 +156,10 @@ def lift_check(params) -> dict:
     out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
     out["weight_press_n"] = tuple(weight_only)
     return out
+
+
+def lift_summary(params) -> dict:
+    """The lift-off check's summary keys of a wheeled run: ``least_press1_n``, ``least_press2_n`` [N] and
+    ``lift_predicted`` (:func:`lift_check`)."""
+    check = lift_check(params)
+    return {key: check[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted")}

@@ -169,6 +169,10 @@ class RunResult:
     def summary(self) -> dict[str, Any]:
         """The summary figures of the command-line contract (docs/cli.md)."""
         summary = summarize(self.series, self.energy)
+        if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
+            from .pipe import lift_summary
+
+            summary.update(lift_summary(self.params))
         summary.update(cycle_summary(self.series, *self.steady_test))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall

@@ -34,7 +34,6 @@ from ipir_mujoco.core.route import Route
 
 from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, dof_address, qpos_address
 from .route_walls import LEAD_IN
-from .wheels_model import SPRING_TRAVEL
 
 WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
@@ -247,12 +246,7 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
-    from .route_walls import check_wall_count
-
-    check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
-    from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
-
-    reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
+    reach = params.L + params.r + 0.5 * params.ring_spacing + params.wheel_radius  # A to the front wheels
     first = route.pieces[0]
     if first.length < reach:
         raise ParameterError(f"{route.source}: segment 1: length={first.length:g} m; the robot starts in it and "
@@ -261,22 +255,14 @@ def check_route(route, model: str, params, until_steady: bool):
     return params.replace(incline=route.incline)
 
 
-def route_decorator(params, route):
-    """``build_wheels_model``'s decorate for the route's walls (:func:`.route_walls.write_route_walls`), or
-    None without a route."""
-    if route is None:
-        return None
-    from .route_walls import write_route_walls
-
-    return lambda spec: write_route_walls(spec, params, route)
-
-
 def route_watch(route: Route | None, model, recorder, params, dt_out: float) -> RouteWatch | None:
     """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
     geometry (:func:`.route_walls.fit_prediction`)."""
     if route is None:
         return None
     from .route_walls import fit_prediction
-    from .wheels_model import STATION_OFFSET
+    from .wheels_model import housing_radius
 
-    return RouteWatch(route, model, recorder, fit_prediction(route, params, STATION_OFFSET, SPRING_TRAVEL), dt_out)
+    fit = fit_prediction(route, params, 0.5 * params.ring_spacing, params.suspension_travel,
+                         housing=(2 * housing_radius(params), params.ring_spacing))
+    return RouteWatch(route, model, recorder, fit, dt_out)
