@@ -14,7 +14,8 @@ and ``mujoco-wheels`` (its automatic settings) run it, and the design lands in o
   2 mm;
 - ``lifted``: a wheel left its wall (``wheel_off_s`` > 0) and the closed-form lift-off check predicted it
   (``lift_predicted``): the constant-press idealization does not hold there, and the run says so;
-- ``stopped``: refused (bad input for a model) or stopped (a stall, the accuracy monitor), with its reason;
+- ``stopped``: refused (bad input for a model), stopped (a stall) or flagged by MuJoCo's accuracy monitor (its
+  figure beyond tolerance, in the run's summary), with its reason;
 - ``outside``: none of these (each printed with its figures).
 
 Prints one line per design and the counts per class. The table in mjcf/README.md ("The round pipe") is this
@@ -83,6 +84,11 @@ def judge(index: int, params: RobotParams, t_end: float) -> dict:
         return {**row, "class": "lifted"}
     if stops:
         return {**row, "class": "stopped", "why": stops[0]}
+    violations = wheels.accuracy.get("violations") or []
+    if violations:  # the run warned: the accuracy monitor's figure beyond its tolerance, said in the summary
+        v = violations[0]
+        return {**row, "class": "stopped", "why": f"flagged by the accuracy monitor: {v['figure']} {v['value']:.3g} "
+                                                  f"(tolerance {v['tolerance']:.3g}) at t = {v['t_s']:.3g} s"}
     return {**row, "class": "outside"}
 
 
@@ -91,12 +97,13 @@ def line(row: dict) -> str:
     drive = f"M {p.M:.3g}" if p.drive == "torque" else f"motor {p.M_stall:.3g} N m/{p.omega_noload:.3g} rad/s"
     head = (f"#{row['design']:3d} {row['class']:8s} m {p.m1:.2f}/{p.m2:.2f} r {p.r:.3f} L/r {p.L / p.r:.2f} "
             f"inc {p.incline:+6.1f} mu {p.mu_wall:.2f} F_n {p.F_n1:.0f}/{p.F_n2:.0f} {drive} {row['t_end']:.2f} s")
-    if row["class"] == "stopped":
+    if row["class"] == "stopped" and "x1_final" not in row:
         return head + f" | {row['why']}"
     figures = " ".join(f"{k} {a:+.4f}/{w:+.4f}" for k, (a, w) in
                        ((k, row[k]) for k in ("x1_final", "x2_final", "slip1_m", "slip2_m")))
     return head + (f" | {figures} | off {row['wheel_off_s']:.3f} s lift predicted {row['lift_predicted']} "
-                   f"press {row['press'][0]:.1f}/{row['press'][1]:.1f} N | {row['wall_s']:.0f} s")
+                   f"press {row['press'][0]:.1f}/{row['press'][1]:.1f} N | {row['wall_s']:.0f} s"
+                   + (f" | {row['why']}" if "why" in row else ""))
 
 
 def main(argv=None) -> int:

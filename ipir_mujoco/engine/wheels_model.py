@@ -281,10 +281,13 @@ def sag(params: RobotParams, module: int) -> float:
 
 def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
     """The loop closed at ``phi0`` with module 1 at 0, both modules sagged by their weight on their springs (the
-    mean of the two sags, so that the loop closes; the springs settle the rest), every wheel on its wall, at rest
+    mean of the two sags, so that the loop closes, and at most to the lower legs' stops; the springs settle the
+    rest), every wheel on its wall, at rest
     or with the crank at ``omega0`` (the slide model's rule, :func:`.model.start_closed_loop`)."""
     freed = start_closed_loop(model, data, params)
-    drop = 0.5 * (sag(params, 0) + sag(params, 1))
+    # no further than the lower legs' stops (a module heavier than its press rests on them; a larger drop would
+    # start its housing inside the wall)
+    drop = min(0.5 * (sag(params, 0) + sag(params, 1)), (STOP_COMPRESSION - 1.0) * params.suspension_travel)
     n = leg_count(params)
     for i in (0, 1):
         data.qpos[qpos_address(model, VERTICALS[i])] = -drop
