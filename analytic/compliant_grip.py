@@ -33,6 +33,8 @@ import math
 
 import numpy as np
 
+from ipir_mujoco.core.results import grip_use
+
 from . import kernels
 from .compliant_state import _HYSTERESIS_FORCE, _HYSTERESIS_OVERLAP, NO_SLIDE, Clutch
 
@@ -150,12 +152,10 @@ def piece_columns(model, regime, times: np.ndarray, columns: dict) -> None:
     shape = np.shape(times)
     for i in (0, 1):
         G = model.grip[i]
-        force = columns[f"lambda{i + 1}"]
-        columns[f"grip_use{i + 1}"] = force / G if G > 0 else np.where(regime.clutch[i] is Clutch.SLIDING, 1.0,
-                                                                         np.zeros(shape))
         state = -1 if regime.clutch[i] is Clutch.SLIDING else \
             (1 if regime.clutch[i] is Clutch.TRACKING and regime.slip[i] == 1 else 0)
         columns[f"wheels{i + 1}"] = np.full(shape, float(state))
+        columns[f"grip_use{i + 1}"] = grip_use(columns[f"lambda{i + 1}"], columns[f"wheels{i + 1}"], G)
 
 
 def run_columns(series: dict, grip: tuple[float, float]) -> dict[str, np.ndarray]:

@@ -50,7 +50,7 @@ import numpy as np
 
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.results import Mode
+from ipir_mujoco.core.results import Mode, grip_use
 
 from . import accel, dop853, kernels
 from .kinematics import Geometry
@@ -289,11 +289,8 @@ class GripModel:
             if state == -1:  # locked wheels skidding: the grip, all through the clutch
                 piece[f"lambda{i + 1}"] = np.full(shape, G)
                 piece[f"resistance{i + 1}"] = np.zeros(shape)
-                use = np.ones(shape)
-            else:
-                use = piece[f"lambda{i + 1}"] / G if G > 0 else np.zeros(shape)  # G = 0: a clutch that holds nothing
-            piece[f"grip_use{i + 1}"] = use
             piece[f"wheels{i + 1}"] = np.full(shape, float(state))
+            piece[f"grip_use{i + 1}"] = grip_use(piece[f"lambda{i + 1}"], piece[f"wheels{i + 1}"], G)
         return piece
 
     def energy_columns(self, series: dict) -> dict[str, np.ndarray]:

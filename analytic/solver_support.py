@@ -9,6 +9,7 @@ import time
 
 import numpy as np
 
+from ipir_mujoco.core.steady_test import steady_target
 from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
@@ -155,7 +156,8 @@ class RunMonitor:
     def __init__(self, options: RunOptions, phi0: float, max_switches: int):
         self.options = options
         self.t_end, self.phi0 = options.t_end, float(phi0)
-        self.watch = SteadyWatch(phi0, options.steady_tol, options.steady_cycles)
+        self.watch = SteadyWatch(phi0, options.steady_tol, options.steady_cycles,
+                                 steady_target("analytic", options.steady_tol))
         self.max_switches = options.max_switches if options.max_switches is not None else int(max_switches)
         self.wall_budget_s, self.progress, self.until_steady = (options.wall_budget_s, options.progress,
                                                                 options.until_steady)

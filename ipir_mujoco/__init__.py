@@ -12,6 +12,16 @@ Layers, bottom up:
 - :mod:`ipir_mujoco.studies`: compare, validate, sweeps, convergence;
 - :mod:`ipir_mujoco.report`: figures and the validation report;
 - :mod:`ipir_mujoco.cli`: the ``ipir-mujoco`` command.
+
+The public Python surface, importable from here::
+
+    from ipir_mujoco import run, RobotParams, RunResult, ParameterError, SimulationError, VARIANTS
+
+    result = run("mujoco-ratchet", RobotParams(drive="motor"), 2.0, dt_out=1e-3)
+
+:func:`run` runs any variant (a name of :data:`VARIANTS`) on a parameter set (:class:`RobotParams`) and
+returns a :class:`RunResult`; bad input is a :class:`ParameterError` (a ValueError), a run that cannot go on a
+:class:`SimulationError`. Everything else is reachable through the subpackages above.
 """
 
 from pathlib import Path as _Path
@@ -24,3 +34,10 @@ __version__ = "0.2.0"
 _here = _Path(__file__).resolve().parent
 if not (_here / "analytic").is_dir() and (_here.parent / "analytic" / "__init__.py").is_file():
     __path__.append(str(_here.parent))  # noqa: F821 (a package's own __path__)
+
+from .core.errors import ParameterError, SimulationError  # noqa: E402  (after the analytic folder is findable)
+from .core.params import RobotParams  # noqa: E402
+from .core.results import RunResult  # noqa: E402
+from .registry import VARIANTS, run  # noqa: E402
+
+__all__ = ["VARIANTS", "ParameterError", "RobotParams", "RunResult", "SimulationError", "__version__", "run"]

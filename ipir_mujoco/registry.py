@@ -39,6 +39,10 @@ from .core.errors import ParameterError
 from .core.params import RobotParams, check_real
 from .core.results import RunResult
 
+__all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
+# beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
+# the public surface: they may change with them)
+
 ENGINES = ("analytic", "mujoco")
 RULES = ("kinematic", "unilateral")
 MUJOCO_MODELS = ("slides", "wheels")  # MuJoCo's models: the modules on slides, or on wheels on the pipe walls
@@ -69,6 +73,7 @@ class Variant:
         return described
 
 
+# every variant by its canonical name: {name: Variant}; ``run(name, ...)`` runs one
 VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("analytic-approx", "analytic", "kinematic", "approx", None, "paper's model"),
     Variant("analytic-exact", "analytic", "kinematic", "exact", None, "analytic, paper's rule"),
@@ -199,17 +204,37 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
 def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options) -> RunResult:
     """Run the variant ``name`` on ``params`` for ``t_end`` [s] (with ``until_steady``, the cap).
 
-    Options every engine takes (:class:`ipir_mujoco.core.options.RunOptions`): ``dt_out`` [s],
-    ``until_steady``, ``steady_tol``, ``steady_cycles``, ``progress``, ``wall_budget_s`` [s]. The analytic
-    engines also take ``rtol``, ``atol``, ``max_switches``, ``method`` (compliant clutches) and ``torque``
-    (a torque profile); MuJoCo ``settings`` (:class:`ipir_mujoco.engine.SolverSettings`), ``timestep`` [s]
-    (short for settings with that step), ``mjcf``, ``accuracy`` ('stop' | 'warn'), ``servo`` and
-    ``every_step`` (sample at every step of the timestep MuJoCo chooses for ``dt_out``: where a sample holds
-    its step's force, so that a mean over a window is the impulse, and no engagement peak falls between
-    samples). An option the variant's engine does not take is refused in one line.
+    Parameters
+    ----------
+    name : str or Variant
+        A name of :data:`VARIANTS` (or an alias, e.g. ``"mujoco-ratchet-unilateral"``).
+    params : RobotParams
+        The robot; what it decides stays in it (a finite ``clutch_stiffness`` makes a one-way variant's
+        clutches compliant, a finite ``mu_wall`` its grip finite, ``drive`` the drive, ``incline`` the slope).
+    t_end : float
+        Simulated time [s]; with ``until_steady`` the cap.
+    **options
+        Every engine: ``dt_out`` [s], ``until_steady``, ``steady_tol``, ``steady_cycles``, ``progress``,
+        ``wall_budget_s`` [s] (:class:`ipir_mujoco.core.options.RunOptions`). The analytic engines also
+        ``rtol``, ``atol``, ``max_switches``, ``method`` (compliant clutches) and ``torque`` (a torque
+        profile); MuJoCo ``settings`` (:class:`ipir_mujoco.engine.SolverSettings`), ``timestep`` [s] (short for
+        settings with that step), ``mjcf``, ``accuracy`` ('stop' | 'warn'), ``servo``, ``route`` and
+        ``every_step`` (sample at every step of the timestep MuJoCo chooses, :func:`timestep`: a sample holds
+        its step's force, so a mean over a window is the impulse and no engagement peak falls between
+        samples). With ``params.drive = 'servo'`` the speed controller's ``feedforward`` table
+        (:func:`feedforward_table`) is computed here unless given.
 
-    With ``params.drive = 'servo'`` the speed controller's feedforward table (:func:`feedforward_table`) is
-    computed here and handed to the engine as data (``feedforward``; give one to use another).
+    Returns
+    -------
+    RunResult
+        The run: series (shape (n,) each), energy audit, summary, settings, accuracy record.
+
+    Raises
+    ------
+    ParameterError
+        An unknown name, an option the variant's engine does not take, or parameters it refuses (one line).
+    SimulationError
+        A run that cannot go on (one line with the time and the reason).
     """
     v = check_options(name, options)
     if params.drive == "servo" and options.get("feedforward") is None:

@@ -42,6 +42,8 @@ HOUSINGS = ("rear_housing", "front_housing")
 OVERLAY_MIN_WIDTH = 320  # px: narrower frames show the robot without the text
 ROUTE_VIEW_DISTANCE = 0.9  # m: the camera above the plane along a route (fovy 45 deg: 0.75 m of it in a frame's
 # height, 0.41 m between the texts: the robot, 0.4 m long, and its pipe, 0.16 m wide by default, fit there)
+SIDE_VIEW = (90.0, -50.0)  # deg: the camera's azimuth and elevation without a route
+PIPE_RGBA = (0.35, 0.45, 0.6, 0.55)  # the slide model's pipe, cut away: more opaque than a whole translucent tube
 LIBRARIES = {"egl": ("EGL", "EGL (Debian: apt-get install libegl1)"),
              "osmesa": ("OSMesa", "OSMesa (Debian: apt-get install libosmesa6)")}
 
@@ -60,6 +62,24 @@ def gl_backend() -> str:
             return name
     missing = " or ".join(LIBRARIES[name][1] for name in candidates)
     raise RenderUnavailable(f"rendering needs a headless OpenGL library and none was found: install {missing}")
+
+
+def view_direction(azimuth: float, elevation: float) -> np.ndarray:
+    """The unit direction a MuJoCo free camera looks along (3,), from its azimuth and elevation [deg]."""
+    az, el = math.radians(azimuth), math.radians(elevation)
+    return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+
+
+def route_view(route) -> tuple[float, float]:
+    """(azimuth, elevation) [deg] of a camera square to the plane a route lies in (the normal of least spread of
+    its centreline's points), looking from above that plane: a route in the horizontal plane is seen from straight
+    above (+x right, +y up), one that turns up into a riser from its side."""
+    if route.planar:
+        return 90.0, -90.0
+    points = np.array([route.at3(route.length * i / 100)[0] for i in range(101)])
+    normal = np.linalg.svd(points - points.mean(axis=0))[2][2]
+    d = normal if normal[2] <= 0 else -normal  # the view direction, downward or level
+    return math.degrees(math.atan2(d[1], d[0])), math.degrees(math.asin(max(-1.0, min(1.0, d[2]))))
 
 
 def _open_context(width: int, height: int):
@@ -130,6 +150,19 @@ def checker_floor(spec) -> None:
     spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]
 
 
+def in_pipe(spec, params: RobotParams, facing=None) -> None:
+    """Draw the slide model's round pipe around it (drawing only, :func:`.engine.pipe_drawing.draw_pipe`): with
+    ``facing`` (the camera's view direction) its far half, the near half cut away; without, the whole tube,
+    translucent. The floor moves under the pipe."""
+    from .engine.pipe_drawing import RGBA, draw_pipe
+    from .engine.pipe_walls import wall_pieces
+
+    D = params.pipe_diameter
+    draw_pipe(spec, wall_pieces(None, D, 0.0), D, facing=facing, rgba=RGBA if facing is None else PIPE_RGBA)
+    floor = spec.geom("pipe_floor")
+    floor.pos = [floor.pos[0], floor.pos[1], -0.5 * D - 0.01]
+
+
 def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: float,
                held: tuple[bool, bool], wheeled: bool = False) -> tuple[str, str]:
     """The overlay's (labels, values) of the robot's state: crank speed and turns, each module's speed and
@@ -155,6 +188,7 @@ def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = 
         spec = build_wheels_spec(params, route=route)
     else:
         spec = build_spec(params)
+        in_pipe(spec, params, view_direction(*SIDE_VIEW))  # the near half cut away
     checker_floor(spec)
     spec.visual.global_.offwidth = settings.width
     spec.visual.global_.offheight = settings.height
@@ -200,9 +234,9 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
     camera = mujoco.MjvCamera()
     camera.type = mujoco.mjtCamera.mjCAMERA_FREE
     if route is None:
-        camera.distance, camera.azimuth, camera.elevation = 0.5, 90.0, -50.0
-    else:  # from above: a route's near wall would hide the robot seen from the side; +x right, +y up
-        camera.distance, camera.azimuth, camera.elevation = ROUTE_VIEW_DISTANCE, 90.0, -90.0
+        camera.distance, (camera.azimuth, camera.elevation) = 0.5, SIDE_VIEW
+    else:  # square to the route's plane: a route's near wall would hide the robot seen along it
+        camera.distance, (camera.azimuth, camera.elevation) = ROUTE_VIEW_DISTANCE, route_view(route)
     option, perturb = mujoco.MjvOption(), mujoco.MjvPerturb()
     font = mujoco.mjtFontScale.mjFONTSCALE_150 if settings.width >= 600 else mujoco.mjtFontScale.mjFONTSCALE_100
     renderer = mujoco.MjrContext(model, font)

@@ -116,3 +116,29 @@ def test_studies_cli_and_report_reach_the_engines_only_through_the_registry():
             if isinstance(node, ast.ImportFrom) and node.module and node.module.endswith("engine.stepper"):
                 found.setdefault(relative, []).append("engine.stepper")
     assert set(found) <= STEPS_ITS_OWN, found
+
+
+def test_the_public_surface_is_importable_from_the_package_and_documented_in_sections():
+    """``from ipir_mujoco import run, RobotParams, RunResult, ParameterError, SimulationError, VARIANTS``: the
+    names a script needs, listed in ``__all__``, each with numpydoc sections; importing them loads no engine."""
+    import inspect
+    import subprocess
+    import sys
+
+    from ipir_mujoco import ParameterError as PE, RobotParams as RP, RunResult, SimulationError, VARIANTS, run
+    from ipir_mujoco.engine.kinds import ModelKind
+
+    assert run is registry.run and VARIANTS is registry.VARIANTS and RP is RobotParams and PE is ParameterError
+    assert set(ipir_mujoco.__all__) >= {"run", "RobotParams", "RunResult", "ParameterError", "SimulationError",
+                                        "VARIANTS"}
+    sections = {run: ("Parameters", "Returns", "Raises"), RP: ("Parameters", "Raises"),
+                RunResult: ("Parameters", "Attributes"), PE: ("Parameters",), SimulationError: ("Parameters",),
+                ModelKind.check: ("Parameters", "Returns", "Raises"), ModelKind: ("Attributes",)}
+    for thing, wanted in sections.items():
+        doc = inspect.cleandoc(thing.__doc__)
+        for section in wanted:
+            assert f"\n{section}\n{'-' * len(section)}\n" in doc, (thing, section)
+    assert all(f"\n    {f} : " in RP.__doc__ for f in ("m1", "mu_wall", "speed_ki"))  # every field, from its metadata
+    code = "import sys, ipir_mujoco; print(sorted(m for m in ('mujoco', 'scipy', 'ipir_mujoco.engine') if m in sys.modules))"
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert loaded.strip() == "[]"

@@ -235,6 +235,7 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
     bend = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "bend:time"][0]
     assert list(bend.get_ydata()) == pytest.approx([1.2 / 1.32, 2.74 / 2.735], rel=1e-12)
     for argv, word in ((("--ratios", "0.4"), "--ratios"), (("--ratios", "1,abc"), "--ratios"),
+                       (("--planes", "200"), "--planes"),
                        (("--set", "pipe_diameter=0.05"), "pipe_diameter")):  # refused before any run or progress
         code, out, err = run_cli(capsys, "bend-study", *argv, "--out", tmp_path / "o")
         assert code == 2 and word in err and len(err.strip().splitlines()) == 1, (argv, err)
@@ -255,3 +256,16 @@ def test_a_route_whose_planar_walls_would_be_too_large_is_refused_before_buildin
     with pytest.raises(ParameterError, match="out of the mechanism's plane"):
         across = [BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.5)]
         check_wall_count(route_from_tables(across), 0.16)
+
+
+def test_a_bend_faster_than_its_twin_says_why_with_the_runs_numbers():
+    """The bend study's note: a bend more than TWIN_SLACK faster than its straight twin is explained by its
+    wheels' time off the wall, or (all wheels on it) by the passage's timing ripple; a slower one has no note."""
+    from ipir_mujoco.studies.bend_study import TWIN_SLACK, twin_note
+
+    twin = {"time_s": 1.0}
+    off = {"time_s": 0.9, "route_wheel_off_s": 0.92, "route_module_off_s": 0.13}
+    assert "10.0 % faster" in twin_note(off, twin) and "off their walls 0.920 s" in twin_note(off, twin)
+    assert "timing ripple" in twin_note({"time_s": 0.99, "route_wheel_off_s": 0.0}, twin)
+    assert twin_note({"time_s": 1.0 - 0.5 * TWIN_SLACK, "route_wheel_off_s": 1.0}, twin) is None
+    assert twin_note({"time_s": None}, twin) is None

@@ -356,3 +356,41 @@ def test_the_overlay_says_a_free_wheeled_module_rolls():
     _, wheels = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True), wheeled=True)
     assert slides.splitlines()[1].endswith("clutch slides") and wheels.splitlines()[1].endswith("clutch free, rolls")
     assert slides.splitlines()[2] == wheels.splitlines()[2] == "0.00 m/s, clutch holds (green)"
+
+
+def test_the_slide_model_is_drawn_in_its_pipe_cut_away_towards_the_camera():
+    """Without OpenGL: the drawing model of a slide run carries the round pipe (a tube of the pipe's diameter
+    about the x axis, colliding with nothing), only its far half as the camera looks (every vertex's outward
+    direction has a non-negative component along the view: 1e-9 for round-off of unit vectors), and the floor
+    below it."""
+    from ipir_mujoco.video import SIDE_VIEW, _render_model, view_direction
+
+    params = RobotParams()
+    model = _render_model(params, VideoSettings(width=96, height=64))
+    geom = model.geom("pipe_drawn1")
+    assert model.geom_contype[geom.id] == 0 and model.geom_conaffinity[geom.id] == 0
+    mesh = model.geom_dataid[geom.id]
+    start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+    local = model.mesh_vert[start:start + count]
+    rotation = np.zeros(9)
+    import mujoco
+
+    mujoco.mju_quat2Mat(rotation, geom.quat)
+    world = local @ rotation.reshape(3, 3).T + geom.pos  # MuJoCo recentres a mesh: its frame is the geom's
+    radius = np.hypot(world[:, 1], world[:, 2])
+    np.testing.assert_allclose(radius, params.pipe_diameter / 2, rtol=1e-6)
+    outward = np.column_stack([np.zeros(count), world[:, 1], world[:, 2]]) / radius[:, None]
+    assert (outward @ view_direction(*SIDE_VIEW) > -1e-6).all()
+    assert model.geom("pipe_floor").pos[2] < -params.pipe_diameter / 2
+
+
+def test_the_camera_along_a_route_looks_square_to_its_plane():
+    """A route in the horizontal plane is seen from straight above; one turning up into a riser (its points in
+    the x-z plane) from its side, level (the view along -+y)."""
+    from ipir_mujoco.core.route import route_from_tables
+    from ipir_mujoco.video import route_view
+
+    assert route_view(route_from_tables(BEND)) == (90.0, -90.0)
+    up = route_from_tables([BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.3)])
+    azimuth, elevation = route_view(up)
+    assert abs(abs(azimuth) - 90.0) < 1e-6 and abs(elevation) < 1e-6

@@ -42,6 +42,7 @@ try:
     from ..resources import shipped
     from . import (bend_study, climb, clutch_study, compare, control_study, kinetostatics, optimize, params, render,
                    sensitivity, simulate, sweep, validate)
+    from . import atlas
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
     if _loading_guard:
@@ -50,7 +51,7 @@ finally:
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "main"]
 
 COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
-            climb, control_study, bend_study)
+            climb, control_study, bend_study, atlas)
 
 
 def build_parser() -> Parser:

@@ -26,6 +26,10 @@ def add_parser(commands) -> None:
     cmd.add_argument("--ratios", metavar="LIST", default=None,
                      help="bend radius over pipe diameter, R/D: a comma-separated list (default 0.6,1,1.5,2,3,5,7.5,10)")
     cmd.add_argument("--quick", action="store_true", help="R/D 2 and 5 only, for a first look")
+    cmd.add_argument("--planes", metavar="LIST", default=None,
+                     help="the bends' planes [deg], turned about the pipe's axis: a comma-separated list (default 0: "
+                          "horizontal, across gravity; 90: turning up, in the plane of gravity; needs a model that "
+                          "bends out of the mechanism's plane)")
     add_study_options(cmd, "bend-study", "e.g. pipe_diameter=0.2; "
                                        "the study runs the default motor and, unless given, mu_wall 0.8")
     cmd.set_defaults(handler=run)
@@ -40,27 +44,30 @@ def run(args: argparse.Namespace) -> int:
     ratios = parse_values("--ratios", args.ratios, log=False) if args.ratios is not None else \
         (bs.RATIOS_QUICK if args.quick else bs.RATIOS)
     bs.check_ratios(ratios, params)
+    planes = parse_values("--planes", args.planes, log=False) if args.planes is not None else bs.PLANES
+    bs.check_planes(planes, params, min(ratios))
     workers = (os.cpu_count() or 1) if args.workers is None else check_whole("workers", args.workers, low=1, high=1024)
     check_output_dir(args.out, files=FILES)
 
     progress = study_progress("bend-study")
-    progress(f"{len(ratios)} bends and their straight twins on {workers} processes (each ~2 s of wall time per "
-             "simulated second)")
-    study = bs.run_study(params, ratios, workers=workers, progress=progress)
+    progress(f"{len(ratios) * len(planes)} bends and {len(ratios)} straight twins on {workers} processes (each ~2 s "
+             "of wall time per simulated second)")
+    study = bs.run_study(params, ratios, workers=workers, progress=progress, planes=planes)
     write_study_files(args.out, FILES, study, write_csv, lambda path: write_bend_figure(study, path),
                       format_table(study), f"{len(study['rows'])} bends")
     return EXIT_OK
 
 
-COLUMNS = ("R_over_D", "radius_m", "window_m", "analytic_time_s", "analytic_energy_j", "straight_time_s",
+COLUMNS = ("plane_deg", "R_over_D", "radius_m", "window_m", "analytic_time_s", "analytic_energy_j", "straight_time_s",
            "straight_energy_j", "bend_time_s", "bend_energy_j", "bend_passed", "bend_route_stop",
            "bend_wheel_off_s", "bend_module_off_s", "bend_arm_reach", "bend_residual_ratio", "bend_skid_j",
-           "predicted")
+           "predicted", "bend_potential_j", "note")
 
 
 def _flat(row: dict) -> dict:
     b, s, a = row["bend"], row["straight"], row["analytic"]
-    return {"R_over_D": row["R_over_D"], "radius_m": row["radius_m"], "window_m": row["window_m"],
+    return {"plane_deg": row.get("plane_deg", 0.0), "note": row.get("note"), "bend_potential_j": b.get("potential_j"),
+            "R_over_D": row["R_over_D"], "radius_m": row["radius_m"], "window_m": row["window_m"],
             "analytic_time_s": a["time_s"], "analytic_energy_j": a["energy_j"], "straight_time_s": s.get("time_s"),
             "straight_energy_j": s.get("energy_j"), "bend_time_s": b.get("time_s"), "bend_energy_j": b.get("energy_j"),
             "bend_passed": b.get("passed"), "bend_route_stop": b.get("error", b.get("route_stop")),
@@ -95,12 +102,13 @@ def format_table(study: dict) -> str:
     def num(v, digits=4):
         return "n/a" if v is None else f"{v:.{digits}g}"
 
-    header = ["R/D", "window [m]", "time [s] bend / straight / analytic", "energy [J] bend / straight / analytic",
+    header = ["plane [deg]", "R/D", "window [m]", "time [s] bend / straight / analytic",
+              "energy [J] bend / straight / analytic",
               "wheels off [s]", "closed form", "outcome"]
     rows = []
     for row in study["rows"]:
         f = _flat(row)
-        rows.append([f"{f['R_over_D']:g}", f"{f['window_m']:.3f}",
+        rows.append([f"{f['plane_deg']:g}", f"{f['R_over_D']:g}", f"{f['window_m']:.3f}",
                      f"{num(f['bend_time_s'])} / {num(f['straight_time_s'])} / {num(f['analytic_time_s'])}",
                      f"{num(f['bend_energy_j'])} / {num(f['straight_energy_j'])} / {num(f['analytic_energy_j'])}",
                      num(f["bend_wheel_off_s"], 3),
@@ -108,6 +116,14 @@ def format_table(study: dict) -> str:
                      "passed" if f["bend_passed"] else f"stopped: {f['bend_route_stop']}"])
     widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
     lines = ["  ".join(str(x).ljust(w) for x, w in zip(r, widths)) for r in [header] + rows]
+    for row in study["rows"]:
+        f = _flat(row)
+        where = f"plane {f['plane_deg']:g} deg, R/D {f['R_over_D']:g}"
+        if abs(f["bend_potential_j"] or 0.0) > 1e-3:  # a bend in the plane of gravity: energy net of the climb, J
+            lines.append(f"{where}: the window climbs ({f['bend_potential_j']:.3g} J of potential energy gained, "
+                         "taken out of the bend's energy; its time includes the climb)")
+        if f["note"]:
+            lines.append(f"{where}: the bend passed {f['note']}")
     ref = study["reference"]
     lines.append(f"analytic straight pipe: {ref['steady_speed_m_s']:.5g} m/s, {ref['energy_per_metre_j_m']:.5g} J/m")
     return "\n".join(lines)

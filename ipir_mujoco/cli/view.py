@@ -41,7 +41,7 @@ from ipir_mujoco.core.params import RobotParams
 from ..engine.kinds import kind_for
 from ..engine.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
 from ..engine.run_setup import RunSetup
-from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
+from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
 
@@ -63,8 +63,13 @@ class ViewedRobot:
         if settings is None:  # the step the engine would choose for a run of t_end [s]
             settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation)
         self.settings = settings
+        def decorate(spec):
+            if not self.wheeled:  # the slide model in its pipe, whole and translucent: the viewer's camera turns
+                in_pipe(spec, params)
+            checker_floor(spec)
+
         self.setup = RunSetup(kind, params, settings, implementation=self.implementation, rule=clutch, route=route,
-                              decorate=checker_floor)
+                              decorate=decorate)
         self.model, self.data = self.setup.model, self.setup.data
         self.housings = [self.model.geom(name).id for name in HOUSINGS]
         self._qvel_before = np.empty((1, self.model.nv))  # the loop's sample buffer (the viewer takes no samples)

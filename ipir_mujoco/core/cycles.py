@@ -40,6 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# LIMIT_ACCURACY's old home: studies and benchmarks import it from here
+from .steady_test import LIMIT_ACCURACY, Steady, find_steady, window_uncertainty  # noqa: F401
 
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
@@ -194,11 +196,13 @@ def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: i
     return None
 
 
-def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> list | None:
-    """The ``n`` whole revolutions (of :func:`cycles`) at whose end the run first is at steady state
-    (:func:`steady_index`), or None: the window every steady-state figure is taken over."""
-    k = steady_index([c.mean_speed_m_s for c in found], tol, n)
-    return None if k is None else found[k - n + 1:k + 1]
+def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES,
+                  target: float | None = None) -> list | None:
+    """The whole revolutions (of :func:`cycles`) at whose end the run first is at steady state, or None: the
+    window every steady-state figure is taken over. ``target``: the statistical test's (None: the exact test
+    alone, :func:`steady_index`'s ``n`` revolutions); see :mod:`.steady_test`."""
+    found_steady = find_steady([c.mean_speed_m_s for c in found], tol, n, target, steady_at_end)
+    return None if found_steady is None else found[found_steady.start:found_steady.end + 1]
 
 
 def efficiency(motor_j: float, resistance_j: float, lifted_j: float = 0.0, kinetic_j: float = 0.0,
@@ -232,12 +236,6 @@ def _stretch_efficiency(series: dict[str, np.ndarray], t0: float, t1: float) -> 
                       gained["clutch_spring_energy"])
 
 
-# The accuracy the steady figures are stated to (relative to the periodic limit each engine converges to) and
-# held to by tests/test_steady_limit.py against runs taken much closer to that limit: the analytic engines'
-# per-revolution figures are smooth to their integration tolerance, so the extrapolation below leaves a
-# second-order error; MuJoCo's wobble from revolution to revolution by a few 1e-5 (where its steps fall in
-# a revolution), which no extrapolation removes.
-LIMIT_ACCURACY = {"analytic": 2e-5, "mujoco": 3e-4}
 
 
 def transit_free_energy(window: list[Cycle]) -> dict[str, float | None]:
@@ -312,7 +310,8 @@ def speed_figures(series: dict[str, np.ndarray], t0: float, t1: float) -> dict:
     return out
 
 
-def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> dict:
+def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int = STEADY_CYCLES,
+                  target: float | None = None) -> dict:
     """The summary's per-revolution keys.
 
     ``steady`` (bool), ``t_steady_s``, ``steady_speed_m_s`` and
@@ -323,20 +322,35 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     else over the whole run (None where the run lacks the columns); ``cycles``: whole
     revolutions; ``cycle_energy_residual_j``: the largest |audit residual| of a
     revolution (None without energy columns); the crank-speed figures of :func:`speed_figures` over the
-    steady window when steady, else over the whole run.
+    steady window when steady, else over the whole run. ``target``: the statistical steady test's
+    (:mod:`.steady_test`; None: the exact test alone). With it, where steady: ``steady_test`` ('exact' or
+    'statistical'), ``steady_revolutions`` (the window's length), ``steady_speed_uncertainty_m_s`` and
+    ``energy_per_metre_uncertainty_j_m`` (:func:`steady_uncertainties`); None where not steady.
     """
     found = cycles(series)
-    k = steady_index([c.mean_speed_m_s for c in found], tol, n)
-    window = None if k is None else found[k - n + 1:k + 1]
+    steady = find_steady([c.mean_speed_m_s for c in found], tol, n, target, steady_at_end)
+    window = None if steady is None else found[steady.start:steady.end + 1]
     out = {"steady": window is not None, "t_steady_s": None, "steady_speed_m_s": None, "energy_per_metre_j_m": None,
            "cycles": len(found)}
+    if target is not None:
+        out.update(steady_test=None, steady_revolutions=None, steady_speed_uncertainty_m_s=None,
+                   energy_per_metre_uncertainty_j_m=None)
     residuals = [abs(c.residual_j) for c in found if c.residual_j is not None]
     out["cycle_energy_residual_j"] = max(residuals) if residuals else None
     if window is not None:
+        k = steady.end
         out["t_steady_s"] = window[-1].t_end
-        out["steady_speed_m_s"], out["distance_per_rev_m"] = limit_motion(found[max(k - 2, 0):k + 1], tol)
+        if steady.test == "exact":
+            out["steady_speed_m_s"], out["distance_per_rev_m"] = limit_motion(found[max(k - 2, 0):k + 1], tol)
+        else:  # no approach left to extrapolate: the window's totals
+            time = sum(c.period_s for c in window)
+            out["distance_per_rev_m"] = sum(c.distance_m for c in window) / len(window)
+            out["steady_speed_m_s"] = sum(c.distance_m for c in window) / time
         energy = transit_free_energy(window)
         out["energy_per_metre_j_m"], out["efficiency"] = energy["energy_per_metre"], energy["efficiency"]
+        if target is not None:
+            out.update(steady_test=steady.test, steady_revolutions=len(window),
+                       **steady_uncertainties(window, steady, out["steady_speed_m_s"], out["energy_per_metre_j_m"]))
         peaks = [c.peak_clutch_force_n for c in window if c.peak_clutch_force_n is not None]
         out["peak_clutch_force_n"] = max(peaks) if peaks else None
         out.update(speed_figures(series, window[0].t_start, window[-1].t_end))
@@ -349,4 +363,22 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     lambdas = [series[c] for c in ("lambda1", "lambda2") if c in series]
     out["peak_clutch_force_n"] = float(max(v.max() for v in lambdas)) if lambdas else None
     out.update(speed_figures(series, float(t[0]), float(t[-1])))
+    return out
+
+
+def steady_uncertainties(window: list[Cycle], steady: Steady, speed: float, energy: float | None) -> dict:
+    """``steady_speed_uncertainty_m_s`` [m/s] and ``energy_per_metre_uncertainty_j_m`` [J/m] of a steady window:
+    by the exact test, the stated accuracy times each figure; by the statistical test, the speed's U
+    (:mod:`.steady_test`) and the same confidence half-width plus trend reach of the revolutions' own energy
+    per metre (motor work less the kinetic and spring energy gained, over the distance; None where a
+    revolution has no such figure)."""
+    out = {"steady_speed_uncertainty_m_s": steady.uncertainty * abs(speed), "energy_per_metre_uncertainty_j_m": None}
+    if energy is None:
+        return out
+    if steady.test == "exact":
+        out["energy_per_metre_uncertainty_j_m"] = steady.uncertainty * abs(energy)
+        return out
+    per_rev = [transit_free_energy([c])["energy_per_metre"] for c in window]
+    if all(e is not None for e in per_rev):
+        out["energy_per_metre_uncertainty_j_m"] = window_uncertainty(per_rev)
     return out

@@ -8,7 +8,12 @@ a simulation that cannot go on is a :class:`SimulationError` (exit status 1).
 class ParameterError(ValueError):
     """A parameter value, name, option or file is not acceptable.
 
-    The message names the offending value and what is allowed.
+    The message names the offending value and what is allowed, in one line (the command line: exit status 2).
+
+    Parameters
+    ----------
+    message : str
+        The one line.
     """
 
 
@@ -20,5 +25,10 @@ class StudyInterrupted(RuntimeError):
 class SimulationError(RuntimeError):
     """A simulation failed (solver failure, instability, chattering).
 
-    The message gives the simulated time and the reason.
+    The message gives the simulated time and the reason, in one line (the command line: exit status 1).
+
+    Parameters
+    ----------
+    message : str
+        The one line.
     """

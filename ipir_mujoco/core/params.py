@@ -286,6 +286,23 @@ def describe_parameters() -> list[dict[str, Any]]:
     return rows
 
 
+def _parameters_section() -> str:
+    """RobotParams' numpydoc ``Parameters`` section, written from the fields' own metadata (one definition)."""
+    import textwrap
+
+    lines = ["", "", "    Parameters", "    ----------"]
+    for row in describe_parameters():
+        lines.append(f"    {row['name']} : {row['units']}")
+        text = f"{row['meaning']}. Default {row['default_text']}; allowed {row['allowed']}."
+        lines += textwrap.wrap(text, 110, initial_indent=" " * 8, subsequent_indent=" " * 8)
+    lines += ["", "    Raises", "    ------", "    ParameterError",
+              "        A value out of its range, an unknown choice, or fields that do not fit together (one line).", ""]
+    return "\n".join(lines)
+
+
+RobotParams.__doc__ = RobotParams.__doc__.rstrip() + _parameters_section()
+
+
 def parameter_units(name: str) -> str:
     """The unit of parameter ``name`` ('-' for a choice)."""
     return _FIELDS[name].metadata["units"]

@@ -30,23 +30,31 @@ Engines add their own columns beside these; every engine that drives the
 robot also writes the cumulative energy columns :mod:`.cycles` reads
 (``motor_work``, ``friction_work``, ``kinetic``, ``potential``, all in J).
 
-With finite grip (``mu_wall``, docs/model.md "Finite grip") an engine writes
-these too, and the summary reads them where present (a run without them, as
-with unlimited grip, has slip1_m = slip2_m = 0.0 and peak_grip_use = None):
+With finite grip (``mu_wall``, docs/model.md "Finite grip") every engine writes
+these too (a run without them, as with unlimited grip, has slip1_m = slip2_m =
+0.0 and peak_grip_use = None). The summary's grip keys are read off them the
+same way for every engine: ``peak_grip_use`` from ``lambda1/2`` and
+``wheels1/2`` (:func:`grip_use`, :func:`peak_grip_use`), ``slip1_m``/``slip2_m``
+from ``slip1/2``, ``mode_switches`` with the changes of ``wheels1/2``:
 
 ===========  ====  ====================================================
 column       unit  meaning
 ===========  ====  ====================================================
+wheels1/2    -     each module's state, +1 rolling forward, 0 standing,
+                   -1 skidding back (its locked wheels slide back on the
+                   wall); a module counts as held (``mode``) only while
+                   it stands
+lambda1/2    N     (the columns above) the clutch's share of the hold
+                   while the module stands, what its clutch carries
+                   while it skids (G_i), 0 while it rolls
 slip1/2      m     backward skid of module 1 / 2's locked wheels on the
-                   wall since t = 0 (cumulative, >= 0; with a compliant
-                   clutch its anchor's, not the module body's)
-grip_use1/2  -     clutch reaction over the grip, lambda_i / G_i (1 while
-                   the module skids; 0 where G_i = 0 and it does not)
+                   wall since t = 0 (cumulative, >= 0: their backward
+                   travel over the samples where it skids; with a
+                   compliant clutch its anchor's, not the module body's)
+grip_use1/2  -     :func:`grip_use`: 1 while the module skids, else
+                   max(lambda_i, 0) / G_i capped at 1 (0 where G_i = 0)
 skid_work    J     cumulative work of the grip against skidding,
                    sum G_i slip_i; an energy audit term (``skid_j``)
-wheels1/2    -     optional: each module's state, +1 rolling forward, 0
-                   standing, -1 skidding back (mode_switches counts its
-                   changes as mode changes)
 ===========  ====  ====================================================
 
 MuJoCo's wheeled model (``mujoco-wheels``) also writes each module's pose in
@@ -70,6 +78,8 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .errors import ParameterError
 from .params import RobotParams
+from .pipe import lift_summary
+from .steady_test import steady_target
 
 # [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
 # orders of magnitude above the creep of a module MuJoCo's soft constraints hold, so every engine's series
@@ -134,6 +144,35 @@ class RunResult:
     ``residual_ratio`` and ``loop_gap_m``), or None. ``route`` is None, or a
     run along a route's summary keys (``route_done``, ``route_time_s``,
     ``route_stop``, ...: ``ipir_mujoco.engine.route_watch``).
+
+    Parameters
+    ----------
+    engine : str
+        'analytic' or 'mujoco'.
+    geometry : str
+        'approx' (the paper's first order) or 'exact'.
+    clutch : str
+        The clutch rule: 'kinematic', 'unilateral' (or 'none').
+    params : RobotParams
+        The parameter set the run used.
+    t_end : float
+        The last sample's time [s].
+    series : dict of str to ndarray
+        Every column of :data:`COLUMNS` (and engine-specific ones), each of shape (n,), in SI units
+        (:data:`SERIES_UNITS`).
+    energy : dict of str to float
+        The energy audit [J].
+    wall_time_s : float
+        Wall time of the run [s].
+    settings : dict
+        Solver settings and what chose them.
+    stall, accuracy, route
+        As above.
+
+    Attributes
+    ----------
+    summary : dict
+        Figures every engine's run gets (revolutions, speeds, peak forces, steady state, efficiency, ...).
     """
 
     engine: str
@@ -166,14 +205,19 @@ class RunResult:
         return (self.settings.get("steady_tol", STEADY_TOL), self.settings.get("steady_cycles", STEADY_CYCLES))
 
     @property
+    def steady_target(self) -> float:
+        """The statistical steady test's target [-] of this run (:func:`.steady_test.steady_target`: the
+        accuracy its engine states for steady figures, or its steady_tol where looser), as its engine's watch
+        applied it."""
+        return steady_target(self.engine, self.steady_test[0])
+
+    @property
     def summary(self) -> dict[str, Any]:
         """The summary figures of the command-line contract (docs/cli.md)."""
-        summary = summarize(self.series, self.energy)
+        summary = summarize(self.series, self.energy, self.params.grip)
         if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
-            from .pipe import lift_summary
-
             summary.update(lift_summary(self.params))
-        summary.update(cycle_summary(self.series, *self.steady_test))
+        summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall
         if self.stall is not None:  # a robot at rest for good has no revolution to be "per": no such figures
@@ -225,14 +269,13 @@ class RunResult:
 
     def plot(self, *others: "RunResult", path: str | Path | None = None):
         """The paper's figures (crank, modules, gap against time) of this run and any ``others`` drawn over it:
-        a list of three matplotlib figures; with ``path`` (a folder) also written there as fig2-4 PNG."""
-        from ipir_mujoco.report import plots  # drawing only: the one import of a layer above, kept lazy
+        a list of three matplotlib figures; with ``path`` (a folder) also written there as fig2-4 PNG.
 
-        runs = [self, *others]
-        if path is not None:
-            Path(path).mkdir(parents=True, exist_ok=True)
-            plots.write_paper_figures(runs, path)
-        return [plots.figure_crank(runs), plots.figure_modules(runs), plots.figure_gap(runs)]
+        A thin call of :func:`ipir_mujoco.report.plots.plot_runs` (the drawing lives in the report layer, which
+        imports nothing of this module: no import cycle)."""
+        from ipir_mujoco.report.plots import plot_runs  # matplotlib is loaded only when a run is drawn
+
+        return plot_runs([self, *others], path)
 
     def write_csv(self, path: str | Path) -> None:
         """Write the time series as CSV with a header row of :data:`COLUMNS`."""
@@ -316,9 +359,26 @@ def slip(series: dict[str, np.ndarray], module: int) -> float:
     return 0.0 if column is None else max(float(column[-1] - column[0]), 0.0)
 
 
-def peak_grip_use(series: dict[str, np.ndarray]) -> float | None:
-    """Largest clutch reaction over the grip, max of ``grip_use1/2`` [-] (1: a module skidded); None
-    where the series has neither (unlimited grip: no ratio exists)."""
+def grip_use(lam, wheels, G: float) -> np.ndarray:
+    """One module's ``grip_use`` column [-], the one definition every engine writes: 1 where its wheels skid
+    (``wheels`` == -1), else its clutch's reaction over its grip, max(lambda, 0) / G, at most 1 (a module that
+    does not skid holds within its grip by the law; what a soft engine shows beyond it, a carriage's or a
+    wheel's inertia force, is not the clutch's use of the grip). G = 0 [N]: 0 unless it skids. Arrays (n,):
+    ``lam`` [N] the ``lambda`` column, ``wheels`` the ``wheels`` column (+1 rolling, 0 standing, -1 skidding)."""
+    lam, wheels = np.asarray(lam, dtype=float), np.asarray(wheels, dtype=float)
+    use = np.minimum(np.maximum(lam, 0.0) / G, 1.0) if G > 0 else np.zeros(lam.shape)
+    return np.where(wheels == -1.0, 1.0, use)
+
+
+def peak_grip_use(series: dict[str, np.ndarray], grip: tuple[float, float] | None = None) -> float | None:
+    """Largest grip use over the run [-] (1: a module skidded), from the columns every engine writes on finite
+    grip, ``lambda1/2`` and ``wheels1/2``, by :func:`grip_use` with ``grip`` (G1, G2) [N] (a series without
+    them: its ``grip_use1/2`` columns). None with unlimited grip (``grip`` None: no ratio exists)."""
+    if grip is None:
+        return None
+    if all(c in series for c in ("lambda1", "lambda2", "wheels1", "wheels2")):
+        return float(max(grip_use(series[f"lambda{k}"], series[f"wheels{k}"], G).max()
+                         for k, G in zip((1, 2), grip)))
     columns = [np.asarray(series[c], dtype=float) for c in ("grip_use1", "grip_use2") if c in series]
     return float(max(c.max() for c in columns)) if columns else None
 
@@ -334,8 +394,10 @@ def wheel_keys(series: dict[str, np.ndarray]) -> dict[str, float]:
             "wheel_off_s": float(np.sum(np.diff(t)[off[:-1] > 0]))}
 
 
-def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[str, Any]:
-    """The summary figures of a run, computed from its time series."""
+def summarize(series: dict[str, np.ndarray], energy: dict[str, float],
+              grip: tuple[float, float] | None = None) -> dict[str, Any]:
+    """The summary figures of a run, computed from its time series; ``grip`` (G1, G2) [N] of finite grip
+    (:attr:`.params.RobotParams.grip`), None for unlimited grip."""
     t, phi = series["t"], series["phi"]
     return {
         "revolutions": float((phi[-1] - phi[0]) / (2 * math.pi)),
@@ -348,7 +410,7 @@ def summarize(series: dict[str, np.ndarray], energy: dict[str, float]) -> dict[s
         "min_clutch_reaction_n": min_locked_reaction(series),
         "slip1_m": slip(series, 1),
         "slip2_m": slip(series, 2),
-        "peak_grip_use": peak_grip_use(series),
+        "peak_grip_use": peak_grip_use(series, grip),
         **wheel_keys(series),
         "energy": dict(energy),
     }

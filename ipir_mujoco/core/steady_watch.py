@@ -1,6 +1,6 @@
 """The periodic steady state watched while a run goes: :class:`SteadyWatch`, fed sample by sample by every
-engine's run loop, and the one check of the steady test's settings (:func:`check_steady_test`). The test
-itself, and the figures read off a finished run, are :mod:`.cycles`'."""
+engine's run loop, and the one check of the steady test's settings (:func:`check_steady_test`). The tests
+themselves are :mod:`.steady_test`'s, the figures read off a finished run :mod:`.cycles`'."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from .cycles import STEADY_CYCLES, STEADY_TOL, steady_at_end
+from .steady_test import steady_at
 from .errors import ParameterError
 from .params import as_real
 
@@ -28,13 +29,16 @@ class SteadyWatch:
     """Tells an engine, sample by sample, when its run has reached the periodic steady state.
 
     Feed it the samples as they come (:meth:`update` with arrays of t [s], phi
-    [rad] and robot travel [m]); it returns True once the last ``n`` revolutions'
-    mean speeds are steady (:func:`steady_at_end`). Cheap: work only where a revolution ends.
+    [rad] and robot travel [m]); it returns True once the per-revolution mean speeds
+    are steady (:func:`.steady_test.steady_at`: the exact test on the last ``n``, or with a ``target``
+    [-], the engine's :func:`.steady_test.steady_target`, the statistical one). Cheap: work only where a
+    revolution ends. ``found``: the :class:`.steady_test.Steady` once steady.
     """
 
-    def __init__(self, phi0: float, tol: float = STEADY_TOL, n: int = STEADY_CYCLES):
+    def __init__(self, phi0: float, tol: float = STEADY_TOL, n: int = STEADY_CYCLES, target: float | None = None):
         tol, n = check_steady_test(tol, n)
-        self.phi0, self.tol, self.n = float(phi0), tol, n
+        self.phi0, self.tol, self.n, self.target = float(phi0), tol, n, target
+        self.found = None
         self.reach = 0.0  # running maximum of phi - phi0
         self.last = None  # (t, reach, travel) of the previous sample
         self.boundary = None  # (t, travel) where the current revolution began
@@ -61,8 +65,10 @@ class SteadyWatch:
                 if tb > self.boundary[0]:
                     self.speeds.append((xb - self.boundary[1]) / (tb - self.boundary[0]))
                 self.boundary = (tb, xb)
-                if self.steady_at is None and steady_at_end(self.speeds[-(self.n + 1):], self.tol, self.n):
-                    self.steady_at = tb
+                if self.steady_at is None and self.speeds:
+                    self.found = steady_at(np.asarray(self.speeds), self.tol, self.n, self.target, steady_at_end)
+                    if self.found is not None:
+                        self.steady_at = tb
                 self.turns += 1  # counted apart from the speeds, or a turn of no duration would loop forever
                 target = 2 * math.pi * (self.turns + 1)
             prev_t, prev_r, prev_x = ti, ri, xi

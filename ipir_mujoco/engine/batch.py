@@ -39,6 +39,7 @@ import numpy as np
 from mujoco import batch as mjbatch
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
+from ipir_mujoco.core.steady_test import steady_target
 from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.options import RunOptions
@@ -211,7 +212,8 @@ class _Batch:
         self.energy0 = self.energy.copy()  # (potential, kinetic) [J] at t = 0
         climb = [climb_energy(m, p) for m, p in zip(self.models, self.designs)]
         self.floor = np.maximum.reduce([self.energy0[:, 1], 2 * math.pi * np.abs(torque), climb])
-        self.watches = [SteadyWatch(float(self.qpos[k, self.crank_q]), self.steady_tol, self.steady_cycles)
+        self.watches = [SteadyWatch(float(self.qpos[k, self.crank_q]), self.steady_tol, self.steady_cycles,
+                                   steady_target("mujoco", self.steady_tol))
                         for k in range(n)] if self.until_steady else None
         self.fed = 0
         self._sample(0, self.qvel - self.dt[:, None] * qacc, np.zeros(n))  # first accelerations: MuJoCo's qacc

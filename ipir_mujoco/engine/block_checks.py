@@ -8,6 +8,7 @@ import time
 
 import numpy as np
 
+from ipir_mujoco.core.steady_test import steady_target
 from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import SimulationError
 
@@ -25,7 +26,8 @@ class BlockChecks:
         rec = run.recorder
         self.r1, self.f2 = rec.qa[REAR_SLIDE], rec.qa[FRONT_SLIDE]
         self.v_adr = [rec.va[n] for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE)]
-        self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles) \
+        self.watch = SteadyWatch(float(rec.qpos[0, rec.qa[CRANK_HINGE]]), run.steady_tol, run.steady_cycles,
+                                 steady_target("mujoco", run.steady_tol)) \
             if run.until_steady else None
         # a stall is final only under constant loads: not with a crank servo's time-varying torque; the speed
         # controller's only while it asks for full voltage (:meth:`_stall`)

@@ -27,6 +27,7 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.results import grip_use
 
 from .common import check_clutch_options
 from .grip import GripRatchet
@@ -34,7 +35,7 @@ from .grip_compliant import CompliantGrip
 from .grip_model import SKIDS
 from .loop_rows import loop_options
 from .model import SolverSettings, build_model, qpos_address, set_closed_loop_state
-from .route_watch import check_route
+from .route_watch import check_route, pipe_fit
 from .slide_clutches import refuse_grip, slide_controller
 from .timestep import choose_settings
 from .wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
@@ -126,6 +127,11 @@ class ModelKind:
         per-sample ``scalars`` (name: (n,)) and the shared columns ``out``."""
         return {}
 
+    def route_fit(self, route, params: RobotParams) -> dict:
+        """The closed-form fit of a route's bends reported beside MuJoCo's outcome (``route_fit``: ``{"bends":
+        [...], "predicted": one line}``), for the kinds that take a route (:meth:`check` refuses it here)."""
+        raise NotImplementedError(f"the {self.name} model takes no route")
+
 
 class GripSlidesKind(ModelKind):
     """The slide model on wheels of finite grip: a carriage per module on the wall, held by friction G_i."""
@@ -141,15 +147,15 @@ class GripSlidesKind(ModelKind):
 
     def columns(self, model, params, q, scalars, out):
         """slip1/2 [m], each carriage's backward travel below its start (its running minimum over the samples:
-        the carriage only skids back, its limit holds it from going forward), grip_use1/2 = lambda_i / G_i (1
-        while skidding where G_i = 0), the grips' cumulative work skid_work [J] and the wheels' states
-        wheels1/2."""
+        the carriage only skids back, its limit holds it from going forward), grip_use1/2
+        (:func:`~ipir_mujoco.core.results.grip_use`), the grips' cumulative work skid_work [J] and the wheels'
+        states wheels1/2."""
         cols = {}
         for k, (name, G) in enumerate(zip(SKIDS, params.grip), start=1):
             adr = qpos_address(model, name)
             wheels = scalars[f"wheels{k}"]
             cols[f"slip{k}"] = q[0, adr] - np.minimum.accumulate(q[:, adr])
-            cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+            cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = scalars["skid_work"].copy()
         return cols
@@ -187,6 +193,9 @@ class WheelsKind(ModelKind):
     def initial_state(self, model, data, params):
         set_wheels_state(model, data, params)
 
+    def route_fit(self, route, params):
+        return pipe_fit(route, params)
+
     def controller(self, model, data, params, implementation, rule="unilateral"):
         return WheelRatchet(model, data, params)
 
@@ -194,18 +203,18 @@ class WheelsKind(ModelKind):
         return wheel_loop_options(model, data)
 
     def columns(self, model, params, q, scalars, out):
-        """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2 = lambda_i / G_i
-        with finite grip (1 while skidding where G_i = 0); the contacts' cumulative work skid_work [J], the
-        wheels' states wheels1/2; the legs' press press1/2 [N] and wheels_off (:func:`.wheels.press_columns`);
+        """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2
+        (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J],
+        the wheels' states wheels1/2; the legs' press press1/2 [N] and wheels_off (:func:`.wheels.press_columns`);
         the modules' pose across the pipe y1/2, z1/2 [m], roll1/2, pitch1/2, yaw1/2 [rad]
         (:func:`.wheels.pose_columns`), which with x1, x2, phi pose the robot for a replay."""
         cols = {}
         for k in (1, 2):
             wheels = scalars[f"wheels{k}"]
             cols[f"slip{k}"] = wheel_slip(out[f"x{k}"])
-            if params.grip is not None:  # as the slide model's: 1 while skidding where G_i = 0 (mu_wall = 0)
+            if params.grip is not None:
                 G = params.grip[k - 1]
-                cols[f"grip_use{k}"] = out[f"lambda{k}"] / G if G > 0 else (wheels == -1.0).astype(float)
+                cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = scalars["skid_work"].copy()
         cols.update(press_columns(model, params, q))

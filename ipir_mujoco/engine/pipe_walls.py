@@ -41,6 +41,8 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 
+from .pipe_drawing import _quat, draw_pipe
+
 PIPE_BIT = 1  # the collision bit of the wall (geom conaffinity) and of the parts that touch it (their contype)
 LEAD_IN = 0.3  # m: the walls behind a route's start, and beyond the robot at its end
 STRAIGHT_HALF = 1000.0  # m: the straight pipe's half-length (no run gets near its ends)
@@ -108,13 +110,6 @@ def install() -> None:
     why = _install()
     if why is not None:
         raise ParameterError(why)
-
-
-def _quat(rotation: np.ndarray) -> list[float]:
-    """The quaternion of a rotation matrix (3, 3) whose columns are the geom's axes in the world."""
-    q = np.zeros(4)
-    mujoco.mju_mat2Quat(q, np.ascontiguousarray(rotation, dtype=float).ravel())
-    return [float(v) for v in q]
 
 
 def wall_pieces(route, diameter: float, robot_length: float) -> list[dict]:
@@ -192,8 +187,6 @@ def add_pipe_walls(spec: mujoco.MjSpec, route, diameter: float, contact: WallCon
                                 rgba=[0.0, 0.0, 0.0, 0.0], userdata=user)
         names.append(name)
     if draw:
-        from .pipe_drawing import draw_pipe
-
         draw_pipe(spec, pieces, diameter, prefix)
     return names
 

@@ -227,10 +227,14 @@ class RouteWatch:
                 "route_piece_times_s": list(self.mark_times)}
 
 
-def check_route(route, model: str, params, until_steady: bool):
+def check_route(route, model: str, params, until_steady: bool, planar: bool = False, reach: float | None = None):
     """``params`` for a run along ``route`` (None: as they are): its incline the route's first straight's;
     ParameterError (one line) for a route on the slide model, with --until-steady, with an incline set apart
-    from the route's, or whose first straight is shorter than the robot (it starts in it)."""
+    from the route's, or whose first straight is shorter than the robot (it starts in it: ``reach`` [m], how far
+    the robot reaches ahead of its rear module's point A; the round-pipe model's by default); with ``planar`` (the
+    retired planar model's box walls) one out of the mechanism's plane or whose walls would be too large
+    (:func:`.route_walls.check_wall_count`). The round pipe's walls (:mod:`.pipe_walls`) take any route: at most
+    MAX_SEGMENTS + 2 pieces."""
     from ipir_mujoco.core.errors import ParameterError
 
     if route is None:
@@ -246,7 +250,12 @@ def check_route(route, model: str, params, until_steady: bool):
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
-    reach = params.L + params.r + 0.5 * params.ring_spacing + params.wheel_radius  # A to the front wheels
+    if planar:
+        from .route_walls import check_wall_count
+
+        check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
+    if reach is None:  # the round-pipe model's: A to its front ring's wheels
+        reach = params.L + params.r + 0.5 * params.ring_spacing + params.wheel_radius
     first = route.pieces[0]
     if first.length < reach:
         raise ParameterError(f"{route.source}: segment 1: length={first.length:g} m; the robot starts in it and "
@@ -255,14 +264,20 @@ def check_route(route, model: str, params, until_steady: bool):
     return params.replace(incline=route.incline)
 
 
-def route_watch(route: Route | None, model, recorder, params, dt_out: float) -> RouteWatch | None:
-    """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
-    geometry (:func:`.route_walls.fit_prediction`)."""
-    if route is None:
-        return None
+def pipe_fit(route: Route, params) -> dict:
+    """The round-pipe model's closed-form fit of the route's bends (:func:`.route_walls.fit_prediction`): its rings
+    ``ring_spacing`` / 2 either side of a module's middle, its legs' springs reaching ``suspension_travel`` beyond
+    their preload, its housing as wide as the ring inside its wheels and as long as its ring spacing."""
     from .route_walls import fit_prediction
     from .wheels_model import housing_radius
 
-    fit = fit_prediction(route, params, 0.5 * params.ring_spacing, params.suspension_travel,
-                         housing=(2 * housing_radius(params), params.ring_spacing))
-    return RouteWatch(route, model, recorder, fit, dt_out)
+    return fit_prediction(route, params, 0.5 * params.ring_spacing, params.suspension_travel,
+                          housing=(2 * housing_radius(params), params.ring_spacing))
+
+
+def route_watch(route: Route | None, model, recorder, params, dt_out: float, fit=pipe_fit) -> RouteWatch | None:
+    """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
+    geometry, ``fit(route, params) -> {"bends": [...], "predicted": one line}`` (the model kind's ``route_fit``)."""
+    if route is None:
+        return None
+    return RouteWatch(route, model, recorder, fit(route, params), dt_out)

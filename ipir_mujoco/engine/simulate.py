@@ -238,7 +238,8 @@ class _Run:
         m, d = self.model, self.data
         self.controller, self.loop = setup.controller, setup.loop
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2, self.controller, self.kind)
-        self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out)  # None without a route
+        # None without a route
+        self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out, self.kind.route_fit)
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ipir_mujoco.core.results import RunResult
+if TYPE_CHECKING:  # annotations only: RunResult.plot calls plot_runs here, so nothing here imports core.results
+    from ipir_mujoco.core.results import RunResult
 
 REAR, FRONT = "black", "tab:red"  # the paper's colours: module 1 black, module 2 red
 STYLES = ("-", "--", ":", "-.")
@@ -125,6 +126,28 @@ PAPER_FIGURES = {
     "fig3_modules.png": figure_modules,
     "fig4_gap.png": figure_gap,
 }
+
+
+def plot_runs(runs: Sequence[RunResult], path: str | Path | None = None) -> list[Figure]:
+    """The paper's figures (crank, modules, gap against time) of ``runs``, the first solid, the others dashed
+    over it.
+
+    Parameters
+    ----------
+    runs : sequence of RunResult
+    path : str or Path or None
+        A folder to write them in as fig2-4 PNG (made if missing); None: not written.
+
+    Returns
+    -------
+    list of matplotlib.figure.Figure
+        The three figures.
+    """
+    runs = list(runs)
+    if path is not None:
+        Path(path).mkdir(parents=True, exist_ok=True)
+        write_paper_figures(runs, path)
+    return [figure_crank(runs), figure_modules(runs), figure_gap(runs)]
 
 
 def write_paper_figures(runs: Sequence[RunResult], directory: str | Path, labels: Sequence[str] | None = None,

@@ -19,7 +19,7 @@ from typing import Callable
 
 from ipir_mujoco.core.params import RobotParams
 
-from . import clutch_section, control_section, cruise_section, grip_section, riser_section
+from . import atlas_section, clutch_section, control_section, cruise_section, grip_section, riser_section
 
 Progress = Callable[[str], None]
 
@@ -41,4 +41,6 @@ SECTIONS: tuple[Section, ...] = (
     Section("finite_grip", "Finite grip", grip_section.compute, grip_section.render, grip_section.verdict),
     Section("speed_control", "Speed control", control_section.compute, control_section.render,
             control_section.verdict),
+    Section("model_holds", "Where the paper's model holds", atlas_section.compute, atlas_section.render,
+            atlas_section.verdict),
 )

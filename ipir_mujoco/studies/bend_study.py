@@ -15,6 +15,17 @@ The references over the same length: the analytic finite-grip model's (``analyti
 steady state in a straight pipe, speed v and energy per metre e: time length / v, energy e x length; and the
 wheeled model's own straight pipe (the same route with the bend straightened: its marks at the same
 distances), so that what the bend costs is told apart from what the wheels cost in any pipe.
+
+``planes`` [deg]: the bend's plane turned about the pipe's axis (:mod:`ipir_mujoco.core.route`): 0 turns it in the
+horizontal plane, across gravity (the default); 90 turns it up, in the plane of gravity, so that the route leaves
+the bend as a riser. The energy over the window is then the motor's work less the kinetic *and potential* energy
+gained (what the robot dissipates, comparable with its level twin's), and the time includes climbing, which the
+level twin and the analytic level reference do not: the row says how much potential energy the window gained.
+Each plane's bends share their straight twins (a straight has no plane).
+
+A bend that passes faster than its straight twin (by more than TWIN_SLACK of the twin's time) gets a note that says
+why with the run's numbers (``note``): wheels off their walls (a module that floats slides without turning its hubs,
+so the rolling resistance does no work), or, with every wheel on its wall, the passage's timing ripple.
 """
 
 from __future__ import annotations
@@ -41,6 +52,10 @@ EXIT = 0.05  # m: straight after the bend
 DT_OUT = 1e-3  # s: the samples the progress is read from (the passage's times are good to this)
 T_CAP_PER_M = 20.0  # s per metre of route: the run's cap (the default motor cruises at ~0.53 m/s: 1.9 s/m)
 MU_WALL = 0.8  # the study's wall friction unless --set gives one: the straight-pipe acceptance case
+PLANES = (0.0,)  # deg: the bends' planes, the default (0: horizontal, across gravity)
+TWIN_SLACK = 0.005  # a bend faster than its twin by more than this share of the twin's time gets a note: the
+# centre's crossing times carry ~0.05 s of a stroke's ripple (module docstring), ~2-7 % of a passage of 0.7-2.7 s
+# at R/D 2-10, but a mean over both marks; half a percent is what the R/D >= 5 rows agree to (mjcf/README.md)
 
 
 def study_params(base: RobotParams) -> RobotParams:
@@ -53,12 +68,26 @@ def study_params(base: RobotParams) -> RobotParams:
     return base.replace(drive="motor", mu_wall=MU_WALL if base.mu_wall is None else base.mu_wall)
 
 
-def case_route(params: RobotParams, ratio: float):
-    """The route of one case: the lead-in, a 90-degree bend of R/D ``ratio``, the exit."""
+def case_route(params: RobotParams, ratio: float, plane: float = 0.0):
+    """The route of one case: the lead-in, a 90-degree bend of R/D ``ratio`` in the plane ``plane`` [deg], the
+    exit."""
     half = dict(kind="straight", length=params.L / 2)
     return route_from_tables([dict(kind="straight", length=LEAD_IN), half,
-                              dict(kind="bend", radius=ratio * params.pipe_diameter, angle=90.0), half,
+                              dict(kind="bend", radius=ratio * params.pipe_diameter, angle=90.0, plane=plane), half,
                               dict(kind="straight", length=EXIT)], "bend study")
+
+
+def check_planes(planes: Sequence[float], params: RobotParams, ratio: float) -> None:
+    """ParameterError (one line) for a plane out of -180..180 deg, or one the wheeled model cannot run (the
+    model's own route check on the first case, before any run)."""
+    from ipir_mujoco.engine.kinds import kind_for
+
+    if not planes:
+        raise ParameterError("--planes is empty; allowed: one or more angles, -180..180 deg")
+    for plane in planes:
+        if not (isinstance(plane, (int, float)) and math.isfinite(plane) and -180 <= plane <= 180):
+            raise ParameterError(f"--planes {plane!r} is out of range; allowed: -180..180 deg")
+        kind_for("wheels", params).check(params, "ratchet", "unilateral", case_route(params, ratio, plane))
 
 
 def straight_route(params: RobotParams, length: float):
@@ -93,20 +122,24 @@ def _passage(run, route, first: int, last: int) -> dict:
            "route_arm_reach": s["route_arm_reach"], "predicted": s["route_fit"]["predicted"],
            "wheels_keep_wall": all(b["wheels_keep_wall"] for b in s["route_fit"]["bends"]),
            "timestep_s": run.settings["timestep"], "residual_ratio": s["accuracy"].get("residual_ratio"),
-           "skid_j": run.energy.get("skid_j"), "passed": t_b is not None, "time_s": None, "energy_j": None}
+           "skid_j": run.energy.get("skid_j"), "passed": t_b is not None, "time_s": None, "energy_j": None,
+           "potential_j": None}
     if t_a is not None and t_b is not None:
-        work = np.interp([t_a, t_b], run.series["t"], run.series["motor_work"])
-        kinetic = np.interp([t_a, t_b], run.series["t"], run.series["kinetic"])
-        out.update(time_s=t_b - t_a, energy_j=float(work[1] - work[0] - (kinetic[1] - kinetic[0])))
+        t = run.series["t"]
+        work, kinetic, potential = (np.interp([t_a, t_b], t, run.series[c]) for c in ("motor_work", "kinetic",
+                                                                                      "potential"))
+        gained = float(potential[1] - potential[0])
+        out.update(time_s=t_b - t_a, potential_j=gained,
+                   energy_j=float(work[1] - work[0] - (kinetic[1] - kinetic[0])) - gained)
     return out
 
 
-def run_case(params: RobotParams, item: tuple[str, float]) -> dict:
-    """One case in a worker: ('bend', R/D) or ('straight', R/D: its bend's length straightened)."""
-    kind, ratio = item
+def run_case(params: RobotParams, item: tuple[str, float, float]) -> dict:
+    """One case in a worker: ('bend', R/D, plane [deg]) or ('straight', R/D: its bend's length straightened, 0)."""
+    kind, ratio, plane = item
     started = time.perf_counter()
     arc = math.pi / 2 * ratio * params.pipe_diameter
-    route = straight_route(params, arc) if kind == "straight" else case_route(params, ratio)
+    route = straight_route(params, arc) if kind == "straight" else case_route(params, ratio, plane)
     t_cap = T_CAP_PER_M * route.length
     try:
         run = registry.run("mujoco-wheels", params, t_cap, dt_out=DT_OUT, route=route, accuracy="warn")
@@ -114,9 +147,22 @@ def run_case(params: RobotParams, item: tuple[str, float]) -> dict:
         return {"kind": kind, "R_over_D": ratio, "error": str(exc), "passed": False,
                 "wall_s": time.perf_counter() - started}
     out = _passage(run, route, 1, 4)
-    out.update(kind=kind, R_over_D=ratio, radius_m=ratio * params.pipe_diameter, window_m=params.L + arc,
-               wall_s=time.perf_counter() - started)
+    out.update(kind=kind, R_over_D=ratio, plane_deg=plane, radius_m=ratio * params.pipe_diameter,
+               window_m=params.L + arc, wall_s=time.perf_counter() - started)
     return out
+
+
+def twin_note(bend: dict, straight: dict) -> str | None:
+    """Why a bend passed faster than its straight twin, with the runs' numbers (module docstring), or None."""
+    tb, ts = bend.get("time_s"), straight.get("time_s")
+    if tb is None or ts is None or not tb < (1 - TWIN_SLACK) * ts:
+        return None
+    faster = f"{100 * (1 - tb / ts):.1f} % faster than its straight twin ({tb:.3f} s against {ts:.3f} s)"
+    if (bend.get("route_wheel_off_s") or 0.0) > 0:
+        return (f"{faster}: wheels were off their walls {bend['route_wheel_off_s']:.3f} s (a whole module "
+                f"{bend['route_module_off_s']:.3f} s); a module off its walls slides without turning its hubs, so the "
+                "rolling resistance does no work there")
+    return f"{faster}, every wheel on its wall: within the passage's timing ripple (a stroke's, ~0.05 s)"
 
 
 def reference(params: RobotParams) -> dict:
@@ -129,35 +175,40 @@ def reference(params: RobotParams) -> dict:
 
 
 def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: int = 1,
-              progress: Callable[[str], None] = lambda _m: None) -> dict:
-    """The study (module docstring) as a JSON-ready dict: ``rows`` (one per R/D: the bend's passage, its
-    straightened twin's, the analytic reference over the same length), ``reference``, ``settings``,
-    ``wall_s``."""
+              progress: Callable[[str], None] = lambda _m: None, planes: Sequence[float] = PLANES) -> dict:
+    """The study (module docstring) as a JSON-ready dict: ``rows`` (one per plane and R/D: the bend's passage,
+    its straightened twin's, the analytic reference over the same length, ``note`` where the bend was faster
+    than its twin), ``reference``, ``settings``, ``wall_s``."""
     started = time.perf_counter()
     params = study_params(base)
     check_ratios(ratios, params)
+    check_planes(planes, params, min(ratios))
     ref = reference(params)
-    items = [(kind, r) for r in sorted(ratios, reverse=True) for kind in ("bend", "straight")]  # longest first
-    results: dict[tuple[str, float], dict] = {}
+    items = [(kind, r, p) for r in sorted(ratios, reverse=True)  # longest first
+             for kind, p in [("bend", p) for p in planes] + [("straight", 0.0)]]
+    results: dict[tuple[str, float, float], dict] = {}
 
     def done(item, result) -> None:
         results[item] = result
-        kind, r = item
+        kind, r, p = item
         status = (result["error"] if "error" in result else
                   f"passage {result['time_s']:.3f} s, {result['energy_j']:.3f} J" if result["passed"] else
                   f"did not pass: {result['route_stop']}")
-        progress(f"[{len(results)}/{len(items)}] R/D {r:g} {kind}: {status} ({result['wall_s']:.1f} s wall)")
+        what = f"bend in plane {p:g} deg" if kind == "bend" else kind
+        progress(f"[{len(results)}/{len(items)}] R/D {r:g} {what}: {status} ({result['wall_s']:.1f} s wall)")
 
     map_unordered(functools.partial(run_case, params), items, workers, done)
     rows = []
-    for r in sorted(ratios):
-        bend, straight = results[("bend", r)], results[("straight", r)]
-        window = params.L + math.pi / 2 * r * params.pipe_diameter
-        analytic = {"time_s": window / ref["steady_speed_m_s"], "energy_j": window * ref["energy_per_metre_j_m"]}
-        rows.append({"R_over_D": r, "radius_m": r * params.pipe_diameter, "window_m": window, "bend": bend,
-                     "straight": straight, "analytic": analytic})
+    for p in planes:
+        for r in sorted(ratios):
+            bend, straight = results[("bend", r, p)], results[("straight", r, 0.0)]
+            window = params.L + math.pi / 2 * r * params.pipe_diameter
+            analytic = {"time_s": window / ref["steady_speed_m_s"], "energy_j": window * ref["energy_per_metre_j_m"]}
+            rows.append({"plane_deg": p, "R_over_D": r, "radius_m": r * params.pipe_diameter, "window_m": window,
+                         "bend": bend, "straight": straight, "analytic": analytic, "note": twin_note(bend, straight)})
     return {"rows": rows, "reference": ref,
             "settings": {"lead_in_m": LEAD_IN, "exit_m": EXIT, "dt_out_s": DT_OUT, "angle_deg": 90.0,
+                         "planes_deg": list(planes),
                          "params": params.as_dict(), "window": "front module entering (A at the bend's start - L) "
                                                               "to rear module leaving (A at its end)"},
             "wall_s": time.perf_counter() - started}

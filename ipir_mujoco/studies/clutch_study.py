@@ -230,7 +230,7 @@ def run_metrics(run, point: OperatingPoint) -> dict:
     s, summary = run.series, run.summary
     found = cycles(s)
     if point.until_steady:
-        window = steady_window(found, *run.steady_test)
+        window = steady_window(found, *run.steady_test, run.steady_target)
         if window is None:
             why = run.stall or f"no periodic steady state by t_end = {point.t_end:g} s"
             return {"error": why}

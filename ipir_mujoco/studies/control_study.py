@@ -114,7 +114,7 @@ def window(run) -> tuple[float, float, bool]:
     whole revolutions)."""
     tol, n = run.steady_test
     found = cycles(run.series)
-    steady = steady_window(found, tol, n)
+    steady = steady_window(found, tol, n, run.steady_target)
     if steady is not None:
         return steady[0].t_start, steady[-1].t_end, True
     last = found[-STEADY_CYCLES:]

@@ -41,7 +41,7 @@ from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.core.params import RobotParams
 
-from . import climbing
+from . import climb_limits as climbing  # the limits and runs (climbing.py puts the study together)
 
 UNLIMITED = "unlimited grip: no traction limit"
 SLIP_TOL = 1e-9  # m: growth of slip1 + slip2 over the steady window still counted as none (roundoff of a sum)

@@ -1,0 +1,110 @@
+"""``ipir-mujoco atlas``: where each of the paper's idealizations can be trusted, over a box of designs."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ipir_mujoco.core.errors import ParameterError
+
+from .common import EXIT_OK, add_model_options, model_params, study_progress
+
+
+def add_parser(commands) -> None:
+    from ..studies.atlas import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE
+    from ..studies.atlas_space import NAMES
+
+    atl = commands.add_parser(
+        "atlas", help="where each of the paper's idealizations costs less than a threshold, over design ranges",
+        description="For each idealization of the paper's model (removed one at a time, as the validation "
+                    "report's ladder does), the relative cost (idealized - real) / |real| of each metric over "
+                    "the box of --vary ranges, and the region where it stays below each --threshold: the "
+                    "equations sampled densely (quasi-random), MuJoCo within --budget runs placed near the "
+                    "boundary by a Gaussian-process surrogate, Sobol indices of each cost. Writes DIR/atlas.json, "
+                    "DIR/samples.csv (streamed; Ctrl-C keeps what is done, --resume completes it) and figures.")
+    atl.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI[:log]", help="a parameter range")
+    atl.add_argument("--idealization", action="append", default=[], metavar="NAME",
+                     help=f"one of: {', '.join(NAMES)} (several allowed; default: every one the options allow)")
+    atl.add_argument("--metric", action="append", default=[], metavar="KEY",
+                     help="revolutions, travel_m, x1_final, x2_final, v1_max, v2_max under constant torque "
+                          "(default revolutions, travel_m); steady_speed_m_s, energy_per_metre_j_m, "
+                          "distance_per_rev_m, efficiency, t_steady_s under --drive motor or servo (default the "
+                          "first two)")
+    atl.add_argument("--threshold", action="append", type=float, default=[], metavar="REL",
+                     help="relative cost below which an idealization is safe, > 0 (several allowed; default 0.01)")
+    atl.add_argument("--budget", type=int, default=None, metavar="N",
+                     help=f"MuJoCo runs for the whole atlas, 2 per design (default {DEFAULT_BUDGET}; 0: the "
+                          "equations only)")
+    atl.add_argument("--samples", type=int, default=None, metavar="N",
+                     help=f"the equations' designs: N x (parameters + 2) (Saltelli; default {DEFAULT_SAMPLES})")
+    atl.add_argument("--boundary-tol", type=float, default=None, metavar="FRACTION",
+                     help="MuJoCo stops once the designs whose side of a threshold is not known at 95 %% are less "
+                          f"than this share of the box (default {DEFAULT_TOLERANCE:g})")
+    atl.add_argument("--seed", type=int, default=None, help="seed, >= 0 (default 0)")
+    atl.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+                     help="simulated time per run (default 1 s; under the motor the cap of a run to its steady "
+                          "state, default 10 s)")
+    add_model_options(atl)
+    atl.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    atl.add_argument("--out", metavar="DIR", default="atlas", help="results folder (default ./atlas)")
+    atl.add_argument("--resume", action="store_true", help="complete an interrupted atlas in DIR")
+    atl.set_defaults(handler=run)
+
+
+def atlas_from_args(args: argparse.Namespace):
+    from ..studies.atlas import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, Atlas
+    from ..studies.sweep_space import parse_vary
+
+    if not args.vary:
+        raise ParameterError("atlas needs at least one --vary NAME=LO:HI[:log]")
+    for t in args.threshold:
+        if not t > 0:
+            raise ParameterError(f"--threshold {t:g} is out of range; allowed: 0 < threshold <= 10 (a relative cost)")
+    return Atlas(tuple(parse_vary(v) for v in args.vary), model_params(args), tuple(args.idealization),
+                 tuple(args.metric), tuple(args.threshold) or (0.01,),
+                 DEFAULT_BUDGET if args.budget is None else args.budget,
+                 DEFAULT_SAMPLES if args.samples is None else args.samples, 0 if args.seed is None else args.seed,
+                 args.t_end, DEFAULT_TOLERANCE if args.boundary_tol is None else args.boundary_tol)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..report.atlas_plots import plot_atlas
+    from ..studies.atlas import run_atlas
+
+    atlas = atlas_from_args(args)
+    if args.workers is not None and args.workers < 1:
+        raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    result = run_atlas(atlas, args.out, resume=args.resume, workers=args.workers, progress=study_progress("atlas"))
+    figures = plot_atlas(result, atlas, args.out)
+    for line in summary_lines(result, atlas):
+        print(line)
+    print(f"  {result['runs']['equations']} equation runs, {result['runs']['mujoco']} MuJoCo runs in "
+          f"{result['wall_s']:.1f} s ({result['workers']} workers)")
+    print(f"  files: {args.out}/atlas.json, {args.out}/samples.csv, " + ", ".join(str(f) for f in figures))
+    sys.stdout.flush()
+    return EXIT_OK
+
+
+def summary_lines(result: dict, atlas) -> list[str]:
+    """One line per idealization, metric and threshold: the safe fraction, its interval, crossings, runs."""
+    lines = []
+    for name, per_metric in result["idealizations"].items():
+        for metric, entry in per_metric.items():
+            for item in entry["by_threshold"]:
+                frac, interval = item["safe_fraction"], item["safe_fraction_interval"]
+                where = ("no value" if frac is None else
+                         f"safe in {100 * frac:.1f} % of the box [{100 * interval[0]:.1f}, {100 * interval[1]:.1f}]")
+                cross = ""
+                for param, values in item.get("crossings_interval", {}).items():
+                    cross = "; crossings " + (", ".join(f"{param}={v:.5g} [{lo:.5g}, {hi:.5g}]" for v, lo, hi in values)
+                                              or "none")
+                regions = item.get("runs_by_region")
+                spent = (f"; {entry['runs']} {entry['measured_by']} runs"
+                         + (f" (safe {regions['safe']}, unsafe {regions['unsafe']}, boundary {regions['boundary']})"
+                            if regions else ""))
+                top = ", ".join(f"{p} ST {v['ST']:.2f}" for p, v in sorted(
+                    ((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict) and
+                     v.get("ST") is not None), key=lambda pv: -pv[1]["ST"])[:2])
+                lines.append(f"{name:24s} {metric:22s} |cost| < {item['threshold']:g}: {where}{cross}{spent}"
+                             + (f"; driven by {top}" if top else ""))
+    return lines

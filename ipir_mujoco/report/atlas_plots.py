@@ -1,0 +1,207 @@
+"""Figures of the idealization atlas (:mod:`ipir_mujoco.studies.atlas`), read at a glance.
+
+* ``atlas_safe.png`` (always): each idealization's safe share of the box per metric and threshold, with its
+  interval, and which measured it (equations or MuJoCo).
+* one varied parameter, ``atlas_1d.png``: |cost| [%] against the parameter, one panel per idealization and
+  metric: the equations' designs (dots), MuJoCo's designs (crosses) and its surrogate with its 95 % band, the
+  thresholds (dashed) and each crossing with its interval (shaded).
+* two, ``atlas_map.png``: |cost| maps (colour, log scale) from each measure's surrogate, the boundary at each
+  threshold (solid) with its 95 % uncertainty (dotted: where the side of the threshold becomes known), and the
+  MuJoCo runs placed (white dots).
+* more, ``atlas_partial.png``: partial dependence of each |cost| on each parameter (the surrogate's mean over
+  the other parameters, with the 10-90 % spread over them), the thresholds dashed.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import LogNorm
+from matplotlib.figure import Figure
+
+from ..studies.atlas_surrogate import CONFIDENT
+
+COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange")
+
+
+def _figure(width: float, height: float) -> Figure:
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _measure(result: dict, name: str) -> tuple[str, dict]:
+    """(fidelity, {metric: surrogate}) the atlas reports for ``name``: MuJoCo's where it ran, else the equations'."""
+    for fidelity in ("mujoco", "equations"):
+        if result["_surrogates"].get((name, fidelity)):
+            return fidelity, result["_surrogates"][(name, fidelity)]
+    return "", {}
+
+
+def plot_atlas(result: dict, atlas, out: str | Path) -> list[Path]:
+    out = Path(out)
+    paths = [plot_safe(result["idealizations"], atlas.axes, out / "atlas_safe.png")]
+    d = len(atlas.axes)
+    draw = {1: plot_1d, 2: plot_map}.get(d, plot_partial)
+    paths.append(draw(result, atlas, out / {1: "atlas_1d.png", 2: "atlas_map.png"}.get(d, "atlas_partial.png")))
+    return paths
+
+
+def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the paper's model holds") -> Path:
+    """Bars: each idealization's safe share per metric and threshold with its interval (``idealizations``:
+    atlas.json's; ``axes``: the varied ranges, sweep_space.Axis)."""
+    rows = [(name, metric, item, entry["measured_by"]) for name, per in idealizations.items()
+            for metric, entry in per.items() for item in entry["by_threshold"]]
+    fig = _figure(8.0, 1.2 + 0.32 * len(rows))
+    ax = fig.add_subplot()
+    for k, (name, metric, item, by) in enumerate(rows):
+        frac, interval = item["safe_fraction"], item["safe_fraction_interval"]
+        if frac is None:
+            continue
+        colour = "tab:red" if by == "mujoco" else "tab:blue"
+        ax.barh(k, 100 * frac, color=colour, alpha=0.55)
+        ax.errorbar(100 * frac, k, xerr=[[100 * (frac - interval[0])], [100 * (interval[1] - frac)]], color="black",
+                    capsize=3, lw=1)
+    ax.set_yticks(range(len(rows)), [f"{n}: {m}, |cost| < {100 * i['threshold']:g} %" for n, m, i, _ in rows],
+                  fontsize="small")
+    ax.invert_yaxis()
+    ax.set(xlim=(0, 100), xlabel="share of the box where the idealization is safe [%] (95 % interval)",
+           title=title + ": " + ", ".join(f"{a.name} {a.low:.3g}..{a.high:.3g}" for a in axes))
+    ax.title.set_fontsize("small")
+    ax.barh([], [], color="tab:blue", alpha=0.55, label="measured by the equations (dense sample)")
+    ax.barh([], [], color="tab:red", alpha=0.55, label="measured by MuJoCo (surrogate)")
+    ax.legend(fontsize="x-small", loc="lower right")
+    ax.grid(alpha=0.3, axis="x")
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def _panels(result: dict, atlas):
+    return [(name, metric) for name in result["idealizations"] for metric in atlas.metrics]
+
+
+def plot_1d(result: dict, atlas, path: Path) -> Path:
+    axis = atlas.axes[0]
+    panels = _panels(result, atlas)
+    cols = len(atlas.metrics)
+    nrows = max(1, len(panels) // cols)
+    fig = _figure(4.2 * cols, 0.8 + 2.8 * nrows)
+    u = np.linspace(0, 1, 400)
+    x = atlas.values(u[:, None])[:, 0]
+    for k, (name, metric) in enumerate(panels):
+        ax = fig.add_subplot(nrows, cols, k + 1)
+        entry = result["idealizations"][name][metric]
+        for fidelity, marker, colour in (("equations", ".", "tab:blue"), ("mujoco", "x", "tab:red")):
+            if (name, fidelity) not in result["_measured"]:
+                continue
+            U, rows = result["_measured"][(name, fidelity)]
+            cost = np.array([np.nan if r["cost"].get(metric) is None else abs(r["cost"][metric]) for r in rows])
+            ax.plot(atlas.values(U)[:, 0], 100 * np.maximum(cost, 1e-6), marker, color=colour, ms=3 if marker == "." else 5,
+                    label=f"{'equations' if fidelity == 'equations' else 'MuJoCo'} "
+                          f"({len({tuple(v) for v in np.round(U, 12)})} designs)")
+            s = result["_surrogates"].get((name, fidelity), {}).get(metric)
+            if fidelity == "mujoco" and s is not None:
+                mean, lo, hi = s.cost(u[:, None])
+                ax.plot(x, 100 * np.maximum(mean, 1e-6), color=colour, lw=1.2, label="MuJoCo surrogate")
+                ax.fill_between(x, 100 * np.maximum(lo, 1e-6), 100 * np.maximum(hi, 1e-6), color=colour, alpha=0.15,
+                                label="its 95 % band")
+        for item in entry["by_threshold"]:
+            ax.axhline(100 * item["threshold"], color="grey", ls="--", lw=0.9)
+            for value, lo, hi in item.get("crossings_interval", {}).get(axis.name, []):
+                ax.axvspan(lo, hi, color="gold", alpha=0.5)
+                ax.axvline(value, color="darkgoldenrod", lw=1)
+                ax.annotate(f"{axis.name} = {value:.4g}\n[{lo:.4g}, {hi:.4g}]", (value, 100 * item["threshold"]),
+                            xytext=(4, 6), textcoords="offset points", fontsize="x-small", color="darkgoldenrod")
+        ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=f"{axis.name}",
+               ylabel=f"|cost| of {metric} [%]", title=f"{name}\n(measured by {entry['measured_by']})")
+        ax.title.set_fontsize("small")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize="xx-small")
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def plot_map(result: dict, atlas, path: Path) -> Path:
+    ax_x, ax_y = atlas.axes
+    panels = _panels(result, atlas)
+    cols = len(atlas.metrics)
+    nrows = max(1, len(panels) // cols)
+    fig = _figure(4.6 * cols, 0.6 + 3.6 * nrows)
+    n = 70
+    g = np.linspace(0, 1, n)
+    UU = np.array([[a, b] for b in g for a in g])
+    XY = atlas.values(UU)
+    X, Y = XY[:, 0].reshape(n, n), XY[:, 1].reshape(n, n)
+    for k, (name, metric) in enumerate(panels):
+        ax = fig.add_subplot(nrows, cols, k + 1)
+        fidelity, fitted = _measure(result, name)
+        s = fitted.get(metric)
+        if s is None:
+            ax.set_title(f"{name}: {metric}: no surrogate", fontsize="small")
+            continue
+        mean = np.maximum(s.cost(UU)[0], 1e-5).reshape(n, n)
+        image = ax.pcolormesh(X, Y, 100 * mean, norm=LogNorm(vmin=max(1e-3, 100 * mean.min()), vmax=100 * mean.max()),
+                              cmap="viridis", shading="auto")
+        fig.colorbar(image, ax=ax, label=f"|cost| of {metric} [%]")
+        for j, t in enumerate(atlas.thresholds):
+            p = s.p_safe(UU, t).reshape(n, n)
+            colour = ("white", "orange", "red")[j % 3]
+            ax.contour(X, Y, p, levels=[0.5], colors=colour, linewidths=1.6)
+            ax.contour(X, Y, p, levels=[1 - CONFIDENT, CONFIDENT], colors=colour, linewidths=0.9, linestyles=":")
+            ax.plot([], [], color=colour, label=f"|cost| = {100 * t:g} % (dotted: its 95 % band)")
+        if (name, "mujoco") in result["_measured"]:
+            U, rows = result["_measured"][(name, "mujoco")]
+            V = atlas.values(U)
+            ax.plot(V[:, 0], V[:, 1], "o", ms=3.5, mfc="white", mec="black", mew=0.5,
+                    label=f"MuJoCo designs ({len(U)}, {2 * len(U)} runs)")
+        ax.set(xscale="log" if ax_x.log else "linear", yscale="log" if ax_y.log else "linear", xlabel=ax_x.name,
+               ylabel=ax_y.name, title=f"{name}: {metric}\n(surrogate of the {fidelity if fidelity == 'equations' else 'MuJoCo'} cost)")
+        ax.title.set_fontsize("small")
+        ax.legend(fontsize="xx-small", loc="upper right", framealpha=0.8)
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def plot_partial(result: dict, atlas, path: Path) -> Path:
+    names = list(result["idealizations"])
+    d = len(atlas.axes)
+    fig = _figure(2.9 * d, 0.8 + 2.5 * len(names))
+    C = result["_candidates"]
+    bins = np.linspace(0, 1, 13)
+    centres = 0.5 * (bins[1:] + bins[:-1])
+    for r, name in enumerate(names):
+        fidelity, fitted = _measure(result, name)
+        for c, axis in enumerate(atlas.axes):
+            ax = fig.add_subplot(len(names), d, r * d + c + 1)
+            x = atlas.values(np.column_stack([centres] * d))[:, c]
+            for j, metric in enumerate(atlas.metrics):
+                s = fitted.get(metric)
+                if s is None:
+                    continue
+                cost = 100 * s.cost(C)[0]
+                which = np.digitize(C[:, c], bins[1:-1])
+                mean = np.array([cost[which == b].mean() for b in range(len(centres))])
+                low = np.array([np.percentile(cost[which == b], 10) for b in range(len(centres))])
+                high = np.array([np.percentile(cost[which == b], 90) for b in range(len(centres))])
+                colour = COLOURS[j % len(COLOURS)]
+                ax.plot(x, np.maximum(mean, 1e-4), color=colour, lw=1.4, label=metric)
+                ax.fill_between(x, np.maximum(low, 1e-4), np.maximum(high, 1e-4), color=colour, alpha=0.15)
+            for t in atlas.thresholds:
+                ax.axhline(100 * t, color="grey", ls="--", lw=0.9)
+            ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=axis.name)
+            if c == 0:
+                ax.set_ylabel(f"{name}\n|cost| [%] ({'MuJoCo' if fidelity == 'mujoco' else 'equations'})",
+                              fontsize="small")
+            ax.grid(alpha=0.3, which="both")
+            if r == 0 and c == 0:
+                ax.legend(fontsize="xx-small")
+            entry = next(iter(result["idealizations"][name].values()))
+            st = entry.get("sensitivity", {}).get(axis.name)
+            if isinstance(st, dict) and st.get("ST") is not None:
+                ax.set_title(f"ST {st['ST']:.2f} +- {st['ST_conf']:.2f} ({atlas.metrics[0]})", fontsize="x-small")
+    fig.suptitle("Partial dependence of each idealization's |cost| on each parameter (line: mean over the other "
+                 "parameters; band: their 10-90 %; dashed: thresholds)", fontsize="small")
+    fig.savefig(path, dpi=100)
+    return path

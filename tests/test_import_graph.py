@@ -1,0 +1,127 @@
+"""No import cycle among the package's modules, the imports inside functions included.
+
+A function-level import only postpones a cycle to the first call, where a half-initialised module can still
+surface; so every ``import`` and ``from ... import`` the source holds counts here, wherever it stands, except
+those under ``if TYPE_CHECKING:`` (never executed: annotations only). An edge goes from a module to each
+package module it names (``from .x import y`` names ``x``, or ``x.y`` where that is a module). The source is
+read, not imported: the repository's ``analytic/`` folder is ``ipir_mujoco.analytic``.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+TREES = {"ipir_mujoco": ROOT / "ipir_mujoco", "ipir_mujoco.analytic": ROOT / "analytic"}
+
+
+def modules() -> dict[str, tuple[Path, bool]]:
+    """{dotted name: (file, is a package's __init__)} of every module of the package."""
+    found = {}
+    for prefix, folder in TREES.items():
+        for file in folder.rglob("*.py"):
+            parts = list(file.relative_to(folder).with_suffix("").parts)
+            package = parts[-1] == "__init__"
+            if package:
+                parts = parts[:-1]
+            found[".".join([prefix, *parts])] = (file, package)
+    return found
+
+
+def _type_checking(node: ast.AST) -> bool:
+    test = getattr(node, "test", None)
+    return isinstance(node, ast.If) and (
+        (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING")
+        or (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"))
+
+
+def _imports(tree: ast.AST):
+    """Every import statement of ``tree`` outside ``if TYPE_CHECKING:`` blocks."""
+    stack = [tree]
+    while stack:
+        node = stack.pop()
+        if _type_checking(node):
+            stack.extend(node.orelse)
+            continue
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            yield node
+        stack.extend(ast.iter_child_nodes(node))
+
+
+def graph() -> dict[str, set[str]]:
+    """{module: the package modules it imports}."""
+    known = modules()
+    edges: dict[str, set[str]] = {name: set() for name in known}
+    for name, (file, package) in known.items():
+        here = name.split(".") if package else name.split(".")[:-1]
+        for node in _imports(ast.parse(file.read_text())):
+            if isinstance(node, ast.Import):
+                targets = [a.name for a in node.names]
+            else:
+                base = ".".join(here[:len(here) - node.level + 1] + ([node.module] if node.module else [])) \
+                    if node.level else node.module or ""
+                targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in known else base for a in node.names]
+            edges[name] |= {t for t in targets if t in known and t != name}
+    return edges
+
+
+def cycles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan's algorithm, iterative)."""
+    index, low, on, stack, found, counter = {}, {}, set(), [], [], [0]
+    for root in edges:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(edges[root])))]
+        index[root] = low[root] = counter[0]
+        counter[0] += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = counter[0]
+                    counter[0] += 1
+                    stack.append(child)
+                    on.add(child)
+                    work.append((child, iter(sorted(edges[child]))))
+                elif child in on:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = []
+                while True:
+                    member = stack.pop()
+                    on.discard(member)
+                    component.append(member)
+                    if member == node:
+                        break
+                if len(component) > 1:
+                    found.append(sorted(component))
+    return found
+
+
+def test_the_finder_sees_every_kind_of_import():
+    """The graph holds top-level, relative, function-level and package-level imports (so the test below has
+    edges to look at), and leaves out TYPE_CHECKING ones."""
+    edges = graph()
+    assert len(edges) > 100
+    assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.engine.simulate"]  # relative, top level
+    assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
+    assert "ipir_mujoco.report.plots" in edges["ipir_mujoco.core.results"]  # inside RunResult.plot
+    assert "ipir_mujoco.core.results" not in edges["ipir_mujoco.report.plots"]  # TYPE_CHECKING only
+    assert "ipir_mujoco.analytic.kinematic_clutch" in edges["ipir_mujoco.analytic"]  # the analytic/ folder
+
+
+def test_cycles_are_found():
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_import_cycle_among_the_packages_modules():
+    assert cycles(graph()) == []
