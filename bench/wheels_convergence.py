@@ -15,6 +15,10 @@ For each figure: its value at each step, and the default's difference from the f
 the finest step's own error, which halves at least with each halving here). The acceptance: the default within
 0.2 % on travel and speed, 1 % on skid length. The table in mjcf/README.md ("The round pipe: convergence") is
 this script's output.
+
+``--time-constants``: why 2e-4 s. The robot with the drive off on a riser (mu_wall 0.18: both modules slide down
+from rest at a = (G1 + G2) / (m1 + m2 + m_rod) - g, the analytic model's Coulomb answer) for 0.3 s, stepped by hand
+at a quarter of each time constant 1e-3, 4e-4, 2e-4, 1e-4 s: the slide's length against the analytic model's.
 """
 
 from __future__ import annotations
@@ -54,10 +58,41 @@ def figures(run) -> dict[str, tuple[str, float]]:
     return out
 
 
+def time_constants(smoke: bool) -> None:
+    """The riser slide at several row time constants (module docstring, ``--time-constants``)."""
+    import mujoco
+
+    from ipir_mujoco.engine.model import MOTOR, SolverSettings, drive_control, qpos_address
+    from ipir_mujoco.engine.wheels import WheelRatchet
+    from ipir_mujoco.engine.wheels_model import RowTimes, build_wheels_model, set_wheels_state
+
+    params, t_end = RobotParams(M=0.0, mu_wall=0.18, incline=90.0), (0.02 if smoke else 0.3)
+    analytic = registry.run("analytic-unilateral", params, t_end, dt_out=1e-3).summary["x1_final"]
+    print("| row time constant [s] | step [s] | slide of module 1 [m] | analytic [m] | difference |")
+    print("|---|---|---|---|---|")
+    for tau in ((2e-4,) if smoke else (1e-3, 4e-4, 2e-4, 1e-4)):
+        model = build_wheels_model(params, SolverSettings(timestep=tau / 4), RowTimes(tau, tau, tau))
+        data = mujoco.MjData(model)
+        set_wheels_state(model, data, params)
+        data.ctrl[model.actuator(MOTOR).id] = drive_control(params)
+        mujoco.mj_forward(model, data)
+        ratchet = WheelRatchet(model, data, params)
+        for _ in range(round(t_end / model.opt.timestep)):
+            ratchet.before_step()
+            mujoco.mj_step(model, data)
+        x1 = float(data.qpos[qpos_address(model, "rear_slide")])
+        print(f"| {tau:g} | {tau / 4:g} | {x1:.6f} | {analytic:.6f} | {100 * (x1 / analytic - 1):+.2f} % |",
+              flush=True)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="one case, 0.05 s, two steps: the script runs")
+    parser.add_argument("--time-constants", action="store_true", help="the riser slide at several time constants")
     args = parser.parse_args(argv)
+    if args.time_constants:
+        time_constants(args.smoke)
+        return 0
     base = registry.timestep("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.5), 1.0, 1e-3)
     factors = (1, 2) if args.smoke else (1, 2, 4, 8)
     cases = {"cruise": (CASES["cruise"][0], 0.05, None)} if args.smoke else CASES
