@@ -198,8 +198,8 @@ def test_the_viewer_builds_the_route_walls():
 
     robot = ViewedRobot(CRUISE, model="wheels", route=route_from_tables(BEND), settings=SolverSettings(timestep=1e-4))
     names = {robot.model.geom(i).name for i in range(robot.model.ngeom)}
-    assert {"route_straight1_top", "route_bend1_inner", "route_bend1_outer1"} <= names
-    assert "wall_top" not in names  # the planes are gone
+    assert {"pipe_straight1", "pipe_bend1", "pipe_straight2"} <= names  # the round pipe's pieces along the route
+    assert sum(1 for n in names if n.startswith(("pipe_straight", "pipe_bend"))) == 3  # and no straight pipe
     robot.step(200)
 
 
