@@ -2,7 +2,7 @@
 
 Run on demand from the repository root (about 30-60 min on 2 busy cores; ``--smoke``: 4 designs, a minute):
 
-    python bench/wheels_agreement.py [--designs 100] [--seed 1] [--workers 2] [--smoke]
+    python bench/wheels_agreement.py [--designs 100] [--seed 1] [--workers 2] [--wall-budget S] [--skip N] [--smoke]
 
 Each design is drawn over the envelope (log-uniform where a range spans decades): m1, m2 0.2-5 kg; r 0.02-0.07 m
 (the crank fits the 0.16 m pipe); L / r 1.5-6; J_A 1e-4-1e-2 kg m^2; F_r1, F_r2 0.2-5 N; the drive a constant
@@ -62,13 +62,15 @@ def within(a: float, b: float, rel: float, floor: float) -> bool:
     return abs(b - a) <= max(rel * abs(a), floor) if floor == TRAVEL_FLOOR else abs(b - a) <= rel * abs(a) + floor
 
 
-def judge(index: int, params: RobotParams, t_end: float) -> dict:
-    """Run one design in both engines and classify it (module docstring)."""
+def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None) -> dict:
+    """Run one design in both engines and classify it (module docstring); ``budget`` [s]: the MuJoCo run's
+    wall-time budget (a run past it stops with that reason)."""
     row = {"design": index, "params": params, "t_end": t_end}
     try:
         analytic = registry.run("analytic-unilateral", params, t_end, dt_out=1e-3)
         started = time.perf_counter()
-        wheels = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3)
+        options = {} if budget is None else {"wall_budget_s": budget}
+        wheels = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, **options)
         row["wall_s"] = time.perf_counter() - started
     except (ParameterError, SimulationError) as exc:
         return {**row, "class": "stopped", "why": " ".join(str(exc).split())}
@@ -111,6 +113,9 @@ def main(argv=None) -> int:
     parser.add_argument("--designs", type=int, default=100)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--skip", type=int, default=0, help="draw and skip the first N designs (resume a run)")
+    parser.add_argument("--wall-budget", type=float, default=None,
+                        help="each MuJoCo run's wall-time budget [s]: a run past it is stopped with that reason")
     parser.add_argument("--smoke", action="store_true", help="4 designs of 0.3 s: the script runs")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
@@ -118,7 +123,8 @@ def main(argv=None) -> int:
     jobs = []
     for k in range(count):
         params, t_end = design(rng)
-        jobs.append((k, params, 0.3 if args.smoke else t_end))
+        if k >= args.skip:
+            jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget))
     counts = {"agree": 0, "lifted": 0, "stopped": 0, "outside": 0}
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = [pool.submit(judge, *job) for job in jobs]
@@ -126,7 +132,7 @@ def main(argv=None) -> int:
             row = future.result()
             counts[row["class"]] += 1
             print(line(row), flush=True)
-            print(f"[{done}/{count}] {counts}", file=sys.stderr, flush=True)
+            print(f"[{done}/{len(jobs)}] {counts}", file=sys.stderr, flush=True)
     print(" ".join(f"{k}: {v}" for k, v in counts.items()))
     return 0
 
