@@ -243,15 +243,20 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
 
 
 def test_a_route_whose_planar_walls_would_be_too_large_is_refused_before_building():
-    """40 half turns of 100 m radius: each bend's outer polygon needs ~7,860 boxes (corners within 2e-6 m of
-    the circle); refused up front with the count, before any wall is built (the check is the closed-form count)."""
+    """40 half turns of 100 m radius: each bend's outer polygon of the planar walls would need ~7,860 boxes
+    (corners within 2e-6 m of the circle): the closed-form count refuses them up front; the round pipe builds
+    each bend as one piece."""
     from ipir_mujoco.engine.route_walls import MAX_WALL_BOXES, check_wall_count
+    from ipir_mujoco.engine.wheels_model import build_wheels_model
 
     tables = [dict(kind="straight", length=0.5)] + [dict(kind="bend", radius=100.0, angle=(-1) ** k * 180.0)
                                                      for k in range(40)]
+    route = route_from_tables(tables, "r.toml")
     with pytest.raises(ParameterError, match=f"need 3[0-9]{{5}} boxes .*allowed: at most {MAX_WALL_BOXES}") as info:
-        registry.run("mujoco-wheels", CRUISE, 1.0, route=route_from_tables(tables, "r.toml"))
+        check_wall_count(route, 0.16)
     assert "\n" not in str(info.value)
+    model = build_wheels_model(CRUISE, route=route)
+    assert sum(1 for g in range(model.ngeom) if model.geom(g).name.startswith("pipe_bend")) == 40
     assert check_wall_count(route_from_tables(BEND), 0.16) < MAX_WALL_BOXES  # a bend of R/D 6 is built
     with pytest.raises(ParameterError, match="out of the mechanism's plane"):
         across = [BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.5)]
