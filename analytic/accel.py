@@ -66,7 +66,14 @@ def accelerate() -> bool:
     if not available():
         _refused = True
         return False
-    import numba
+    loaded = set(sys.modules)
+    try:
+        import numba
+    except BaseException:  # Ctrl-C (or anything) while numba loads: leave no half-loaded module (numba's or one
+        # it imports) behind, so that the next try imports them afresh rather than failing on missing attributes
+        for name in set(sys.modules) - loaded:
+            del sys.modules[name]
+        raise
 
     if numba.config.DISABLE_JIT:
         _refused = True

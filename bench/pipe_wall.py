@@ -13,19 +13,23 @@ and a 60-degree bend in another plane. Prints, per wall: the ripple (the largest
 deviation over its mean, over the whole roll, bends and their joints included), its peak-to-peak over the mean,
 and the cost of one mj_step with the carriage at rest (MuJoCo's own loop, ``nstep``, best of 5), with the
 route's pieces in the model; and with 40 bends of 100 m radius in the model (pieces far from the wheels cost
-only their broad-phase test).
+only their broad-phase test). Then the rig on joints, its wheels rolling on hub hinges with friction 0.5 (the
+carriage on a slide along a straight, or on a hinge about a bend's axis at R/D 2.5 and 1.25, driven at 0.5 m/s;
+the cost here includes the Python loop's contact reading): the ripple with rolling, and each wheel's mean force
+(in a bend the wheels' own m v^2 / R, 0.0125 N at R 0.4 m, shifts them apart: physics, not the wall).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import time
 
 import mujoco
 import numpy as np
 
 from ipir_mujoco.core.route import route_from_tables
-from ipir_mujoco.engine.pipe_rig import build_rig, ripple, roll
+from ipir_mujoco.engine.pipe_rig import build_rig, ripple, roll, roll_on_joints, rolling_rig
 
 ROUTE = [dict(kind="straight", length=0.3), dict(kind="bend", radius=0.4, angle=90, plane=90),
          dict(kind="straight", length=0.2), dict(kind="bend", radius=0.3, angle=-60, plane=30),
@@ -62,6 +66,15 @@ def main() -> None:
         print(f"{label:44s} {ripple(run):16.2e} {ptp:15.2e} {step_cost(model, steps):8.2f} {run.contacts:15d}")
     model = build_rig(route_from_tables(LONG))
     print(f"{'exact pipe, 40 bends of R 100 m in the model':44s} {'':16s} {'':15s} {step_cost(model, steps):8.2f}")
+    duration = 0.2 if args.smoke else 1.0
+    for label, radius in (("rolling (mu 0.5), straight", None), ("rolling (mu 0.5), in a bend of R/D 2.5", 0.4),
+                          ("rolling (mu 0.5), in a bend of R/D 1.25", 0.2)):
+        within = duration if radius is None else min(duration, 0.8 * (math.pi * radius - 0.3 * 0.5) / 0.5)
+        run = roll_on_joints(rolling_rig(bend_radius=radius), 0.5, within)  # the carriage stays in the half turn
+        ptp = max(np.ptp(run.force[:, k]) / np.mean(run.force[:, k]) for k in range(run.force.shape[1]))
+        means = ", ".join(f"{v:.4f}" for v in run.force.mean(axis=0))
+        print(f"{label:44s} {ripple(run):16.2e} {ptp:15.2e} {run.us_per_step:8.2f} {run.contacts:15d}   "
+              f"mean forces {means} N")
 
 
 if __name__ == "__main__":

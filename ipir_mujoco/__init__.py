@@ -24,20 +24,35 @@ returns a :class:`RunResult`; bad input is a :class:`ParameterError` (a ValueErr
 :class:`SimulationError`. Everything else is reachable through the subpackages above.
 """
 
-from pathlib import Path as _Path
+import os as _os
+import sys as _sys
+
+# The command line (`ipir-mujoco`, `python -m ipir_mujoco`) starts here: its Ctrl-C guard goes in before the
+# imports below (numpy and the registry), so that a Ctrl-C while they load is one line, not a traceback
+# (ipir_mujoco.interrupts; a Python program importing the package gets no handler from here).
+_starting_command = bool(_sys.argv) and _os.path.basename(_sys.argv[0]) in ("ipir-mujoco", "-m")
+if _starting_command:
+    from . import interrupts as _interrupts
+
+    _starting_command = _interrupts.guard_loading()
 
 __version__ = "0.2.0"
 
 # Installed, the repository's analytic/ and mjcf/ folders are ipir_mujoco/analytic and
 # ipir_mujoco/mjcf. In a source checkout run without installing, they sit beside this
 # package: let the subpackage import find them there.
-_here = _Path(__file__).resolve().parent
-if not (_here / "analytic").is_dir() and (_here.parent / "analytic" / "__init__.py").is_file():
-    __path__.append(str(_here.parent))  # noqa: F821 (a package's own __path__)
+_here = _os.path.dirname(_os.path.realpath(__file__))
+if (not _os.path.isdir(_os.path.join(_here, "analytic"))
+        and _os.path.isfile(_os.path.join(_here, "..", "analytic", "__init__.py"))):
+    __path__.append(_os.path.dirname(_here))  # noqa: F821 (a package's own __path__)
 
-from .core.errors import ParameterError, SimulationError  # noqa: E402  (after the analytic folder is findable)
-from .core.params import RobotParams  # noqa: E402
-from .core.results import RunResult  # noqa: E402
-from .registry import VARIANTS, run  # noqa: E402
+try:
+    from .core.errors import ParameterError, SimulationError  # noqa: E402  (after the analytic folder is findable)
+    from .core.params import RobotParams  # noqa: E402
+    from .core.results import RunResult  # noqa: E402
+    from .registry import VARIANTS, run  # noqa: E402
+finally:
+    if _starting_command:
+        _interrupts.loaded()
 
 __all__ = ["VARIANTS", "ParameterError", "RobotParams", "RunResult", "SimulationError", "__version__", "run"]

@@ -5,7 +5,9 @@ its own files into it, replacing earlier copies of those names, and leaves every
 it writes that is taken by something of another kind (a folder where ``summary.json`` goes, a file where
 ``figures/`` goes, a link) is refused in one line before any work, and again before anything is moved in.
 Files are staged in ``.DIR-partial-PID-*`` beside DIR; one left by a process that was killed (SIGKILL, power
-loss) is removed by the next run that writes DIR.
+loss) is removed by the next run that writes DIR. A study that streams into DIR (sweep, optimize, sensitivity)
+holds it locked while it runs (:func:`study_folder`): a second run on the same folder, resumed or not, is
+refused in one line rather than running every design again beside the first.
 """
 
 from __future__ import annotations
@@ -125,3 +127,70 @@ def staged_output(out: str | Path) -> Iterator[Path]:
             item.replace(target)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+class FolderLock:
+    """An exclusive lock on the folder ``out`` (``fcntl.flock`` on the folder itself: no file is left in it),
+    held until :meth:`release` (or the object's end, or the process's); a folder another process holds is
+    a one-line ParameterError naming it. Where the file system has no locks (some network mounts) or the
+    platform no fcntl, nothing is locked."""
+
+    def __init__(self, out: Path, option: str = "--out"):
+        self.fd: int | None = None
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover (Windows)
+            return
+        fd = os.open(out, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise ParameterError(f"{option} {str(out)!r} is in use by another run (a study writing there now); "
+                                 f"wait for it to end, or give another {option}") from None
+        except OSError:  # no locks on this file system
+            os.close(fd)
+            return
+        self.fd = fd
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+    def __del__(self):
+        self.release()
+
+
+@contextlib.contextmanager
+def study_folder(out: str | Path, option: str = "--out") -> Iterator[Path]:
+    """The results folder of a study that streams into it: created if need be and locked for the block
+    (:class:`FolderLock`); a ParameterError inside the block (a resume file refused before any design) leaves
+    no folder this call created."""
+    out = Path(out)
+    created = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    lock = FolderLock(out, option)
+    try:
+        yield out
+    except ParameterError:
+        if created:
+            with contextlib.suppress(OSError):
+                out.rmdir()  # only if empty
+        raise
+    finally:
+        lock.release()
+
+
+def write_atomically(path: str | Path, write) -> None:
+    """``write(temporary path)``, then the temporary renamed to ``path``: a failure (a full disk) leaves the
+    earlier file, or none, never a cut one."""
+    path = Path(path)
+    staged = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")  # umask permissions (mkstemp: 0600)
+    try:
+        write(staged)
+        os.replace(staged, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(staged)
+        raise

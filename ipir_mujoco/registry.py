@@ -34,9 +34,11 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
+from . import interrupts
 from .core.control import FeedforwardTable
-from .core.errors import ParameterError
-from .core.params import RobotParams, check_real
+from .core.errors import ParameterError, ParameterTypeError
+from .core.options import check_type
+from .core.params import RobotParams, check_real, check_whole, require_params
 from .core.results import RunResult
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
@@ -45,7 +47,6 @@ __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep
 
 ENGINES = ("analytic", "mujoco")
 RULES = ("kinematic", "unilateral")
-MUJOCO_MODELS = ("slides", "wheels")  # MuJoCo's models: the modules on slides, or on wheels on the pipe walls
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,7 @@ class Variant:
     clutch: str | None  # MuJoCo's clutch: 'ratchet' | 'lock'; None for the equations
     label: str  # in words, for figures and reports
     model: str = "slides"  # MuJoCo's model of the robot: 'slides' | 'wheels' (the equations: 'slides')
+    clutches: str = ""  # its clutches in words, where its model has only those (for a refused flag's message)
 
     @property
     def is_mujoco(self) -> bool:
@@ -83,7 +85,8 @@ VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("mujoco-lock", "mujoco", "kinematic", "exact", "lock", "MuJoCo, paper's rule"),
     Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
     Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
-    Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels"),
+    Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels",
+            "one-way ratchets in the wheels' hubs"),
 )}
 ALIASES = {
     "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
@@ -91,11 +94,15 @@ ALIASES = {
     "mujoco-lock-kinematic": "mujoco-lock",
 }
 NAMES = tuple(VARIANTS)
+# MuJoCo's models of the robot (``--mujoco-model``): the modules on slides, or on wheels on the pipe walls, ...
+MUJOCO_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.engine == "mujoco"))
 
 # the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
 ANALYTIC_OPTIONS = ("rtol", "atol", "max_switches", "method", "torque")
 MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step", "route")
+# what every engine takes: RunOptions' fields but t_end and max_switches (analytic), and the servo's table
+COMMON_OPTIONS = ("dt_out", "until_steady", "steady_tol", "steady_cycles", "progress", "wall_budget_s", "feedforward")
 _WHY_NOT = {"analytic": "the analytic engines hold their solver tolerance and have no timestep, clutch "
                         "implementation or MJCF",
             "mujoco": "MuJoCo's cost is its step count, t_end / timestep, and its accuracy its own monitor's"}
@@ -120,8 +127,8 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     clutches; ``rule`` None is the paper's rule, or one-way clutches on the wheeled model (its only ones)."""
     if model not in MUJOCO_MODELS:
         raise ParameterError(f"--mujoco-model {model!r} is unknown; allowed: {', '.join(MUJOCO_MODELS)}")
-    if model == "wheels":
-        return _wheels_from_flags(engine, geometry, rule, clutch)
+    if model != "slides":
+        return _model_from_flags(engine, geometry, rule, clutch, model)
     rule = "kinematic" if rule is None else rule
     if engine not in ENGINES:
         raise ParameterError(f"--engine {engine!r} is unknown; allowed: {', '.join(ENGINES)}")
@@ -146,20 +153,23 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     return _find(engine, rule, "exact", clutch)
 
 
-def _wheels_from_flags(engine: str, geometry: str | None, rule: str | None, clutch: str | None) -> Variant:
-    """``mujoco-wheels``, after refusing the flags it does not take (one line each)."""
+def _model_from_flags(engine: str, geometry: str | None, rule: str | None, clutch: str | None,
+                      model: str) -> Variant:
+    """The one variant of MuJoCo's model ``model`` (not the slides: ``mujoco-wheels`` for 'wheels'), after
+    refusing the flags it does not take (one line each)."""
+    v = next(v for v in VARIANTS.values() if v.model == model)
     if engine != "mujoco":
-        raise ParameterError("--mujoco-model wheels applies only to --engine mujoco")
+        raise ParameterError(f"--mujoco-model {model} applies only to --engine mujoco")
     if geometry == "approx":
         raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real linkage; "
                              "allowed: --geometry exact (or leave it out)")
-    if rule not in (None, "unilateral"):
-        raise ParameterError(f"--clutch {rule} with --mujoco-model wheels: its clutches are one-way ratchets in the "
-                             "wheels' hubs; allowed: --clutch unilateral (or leave it out)")
-    if clutch not in (None, "ratchet"):
-        raise ParameterError(f"--mujoco-clutch {clutch} with --mujoco-model wheels: its clutches are ratchets in the "
-                             "wheels' hubs; allowed: --mujoco-clutch ratchet (or leave it out)")
-    return VARIANTS["mujoco-wheels"]
+    if rule not in (None, v.rule):
+        raise ParameterError(f"--clutch {rule} with --mujoco-model {model}: its clutches are {v.clutches}; "
+                             f"allowed: --clutch {v.rule} (or leave it out)")
+    if clutch not in (None, v.clutch):
+        raise ParameterError(f"--mujoco-clutch {clutch} with --mujoco-model {model}: its clutches are {v.clutches}; "
+                             f"allowed: --mujoco-clutch {v.clutch} (or leave it out)")
+    return v
 
 
 def _find(engine: str, rule: str, geometry: str, clutch: str | None) -> Variant:
@@ -235,8 +245,32 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         An unknown name, an option the variant's engine does not take, or parameters it refuses (one line).
     SimulationError
         A run that cannot go on (one line with the time and the reason).
+    KeyboardInterrupt
+        Ctrl-C during the run, wherever it landed (compiled code included), never another exception or a result.
     """
     v = check_options(name, options)
+    require_params(params)
+    unknown = [k for k in options if k not in (*COMMON_OPTIONS, *ANALYTIC_OPTIONS, *MUJOCO_OPTIONS)]
+    if unknown:  # (an option of the other engine given as None or False counts as not given: check_options)
+        known = (*COMMON_OPTIONS, *(MUJOCO_OPTIONS if v.is_mujoco else ANALYTIC_OPTIONS))
+        raise ParameterTypeError(f"option {unknown[0]}={options[unknown[0]]!r} is unknown to {v.name}; "
+                                 f"allowed: {', '.join(known)}")
+    if not isinstance(options.get("every_step", False), (bool, type(None))):
+        raise ParameterTypeError(f"every_step={options['every_step']!r} is not a bool; allowed: True or False")
+    # Ctrl-C during the run is KeyboardInterrupt, whatever the code it landed in made of it (ipir_mujoco.interrupts)
+    with interrupts.watching() as since:
+        try:
+            result = _run(v, params, t_end, options)
+        except BaseException:
+            if interrupts.interrupted_since(since):
+                raise KeyboardInterrupt from None
+            raise
+        if interrupts.interrupted_since(since):
+            raise KeyboardInterrupt
+    return result
+
+
+def _run(v: Variant, params: RobotParams, t_end: float, options: dict[str, Any]) -> RunResult:
     if params.drive == "servo" and options.get("feedforward") is None:
         options["feedforward"] = feedforward_table(params)
     foreign = MUJOCO_OPTIONS if not v.is_mujoco else ANALYTIC_OPTIONS  # given as None or False: not given
@@ -321,10 +355,25 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
     outcome per design, as :func:`ipir_mujoco.engine.batch.run_ratchet_batch` gives them."""
     if not batched(name):
         raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
+    if not isinstance(designs, (list, tuple)):
+        raise ParameterTypeError(f"designs={designs!r} is not a list of RobotParams")
+    for params in designs:
+        require_params(params)
+    check_whole("nthread", nthread, low=1, high=1024)
+    check_type("until_steady", until_steady, bool, "True or False")
     from .engine import batch
 
     steady = {"until_steady": True} if until_steady else {}
-    return batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
+    with interrupts.watching() as since:  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design
+        try:
+            outcomes = batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
+        except BaseException:
+            if interrupts.interrupted_since(since):
+                raise KeyboardInterrupt from None
+            raise
+        if interrupts.interrupted_since(since):
+            raise KeyboardInterrupt
+    return outcomes
 
 
 def batch_models(params: RobotParams) -> bool:

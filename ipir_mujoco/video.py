@@ -72,13 +72,16 @@ def view_direction(azimuth: float, elevation: float) -> np.ndarray:
 
 def route_view(route) -> tuple[float, float]:
     """(azimuth, elevation) [deg] of a camera square to the plane a route lies in (the normal of least spread of
-    its centreline's points), looking from above that plane: a route in the horizontal plane is seen from straight
-    above (+x right, +y up), one that turns up into a riser from its side."""
+    its centreline's points), from the side where the route starts towards the frame's right (and, for a plane
+    near the horizontal, from above): a route in the horizontal plane is seen from straight above (+x right, +y
+    up), one that turns up into a riser from its side."""
     if route.planar:
         return 90.0, -90.0
     points = np.array([route.at3(route.length * i / 100)[0] for i in range(101)])
     normal = np.linalg.svd(points - points.mean(axis=0))[2][2]
     d = normal if normal[2] <= 0 else -normal  # the view direction, downward or level
+    if abs(d[2]) < 0.99 and float(np.cross(d, [0.0, 0.0, 1.0]) @ route.pieces[0].frame[0]) < 0:
+        d = -d  # the route's start runs to the right of the frame, as it does seen from above
     return math.degrees(math.atan2(d[1], d[0])), math.degrees(math.asin(max(-1.0, min(1.0, d[2]))))
 
 

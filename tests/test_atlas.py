@@ -135,3 +135,38 @@ def test_mujoco_runs_stay_within_the_budget_and_the_boundary_is_reported(tmp_pat
         assert c_lo <= value <= c_hi
         assert min(abs(value - e) for e in eq) < max(0.1 * 2.7, c_hi - c_lo)
     assert all(math.isfinite(v) for v in entry["crossings"]["m2"])
+
+
+def test_the_report_neighbourhood_keeps_L_above_r_and_follows_the_drive():
+    from ipir_mujoco.report.atlas_section import neighbourhood
+
+    axes = {a.name: a for a in neighbourhood(RobotParams(L=0.07, r=0.05))}
+    assert axes["L"].low == pytest.approx(1.05 * 0.05) and axes["L"].high == pytest.approx(1.5 * 0.07)
+    assert "M" in axes and "M_stall" not in axes
+    motor = {a.name: a for a in neighbourhood(RobotParams(drive="motor", M_stall=0.4))}
+    assert "M_stall" in motor and motor["M_stall"].low == pytest.approx(0.2) and motor["M_stall"].high == \
+        pytest.approx(0.6)
+
+
+@pytest.mark.slow
+def test_report_section_where_the_paper_model_holds(tmp_path):
+    from ipir_mujoco.report import atlas_section
+    from ipir_mujoco.report.document import Image, Table, to_markdown
+
+    metrics = atlas_section.compute(RobotParams(), True, lambda _m: None)
+    # the equations only, every idealization they measure at the paper's case (unlimited grip: not that one)
+    assert set(metrics["idealizations"]) == {"first-order-kinematics", "massless-rod", "locking-clutches"}
+    assert metrics["metrics"] == ["revolutions", "travel_m"]
+    first = metrics["idealizations"]["first-order-kinematics"]["revolutions"]
+    # the paper's L/r = 4 lies below the 1 % crossing (L/r ~ 5.1), L spans 2..6 r: part of the box is safe, part not
+    assert 0 < first["safe_fraction"] < 1
+    # the paper's locks cost ~9 % in revolutions at the paper's case: nowhere near within 1 % over +-50 %
+    assert metrics["idealizations"]["locking-clutches"]["revolutions"]["safe_fraction_interval"][1] < 0.5
+    blocks = atlas_section.render(metrics, tmp_path)
+    assert (tmp_path / "atlas_safe.png").stat().st_size > 0
+    assert any(isinstance(b, Image) and b.path == "figures/atlas_safe.png" for b in blocks)
+    table = next(b for b in blocks if isinstance(b, Table))
+    assert len(table.rows) == 3 * 2  # idealizations x metrics
+    verdict = atlas_section.verdict(metrics)
+    assert verdict["short"] == "least safe: locking-clutches" and "revolutions" in verdict["answer"]
+    assert "Where the paper's model holds" in to_markdown(blocks)

@@ -125,3 +125,13 @@ def test_cycles_are_found():
 
 def test_no_import_cycle_among_the_packages_modules():
     assert cycles(graph()) == []
+
+
+def test_the_architecture_document_places_every_module_of_the_engine_core_and_analytic_model():
+    """docs/architecture.md names each module of the engine, the core, the analytic model and the package's top
+    level (the studies', report's and command line's are placed there by group)."""
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    folders = (ROOT / "ipir_mujoco" / "engine", ROOT / "ipir_mujoco" / "core", ROOT / "analytic", ROOT / "ipir_mujoco")
+    missing = [f"{folder.name}/{file.name}" for folder in folders for file in sorted(folder.glob("*.py"))
+               if file.name not in ("__init__.py", "__main__.py") and file.name not in text]
+    assert missing == []

@@ -118,3 +118,24 @@ def test_kinds_are_named_once_and_unknown_models_are_one_line():
         kinds.kind_for("tracks", RobotParams())
     assert [kind.accuracy for kind in (kinds.SLIDES, kinds.GRIP_SLIDES, kinds.WHEELS)] == ["stop", "stop", "warn"]
     assert isinstance(_setup("mujoco-ratchet", RobotParams()).model, mujoco.MjModel)
+
+
+def test_every_engine_audits_the_energy_terms_of_the_one_table():
+    """Both engines' audits report each term under the table's key (core.energy), its column's change over the
+    run, and a residual that closes the table's balance; a run with compliant clutches on finite grip has every
+    term."""
+    from ipir_mujoco.core import energy
+
+    p = RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0, clutch_stiffness=1e5, clutch_damping=5.0)
+    for variant in ("analytic-unilateral", "mujoco-ratchet"):
+        run = registry.run(variant, p, 0.05, dt_out=1e-3)
+        terms = energy.terms_of(run.series)
+        assert terms == energy.ENERGY_TERMS, variant  # every term, in the table's order
+        assert set(run.energy) == {t.audit_key for t in terms} | {energy.RESIDUAL_KEY}
+        change = energy.changes(run.series)
+        for term in terms:
+            assert run.energy[term.audit_key] == pytest.approx(change[term], rel=1e-12, abs=1e-15), term
+        total = energy.by_role(change)
+        closed = total["input"] - total["dissipated"] - total["kinetic"] - total["stored"]
+        # the residual is the balance of the table's roles (to the last ulps of the summed terms)
+        assert run.energy[energy.RESIDUAL_KEY] == pytest.approx(closed, abs=1e-12 * abs(total["input"]))

@@ -127,3 +127,42 @@ def test_a_route_file_that_cannot_be_read_is_refused_in_one_line(tmp_path, conte
     with pytest.raises(ParameterError, match=word) as info:
         read_route(path)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("radius", [None, 0.2])
+def test_wheels_rolling_with_friction_see_a_round_wall(radius):
+    """The rig on joints, wheels rolling with friction 0.5 at 0.5 m/s along a straight and inside a bend of
+    R/D 1.25: each wheel's force holds constant to 1e-6 of it (the contact solver's convergence, as above), and
+    its mean is the preload but for the wheel's own centripetal load in the bend, m v^2 / R = 0.02 x 0.25 / 0.2 =
+    0.025 N spread over the legs by their directions (at most that much off 10 N), and the contact's sinking
+    (the spring's 0.1 % of travel at most)."""
+    from ipir_mujoco.engine.pipe_rig import WHEEL_MASS, roll_on_joints, rolling_rig
+
+    run = roll_on_joints(rolling_rig(bend_radius=radius), 0.5, 0.1, settle=0.2)
+    assert run.contacts == 1 and ripple(run) < 1e-6
+    centripetal = 0.0 if radius is None else WHEEL_MASS * 0.5 ** 2 / radius
+    assert np.all(np.abs(run.force.mean(axis=0) - 10.0) <= centripetal + 0.01)
+
+
+def test_a_housing_capsule_tilted_in_a_bend_rests_on_its_deepest_point():
+    """A capsule (the round-pipe robot's housing) inside a bend of R 0.4 m, tilted so one end sinks into the
+    outer wall: one contact, at that end, its depth the end's distance from the centreline past D/2."""
+    route = route_from_tables([dict(kind="straight", length=0.3), dict(kind="bend", radius=0.4, angle=90)])
+    spec = mujoco.MjSpec()
+    add_pipe_walls(spec, route, 0.16, CONTACT, draw=False)
+    centre, t = route.at3(0.3 + 0.2)  # 0.5 rad into the bend
+    body = spec.worldbody.add_body(name="housing", pos=centre.tolist())
+    body.add_freejoint()
+    outward = (centre - route.pieces[1].centre3) / 0.4  # the bend's outer side there
+    ends = -0.05 * t, 0.05 * t + 0.06 * outward  # from the housing's centre: its far end sunk in the outer wall
+    body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[*ends[0], *ends[1]], size=[0.03, 0, 0],
+                  contype=PIPE_BIT, conaffinity=0)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    depths = []
+    for end in ends:
+        p = centre + end
+        depths.append(0.08 - (np.linalg.norm(p - route.at3(route.project3(p))[0]) + 0.03))
+    assert data.ncon == 1
+    assert data.contact.dist[0] == pytest.approx(min(depths), abs=1e-12)

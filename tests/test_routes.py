@@ -274,3 +274,13 @@ def test_a_bend_faster_than_its_twin_says_why_with_the_runs_numbers():
     assert "timing ripple" in twin_note({"time_s": 0.99, "route_wheel_off_s": 0.0}, twin)
     assert twin_note({"time_s": 1.0 - 0.5 * TWIN_SLACK, "route_wheel_off_s": 1.0}, twin) is None
     assert twin_note({"time_s": None}, twin) is None
+
+
+def test_the_wall_budget_covers_building_the_model():
+    """A budget no build can meet (1 ns: compiling any model takes far longer) ends the run before its first
+    step, saying so in one line."""
+    from ipir_mujoco.core.errors import SimulationError
+
+    with pytest.raises(SimulationError, match="while building its model") as info:
+        registry.run("mujoco-wheels", CRUISE, 1.0, route=route_from_tables(BEND), wall_budget_s=1e-9)
+    assert "\n" not in str(info.value)

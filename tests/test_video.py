@@ -386,11 +386,11 @@ def test_the_slide_model_is_drawn_in_its_pipe_cut_away_towards_the_camera():
 
 def test_the_camera_along_a_route_looks_square_to_its_plane():
     """A route in the horizontal plane is seen from straight above; one turning up into a riser (its points in
-    the x-z plane) from its side, level (the view along -+y)."""
+    the x-z plane) from its side, level, its start running to the frame's right."""
     from ipir_mujoco.core.route import route_from_tables
     from ipir_mujoco.video import route_view
 
     assert route_view(route_from_tables(BEND)) == (90.0, -90.0)
     up = route_from_tables([BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.3)])
-    azimuth, elevation = route_view(up)
-    assert abs(abs(azimuth) - 90.0) < 1e-6 and abs(elevation) < 1e-6
+    azimuth, elevation = route_view(up)  # from -y, looking along +y: +x to the right, +z up
+    assert abs(azimuth - 90.0) < 1e-6 and abs(elevation) < 1e-6

@@ -10,29 +10,16 @@ subcommand lives in its own module with ``add_parser(commands)`` and
 
 from __future__ import annotations
 
-import os
-import signal
+from ipir_mujoco import interrupts  # first: its SIGINT handler guards every import below
 
-EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
-
-
-def _interrupted_while_loading(signum, frame):  # pragma: no cover (timing)
-    # Ctrl-C while numpy, scipy, matplotlib or MuJoCo load: nothing is open yet, so leave at once,
-    # in one line (a KeyboardInterrupt here would print a traceback from inside an import)
-    os.write(2, b"ipir-mujoco: interrupted\n")
-    os._exit(EXIT_INTERRUPTED)
-
-
-# installed first thing, before any further import: only from the main thread (signal.signal raises elsewhere)
-# and never over a handler the caller set
-try:
-    _loading_guard = signal.getsignal(signal.SIGINT) is signal.default_int_handler
-    if _loading_guard:
-        signal.signal(signal.SIGINT, _interrupted_while_loading)
-except ValueError:
-    _loading_guard = False
+# Ctrl-C while numpy, scipy, matplotlib or MuJoCo load: nothing is open yet, so leave at once, in one line (a
+# KeyboardInterrupt there would print a traceback from inside an import); installed first thing, only from the
+# main thread and never over a handler the caller set. Once loaded, the handler raises KeyboardInterrupt as
+# Python's own does (and counts: see ipir_mujoco.interrupts).
+_loading_guard = interrupts.guard_loading()
 try:
     import logging
+    import os
     import sys
     from typing import Sequence
 
@@ -40,18 +27,19 @@ try:
 
     from .. import __version__
     from ..resources import shipped
-    from . import (bend_study, climb, clutch_study, compare, control_study, kinetostatics, optimize, params, render,
-                   sensitivity, simulate, sweep, validate)
+    from . import (bend_study, calibrate, climb, clutch_study, compare, control_study, kinetostatics, optimize,
+                   params, render, sensitivity, simulate, sweep, uncertainty, validate)
     from . import atlas
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
-    if _loading_guard:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+    interrupts.loaded()
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "main"]
+EXIT_INTERRUPTED = interrupts.EXIT_INTERRUPTED  # 128 + SIGINT, as shells report it
+
+__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "console", "main"]
 
 COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
-            climb, control_study, bend_study, atlas)
+            climb, control_study, bend_study, atlas, uncertainty, calibrate)
 
 
 def build_parser() -> Parser:
@@ -72,26 +60,47 @@ def build_parser() -> Parser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit status (see the module docstring)."""
+    """Run the command line; return the exit status (see the module docstring).
+
+    Ctrl-C anywhere in it is exit status 130 and one line: the first SIGINT raises KeyboardInterrupt, any later
+    one is only counted, so that the clean-up runs (:mod:`ipir_mujoco.interrupts`)."""
+    swapped = interrupts.begin_command()
+    try:
+        try:
+            return _command(argv)
+        except KeyboardInterrupt:  # landed outside the command's own handling (parsing, its last lines)
+            print("ipir-mujoco: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+    finally:
+        interrupts.end_command(swapped)
+
+
+def console() -> int:
+    """The ``ipir-mujoco`` command's entry point (and ``python -m ipir_mujoco``'s): :func:`main` as the process's
+    own command, after which a Ctrl-C changes nothing (the result is decided) and is ignored."""
+    interrupts.state.process = True
+    return main()
+
+
+def _command(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
-    except KeyboardInterrupt:
-        print("ipir-mujoco: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    prefix = f"ipir-mujoco {args.command}"
-    notes = _show_notes(prefix)
-    try:
-        return args.handler(args)
-    except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
-        if args.debug or isinstance(exc, SystemExit):
-            raise
-        if isinstance(exc, BrokenPipeError):
-            return _reader_gone()
-        code, message = _describe_failure(exc)
-        print(f"{prefix}: {message}", file=sys.stderr)
-        return code
+        prefix = f"ipir-mujoco {args.command}"
+        notes = _show_notes(prefix)
+        try:
+            return args.handler(args)
+        except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
+            if args.debug or isinstance(exc, SystemExit):
+                raise
+            if isinstance(exc, BrokenPipeError):
+                return _reader_gone()
+            code, message = _describe_failure(exc)
+            print(f"{prefix}: {message}", file=sys.stderr)
+            return code
+        finally:
+            logging.getLogger("ipir_mujoco").removeHandler(notes)
     finally:
-        logging.getLogger("ipir_mujoco").removeHandler(notes)
+        interrupts.state.armed = False  # first, with no call before it: no KeyboardInterrupt from here on
 
 
 MAX_MESSAGE = 1000  # characters of a one-line failure message shown (a huge value in it is cut)
@@ -145,4 +154,4 @@ def _describe_failure(exc: BaseException) -> tuple[int, str]:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    sys.exit(console())

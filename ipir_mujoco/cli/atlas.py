@@ -87,6 +87,8 @@ def run(args: argparse.Namespace) -> int:
 
 def summary_lines(result: dict, atlas) -> list[str]:
     """One line per idealization, metric and threshold: the safe fraction, its interval, crossings, runs."""
+    from ..studies.atlas import top_drivers
+
     lines = []
     for name, per_metric in result["idealizations"].items():
         for metric, entry in per_metric.items():
@@ -102,9 +104,7 @@ def summary_lines(result: dict, atlas) -> list[str]:
                 spent = (f"; {entry['runs']} {entry['measured_by']} runs"
                          + (f" (safe {regions['safe']}, unsafe {regions['unsafe']}, boundary {regions['boundary']})"
                             if regions else ""))
-                top = ", ".join(f"{p} ST {v['ST']:.2f}" for p, v in sorted(
-                    ((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict) and
-                     v.get("ST") is not None), key=lambda pv: -pv[1]["ST"])[:2])
+                top = top_drivers(entry)
                 lines.append(f"{name:24s} {metric:22s} |cost| < {item['threshold']:g}: {where}{cross}{spent}"
-                             + (f"; driven by {top}" if top else ""))
+                             + (f"; driven by {top}" if top != "-" else ""))
     return lines

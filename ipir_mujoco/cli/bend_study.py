@@ -50,8 +50,8 @@ def run(args: argparse.Namespace) -> int:
     check_output_dir(args.out, files=FILES)
 
     progress = study_progress("bend-study")
-    progress(f"{len(ratios) * len(planes)} bends and {len(ratios)} straight twins on {workers} processes (each ~2 s "
-             "of wall time per simulated second)")
+    progress(f"{len(ratios) * len(planes)} bends and {len(ratios)} straight twins on {workers} processes (a line "
+             "per finished run, and every 10 s of a running one)")
     study = bs.run_study(params, ratios, workers=workers, progress=progress, planes=planes)
     write_study_files(args.out, FILES, study, write_csv, lambda path: write_bend_figure(study, path),
                       format_table(study), f"{len(study['rows'])} bends")
@@ -119,9 +119,9 @@ def format_table(study: dict) -> str:
     for row in study["rows"]:
         f = _flat(row)
         where = f"plane {f['plane_deg']:g} deg, R/D {f['R_over_D']:g}"
-        if abs(f["bend_potential_j"] or 0.0) > 1e-3:  # a bend in the plane of gravity: energy net of the climb, J
-            lines.append(f"{where}: the window climbs ({f['bend_potential_j']:.3g} J of potential energy gained, "
-                         "taken out of the bend's energy; its time includes the climb)")
+        if abs(f["bend_potential_j"] or 0.0) > 1e-3:  # J: MuJoCo's potential energy, height and springs
+            lines.append(f"{where}: the robot's potential energy (its height, its legs' springs) changed by "
+                         f"{f['bend_potential_j']:.3g} J over the window, taken out of the bend's energy")
         if f["note"]:
             lines.append(f"{where}: the bend passed {f['note']}")
     ref = study["reference"]

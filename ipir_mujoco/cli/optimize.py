@@ -62,11 +62,13 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
-    with scheduler_executor(args.scheduler) as executor:
-        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor)
     from ..report.optimize_plots import plot_pareto
 
-    figure = plot_pareto(args.out, problem)
+    drawn = []
+    with scheduler_executor(args.scheduler) as executor:
+        record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor,
+                              figure=lambda out: drawn.append(plot_pareto(out, problem)))
+    figure = drawn[0]
     print(f"{record['evaluations']} evaluations ({record['reused_on_resume']} re-used), {record['feasible']} feasible")
     items = [record["best"]] if "best" in record else record["front"]
     if "best" in record and record["best"] is None:

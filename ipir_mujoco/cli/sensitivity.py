@@ -36,14 +36,16 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")
     axes = tuple(parse_vary(v) for v in args.vary)
     metrics = tuple(check_key(m, f"--metric {m!r}") for m in args.metric)
+    drawn = []
     with scheduler_executor(args.scheduler) as executor:
         indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
                                   engine=args.engine or "analytic-unilateral", t_end=design_t_end(args),
                                   until_steady=bool(args.until_steady),
                                   samples=64 if args.samples is None else args.samples,
                                   seed=0 if args.seed is None else args.seed, resume=args.resume,
-                                  workers=args.workers, executor=executor)
-    figure = plot_indices(args.out, indices, list(metrics))
+                                  workers=args.workers, executor=executor,
+                                  figure=lambda out, found: drawn.append(plot_indices(out, found, list(metrics))))
+    figure = drawn[0]
     for i in indices:
         print(f"  {i['metric']:22s} {i['parameter']:12s} S1 {i['S1']:+.3f} +- {i['S1_conf']:.3f}   "
               f"ST {i['ST']:+.3f} +- {i['ST_conf']:.3f}")

@@ -42,12 +42,12 @@ import numpy as np
 
 # LIMIT_ACCURACY's old home: studies and benchmarks import it from here
 from .steady_test import LIMIT_ACCURACY, Steady, find_steady, window_uncertainty  # noqa: F401
+from .energy import ENERGY_COLUMNS as _TABLE_COLUMNS
 
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
 _WHOLE_TOL = 1e-9  # revolutions: see cycle_boundaries
-ENERGY_COLUMNS = ("motor_work", "friction_work", "kinetic", "potential", "clutch_spring_energy",
-                  "clutch_damper_work", "skid_work")
+ENERGY_COLUMNS = _TABLE_COLUMNS  # the energy terms' columns (core.energy's table)
 
 
 def travel(series: dict[str, np.ndarray]) -> np.ndarray:

@@ -17,6 +17,12 @@ class ParameterError(ValueError):
     """
 
 
+class ParameterTypeError(ParameterError, TypeError):
+    """An argument of the wrong type (``params=None``, a string where a tuple of axes goes): a
+    :class:`ParameterError`, so one ``except ValueError`` catches every bad input, and a ``TypeError``, as
+    Python users expect of a wrong type."""
+
+
 class StudyInterrupted(RuntimeError):
     """Ctrl-C (or SIGINT) stopped a study of many designs (sweep, optimize, sensitivity); the message says
     where the results written so far are kept (the command line: exit status 130)."""

@@ -19,7 +19,7 @@ import numpy as np
 
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .steady_watch import check_steady_test
-from .errors import ParameterError
+from .errors import ParameterError, ParameterTypeError
 from .params import as_real, check_real, check_whole
 
 MAX_T_END = 3600.0  # s: an hour of simulated motion; a motor reaches its steady state in seconds, and a
@@ -146,7 +146,7 @@ def check_type(name: str, value: Any, types: type | tuple[type, ...], allowed: s
     one-line ParameterError naming the argument, what it got and ``allowed``: the public entry points check
     their arguments so that misuse is not a TypeError from deep inside."""
     if isinstance(value, bool) and bool not in (types if isinstance(types, tuple) else (types,)):
-        raise ParameterError(f"{name}={value!r} is not allowed; allowed: {allowed}")
+        raise ParameterTypeError(f"{name}={value!r} is not allowed; allowed: {allowed}")
     if not isinstance(value, types):
-        raise ParameterError(f"{name}={value!r} ({type(value).__name__}) is not allowed; allowed: {allowed}")
+        raise ParameterTypeError(f"{name}={value!r} ({type(value).__name__}) is not allowed; allowed: {allowed}")
     return value

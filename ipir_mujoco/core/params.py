@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from .checks import as_real, check_real, check_whole  # noqa: F401  (re-exported: their home was here)
-from .errors import ParameterError
+from .errors import ParameterError, ParameterTypeError
 from .files import MAX_TEXT_BYTES, read_text_file, read_toml_file  # noqa: F401  (re-exported)
 
 DRIVES = ("torque", "motor", "servo")
@@ -431,6 +431,6 @@ def refuse_idle_parameters(params: RobotParams) -> None:
 def require_params(params: Any) -> RobotParams:
     """``params`` if it is a :class:`RobotParams`, else a ParameterError (for the Python API's entry points)."""
     if not isinstance(params, RobotParams):
-        raise ParameterError(f"params={params!r} is not a RobotParams; build one with RobotParams(...) "
+        raise ParameterTypeError(f"params={params!r} is not a RobotParams; build one with RobotParams(...) "
                              "or load_params(...)")
     return params

@@ -426,5 +426,17 @@ def stall_reason(t: float, phi: float, torque: float, gravity: bool) -> str:
 
 
 def write_json(path: str | Path, data: dict[str, Any]) -> None:
-    """Write ``data`` as indented JSON (NaN is not valid JSON: refuse it)."""
-    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
+    """Write ``data`` as indented JSON (NaN is not valid JSON: refuse it), through a temporary file renamed into
+    place: a failed write (a full disk) leaves the earlier file, or none, never a cut one."""
+    import os
+
+    text = json.dumps(data, indent=2, allow_nan=False) + "\n"
+    path = Path(path)
+    staged = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")  # umask permissions (mkstemp: 0600)
+    try:
+        staged.write_text(text, encoding="utf-8")
+        os.replace(staged, path)
+    except BaseException:
+        if os.path.exists(staged):
+            os.unlink(staged)
+        raise

@@ -1,55 +1,60 @@
 """The finite-grip clutch controllers in the compiled loop: their indices and state in ``_stepper.c``'s arrays.
 
-:class:`.stepper.CompiledSteps` copies a controller's state into the C loop's CONFIG (indices) and STATE
-(doubles) arrays before it runs and back after each call; :func:`load_grip` does it for the two controllers
-on finite grip, :class:`.grip.GripRatchet` and :class:`.grip_compliant.CompliantGrip`.
+:class:`.stepper.CompiledSteps` asks a controller to copy its state into the C loop's CONFIG (indices) and STATE
+(doubles) arrays before it runs and back after each call (``load_compiled``); the two controllers on finite
+grip, :class:`.grip.GripRatchet` and :class:`.grip_compliant.CompliantGrip`, do it here.
 """
 
 from __future__ import annotations
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from .grip import GripRatchet
 from .native import LayoutError
 
 
-def load_grip(ctl, grip: dict | None, timestep: float, set_config, set_state):
-    """Write ``ctl``'s indices and state through ``set_config`` and ``set_state`` (name=value keywords), for a
-    loop whose friction rows are ``grip`` (:func:`.loop_rows.grip_layout`) and whose model steps ``timestep``
-    [s]. Returns (the clutch kind, the STATE names to read back, sync(ctl, values) writing them into ``ctl``).
-    Raises LayoutError where the controller does not fit the loop."""
-    modules = ctl.x_dof if isinstance(ctl, GripRatchet) else ctl.dof_adr
+def _common(ctl, loop, modules: list[int]) -> None:
+    """The carriages' indices and state, after checking that the controller's dofs are the loop's."""
+    grip = loop.grip
     if grip is None or [modules, ctl.c_dof] != [grip["x_dof"], grip["c_dof"]]:
         raise LayoutError("the grip controller's dofs are not the loop's")
-    common = dict(cmin0=ctl.lowest[0], cmin1=ctl.lowest[1], cmargin0=ctl.skid_margins[0],
-                  cmargin1=ctl.skid_margins[1], grip0=ctl.grip[0], grip1=ctl.grip[1], rest_speed=REST_SPEED,
-                  excursion=ctl.excursion)
-    set_config(skid_q0=ctl.c_adr[0], skid_q1=ctl.c_adr[1], skid_j0=ctl.skid_ids[0], skid_j1=ctl.skid_ids[1])
-    if isinstance(ctl, GripRatchet):
-        set_config(slide_q0=ctl.x_adr[0], slide_q1=ctl.x_adr[1], roll_t0=ctl.roll_ids[0], roll_t1=ctl.roll_ids[1])
-        set_state(lmax0=ctl.bounds[0], lmax1=ctl.bounds[1], tmargin0=ctl.roll_margins[0],
-                  tmargin1=ctl.roll_margins[1], **common)
-        return "grip_ratchet", ("lmax0", "lmax1", "cmin0", "cmin1", "excursion"), _sync_ratchet
-    if ctl.dt != timestep:
+    loop.set_config(skid_q0=ctl.c_adr[0], skid_q1=ctl.c_adr[1], skid_j0=ctl.skid_ids[0], skid_j1=ctl.skid_ids[1])
+    loop.set_state(cmin0=ctl.lowest[0], cmin1=ctl.lowest[1], cmargin0=ctl.skid_margins[0],
+                   cmargin1=ctl.skid_margins[1], grip0=ctl.grip[0], grip1=ctl.grip[1], rest_speed=REST_SPEED,
+                   excursion=ctl.excursion)
+
+
+def load_grip_ratchet(ctl, loop):
+    """:class:`.grip.GripRatchet`'s layout in ``loop`` (a :class:`.stepper.CompiledSteps`): returns (its C kind,
+    sync(state values))."""
+    _common(ctl, loop, ctl.x_dof)
+    loop.set_config(slide_q0=ctl.x_adr[0], slide_q1=ctl.x_adr[1], roll_t0=ctl.roll_ids[0], roll_t1=ctl.roll_ids[1])
+    loop.set_state(lmax0=ctl.bounds[0], lmax1=ctl.bounds[1], tmargin0=ctl.roll_margins[0],
+                   tmargin1=ctl.roll_margins[1])
+    get = loop.getter("lmax0", "lmax1", "cmin0", "cmin1", "excursion")
+
+    def sync(state) -> None:
+        l0, l1, c0, c1, ctl.excursion = get(state)
+        ctl.bounds[0], ctl.bounds[1], ctl.lowest[0], ctl.lowest[1] = l0, l1, c0, c1
+    return "grip_ratchet", sync
+
+
+def load_compliant_grip(ctl, loop):
+    """:class:`.grip_compliant.CompliantGrip`'s layout in ``loop``: returns (its C kind, sync(state values))."""
+    _common(ctl, loop, ctl.dof_adr)
+    if ctl.dt != loop.model.opt.timestep:
         raise LayoutError("the compliant clutches' timestep is not the model's")
-    set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], act0=ctl.act[0], act1=ctl.act[1],
-               implicit=ctl.implicit)
-    set_state(anchor0=ctl.anchor[0], anchor1=ctl.anchor[1], overlap0=ctl.overlap[0], overlap1=ctl.overlap[1],
-              v_before0=ctl.v_before[0], v_before1=ctl.v_before[1], damped0=ctl.damped[0], damped1=ctl.damped[1],
-              damper_work=ctl.damper_work, k=ctl.k, c=ctl.c, backlash=ctl.backlash, tracking0=ctl.tracking[0],
-              tracking1=ctl.tracking[1], **common)
-    return "compliant_grip", ("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
-                              "damped1", "damper_work", "tracking0", "tracking1", "cmin0", "cmin1",
-                              "excursion"), _sync_compliant
+    loop.set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], act0=ctl.act[0], act1=ctl.act[1],
+                    implicit=ctl.implicit)
+    loop.set_state(anchor0=ctl.anchor[0], anchor1=ctl.anchor[1], overlap0=ctl.overlap[0], overlap1=ctl.overlap[1],
+                   v_before0=ctl.v_before[0], v_before1=ctl.v_before[1], damped0=ctl.damped[0],
+                   damped1=ctl.damped[1], damper_work=ctl.damper_work, k=ctl.k, c=ctl.c, backlash=ctl.backlash,
+                   tracking0=ctl.tracking[0], tracking1=ctl.tracking[1])
+    get = loop.getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0", "damped1",
+                      "damper_work", "tracking0", "tracking1", "cmin0", "cmin1", "excursion")
 
-
-def _sync_ratchet(ctl, values) -> None:
-    l0, l1, c0, c1, ctl.excursion = values
-    ctl.bounds[0], ctl.bounds[1], ctl.lowest[0], ctl.lowest[1] = l0, l1, c0, c1
-
-
-def _sync_compliant(ctl, values) -> None:
-    a0, a1, d0, d1, v0, v1, damped0, damped1, ctl.damper_work, t0, t1, c0, c1, ctl.excursion = values
-    ctl.anchor, ctl.overlap, ctl.v_before = [a0, a1], [d0, d1], [v0, v1]
-    ctl.damped, ctl.tracking = [damped0 != 0.0, damped1 != 0.0], [t0 != 0.0, t1 != 0.0]
-    ctl.lowest[0], ctl.lowest[1] = c0, c1  # in place: the wall's running bound holds this list
+    def sync(state) -> None:
+        a0, a1, d0, d1, v0, v1, damped0, damped1, ctl.damper_work, t0, t1, c0, c1, ctl.excursion = get(state)
+        ctl.anchor, ctl.overlap, ctl.v_before = [a0, a1], [d0, d1], [v0, v1]
+        ctl.damped, ctl.tracking = [damped0 != 0.0, damped1 != 0.0], [t0 != 0.0, t1 != 0.0]
+        ctl.lowest[0], ctl.lowest[1] = c0, c1  # in place: the wall's running bound holds this list
+    return "compliant_grip", sync

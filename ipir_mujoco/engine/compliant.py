@@ -47,6 +47,7 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 
 from .controller import ControllerBase
+from .native import LayoutError
 from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
@@ -98,46 +99,65 @@ class CompliantClutches(ControllerBase):
         self.act = [model.actuator(n).id for n in CLUTCHES]
         self.qpos_adr = [qpos_address(model, n) for n in SLIDES]
         self.dof_adr = [dof_address(model, n) for n in SLIDES]
-        check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_JOINT, [model.joint(n).id for n in SLIDES], SLIDES)
+        self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
+        self.attach(model, data, params)
         k, c = clutch_actuators(model, self.act, params)
         self.k, self.c, self.backlash, self.dt = float(k), float(c), params.clutch_backlash, float(model.opt.timestep)
         # the implicit integrators integrate the damping implicitly (MuJoCo's D matrix); Euler does not
         self.implicit = implicit_damping(model)
         self._ctrl, self._biasprm = data.ctrl, model.actuator_biasprm
-        self._qpos, self._qvel, self._force = data.qpos, data.qvel, data.actuator_force
-        self.anchor = [float(data.qpos[a]) - self.backlash for a in self.qpos_adr]  # running maximum - backlash
+        self.anchor = [self.coordinate(i) - self.backlash for i in (0, 1)]  # running maximum - backlash
         for u, a in zip(self.act, self.anchor):
             data.ctrl[u] = a
-        self._per_module = tuple(zip((0, 1), self.qpos_adr, self.dof_adr, self.act))
+        self._modules = tuple(zip((0, 1), self.act))
         self.damped = [True, True]  # as built: biasprm[2] = -c
         self.overlap = [0.0, 0.0]
         self.v_before = [0.0, 0.0]
+        self.tracking = [False, False]  # whether each module was at its running maximum at the last step's start
         self.damper_work = 0.0
         self.before_step()
 
+    # the pieces a compliant clutch on another coordinate replaces (.grip_compliant.CompliantGrip: the roll)
+    def attach(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
+        """Check that the clutch actuators act on the slides (and set up what else the coordinate needs)."""
+        check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_JOINT, [model.joint(n).id for n in SLIDES], SLIDES)
+
+    def coordinate(self, i: int) -> float:
+        """Module ``i``'s coordinate the clutch acts along [m]: its slide x_i."""
+        return self._qpos.item(self.qpos_adr[i])
+
+    def speed(self, i: int) -> float:
+        """Its rate [m/s]."""
+        return self._qvel.item(self.dof_adr[i])
+
+    def after_module(self, i: int) -> None:
+        """What else a step's start does for module ``i`` (nothing here)."""
+
     def before_step(self) -> None:
-        """Raise each anchor to (x - backlash) if the module went further; damper on while d > 0."""
-        q, v, backlash, anchor, overlap = self._qpos, self._qvel, self.backlash, self.anchor, self.overlap
-        for i, adr, dof, act in self._per_module:  # this runs before every step: plain floats only
-            x = q.item(adr)
-            if x - backlash > anchor[i]:
+        """Raise each anchor to (coordinate - backlash) if the module went further; damper on while d > 0."""
+        backlash, anchor, overlap = self.backlash, self.anchor, self.overlap
+        for i, act in self._modules:  # this runs before every step: plain floats only
+            x = self.coordinate(i)
+            self.tracking[i] = tracking = x - backlash > anchor[i]
+            if tracking:
                 anchor[i] = x - backlash
                 self._ctrl[act] = anchor[i]
             d = anchor[i] - x
             overlap[i] = d
-            self.v_before[i] = v.item(dof)
+            self.v_before[i] = self.speed(i)
             if (d > 0.0) != self.damped[i]:
                 self.damped[i] = d > 0.0
                 self._biasprm[act, 2] = -self.c if d > 0.0 else 0.0
+            self.after_module(i)
 
     def after_step(self) -> None:
-        """Add the step's damper dissipation: (spring force - applied force) * v_{n+1} * dt, both modules."""
+        """Add the step's damper dissipation: (spring force - applied force) * speed_{n+1} * dt, both modules."""
         work = 0.0
-        for i, _, dof, act in self._per_module:
+        for i, act in self._modules:
             d, applied = self.overlap[i], self._force.item(act)
             if d <= 0.0 and applied == 0.0:
                 continue  # inside the play: no force, nothing dissipated (the common case)
-            speed = self._qvel.item(dof)
+            speed = self.speed(i)
             if applied > 0.0 and self.damped[i] and self.implicit:
                 applied -= self.c * (speed - self.v_before[i])  # the implicit integrators' damping over the step
             work += ((self.k * d if d > 0.0 else 0.0) - applied) * speed
@@ -165,6 +185,25 @@ class CompliantClutches(ControllerBase):
     def forces(self) -> tuple[float, float]:
         """The clutch forces [N] MuJoCo computed at the last step's start (or the last mj_forward)."""
         return self._force.item(self.act[0]), self._force.item(self.act[1])
+
+    def load_compiled(self, loop):
+        """Its layout in the compiled loop (:mod:`.controller`): the slides, the clutch actuators, the anchors."""
+        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], slide_v0=self.dof_adr[0],
+                        slide_v1=self.dof_adr[1], act0=self.act[0], act1=self.act[1], implicit=self.implicit)
+        loop.set_state(anchor0=self.anchor[0], anchor1=self.anchor[1], overlap0=self.overlap[0],
+                       overlap1=self.overlap[1], v_before0=self.v_before[0], v_before1=self.v_before[1],
+                       damped0=self.damped[0], damped1=self.damped[1], damper_work=self.damper_work, k=self.k,
+                       c=self.c, backlash=self.backlash)
+        if self.dt != loop.model.opt.timestep:
+            raise LayoutError("the compliant clutches' timestep is not the model's")
+        get = loop.getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
+                          "damped1", "damper_work")
+
+        def sync(state) -> None:
+            a0, a1, d0, d1, v0, v1, damped0, damped1, self.damper_work = get(state)
+            self.anchor, self.overlap, self.v_before = [a0, a1], [d0, d1], [v0, v1]
+            self.damped = [damped0 != 0.0, damped1 != 0.0]
+        return "compliant", sync
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear force [N], front force [N]): held while its clutch pushes."""

@@ -41,6 +41,7 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_SPEED
 
+from .compiled_grip import load_grip_ratchet
 from .controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
 from .grip_model import ROLLS, SKIDS
 from .model import SLIDES, dof_address, qpos_address
@@ -124,6 +125,13 @@ class GripRatchet(ControllerBase):
             give = wall(k, c)
             if give > self.excursion:
                 self.excursion = give
+
+    def compiled_rows(self) -> tuple[list[int], list[float]]:
+        return [-1, -1], self.resistance
+
+    def load_compiled(self, loop):
+        """Its layout in the compiled loop (:func:`.compiled_grip.load_grip_ratchet`)."""
+        return load_grip_ratchet(self, loop)
 
     def _clutch_rows(self) -> list[float]:
         """The rolls' limit rows [N] of the last step (0.0 for a roll without one): the limit rows follow the

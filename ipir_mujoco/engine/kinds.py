@@ -93,6 +93,11 @@ class ModelKind:
         check_clutch_options(params, rule, implementation)
         return params
 
+    def takes(self, params: RobotParams) -> bool:
+        """Whether this kind is the one for ``params`` among the kinds of its ``model`` (:func:`kind_for` asks
+        the kinds of :data:`KINDS` in order): the slides with unlimited grip."""
+        return params.grip is None
+
     def settings(self, params: RobotParams, t_end: float, dt_out: float, servo=None,
                  implementation: str = "ratchet") -> tuple[SolverSettings, dict]:
         """The automatic settings of a run of ``t_end`` [s] sampled every ``dt_out`` [s], and why: (settings,
@@ -139,6 +144,9 @@ class GripSlidesKind(ModelKind):
     name = "slides-grip"
     skid = True
 
+    def takes(self, params):
+        return params.grip is not None
+
     def controller(self, model, data, params, implementation, rule="unilateral"):
         refuse_grip(params, implementation)
         if params.clutch_stiffness is None:
@@ -171,6 +179,9 @@ class WheelsKind(ModelKind):
     # residual is recorded and shown rather than stopping the run (or halving its step, which does not lower it)
     accuracy = "warn"
     skid = True
+
+    def takes(self, params):
+        return True  # unlimited or finite grip alike: the contacts' friction is mu_wall
 
     def check(self, params, implementation, rule, route=None, until_steady=False):
         refuse_clutches(params, implementation)
@@ -223,8 +234,8 @@ class WheelsKind(ModelKind):
 
 
 SLIDES, GRIP_SLIDES, WHEELS = ModelKind(), GripSlidesKind(), WheelsKind()
-KINDS = {kind.name: kind for kind in (SLIDES, GRIP_SLIDES, WHEELS)}
-MODELS = ("slides", "wheels")  # the MuJoCo models a user names (simulate_mujoco's ``model``)
+KINDS = {kind.name: kind for kind in (SLIDES, GRIP_SLIDES, WHEELS)}  # kind_for asks them in this order
+MODELS = tuple(dict.fromkeys(kind.model for kind in KINDS.values()))  # the words a user names them by
 
 
 def kind_for(model: str, params: RobotParams) -> ModelKind:
@@ -245,10 +256,9 @@ def kind_for(model: str, params: RobotParams) -> ModelKind:
     ParameterError
         For an unknown ``model``.
     """
-    if model == "wheels":
-        return WHEELS
-    if model == "slides":
-        return SLIDES if params.grip is None else GRIP_SLIDES
+    for kind in KINDS.values():
+        if kind.model == model and kind.takes(params):
+            return kind
     raise ParameterError(f"mujoco model {model!r} is unknown; allowed: {', '.join(MODELS)}")
 
 
@@ -257,14 +267,3 @@ def clutch_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotP
     """The slide model's clutch controller of a run (the slide kinds' :meth:`ModelKind.controller`): kept for
     scripts that built the slide model themselves."""
     return kind_for("slides", params).controller(model, data, params, implementation, rule)
-
-
-def check_mujoco_model(model: str, params: RobotParams, implementation: str) -> None:
-    """ParameterError (one line) for an unknown MuJoCo ``model`` or a clutch the wheeled model does not have."""
-    if kind_for(model, params) is WHEELS:
-        refuse_clutches(params, implementation)
-
-
-def default_accuracy(model: str) -> str:
-    """The accuracy monitor's mode where a run does not choose one: the kind's (:attr:`ModelKind.accuracy`)."""
-    return kind_for(model, RobotParams()).accuracy

@@ -49,6 +49,8 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
+from ipir_mujoco.core.energy import DISSIPATED, INPUT, KINETIC, RESIDUAL_KEY, STORED, audit_keys, by_role
+from ipir_mujoco.core.energy import changes as energy_changes
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
 from ipir_mujoco.core.params import RobotParams, require_params
@@ -111,8 +113,8 @@ def simulate_mujoco(
     None chooses the timestep from the motion (:func:`.timestep.choose_settings`)
     and halves it (at most twice) if the accuracy monitor fails; given settings
     are used as they are. ``accuracy``: 'stop' (a failed accuracy check is a
-    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``); None: the model's own,
-    :func:`.wheels.default_accuracy` ('stop' on the slides, 'warn' on wheels).
+    SimulationError) or 'warn' (recorded in ``RunResult.accuracy``); None: the model kind's own
+    (:attr:`.kinds.ModelKind.accuracy`: 'stop' on the slides, 'warn' on wheels).
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
     simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
@@ -183,6 +185,10 @@ class _Run:
         self.setup = RunSetup(kind, params, settings, implementation=implementation, rule=clutch, mjcf=mjcf,
                               route=route, servo=servo)
         self.model, self.data = self.setup.model, self.setup.data
+        built = time.perf_counter() - self.started
+        if wall_budget_s is not None and built > wall_budget_s:  # the budget covers building, not only stepping
+            raise SimulationError(f"the run exceeded its wall-time budget of {wall_budget_s:g} s while building its "
+                                  f"model ({built:.3g} s), before the first step")
         self.monitor = AccuracyMonitor(Tolerances.for_params(params), accuracy, dt)
         self.stall: str | None = None
         self.recorder: Recorder | None = None  # made by _setup
@@ -203,22 +209,11 @@ class _Run:
             series = self.route_watch.along_series(series)
         if self.ticked is not None:
             series["drive_u"] = self.ticked.u_column(series["t"])
-        wm, wf = series["motor_work"][-1], series["friction_work"][-1]
-        kinetic = series["kinetic"][-1] - series["kinetic"][0]
-        potential = series["potential"][-1]
-        energy = {"motor_work_j": float(wm), "kinetic_j": float(kinetic), "friction_j": float(wf),
-                  "potential_j": float(potential)}
-        damper = spring = 0.0
-        if self.compliant:
-            spring = series["clutch_spring_energy"][-1] - series["clutch_spring_energy"][0]
-            damper = series["clutch_damper_work"][-1]
-            energy["clutch_spring_j"], energy["clutch_damper_j"] = float(spring), float(damper)
-        dissipated = wf + damper
-        if self.kind.skid:
-            energy["skid_j"] = float(series["skid_work"][-1])
-            dissipated = dissipated + series["skid_work"][-1]
-        residual, scale = energy_audit(wm, dissipated, kinetic, potential + spring, self.energy_floor)
-        energy["residual_j"] = float(residual)
+        change = energy_changes(series)  # every energy term the series has (core.energy's table)
+        total = by_role(change)
+        residual, scale = energy_audit(total[INPUT], total[DISSIPATED], total[KINETIC], total[STORED],
+                                       self.energy_floor)
+        energy = {**audit_keys(change), RESIDUAL_KEY: float(residual)}
         label = {"ratchet": "unilateral", "lock": self.clutch, "none": "none"}[self.implementation]
         return RunResult(
             engine="mujoco", geometry="exact", clutch=label, params=self.params, t_end=float(series["t"][-1]),

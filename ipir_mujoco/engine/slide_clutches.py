@@ -40,6 +40,7 @@ from ipir_mujoco.core.params import RobotParams
 
 from .compliant import CompliantClutches
 from .controller import ControllerBase, RunningBound
+from .native import LayoutError
 from .model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
 from .rows import FrictionRows, clutch_share, equality_row, missing_rows
 
@@ -87,6 +88,21 @@ class Ratchet(ControllerBase):
             give = follow(k, float(q[a]))
             if give > self.excursion:
                 self.excursion = give
+
+    def compiled_rows(self) -> tuple[list[int], list[float]]:
+        return self.friction.offsets, self.friction.resistance
+
+    def load_compiled(self, loop):
+        """Its layout in the compiled loop (:mod:`.controller`): the slides and their bounds."""
+        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], joint0=self.joint_ids[0],
+                        joint1=self.joint_ids[1])
+        loop.set_state(bound0=self.bounds[0], bound1=self.bounds[1], margin0=self.margins[0],
+                       margin1=self.margins[1], excursion=self.excursion)
+        get = loop.getter("bound0", "bound1", "excursion")
+
+        def sync(state) -> None:
+            self.bounds[0], self.bounds[1], self.excursion = get(state)
+        return "ratchet", sync
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
@@ -202,6 +218,25 @@ class Locks(ControllerBase):
                 forces[i] = float(self.data.efc_force[row])
         return forces
 
+    def compiled_rows(self) -> tuple[list[int], list[float]]:
+        return self.friction.offsets, self.friction.resistance
+
+    def load_compiled(self, loop):
+        """Its layout in the compiled loop (:mod:`.controller`): the slides, the locks, the linkage's joints."""
+        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], slide_v0=self.dof_adr[0],
+                        slide_v1=self.dof_adr[1], eq0=self.eq_ids[0], eq1=self.eq_ids[1], rod_q=self.rod_q,
+                        rod_v=self.rod_v)
+        if (self.crank_q, self.crank_v) != (loop.crank_q, loop.crank_v):
+            raise LayoutError("the locks' crank joint is not the run's")
+        loop.set_state(held0=self.held[0], held1=self.held[1], force0=self.forces[0], force1=self.forces[1],
+                       r=self.r, L=self.L, excursion=self.excursion)
+        get = loop.getter("held0", "held1", "force0", "force1", "excursion")
+
+        def sync(state) -> None:
+            held0, held1, force0, force1, self.excursion = get(state)
+            self.held, self.forces = [held0 != 0.0, held1 != 0.0], [force0, force1]
+        return "lock_" + self.rule, sync
+
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
 
@@ -239,6 +274,10 @@ class NoClutch(ControllerBase):
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         return False, False, 0.0, 0.0
+
+    def load_compiled(self, loop):
+        """Nothing to load or read back in the compiled loop."""
+        return "none", lambda state: None
 
 
 def refuse_compliant(params: RobotParams, implementation: str) -> None:

@@ -37,16 +37,11 @@ from operator import itemgetter
 import mujoco
 import numpy as np
 
-from .compiled_grip import load_grip
-from .compliant import CompliantClutches
-from .grip import GripRatchet
-from .grip_compliant import CompliantGrip
 from .loop_rows import loop_options  # noqa: F401  (make_steps' options: the viewer imports it from here)
 from .native import LayoutError, compiled, pointers
 from .native import address as array_address
 from .recorder import Recorder
 from .rows import EQUALITY_ROWS, missing_rows
-from .slide_clutches import Locks, NoClutch, Ratchet
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
 # the clutch kinds, in the order of _stepper.c's enum
@@ -260,11 +255,7 @@ class CompiledSteps(PythonSteps):
     def _bind(self, rec: Recorder) -> None:
         """Where the C loop writes ``rec``'s samples (its arrays: C-contiguous float64, qvel_before the
         loop's own) and what it reads for them (the rod end's site, the front module's body, the loop)."""
-        ctl = self.controller
-        friction = getattr(ctl, "friction", None)
-        fric_off, resist = (friction.offsets, friction.resistance) if friction is not None else ([-1, -1], [0, 0])
-        if isinstance(ctl, GripRatchet):
-            resist = ctl.resistance
+        fric_off, resist = self.controller.compiled_rows()
         self._set_config(
             rod_site=rec.site, front_body=rec.front, loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
             rec_qpos=array_address(rec.qpos), rec_qvel=array_address(rec.qvel),
@@ -284,67 +275,22 @@ class CompiledSteps(PythonSteps):
             self._st[self.S[name]] = float(value)
 
     def _load_controller(self) -> None:
-        """The controller's state and indices into the C arrays; picks the sync after each run."""
-        ctl, set_config, set_state = self.controller, self._set_config, self._set_state
-        if isinstance(ctl, Ratchet):
-            kind = "ratchet"
-            set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], joint0=ctl.joint_ids[0],
-                       joint1=ctl.joint_ids[1])
-            set_state(bound0=ctl.bounds[0], bound1=ctl.bounds[1], margin0=ctl.margins[0], margin1=ctl.margins[1],
-                      excursion=ctl.excursion)
-            self._sync, self._get = self._sync_ratchet, self._getter("bound0", "bound1", "excursion")
-        elif isinstance(ctl, Locks):
-            kind = "lock_" + ctl.rule
-            set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], slide_v0=ctl.dof_adr[0],
-                       slide_v1=ctl.dof_adr[1], eq0=ctl.eq_ids[0], eq1=ctl.eq_ids[1], rod_q=ctl.rod_q,
-                       rod_v=ctl.rod_v)
-            if (ctl.crank_q, ctl.crank_v) != (self.crank_q, self.crank_v):
-                raise LayoutError("the locks' crank joint is not the run's")
-            set_state(held0=ctl.held[0], held1=ctl.held[1], force0=ctl.forces[0], force1=ctl.forces[1], r=ctl.r,
-                      L=ctl.L, excursion=ctl.excursion)
-            self._sync, self._get = self._sync_locks, self._getter("held0", "held1", "force0", "force1", "excursion")
-        elif isinstance(ctl, (GripRatchet, CompliantGrip)):  # finite grip (compiled_grip)
-            kind, names, sync = load_grip(ctl, self.grip, self.model.opt.timestep, set_config, set_state)
-            get = self._getter(*names)
-            self._sync = lambda state: sync(self.controller, get(state))
-        elif isinstance(ctl, CompliantClutches):
-            kind = "compliant"
-            set_config(slide_q0=ctl.qpos_adr[0], slide_q1=ctl.qpos_adr[1], slide_v0=ctl.dof_adr[0],
-                       slide_v1=ctl.dof_adr[1], act0=ctl.act[0], act1=ctl.act[1], implicit=ctl.implicit)
-            set_state(anchor0=ctl.anchor[0], anchor1=ctl.anchor[1], overlap0=ctl.overlap[0],
-                      overlap1=ctl.overlap[1], v_before0=ctl.v_before[0], v_before1=ctl.v_before[1],
-                      damped0=ctl.damped[0], damped1=ctl.damped[1], damper_work=ctl.damper_work, k=ctl.k, c=ctl.c,
-                      backlash=ctl.backlash)
-            if ctl.dt != self.model.opt.timestep:
-                raise LayoutError("the compliant clutches' timestep is not the model's")
-            self._sync = self._sync_compliant
-            self._get = self._getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
-                                     "damped1", "damper_work")
-        elif isinstance(ctl, NoClutch):
-            kind = "none"
-            self._sync = lambda state: None
-        else:
+        """The controller's state and indices into the C arrays, written by the controller itself
+        (``load_compiled(loop)``: its own compiled layout), which returns its C kind and its sync."""
+        ctl = self.controller
+        load = getattr(ctl, "load_compiled", None)
+        if load is None:
             raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
+        kind, self._sync = load(self)
         self._set_config(clutch=CLUTCH_KINDS.index(kind))
         self._rec = None
 
-    def _getter(self, *names):
+    def getter(self, *names):
+        """A function reading the STATE fields ``names`` from a list of the state's values, in that order."""
         return itemgetter(*(self.S[n] for n in names))
 
-    def _sync_ratchet(self, state: list[float]) -> None:
-        ctl = self.controller
-        ctl.bounds[0], ctl.bounds[1], ctl.excursion = self._get(state)
-
-    def _sync_locks(self, state: list[float]) -> None:
-        ctl = self.controller
-        held0, held1, force0, force1, ctl.excursion = self._get(state)
-        ctl.held, ctl.forces = [held0 != 0.0, held1 != 0.0], [force0, force1]
-
-    def _sync_compliant(self, state: list[float]) -> None:
-        ctl = self.controller
-        a0, a1, d0, d1, v0, v1, damped0, damped1, ctl.damper_work = self._get(state)
-        ctl.anchor, ctl.overlap, ctl.v_before = [a0, a1], [d0, d1], [v0, v1]
-        ctl.damped = [damped0 != 0.0, damped1 != 0.0]
+    set_config = property(lambda self: self._set_config)
+    set_state = property(lambda self: self._set_state)
 
 
 def make_steps(model, data, controller, qvel_before, **options) -> PythonSteps:

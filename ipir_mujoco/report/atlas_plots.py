@@ -20,6 +20,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter
 
 from ..studies.atlas_surrogate import CONFIDENT
 
@@ -52,30 +54,41 @@ def plot_atlas(result: dict, atlas, out: str | Path) -> list[Path]:
 def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the paper's model holds") -> Path:
     """Bars: each idealization's safe share per metric and threshold with its interval (``idealizations``:
     atlas.json's; ``axes``: the varied ranges, sweep_space.Axis)."""
-    rows = [(name, metric, item, entry["measured_by"]) for name, per in idealizations.items()
-            for metric, entry in per.items() for item in entry["by_threshold"]]
-    fig = _figure(8.0, 1.2 + 0.32 * len(rows))
+    rows = []
+    for name, per in idealizations.items():
+        for metric, entry in per.items():
+            for k, item in enumerate(entry["by_threshold"]):
+                rows.append((f"{name}: {metric}, |cost| < {100 * item['threshold']:g} %", item, entry["measured_by"]))
+                if "equations" in entry:  # MuJoCo measured it; the equations' answer beside it
+                    rows.append(("    the equations", entry["equations"]["by_threshold"][k], "equations"))
+    fig = _figure(8.0, 1.3 + 0.32 * len(rows))
     ax = fig.add_subplot()
-    for k, (name, metric, item, by) in enumerate(rows):
+    colours = {"mujoco": "tab:red", "equations": "tab:blue"}
+    for k, (_label, item, by) in enumerate(rows):
         frac, interval = item["safe_fraction"], item["safe_fraction_interval"]
         if frac is None:
             continue
-        colour = "tab:red" if by == "mujoco" else "tab:blue"
-        ax.barh(k, 100 * frac, color=colour, alpha=0.55)
-        ax.errorbar(100 * frac, k, xerr=[[100 * (frac - interval[0])], [100 * (interval[1] - frac)]], color="black",
-                    capsize=3, lw=1)
-    ax.set_yticks(range(len(rows)), [f"{n}: {m}, |cost| < {100 * i['threshold']:g} %" for n, m, i, _ in rows],
-                  fontsize="small")
+        ax.barh(k, 100 * frac, color=colours[by], alpha=0.55)
+        ax.errorbar(100 * frac, k, xerr=[[100 * max(0.0, frac - interval[0])], [100 * max(0.0, interval[1] - frac)]],
+                    color="black", capsize=3, lw=1)
+        ax.text(min(100 * interval[1] + 1, 88), k, f"{100 * frac:.1f} %", va="center", fontsize="x-small")
+    ax.set_yticks(range(len(rows)), [label for label, _i, _b in rows], fontsize="small")
     ax.invert_yaxis()
     ax.set(xlim=(0, 100), xlabel="share of the box where the idealization is safe [%] (95 % interval)",
            title=title + ": " + ", ".join(f"{a.name} {a.low:.3g}..{a.high:.3g}" for a in axes))
     ax.title.set_fontsize("small")
-    ax.barh([], [], color="tab:blue", alpha=0.55, label="measured by the equations (dense sample)")
-    ax.barh([], [], color="tab:red", alpha=0.55, label="measured by MuJoCo (surrogate)")
-    ax.legend(fontsize="x-small", loc="lower right")
+    ax.legend(handles=[Patch(color=colours["equations"], alpha=0.55, label="measured by the equations (dense sample)"),
+                       Patch(color=colours["mujoco"], alpha=0.55, label="measured by MuJoCo (surrogate)")],
+              fontsize="x-small", loc="lower right")
     ax.grid(alpha=0.3, axis="x")
     fig.savefig(path, dpi=110)
     return path
+
+
+def _plain_log_ticks(axis) -> None:
+    """Log-axis labels as plain numbers (0.5, 2, 10), not powers of ten."""
+    axis.set_major_formatter(FuncFormatter(lambda v, _p: f"{v:g}"))
+    axis.set_minor_formatter(FuncFormatter(lambda v, _p: f"{v:g}" if str(f"{v:g}")[0] in "25" else ""))
 
 
 def _panels(result: dict, atlas):
@@ -117,6 +130,7 @@ def plot_1d(result: dict, atlas, path: Path) -> Path:
         ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=f"{axis.name}",
                ylabel=f"|cost| of {metric} [%]", title=f"{name}\n(measured by {entry['measured_by']})")
         ax.title.set_fontsize("small")
+        _plain_log_ticks(ax.yaxis)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize="xx-small")
     fig.savefig(path, dpi=110)
@@ -170,6 +184,7 @@ def plot_partial(result: dict, atlas, path: Path) -> Path:
     fig = _figure(2.9 * d, 0.8 + 2.5 * len(names))
     C = result["_candidates"]
     bins = np.linspace(0, 1, 13)
+    floor = min(atlas.thresholds)  # [%]: costs below 1/100 of the smallest threshold are drawn on the axis's floor
     centres = 0.5 * (bins[1:] + bins[:-1])
     for r, name in enumerate(names):
         fidelity, fitted = _measure(result, name)
@@ -186,11 +201,12 @@ def plot_partial(result: dict, atlas, path: Path) -> Path:
                 low = np.array([np.percentile(cost[which == b], 10) for b in range(len(centres))])
                 high = np.array([np.percentile(cost[which == b], 90) for b in range(len(centres))])
                 colour = COLOURS[j % len(COLOURS)]
-                ax.plot(x, np.maximum(mean, 1e-4), color=colour, lw=1.4, label=metric)
-                ax.fill_between(x, np.maximum(low, 1e-4), np.maximum(high, 1e-4), color=colour, alpha=0.15)
+                ax.plot(x, np.maximum(mean, floor), color=colour, lw=1.4, label=metric)
+                ax.fill_between(x, np.maximum(low, floor), np.maximum(high, floor), color=colour, alpha=0.15)
             for t in atlas.thresholds:
                 ax.axhline(100 * t, color="grey", ls="--", lw=0.9)
             ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=axis.name)
+            _plain_log_ticks(ax.yaxis)
             if c == 0:
                 ax.set_ylabel(f"{name}\n|cost| [%] ({'MuJoCo' if fidelity == 'mujoco' else 'equations'})",
                               fontsize="small")

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ipir_mujoco.core.params import RobotParams
 
+from ..studies.atlas import Atlas, run_atlas, top_drivers
 from ..studies.sweep_space import Axis
 from .atlas_plots import plot_safe
 from .document import Heading, Image, Paragraph, Table
@@ -35,8 +36,6 @@ def neighbourhood(params: RobotParams) -> tuple[Axis, ...]:
 
 
 def compute(params: RobotParams, quick: bool, progress) -> dict:
-    from ..studies.atlas import Atlas, run_atlas
-
     axes = neighbourhood(params)
     atlas = Atlas(axes, params, budget=0, samples=SAMPLES[quick], thresholds=THRESHOLDS)
     with tempfile.TemporaryDirectory(prefix="ipir-atlas-") as folder:
@@ -44,13 +43,6 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     return {"axes": [{"name": a.name, "low": a.low, "high": a.high} for a in axes], "drive": params.drive,
             "metrics": list(atlas.metrics), "thresholds": list(THRESHOLDS), "samples": atlas.samples,
             "idealizations": result["idealizations"], "runs": result["runs"]["equations"], "wall_s": result["wall_s"]}
-
-
-def _top(entry: dict) -> str:
-    """The two parameters of largest total Sobol index whose 95 % interval excludes 0 ('-' if none)."""
-    ranked = sorted(((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict)
-                     and v.get("ST") is not None and v["ST"] - v["ST_conf"] > 0), key=lambda pv: -pv[1]["ST"])
-    return ", ".join(f"{p} (ST {v['ST']:.2f} +- {v['ST_conf']:.2f})" for p, v in ranked[:2]) or "-"
 
 
 def render(metrics: dict, figures_dir: Path) -> list:
@@ -72,7 +64,7 @@ def render(metrics: dict, figures_dir: Path) -> list:
             for item in entry["by_threshold"]:
                 lo, hi = item["safe_fraction_interval"]
                 cells.append(f"{100 * item['safe_fraction']:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]")
-            rows.append(cells + [_top(entry)])
+            rows.append(cells + [top_drivers(entry)])
     blocks.append(Table(["idealization", "metric"] + [f"safe share, |cost| < {100 * t:g} %"
                                                       for t in metrics["thresholds"]] + ["driven by"], rows))
     plot_safe(metrics["idealizations"], axes, Path(figures_dir) / "atlas_safe.png",
@@ -89,7 +81,7 @@ def verdict(metrics: dict) -> dict | None:
         item = per[first]["by_threshold"][0]
         frac = item["safe_fraction"]
         parts.append(f"{name} within {100 * item['threshold']:g} % in {100 * frac:.0f} % of it (driven by "
-                     f"{_top(per[first])})")
+                     f"{top_drivers(per[first])})")
         if worst is None or frac < worst[1]:
             worst = (name, frac)
     if worst is None:

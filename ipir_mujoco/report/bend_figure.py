@@ -66,7 +66,8 @@ def bend_figure(study: dict) -> Figure:
         ax.set_ylabel(label)
         ax.set_xscale("log")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=7.5, loc="lower right")
+    handles, labels = axes[0].get_legend_handles_labels()  # below the axes: inside, it would hide points
+    fig.legend(handles, labels, fontsize=7.5, loc="outside lower center", ncol=1)
     axes[1].set_xlabel("bend radius over pipe diameter, R/D [-]")
     params = study["settings"]["params"]
     fig.suptitle(f"Passing a 90-degree bend (window: L + pi R / 2 of centreline): D = {params['pipe_diameter']:g} m, "

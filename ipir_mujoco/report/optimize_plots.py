@@ -16,6 +16,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..output import write_atomically
 from ..studies.design_eval import key_value
 
 
@@ -78,7 +79,7 @@ def plot_pareto(out: str | Path, problem) -> Path:
     senses = ", ".join(f"{o.sense} {o.key}" for o in problem.objectives)
     fig.suptitle(f"{problem.engine}: {senses}\n{len(evaluations)} evaluations", fontsize="small")
     path = out / "pareto.png"
-    fig.savefig(path, dpi=110)
+    write_atomically(path, lambda staged: fig.savefig(staged, dpi=110))
     return path
 
 
@@ -99,5 +100,5 @@ def plot_indices(out: str | Path, indices: list[dict], metrics: list[str]) -> Pa
         ax.axhline(0.0, color="0.6", lw=0.6)
         ax.legend(fontsize="small")
     path = out / "sensitivity.png"
-    fig.savefig(path, dpi=110)
+    write_atomically(path, lambda staged: fig.savefig(staged, dpi=110))
     return path

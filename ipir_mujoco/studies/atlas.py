@@ -21,8 +21,9 @@ Files: ``OUT/samples.csv`` (:mod:`.atlas_eval`: every pair, streamed, resumable)
         "crossings": {PARAM: [values]}, "crossings_interval": {PARAM: [[value, lo, hi]]} (one varied
         parameter only), "sensitivity": {PARAM: {S1, S1_conf, ST, ST_conf}}, "runs", "measured_by":
         "equations" | "mujoco", "designs", "runs_by_region": {safe, unsafe, boundary} (MuJoCo),
-        "by_threshold": [{threshold, safe_fraction, safe_fraction_interval, crossings...}] (every threshold;
-        the top level repeats the first), "equations": {...} (where MuJoCo measured it too)}}},
+        "by_threshold": [{threshold, safe_fraction, safe_fraction_interval, crossings...}] (every
+        threshold, smallest first; the top level repeats the smallest), "equations": {...} (where MuJoCo
+        measured it too)}}},
      "settings": ..., "fingerprint", "status", "wall_s", "runs": {equations, mujoco}, "stopped": {NAME: why}}
 """
 
@@ -190,7 +191,16 @@ def wilson(safe: int, n: int) -> list[float]:
     z, p = 1.96, safe / n
     centre = (p + z * z / (2 * n)) / (1 + z * z / n)
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return [max(0.0, centre - half), min(1.0, centre + half)]
+    return [max(0.0, min(p, centre - half)), min(1.0, max(p, centre + half))]  # p inside it, whatever the rounding
+
+
+def top_drivers(entry: dict, count: int = 2) -> str:
+    """'L (ST 0.95 +- 0.10), m2 (...)': the parameters of largest total Sobol index whose 95 % interval
+    excludes 0 ('-' if none: too few samples to tell, or a cost that does not vary)."""
+    ranked = sorted(((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict)
+                     and v.get("ST") is not None and v.get("ST_conf") is not None and v["ST"] - v["ST_conf"] > 0),
+                    key=lambda pv: -pv[1]["ST"])
+    return ", ".join(f"{p} (ST {v['ST']:.2f} +- {v['ST_conf']:.2f})" for p, v in ranked[:count]) or "-"
 
 
 def _costs(rows: list[dict], metric: str) -> np.ndarray:
@@ -253,11 +263,15 @@ def run_atlas(atlas: Atlas, out: str | Path, *, resume: bool = False, workers: i
                 pass  # no design gave a cost: reported per metric below
             for m in atlas.metrics:
                 entry[m] = _equations_entry(atlas, name, m, U, rows, saltelli, store, workers)
+            for m in atlas.metrics:  # the dense sample and every metric's crossings: the idealization's runs
+                entry[m]["runs"] = 2 * store.count(name, "equations")
 
         mj_names = atlas.mujoco_names()
         if mj_names:
-            def evaluate(name: str, Um: np.ndarray) -> list[dict]:
-                return store.evaluate(name, "mujoco", atlas.designs(Um))
+            def evaluate(asked: dict) -> dict:
+                names = list(asked)
+                rows = store.evaluate_many([(n, "mujoco", atlas.designs(asked[n])) for n in names])
+                return dict(zip(names, rows))
 
             state = explore(mj_names, evaluate, lambda n, Um, rows: fit(n, "mujoco", Um, rows),
                             lambda n, s: unit_sobol(n, d, s), atlas.budget, d, atlas.thresholds, atlas.tolerance,
@@ -311,7 +325,6 @@ def _equations_entry(atlas: Atlas, name: str, metric: str, U: np.ndarray, rows: 
                 [float(v), *map(float, atlas.values(np.array([[lo], [hi]]))[:, 0])] for v, (_, lo, hi)
                 in zip(values, found)]}
         entry["by_threshold"].append(item)
-    entry["runs"] = 2 * store.count(name, "equations")  # the dense sample and the crossings' designs
     if saltelli and ok.all():
         entry["sensitivity"] = {"of": "equations", **sobol_indices(atlas.names, np.abs(cost), atlas.seed)}
     elif saltelli:

@@ -52,23 +52,23 @@ def uncertain(surrogates: dict, thresholds, U: np.ndarray) -> float:
 def explore(names: list[str], evaluate: Callable, fit: Callable, unit_designs: Callable, budget: int, d: int,
             thresholds, tolerance: float, candidates: np.ndarray, batch: int, seed: int,
             progress: Callable[[str], None]) -> dict:
-    """Run the adaptive loop (module docstring). ``evaluate(name, U) -> rows`` runs MuJoCo pairs at unit
-    designs U; ``fit(name, U, rows) -> {metric: CostSurrogate}``; ``unit_designs(n, seed)``: n Sobol points.
+    """Run the adaptive loop (module docstring). ``evaluate({name: U}) -> {name: rows}`` runs MuJoCo pairs at
+    unit designs U, every idealization's at once; ``fit(name, U, rows) -> {metric: CostSurrogate}``;
+    ``unit_designs(n, seed)``: n Sobol points.
     Returns {name: {"U", "rows", "surrogates", "stopped": why, "rounds"}}."""
     from scipy.stats import qmc  # noqa: F401 (unit_designs uses it; imported here to fail early)
 
     state = {}
     share = budget // 2 // max(1, len(names))  # designs per idealization, before any stops early
-    spent = 0
+    spent, first = 0, {}
     for k, name in enumerate(names):
         n0 = min(initial_count(d, share), (budget - spent) // 2)
-        if n0 < 1:
-            state[name] = {"U": np.zeros((0, d)), "rows": [], "surrogates": {}, "stopped": "no budget", "rounds": 0}
-            continue
-        U = unit_designs(n0, seed + 101 + k)
-        rows = evaluate(name, U)
-        spent += 2 * len(U)
-        state[name] = {"U": U, "rows": rows, "surrogates": {}, "stopped": None, "rounds": 0, "used": set()}
+        first[name] = unit_designs(n0, seed + 101 + k) if n0 >= 1 else np.zeros((0, d))
+        spent += 2 * len(first[name])
+    rows = evaluate({name: U for name, U in first.items() if len(U)})
+    for name, U in first.items():
+        state[name] = {"U": U, "rows": rows.get(name, []), "surrogates": {}, "rounds": 0, "used": set(),
+                       "stopped": None if len(U) else "no budget"}
     for _ in range(ROUNDS_MAX):
         active = []
         for name in names:
@@ -107,17 +107,21 @@ def explore(names: list[str], evaluate: Callable, fit: Callable, unit_designs: C
                     s.believe(candidates[best])
             picks[name] = candidates[chosen]
             picks_index[name] = chosen
+        for name in list(picks):
+            if budget - spent < 2 * len(picks[name]):
+                picks[name] = picks[name][:max(0, (budget - spent) // 2)]
+            spent += 2 * len(picks[name])
+            if not len(picks[name]):
+                del picks[name]
+        if not picks:
+            break
+        rows = evaluate(picks)
         for name, U in picks.items():
-            if budget - spent < 2 * len(U):
-                U = U[:(budget - spent) // 2]
-            if not len(U):
-                continue
             st = state[name]
             st["used"].update(int(i) for i in picks_index[name][:len(U)])
-            st["rows"] = st["rows"] + evaluate(name, U)
+            st["rows"] = st["rows"] + rows[name]
             st["U"] = np.vstack([st["U"], U])
             st["rounds"] += 1
-            spent += 2 * len(U)
     return state
 
 

@@ -16,6 +16,7 @@ import csv
 import os
 from pathlib import Path
 
+from ipir_mujoco.core.errors import StudyInterrupted
 from ipir_mujoco.core.params import RobotParams
 
 from .atlas_space import IDEALIZATIONS, measure
@@ -88,6 +89,9 @@ class Samples:
         self.file.close()
         if kind is None:
             self.file.sort()
+        if kind is KeyboardInterrupt:
+            raise StudyInterrupted(f"interrupted; the {len(self.cache)} pairs so far are in {self.file.path}; run "
+                                   "again with --resume to complete it") from None
         return False
 
     def count(self, name: str, fidelity: str) -> int:
@@ -99,22 +103,34 @@ class Samples:
                 "note": raw["notes"], "error": raw["error"]}
 
     def evaluate(self, name: str, fidelity: str, designs: list[dict], label: str = "") -> list[dict]:
-        keys = [(name, fidelity, *(repr(float(d[n])) for n in self.names)) for d in designs]
-        todo: dict[tuple, dict] = {}
-        for key in keys:
-            if key not in self.ids:
-                self.ids[key] = self.asked
-                self.asked += 1
-            if key not in self.cache and key not in todo:
-                todo[key] = {n: float(v) for n, v in zip(self.names, key[2:])}
+        """Rows of the pair of ``name`` at ``fidelity`` on ``designs``, in their order (pairs already evaluated,
+        this run or resumed, are not run again)."""
+        return self.evaluate_many([(name, fidelity, designs)], label)[0]
+
+    def evaluate_many(self, requests: list[tuple[str, str, list[dict]]], label: str = "") -> list[list[dict]]:
+        """:meth:`evaluate` of several (name, fidelity, designs) at once, all on the pool together (so that one
+        idealization's slow runs do not leave cores idle while the others wait for their turn)."""
+        asked, todo = [], {}
+        for name, fidelity, designs in requests:
+            keys = [(name, fidelity, *(repr(float(d[n])) for n in self.names)) for d in designs]
+            asked.append(keys)
+            for key in keys:
+                if key not in self.ids:
+                    self.ids[key] = self.asked
+                    self.asked += 1
+                if key not in self.cache and key not in todo:
+                    todo[key] = {n: float(v) for n, v in zip(self.names, key[2:])}
         if todo:
+            what = label or ", ".join(dict.fromkeys(f"{n} ({f})" for n, f, _d in requests))
             # a bar for batches worth waiting for (MuJoCo's adaptive batches of a few designs have their own lines)
-            bar = Progress(len(todo), 0, self.progress and len(todo) >= 8, what=f"atlas {label or name} ({fidelity})")
-            chunk = CHUNK if fidelity == "equations" else 1
-            items = list(todo.items())
-            groups = [items[k:k + chunk] for k in range(0, len(items), chunk)]
+            bar = Progress(len(todo), 0, self.progress and len(todo) >= 8, what=f"atlas {what}")
+            groups = []
+            for (name, fidelity) in dict.fromkeys(k[:2] for k in todo):
+                items = [(k, d) for k, d in todo.items() if k[:2] == (name, fidelity)]
+                chunk = CHUNK if fidelity == "equations" else 1
+                groups += [(name, fidelity, items[k:k + chunk]) for k in range(0, len(items), chunk)]
             if self.workers <= 1 or len(groups) == 1:
-                for group in groups:
+                for name, fidelity, group in groups:
                     self._record(name, fidelity, group, _measure_many(self.base, name, fidelity, [d for _, d in group],
                                                                       self.metrics, self.t_end, self.until_steady))
                     bar.advance(len(group))
@@ -123,12 +139,13 @@ class Samples:
                     self.pool = futures.ProcessPoolExecutor(max_workers=self.workers, initializer=worker_init,
                                                             initargs=(os.getpid(),))
                 pending = {self.pool.submit(_measure_many, self.base, name, fidelity, [d for _, d in group],
-                                            self.metrics, self.t_end, self.until_steady): group for group in groups}
+                                            self.metrics, self.t_end, self.until_steady): (name, fidelity, group)
+                           for name, fidelity, group in groups}
                 for future in futures.as_completed(pending):
-                    group = pending[future]
+                    name, fidelity, group = pending[future]
                     self._record(name, fidelity, group, future.result())
                     bar.advance(len(group))
-        return [self.cache[k] for k in keys]
+        return [[self.cache[k] for k in keys] for keys in asked]
 
     def _record(self, name: str, fidelity: str, group: list, results: list[dict]) -> None:
         for (key, design), result in zip(group, results):

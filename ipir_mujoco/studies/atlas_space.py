@@ -178,6 +178,8 @@ def measure(pair: Pair, params: RobotParams, metrics: tuple[str, ...], t_end: fl
             break
         if run.stall:
             notes.append(f"{side.variant}: stalled: {run.stall}")
+        elif until_steady and not run.summary.get("steady"):  # its steady figures are empty: say why
+            notes.append(f"{side.variant}: not steady by {t_end:g} s")
         out[key] = {m: metric_value(m, run) for m in metrics}
     out["note"] = " | ".join(notes)
     if not out["error"]:

@@ -4,9 +4,8 @@ A cost c(x) = (idealized - real) / |real| (signed) is modelled as z = asinh(c / 
 (:mod:`.gp`) on the unit box: asinh is linear near 0 and logarithmic far from it, so costs from 0.01 % to
 50 % sit on one smooth scale, and the threshold T maps to +-asinh(T / s) (s: the smallest threshold asked).
 A MuJoCo cost is modelled on top of the equations' surrogate of the same idealization where there is one
-(its prior mean, a fixed trend: the GP learns the difference, which for one mechanism in two engines is small
-and smooth, and which includes the equations' surrogate's own interpolation error, so that MuJoCo's runs, and
-only they, decide the uncertainty); otherwise on a constant mean.
+(a two-level co-kriging: the equations' posterior, mean and covariance, plus a GP of the difference, which for
+one mechanism in two engines is small and smooth; :class:`CostSurrogate`); otherwise on a constant mean.
 
 At a design x the posterior z ~ N(m, sd^2) gives p(x) = P(|c| < T) = Phi((a - m) / sd) - Phi((-a - m) / sd),
 a = asinh(T / s). A design is *safe* where p >= 0.975, *unsafe* where p <= 0.025, on the *boundary* (its side
@@ -22,7 +21,7 @@ import math
 import numpy as np
 from scipy.special import ndtr
 
-from .gp import GaussianProcess
+from .gp import GaussianProcess, one_blas_thread
 
 CONFIDENT = 0.975  # p beyond which a design's side of the threshold is known (two-sided 95 %)
 MAX_POINTS = 128  # points an equations' surrogate is fitted on (the first of its dense sample): the fit is O(n^3)
@@ -30,7 +29,13 @@ REFIT_GROWTH = 1.25  # hyper-parameters are fitted again once the points have gr
 
 
 class CostSurrogate:
-    """The surrogate of one cost (module docstring): ``update(U, costs)`` then ``predict``, ``p_safe``."""
+    """The surrogate of one cost (module docstring): ``update(U, costs)`` then ``predict``, ``p_safe``.
+
+    With a ``prior`` (the equations' surrogate of the same idealization and metric) the cost is modelled as
+    z = g + delta: g the prior's posterior (its mean and its covariance: its interpolation error, which this
+    surrogate's own runs reduce too), delta a GP of its own whose hyper-parameters are fitted on the residuals
+    z - mean(g) (a two-level co-kriging in the manner of Kennedy & O'Hagan, 2000, with the levels' scale 1).
+    """
 
     def __init__(self, scale: float, prior: "CostSurrogate | None" = None):
         self.scale, self.prior = scale, prior
@@ -38,7 +43,7 @@ class CostSurrogate:
         self.fitted_at = 0
         self.U = np.zeros((0, 0))
         self.residual = np.zeros(0)
-        self._prior_cache: dict = {}  # the prior's prediction at the designs it was last asked for (fixed: it is fitted)
+        self._cache: dict = {}  # the prior's mean, variance and whitened kernel at designs asked for before
 
     def update(self, U: np.ndarray, costs) -> "CostSurrogate":
         """Condition on designs U (n, d) of the unit box and their signed costs (None/nan: left out)."""
@@ -47,35 +52,63 @@ class CostSurrogate:
         U, z = np.asarray(U, dtype=float)[ok], np.arcsinh(costs[ok] / self.scale)
         if len(z) == 0:
             raise ValueError("no design gave this cost")
-        base = self.prior.predict(U)[0] if self.prior is not None else 0.0
+        base = self._prior(U)[0] if self.prior is not None else 0.0
         self.U, self.residual = U, z - base
         refit = self.fitted_at == 0 or len(z) >= REFIT_GROWTH * self.fitted_at
         self.gp.fit(U, self.residual, refit=refit)
         if refit:
             self.fitted_at = len(z)
+        self._condition()
         return self
 
     def believe(self, u: np.ndarray) -> None:
         """Add the design u with the surrogate's own mean there (kriging believer): the uncertainty shrinks
         around it, so the next design of a batch goes elsewhere. Hyper-parameters kept."""
-        m = self.gp.predict(u[None, :])[0]
+        m = self.predict(u[None, :])[0] - (self._prior(u[None, :])[0] if self.prior is not None else 0.0)
         self.U, self.residual = np.vstack([self.U, u]), np.append(self.residual, m)
         self.gp.fit(self.U, self.residual, refit=False)
+        self._condition()
+
+    def _prior(self, U: np.ndarray):
+        """(mean, variance, whitened kernel) of the prior at U, cached (the prior is fitted once)."""
+        U = np.asarray(U, dtype=float)
+        key = (U.shape, hash(U.tobytes()))
+        if key not in self._cache:
+            if len(self._cache) > 8:
+                self._cache.clear()
+            mean, sd = self.prior.predict(U)
+            self._cache[key] = (mean, sd * sd, self.prior.gp.whitened(U))
+        return self._cache[key]
+
+    def _prior_cov(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """The prior's posterior covariance between A and B (z units squared)."""
+        return self.prior.gp.prior_cov(A, B) - self._prior(A)[2].T @ self._prior(B)[2]
+
+    def _condition(self) -> None:
+        if self.prior is None:
+            return
+        with one_blas_thread():
+            self._condition_here()
+
+    def _condition_here(self) -> None:
+        gp, U = self.gp, self.U
+        K = self._prior_cov(U, U) + gp.prior_cov(U, U) + gp.noise * np.eye(len(U))
+        self._chol = np.linalg.cholesky(K + 1e-12 * np.trace(K) / len(U) * np.eye(len(U)))
+        self._alpha = np.linalg.solve(self._chol.T, np.linalg.solve(self._chol, self.residual - gp.offset))
 
     def predict(self, U) -> tuple[np.ndarray, np.ndarray]:
         """Posterior mean and sd of z = asinh(cost / scale) at U (m, d)."""
-        m, sd = self.gp.predict(U)
-        if self.prior is not None:
-            m = m + self._prior(np.asarray(U, dtype=float))
-        return m, sd
+        if self.prior is None:
+            return self.gp.predict(U)
+        with one_blas_thread():
+            return self._predict_here(np.asarray(U, dtype=float))
 
-    def _prior(self, U: np.ndarray):
-        key = (U.shape, hash(U.tobytes()))
-        if key not in self._prior_cache:
-            if len(self._prior_cache) > 8:
-                self._prior_cache.clear()
-            self._prior_cache[key] = self.prior.predict(U)[0]
-        return self._prior_cache[key]
+    def _predict_here(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        mean_g, var_g, _ = self._prior(U)
+        kx = self._prior_cov(U, self.U) + self.gp.prior_cov(U, self.U)
+        v = np.linalg.solve(self._chol, kx.T)
+        var = np.maximum(var_g + self.gp.scale ** 2 * self.gp.s2 - np.sum(v * v, axis=0), 0.0)
+        return mean_g + self.gp.offset + kx @ self._alpha, np.sqrt(var)
 
     def cost(self, U) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """|cost| at U: the surrogate's mean, and its 95 % band [lo, hi] (of |cost|)."""

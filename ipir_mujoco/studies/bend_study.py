@@ -18,8 +18,9 @@ distances), so that what the bend costs is told apart from what the wheels cost 
 
 ``planes`` [deg]: the bend's plane turned about the pipe's axis (:mod:`ipir_mujoco.core.route`): 0 turns it in the
 horizontal plane, across gravity (the default); 90 turns it up, in the plane of gravity, so that the route leaves
-the bend as a riser. The energy over the window is then the motor's work less the kinetic *and potential* energy
-gained (what the robot dissipates, comparable with its level twin's), and the time includes climbing, which the
+the bend as a riser. The energy over the window is the motor's work less the kinetic *and potential* energy gained
+(MuJoCo's potential energy: the height, and the springs of the wheels' legs; what is left is what the robot
+dissipates, comparable with its level twin's); a bend that turns up also climbs, which its time includes and the
 level twin and the analytic level reference do not: the row says how much potential energy the window gained.
 Each plane's bends share their straight twins (a straight has no plane).
 
@@ -32,14 +33,15 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 import time
 from typing import Callable, Sequence
 
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError
+from ipir_mujoco.core.params import RobotParams, check_whole, require_params
 from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
 
@@ -52,6 +54,7 @@ EXIT = 0.05  # m: straight after the bend
 DT_OUT = 1e-3  # s: the samples the progress is read from (the passage's times are good to this)
 T_CAP_PER_M = 20.0  # s per metre of route: the run's cap (the default motor cruises at ~0.53 m/s: 1.9 s/m)
 MU_WALL = 0.8  # the study's wall friction unless --set gives one: the straight-pipe acceptance case
+PROGRESS_EVERY_S = 10.0  # s of wall time between a running case's progress lines
 PLANES = (0.0,)  # deg: the bends' planes, the default (0: horizontal, across gravity)
 TWIN_SLACK = 0.005  # a bend faster than its twin by more than this share of the twin's time gets a note: the
 # centre's crossing times carry ~0.05 s of a stroke's ripple (module docstring), ~2-7 % of a passage of 0.7-2.7 s
@@ -141,8 +144,10 @@ def run_case(params: RobotParams, item: tuple[str, float, float]) -> dict:
     arc = math.pi / 2 * ratio * params.pipe_diameter
     route = straight_route(params, arc) if kind == "straight" else case_route(params, ratio, plane)
     t_cap = T_CAP_PER_M * route.length
+    what = f"R/D {ratio:g} " + (f"bend in plane {plane:g} deg" if kind == "bend" else kind)
     try:
-        run = registry.run("mujoco-wheels", params, t_cap, dt_out=DT_OUT, route=route, accuracy="warn")
+        run = registry.run("mujoco-wheels", params, t_cap, dt_out=DT_OUT, route=route, accuracy="warn",
+                           progress=_quiet_printer(what, started))
     except SimulationError as exc:
         return {"kind": kind, "R_over_D": ratio, "error": str(exc), "passed": False,
                 "wall_s": time.perf_counter() - started}
@@ -150,6 +155,19 @@ def run_case(params: RobotParams, item: tuple[str, float, float]) -> dict:
     out.update(kind=kind, R_over_D=ratio, plane_deg=plane, radius_m=ratio * params.pipe_diameter,
                window_m=params.L + arc, wall_s=time.perf_counter() - started)
     return out
+
+
+def _quiet_printer(what: str, started: float, every: float = PROGRESS_EVERY_S):
+    """A run's progress callback (simulated time [s]) printing on stderr at most every ``every`` seconds of wall
+    time, from the run's worker: a case's run takes minutes, and its end alone would leave the study silent."""
+    last = [started]
+
+    def progress(t: float) -> None:
+        now = time.perf_counter()
+        if now - last[0] >= every:
+            last[0] = now
+            print(f"bend-study: {what}: simulated {t:.2f} s ({now - started:.0f} s wall)", file=sys.stderr, flush=True)
+    return progress
 
 
 def twin_note(bend: dict, straight: dict) -> str | None:
@@ -179,6 +197,10 @@ def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: i
     """The study (module docstring) as a JSON-ready dict: ``rows`` (one per plane and R/D: the bend's passage,
     its straightened twin's, the analytic reference over the same length, ``note`` where the bend was faster
     than its twin), ``reference``, ``settings``, ``wall_s``."""
+    require_params(base)
+    check_whole("workers", workers, low=1, high=1024)
+    if not callable(progress):
+        raise ParameterTypeError(f"progress={progress!r} is not callable; allowed: a function of one message")
     started = time.perf_counter()
     params = study_params(base)
     check_ratios(ratios, params)

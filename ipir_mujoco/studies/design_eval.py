@@ -16,7 +16,6 @@ design's: varied, or the base's).
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from concurrent import futures
@@ -30,12 +29,20 @@ from .sweep import run_design
 from .sweep_files import Progress, ResultsFile, _cell
 from .sweep_metrics import METRICS
 
-KEYS = (*METRICS, *PARAMETER_NAMES)
+# the parameters whose value is a word (drive, feedforward), not a number an objective can rank
+WORDS = tuple(n for n in PARAMETER_NAMES if isinstance(getattr(RobotParams(), n), str))
+KEYS = (*METRICS, *(n for n in PARAMETER_NAMES if n not in WORDS))
 
 
 def check_key(key: str, option: str) -> str:
-    """A metric or parameter name, or a one-line ParameterError naming what is allowed."""
+    """A metric or numeric parameter name, or a one-line ParameterError naming what is allowed."""
+    if not isinstance(key, str):
+        raise ParameterError(f"{option}: key {key!r} is not a string; allowed: a metric or a parameter name")
     key = key.strip()
+    if key in WORDS:
+        raise ParameterError(f"{option}: {key!r} is not a number (it names a choice, e.g. "
+                             f"{getattr(RobotParams(), key)!r}); allowed: a metric ({', '.join(METRICS)}) or a "
+                             "numeric parameter")
     if key not in KEYS:
         raise ParameterError(f"{option}: unknown key {key!r}; allowed: a metric ({', '.join(METRICS)}) or a "
                              "parameter name ('ipir-mujoco params' lists them)")
@@ -77,15 +84,19 @@ class Evaluator:
 
     def __init__(self, path: Path, names: list[str], base: RobotParams, engine: str, t_end: float,
                  dt_out: float, options: dict, resume: bool, workers: int | None, progress: bool = True,
-                 label: str = "optimize", total: int = 0, executor: futures.Executor | None = None):
+                 label: str = "optimize", total: int = 0, executor: futures.Executor | None = None,
+                 axes=()):
         self.names, self.base, self.engine = list(names), base, engine
         self.t_end, self.dt_out, self.options = t_end, dt_out, options
         self.header = ["eval_id", *self.names, *METRICS, "notes", "error"]
-        self.file = ResultsFile(path, self.header, resume)
+        self.file = ResultsFile(path, self.header, resume, numeric={*self.names, *METRICS})
         self.cache: dict[tuple, dict] = {}
-        with path.open(newline="", encoding="utf-8") as fh:
-            for raw in csv.DictReader(fh):
-                self.cache[tuple(raw[n] for n in self.names)] = _parse(raw)
+        self.by_id: dict[int, tuple] = {}  # the resumed file's designs by eval_id: a replay must ask them so
+        for number, (eval_id, raw) in enumerate(sorted(self.file.rows.items()), start=2):
+            key = tuple(raw[n] for n in self.names)
+            _check_resumed(path, eval_id, key, raw, self.names, axes, total, self.by_id, self.cache)
+            self.cache[key] = _parse(raw)
+            self.by_id[eval_id] = key
         self.asked = 0  # distinct designs asked for so far: the next one's eval_id (the same on every run)
         self.seen: set[tuple] = set()
         self.resumed = set(self.cache)  # designs of the file resumed, not yet asked for again
@@ -125,6 +136,7 @@ class Evaluator:
             if k not in self.seen:
                 self.seen.add(k)
                 ids[k] = self.asked
+                self._check_replay(k, self.asked)
                 self.asked += 1
             if k in self.resumed:
                 self.resumed.discard(k)
@@ -148,6 +160,18 @@ class Evaluator:
                     self._record(k, ids[k], todo[k], future.result())
         return [self.cache[k] for k in keys]
 
+    def _check_replay(self, key: tuple, eval_id: int) -> None:
+        """A resumed study asks its designs in the order it first did: the file's row ``eval_id`` is this
+        design, and this design is no other row (else the file is another study's, or was edited)."""
+        held = self.by_id.get(eval_id)
+        found = self.cache.get(key)
+        if (held is not None and held != key) or (found is not None and found["eval_id"] != eval_id):
+            where = ", ".join(f"{n}={v}" for n, v in zip(self.names, key))
+            raise ParameterError(f"{str(self.file.path)!r} does not belong to this study: its evaluation "
+                                 f"{eval_id if held != key else found['eval_id']} is not the design this study "
+                                 f"asks for as evaluation {eval_id} ({where}); it is another study's, or was "
+                                 "edited: run again in another --out, or without --resume in an empty one")
+
     def _task(self, design: dict) -> dict:
         return run_design(design, self.base, (self.engine,), self.t_end, self.dt_out, self.options)
 
@@ -161,6 +185,29 @@ class Evaluator:
         self.cache[key] = _parse({c: _cell(row.get(c)) for c in self.header})
         if self.bar is not None:
             self.bar.advance()
+
+
+def _check_resumed(path: Path, eval_id: int, key: tuple, raw: dict, names: list[str], axes, total: int,
+                   by_id: dict, cache: dict) -> None:
+    """One row of a resumed evaluations.csv: an eval_id the study can ask for (< ``total``), a design inside the
+    ``axes``' bounds, given once (a one-line ParameterError naming the file and what is wrong)."""
+    fault = None
+    if total and eval_id >= total:
+        fault = f"eval_id {eval_id} is past the study's {total} designs"
+    elif key in cache:
+        fault = f"eval_id {eval_id} repeats the design of eval_id {cache[key]['eval_id']}"
+    else:
+        for name, axis in zip(names, axes):
+            value = _number(raw[name])
+            if axis.low is None:
+                continue
+            slack = 1e-12 * max(abs(axis.low), abs(axis.high))  # a log axis's exp(log(hi)) may round past hi
+            if not isinstance(value, float) or not axis.low - slack <= value <= axis.high + slack:
+                fault = f"eval_id {eval_id} has {name}={raw[name]!r}, outside the study's {axis.low:g}..{axis.high:g}"
+                break
+    if fault:
+        raise ParameterError(f"{str(path)!r}: {fault} (another study's file, or an edited one); resume needs the "
+                             "evaluations.csv this study wrote: run again in another --out")
 
 
 def usable(value) -> bool:

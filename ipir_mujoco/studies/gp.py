@@ -157,6 +157,23 @@ class GaussianProcess:
         self.y = y
         return self
 
+    @property
+    def noise(self) -> float:
+        """The fitted noise variance, in the outputs' units squared."""
+        return math.exp(self.theta[-1]) * self.scale ** 2
+
+    def prior_cov(self, A, B) -> np.ndarray:
+        """The kernel's covariance (outputs' units squared) between the rows of A and B, before any data."""
+        with one_blas_thread():
+            return self.scale ** 2 * self.s2 * matern52(np.atleast_2d(A), np.atleast_2d(B), self.lengths)[0]
+
+    def whitened(self, A) -> np.ndarray:
+        """L^-1 k(X, A) (n, m), in output units: the posterior covariance is prior_cov(A, B) - whitened(A).T @
+        whitened(B)."""
+        with one_blas_thread():
+            ks = self.scale * self.s2 * matern52(self.X, np.atleast_2d(np.asarray(A, dtype=float)), self.lengths)[0]
+            return solve_triangular(self.chol, ks, lower=True)
+
     def predict(self, Xs) -> tuple[np.ndarray, np.ndarray]:
         """Posterior mean and standard deviation (of the latent function, the noise left out) at Xs (m, d)."""
         with one_blas_thread():

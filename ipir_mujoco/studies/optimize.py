@@ -25,17 +25,20 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import re
+import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import RobotParams, check_whole
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError
+from ipir_mujoco.core.options import check_type
+from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
-from ..output import check_output_dir
+from ..output import check_output_dir, study_folder
 from .design_eval import Evaluator, check_key, key_value, usable, verify_rows
 from .sweep_space import Axis, Study
 
@@ -50,12 +53,24 @@ class Objective:
     sense: str  # "min" or "max"
     key: str
 
+    def __post_init__(self) -> None:
+        if self.sense not in ("min", "max"):
+            raise ParameterError(f"Objective sense={self.sense!r} is not allowed; allowed: 'min' or 'max'")
+        object.__setattr__(self, "key", check_key(self.key, f"Objective key={self.key!r}"))
+
 
 @dataclass(frozen=True)
 class Constraint:
     key: str
     op: str  # "<=" or ">="
     value: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "key", check_key(self.key, f"Constraint key={self.key!r}"))
+        if self.op not in ("<=", ">="):
+            raise ParameterError(f"Constraint op={self.op!r} is not allowed; allowed: '<=' or '>=' (a design is "
+                                 "feasible where KEY <= VALUE, or KEY >= VALUE)")
+        object.__setattr__(self, "value", check_real("Constraint value", self.value, low=-math.inf, low_open=False))
 
     def slack(self, value) -> float:
         """>= 0 where satisfied; -inf where the value is missing (a stalled or failed design)."""
@@ -99,6 +114,13 @@ class Problem:
     seed: int = 0
 
     def __post_init__(self) -> None:
+        for name, kind in (("axes", Axis), ("objectives", Objective), ("constraints", Constraint)):
+            value = getattr(self, name)
+            if not isinstance(value, (tuple, list)) or not all(isinstance(v, kind) for v in value):
+                raise ParameterTypeError(f"Problem {name}={value!r} is not a tuple of {kind.__name__}; allowed: e.g. "
+                                     f"({kind.__name__}(...),)" + (" or (parse_vary('L=0.1:0.3'),)" if kind is Axis
+                                                                  else ""))
+            object.__setattr__(self, name, tuple(value))
         if not self.objectives:
             raise ParameterError("optimize needs at least one --objective min:KEY or max:KEY")
         for axis in self.axes:
@@ -181,7 +203,9 @@ def _single(problem: Problem, ev: Evaluator) -> None:
 
     d = len(problem.axes)
     n0 = min(problem.budget, max(8, 4 * d))
-    unit = qmc.Sobol(d=d, scramble=True, seed=problem.seed).random(n0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # scipy's note when n0 is not a power of 2: the start stays space-filling
+        unit = qmc.Sobol(d=d, scramble=True, seed=problem.seed).random(n0)
     rows = ev.evaluate([problem.design(u) for u in unit])
     left = problem.budget - n0
     if left < 2:
@@ -251,30 +275,51 @@ def _multi(problem: Problem, ev: Evaluator) -> None:
              NSGA2(pop_size=pop), ("n_gen", generations), seed=problem.seed, verbose=False)
 
 
+OUTPUT_FILES = ("evaluations.csv", "pareto.csv", "optimize.json", "pareto.png")
+
+
 def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, workers: int | None = None,
-                 progress: bool = True, executor=None) -> dict:
+                 progress: bool = True, executor=None, figure=None) -> dict:
     """Run ``problem``; write OUT/evaluations.csv, pareto.csv, optimize.json; return optimize.json's record.
 
     ``executor``: any ``concurrent.futures.Executor`` (a Dask client's, ``--scheduler``) instead of the pool.
-    Ctrl-C raises :class:`~ipir_mujoco.studies.design_eval.StudyInterrupted` with every evaluation kept.
+    ``figure``: a function of the folder that draws into it (the command line's pareto.png), called before
+    optimize.json says ``"status": "done"``, which it says last. Every argument, the folder and the file to
+    resume are checked before the first design; the folder is locked while the study runs (a second run on it
+    is refused). Ctrl-C raises :class:`~ipir_mujoco.core.errors.StudyInterrupted` with every evaluation kept.
     """
+    check_type("problem", problem, Problem, "an optimize.Problem")
+    check_type("out", out, (str, os.PathLike), "the path of the results folder")
+    check_type("resume", resume, bool, "True or False")
+    check_type("progress", progress, bool, "True or False")
     if workers is not None:
         check_whole("workers", workers, low=1, high=1024)
-    out = check_output_dir(out)
+    if figure is not None and not callable(figure):
+        raise ParameterTypeError(f"figure={figure!r} is not callable; allowed: a function of the results folder, "
+                                 "or None")
+    out = check_output_dir(out, files=OUTPUT_FILES)
     check_resume(out, problem, resume)
     if len(problem.objectives) > 1:
         try:
             import pymoo  # noqa: F401
         except ImportError:
             raise ParameterError("several objectives need pymoo: pip install 'ipir-mujoco[optimize]'") from None
-    out.mkdir(parents=True, exist_ok=True)
+    with study_folder(out):
+        check_resume(out, problem, resume)  # again, under the lock: what another run may have left
+        return _run_locked(problem, out, resume, workers, progress, executor, figure)
+
+
+def _run_locked(problem: Problem, out: Path, resume: bool, workers, progress: bool, executor, figure) -> dict:
     settings = problem.to_json()
-    write_json(out / "optimize.json", {"fingerprint": problem.fingerprint(), "settings": settings, "status": "running"})
     options = {"until_steady": problem.until_steady}
     # progress against the budget: the most the search may ask for (COBYQA may converge before it)
-    with Evaluator(out / "evaluations.csv", problem.names, problem.base, problem.engine, problem.t_end,
+    ev = Evaluator(out / "evaluations.csv", problem.names, problem.base, problem.engine, problem.t_end,
                    problem.study.dt_out, options, resume, workers, progress, total=problem.budget,
-                   executor=executor) as ev:
+                   executor=executor, axes=problem.axes)
+    if not (resume and (out / "optimize.json").is_file()):  # resumed: the same study's (check_resume), left as it is
+        write_json(out / "optimize.json", {"fingerprint": problem.fingerprint(), "settings": settings,
+                                           "status": "running"})
+    with ev:
         (_single if len(problem.objectives) == 1 else _multi)(problem, ev)
         rows = list(ev.cache.values())
         reused = ev.reused
@@ -302,7 +347,9 @@ def run_optimize(problem: Problem, out: str | Path, *, resume: bool = False, wor
         record["best"] = summary[0] if summary else None
     else:
         record["front"] = summary
-    write_json(out / "optimize.json", _finite(record))
+    if figure is not None:
+        figure(out)
+    write_json(out / "optimize.json", _finite(record))  # last: "done" only once every file is written
     return record
 
 

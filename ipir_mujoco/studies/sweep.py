@@ -60,9 +60,11 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError, StudyInterr
 from ipir_mujoco.core.options import check_type
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
-from ..output import check_output_dir
+from ipir_mujoco.core.results import write_json
+
+from ..output import check_output_dir, study_folder
 from .pool import kill_workers, worker_init
-from .sweep_files import Progress, ResultsFile, header_for, make_row
+from .sweep_files import Progress, ResultsFile, _cell, header_for, make_row
 from .sweep_metrics import batch_metrics, run_metrics
 from .sweep_space import Study
 
@@ -269,9 +271,32 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
                                  "same one")
     designs = study.designs()
     refuse_all_invalid(study.base, designs)
-    out.mkdir(parents=True, exist_ok=True)
-    results_file = ResultsFile(out / "results.csv", header_for(study), resume)
-    meta.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+    with study_folder(out):  # locked against a second run while this one writes
+        results_file = _open_results(out, study, designs, resume)
+        write_json(meta, record)
+        _run_designs(study, designs, out, results_file, executor, batch_mujoco, workers, progress, on_row,
+                     timeout_per_design, batch_size)
+    return out / "results.csv"
+
+
+def _open_results(out: Path, study: Study, designs: list[dict], resume: bool) -> ResultsFile:
+    """OUT/results.csv, new or resumed; a resumed row must be this study's design of its id (else the file is
+    another study's, or was edited: refused in one line before any design runs)."""
+    header = header_for(study)
+    numeric = {c for c in header if c not in ("design_id", "notes", "error")}
+    results_file = ResultsFile(out / "results.csv", header, resume, numeric=numeric)
+    for design_id, row in sorted(results_file.rows.items()):
+        expected = designs[design_id] if design_id < len(designs) else None
+        if expected is None or any(row[name] != _cell(float(value)) for name, value in expected.items()):
+            found = ", ".join(f"{a.name}={row[a.name]}" for a in study.axes)
+            raise ParameterError(f"{str(results_file.path)!r}: design_id {design_id} ({found}) is not this study's "
+                                 f"design {design_id} (another study's file, or an edited one); resume needs the "
+                                 "results.csv this sweep wrote: run again in another --out")
+    return results_file
+
+
+def _run_designs(study: Study, designs: list[dict], out: Path, results_file: ResultsFile, executor, batch_mujoco,
+                 workers, progress: bool, on_row, timeout_per_design, batch_size) -> None:
     todo = [i for i in range(len(designs)) if i not in results_file.done]
     bar = Progress(len(designs), len(designs) - len(todo), progress)
     engines = study.engines
@@ -370,7 +395,6 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
                 future.cancel()
         results_file.close()
     results_file.sort()
-    return out / "results.csv"
 
 
 def _abandon_stuck(running: dict, budget: float | None, pooled, finish) -> bool:

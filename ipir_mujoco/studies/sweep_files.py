@@ -99,19 +99,44 @@ def _done_designs(path: Path, rows: list[list[str]], width: int) -> set[int]:
             continue
         if len(row) != width or not row[0].isdigit():
             what = (f"has {len(row)} cells; the header has {width}" if len(row) != width
-                    else f"design_id {row[0][:20]!r} is not a whole number")
+                    else f"{rows[0][0]} {row[0][:20]!r} is not a whole number")
             raise ParameterError(f"{str(path)!r} line {number} {what} (a corrupted row?); resume needs the "
-                                 "results.csv a sweep wrote: remove the line, or run again in another --out")
+                                 f"{path.name} this study wrote: remove the line, or run again in another --out")
+        if int(row[0]) in done:
+            raise ParameterError(f"{str(path)!r} line {number} repeats {rows[0][0]} {row[0]} (a duplicated row?); "
+                                 f"resume needs the {path.name} this study wrote: remove the line, or run again in "
+                                 "another --out")
         done.add(int(row[0]))
     return done
 
 
-class ResultsFile:
-    """results.csv: header once, one flushed row per finished design; sorted by design_id when complete."""
+def check_cells(path: Path, rows: list[list[str]], numeric: set[str]) -> None:
+    """Every cell of the ``numeric`` columns of the data rows ``rows[1:]`` is a number or empty (a text where a
+    metric goes is a one-line ParameterError naming the file, the line and the cell)."""
+    columns = [k for k, name in enumerate(rows[0]) if name in numeric]
+    for number, row in enumerate(rows[1:], start=2):
+        for k in columns if row else ():
+            if row[k] == "":
+                continue
+            try:
+                float(row[k])
+            except ValueError:
+                raise ParameterError(f"{str(path)!r} line {number}: {rows[0][k]}={row[k][:40]!r} is not a number "
+                                     f"(an edited row?); resume needs the {path.name} this study wrote: remove "
+                                     "the line, or run again in another --out") from None
 
-    def __init__(self, path: Path, header: list[str], resume: bool):
+
+class ResultsFile:
+    """results.csv: header once, one flushed row per finished design; sorted by design_id when complete.
+
+    Resumed, the file is checked before anything runs: its header is ``header``, every row has its cells, a
+    whole-number id (its first column) found once, and a number or nothing in each column of ``numeric``;
+    :attr:`rows` holds the data rows read ({id: {column: text}})."""
+
+    def __init__(self, path: Path, header: list[str], resume: bool, numeric: set[str] = frozenset()):
         self.path, self.header = path, header
         self.done: set[int] = set()
+        self.rows: dict[int, dict[str, str]] = {}
         if path.exists():
             if not resume:
                 raise ParameterError(f"{str(path)!r} exists; use --resume to complete it, or another --out")
@@ -121,6 +146,8 @@ class ResultsFile:
                 raise ParameterError(f"{str(path)!r} was written for other engines, metrics or parameters; "
                                      "resume needs the same study and version")
             self.done = _done_designs(path, rows, len(header))
+            check_cells(path, rows, set(numeric))
+            self.rows = {int(r[0]): dict(zip(header, r)) for r in rows[1:] if r}
             path.write_text("".join(complete), encoding="utf-8")
         else:
             with path.open("w", newline="", encoding="utf-8") as fh:

@@ -102,6 +102,9 @@ def parse_vary(text: str) -> Axis:
         raise ParameterError(f"--vary {text!r}: {spec!r} is not a list of numbers") from None
     if not all(math.isfinite(v) for v in numbers):
         raise ParameterError(f"--vary {text!r}: every bound must be finite")
+    if len(numbers) not in (2, 3):  # NAME=log, NAME=1:2:3:4
+        raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N, NAME=A,B,C or "
+                             "NAME=LO:HI (each with :log for log spacing)")
     if log and min(numbers[:2]) <= 0:
         raise ParameterError(f"--vary {text!r}: a log-spaced range needs positive bounds")
     if len(numbers) == 2:

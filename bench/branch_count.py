@@ -1,0 +1,62 @@
+"""Count the branch tests that name a MuJoCo model kind or finite grip outside that kind's own modules.
+
+The measure of how well the engine's seam holds (a kind's concerns live in its own modules, not as flags
+threaded through the rest): every ``if``/``elif``/``while`` test, conditional expression and comprehension
+filter of the package's source (``ipir_mujoco/`` and ``analytic/``) whose text names finite grip (``grip``,
+``mu_wall``, ``has_grip``, ``skid_q``, the grip controllers) or the wheeled model (``wheeled``, ``'wheels'``,
+``WHEELS``, ``WheelRatchet``), leaving out the kinds' own modules (``engine/kinds.py``; finite grip's
+``*grip*.py``; the wheels' ``wheels*.py``, ``route_*.py``, ``pipe_*.py``). Run from the repository root:
+
+    python bench/branch_count.py [ROOT] [-v]
+
+``-v`` lists each test (file:line, which concern, its text).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import sys
+from pathlib import Path
+
+GRIP = re.compile(r"\bgrip\b|mu_wall|has_grip|skid_q|\bGRIP_SLIDES\b|GripRatchet|CompliantGrip")
+WHEELS = re.compile(r"wheeled|[\"']wheels[\"']|\bWHEELS\b|is_wheeled|WheelRatchet")
+OWN = {"grip": re.compile(r"(^|/)(grip[^/]*|[^/]*_grip)\.py$"),
+       "wheels": re.compile(r"(^|/)(wheels[^/]*|route_\w+|pipe_\w+)\.py$")}
+KINDS = re.compile(r"(^|/)engine/kinds\.py$")
+
+
+def count(root: Path) -> dict[str, list[tuple[str, int, str]]]:
+    """{'grip': [...], 'wheels': [...]}: each branch test as (file, line, text)."""
+    found: dict[str, list] = {"grip": [], "wheels": []}
+    for file in sorted([*(root / "ipir_mujoco").rglob("*.py"), *(root / "analytic").rglob("*.py")]):
+        rel = file.relative_to(root).as_posix()
+        if KINDS.search(rel):
+            continue
+        source = file.read_text()
+        for node in ast.walk(ast.parse(source)):
+            tests = [node.test] if isinstance(node, (ast.If, ast.IfExp, ast.While)) else (
+                list(node.ifs) if isinstance(node, ast.comprehension) else [])
+            for test in tests:
+                text = ast.get_source_segment(source, test) or ""
+                for concern, pattern in (("grip", GRIP), ("wheels", WHEELS)):
+                    if pattern.search(text) and not OWN[concern].search(rel):
+                        found[concern].append((rel, node.lineno, text))
+    return found
+
+
+def main() -> int:
+    args = [a for a in sys.argv[1:] if a != "-v"]
+    found = count(Path(args[0]) if args else Path("."))
+    files = {f for items in found.values() for f, _, _ in items}
+    print(f"grip {len(found['grip'])}, wheels {len(found['wheels'])}, total "
+          f"{sum(len(v) for v in found.values())} in {len(files)} files")
+    if "-v" in sys.argv:
+        for concern, items in found.items():
+            for rel, line, text in items:
+                print(f"  {rel}:{line} [{concern}] {' '.join(text.split())[:90]}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,84 @@
+"""The energy terms of a run, one table for every engine: a new effect's energy is a row here.
+
+Each term is a series column (cumulative from 0 at the first sample, or a state whose change counts), the key
+under which a run's energy audit (``RunResult.energy``) reports its change [J], and its role in the balance
+
+    input = kinetic gained + stored gained + dissipated + residual
+
+``input``: the drive's work; ``kinetic``: the kinetic energy; ``stored``: energy held and given back
+(gravity's potential, the compliant clutches' springs); ``dissipated``: work lost (against the resistances,
+in the clutches' dampers, by skidding wheels). A run has the terms whose columns it writes (:func:`terms_of`);
+the per-revolution audit (:mod:`.cycles`), the summary's efficiency and the MuJoCo engine's audit read this
+table; the analytic engines write the same audit keys.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+INPUT, KINETIC, STORED, DISSIPATED = "input", "kinetic", "stored", "dissipated"
+
+
+@dataclass(frozen=True)
+class EnergyTerm:
+    """One energy term.
+
+    Attributes
+    ----------
+    name : str
+        Its name in words.
+    column : str
+        The series column [J] it is read from.
+    audit_key : str
+        Its key in ``RunResult.energy`` [J]: the column's change over the run.
+    role : str
+        INPUT, KINETIC, STORED or DISSIPATED (module docstring).
+    """
+
+    name: str
+    column: str
+    audit_key: str
+    role: str
+
+
+ENERGY_TERMS = (
+    EnergyTerm("motor", "motor_work", "motor_work_j", INPUT),
+    EnergyTerm("friction", "friction_work", "friction_j", DISSIPATED),
+    EnergyTerm("kinetic", "kinetic", "kinetic_j", KINETIC),
+    EnergyTerm("potential", "potential", "potential_j", STORED),
+    EnergyTerm("clutch spring", "clutch_spring_energy", "clutch_spring_j", STORED),
+    EnergyTerm("clutch damper", "clutch_damper_work", "clutch_damper_j", DISSIPATED),
+    EnergyTerm("skid", "skid_work", "skid_j", DISSIPATED),
+)
+ENERGY_COLUMNS = tuple(term.column for term in ENERGY_TERMS)
+RESIDUAL_KEY = "residual_j"  # the audit's residual: input - kinetic - stored - dissipated [J]
+
+
+def terms_of(columns) -> tuple[EnergyTerm, ...]:
+    """The terms of a run whose series has ``columns`` (any container of names), in the table's order."""
+    return tuple(term for term in ENERGY_TERMS if term.column in columns)
+
+
+def changes(series: dict, terms=None) -> dict[EnergyTerm, float]:
+    """Each term's change [J] over a run, first to last sample of its column in ``series`` (columns of shape
+    (n,)); ``terms``: the run's (default: those whose columns ``series`` has)."""
+    terms = terms_of(series) if terms is None else terms
+    return {term: series[term.column][-1] - series[term.column][0] for term in terms}
+
+
+def by_role(change: dict) -> dict[str, float]:
+    """{role: the sum of its terms' changes, added in the table's order (0.0 where it has none)} of ``change``
+    ({EnergyTerm: J}); residual = input - dissipated - kinetic - stored."""
+    out = {}
+    for role in (INPUT, KINETIC, STORED, DISSIPATED):
+        values = [change[t] for t in ENERGY_TERMS if t in change and t.role == role]
+        total = values[0] if values else 0.0
+        for value in values[1:]:
+            total = total + value
+        out[role] = total
+    return out
+
+
+def audit_keys(change: dict) -> dict[str, float]:
+    """``change`` ({EnergyTerm: J}) under the terms' audit keys, as floats."""
+    return {term.audit_key: float(value) for term, value in change.items()}

@@ -1,0 +1,343 @@
+"""Uncertainty propagation with two fidelities: the equations on many samples, MuJoCo on a few of them.
+
+:func:`run_uncertainty` draws N samples of the uncertain parameters (:mod:`.uq_dists`), runs the equations (the
+analytic variant matching the engine, :func:`engine_pair`) on all of them and MuJoCo on the first M
+(``mujoco_samples``; M << N, the same draws: paired), and gives per metric its mean, standard deviation and 5/50/95 %
+quantiles with confidence intervals, and the probability of each event, by the estimators of :mod:`.uq_stats`:
+plain Monte Carlo of the equations without MuJoCo samples; with them, the multi-fidelity estimate (the equations
+as a control variate of MuJoCo) beside MuJoCo's plain Monte Carlo on its M samples, with the variance reduction.
+
+A metric (``--metric KEY``) is any number of a run's summary (``simulate --json``'s ``summary``, its ``energy``
+figures included: ``motor_work_j``, ...), any sweep metric (``mean_speed_m_s``, ``steady``, ``stalled``, ...: as
+:mod:`.sweep_metrics` reads them, the same for every engine), or one of :data:`DERIVED`. An event is
+``KEY>V`` (also ``<``, ``>=``, ``<=``) or a name of :data:`NAMED_EVENTS`. A metric a sample does not give (a
+stalled run's energy per metre) leaves that sample out of the metric's statistics (their count is reported);
+it is not the event ``KEY>V``. A run that fails (an invalid draw, a simulation failure) leaves its sample out of
+everything, and is counted.
+
+Files (written all at once at the end, nothing half-written): ``uncertainty.json`` (the contract's structure:
+``metrics`` {KEY: mean, mean_interval, std, std_interval, quantiles, estimator, variance_reduction, ...},
+``events`` {TEXT: probability, interval, ...}), ``samples.csv`` (one row per sample: the parameters, then
+``ENGINE:KEY`` for each engine, metric and event key, and ``ENGINE:error``), ``uncertainty.png``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import operator
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ipir_mujoco import registry
+from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.options import MAX_T_END, refuse_steady_without_motor
+from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse_idle_parameters
+from ipir_mujoco.core.results import write_json
+
+from . import uq_stats
+from .sweep_files import Progress
+from ..labels import SUMMARY
+from .sweep_metrics import METRICS, UNITS, run_metrics
+from .uq_dists import Dist, sample
+
+# a run's number beside its summary's and the sweep metrics: [unit] meaning
+DERIVED = {"travel_m": "m: mean travel of the two modules over the run, (x1_final + x2_final) / 2 (< 0: slid back)",
+           "skid_m": "m: the larger module's backward skid on the wall, max(slip1_m, slip2_m)"}
+SUMMARY_KEYS = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s", "mode_switches",
+                "min_clutch_reaction_n", "slip1_m", "slip2_m", "peak_grip_use", "cycles", "cycle_energy_residual_j",
+                "motor_work_j", "kinetic_j", "friction_j", "residual_j", "wheel_off_s", "press1_n", "press2_n",
+                "route_done", "route_time_s")
+KEYS = tuple(dict.fromkeys((*METRICS, *SUMMARY_KEYS, *DERIVED)))
+KEY_UNITS = {**{k: u for k, (_, u) in SUMMARY.items()}, **UNITS, "x1_final": "m", "x2_final": "m", "v1_max": "m/s",
+             "v2_max": "m/s", "slip1_m": "m", "slip2_m": "m", "peak_grip_use": "-", "motor_work_j": "J",
+             "kinetic_j": "J", "friction_j": "J", "residual_j": "J", "wheel_off_s": "s", "press1_n": "N",
+             "press2_n": "N", "route_time_s": "s", "travel_m": "m", "skid_m": "m"}
+NAMED_EVENTS = {"stall": ("stalled", ">", 0.5), "no-steady-state": ("steady", "<", 0.5),
+                "slides-back": ("travel_m", "<", 0.0)}
+OPERATORS = {">=": operator.ge, "<=": operator.le, ">": operator.gt, "<": operator.lt}
+MAX_SAMPLES = 100_000
+MIN_MUJOCO = 3  # pairs the multi-fidelity estimate needs (a correlation and a coefficient from them)
+# the equation's variant paired with each MuJoCo variant: the same clutch rule, the exact geometry
+_ANALYTIC_OF = {"unilateral": "analytic-unilateral", "kinematic": "analytic-exact"}
+_MUJOCO_OF = {"unilateral": "mujoco-ratchet", "kinematic": "mujoco-lock"}
+
+
+@dataclass(frozen=True)
+class Event:
+    """``key op value``, with the text the user gave (its name in the output)."""
+
+    text: str
+    key: str
+    op: str
+    value: float
+
+    def hits(self, values: np.ndarray) -> np.ndarray:
+        """Booleans of shape (n,): the samples with the event (a missing value, NaN, is not the event)."""
+        with np.errstate(invalid="ignore"):
+            return np.isfinite(values) & OPERATORS[self.op](values, self.value)
+
+
+def check_metric(key: str) -> str:
+    key = key.strip()
+    if key not in KEYS:
+        raise ParameterError(f"--metric {key!r} is unknown; allowed: {', '.join(KEYS)}")
+    return key
+
+
+def parse_event(text: str) -> Event:
+    """``KEY>V``, ``KEY>=V``, ``KEY<V``, ``KEY<=V`` or a name of :data:`NAMED_EVENTS`."""
+    spec = text.strip()
+    if spec in NAMED_EVENTS:
+        return Event(spec, *NAMED_EVENTS[spec])
+    for op in (">=", "<=", ">", "<"):
+        key, sep, value = spec.partition(op)
+        if sep:
+            key = key.strip()
+            if key not in KEYS:
+                raise ParameterError(f"--event {text!r}: unknown key {key!r}; allowed: {', '.join(KEYS)}")
+            try:
+                number = float(value)
+            except ValueError:
+                raise ParameterError(f"--event {text!r}: {value.strip()!r} is not a number") from None
+            if not math.isfinite(number):
+                raise ParameterError(f"--event {text!r}: the threshold must be finite")
+            return Event(spec, key, op, number)
+    raise ParameterError(f"--event {text!r} is malformed; allowed: KEY>V, KEY>=V, KEY<V, KEY<=V or one of "
+                         f"{', '.join(NAMED_EVENTS)}")
+
+
+def engine_pair(engine: str | None) -> tuple[str, str]:
+    """(the equations' variant, MuJoCo's variant) for ``--engine``: either side names the other by its clutch
+    rule (one-way clutches: analytic-unilateral and mujoco-ratchet, the default; the paper's rule:
+    analytic-exact and mujoco-lock)."""
+    if engine is None:
+        return "analytic-unilateral", "mujoco-ratchet"
+    v = registry.variant(engine)
+    if v.is_mujoco:
+        return _ANALYTIC_OF[v.rule], v.name
+    return v.name, _MUJOCO_OF[v.rule]
+
+
+def sample_values(run) -> dict[str, float]:
+    """Every number of a run :data:`KEYS` names (NaN where the run has none)."""
+    summary = run.summary
+    flat = dict(summary)
+    flat.update(summary.get("energy") or {})
+    values = {k: _number(flat.get(k)) for k in SUMMARY_KEYS}
+    values.update(run_metrics(run))
+    values["travel_m"] = 0.5 * (values["x1_final"] + values["x2_final"])
+    values["skid_m"] = max(values["slip1_m"], values["slip2_m"])
+    return values
+
+
+def _number(value) -> float:
+    if isinstance(value, bool):
+        return float(value)
+    if isinstance(value, (int, float)):
+        return float(value)
+    return math.nan
+
+
+class SampleTask:
+    """One sample in one engine (picklable, for the pool): (index, {parameter: value}) -> (index, values or
+    {"error": message})."""
+
+    def __init__(self, base: RobotParams, engine: str, t_end: float, dt_out: float, until_steady: bool,
+                 keys: tuple[str, ...]):
+        self.base, self.engine, self.t_end, self.dt_out = base, engine, t_end, dt_out
+        self.until_steady, self.keys = until_steady, keys
+
+    def __call__(self, item: tuple[int, dict]) -> tuple[int, dict]:
+        index, design = item
+        registry.prepare_for_many((self.engine,))
+        try:
+            params = self.base.replace(**design)
+            run = registry.run(self.engine, params, self.t_end, dt_out=self.dt_out, until_steady=self.until_steady)
+        except (ParameterError, ValueError) as exc:  # this draw is not a valid design, or not for this engine
+            return index, {"error": " ".join(str(exc).split()), "bad_input": True}
+        except SimulationError as exc:
+            return index, {"error": " ".join(str(exc).split())}
+        values = sample_values(run)
+        return index, {k: values[k] for k in self.keys}
+
+
+def evaluate(task: SampleTask, designs: list[dict], workers: int, progress: Progress | None) -> list[dict]:
+    """``task`` on every design, on ``workers`` processes: results in the designs' order."""
+    from .pool import map_unordered
+
+    results: list[dict | None] = [None] * len(designs)
+
+    def done(item, result):
+        results[result[0]] = result[1]
+        if progress is not None:
+            progress.advance()
+
+    map_unordered(task, list(enumerate(designs)), max(1, min(workers, len(designs))), done)
+    return results  # type: ignore[return-value]
+
+
+def run_uncertainty(dists: list[Dist], metrics: tuple[str, ...], events: tuple[Event, ...] = (), *,
+                    base: RobotParams | None = None, engine: str | None = None, samples: int = 1000,
+                    mujoco_samples: int = 0, t_end: float = 1.0, until_steady: bool = False, seed: int = 0,
+                    correlation=None, workers: int | None = None, progress: bool = True) -> dict:
+    """Run the study (module docstring); returns {"study": ..., "metrics": ..., "events": ..., "rows": ...}
+    (``rows``: one dict per sample, what samples.csv holds). Nothing is written here (see :func:`write_files`)."""
+    base = RobotParams() if base is None else base
+    if not metrics and not events:
+        raise ParameterError("uncertainty needs at least one --metric KEY or --event")
+    samples = check_whole("samples", samples, low=2, high=MAX_SAMPLES)
+    mujoco_samples = check_whole("mujoco_samples", mujoco_samples, low=0, high=samples)
+    if 0 < mujoco_samples < MIN_MUJOCO:
+        raise ParameterError(f"--mujoco-samples {mujoco_samples}: allowed: 0, or {MIN_MUJOCO} to --samples "
+                             f"({samples}) (the pairs give the correlation the estimate uses)")
+    seed = check_whole("seed", seed, low=0)
+    t_end = check_real("t_end", t_end, high=MAX_T_END, unit="s")
+    refuse_steady_without_motor(base.drive, until_steady)
+    workers = check_whole("workers", workers, low=1, high=1024) if workers is not None else (os.cpu_count() or 1)
+    cheap, faithful = engine_pair(engine)
+    names = [d.name for d in dists]
+    draws = sample(dists, samples, seed, correlation)
+    designs = [dict(zip(names, map(float, row))) for row in draws]
+    first = next((d for d in designs[:50] if _valid(base, d)), None)
+    if first is None:
+        base.replace(**designs[0])  # every draw invalid (say L <= r against the base): refuse, naming the first
+    # a parameter that acts only through another the base leaves idle (F_n1 with unlimited grip): every run
+    # would refuse it; refused here, once
+    refuse_idle_parameters(base.replace(**first))
+    keys = tuple(dict.fromkeys((*metrics, *(e.key for e in events))))
+    dt_out = min(1e-3, t_end)
+    started = time.perf_counter()
+    cheap_rows = evaluate(SampleTask(base, cheap, t_end, dt_out, until_steady, keys), designs, workers,
+                          Progress(samples, 0, progress, what=f"uncertainty {cheap}") if progress else None)
+    faithful_rows = []
+    if mujoco_samples:
+        faithful_rows = evaluate(SampleTask(base, faithful, t_end, dt_out, until_steady, keys),
+                                 designs[:mujoco_samples], workers,
+                                 Progress(mujoco_samples, 0, progress, what=f"uncertainty {faithful}")
+                                 if progress else None)
+    result = {"study": {"dists": [d.text for d in dists], "metrics": list(metrics), "events": [e.text for e in events],
+                        "engine": cheap, "mujoco_engine": faithful if mujoco_samples else None,
+                        "samples": samples, "mujoco_samples": mujoco_samples, "t_end": t_end,
+                        "until_steady": until_steady, "seed": seed, "base": base.as_dict(),
+                        "correlation": None if correlation is None else {"names": correlation[0],
+                                                                         "matrix": correlation[1].tolist()}}}
+    result.update(estimate(cheap_rows, faithful_rows, metrics, events, seed))
+    result["study"]["wall_s"] = time.perf_counter() - started
+    result["rows"] = _rows(designs, cheap, cheap_rows, faithful, faithful_rows, keys)
+    return result
+
+
+def _valid(base: RobotParams, design: dict) -> bool:
+    try:
+        base.replace(**design)
+        return True
+    except ValueError:
+        return False
+
+
+def _column(rows: list[dict], key: str) -> np.ndarray:
+    return np.array([r.get(key, math.nan) if "error" not in r else math.nan for r in rows], dtype=float)
+
+
+def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events, seed: int = 0) -> dict:
+    """The statistics of every metric and event from the two engines' per-sample values (module docstring):
+    {"metrics": {KEY: {...}}, "events": {TEXT: {...}}, "failures": {...}}."""
+    m = len(faithful_rows)
+    ok_cheap = np.array(["error" not in r for r in cheap_rows])
+    ok_pair = np.array(["error" not in r for r in faithful_rows], dtype=bool) & ok_cheap[:m] if m else np.array([])
+    failures = {"equations": int((~ok_cheap).sum()), "mujoco": int(m - ok_pair.sum()) if m else 0,
+                "first_error": next((r["error"] for r in [*cheap_rows, *faithful_rows] if "error" in r), None)}
+    if not ok_cheap.any():
+        if all(r.get("bad_input") for r in cheap_rows):
+            raise ParameterError(f"every sample was refused by the equations; the first: {failures['first_error']}")
+        raise SimulationError(f"every sample failed in the equations; the first: {failures['first_error']}")
+    out: dict = {"metrics": {}, "events": {}, "failures": failures}
+    for key in metrics:
+        g = _column(cheap_rows, key)
+        usable_g = np.isfinite(g)
+        entry: dict
+        f = _column(faithful_rows, key) if m else np.array([])
+        pair = np.isfinite(f) & usable_g[:m] if m else np.array([], dtype=bool)
+        if m and pair.sum() >= MIN_MUJOCO:
+            rest = usable_g.copy()
+            rest[:m] = False
+            entry = uq_stats.multi_fidelity(f[pair], g[:m][pair], g[rest], seed)
+            entry["estimator"] = "multi-fidelity"
+            entry["mujoco_mc"] = uq_stats.mc_statistics(f[pair], seed)
+            entry["equations_mc"] = uq_stats.mc_statistics(g[usable_g], seed)
+            entry["missing"] = int((~usable_g).sum() + (~np.isfinite(f)).sum())
+        else:
+            if usable_g.sum() < 2:
+                raise SimulationError(f"{key}: only {int(usable_g.sum())} of the {len(g)} samples give it (stalled "
+                                      "or failed runs); statistics need 2")
+            entry = uq_stats.mc_statistics(g[usable_g], seed)
+            entry.update(estimator="mc", variance_reduction=None, missing=int((~usable_g).sum()))
+            if m:  # MuJoCo ran but gives too few values of this metric to pair (a rigid clutch's peak force: none)
+                entry["note"] = (f"only {int(pair.sum())} of the {m} MuJoCo runs give {key} (MuJoCo leaves some "
+                                 "metrics empty, e.g. a rigid clutch's peak force; or they stalled or failed): the "
+                                 f"equations' Monte Carlo alone (multi-fidelity needs {MIN_MUJOCO} pairs)")
+        out["metrics"][key] = _finite(entry)
+    for event in events:
+        g = _column(cheap_rows, event.key)[ok_cheap]
+        if m:
+            f = _column(faithful_rows, event.key)
+            g_pair = _column(cheap_rows, event.key)[:m]
+            entry = uq_stats.multi_fidelity_event(event.hits(f[ok_pair]), event.hits(g_pair[ok_pair]), event.hits(g))
+            entry["mujoco_mc"] = uq_stats.event_probability(event.hits(f[ok_pair]))
+            entry["equations_mc"] = uq_stats.event_probability(event.hits(g))
+        else:
+            entry = uq_stats.event_probability(event.hits(g))
+        out["events"][event.text] = _finite(entry)
+    return out
+
+
+def _finite(value):
+    """JSON has no NaN or infinity: None in their place (an interval the samples cannot bound on one side)."""
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _rows(designs, cheap, cheap_rows, faithful, faithful_rows, keys) -> list[dict]:
+    rows = []
+    for i, design in enumerate(designs):
+        row = {"sample": i, **design}
+        for engine, results in ((cheap, cheap_rows), (faithful, faithful_rows)):
+            if i < len(results):
+                r = results[i]
+                row.update({f"{engine}:{k}": r.get(k) for k in keys})
+                row[f"{engine}:error"] = r.get("error", "")
+        rows.append(row)
+    return rows
+
+
+def write_files(out: str | Path, result: dict) -> Path:
+    """uncertainty.json, samples.csv and uncertainty.png into ``out``, all or nothing; returns the figure's path."""
+    from ..output import staged_output
+    from ..report.uncertainty_figure import plot_uncertainty
+
+    with staged_output(out) as staging:
+        rows = result["rows"]
+        header = list(dict.fromkeys(k for r in rows for k in r))
+        with (staging / "samples.csv").open("w", newline="", encoding="utf-8") as fh:
+            writer = csv.DictWriter(fh, fieldnames=header)
+            writer.writeheader()
+            writer.writerows({k: _cell(v) for k, v in r.items()} for r in rows)
+        write_json(staging / "uncertainty.json", {k: v for k, v in result.items() if k != "rows"})
+        plot_uncertainty(staging / "uncertainty.png", result, KEY_UNITS)
+    return Path(out) / "uncertainty.png"
+
+
+def _cell(value) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    return repr(value) if isinstance(value, float) else str(value)
