@@ -25,6 +25,8 @@ import importlib.util
 import logging
 import os
 import sys
+import threading
+import time
 from pathlib import Path
 
 MODES = ("auto", "1", "0")
@@ -80,8 +82,9 @@ def accelerate() -> bool:
         return False
     _drop_stale_cache()
     if compilation_pending():
-        log.info("compiling the analytic engines' kernels for this machine, once (about 15 s; later runs reuse "
-                 "them)")
+        log.info("compiling the analytic engines' kernels for this machine, once (12-15 s on an idle machine, "
+                 "longer under load; later runs reuse them)")
+        _heartbeat()
     compiled = {id(f): numba.njit(cache=True, nogil=True, error_model="numpy")(f) for f in _FUNCTIONS}
     for name in _COMPILED_MODULES:
         module = sys.modules[f"{__package__}.{name}"]
@@ -90,6 +93,28 @@ def accelerate() -> bool:
                 setattr(module, attribute, compiled[id(value)])
     ACCELERATED = True
     return True
+
+
+HEARTBEAT_S = 10.0  # s between two "still compiling" lines
+HEARTBEAT_MAX = 30  # lines at most (5 min): where the cache cannot be written, compiling never shows as done
+
+
+def _heartbeat() -> None:
+    """While the kernels compile (numba compiles each at its first call, inside the run that follows), say
+    every HEARTBEAT_S that it is still compiling, on logger 'ipir_mujoco', until the compiled stepper's
+    cache index appears (:func:`compilation_pending` turns False). A daemon thread: it never holds up the
+    process's exit."""
+    started = time.monotonic()
+
+    def beat() -> None:
+        for _ in range(HEARTBEAT_MAX):
+            time.sleep(HEARTBEAT_S)
+            if not compilation_pending():
+                log.info(f"kernels compiled ({time.monotonic() - started:.0f} s)")
+                return
+            log.info(f"still compiling the kernels ({time.monotonic() - started:.0f} s so far)")
+
+    threading.Thread(target=beat, name="ipir-compile-heartbeat", daemon=True).start()
 
 
 def run_started() -> None:

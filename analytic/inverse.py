@@ -172,13 +172,14 @@ class _Prescribed:
 
 def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Geometry | str = Geometry.EXACT,
                           clutch: str = "kinematic", *, dt_out: float | None = None, rtol: float = 1e-10,
-                          atol: float = 1e-12) -> RunResult:
+                          atol: float = 1e-12, progress=None) -> RunResult:
     """Torque, clutch reactions and rod force for a prescribed crank motion.
 
     The run starts with both modules at rest (unless the paper's rule moves
     one with the crank). Its series has the shared columns plus
     ``motor_torque`` [N m] (and ``rod_force``, ``crank_pin_force``,
-    ``motor_power``); ``params.M`` is not used.
+    ``motor_power``); ``params.M`` is not used. ``progress``: called with the
+    simulated time reached [s] at every clutch-mode change and at the end.
     """
     if clutch not in ("kinematic", "unilateral"):
         raise ParameterError(f"clutch={clutch!r} is unknown; allowed: kinematic, unilateral")
@@ -205,6 +206,8 @@ def inverse_kinetostatics(params: RobotParams, motion: CrankMotion, geometry: Ge
             raise SimulationError(f"integration failed at t={sol.t[-1]:.6g} s: {sol.message}")
         times = sample_times(t, float(sol.t[-1]), grid)
         pieces.append(_piece(model, mode, times, sol.sol(times)))
+        if progress is not None:
+            progress(float(sol.t[-1]))
         if sol.status != 1:
             break
         hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])

@@ -3,6 +3,7 @@
 Run on demand (not part of the test suite):
 
     python bench/agreement_random.py [--designs 60] [--seed 1] [--t-end 1] [--budget 60] [--workers 2]
+    python bench/agreement_random.py --smoke    # 2 designs of 0.05 s: a check that it runs
 
 How designs are drawn and judged: :mod:`ipir_mujoco.studies.agreement`. Each
 design's verdict prints as it finishes (with the design itself unless it
@@ -30,7 +31,10 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=1.0, help="simulated time per design [s]")
     parser.add_argument("--budget", type=float, default=60.0, help="wall-time budget per engine and design [s]")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.designs, args.t_end = 2, 0.05
     rng = np.random.default_rng(args.seed)
     designs = [draw(rng) for _ in range(args.designs)]
     counts: dict[str, int] = {}

@@ -2,12 +2,18 @@
 
 Run on demand (not part of the test suite), from the repository root:
 
-    python bench/analytic_speed.py [--before REV] [--repeats R] [--skip-long]
+    python bench/analytic_speed.py [--before REV|none] [--repeats R] [--skip-long] [--smoke]
 
 "Before" is the analytic package at git revision REV (default: 5590109, the
 last main on solve_ivp, before the compiled stepper), copied
 from git into a temporary folder and imported from there under another name
-(nothing is committed or installed); "after" is the installed one. Both run
+(nothing is committed or installed); "after" is the installed one. The old
+package has fewer parameters: a case whose parameters it does not know at
+their defaults runs "after" only; without git history (an installed package)
+or with ``--before none`` every case runs "after" only, and the bench says so.
+``--smoke`` runs each code path once in seconds (1 repeat, the 1 s cases cut
+to 0.05 s, no long cases, no child processes): a check that the bench runs,
+not a measurement. Both run
 the same cases, interleaved in one process so machine load affects them alike;
 each time is the best of R runs (10 s cases: one run before, three after). Printed:
 absolute wall times, the ratio after/before, each engine's 10 s / 1 s ratio
@@ -21,6 +27,7 @@ empty numba cache and with a warm one, and the Python fallback
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib
 import json
 import os
@@ -71,19 +78,47 @@ PAIRS = [("paper model (approx, kinematic), 1 s", "paper model, 10 s"),
 
 
 def load_before(rev: str, folder: Path):
-    """The analytic package at ``rev`` as the module ``analytic_before`` (relative imports only)."""
+    """The analytic package at ``rev`` as the module ``analytic_before`` (relative imports only), or None
+    (after printing why) where ``rev`` is 'none', git or the revision is missing, or it does not import."""
+    if rev == "none":
+        print("before: none asked for (--before none); every case runs after only")
+        return None
     target = folder / "analytic_before"
     target.mkdir()
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "analytic"], capture_output=True, check=True)
-    subprocess.run(["tar", "-x", "--strip-components=1", "-C", str(target)], input=archive.stdout, check=True)
-    sys.path.insert(0, str(folder))
-    return importlib.import_module("analytic_before")
+    try:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "analytic"], capture_output=True,
+                                 check=True)
+        subprocess.run(["tar", "-x", "--strip-components=1", "-C", str(target)], input=archive.stdout, check=True)
+        sys.path.insert(0, str(folder))
+        return importlib.import_module("analytic_before")
+    except (OSError, subprocess.CalledProcessError, ImportError) as error:
+        reason = getattr(error, "stderr", b"") or str(error)
+        reason = reason.decode(errors="replace") if isinstance(reason, bytes) else reason
+        print(f"before: the analytic package at {rev} is not available here ({reason.strip().splitlines()[-1]}); "
+              "every case runs after only")
+        return None
+
+
+def old_params(engine, params):
+    """``params`` in the old package's dataclass, or None where it sets a field the old one does not have
+    to other than its default (the old package cannot run that case)."""
+    known = {f.name for f in dataclasses.fields(engine.RobotParams)}
+    default = RobotParams()
+    if any(getattr(params, k) != getattr(default, k) for k in params.as_dict() if k not in known):
+        return None
+    return engine.RobotParams(**{k: v for k, v in params.as_dict().items() if k in known})
 
 
 def best(engine, case, repeats):
+    """(best wall time [s] of ``repeats`` runs, the last run), or (None, None) if the old package at
+    ``engine`` is None or cannot run the case."""
     params, geometry, clutch, t_end, options = case
+    if engine is None:
+        return None, None
     if engine.__name__ == "analytic_before":  # the same parameters in the old package's dataclass
-        params = engine.RobotParams(**{k: v for k, v in params.as_dict().items()})
+        params = old_params(engine, params)
+        if params is None:
+            return None, None
     times, run = [], None
     for _ in range(repeats):
         started = time.perf_counter()
@@ -130,22 +165,32 @@ print(json.dumps(out))
 """
 
 
+def smoke_cases() -> dict:
+    """The 1 s cases cut to 0.05 s (the steady-state ones to a 0.05 s cap), for --smoke."""
+    return {name: (params, geometry, clutch, 0.05, options) for name, (params, geometry, clutch, t_end, options)
+            in CASES.items() if name not in LONG}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--before", default=BEFORE, help="git revision of the 'before' analytic package")
+    parser.add_argument("--before", default=BEFORE, help="git revision of the 'before' analytic package ('none': "
+                                                          "after only)")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--skip-long", action="store_true", help="skip the 10 s cases before (about 40 s)")
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
-    print(f"numba compiled kernels: {accel.accelerate()}; before = {args.before}; best of {args.repeats}; "
-          f"machine load (1 min) {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    cases, repeats = (smoke_cases(), 1) if args.smoke else (CASES, args.repeats)
+    print(f"numba compiled kernels: {accel.accelerate()}; before = {args.before}; best of {repeats}; "
+          f"machine load (1 min) {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores"
+          + ("; --smoke: cases cut to 0.05 s, not a measurement" if args.smoke else ""))
     with tempfile.TemporaryDirectory() as folder:
         before = load_before(args.before, Path(folder))
-        best(analytic, CASES["paper model (approx, kinematic), 1 s"], 1)  # load the compiled kernels once
+        best(analytic, cases["paper model (approx, kinematic), 1 s"], 1)  # load the compiled kernels once
         rows = {}
-        for name, case in CASES.items():
+        for name, case in cases.items():
             long = name in LONG
-            old = (None, None) if long and args.skip_long else best(before, case, 1 if long else args.repeats)
-            new = best(analytic, case, 3 if long else args.repeats)
+            old = (None, None) if long and args.skip_long else best(before, case, 1 if long else repeats)
+            new = best(analytic, case, 3 if long else repeats)
             rows[name] = (old, new)
             ratio = f"{new[0] / old[0]:7.3f}" if old[0] else "      -"
             print(f"{name:48s} before {old[0] or float('nan'):8.3f} s  after {new[0] * 1e3:8.1f} ms  "
@@ -155,33 +200,37 @@ def main() -> None:
                 check = max(abs(new[1].summary[k] - old[1].summary[k]) / max(abs(old[1].summary[k]), 1e-12)
                             for k in ("revolutions", "x1_final", "x2_final"))
                 print(f"{'':48s} same run: revolutions, x1, x2 agree to {check:.1e} relative")
-    print("\ncost linear in the work: a longer run against a shorter one")
-    for short, long in PAIRS:
+    pairs = [pair for pair in PAIRS if all(name in rows for name in pair)]
+    if pairs:
+        print("\ncost linear in the work: a longer run against a shorter one")
+    for short, long in pairs:
         (old1, new1), (old10, new10) = rows[short], rows[long]
         revs = new10[1].summary["revolutions"] / new1[1].summary["revolutions"]
-        before = f"{old10[0] / old1[0]:6.1f}x" if old10[0] else "     -"
-        print(f"{long:40s} before {before}  after {new10[0] / new1[0]:6.1f}x  revolutions {revs:6.1f}x  "
+        before_ratio = f"{old10[0] / old1[0]:6.1f}x" if old10[0] and old1[0] else "     -"
+        print(f"{long:40s} before {before_ratio}  after {new10[0] / new1[0]:6.1f}x  revolutions {revs:6.1f}x  "
               f"after per revolution: {new1[0] / new1[1].summary['revolutions'] * 1e3:.2f} ms "
               f"({new1[1].t_end:g} s), {new10[0] / new10[1].summary['revolutions'] * 1e3:.2f} ms "
               f"({new10[1].t_end:g} s)")
-    with tempfile.TemporaryDirectory() as cache:
-        cold = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache, "IPIR_MUJOCO_JIT": "1"})
-        warm = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache, "IPIR_MUJOCO_JIT": "1"})
-    print("\nfirst call in a new process (paper model 1 s; then the one-way and compliant models' first runs):")
-    for label, t in (("empty numba cache", cold), ("warm numba cache", warm)):
-        print(f"  {label:18s} import {t['import']:.2f} s, first run {t['first']:.2f} s, other models' first runs "
-              f"{t['others']:.2f} s, the same run again {t['again'] * 1e3:.1f} ms")
-    fallback = child(FALLBACK, {"IPIR_MUJOCO_JIT": "0"})
-    old = {k: rows[n][0][0] for k, n in (("paper", "paper model (approx, kinematic), 1 s"),
-                                         ("one-way", "one-way model (exact, unilateral), 1 s"),
-                                         ("compliant", "compliant clutch 1e6 N/m (exact), 1 s"))}
-    print("Python fallback (IPIR_MUJOCO_JIT=0), 1 s: " + ", ".join(
-        f"{k} {fallback[k] * 1e3:.0f} ms ({fallback[k] / old[k]:.2f} of before)" for k in old))
+    if not args.smoke:  # child processes: a cold numba cache compiles for 12-15 s
+        with tempfile.TemporaryDirectory() as cache:
+            cold = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache, "IPIR_MUJOCO_JIT": "1"})
+            warm = child(FIRST_CALL, {"NUMBA_CACHE_DIR": cache, "IPIR_MUJOCO_JIT": "1"})
+        print("\nfirst call in a new process (paper model 1 s; then the one-way and compliant models' first runs):")
+        for label, t in (("empty numba cache", cold), ("warm numba cache", warm)):
+            print(f"  {label:18s} import {t['import']:.2f} s, first run {t['first']:.2f} s, other models' first "
+                  f"runs {t['others']:.2f} s, the same run again {t['again'] * 1e3:.1f} ms")
+        fallback = child(FALLBACK, {"IPIR_MUJOCO_JIT": "0"})
+        old = {k: rows[n][0][0] for k, n in (("paper", "paper model (approx, kinematic), 1 s"),
+                                             ("one-way", "one-way model (exact, unilateral), 1 s"),
+                                             ("compliant", "compliant clutch 1e6 N/m (exact), 1 s"))}
+        print("Python fallback (IPIR_MUJOCO_JIT=0), 1 s: " + ", ".join(
+            f"{k} {fallback[k] * 1e3:.0f} ms" + (f" ({fallback[k] / old[k]:.2f} of before)" if old[k] else "")
+            for k in old))
     print("\n| case | before | after | after/before |\n|---|---:|---:|---:|")
     for name, ((t_old, _), (t_new, _)) in rows.items():
-        before = f"{t_old:.3f} s" if t_old else "-"
+        before_time = f"{t_old:.3f} s" if t_old else "-"
         ratio = f"{t_new / t_old:.3f}" if t_old else "-"
-        print(f"| {name} | {before} | {t_new * 1e3:.1f} ms | {ratio} |")
+        print(f"| {name} | {before_time} | {t_new * 1e3:.1f} ms | {ratio} |")
 
 
 if __name__ == "__main__":

@@ -7,9 +7,10 @@ filter of the package's source (``ipir_mujoco/`` and ``analytic/``) whose text n
 ``WHEELS``, ``WheelRatchet``), leaving out the kinds' own modules (``engine/kinds.py``; finite grip's
 ``*grip*.py``; the wheels' ``wheels*.py``, ``route_*.py``, ``pipe_*.py``). Run from the repository root:
 
-    python bench/branch_count.py [ROOT] [-v]
+    python bench/branch_count.py [ROOT] [-v] [--smoke]
 
-``-v`` lists each test (file:line, which concern, its text).
+``-v`` lists each test (file:line, which concern, its text). ``--smoke`` changes nothing (the count takes
+seconds already); it is there because every bench takes it.
 """
 
 from __future__ import annotations
@@ -46,7 +47,11 @@ def count(root: Path) -> dict[str, list[tuple[str, int, str]]]:
 
 
 def main() -> int:
-    args = [a for a in sys.argv[1:] if a != "-v"]
+    if "-h" in sys.argv or "--help" in sys.argv:
+        print(__doc__)
+        return 0
+    # the options by hand (no argparse): a ROOT, -v, and --smoke, which every bench takes
+    args = [a for a in sys.argv[1:] if a not in ("-v", "--smoke")]
     found = count(Path(args[0]) if args else Path("."))
     files = {f for items in found.values() for f, _, _ in items}
     print(f"grip {len(found['grip'])}, wheels {len(found['wheels'])}, total "

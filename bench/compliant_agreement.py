@@ -7,6 +7,9 @@ Run on demand (not part of the test suite):
     python bench/compliant_agreement.py --omega-dt 0.4,0.2,0.1,0.05 [--stiffness 1e6,1e7,1e8]
     python bench/compliant_agreement.py --rigid-limit [--stiffness 1e5,1e6,1e7,1e8]
 
+Any of them with ``--smoke``: one stiffness (1e5 N/m), one backlash, runs of 0.02 s (a check that it runs,
+not a measurement).
+
 Cases: the paper's start (constant torque 0.25 N m from rest, ``--paper-t-end``
 seconds) and the default motor at cruise (``--cruise-t-end`` seconds from rest;
 the "peak" is then the last whole revolution's). For every stiffness and
@@ -103,7 +106,11 @@ def main() -> None:
     parser.add_argument("--cruise-t-end", type=float, default=3.0)
     parser.add_argument("--omega-dt", default=None)
     parser.add_argument("--rigid-limit", action="store_true")
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.stiffness, args.backlash, args.paper_t_end, args.cruise_t_end = "1e5", "1e-3", 0.02, 0.02
+        args.omega_dt = None if args.omega_dt is None else args.omega_dt.split(",")[0]
     if args.rigid_limit:
         rigid_limit_table([float(v) for v in args.stiffness.split(",")])
         return

@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/compliant_clutch.py [--t-end SECONDS] [--repeats R] [--radau]
+    python bench/compliant_clutch.py [--t-end SECONDS] [--repeats R] [--radau] [--smoke]
 
 For clutch stiffness 1e3..1e8 N/m (no damping, no backlash) it reports the
 crank revolutions and robot travel at t_end, their difference from the rigid
@@ -36,7 +36,10 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--radau", action="store_true")
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.t_end, args.repeats = 0.02, 1
 
     rigid_time, rigid = best_of(args.repeats, lambda: analytic.simulate(RobotParams(), "exact", "unilateral",
                                                                          args.t_end))

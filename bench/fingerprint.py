@@ -20,6 +20,9 @@ check that it changed nothing else, leave the new names out of the later fingerp
 
 (every dictionary key and sweep column of those names is dropped before hashing; a name that does
 not occur changes nothing, so the earlier fingerprint compares as it is).
+
+``--smoke`` fingerprints the first two runs of each kind only, in seconds (a check that the bench runs;
+compare smoke fingerprints only with smoke fingerprints).
 """
 
 from __future__ import annotations
@@ -136,14 +139,17 @@ def main() -> int:
     parser.add_argument("--skip-studies", action="store_true")
     parser.add_argument("--leave-out", default="", metavar="NAME,...",
                         help="summary keys and parameters to leave out (names added since the fingerprint compared)")
+    parser.add_argument("--smoke", action="store_true", help="the first two runs only, in seconds (a check that "
+                        "it runs; compare smoke fingerprints only with smoke fingerprints)")
     args = parser.parse_args()
     LEFT_OUT.update(name for name in args.leave_out.split(",") if name)
     from ipir_mujoco.engine import simulate_mujoco
 
-    for name, (params, geometry, clutch, t_end, options) in ANALYTIC.items():
+    smoke = slice(0, 2 if args.smoke else None)
+    for name, (params, geometry, clutch, t_end, options) in list(ANALYTIC.items())[smoke]:
         options = _with_table(params, options)
         print(f"{name:45s} {digest_run(analytic.simulate(params, geometry, clutch, t_end, **options))}", flush=True)
-    for name, (params, rule, implementation, t_end, options) in MUJOCO.items():
+    for name, (params, rule, implementation, t_end, options) in list(MUJOCO.items())[smoke]:
         options = _with_table(params, options)
         if options.get("settings") is not None:
             from ipir_mujoco.engine import SolverSettings
@@ -152,9 +158,9 @@ def main() -> int:
         print(f"{name:45s} {digest_run(simulate_mujoco(params, rule, implementation, t_end, **options))}", flush=True)
     from ipir_mujoco import registry
 
-    for name, (variant, params, t_end, options) in REGISTRY.items():
+    for name, (variant, params, t_end, options) in list(REGISTRY.items())[smoke]:
         print(f"{name:45s} {digest_run(registry.run(variant, params, t_end, **options))}", flush=True)
-    if args.skip_studies:
+    if args.skip_studies or args.smoke:
         return 0
     from ipir_mujoco.studies.climbing import climb_study
     from ipir_mujoco.studies.cruise import cruise_study

@@ -2,7 +2,9 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/grip_agreement.py
+    python bench/grip_agreement.py [--smoke]
+
+``--smoke`` runs the riser over 0.05 s only (a check that it runs, not a measurement).
 
 Two cases, each run through the registry as the studies run them:
 
@@ -18,6 +20,8 @@ Two cases, each run through the registry as the studies run them:
 """
 
 from __future__ import annotations
+
+import argparse
 
 import numpy as np
 
@@ -40,6 +44,12 @@ def skid_per_rev(run, first: int, last: int) -> list[float]:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true", help="the riser over 0.05 s only, in seconds (not a "
+                                                             "measurement)")
+    if parser.parse_args().smoke:
+        riser(0.05)
+        return
     analytic = registry.run("analytic-unilateral", CRUISE, 10.0, dt_out=1e-3, until_steady=True)
     mujoco_ = registry.run("mujoco-ratchet", CRUISE, 10.0, dt_out=1e-3, until_steady=True)
     a, m = analytic.summary, mujoco_.summary
@@ -59,8 +69,12 @@ def main() -> None:
         print(f"  module {k} skid per revolution (revolutions {last - 3}..{last}): analytic {1e3 * s_an:.5f} mm, "
               f"MuJoCo {1e3 * s_mj:.5f} mm ({s_mj / s_an - 1:+.2e}; at dt/2 {s_half / s_an - 1:+.2e}); "
               f"Richardson {richardson:.2e}, allowed {1.5 * richardson + CARRIAGE_SHARE:.2e}")
-    print("riser on 6 N of grip per module (incline 90, mu_wall 0.3, F_n 20 N, M_stall 1 N m), 1 s:")
-    runs = [registry.run(v, RISER, 1.0, dt_out=1e-3) for v in ("analytic-unilateral", "mujoco-ratchet")]
+    riser(1.0)
+
+
+def riser(t_end: float) -> None:
+    print(f"riser on 6 N of grip per module (incline 90, mu_wall 0.3, F_n 20 N, M_stall 1 N m), {t_end:g} s:")
+    runs = [registry.run(v, RISER, t_end, dt_out=1e-3) for v in ("analytic-unilateral", "mujoco-ratchet")]
     for name, run in zip(("analytic-unilateral", "mujoco-ratchet"), runs):
         s = run.summary
         print(f"  {name:20s} x1 {s['x1_final']:+.5f} m, x2 {s['x2_final']:+.5f} m, slip {s['slip1_m']:.5f} / "

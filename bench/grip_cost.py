@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/grip_cost.py [--t-end SECONDS] [--repeats R]
+    python bench/grip_cost.py [--t-end SECONDS] [--repeats R] [--smoke]
 
 Each line times one design over t_end (default 1 s) from rest, output every 1 ms, the engine's automatic
 timestep: on unlimited grip and on finite grip (the carriages, grip_model.py), best of R runs each, and
@@ -42,7 +42,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.t_end, args.repeats = 0.02, 1
     print(f"MuJoCo loop: {compiled_status()[1]}; t_end = {args.t_end:g} s, best of {args.repeats}")
     print(f"{'design':44s} {'unlimited [s]':>13} {'finite [s]':>10} {'ratio':>6} {'steps':>17} {'slip1, slip2 [mm]':>18}")
     for name, base in DESIGNS.items():

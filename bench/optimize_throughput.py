@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/optimize_throughput.py [--designs N] [--workers W]
+    python bench/optimize_throughput.py [--designs N] [--workers W] [--smoke]
 
 One run each, on this machine, of N designs of ``analytic-unilateral`` under the motor to its steady state
 over L and m2: ``sweep --sample N`` (every design at once on the pool), ``optimize`` with one objective
@@ -28,7 +28,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--designs", type=int, default=200)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.designs = 4
     base = RobotParams().replace(drive="motor")
     axes = (parse_vary("L=0.06:0.5"), parse_vary("m2=0.2:3"))
     with tempfile.TemporaryDirectory() as tmp:

@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/ratchet_random.py [--designs 100] [--seed 0] [--engine-module MODULE] [--budget 60]
+    python bench/ratchet_random.py [--designs 100] [--seed 0] [--engine-module MODULE] [--budget 60] [--smoke]
 
 Designs are drawn with numpy's default_rng(seed), each parameter independently:
 log-uniform m1, m2 in [0.1, 10] kg, r in [0.005, 0.1] m, L / r in [1.1, 30],
@@ -57,7 +57,10 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--engine-module", default="ipir_mujoco.engine", help="engine package to run")
     parser.add_argument("--budget", type=float, default=60.0, help="wall-time budget per design [s]")
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.designs = 2
     engine = importlib.import_module(args.engine_module)
     budgeted = "wall_budget_s" in inspect.signature(engine.simulate_mujoco).parameters
     rng = np.random.default_rng(args.seed)

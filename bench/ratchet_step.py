@@ -2,8 +2,16 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/ratchet_step.py [--t-end 5] [--dt-out 1e-3] [--repeats 3] [--before REV] [--cases ...]
+    python bench/ratchet_step.py [--t-end 5] [--dt-out 1e-3] [--repeats 3] [--before REV|none] [--cases ...]
     python bench/ratchet_step.py --compare [--before REV]
+    python bench/ratchet_step.py --smoke
+
+The "before" engine is an old revision's, copied from git: where that is
+missing (an installed package without git history) or no longer imports
+against this package (its modules moved since), the bench says so in one line
+and times the other variants; ``--compare`` needs it and says so. ``--smoke``
+runs every case once over 0.05 s, without "before": a check that it runs, not
+a measurement.
 
 Cases (default all): 'ratchet' (the paper's case, rigid one-way clutches),
 'lock' (the paper's case, locks with the paper's rule), 'lock-unilateral'
@@ -76,7 +84,18 @@ CASES = {
 
 
 def engine_at(revision: str):
-    """The engine package as it was at ``revision``, imported from a temporary copy under another name."""
+    """The engine package as it was at ``revision``, imported from a temporary copy under another name, or
+    None (after printing why) where git, the revision or one of its imports is missing."""
+    try:
+        return _engine_at(revision)
+    except (OSError, subprocess.CalledProcessError, ImportError) as error:
+        reason = getattr(error, "stderr", "") or f"{type(error).__name__}: {error}"
+        print(f"before: the engine at {revision} is not available here ({str(reason).strip().splitlines()[-1]}); "
+              "it is left out", flush=True)
+        return None
+
+
+def _engine_at(revision: str):
     folder = Path(tempfile.mkdtemp(prefix="ipir_engine_"))
     package = folder / "ipir_before"
     (package / "engine").mkdir(parents=True)
@@ -167,9 +186,16 @@ def engine_step(simulate, settings_class, case, t_end: float, dt_out: float, tim
             os.environ[stepper.ENV] = previous
 
 
-def compare(before, revision: str) -> None:
-    """Each design through the engine at ``revision`` and this one's two loops: identical or what differs."""
-    print(f"against the engine at {revision}, mujoco {mujoco.__version__}")
+def compare(before, revision: str, smoke: bool = False) -> None:
+    """Each design through the engine at ``revision`` and this one's two loops: identical or what differs.
+    Without that engine (``before`` None) the reference is this engine's Python loop. ``smoke``: the first
+    two designs over 0.05 s."""
+    if before is None:
+        print(f"against this engine's Python loop (no engine at {revision} here), mujoco {mujoco.__version__}")
+        before = importlib.import_module("ipir_mujoco.engine")
+        os.environ[stepper.ENV] = "python"
+    else:
+        print(f"against the engine at {revision}, mujoco {mujoco.__version__}")
     designs = {
         "ratchet, 1 s": (RobotParams(), "unilateral", "ratchet", 1.0, {}),
         "locks, paper's rule": (RobotParams(), "kinematic", "lock", 0.5, {}),
@@ -185,6 +211,9 @@ def compare(before, revision: str) -> None:
         "motor until steady (cap 10 s)": (RobotParams(drive="motor"), "unilateral", "ratchet", 10.0,
                                           {"until_steady": True}),
     }
+    if smoke:
+        designs = {name: design[:3] + (0.05,) + design[4:] for name, design in list(designs.items())[:2]}
+    reference_loop = os.environ.get(stepper.ENV, "")
     for name, (params, rule, implementation, t_end, options) in designs.items():
         def run(engine):
             kwargs = dict(options)
@@ -196,6 +225,7 @@ def compare(before, revision: str) -> None:
             kwargs.setdefault("dt_out", 1e-3)
             return engine.simulate_mujoco(params, rule, implementation, t_end, **kwargs)
 
+        os.environ[stepper.ENV] = reference_loop
         reference = run(before)
         verdicts = []
         for label, value in (("Python loop", "python"), ("compiled", "")):
@@ -219,13 +249,18 @@ def main() -> None:
     parser.add_argument("--before", default="2e6b2fe", help="git revision of the 'before' engine ('none': skip)")
     parser.add_argument("--cases", default=",".join(CASES), help=f"comma-separated, of: {', '.join(CASES)}")
     parser.add_argument("--compare", action="store_true", help="check results against --before instead of timing")
+    parser.add_argument("--smoke", action="store_true", help="every case once over 0.05 s, no 'before' (a check "
+                                                             "that the bench runs, not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.t_end, args.repeats, args.before = 0.05, 1, "none"
+        CASES["fixed-step"] = CASES["fixed-step"][:3] + (0.05, 1e-4)
     before = None if args.before == "none" else engine_at(args.before)
     if args.compare:
-        compare(before, args.before)
+        compare(before, args.before, args.smoke)
         return
     compiled, why = stepper.compiled_status()
-    overhead = timer_cost()
+    overhead = timer_cost(2000 if args.smoke else 200_000)
     load = os.getloadavg()
     print(f"mujoco {mujoco.__version__}; load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} on "
           f"{os.cpu_count()} cores; best of {args.repeats}; timer cost {overhead * 1e9:.0f} ns taken off the plain "
@@ -253,7 +288,7 @@ def main() -> None:
         for _ in range(args.repeats):
             for label, timed in variants.items():
                 best[label] = min(best[label], timed())
-        call = call_overhead(case, timestep)
+        call = call_overhead(case, timestep, *((200, 1) if args.smoke else ()))
         floor = best["plain mj_step"] - call  # mj_step in a C loop: what the compiled engine calls
         print(f"\n{name}: {implementation} ({rule}), t_end {t_end:g} s, dt_out {dt_out:g} s, timestep "
               f"{timestep:.4g} s ({'given' if given else 'automatic'}), {steps} steps, "

@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite), from the repository root:
 
-    python bench/servo_cost.py [--repeats R]
+    python bench/servo_cost.py [--repeats R] [--smoke]
 
 Every case runs to its periodic steady state (dt_out 1 ms) through the registry, in the exact one-way
 equations and MuJoCo's ratchet: the motor at full voltage, the servo at 10 rad/s with the PI alone and with
@@ -29,17 +29,21 @@ CASES = {"motor": RobotParams(drive="motor"), "servo PI": RobotParams(drive="ser
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    t_cap, steady = (0.05, False) if args.smoke else (30.0, True)
+    if args.smoke:
+        args.repeats = 1
     for params in CASES.values():
         registry.feedforward_table(params)  # cached: the runs below time the engines, not the table
         for engine in ENGINES:  # warm: the numba kernels, MuJoCo's import
-            registry.run(engine, params, 30.0, dt_out=1e-3, until_steady=True)
+            registry.run(engine, params, t_cap, dt_out=1e-3, until_steady=steady)
     best: dict[tuple[str, str], tuple[float, float]] = {}
     for _ in range(args.repeats):
         for name, params in CASES.items():
             for engine in ENGINES:
                 started = time.perf_counter()
-                run = registry.run(engine, params, 30.0, dt_out=1e-3, until_steady=True)
+                run = registry.run(engine, params, t_cap, dt_out=1e-3, until_steady=steady)
                 wall = time.perf_counter() - started
                 if (engine, name) not in best or wall < best[(engine, name)][0]:
                     best[(engine, name)] = (wall, run.t_end)

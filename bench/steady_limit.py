@@ -2,7 +2,9 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/steady_limit.py
+    python bench/steady_limit.py [--smoke]
+
+``--smoke``: the first design, MuJoCo left out (a check that it runs, not a measurement).
 
 For each design of tests/test_steady_limit.py and each engine (the one-way-clutch equations, MuJoCo's
 ratchet) it prints the relative error against that test's converged reference of the summary's steady
@@ -14,6 +16,7 @@ itself costs no simulation).
 
 from __future__ import annotations
 
+import argparse
 import pathlib
 import sys
 import time
@@ -28,14 +31,19 @@ from ipir_mujoco.core.params import RobotParams  # noqa: E402
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
+    smoke = parser.parse_args().smoke
+    designs = dict(list(DESIGNS.items())[:1]) if smoke else DESIGNS
+    variants = {"analytic": VARIANTS["analytic"]} if smoke else VARIANTS
     short = {"steady_speed_m_s": "speed", "distance_per_rev_m": "dist/rev", "energy_per_metre_j_m": "J/m",
              "efficiency": "eff"}
     print(f"{'design':34s} {'engine':8s} " + " ".join(f"{short[k]:>19s}" for k in FIGURES) + "   ref/run wall")
     print(f"{'':34s} {'':8s} " + " ".join(f"{'summary   window':>19s}" for _ in FIGURES))
-    worst = {engine: 0.0 for engine in VARIANTS}
-    for name, fields in DESIGNS.items():
+    worst = {engine: 0.0 for engine in variants}
+    for name, fields in designs.items():
         params = RobotParams(**fields)
-        for engine, variant in VARIANTS.items():
+        for engine, variant in variants.items():
             started = time.perf_counter()
             run = registry.run(variant, params, T_CAP, dt_out=1e-3, until_steady=True)
             wall = time.perf_counter() - started

@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite; needs a C compiler, ``cc``, for the callback prototype):
 
-    python bench/step_options.py [--steps 10000] [--repeats 5] [--chunk 10]
+    python bench/step_options.py [--steps 10000] [--repeats 5] [--chunk 10] [--smoke]
 
 The paper's case with the rigid ratchet at a given timestep of 1e-4 s, the
 same compiled model and initial state for every variant; each steps
@@ -210,7 +210,10 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=10000, help="steps per timing (default 10000 = 1 s)")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--chunk", type=int, default=10, help="steps between two returns to Python (default 10)")
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.steps, args.repeats = 200, 1
     params, timestep, kv_timed = RobotParams(), 1e-4, 1e5
     with tempfile.TemporaryDirectory() as folder:
         library = compile_callback(folder)

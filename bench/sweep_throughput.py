@@ -2,7 +2,7 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/sweep_throughput.py [--designs N] [--t-end SECONDS]
+    python bench/sweep_throughput.py [--designs N] [--t-end SECONDS] [--smoke]
 
 Reports, measured in one run on this machine:
 - designs per second of the analytic one-way-clutch model through the process
@@ -41,7 +41,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--designs", type=int, default=32)
     parser.add_argument("--t-end", type=float, default=0.5)
+    parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
+    if args.smoke:
+        args.designs, args.t_end = 2, 0.02
     n, t_end = args.designs, args.t_end
     study = Study((parse_vary(f"L=0.06:0.5:{n}"),), engines=("analytic-unilateral",), t_end=t_end)
     designs = [RobotParams(L=d["L"]) for d in study.designs()]

@@ -170,3 +170,20 @@ def test_report_section_where_the_paper_model_holds(tmp_path):
     verdict = atlas_section.verdict(metrics)
     assert verdict["short"] == "least safe: locking-clutches" and "revolutions" in verdict["answer"]
     assert "Where the paper's model holds" in to_markdown(blocks)
+
+
+def test_a_folder_another_run_is_writing_is_refused(tmp_path):
+    from ipir_mujoco.output import FolderLock
+
+    out = tmp_path / "busy"
+    out.mkdir()
+    lock = FolderLock(out)
+    try:
+        if lock.fd is None:
+            pytest.skip("no file locks on this file system")
+        with pytest.raises(ParameterError, match="in use"):
+            run_atlas(Atlas((parse_vary("L=0.1:0.3"),), idealizations=("massless-rod",), samples=2, budget=0), out,
+                      workers=1, show_bars=False)
+        assert not (out / "samples.csv").exists()
+    finally:
+        lock.release()

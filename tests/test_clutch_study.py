@@ -19,6 +19,7 @@ from ipir_mujoco.engine.timestep import clutch_rate
 from ipir_mujoco.report.clutch_section import study_figure
 from ipir_mujoco.studies.clutch_study import OperatingPoint, run_study
 
+import figure_checks
 from cli_run import run_cli
 
 # the paper's start-up up to the first engagement of each clutch (the rear one at 0.245 s, with 1 mm of play
@@ -208,6 +209,26 @@ def test_the_figure_draws_the_rows_of_both_engines_and_the_rigid_limit(first_eng
     for engine in ("analytic", "mujoco"):
         assert markers[f"rigid:{engine}"].get_ydata()[0] == cruise["rigid"]["cruise"][engine]["peak_clutch_force_n"]
     assert not any("rigid analytic" in text.get_text() for text in ax.texts)
+
+
+def test_the_figure_reads_right_its_legend_lists_only_what_is_drawn(first_engagements, cruise):
+    """Every legend entry has a drawn artist of its look, axes have units, no note lies over data: on the
+    full grid with marked designs, and where a backlash has one design only (a colour without a curve is
+    left out of the legend and the design named where it is drawn, with its play)."""
+    highlight = [{"name": "sprag", "clutch_stiffness": 1e6, "clutch_backlash": 0.0}]
+    fig = study_figure(first_engagements, highlight)
+    assert not figure_checks.undrawn_legend_entries(fig)
+    assert not figure_checks.bad_axis_labels(fig)
+    assert not figure_checks.texts_over_data(fig)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "backlash 1 mm" in labels and "realistic clutches" in labels
+    assert any(t.get_text() == "sprag (no play)" for t in fig.axes[0].texts)
+    # the cruise study: one design (1e6 N/m, 1 mm): no curve, so no backlash colour and no analytic line
+    fig = study_figure(cruise)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert not any(label.startswith("backlash") for label in labels), labels
+    assert "analytic compliant clutch (lines)" not in labels and "MuJoCo compliant ratchet (markers)" in labels
+    assert not figure_checks.undrawn_legend_entries(fig)
 
 
 

@@ -12,6 +12,7 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.report.control_figure import study_figure
 from ipir_mujoco.studies import control_study as cs
 
+import figure_checks
 from cli_run import run_cli
 
 
@@ -82,6 +83,10 @@ def test_files_and_figure(study, tmp_path):
     assert {"trace:pi", "trace:pi+exact", "ripple:mujoco-ratchet", "force:analytic-unilateral",
             "profile-force:analytic-unilateral", "profile-energy:mujoco-ratchet"} <= gids
     assert all(ax.get_ylabel() for ax in fig.axes)
+    # legends off the data (a legend used to cover the bars), every entry drawn, axes with units
+    assert not figure_checks.texts_over_data(fig)
+    assert not figure_checks.undrawn_legend_entries(fig)
+    assert not figure_checks.bad_axis_labels(fig)
     text = format_table(study)
     assert "ripple [-]" in text and "dead-centre profile" in text
 

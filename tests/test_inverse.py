@@ -121,3 +121,32 @@ def test_on_a_slope_the_inverse_torque_drives_the_forward_model_the_same_way(clu
     assert np.max(np.abs(forward["phi"] - OMEGA * forward["t"])) < 1e-5
     for column in ("x1", "x2"):
         assert forward[column][-1] == pytest.approx(s[column][-1], rel=1e-4, abs=1e-9)
+
+
+def test_progress_reports_the_simulated_time_up_to_the_end():
+    """progress(t) at every clutch-mode change: increasing simulated times [s], the last the run's end, so
+    that the command line can say where a long prescribed motion is (kinetostatics --samples)."""
+    reached = []
+    run = inverse_kinetostatics(RobotParams(), CrankMotion.constant_speed(20.0, 0.0, 2.0), "exact", "unilateral",
+                                progress=reached.append)
+    assert len(reached) >= 4 and np.all(np.diff(reached) > 0)  # two mode changes a revolution at least
+    assert reached[-1] == pytest.approx(run.t_end, rel=1e-12)
+
+
+def test_a_throttled_progress_passes_the_time_on_at_most_once_per_period():
+    """core.options.throttled: the studies' heartbeat inside a long run (validate's rungs, the convergence
+    runs): with no period every call goes through; with a period longer than the test, none (the first only
+    after a whole period)."""
+    from ipir_mujoco.core.options import throttled
+
+    seen = []
+    every = throttled(seen.append, every_s=0.0)
+    for t in (0.1, 0.2, 0.3):
+        every(t)
+    assert seen == [0.1, 0.2, 0.3]
+    quiet = throttled(seen.append, every_s=1e9)
+    quiet(0.4)
+    assert seen == [0.1, 0.2, 0.3]
+    run = analytic.simulate(RobotParams(), "exact", "unilateral", 0.3,
+                            progress=throttled(seen.append, every_s=0.0))
+    assert seen[3:] and seen[-1] <= run.t_end + 1e-12 and np.all(np.diff(seen[3:]) >= 0)

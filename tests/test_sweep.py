@@ -23,6 +23,7 @@ from ipir_mujoco.studies import sweep as sweep_module
 from ipir_mujoco.cli import main
 from ipir_mujoco.studies.sweep import run_sweep
 from ipir_mujoco.engine.batch import run_ratchet_batch
+import figure_checks
 from ipir_mujoco.studies.sweep_metrics import batch_metrics, run_metrics
 from ipir_mujoco.report.sweep_plots import best_designs, read_results
 from ipir_mujoco.studies.sweep_space import Study, parse_vary, read_study
@@ -612,9 +613,12 @@ def test_a_panel_flat_within_what_the_runs_resolve_says_so_and_names_no_best():
     columns["a:energy_per_metre_j_m"] = 2.0 * (1 + np.array([1e-4, -2e-4, 3e-4, 0.0]))  # within RESOLVED
     columns["a:steady_speed_m_s"] = np.array([0.55, 0.54, 0.53, 0.53])
     fig = lines_figure(columns, SimpleNamespace(name="L", log=False), ["a"], caption="a sweep")
-    notes = {text.get_gid() for ax in fig.axes for text in ax.texts}
-    assert "flat:energy_per_metre_j_m" in notes and "flat:steady_speed_m_s" not in notes
-    energy_axis = next(ax for ax in fig.axes if ax.texts and ax.texts[-1].get_gid() == "flat:energy_per_metre_j_m")
+    # the note is the panel's title (above it: a note inside the panel lay on a curve)
+    notes = {ax.get_title(loc="right"): ax for ax in fig.axes if ax.get_title(loc="right")}
+    energy_axis = next(ax for ax in fig.axes if ax.get_ylabel().startswith("energy per"))
+    assert energy_axis.get_title(loc="right").startswith("flat: within")
+    assert all("steady" not in ax.get_ylabel() for ax in notes.values())
+    assert not figure_checks.texts_over_data(fig) and not figure_checks.undrawn_legend_entries(fig)
     low, high = energy_axis.get_ylim()
     assert high - low == pytest.approx(3 * RESOLVED * 2.0, rel=1e-3)  # the band, not the wiggle's own 1e-3 J/m
     assert [b["metric"] for b in best_designs(columns, ["L"], ["a"])] == ["steady_speed_m_s"]

@@ -118,6 +118,20 @@ def progress_printer(t_end: float):
     return tenths_printer(t_end, lambda t: f"simulated {t:.2f} / {t_end:g} s", final_within=0.05)
 
 
+def wall_progress(total: float, text: Callable[[float], str], after_s: float = 2.0) -> Callable[[float], None]:
+    """:func:`tenths_printer` of ``total`` that prints nothing during the first ``after_s`` seconds of wall
+    time (a short job stays quiet, a long one says where it is; the first line it prints says how far the
+    work went before)."""
+    import time
+
+    started, report = time.monotonic(), tenths_printer(total, text)
+
+    def maybe(done: float) -> None:
+        if time.monotonic() - started >= after_s:
+            report(done)
+    return maybe
+
+
 def study_progress(command: str) -> Callable[[str], None]:
     """A study's progress on stderr, one line per message, prefixed with the command's name."""
     def progress(message: str) -> None:

@@ -13,7 +13,7 @@ from ipir_mujoco.core.results import write_json
 
 from ..labels import signed
 from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, check_input_file, model_params
+from .common import EXIT_OK, add_model_options, check_input_file, model_params, wall_progress
 
 
 def add_parser(commands) -> None:
@@ -102,7 +102,9 @@ def run(args: argparse.Namespace) -> int:
             check_run_options(motion.t_end, motion.t_end / 2000)  # its output grid: 2000 intervals
         except ParameterError as exc:
             raise ParameterError(f"--samples {args.samples!r}: {exc}") from None
-    run = inverse_kinetostatics(params, motion, args.geometry, args.clutch)
+    progress = wall_progress(motion.t_end, lambda t: f"kinetostatics: prescribed motion solved to {t:.3g} / "
+                                                     f"{motion.t_end:.4g} s")
+    run = inverse_kinetostatics(params, motion, args.geometry, args.clutch, progress=progress)
     s = run.series
     with staged_output(args.out) as staging:
         run.write_csv(staging / "kinetostatics.csv")

@@ -51,6 +51,10 @@ def add_parser(commands) -> None:
                           "audit does not count, mjcf/README.md)")
     sim.add_argument("--mjcf", metavar="FILE.xml", default=None,
                      help="MJCF template for --engine mujoco (default: the shipped inchworm.xml)")
+    sim.add_argument("--save-mjcf", metavar="FILE.xml", default=None,
+                     help="with --engine mujoco: write the compiled model this run uses (its timestep, its initial "
+                          "state as the keyframe run_start, a header saying what the package's controllers do "
+                          "between steps) before the run")
     add_model_options(sim)
     sim.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
                      help="simulated time (default 1 s); with --until-steady, the cap (default 30 s)")
@@ -219,6 +223,29 @@ def _energy_line(e: dict) -> str:
     return f"motor {e['motor_work_j']:.6g} = " + " + ".join(terms) + f" + residual {e['residual_j']:.2e}"
 
 
+def save_run_mjcf(args: argparse.Namespace) -> None:
+    """--save-mjcf FILE.xml: the model the run compiles (:func:`ipir_mujoco.engine.export.save_mjcf`), written
+    before the run; refused in one line for the equations or a name that is not an .xml file."""
+    from ipir_mujoco.engine.export import save_mjcf
+
+    variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch, args.mujoco_model)
+    if not variant.is_mujoco:
+        raise ParameterError(f"--save-mjcf {args.save_mjcf}: the analytic engines have no MJCF; allowed: with "
+                             "--engine mujoco")
+    if not str(args.save_mjcf).endswith(".xml"):
+        raise ParameterError(f"--save-mjcf {args.save_mjcf!r} is not an .xml file name; allowed: FILE.xml")
+    settings = None
+    if args.timestep is not None:
+        from ipir_mujoco.engine import SolverSettings
+
+        settings = SolverSettings(timestep=args.timestep)
+    save_mjcf(args.save_mjcf, model_params(args), variant.rule, variant.clutch, model=variant.model,
+              t_end=args.t_end, dt_out=args.dt_out, settings=settings, mjcf=args.mjcf,
+              route=getattr(args, "route_parsed", None))
+    if not args.json:
+        print(f"  wrote {args.save_mjcf}: the compiled model of this run (its header says what runs between steps)")
+
+
 def run(args: argparse.Namespace) -> int:
     check_options(args)
     # bad parameters are reported before the output folder is looked at
@@ -226,6 +253,8 @@ def run(args: argparse.Namespace) -> int:
     if args.out is not None:
         check_output_dir(args.out, files=("timeseries.csv", "mode_changes.csv", "summary.json", "fig2_crank.png",
                                           "fig3_modules.png", "fig4_gap.png"))
+    if args.save_mjcf is not None:
+        save_run_mjcf(args)
     result = run_simulation(args)
     record = result.to_json_dict()
     if args.out is not None:

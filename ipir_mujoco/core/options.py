@@ -150,3 +150,19 @@ def check_type(name: str, value: Any, types: type | tuple[type, ...], allowed: s
     if not isinstance(value, types):
         raise ParameterTypeError(f"{name}={value!r} ({type(value).__name__}) is not allowed; allowed: {allowed}")
     return value
+
+
+def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable[[float], None]:
+    """A run's ``progress=`` callable that passes the simulated time [s] on to ``report`` at most once every
+    ``every_s`` seconds of wall time (the first after ``every_s``): a heartbeat inside a long run of a study,
+    silent in a short one."""
+    import time
+
+    last = [time.monotonic()]
+
+    def progress(t: float) -> None:
+        now = time.monotonic()
+        if now - last[0] >= every_s:
+            last[0] = now
+            report(t)
+    return progress

@@ -11,7 +11,9 @@ result container, the errors, the per-revolution figures), never
 :mod:`ipir_mujoco.analytic`.
 """
 
+from .export import compiled_mjcf, save_mjcf
 from .model import SolverSettings, build_model
 from .simulate import CrankServo, captured_warnings, simulate_mujoco
 
-__all__ = ["CrankServo", "SolverSettings", "build_model", "captured_warnings", "simulate_mujoco"]
+__all__ = ["CrankServo", "SolverSettings", "build_model", "captured_warnings", "compiled_mjcf", "save_mjcf",
+           "simulate_mujoco"]

@@ -27,15 +27,17 @@ So a held module stands while the whole ground force g on it satisfies
 -F_ri <= g <= G_i, skids back at G_i beyond, and rolls forward at F_ri: the
 limits are MuJoCo's friction rows' bounds, by construction.
 
-The carriage's inertia, CARRIAGE_SHARE of its module's mass, is its slide's
-``armature`` (an inertia without weight, so it adds no load in a riser and no
+The carriage's inertia, :func:`carriage_share` of its module's mass
+(CARRIAGE_SHARE = 3e-4 with rigid clutches, COMPLIANT_CARRIAGE_SHARE = 1e-3
+with compliant ones, whose spring acts on it and whose step must resolve
+that), is its slide's ``armature`` (an inertia without weight, so it adds no load in a riser and no
 potential energy; its body has the nominal BODY_MASS MuJoCo requires of a
 moving body). It moves only while its module skids (with it, the clutch
 holding), where it adds its inertia to the module's: a relative bias of at
-most CARRIAGE_SHARE on a skid. MuJoCo scales a row's softness with the
+most that share on a skid. MuJoCo scales a row's softness with the
 inverse inertia it sees at qpos0 (``dof_invweight0``, ``tendon_invweight0``),
-which for a carriage row is the carriage's, 1 / CARRIAGE_SHARE times its
-module's: the held module would creep back 1000 times faster than a module
+which for a carriage row is the carriage's, 1 / share times its
+module's: the held module would creep back 1e3-1e5 times faster than a module
 on its resistance today. The grip acts on the module through the carriage, so
 :func:`scale_grip_rows` gives the carriage's and the tendon's rows the
 module slide's own inverse weight: every row then leaks as today's module
@@ -51,10 +53,19 @@ from ipir_mujoco.core.params import RobotParams
 CARRIAGES = ("rear_carriage", "front_carriage")  # bodies
 SKIDS = ("rear_skid", "front_skid")  # the carriages' slides: c_i
 ROLLS = ("rear_roll", "front_roll")  # tendons L_i = x_i - c_i
-CARRIAGE_SHARE = 1e-3  # carriage inertia over its module's mass
+# carriage inertia over its module's mass: rigid clutches (a skid's bias of about 0.85 of it). Lighter let the
+# one-way limits give: at 1e-4 a 40 deg design's limits gave 3.3e-3 m at 1e-4 s (1.2e-10 m at 3e-4 and 1e-3);
+# the solver's rare unconverged steps, ~2e-4 N for one step, were as frequent at 1e-3, 1e-4 and 1e-5
+CARRIAGE_SHARE = 3e-4
+COMPLIANT_CARRIAGE_SHARE = 1e-3  # compliant clutches: the spring on it sets the step (timestep.clutch_rate)
 BODY_MASS = 1e-12  # kg, inertia 1e-12 kg m^2: the carriage body's own (MuJoCo needs > 1e-15 on a moving body)
 MARGIN = 1e-9  # m: the one-way limits' margin, as the ratchet's (clutches.Ratchet)
 RANGE_FAR = 1e6  # m: a bound that never acts (the other side of each one-way limit)
+
+
+def carriage_share(params: RobotParams) -> float:
+    """The carriage's inertia over its module's mass [-] for ``params``' clutches (module docstring)."""
+    return CARRIAGE_SHARE if params.clutch_stiffness is None else COMPLIANT_CARRIAGE_SHARE
 
 
 def write_grip(spec: mujoco.MjSpec, params: RobotParams, solref: list, solimp: list, slides: tuple[str, str],
@@ -75,7 +86,7 @@ def write_grip(spec: mujoco.MjSpec, params: RobotParams, solref: list, solimp: l
         body.explicitinertial = True
         body.mass, body.ipos, body.inertia = BODY_MASS, [0, 0, 0], [BODY_MASS] * 3
         skid = body.add_joint(name=SKIDS[i], type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
-        skid.armature = CARRIAGE_SHARE * masses[i]
+        skid.armature = carriage_share(params) * masses[i]
         skid.frictionloss = grips[i]
         skid.limited = mujoco.mjtLimited.mjLIMITED_TRUE
         skid.range = [-RANGE_FAR, RANGE_FAR]  # the engine sets the upper bound before the first step

@@ -58,12 +58,16 @@ class ModelKind:
         The accuracy monitor's mode where a run does not choose one ('stop' | 'warn').
     skid : bool
         Whether the energy audit books the grips' (or the contacts') work against skidding, ``skid_j``.
+    verifies_skids : bool
+        Whether an automatically stepped run whose modules skidded is checked at half its step
+        (:mod:`.skid_check`).
     """
 
     name = "slides"
     model = "slides"
     accuracy = "stop"
     skid = False
+    verifies_skids = False
 
     def check(self, params: RobotParams, implementation: str, rule: str, route=None,
               until_steady: bool = False) -> RobotParams:
@@ -143,6 +147,7 @@ class GripSlidesKind(ModelKind):
 
     name = "slides-grip"
     skid = True
+    verifies_skids = True
 
     def takes(self, params):
         return params.grip is not None

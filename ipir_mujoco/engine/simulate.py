@@ -60,6 +60,7 @@ from .block_checks import BlockChecks
 from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, climb_energy, monotone,
                      mujoco_failure, steps_per_output)
 from .kinds import ModelKind, kind_for
+from .skid_check import skidded, verify_skids
 from .model import SolverSettings
 from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
@@ -149,20 +150,35 @@ def simulate_mujoco(
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
                    kind=kind, feedforward=feedforward, route=route)
     if settings is not None:
-        return _Run(params, settings, **options).result({"timestep_source": "given"})
+        result = _Run(params, settings, **options).result({"timestep_source": "given"})
+        if kind.verifies_skids and skidded(result):
+            result.accuracy["skid_check"] = "not verified: timestep given"
+        return result
+    verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
     started = time.perf_counter()
     chosen, why = kind.settings(params, t_end, dt_out, servo, implementation)
     failures = []
+    extra = {"timestep_source": "auto", "timestep_rule": why, "refinements": failures}
     for attempt in range(REFINEMENTS + 1):
         try:
-            run = _Run(params, chosen, started=started, **options)
-            return run.result({"timestep_source": "auto", "timestep_rule": why, "refinements": failures})
+            result = _Run(params, chosen, started=started, **options).result(extra)
+            break
         except AccuracyError as exc:
             if attempt == REFINEMENTS or chosen.timestep / 2 < DT_MIN:
                 raise
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
             chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
-    raise AssertionError("unreachable")  # pragma: no cover
+    if not verify:
+        if kind.verifies_skids and skidded(result):
+            result.accuracy["skid_check"] = "not verified: compliant clutches"
+        return result
+    every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
+
+    def rerun(dt: float) -> RunResult:
+        finer = {**options, "dt_out": dt} if every_step else options
+        return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
+
+    return verify_skids(result, rerun, accuracy, DT_MIN)
 
 
 class _Run:

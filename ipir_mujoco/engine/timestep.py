@@ -57,7 +57,7 @@ import math
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from .grip_model import CARRIAGE_SHARE
+from .grip_model import COMPLIANT_CARRIAGE_SHARE
 from .model import SolverSettings
 from .monitor import RESIDUAL_TOL
 
@@ -77,13 +77,13 @@ CLUTCH_SHARE = 0.1  # of 1 / omega_c, the fastest clutch spring's angular freque
 def clutch_rate(params: RobotParams) -> float:
     """omega_c = sqrt(k / min(m1, m2)) [rad/s]: no clutch spring oscillates faster (0 for rigid clutches).
     With finite grip the spring acts between the module and its carriage (:mod:`.grip_model`), whose inertia
-    m_c = CARRIAGE_SHARE m_i moves with it while the carriage slides: then omega_c = sqrt(k (1 / min(m1, m2) +
-    1 / min(m_c1, m_c2))) (the Rayleigh quotient k (u - w)^2 / (m u^2 + m_c w^2) is at most k (1/m + 1/m_c))."""
+    m_c = COMPLIANT_CARRIAGE_SHARE m_i moves with it while the carriage slides: then
+    omega_c = sqrt(k (1 / min(m1, m2) + 1 / min(m_c1, m_c2))) (the Rayleigh quotient k (u - w)^2 / (m u^2 + m_c w^2) is at most k (1/m + 1/m_c))."""
     if params.clutch_stiffness is None:
         return 0.0
     lightest = min(params.m1, params.m2)
     if params.grip is not None:
-        return math.sqrt(params.clutch_stiffness * (1.0 / lightest + 1.0 / (CARRIAGE_SHARE * lightest)))
+        return math.sqrt(params.clutch_stiffness * (1.0 / lightest + 1.0 / (COMPLIANT_CARRIAGE_SHARE * lightest)))
     return math.sqrt(params.clutch_stiffness / lightest)
 
 

@@ -59,7 +59,7 @@ def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the pap
         for metric, entry in per.items():
             for k, item in enumerate(entry["by_threshold"]):
                 rows.append((f"{name}: {metric}, |cost| < {100 * item['threshold']:g} %", item, entry["measured_by"]))
-                if "equations" in entry:  # MuJoCo measured it; the equations' answer beside it
+                if entry.get("equations"):  # MuJoCo measured it; the equations' answer beside it
                     rows.append(("    the equations", entry["equations"]["by_threshold"][k], "equations"))
     fig = _figure(8.0, 1.3 + 0.32 * len(rows))
     ax = fig.add_subplot()
@@ -71,15 +71,18 @@ def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the pap
         ax.barh(k, 100 * frac, color=colours[by], alpha=0.55)
         ax.errorbar(100 * frac, k, xerr=[[100 * max(0.0, frac - interval[0])], [100 * max(0.0, interval[1] - frac)]],
                     color="black", capsize=3, lw=1)
-        ax.text(min(100 * interval[1] + 1, 88), k, f"{100 * frac:.1f} %", va="center", fontsize="x-small")
+        right = 100 * interval[1] + 1 < 88  # the figure right of the error bar, else inside the bar
+        ax.text(100 * interval[1] + 1 if right else 100 * frac - 1, k, f"{100 * frac:.1f} %", va="center",
+                ha="left" if right else "right", fontsize="x-small",
+                bbox=None if right else {"facecolor": "white", "edgecolor": "none", "pad": 0.5, "alpha": 0.8})
     ax.set_yticks(range(len(rows)), [label for label, _i, _b in rows], fontsize="small")
     ax.invert_yaxis()
     ax.set(xlim=(0, 100), xlabel="share of the box where the idealization is safe [%] (95 % interval)",
-           title=title + ": " + ", ".join(f"{a.name} {a.low:.3g}..{a.high:.3g}" for a in axes))
+           title=title + ":\n" + ", ".join(f"{a.name} {a.low:.3g}..{a.high:.3g}" for a in axes))
     ax.title.set_fontsize("small")
-    ax.legend(handles=[Patch(color=colours["equations"], alpha=0.55, label="measured by the equations (dense sample)"),
-                       Patch(color=colours["mujoco"], alpha=0.55, label="measured by MuJoCo (surrogate)")],
-              fontsize="x-small", loc="lower right")
+    fig.legend(handles=[Patch(color=colours["equations"], alpha=0.55, label="measured by the equations (dense sample)"),
+                        Patch(color=colours["mujoco"], alpha=0.55, label="measured by MuJoCo (surrogate)")],
+               fontsize="x-small", loc="outside lower center", ncol=2)
     ax.grid(alpha=0.3, axis="x")
     fig.savefig(path, dpi=110)
     return path

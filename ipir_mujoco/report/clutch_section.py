@@ -29,7 +29,7 @@ from .document import Heading, Image, Paragraph, Table, fmt
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 RIGID_OFFSET = 0.8  # decades right of the stiffest design where the rigid clutches are drawn
 ENGINE_STYLE = {"analytic": {"ls": "-", "lw": 1.6}, "mujoco": {"ls": "none", "marker": "o", "mfc": "none", "ms": 6}}
-LABEL_OFFSETS = (((8, -14), "left"), ((8, 6), "left"), ((-10, 8), "right"))  # [points] for marked designs
+LABEL_OFFSETS = (((8, -14), "left"), ((8, 6), "left"), ((8, -14), "left"))  # [points] for marked designs
 RIGID_STYLE = {"analytic": {"marker": "*", "color": "black", "ms": 13},
                "mujoco": {"marker": "X", "color": "dimgrey", "ms": 9}}
 
@@ -51,6 +51,7 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
     axes = fig.subplots(1, len(points), squeeze=False)[0]
     stiffness = np.array(study["stiffness_n_m"])
     rigid_x = stiffness.max() * 10**RIGID_OFFSET
+    drawn = set()  # what the legend may show: ("backlash", j), "analytic", "mujoco", "rigid:ENGINE", "slope"
     for ax, key in zip(axes, points):
         rows = [r for r in study["rows"] if r["point"] == key]
         for j, b in enumerate(study["backlash_m"]):
@@ -59,12 +60,18 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
                 data = [(r["clutch_stiffness_n_m"], r[engine]["peak_clutch_force_n"]) for r in chosen if _ok(r[engine])]
                 if data:
                     x, y = zip(*data)
+                    if engine == "analytic" and len(data) == 1:  # a line of one point is not drawn: the marker is
+                        continue
                     ax.plot(x, y, color=COLOURS[j % len(COLOURS)], gid=f"{engine}:{b!r}", **style)
+                    drawn.add(engine)
+                    if len(data) > 1:  # a colour in the legend is a curve (a lone design is named where drawn)
+                        drawn.add(("backlash", j))
         missing = []
         for engine, style in RIGID_STYLE.items():
             ref = study["rigid"][key][engine]
             if _ok(ref):
                 ax.plot([rigid_x], [ref["peak_clutch_force_n"]], ls="none", gid=f"rigid:{engine}", **style)
+                drawn.add(f"rigid:{engine}")
             else:
                 missing.append(engine)
         if missing:  # say so where the marker would be
@@ -78,9 +85,11 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
                 ax.plot([pair["clutch_stiffness"]], [force], ls="none", marker="D", ms=10, mfc="none", mec="black",
                         mew=1.5, gid=f"pair:{pair['name']}")
                 (dx, dy), align = LABEL_OFFSETS[n % len(LABEL_OFFSETS)]
-                ax.annotate(pair["name"], (pair["clutch_stiffness"], force), xytext=(dx, dy), ha=align,
-                            textcoords="offset points", fontsize="small")
-        _slope_guide(ax, rows, study["backlash_m"])
+                play = f"{1e3 * pair['clutch_backlash']:g} mm play" if pair["clutch_backlash"] else "no play"
+                ax.annotate(f"{pair['name']} ({play})", (pair["clutch_stiffness"], force), xytext=(dx, dy),
+                            ha=align, textcoords="offset points", fontsize="small")
+        if _slope_guide(ax, rows, study["backlash_m"]):
+            drawn.add("slope")
         ax.axvline(stiffness.max() * 10 ** (RIGID_OFFSET / 2), color="grey", lw=0.8, ls=":")
         decades = 10.0 ** np.arange(np.floor(np.log10(stiffness.min())), np.floor(np.log10(stiffness.max())) + 1)
         ax.set_xscale("log")
@@ -97,28 +106,32 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
                title=study["points"][key]["label"], xlim=(stiffness.min() / 2, rigid_x * 2))
         ax.title.set_fontsize("medium")
         ax.grid(alpha=0.3, which="major")
+    # the legend lists only what is drawn: a colour with a curve, each kind of mark present
     handles = [Line2D([], [], color=COLOURS[j % len(COLOURS)], lw=3, label=f"backlash {1e3 * b:g} mm")
-               for j, b in enumerate(study["backlash_m"])]
-    handles += [Line2D([], [], color="black", label="analytic compliant clutch (lines)", **ENGINE_STYLE["analytic"]),
-                Line2D([], [], color="black", label="MuJoCo compliant ratchet (markers)", **ENGINE_STYLE["mujoco"]),
-                Line2D([], [], ls="none", label="rigid one-way model (analytic)", **RIGID_STYLE["analytic"]),
-                Line2D([], [], ls="none", label="rigid ratchet (MuJoCo)", **RIGID_STYLE["mujoco"]),
-                Line2D([], [], color="grey", ls="--", lw=1, label="slope 1/2: an impact, F ~ sqrt(k)")]
-    if highlight:
+               for j, b in enumerate(study["backlash_m"]) if ("backlash", j) in drawn]
+    kinds = (("analytic", dict(color="black", label="analytic compliant clutch (lines)", **ENGINE_STYLE["analytic"])),
+             ("mujoco", dict(color="black", label="MuJoCo compliant ratchet (markers)", **ENGINE_STYLE["mujoco"])),
+             ("rigid:analytic", dict(ls="none", label="rigid one-way model (analytic)", **RIGID_STYLE["analytic"])),
+             ("rigid:mujoco", dict(ls="none", label="rigid ratchet (MuJoCo)", **RIGID_STYLE["mujoco"])),
+             ("slope", dict(color="grey", ls="--", lw=1, label="slope 1/2: an impact, F ~ sqrt(k)")))
+    handles += [Line2D([], [], **style) for kind, style in kinds if kind in drawn]
+    if any(a.get_gid() and a.get_gid().startswith("pair:") for ax in axes for a in ax.lines):
         handles.append(Line2D([], [], ls="none", marker="D", mfc="none", mec="black", label="realistic clutches"))
     fig.legend(handles=handles, loc="outside lower center", ncols=min(5, len(handles)), fontsize="small")
     return fig
 
 
-def _slope_guide(ax, rows: list[dict], backlash: list[float]) -> None:
-    """A dashed slope-1/2 line ending at the largest backlash's stiffest analytic point."""
+def _slope_guide(ax, rows: list[dict], backlash: list[float]) -> bool:
+    """A dashed slope-1/2 line ending at the largest backlash's stiffest analytic point; whether drawn."""
     if not backlash or max(backlash) == 0:
-        return
+        return False
     ends = sorted((r["clutch_stiffness_n_m"], r["analytic"]["peak_clutch_force_n"]) for r in rows
                   if r["clutch_backlash_m"] == max(backlash) and _ok(r["analytic"]))
     if len(ends) >= 2:
         (k0, _), (k1, f1) = ends[0], ends[-1]
-        ax.plot([k0, k1], [f1 * (k0 / k1) ** 0.5 * 1.6, f1 * 1.6], color="grey", ls="--", lw=1)
+        ax.plot([k0, k1], [f1 * (k0 / k1) ** 0.5 * 1.6, f1 * 1.6], color="grey", ls="--", lw=1, gid="slope")
+        return True
+    return False
 
 
 def write_study_figure(study: dict, path: Path, highlight: Sequence[dict] = ()) -> None:

@@ -57,14 +57,15 @@ def study_figure(study: dict) -> Figure:
         ax_trace.axhline(0.0, color="black", ls=":", lw=1.0, label="target")
         for dc in (0, 180, 360):
             ax_trace.axvline(dc, color="lightgrey", lw=0.8, zorder=0)
-        if off_scale:
-            ax_trace.text(0.02, 0.03, off_scale[0], transform=ax_trace.transAxes, fontsize=8, color="tab:grey")
         ax_trace.set_xlim(0, 360)
         ax_trace.set_xticks(range(0, 361, 45))
         ax_trace.set_title(f"(a) crank speed over a steady revolution, {fastest:g} rad/s target (MuJoCo)")
         ax_trace.set_xlabel("crank angle phi [deg] (dead centres at 0 and 180)")
         ax_trace.set_ylabel("crank speed - target [% of target]")
-        ax_trace.legend(fontsize=8, loc="upper right")
+        # legends of line panels sit below them, off the curves
+        # (the open loop's swing, off this scale, is said in the legend's title: a note in the panel lay on a curve)
+        ax_trace.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=4,
+                        title=off_scale[0] if off_scale else None, title_fontsize=8)
 
     groups = [(w, c) for w in speeds for c in controllers]
     x = np.arange(len(groups))
@@ -88,7 +89,12 @@ def study_figure(study: dict) -> Figure:
         ax.set_title(title)
         ax.set_ylabel(f"{title.split(') ')[1].split(' (')[0]} [{unit}]")
         ax.set_xlabel("controller and mean crank speed")
-        ax.legend(fontsize=8, title="bars: hatch = model", title_fontsize=8)
+        # headroom above the tallest bar for the legend (a decade on the log axis, 45 % on the linear one)
+        tallest = max((value for v in shown for value in table[v] if not math.isnan(value)), default=None)
+        if tallest:
+            bottom = ax.get_ylim()[0]
+            ax.set_ylim(bottom, tallest * (12.0 if log else 1.45))
+        ax.legend(fontsize=8, title="bars: hatch = model", title_fontsize=8, loc="upper center", ncols=len(shown))
         if missing:  # MuJoCo's rigid ratchet: its peaks measure its timestep (studies/control_study.py)
             ax.set_xlabel(f"controller and mean crank speed\n({', '.join(missing)}: n/a, a rigid ratchet's sampled "
                           "peak measures its timestep)")
@@ -113,7 +119,8 @@ def study_figure(study: dict) -> Figure:
         ax_profile.set_ylabel("peak clutch force [N]", color="tab:red")
         energy_ax.set_ylabel("electrical energy per metre [J/m]", color="tab:purple")
         lines = ax_profile.get_lines() + energy_ax.get_lines()
-        ax_profile.legend(lines, [ln.get_label() for ln in lines], fontsize=8, loc="upper center")
+        ax_profile.legend(lines, [ln.get_label() for ln in lines], fontsize=8, loc="upper center",
+                          bbox_to_anchor=(0.5, -0.14), ncols=2)
     fig.suptitle("Speed control of the inchworm robot's crank: controllers and a dead-centre profile")
     return fig
 

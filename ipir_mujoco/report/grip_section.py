@@ -71,6 +71,11 @@ def _mujoco(m: dict | None, drive: str) -> str:
     return f"{fmt(m['travel_m'])} m, {fmt(_speed(m, drive))} m/s"
 
 
+def _travel(m: dict) -> str:
+    """'1.363 in 2.61 s': a run's travel [m] with the time it took [s]."""
+    return "n/a" if "error" in m or m.get("travel_m") is None else f"{fmt(m['travel_m'])} in {fmt(m['t_end_s'], 3)} s"
+
+
 def render(metrics: dict, figures_dir: Path) -> list:
     """The demands and finite-grip tables, the figure (figures/finite_grip.png), the riser press and a verdict."""
     titles = {"startup": "the paper's start-up (constant torque, 1 s from rest)",
@@ -82,21 +87,21 @@ def render(metrics: dict, figures_dir: Path) -> list:
     blocks.append(Table(["case", "paper's model: peak reaction [N]", "one-way model: peak reaction [N]"],
                         [[titles[k], _demand(c["unlimited"][PAPER]), _demand(c["unlimited"][ONE_WAY])]
                          for k, c in metrics["cases"].items()]))
-    header = ["case", "mu_wall", "F_n [N]", "G [N]", "travel [m] (cruise: to its steady state)",
-              "speed [m/s] (steady, or mean over 1 s)", "skid back 1 + 2 [m]",
-              "MuJoCo (travel, speed)"]
+    # a run to its steady state lasts as long as it needs: its travel and skid are over its own time, so
+    # that time is shown beside them, and the speed is the column to compare
+    header = ["case", "mu_wall", "F_n [N]", "G [N]", "speed [m/s] (steady, or mean over 1 s)",
+              "travel [m] in the run's time [s]", "skid back 1 + 2 [m]", "MuJoCo (travel, speed)"]
     rows, refusals = [], set()
     for key, case in metrics["cases"].items():
         base = case["unlimited"][ONE_WAY]
-        rows.append([titles[key], "unlimited", "-", "-", fmt(base.get("travel_m")),
-                     fmt(_speed(base, case["drive"])), "0", "-"])
+        rows.append([titles[key], "unlimited", "-", "-", fmt(_speed(base, case["drive"])), _travel(base), "0", "-"])
         for row in case["rows"]:
             m = row[ONE_WAY]
             mj = row.get(MUJOCO)
             if mj is not None and "error" in mj:
                 refusals.add(mj["error"])
             rows.append(["", fmt(row["mu"], 2), fmt(row["press_n"], 3), fmt(row["grip_n"], 3),
-                         m.get("error") or fmt(m["travel_m"]), fmt(_speed(m, case["drive"])),
+                         m.get("error") or fmt(_speed(m, case["drive"])), "n/a" if "error" in m else _travel(m),
                          "n/a" if "error" in m else fmt(m["slip_m"]), _mujoco(mj, case["drive"])])
     blocks.append(Table(header, rows))
     write_figure(metrics, Path(figures_dir) / "finite_grip.png")
@@ -118,27 +123,40 @@ def render(metrics: dict, figures_dir: Path) -> list:
 
 def write_figure(metrics: dict, path: Path) -> None:
     """One panel per case: relative speed [-] against the grip G [N] (log axis), with the demanded grip."""
+    grip_figure(metrics).savefig(path, dpi=110)
+
+
+def grip_figure(metrics: dict):
+    """The figure of :func:`write_figure` (a matplotlib Figure, for tests to read)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from matplotlib.ticker import NullFormatter
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-    fig = Figure(figsize=(8.0, 3.0), layout="constrained")
+    fig = Figure(figsize=(8.0, 3.4), layout="constrained")
     FigureCanvasAgg(fig)
     for ax, (key, case) in zip(fig.subplots(1, len(metrics["cases"]), squeeze=False)[0], metrics["cases"].items()):
         base = _speed(case["unlimited"][ONE_WAY], case["drive"])
         points = sorted((r["grip_n"], _speed(r[ONE_WAY], case["drive"])) for r in case["rows"]
                         if "error" not in r[ONE_WAY])
         if base and points:
-            ax.plot([g for g, _v in points], [v / base for _g, v in points], "o-")
+            ax.plot([g for g, _v in points], [v / base for _g, v in points], "o-", color="tab:blue")
         need = case["unlimited"][ONE_WAY].get("peak_clutch_force_n")
         if need:
             ax.axvline(need, linestyle="--", color="gray")
         ax.set_xscale("log")
+        # labelled ticks at 1, 2, 5 of each decade: a panel spanning about a decade shows several
+        ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xlabel("grip G = mu_wall F_n [N]")
-        ax.set_ylabel("speed / unlimited-grip speed [-]")
+        ax.set_xlabel("grip per module, G [N]")
+        ax.set_ylabel("speed: finite / unlimited grip [-]")
         ax.set_title("paper's start-up (1 s)" if key == "startup" else "motor's cruise (steady)", fontsize=9)
-    fig.savefig(path, dpi=110)
+        ax.grid(alpha=0.3)
+    fig.legend(handles=[Line2D([], [], color="tab:blue", marker="o", label="one-way model on finite grip"),
+                        Line2D([], [], color="gray", ls="--", label="grip needed for no skid (peak clutch reaction)")],
+               loc="outside lower center", ncols=2, fontsize="small")
+    return fig
 
 
 def verdict(metrics: dict) -> dict:

@@ -163,32 +163,37 @@ def lines_figure(columns, axis, engines, caption: str | None = None):
             if stalled.any():
                 ax.plot(x[order][stalled], values[stalled], "x", ms=6, color=line.get_color(),
                         label=f"{engine}: stalled" if metric == shown[0] else None, gid=f"stalled:{engine}:{metric}")
+        notes = []  # said above the panel (a note inside it lay on a curve)
         absent = [e for e in engines if not np.isfinite(columns[f"{e}:{metric}"]).any()]
         if absent:  # e.g. MuJoCo's rigid clutches' peak forces, which would measure its step (docs/cli.md)
-            ax.text(0.99, 0.96, f"not given by {', '.join(absent)}", transform=ax.transAxes, ha="right", va="top",
-                    fontsize="x-small", color="0.3")
+            notes.append(f"not given by {', '.join(absent)}")
         ax.set_ylabel("\n".join(textwrap.wrap(described(metric), 22)), fontsize="small")
         ax.ticklabel_format(axis="y", useOffset=False)
-        _flatten(ax, metric, [columns[f"{e}:{metric}"] for e in engines])
+        flat = _flatten(ax, metric, [columns[f"{e}:{metric}"] for e in engines])
+        if flat:
+            notes.append(flat)
+        if notes:
+            ax.set_title("; ".join(notes), fontsize="x-small", color="0.3", loc="right", gid=f"note:{metric}")
         ax.grid(alpha=0.3)
         if axis.log:
             ax.set_xscale("log")
-    panels[0].legend(fontsize="small")
+    fig.legend(*panels[0].get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize="small")
     panels[-1].set_xlabel(_label(axis.name))
     return fig
 
 
-def _flatten(ax, metric: str, values: list[np.ndarray]) -> None:
-    """Draw a panel whose finite values all lie within RESOLVED of their mean across that band, and say so."""
+def _flatten(ax, metric: str, values: list[np.ndarray]) -> str | None:
+    """Draw a panel whose finite values all lie within RESOLVED of their mean across that band; the note that
+    says so (None if the values vary more)."""
     finite = np.concatenate([v[np.isfinite(v)] for v in values])
     if finite.size < 2:
-        return
+        return None
     mean = float(finite.mean())
     half = RESOLVED * abs(mean)
     if half > 0 and float(finite.max() - finite.min()) <= 2 * half:
         ax.set_ylim(mean - 1.5 * half, mean + 1.5 * half)
-        ax.text(0.01, 0.04, f"flat: within {100 * RESOLVED:g} % of {mean:.5g} everywhere (below what the runs "
-                "resolve)", transform=ax.transAxes, fontsize="x-small", color="0.3", gid=f"flat:{metric}")
+        return f"flat: within {100 * RESOLVED:g} % of {mean:.5g} everywhere (below what the runs resolve)"
+    return None
 
 
 def _words(metric: str) -> str:

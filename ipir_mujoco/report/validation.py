@@ -21,6 +21,9 @@ import numpy as np
 from ipir_mujoco.core.results import Mode
 
 from ..labels import summary_label
+from .overview import FIGURE as OVERVIEW
+from .overview import (accuracy_flag, ladder_change, monitor_verdict, overview_caption, overview_figure,
+                       place_moved, verdict_blocks)
 from ..resources import shipped
 from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Link, Paragraph, Table, fmt, pct, to_html, to_markdown
@@ -214,13 +217,14 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                     Paragraph("The paper's analytic model of the two-module inchworm robot, reproduced and "
                               f"taken apart one idealization at a time {where} "
                               f"(simulated {metrics['settings']['t_end_s']:g} s from rest).")]
+    if OVERVIEW in figures:  # the picture a reader grasps first (report/overview.py)
+        blocks.append(Image(figures[OVERVIEW], overview_caption(metrics)))
     blocks.append(Heading("Summary"))
     blocks.append(Table(["question", "verdict", "key figure", "where"],
                         [[v["question"], v["short"], v["key"],
                           Link(v["section"], v["section"]) if v.get("section") else ""] for v in metrics["verdicts"]]))
-    blocks.append(Heading("Verdicts"))
-    for verdict in metrics["verdicts"]:
-        blocks.append(Paragraph(f"**{verdict['question']}** {verdict['answer']}"))
+    verdicts, moved = verdict_blocks(metrics["verdicts"])  # short; the full answers open their sections
+    blocks += verdicts
     blocks += _mechanism_section(figures, animation_note, animation or ANIMATION)
     blocks += _paper_section(metrics, figures)
 
@@ -228,13 +232,15 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     blocks.append(Paragraph("Each rung removes one idealization; the change against the rung before (in brackets) "
                             "is what that idealization costs."))
     header = ["rung", "removes"] + [summary_label(k) for k in LADDER_FIGURES]
-    rows = []
+    rows, previous = [], None
     for rung in metrics["ladder"]:
         cells = [rung["name"], rung["isolates"]]
         for key in LADDER_FIGURES:
-            change = pct(rung["change_vs_previous"][key])
+            change = ladder_change(rung["summary"][key], None if previous is None else previous["summary"][key],
+                                   rung["change_vs_previous"][key], key)
             cells.append(fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
+        previous = rung
     blocks.append(Table(header, rows))
 
     from ..studies.lr_study import FIGURES as LR_FIGURES, describe_threshold
@@ -282,10 +288,14 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     blocks.append(Paragraph("For the equations the residual is the integration error; for MuJoCo it is what "
                             "the soft constraints and the time stepping took."))
     blocks.append(Table(["rung", "motor work [J]", "kinetic [J]", "friction [J]", "residual [J]",
-                         "residual / motor work [-]"],
+                         "residual / motor work [-]", "MuJoCo's accuracy monitor"],
                         [[r["name"], fmt(e["motor_work_j"], 8), fmt(e["kinetic_j"], 8), fmt(e["friction_j"], 8),
-                          f"{e['residual_j']:.2e}", f"{e['residual_j'] / e['motor_work_j']:.1e}"]
+                          f"{e['residual_j']:.2e}", f"{e['residual_j'] / e['motor_work_j']:.1e}",
+                          monitor_verdict(r["summary"].get("accuracy"))]
                          for r in metrics["ladder"] for e in [r["summary"]["energy"]]]))
+    flagged = [flag for r in metrics["ladder"] if (flag := accuracy_flag(r["name"], r["summary"].get("accuracy")))]
+    if flagged:
+        blocks.append(Paragraph("**Flagged:** " + " ".join(flagged)))
 
     blocks += list(extra)
 
@@ -326,7 +336,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                             "the model and its conventions are in docs/model.md. The documents this report names "
                             f"are installed with the package: docs/model.md as {shipped('docs/model.md')}, "
                             f"mjcf/README.md as {shipped('mjcf/README.md')}."))
-    return blocks
+    return place_moved(blocks, moved)
 
 
 def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | None, dict]:
@@ -356,6 +366,7 @@ def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: 
     figure_clutch_reactions(rungs[0], figures_dir / "clutch_reactions.png")
     figure_lr_study(metrics["lr_study"], figures_dir / "lr_study.png")
     figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
+    overview_figure(metrics).savefig(figures_dir / OVERVIEW, dpi=110)
     physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
     note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
     extra = []

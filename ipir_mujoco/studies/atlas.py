@@ -45,7 +45,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
-from ..output import check_output_dir
+from ..output import check_output_dir, study_folder
 from .atlas_adaptive import explore, refine_crossings
 from .atlas_eval import Samples
 from .atlas_space import DEFAULT_METRICS, IDEALIZATIONS, MOTOR_METRICS, NAMES, TORQUE_METRICS, allowed
@@ -220,20 +220,33 @@ def run_atlas(atlas: Atlas, out: str | Path, *, resume: bool = False, workers: i
     out = check_output_dir(out, files=("samples.csv", "atlas.json"))
     meta = out / "atlas.json"
     fingerprint = atlas.fingerprint()
+    _check_resume(out, fingerprint, resume)
+    d = len(atlas.axes)
+    U, saltelli = dense_sample(d, atlas.samples, atlas.seed)
+    designs = atlas.designs(U)
+    refuse_all_invalid(atlas.base, designs)
+    with study_folder(out):  # locked: a second run on this folder is refused
+        _check_resume(out, fingerprint, resume)  # again, under the lock
+        return _run(atlas, out, meta, fingerprint, U, saltelli, designs, resume, workers, progress, show_bars,
+                    started)
+
+
+def _check_resume(out: Path, fingerprint: str, resume: bool) -> None:
+    """An atlas resumed in a folder that holds another one, or started over one, refused in one line."""
     if resume and out.is_dir() and any(out.iterdir()):
         try:
-            previous = json.loads(meta.read_text(encoding="utf-8")).get("fingerprint")
+            previous = json.loads((out / "atlas.json").read_text(encoding="utf-8")).get("fingerprint")
         except (OSError, ValueError, UnicodeDecodeError, AttributeError):
             previous = None
         if previous != fingerprint:
             raise ParameterError(f"{str(out)!r} holds no atlas with these settings; resume needs the same one")
     elif (out / "samples.csv").exists():
         raise ParameterError(f"{str(out / 'samples.csv')!r} exists; use --resume to complete it, or another --out")
+
+
+def _run(atlas: Atlas, out: Path, meta: Path, fingerprint: str, U: np.ndarray, saltelli: bool, designs: list,
+         resume: bool, workers: int, progress, show_bars: bool, started: float) -> dict:
     d = len(atlas.axes)
-    U, saltelli = dense_sample(d, atlas.samples, atlas.seed)
-    designs = atlas.designs(U)
-    refuse_all_invalid(atlas.base, designs)
-    out.mkdir(parents=True, exist_ok=True)
     write_json(meta, {"fingerprint": fingerprint, "settings": atlas.to_json(), "status": "running"})
     candidates = unit_sobol(CANDIDATES, d, atlas.seed + 7)
     scale = min(atlas.thresholds)

@@ -307,6 +307,8 @@ def run_tasks(base: RobotParams, tasks: list[Task], points_table: dict[str, Oper
     def done(task: Task, result: dict) -> None:
         results[task] = result
         what = "rigid" if task.stiffness is None else f"k={task.stiffness:.3g} N/m, backlash={1e3 * task.backlash:g} mm"
+        if task.stiffness is None and task.timestep is not None:  # one rigid MuJoCo run per compliant step
+            what += f" at step {task.timestep:.3g} s"
         status = result["error"] if "error" in result else f"{result['wall_s']:.2f} s"
         progress(f"[{len(results)}/{len(tasks)}] {task.point} {task.engine} {what}: {status}")
 

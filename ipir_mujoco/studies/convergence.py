@@ -25,6 +25,7 @@ from typing import Callable, Sequence
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.cycles import travel
+from ipir_mujoco.core.options import throttled
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams
 
@@ -61,7 +62,9 @@ def timestep_study(cases: dict[str, RobotParams] = CASES, timesteps: Sequence[fl
             for dt in timesteps:
                 progress(f"{case}, {implementation}, dt = {dt:g} s")
                 started = time.perf_counter()
-                run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=4e-4, timestep=dt, accuracy="warn")
+                run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=4e-4, timestep=dt, accuracy="warn",
+                                   progress=throttled(lambda t: progress(f"{case}, {implementation}, dt = {dt:g} s: "
+                                                                         f"{t:.2f} / {t_end:g} s simulated")))
                 s = run.summary
                 row = {"case": case, "clutch": implementation, "rule": rule, "timestep": dt,
                        "wall_s": time.perf_counter() - started,
@@ -112,8 +115,10 @@ def envelope_study(quick: bool = False, progress: Callable[[str], None] = lambda
             started = time.perf_counter()
             reference = registry.run(PAIRS[implementation][1], params, t_end, dt_out=1e-3)
             analytic_wall = time.perf_counter() - started
+            beat = throttled(lambda t, label=label, implementation=implementation, t_end=t_end: progress(
+                f"{label}, {implementation}: {t:.2f} / {t_end:g} s simulated"))
             try:
-                run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=1e-3)
+                run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=1e-3, progress=beat)
             except SimulationError as exc:  # default options: a run the monitor stops is a finding, not a crash
                 rows.append({"case": label, "clutch": implementation, "rule": rule, "t_end": t_end,
                              "stopped": str(exc), "analytic_wall_s": analytic_wall})

@@ -70,6 +70,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
+from ipir_mujoco.core.options import throttled
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
@@ -106,7 +107,9 @@ def run_ladder(params: RobotParams, t_end: float, dt_out: float, rtol: float, at
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name} ...")
         tolerances = ({"accuracy": rung.accuracy} if registry.variant(rung.variant).is_mujoco
                       else {"rtol": rtol, "atol": atol})
-        run = registry.run(rung.variant, rung.params(params), t_end, dt_out=dt_out, **tolerances)
+        beat = throttled(lambda t, i=i, rung=rung: progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: "
+                                                            f"{t:.2f} / {t_end:g} s simulated"))
+        run = registry.run(rung.variant, rung.params(params), t_end, dt_out=dt_out, progress=beat, **tolerances)
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: {run.summary['revolutions']:.3f} rev "
                  f"({time.perf_counter() - started:.2f} s)")
         rungs.append(LadderRun(rung.name, rung.describe(params), run))

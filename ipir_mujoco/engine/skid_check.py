@@ -1,0 +1,153 @@
+"""Skids verified by the step: a run on finite grip whose modules skidded is run again at half its step until
+two runs agree to the stated accuracy, or the run says it cannot.
+
+Why: a skid ends and starts where the steps fall, and MuJoCo's one-way limits (the clutch on the wheels'
+roll, the wall's on the carriage) answer a reversal through their soft rows' damping, within a constraint time
+constant (two steps): the skid a module makes per stroke is off by an amount that shrinks with the step
+(first order or a little faster) and that no figure of the accuracy monitor shows (the energy audit closes,
+the limits give ~1e-10 m). Measured on a riser that climbs 0.15 m in 2 s while skidding 0.29 m (M_stall 2 N m,
+mu_wall 0.5, F_n 45 N) at 5e-5 s: module 2's travel off the equations by 1.3e-3 with the limits' time constant
+at 2 steps, 5.3e-3 at 4 and 1.3e-2 at 8, and unchanged (1.3e-3) with the friction rows' or the loop's at 8.
+How far the skids' error moves the travel depends on the skid against the net travel, which no bound known
+before the run gives. So the run measures it: the same run at half the step, the difference of the figures
+the user reads (fixed time: revolutions and each module's travel; to the steady state: the steady speed and
+the energy per metre) estimates the finer run's error for a scheme that converges at first order or faster
+(Richardson's estimate, |f(dt) - f(dt/2)| >= |f(dt/2) - f(0)|).
+
+The finest run is kept once the differences of its last two halvings are within half (:data:`ACCEPT`) the
+accuracy stated for the figures (1e-3 at fixed time, the monitor's; 3e-4 for the steady figures,
+:data:`ipir_mujoco.core.steady_test.LIMIT_ACCURACY`), each
+relative to its value, a module's travel to at least a tenth of a stroke (:data:`TRAVEL_FLOOR`: a robot that
+holds its place has no relative travel error). At most :data:`HALVINGS` halvings; where they do not reach it,
+the accuracy monitor's mode decides, as for its own figures: 'stop' raises an :class:`.monitor.AccuracyError`
+naming the figure, 'warn' returns the finest run with the figure in its accuracy record. Runs whose timestep
+was given, and compliant clutches (whose spring's rate already sets a step of a few microseconds, and whose
+skid is the anchor's slide on that spring, not a limit's reversal), are not rerun: their accuracy record says
+the skids were not verified.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ipir_mujoco.core.results import RunResult
+from ipir_mujoco.core.steady_test import LIMIT_ACCURACY
+
+from .grip_model import carriage_share
+from .monitor import RESIDUAL_TOL, AccuracyError
+
+HALVINGS = 3  # the most halvings of the step a skid check makes (1e-4 s down to 1.25e-5 s)
+TRAVEL_FLOOR = 0.1  # strokes (2 r): the smallest travel a module's difference is taken relative to
+SKID_TOL = {"fixed": RESIDUAL_TOL, "steady": LIMIT_ACCURACY["mujoco"]}
+# the share of the tolerance a halving's difference may take, over the last two halvings: a difference estimates
+# the finer run's error only where the skids converge steadily, and they need not. A 60 deg design (M_stall
+# 1.5 N m, mu_wall 0.5, F_n 40 N, 1 s) had module 2's travel off the equations by 1.90e-3, 1.91e-3, 1.36e-3,
+# 5.0e-4 and 3.9e-4 at 1e-4 s halved four times: the first pair agrees within 1e-5 while both miss by 1.9e-3
+ACCEPT = 0.5
+SKID_FLOOR = 1e-4  # of the travel floor: a skid below it is not checked (:func:`skidded`)
+
+
+def skidded(result: RunResult) -> bool:
+    """Whether either module of ``result`` skidded by more than SKID_FLOOR of the travel floor (TRAVEL_FLOOR
+    strokes): a shorter skid (a held module's soft rows creep ~1e-9 m per revolution) could not move the travel
+    by the tolerance even if it were wrong by the whole of itself."""
+    summary = result.summary
+    least = SKID_FLOOR * TRAVEL_FLOOR * 2 * result.params.r
+    return (summary["slip1_m"] or 0.0) > least or (summary["slip2_m"] or 0.0) > least
+
+
+def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, float]]:
+    """('steady' | 'fixed', {figure: relative difference}) of two runs of one design at two steps: their steady
+    speed and energy per metre where both reached the steady state (inf where only one did; where the finer run
+    was found steady by the statistical test, its figure's own uncertainty U is added: what is left to trust
+    is the difference and U together), else revolutions and x1_final, x2_final (travel relative to at least
+    TRAVEL_FLOOR strokes). To each travel and steady figure the bias no halving shows is added: the carriage's
+    inertia shortens a skid by about its share of the module's mass (:func:`.grip_model.carriage_share`), so a
+    module's travel by that share of its slip (the steady figures: of both slips over both travels)."""
+    a, b = coarse.summary, fine.summary
+    share = carriage_share(fine.params)  # the carriages' inertia: a skid short by about this share of itself
+    if a["steady"] or b["steady"]:
+        if not (a["steady"] and b["steady"]):
+            return "steady", {"steady": math.inf}
+        out = {}
+        for key, spread in (("steady_speed_m_s", "steady_speed_uncertainty_m_s"),
+                            ("energy_per_metre_j_m", "energy_per_metre_uncertainty_j_m")):
+            if a[key] is not None and b[key] is not None:
+                scale = max(abs(a[key]), abs(b[key]), 1e-300)
+                own = (b[spread] or 0.0) if b["steady_test"] == "statistical" else 0.0
+                moved = abs(b["x1_final"]) + abs(b["x2_final"])
+                bias = share * (b["slip1_m"] + b["slip2_m"]) / moved if moved > 0 else math.inf
+                out[key] = (abs(a[key] - b[key]) + own) / scale + bias
+        return "steady", out
+    floor = TRAVEL_FLOOR * 2 * fine.params.r
+    out = {"revolutions": abs(a["revolutions"] - b["revolutions"]) / max(abs(a["revolutions"]), abs(b["revolutions"]),
+                                                                        TRAVEL_FLOOR)}
+    for k, key in ((1, "x1_final"), (2, "x2_final")):
+        out[key] = (abs(a[key] - b[key]) + share * b[f"slip{k}_m"]) / max(abs(a[key]), abs(b[key]), floor)
+    return "fixed", out
+
+
+def verify_skids(result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+    """``result`` (an automatically stepped run on finite grip) or a finer run of the same design, verified as
+    the module docstring says. ``rerun(timestep)`` runs the design again at that step [s] and returns its
+    RunResult; ``mode``: the accuracy monitor's ('stop' | 'warn'); ``dt_min`` [s]: the smallest step a run may
+    take (halving stops before it)."""
+    if not skidded(result):
+        result.accuracy["skid_check"] = "no skid"
+        return result
+    coarse, history = result, []
+    fine = result
+    for _ in range(HALVINGS):
+        dt = coarse.settings["timestep"] / 2
+        if dt < dt_min:
+            break
+        fine = rerun(dt)
+        kind, diff = differences(coarse, fine)
+        worst_key = max(diff, key=diff.get)
+        worst, tolerance = diff[worst_key], SKID_TOL[kind]
+        history.append({"timestep": coarse.settings["timestep"], "half": dt, "figure": worst_key,
+                        "difference": worst, "differences": diff})
+        # two halvings at least, each within ACCEPT of the tolerance: one pair of runs can agree by chance
+        if len(history) >= 2 and max(h["difference"] for h in history[-2:]) <= ACCEPT * tolerance:
+            return _verified(fine, history, ACCEPT * tolerance, None)
+        coarse = fine
+    if len(history) < 2:  # the step cannot be halved twice above the smallest a run may take: unverifiable
+        message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and their error under "
+                   f"the step cannot be checked: the timestep {result.settings['timestep']:.3g} s cannot be halved "
+                   f"twice above {dt_min:g} s; use --accuracy warn to finish the run and record it")
+        if mode == "stop":
+            raise AccuracyError(message)
+        history = history or [{"timestep": result.settings["timestep"], "half": result.settings["timestep"],
+                               "figure": "none", "difference": math.inf, "differences": {}}]
+        return _verified(fine, history, ACCEPT * SKID_TOL["fixed"], message)
+    step = max(history[-2:], key=lambda h: h["difference"])  # the halving that kept the check from passing
+    message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and halving the timestep "
+               f"from {step['timestep']:.3g} s to {step['half']:.3g} s moved {step['figure']} by "
+               f"{step['difference']:.2e} of it, more than {ACCEPT:g} of the tolerance {tolerance:.3g} (each of the "
+               f"last two halvings must stay within it; the skids' error under the step); use a smaller --timestep "
+               f"(e.g. {history[-1]['half'] / 2:.3g}), or --accuracy warn to finish the run and record it")
+    if mode == "stop":
+        raise AccuracyError(message)
+    return _verified(fine, history, ACCEPT * tolerance, message)
+
+
+def _verified(run: RunResult, history: list, tolerance: float, failed: str | None) -> RunResult:
+    """``run`` with the check recorded: ``settings['skid_check']`` (each halving's differences) and, in its
+    accuracy record, ``skid_difference`` (the last one), its ``tolerance`` (the share ACCEPT of the stated
+    accuracy a halving may move the figures by) and, where the check ``failed`` (its one-line reason), a
+    violation."""
+    finite = lambda x: float(x) if math.isfinite(x) else None  # noqa: E731  (JSON has no inf: None, not compared)
+    history = [{**h, "difference": finite(h["difference"]),
+                "differences": {k: finite(v) for k, v in h["differences"].items()}} for h in history]
+    last = history[-1]
+    run.settings["skid_check"] = history
+    record = run.accuracy
+    record["skid_check"] = "verified" if failed is None else "failed"
+    record["skid_difference"] = last["difference"]
+    record.setdefault("tolerances", {})["skid_difference"] = float(tolerance)
+    if failed is not None:
+        record["ok"] = False
+        record.setdefault("violations", []).append({"figure": "skid_difference", "t_s": float(run.t_end),
+                                                    "value": last["difference"],
+                                                    "tolerance": float(tolerance), "reason": failed})
+    return run

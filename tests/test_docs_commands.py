@@ -1,0 +1,172 @@
+"""Every command the documentation shows runs, and prints what the documentation quotes.
+
+The commands come from README.md, docs/*.md, mjcf/README.md, the route files' headers and the modules'
+docstrings (tests/docs_commands.py says how they are found and shortened). They run as a user types them,
+in a scratch folder, through the installed ``ipir-mujoco`` and this interpreter as ``python``, two at a
+time; each must exit 0 with no traceback, a synopsis must match its ``--help``, quoted output must be
+printed. Running them takes minutes: those tests are marked slow; the extraction itself is checked fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import functools
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import docs_commands as dc  # noqa: E402
+
+GROUPS = dc.all_commands()
+COMMANDS = [command for group in GROUPS.values() for command in group]
+TIMEOUT_S = 900  # per command: a bound on a hung run, far above any documented command's shortened run
+ENV = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}",
+       "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"}
+for _name in ("DISPLAY", "WAYLAND_DISPLAY"):  # no screen: the viewer must refuse in one line
+    ENV.pop(_name, None)
+
+
+def _subcommands() -> dict[str, argparse.ArgumentParser]:
+    from ipir_mujoco.cli import build_parser
+
+    parser = build_parser()
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+
+
+def needs_arguments(command: dc.Command) -> bool:
+    """A command named, not shown: an inline ``ipir-mujoco NAME`` or ``python -m MODULE`` with no arguments
+    in running text or a heading ('## `ipir-mujoco sweep`', '`ipir-mujoco clutch-study`: the engagement
+    loads ...'), or a bare subcommand that cannot run without arguments. The test runs its --help (the
+    command's examples and synopsis, shown in code blocks, are run and checked where they stand)."""
+    words = command.text.split()
+    if command.inline and not command.screen and (
+            (words[0] == "ipir-mujoco" and len(words) <= 2) or (words[0].startswith("python") and len(words) == 3
+                                                                and words[1] == "-m")):
+        return True
+    if words[0] != "ipir-mujoco" or len(words) != 2 or words[1] not in _subcommands():
+        return False
+    return any(a.required or not a.option_strings for a in _subcommands()[words[1]]._actions
+               if a.dest != "help")
+
+
+def run(text: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(text, shell=True, executable="/bin/bash", cwd=cwd, env=ENV, capture_output=True,
+                          text=True, timeout=TIMEOUT_S)
+
+
+@functools.lru_cache(maxsize=None)
+def help_text(prog: tuple[str, ...]) -> tuple[int, str]:
+    done = run(" ".join(prog) + " --help", dc.ROOT)
+    return done.returncode, done.stdout + done.stderr
+
+
+def takes_quick(prog) -> bool:
+    code, text = help_text(tuple(prog))
+    return code == 0 and "--quick" in text
+
+
+def scratch(folder: Path) -> Path:
+    """A folder as the repository's root looks to a user: mjcf/ and docs/ copied (commands write there),
+    bench/ and tests/ linked (the benchmarks import the tests' designs)."""
+    folder.mkdir(parents=True)
+    for name in ("mjcf", "docs"):
+        shutil.copytree(dc.ROOT / name, folder / name)
+    for name in ("bench", "tests"):
+        (folder / name).symlink_to(dc.ROOT / name)
+    return folder
+
+
+def run_group(commands: list[dc.Command], folder: Path) -> dict[int, dict]:
+    out = {}
+    for command in commands:
+        if command.synopsis or needs_arguments(command):
+            prog = dc.program(command.text)
+            code, text = help_text(tuple(prog))
+            out[id(command)] = dict(ran=" ".join(prog) + " --help", how="synopsis", code=code, stdout=text,
+                                    stderr="")
+            continue
+        missing = dc.missing_inputs(command.text, folder)
+        if missing:  # an example's own data: the command's --help, and the synopsis check
+            prog = dc.program(command.text)
+            code, text = help_text(tuple(prog))
+            out[id(command)] = dict(ran=" ".join(prog) + " --help", how=f"needs {', '.join(missing)}", code=code,
+                                    stdout=text, stderr="")
+            continue
+        ran, how = dc.shortened(command.text, takes_quick)
+        if "mujoco.viewer" in command.text:  # MuJoCo's own viewer needs a screen: load the file it opens
+            path = command.text.split("--mjcf", 1)[1].split()[0]
+            ran, how = f"python -c 'import mujoco; mujoco.MjModel.from_xml_path(\"{path}\")'", "loads the model"
+        started = time.monotonic()
+        done = run(ran, folder)
+        out[id(command)] = dict(ran=ran, how=how, code=done.returncode, stdout=done.stdout, stderr=done.stderr,
+                                seconds=time.monotonic() - started)
+    return out
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    """Every group of commands, two at a time (the machine's cores), each group in its own scratch folder."""
+    base = tmp_path_factory.mktemp("docs")
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        jobs = [pool.submit(run_group, commands, scratch(base / f"g{i}"))
+                for i, commands in enumerate(GROUPS.values())]
+        merged = {}
+        for job in jobs:
+            merged.update(job.result())
+    return merged
+
+
+def test_the_docs_show_commands_of_every_kind():
+    """The extraction finds what the pages show: if it found nothing the slow test would pass vacuously."""
+    texts = [c.text for c in COMMANDS]
+    assert len(COMMANDS) >= 80
+    assert sum(c.synopsis for c in COMMANDS) >= 20
+    assert sum(bool(c.output) for c in COMMANDS) >= 5
+    # every benchmark shows its usage, and every subcommand is shown somewhere
+    for bench in sorted((dc.ROOT / "bench").glob("*.py")):
+        assert any(f"bench/{bench.name}" in t for t in texts), bench.name
+    for name in _subcommands():
+        assert any(t.startswith(f"ipir-mujoco {name}") for t in texts), name
+    # a continued line is one command; quoted output stays with its command
+    simulate = next(c for c in COMMANDS if c.text == "ipir-mujoco simulate" and c.output)
+    assert simulate.output[0].startswith("analytic engine")
+
+
+def test_every_benchmark_has_a_smoke_mode():
+    """Each bench declares --smoke (read from its source: running 20 interpreters is the slow test's job,
+    which runs each bench with it) and says so in its usage."""
+    for bench in sorted((dc.ROOT / "bench").glob("*.py")):
+        source = bench.read_text()
+        assert '"--smoke"' in source, bench.name  # the option in its code (argparse or by hand)
+        assert "--smoke" in (ast.get_docstring(ast.parse(source)) or ""), bench.name
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", COMMANDS, ids=[f"{c.source} {c.text[:60]}" for c in COMMANDS])
+def test_documented_command(command, results):
+    got = results[id(command)]
+    where = f"{command.source}: {got['ran']}"
+    if command.screen and "mujoco.viewer" not in command.text:
+        # without a screen the viewer refuses: one line naming what is missing, exit 2
+        assert got["code"] == 2, where
+        assert len(got["stderr"].strip().splitlines()) == 1 and "screen" in got["stderr"], where
+        return
+    assert got["code"] == 0, f"{where}\nexit {got['code']}\n{got['stderr'][-2000:]}"
+    assert "Traceback" not in got["stderr"], f"{where}\n{got['stderr'][-2000:]}"
+    if got["how"] == "synopsis":
+        missing = [o for o in dc.options_shown(command.text) if o not in got["stdout"]]
+        assert not missing, f"{where}: the synopsis shows {missing}, which --help does not list"
+    elif command.output and not got["how"]:  # run as written: what it prints must hold the quoted lines
+        missing = dc.missing_output(command.output, got["stdout"])
+        assert not missing, f"{where}: quoted but not printed:\n" + "\n".join(missing) + \
+            "\n--- printed:\n" + got["stdout"][-3000:]
