@@ -270,6 +270,7 @@ def _lagrange_rows(p: RobotParams, g1, g2):
 
 @pytest.mark.parametrize("mode", [GripMode.REAR_SKIDS, GripMode.FRONT_SKIDS, GripMode.REAR_SKIDS_FRONT_ROLLS,
                                   GripMode.FRONT_SKIDS_REAR_ROLLS, GripMode.BOTH_SKID])
+@pytest.mark.slow
 def test_skid_mode_accelerations_and_holds_match_symbolic_lagrange(mode):
     """Each skid mode's alpha, a1, a2 and standing module's ground force, against Lagrange's equations
     solved with a skidding module's force +G_i, a rolling one's -F_ri and a standing one's hold unknown

@@ -222,6 +222,7 @@ CASES = [
 
 
 @pytest.mark.parametrize("argv,code,fragment", CASES, ids=[" ".join(c[0])[:60] for c in CASES])
+@pytest.mark.slow
 def test_bad_input_is_one_line_with_the_right_exit_status_and_creates_nothing(capsys, files, argv, code, fragment):
     before = sorted(p.name for p in files.iterdir())
     got, _, err, caught = run_cli(capsys, [a.format(f=files) for a in argv])
@@ -268,6 +269,7 @@ def test_a_run_killed_while_staging_is_cleaned_by_the_next_run(capsys, tmp_path)
     assert not stale.exists() and live.is_dir() and (tmp_path / "out" / "summary.json").is_file()
 
 
+@pytest.mark.slow
 def test_an_existing_output_folder_keeps_what_the_command_did_not_write(capsys, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
@@ -374,6 +376,9 @@ def test_numbers_of_every_numeric_type_are_numbers(value):
      "workers=0"),
     (lambda: _bend_study().run_study(RobotParams(), workers=0), "workers=0"),
     (lambda: _bend_study().run_study(None), "params=None"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", resume="no"), "resume='no'"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", workers=0), "workers=0"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", on_row=3), "on_row=3 is not callable"),
 ])
 def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # a call that wrongly went ahead would write here, and be seen below
@@ -460,6 +465,7 @@ def test_mujoco_never_runs_past_t_end_by_a_sample_interval_it_was_not_given():
 
 @settings(max_examples=EXAMPLES)
 @given(st.text(max_size=40))
+@pytest.mark.slow
 def test_vary_parser_accepts_or_refuses_cleanly(text):
     try:
         axis = parse_vary(text)

@@ -39,6 +39,7 @@ def test_frames_follow_the_playback_speed(short_run):
     assert len(frame_times(short_run, settings, t_end=0.02)) == 3
 
 
+@pytest.mark.slow
 def test_gif_has_the_promised_frames_size_and_clutch_colours(short_run, tmp_path):
     _require_gl()
     from PIL import Image
@@ -66,6 +67,7 @@ def test_gif_has_the_promised_frames_size_and_clutch_colours(short_run, tmp_path
         assert np.count_nonzero((g > r + 50) & (g > b + 50)) > 10
 
 
+@pytest.mark.slow
 def test_render_command_writes_the_video(tmp_path, capsys):
     _require_gl()
     from PIL import Image
@@ -128,6 +130,7 @@ def bend_run():
     return run, route
 
 
+@pytest.mark.slow
 def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_run):
     """Without OpenGL: the drawing model carries the walls the run's model had, and at every frame time (each a
     sample time here, so nothing is interpolated) each module stands at its recorded pose in the plane and the
@@ -183,6 +186,7 @@ def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_ru
     assert math.degrees(s["yaw2"][rows[-1]]) > 2 and s["y2"][rows[-1]] > 2e-3
 
 
+@pytest.mark.slow
 def test_route_frames_draw_the_robot_turning_where_a_straight_replay_does_not(bend_run):
     """The frames follow the recorded pose: at t = 0 (on the axis, unturned) a frame is the frame of a replay with
     y and yaw zeroed, pixel for pixel; at 0.6 s, with the front module turned and off the axis in the bend, they
@@ -206,6 +210,7 @@ def test_route_frames_draw_the_robot_turning_where_a_straight_replay_does_not(be
         next(render_frames(run, settings))
 
 
+@pytest.mark.slow
 def test_render_takes_a_route_for_the_wheeled_model_only(tmp_path, capsys):
     good = tmp_path / "bend.toml"
     good.write_text("".join("[[segment]]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in seg.items())
@@ -263,6 +268,7 @@ def test_viewer_without_a_screen_exits_2(monkeypatch, capsys):
     assert len(err.splitlines()) == 1 and "ipir-mujoco render" in err
 
 
+@pytest.mark.slow
 def test_mechanism_diagram_is_drawn_to_the_parameters(tmp_path):
     from PIL import Image
 
