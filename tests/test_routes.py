@@ -75,6 +75,7 @@ def test_the_closed_form_fits_against_hand_cases():
     assert bend_rod_clearance(1.2, 0.0, 0.5, 0.2) == -math.inf  # longer than the centreline's diameter
 
 
+@pytest.mark.slow
 def test_a_straight_route_runs_as_the_straight_pipe_and_ends_at_its_end():
     """Box walls in place of the planes: the same contacts (capsule against a face at the same distance and
     normal), so the motion is the plane model's to round-off (1e-9 of the travel is far above round-off,
@@ -104,6 +105,7 @@ def test_a_straight_route_runs_as_the_straight_pipe_and_ends_at_its_end():
     assert short.t_end < t_end
 
 
+@pytest.mark.slow
 def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(capsys, tmp_path):
     """A tight bend (R/D 2, 30 degrees): the closed form says the wheels need more spread than their springs
     reach, and MuJoCo's wheels are indeed off their walls for a while; the run either reaches the end or
@@ -141,6 +143,7 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
     assert code == 0 and "module 1 (rear) moved" in out and "m along the route" in out
 
 
+@pytest.mark.slow
 def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monkeypatch):
     """A horizontal pipe with a grip of half the rolling resistance (mu_wall 0.01: 0.5 N against F_r = 1 N): the
     held module cannot hold the other's resistance, the crank turns and the robot gets nowhere; the run stops
