@@ -52,6 +52,7 @@ def test_a_design_failing_the_monitor_is_marked_and_the_others_kept():
     assert recorded["accuracy"]["violations"][0]["figure"] == "residual_ratio"
 
 
+@pytest.mark.slow
 def test_batch_stops_steady_and_stalled_designs():
     designs = [RobotParams(drive="motor"), RobotParams(drive="motor", M_stall=0.02)]
     # one thread: two designs are too few to gain from more, and the suite shares the machine
@@ -64,6 +65,7 @@ def test_batch_stops_steady_and_stalled_designs():
     assert not stalled["steady"] and stalled["series"]["t"][-1] < 1.0
 
 
+@pytest.mark.slow
 def test_batch_halves_an_automatic_step_that_fails(monkeypatch):
     """As a serial run: an automatic step the monitor stops (4e-4 s, residual -7e-3 at the paper's
     case) is halved for that design only, and the design comes back within the tolerance."""

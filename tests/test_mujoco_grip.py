@@ -284,6 +284,7 @@ def test_a_grip_below_the_rolling_resistance_still_never_drags_a_module_forward(
 COMPLIANT = RobotParams(drive="motor", clutch_stiffness=1e6, mu_wall=0.5, F_n1=10.0, F_n2=10.0)
 
 
+@pytest.mark.slow
 def test_a_compliant_clutchs_force_is_capped_by_the_grip_and_its_anchor_slides():
     """Stepping the default motor with an undamped 1e6 N/m clutch on 5 N of grip (0.6 s, at the automatic
     step): the clutch actuator acts on the roll tendon, so what it applies, MuJoCo's actuator_force (no damper:

@@ -28,6 +28,7 @@ def _min_stall(budget=60, verify="mujoco-ratchet"):
                    until_steady=True, budget=budget)
 
 
+@pytest.mark.slow
 def test_smallest_stall_torque_for_half_a_metre_per_second(tmp_path, capsys):
     """(a) The default motor line cruises at 0.5 m/s from M_stall ~ 0.3162 N m (the steady speed rises
     ~0.28 m/s per N m there, so the 0.316..0.321 window is 1.4 mm/s of speed wide): found in <= 60 runs,
@@ -47,6 +48,7 @@ def test_smallest_stall_torque_for_half_a_metre_per_second(tmp_path, capsys):
     assert (tmp_path / "o" / "pareto.png").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_energy_per_metre_depends_on_the_resistances_only(tmp_path, capsys):
     """(b) With rigid clutches at cruise the motor's work per metre is F_r1 + F_r2 whatever L: each
     resistance has half the variance (ST = S1 = 0.5; tolerance: twice SALib's 95 % half-width, about four

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import ast
 import re
 import shutil
@@ -97,6 +99,7 @@ def test_studies_and_report_never_import_the_command_line():
             assert not name.startswith("ipir_mujoco.cli"), f"{layer}/{file} imports {name}"
 
 
+@pytest.mark.slow
 def test_a_local_analytic_module_does_not_shadow_the_package(tmp_path):
     """A user's own analytic.py in the working directory must not break the tool."""
     (tmp_path / "analytic.py").write_text("raise ImportError('this is the user\\'s own module')\n")
@@ -168,6 +171,7 @@ REPOSITORY_ONLY = re.compile(r"(?<![\w/])(README\.md|bench/|tests/|setup\.py|pyp
 DOCUMENT = re.compile(r"(?<![\w/])((?:docs|mjcf)/[\w.-]+\.\w+)")  # a shipped folder's file, as named
 
 
+@pytest.mark.slow
 def test_the_wheel_ships_every_document_the_output_names(tmp_path):
     """Built from a clean copy of the checkout, the wheel holds the user docs (ipir_mujoco/docs) and the MJCF
     folder; every docs/ or mjcf/ file the program's messages, help or report name is in it, their relative
