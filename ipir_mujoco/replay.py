@@ -1,15 +1,15 @@
 """A recorded MuJoCo run put back into a drawing model, at any time of its series (for ``render``).
 
 The series holds what poses the robot: the crank angle ``phi`` and the modules' travel ``x1``, ``x2``; the
-wheeled model's runs (``mujoco-wheels``) also each module's pose in the plane, ``y1``, ``y2``, ``yaw1``,
-``yaw2`` (:mod:`ipir_mujoco.engine.recorder`). Values between samples are interpolated linearly. What the
-series does not hold follows from it:
+wheeled model's runs (``mujoco-wheels``) also each module's pose across the pipe, ``y1/2``, ``z1/2`` and its
+turn ``roll1/2``, ``pitch1/2``, ``yaw1/2`` (:func:`ipir_mujoco.engine.wheels.pose_columns`). Values between
+samples are interpolated linearly. What the series does not hold follows from it:
 
 - the rod's hinge closes the loop: the rod points from its pin on the crank (B) at module 2's pin (C),
   as MuJoCo's loop constraint holds it to within the run's ``loop_gap`` (a few micrometres: far below a pixel);
 - the wheeled model's wheels turn by their module's travel along its own axis over the wheel radius (the
-  run records no hub angles), and their arms stand at the springs' preload (arm slide 0: the springs'
-  whole travel, SPRING_TRAVEL = 0.1 mm, is below a pixel in any frame ``render`` draws).
+  run records no hub angles), and their arms stand at the springs' preload (arm slide 0: a module's sag on its
+  springs, a few millimetres, is drawn by its recorded place; its legs stay at their preload length).
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ from ipir_mujoco.core.results import RunResult
 from .engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, closed_loop_pose,
                            qpos_address)
 
-PLANAR = ("y1", "y2", "yaw1", "yaw2")  # the wheeled model's columns beside x1, x2
+SLIDES_ACROSS = ("y1", "y2", "z1", "z2")  # the wheeled model's columns beside x1, x2: its modules' slides
+TURNS = ("roll", "pitch", "yaw")  # and their ball joints' rotation vectors, roll1 ... yaw2
 
 
 class SlideReplay:
@@ -62,20 +63,23 @@ class SlideReplay:
 
 
 class WheeledReplay(SlideReplay):
-    """The wheeled model's pose at a time of ``run``: each module at its recorded (x, y, yaw), the crank at phi,
+    """The wheeled model's pose at a time of ``run``: each module at its recorded place and turn, the crank at phi,
     the rod closing the loop between the modules as they stand, the wheels turned by their travel (module
-    docstring). ParameterError if the run lacks the planar columns (not a wheeled MuJoCo run)."""
+    docstring). ParameterError if the run lacks the pose columns (not a wheeled MuJoCo run)."""
 
     def __init__(self, model: mujoco.MjModel, run: RunResult):
-        from .engine.wheels_model import LATERALS, WHEEL_NAMES, YAWS
+        from .engine.wheels_model import LATERALS, TILTS, VERTICALS, leg_names
 
-        missing = [c for c in PLANAR if c not in run.series]
+        columns = SLIDES_ACROSS + tuple(f"{turn}{k}" for k in (1, 2) for turn in TURNS)
+        missing = [c for c in columns if c not in run.series]
         if missing:
             raise ParameterError(f"the run's series lacks {', '.join(missing)}; allowed: a run of the wheeled MuJoCo "
-                                 "model (mujoco-wheels), which records each module's pose in the plane")
+                                 "model (mujoco-wheels), which records each module's pose in the pipe")
         super().__init__(model, run)
-        self.address.update({name: qpos_address(model, joint) for name, joint in zip(PLANAR, (*LATERALS, *YAWS))})
-        self.hubs = [[qpos_address(model, n + "_hub") for n in names] for names in WHEEL_NAMES]
+        self.address.update({name: qpos_address(model, joint) for name, joint in
+                             zip(SLIDES_ACROSS, (LATERALS[0], LATERALS[1], VERTICALS[0], VERTICALS[1]))})
+        self.tilts = [qpos_address(model, joint) for joint in TILTS]
+        self.hubs = [[qpos_address(model, n + "_hub") for n in names] for names in leg_names(run.params)]
         s = self.series
         # the x slides' values: a run along a route reads x1, x2 along the route and keeps the modules' world
         # positions (x1_world, x2_world: the module body's place in the template plus its slide)
@@ -85,7 +89,7 @@ class WheeledReplay(SlideReplay):
         else:
             self.slides = [s["x1"], self.front0 + s["x2"]]
         self.travel = [_axial_travel(x, s[f"y{k}"], s[f"yaw{k}"]) for k, x in zip((1, 2), self.slides)]
-        self.crank, self.rod = model.body("crank").id, model.body("rod").id
+        self.rear, self.rod = model.body("rear_module").id, model.body("rod").id
         self.front, self.end = model.body("front_module").id, model.site(ROD_END).id
         self.pin = model.eq_data[model.equality(LOOP).id, 3:6].copy()  # C in module 2's frame
 
@@ -94,24 +98,33 @@ class WheeledReplay(SlideReplay):
         t = self.series["t"]
         data.qpos[a[REAR_SLIDE]] = float(np.interp(when, t, self.slides[0]))
         data.qpos[a[FRONT_SLIDE]] = float(np.interp(when, t, self.slides[1]))
-        for name in PLANAR:
+        for name in SLIDES_ACROSS:
             data.qpos[a[name]] = self.value(name, when)
+        for k, adr in enumerate(self.tilts, start=1):
+            turn = np.array([self.value(f"{name}{k}", when) for name in TURNS])
+            angle = float(np.linalg.norm(turn))
+            quat = np.array([1.0, 0.0, 0.0, 0.0])
+            if angle > 0:
+                mujoco.mju_axisAngle2Quat(quat, turn / angle, angle)
+            data.qpos[adr:adr + 4] = quat
         data.qpos[a[CRANK_HINGE]] = self.value("phi", when)
         data.qpos[a[ROD_HINGE]] = 0.0
         for travel, module in zip(self.travel, self.hubs):
             data.qpos[module] = float(np.interp(when, self.series["t"], travel)) / self.params.wheel_radius
         mujoco.mj_kinematics(m, data)
-        # the rod along the crank (hinge 0) now; turn it to point from B at C
+        # the rod along the crank (hinge 0) now; turn it in module 1's plane to point from B at C
+        frame = data.xmat[self.rear].reshape(3, 3)
         b, tip = data.xpos[self.rod], data.site_xpos[self.end]
         c = data.xpos[self.front] + data.xmat[self.front].reshape(3, 3) @ self.pin
-        turn = math.atan2(c[1] - b[1], c[0] - b[0]) - math.atan2(tip[1] - b[1], tip[0] - b[0])
+        to_c, to_tip = frame.T @ (c - b), frame.T @ (tip - b)
+        turn = math.atan2(to_c[1], to_c[0]) - math.atan2(to_tip[1], to_tip[0])
         data.qpos[a[ROD_HINGE]] = math.remainder(turn, 2 * math.pi)
         mujoco.mj_kinematics(m, data)
 
     def lookat(self, data: mujoco.MjData) -> list[float]:
-        """Midway between the modules' frames (A and C) in the plane, below it."""
-        rear, front = data.xpos[self.model.body("rear_module").id], data.xpos[self.front]
-        return [0.5 * float(rear[0] + front[0]), 0.5 * float(rear[1] + front[1]), -0.02]
+        """Midway between the modules' frames (A and C)."""
+        rear, front = data.xpos[self.rear], data.xpos[self.front]
+        return [0.5 * float(rear[0] + front[0]), 0.5 * float(rear[1] + front[1]), 0.5 * float(rear[2] + front[2])]
 
 
 def _axial_travel(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:

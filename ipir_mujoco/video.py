@@ -181,17 +181,14 @@ def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: f
 def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = False, route=None):
     """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
     ``wheeled``: the wheeled model (its pipe walls and wheels drawn too); ``route``: its walls along the route,
-    built as the run built them (:func:`ipir_mujoco.engine.route_watch.route_decorator`)."""
+    built as the run built them (:func:`ipir_mujoco.engine.wheels_model.build_wheels_spec`)."""
 
     from .engine.model import build_spec
 
     if wheeled:
-        from .engine.route_watch import route_decorator
         from .engine.wheels_model import build_wheels_spec
 
-        spec = build_wheels_spec(params)
-        if route is not None:
-            route_decorator(params, route)(spec)
+        spec = build_wheels_spec(params, route=route)
     else:
         spec = build_spec(params)
         in_pipe(spec, params, view_direction(*SIDE_VIEW))  # the near half cut away

@@ -23,8 +23,9 @@ What a command is:
 - a command that reads a file the pages do not make (``--data run.csv``) runs its ``--help``;
 - anything else runs as written, with these shortenings (said so in docs/cli.md, "Every documented command
   is tested"): a benchmark (``python bench/NAME.py``) gets ``--smoke``, a command that takes ``--quick``
-  gets it, ``--samples`` above 64 and ``--mujoco-samples`` above 2 are cut to that; a shortened command's
-  output is not compared.
+  gets it, ``--samples`` above 64 and ``--mujoco-samples`` above 2 are cut to that, and a command that
+  leaves ``--samples`` or ``--budget`` (where it has them) at its default runs with ``--samples 16``,
+  ``--budget 8``; a shortened command's output is not compared.
 
 Commands of one file run in their order in one scratch folder holding copies of mjcf/ and docs/ and the
 bench/ and tests/ folders (so that ``--out sizing`` then ``python -c ... open('sizing/results.csv')``
@@ -228,12 +229,16 @@ def program(command: str) -> list[str]:
 
 # counts of draws a command's options set, capped by the test: (option, largest value run)
 CAPS = (("--samples", 64), ("--mujoco-samples", 2))
+# where a command's --help offers these and the command leaves them at their defaults: (option, value run)
+DEFAULT_CAPS = (("--samples", 16), ("--budget", 8))
 
 
-def shortened(command: str, takes_quick) -> tuple[str, str]:
+def shortened(command: str, help_of) -> tuple[str, str]:
     """(the command as the test runs it, how it was shortened or ''): benchmarks get --smoke, a command
-    whose program takes --quick (``takes_quick(program(command))``) gets it, and a count of random draws
-    (``--samples N``, ``--mujoco-samples M``) is capped (:data:`CAPS`)."""
+    whose program takes --quick (``help_of(program(command))`` lists it) gets it, a count of random draws
+    (``--samples N``, ``--mujoco-samples M``) is capped (:data:`CAPS`), and where the program offers
+    ``--samples`` or ``--budget`` and the command leaves them at their defaults they are set small
+    (:data:`DEFAULT_CAPS`)."""
     if re.search(r"python3? bench/\w+\.py", command):
         if "--smoke" in command.split():
             return command, "--smoke"
@@ -245,9 +250,16 @@ def shortened(command: str, takes_quick) -> tuple[str, str]:
         if match and int(match.group(1)) > cap and command.startswith("ipir-mujoco "):
             command = command[:match.start(1)] + str(cap) + command[match.end(1):]
             how.append(f"{option} {cap}")
-    if "--quick" not in command.split() and not re.search(r"[|>&]", command) and takes_quick(program(command)):
+    if re.search(r"[|>&]", command) or not command.startswith(("ipir-mujoco ", "python -m ")):
+        return command, ", ".join(how)
+    text = help_of(tuple(program(command)))
+    if "--quick" not in command.split() and "--quick" in text:
         command += " --quick"
         how.append("--quick")
+    for option, value in DEFAULT_CAPS:
+        if re.search(rf"(?<![\w-]){option}(?![\w-])", text) and option not in command.split():
+            command += f" {option} {value}"
+            how.append(f"{option} {value}")
     return command, ", ".join(how)
 
 

@@ -10,6 +10,8 @@ mjcf/README.md.
 
 from __future__ import annotations
 
+import pytest
+
 import numpy as np
 
 from ipir_mujoco.studies.agreement import TIGHT, describe, draw, judge, run_pair
@@ -17,6 +19,7 @@ from ipir_mujoco.studies.agreement import TIGHT, describe, draw, judge, run_pair
 DESIGNS = 40
 
 
+@pytest.mark.slow
 def test_random_designs_agree_within_the_promise_or_are_refused_with_a_reason():
     rng = np.random.default_rng(1)
     verdicts = []

@@ -29,6 +29,7 @@ from ipir_mujoco.studies.sweep_space import parse_vary
     (["--threshold", "-0.01"], "-0.01"),
     (["--budget", "-1"], "budget"),
 ])
+@pytest.mark.slow
 def test_bad_input_exits_2_with_one_line_naming_it(argv, named, tmp_path, capsys):
     out = tmp_path / "atlas"
     assert main(["atlas", "--vary", "L=0.1:0.3", *argv, "--out", str(out)]) == 2
@@ -54,6 +55,7 @@ def _lr_divergence(L: float) -> float:
     return (first - exact) / abs(exact)
 
 
+@pytest.mark.slow
 def test_first_order_crossing_over_L_is_where_the_report_line_crosses_one_percent(tmp_path):
     atlas = Atlas((parse_vary("L=0.06:0.5"),), idealizations=("first-order-kinematics",), metrics=("revolutions",),
                   samples=8, budget=0)
@@ -76,6 +78,7 @@ def test_first_order_crossing_over_L_is_where_the_report_line_crosses_one_percen
         2 * len(rows)
 
 
+@pytest.mark.slow
 def test_costs_are_the_pairs_relative_difference_on_random_designs(tmp_path):
     # every idealization the equations measure, over a box across the envelope; two random rows recomputed
     base = RobotParams(mu_wall=0.6, F_n1=30.0, F_n2=30.0)
@@ -187,3 +190,17 @@ def test_a_folder_another_run_is_writing_is_refused(tmp_path):
         assert not (out / "samples.csv").exists()
     finally:
         lock.release()
+
+
+def test_command_prints_one_line_per_idealization_metric_and_threshold(tmp_path, capsys):
+    out = tmp_path / "cli"
+    assert main(["atlas", "--vary", "L=0.1:0.3", "--idealization", "first-order-kinematics", "--threshold", "0.01",
+                 "--threshold", "0.02", "--samples", "2", "--budget", "0", "--workers", "1", "--out", str(out)]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("first-order-kinematics")]
+    assert len(lines) == 2 * 2  # metrics (revolutions, travel_m) x thresholds
+    saved = json.loads((out / "atlas.json").read_text())["idealizations"]["first-order-kinematics"]
+    for line, (metric, k) in zip(lines, [(m, k) for m in ("revolutions", "travel_m") for k in (0, 1)]):
+        item = saved[metric]["by_threshold"][k]
+        assert metric in line and f"safe in {100 * item['safe_fraction']:.1f} %" in line
+        assert all(f"L={v:.5g}" in line for v in item["crossings"]["L"])
+    assert (out / "atlas_1d.png").is_file() and (out / "atlas_safe.png").is_file()

@@ -43,6 +43,7 @@ def test_set_and_config_reach_the_model(capsys, tmp_path):
     assert record["geometry"] == "exact" and record["t_end"] == 0.3
 
 
+@pytest.mark.slow
 def test_out_writes_csv_summary_and_figures(capsys, tmp_path):
     out_dir = tmp_path / "run"
     code, out, _ = run_cli(capsys, "simulate", "--out", str(out_dir), "--t-end", "0.5")
@@ -93,6 +94,7 @@ def test_out_that_is_a_file_is_bad_input(capsys, tmp_path):
     assert code == 2 and "not a folder" in err and target.read_text() == "keep me"
 
 
+@pytest.mark.slow
 def test_console_script_and_module_behave_the_same(tmp_path):
     script = shutil.which("ipir-mujoco", path=str(Path(sys.executable).parent)) or shutil.which("ipir-mujoco")
     if script is None:

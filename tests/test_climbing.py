@@ -283,6 +283,7 @@ def test_an_incline_outside_plus_minus_90_deg_or_nan_exits_2_in_one_line(argv, f
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.slow
 def test_climb_command_writes_its_study_and_figure(capsys, tmp_path):
     """A constant torque (no bisection: it has no steady state): the restart limit printed is the tool's, a
     stall is a row, and the figure holds the rows' numbers."""
@@ -310,6 +311,7 @@ def test_climb_command_writes_its_study_and_figure(capsys, tmp_path):
     assert lines["restart"].get_xdata()[0] == pytest.approx(study["restart"]["incline_deg"])
 
 
+@pytest.mark.slow
 def test_the_sweep_preset_over_the_incline_runs_end_to_end(capsys, tmp_path):
     """sweep --vary incline=... --drive motor --until-steady with the default engines (MuJoCo batched): every
     design runs, the riser stalls in both, and the steady speeds agree within TARGET."""

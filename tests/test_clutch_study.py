@@ -45,6 +45,7 @@ def rows(study, backlash):
                   key=lambda r: r["clutch_stiffness_n_m"])
 
 
+@pytest.mark.slow
 def test_rows_agree_between_the_engines(first_engagements, cruise):
     """The tolerance tests/test_mujoco_compliant.py derives and holds at these stiffnesses (1e5..1e7 N/m, 0 and
     1 mm of play, the paper's start and the default motor's cruise, MuJoCo at its automatic step): revolutions,
@@ -91,6 +92,7 @@ def test_a_damped_analytic_peak_does_not_depend_on_the_output_grid():
     assert peak == pytest.approx(metrics["peak_clutch_force_n"], rel=bound, abs=0)
 
 
+@pytest.mark.slow
 def test_the_rigid_limit_is_approached_at_rate_one_over_k(first_engagements):
     """No play: each engine's revolutions differ from its own rigid clutch's (MuJoCo: its ratchet at the same
     step, so the stepping errors cancel) as C/k, the regular perturbation tests/test_compliant_clutch.py and
@@ -128,6 +130,7 @@ def impact_shares(study, engine):
 
 
 @pytest.mark.parametrize("engine", ["analytic", "mujoco"])
+@pytest.mark.slow
 def test_with_play_the_peak_force_is_an_impact_growing_as_sqrt_k(first_engagements, engine):
     """A mass m_eff pressed by a load Q onto a spring at speed v0 peaks at F = Q + sqrt(Q^2 + k m_eff v0^2):
     finite, and its log-log slope in k is 0.5 (1 - Q / (F - Q)), rising to 1/2 as the impact dominates. The
@@ -151,6 +154,7 @@ def test_with_play_the_peak_force_is_an_impact_growing_as_sqrt_k(first_engagemen
 
 
 @pytest.mark.parametrize("engine", ["analytic", "mujoco"])
+@pytest.mark.slow
 def test_without_play_the_peak_force_tends_to_twice_the_rigid_jump(first_engagements, engine):
     """No play: where the rigid clutch's reaction jumps from 0 to R_jump, the spring takes a suddenly applied load
     R_jump - F_r1 and an undamped spring peaks at twice that, 2 (R_jump - F_r1), for every k; it falls short by the
@@ -169,6 +173,7 @@ def test_without_play_the_peak_force_tends_to_twice_the_rigid_jump(first_engagem
     assert scaling[(0.0, engine)]["slope_stiff"] < 0.1 < 0.45 < scaling[(1e-3, engine)]["slope_stiff"]
 
 
+@pytest.mark.slow
 def test_the_analytic_peak_force_is_a_sample_whatever_the_output_grid():
     """Without damping the clutch force k d peaks where the module turns (d' = -v), which ends a segment: the
     peak is sampled exactly on any output grid. With damping it peaks between the turning points; the run
@@ -186,6 +191,7 @@ def test_the_analytic_peak_force_is_a_sample_whatever_the_output_grid():
     assert peak(damped, grid) == pytest.approx(fine, rel=(clutch_rate(damped) * grid) ** 2 / 8)
 
 
+@pytest.mark.slow
 def test_the_figure_draws_the_rows_of_both_engines_and_the_rigid_limit(first_engagements, cruise):
     fig = study_figure(first_engagements)
     (ax,) = fig.axes
@@ -211,6 +217,7 @@ def test_the_figure_draws_the_rows_of_both_engines_and_the_rigid_limit(first_eng
     assert not any("rigid analytic" in text.get_text() for text in ax.texts)
 
 
+@pytest.mark.slow
 def test_the_figure_reads_right_its_legend_lists_only_what_is_drawn(first_engagements, cruise):
     """Every legend entry has a drawn artist of its look, axes have units, no note lies over data: on the
     full grid with marked designs, and where a backlash has one design only (a colour without a curve is
@@ -232,6 +239,7 @@ def test_the_figure_reads_right_its_legend_lists_only_what_is_drawn(first_engage
 
 
 
+@pytest.mark.slow
 def test_the_command_writes_its_files_and_prints_the_table(capsys, tmp_path):
     out = tmp_path / "study"
     code, stdout, stderr = run_cli(capsys, "clutch-study", "--stiffness", "1e5", "--backlash", "0,1e-3",

@@ -75,6 +75,7 @@ def test_a_crank_that_does_not_turn_forward_has_no_angle_grid():
     assert compare_runs(rocking, rocking)["angle_grid"] is None
 
 
+@pytest.mark.slow
 def test_compare_command_on_two_run_folders(tmp_path, capsys):
     for name, extra in (("a", []), ("b", ["--geometry", "exact"])):
         assert main(["simulate", "--t-end", "0.5", "--out", str(tmp_path / name), *extra]) == 0

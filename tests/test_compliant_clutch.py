@@ -28,6 +28,7 @@ def travel(summary):
     return 0.5 * (summary["x1_final"] + summary["x2_final"])
 
 
+@pytest.mark.slow
 def test_converges_to_the_rigid_one_way_clutch_at_rate_one_over_k():
     """With no backlash a module meets its clutch at zero speed (the rigid model's velocity reaches zero
     continuously: no impact). The compliant model is then a regular perturbation of the rigid one in
@@ -186,6 +187,7 @@ def test_without_backlash_the_peak_force_tends_to_twice_the_rigid_jump():
 
 
 @pytest.mark.parametrize("damping, backlash", [(30.0, 0.0), (300.0, 0.0), (300.0, 1e-4)])
+@pytest.mark.slow
 def test_a_damped_clutchs_peak_force_does_not_depend_on_the_output_grid(damping, backlash):
     """With damping the clutch force k d - c v peaks between the module's turning points, so between
     samples: on the 1e-4 s grid it read 1.2e-3 low at 1e7 N/m and 300 N s/m ((omega_c dt_out)^2 / 8 with
@@ -199,6 +201,7 @@ def test_a_damped_clutchs_peak_force_does_not_depend_on_the_output_grid(damping,
     assert peaks[0] == pytest.approx(peaks[1], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_with_backlash_the_peak_force_is_an_impact_growing_as_sqrt_k():
     """With play the module crosses it and hits its clutch at a speed v0 that k does not change. A mass
     m_eff pressed by a load Q hitting a spring at v0 compresses it to k d_max = Q + sqrt(Q^2 + k m_eff v0^2):
@@ -238,6 +241,7 @@ finite = dict(allow_nan=False, allow_infinity=False)
        log_k=st.floats(3, 7.5, **finite), damping=st.sampled_from([0.0, 30.0]),
        backlash=st.floats(0, 0.025, **finite), drive=st.sampled_from(["torque", "motor"]),
        incline=st.floats(-90, 90, **finite), geometry=st.sampled_from(["approx", "exact"]))
+@pytest.mark.slow
 def test_properties_over_a_wide_range_of_designs(m1, m2, ratio, F_r1, F_r2, M, phi0, omega0, log_k, damping, backlash,
                                                  drive, incline, geometry):
     params = RobotParams(m1=m1, m2=m2, L=0.05 * ratio, F_r1=F_r1, F_r2=F_r2, M=M, phi0=phi0, omega0=omega0,

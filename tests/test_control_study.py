@@ -25,6 +25,7 @@ def _row(study, controller, variant):
     return next(r for r in study["rows"] if r["controller"] == controller and r["variant"] == variant)
 
 
+@pytest.mark.slow
 def test_every_run_settles_and_the_open_loop_matches_the_speed(study):
     for r in study["rows"] + study["profile"]["rows"]:
         assert "error" not in r and r["steady"], r
@@ -36,6 +37,7 @@ def test_every_run_settles_and_the_open_loop_matches_the_speed(study):
             assert r["mean_omega_rad_s"] == pytest.approx(10.0, rel=0.01)  # the servo holds its target
 
 
+@pytest.mark.slow
 def test_feedback_and_the_exact_feedforward_shrink_the_ripple_on_the_real_linkage(study):
     for variant in ("analytic-unilateral", "mujoco-ratchet"):
         ripple = {c: _row(study, c, variant)["speed_ripple"] for c in cs.CONTROLLERS}
@@ -43,12 +45,14 @@ def test_feedback_and_the_exact_feedforward_shrink_the_ripple_on_the_real_linkag
         assert ripple["pi+exact"] < ripple["pi+paper"]
 
 
+@pytest.mark.slow
 def test_the_paper_feedforward_delivers_less_than_it_promised(study):
     promised = _row(study, "pi+paper", "analytic-approx-unilateral")["speed_ripple"]
     for variant in ("analytic-unilateral", "mujoco-ratchet"):
         assert _row(study, "pi+paper", variant)["speed_ripple"] > 2 * promised
 
 
+@pytest.mark.slow
 def test_the_engines_agree_on_every_servo_run(study):
     # both engines hold the same speed; their ripples agree to the sampling of MuJoCo's 1 ms output and the
     # controller's ticks landing on its steps (a tenth of the ripple at most)
@@ -59,18 +63,21 @@ def test_the_engines_agree_on_every_servo_run(study):
         assert m["electrical_energy_per_metre_j_m"] == pytest.approx(a["electrical_energy_per_metre_j_m"], rel=3e-3)
 
 
+@pytest.mark.slow
 def test_mujoco_leaves_its_rigid_ratchets_peaks_out(study):
     for r in study["rows"] + study["profile"]["rows"]:
         missing = r["peak_clutch_force_n"] is None and r["peak_module_accel_m_s2"] is None
         assert missing == (r["variant"] == "mujoco-ratchet")
 
 
+@pytest.mark.slow
 def test_the_energy_drawn_covers_the_work_at_the_crank(study):
     # the winding's loss tau^2 omega_noload / M_stall >= 0: what the motor draws is at least its work
     for r in study["rows"] + study["profile"]["rows"]:
         assert r["electrical_energy_per_metre_j_m"] >= r["energy_per_metre_j_m"] * (1 - 1e-3)
 
 
+@pytest.mark.slow
 def test_files_and_figure(study, tmp_path):
     write_csv(tmp_path / FILES[0], study)
     with open(tmp_path / FILES[0], newline="") as handle:

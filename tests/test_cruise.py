@@ -58,6 +58,7 @@ def runs():
 
 
 @pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
+@pytest.mark.slow
 def test_mujoco_agrees_with_the_equations_of_its_mechanism_at_steady_state(runs, pair):
     equations, mujoco = runs[pair]
     for run in (equations, mujoco):
@@ -73,6 +74,7 @@ def test_mujoco_agrees_with_the_equations_of_its_mechanism_at_steady_state(runs,
 
 
 @pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
+@pytest.mark.slow
 def test_the_energy_audit_closes_over_the_steady_revolutions(runs, pair):
     """Motor work = work against the resistances + kinetic energy gained, per revolution (core.cycles)."""
     for run in runs[pair]:
@@ -105,6 +107,7 @@ def _held_after_engagement(run, start: float) -> np.ndarray:
 
 
 @pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
+@pytest.mark.slow
 def test_mujocos_held_reaction_is_the_equations_after_engagement(runs, pair):
     """The peak clutch reaction is not held to TOL: MuJoCo's soft clutch overshoots for a step or two where
     it engages (left out here: the first sample of each hold). Both engines split a held module's hold
@@ -160,6 +163,7 @@ def test_a_motor_too_weak_to_reach_the_dead_centre_is_reported_stalled(capsys, e
     assert f"stalled: {s['stall_reason']}" in text and "steady state            not reached" in text
 
 
+@pytest.mark.slow
 def test_a_sweep_to_steady_state_under_the_motor(tmp_path, capsys):
     """Both engines (MuJoCo batched), steady columns, a stalled design marked (not failed), rankings."""
     out = tmp_path / "sweep"
@@ -195,6 +199,7 @@ def test_a_sweep_to_steady_state_under_the_motor(tmp_path, capsys):
     assert (out / "sweep_heatmap.png").is_file()
 
 
+@pytest.mark.slow
 def test_compare_shows_the_steady_state_with_units(runs):
     equations, mujoco = runs["one-way"]
     text = format_comparison(compare_runs(equations, mujoco))
@@ -213,6 +218,7 @@ def study():
     return cruise.cruise_study(RobotParams(), quick=True, workers=1)
 
 
+@pytest.mark.slow
 def test_every_rung_reaches_its_steady_state_and_the_study_records_the_runs(study, runs):
     records = {r["name"]: r for r in study["rungs"]}
     assert list(records) == [r.name for r in cruise.RUNGS]
@@ -240,6 +246,7 @@ def test_every_rung_reaches_its_steady_state_and_the_study_records_the_runs(stud
 
 
 @pytest.mark.parametrize("pair", ["paper's rule", "one-way"])
+@pytest.mark.slow
 def test_the_study_reads_mujocos_peak_clutch_reaction_at_every_step(study, runs, pair):
     """A rigid MuJoCo clutch engages within a few steps; read every 1 ms its peak reaction is whichever step a
     sample hits (at the default cruise 11.96 N for the ratchet and 95.0 N for the lock, both below the
@@ -255,6 +262,7 @@ def test_the_study_reads_mujocos_peak_clutch_reaction_at_every_step(study, runs,
     assert record["peak_clutch_force_n"] > runs[pair][0].summary["peak_clutch_force_n"]
 
 
+@pytest.mark.slow
 def test_the_report_section_says_what_the_paper_gets_wrong_at_cruise(study, tmp_path):
     from ipir_mujoco.report import cruise_section
     from ipir_mujoco.report.document import Image, Table, to_markdown

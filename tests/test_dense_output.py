@@ -60,6 +60,7 @@ def kernel_variants(function):
 
 
 @pytest.mark.parametrize("case", range(3))
+@pytest.mark.slow
 def test_the_compiled_dense_output_is_numpys(case):
     """Many times at once (grid points inside steps, step ends, times before and after the segment) through the
     compiled loop, its Python source and numpy's gather: the same floats. One time through the scalar path and

@@ -70,9 +70,10 @@ def help_text(prog: tuple[str, ...]) -> tuple[int, str]:
     return done.returncode, done.stdout + done.stderr
 
 
-def takes_quick(prog) -> bool:
+def help_of(prog) -> str:
+    """A program's --help text ('' if it has none)."""
     code, text = help_text(tuple(prog))
-    return code == 0 and "--quick" in text
+    return text if code == 0 else ""
 
 
 def scratch(folder: Path) -> Path:
@@ -102,12 +103,17 @@ def run_group(commands: list[dc.Command], folder: Path) -> dict[int, dict]:
             out[id(command)] = dict(ran=" ".join(prog) + " --help", how=f"needs {', '.join(missing)}", code=code,
                                     stdout=text, stderr="")
             continue
-        ran, how = dc.shortened(command.text, takes_quick)
+        ran, how = dc.shortened(command.text, help_of)
         if "mujoco.viewer" in command.text:  # MuJoCo's own viewer needs a screen: load the file it opens
             path = command.text.split("--mjcf", 1)[1].split()[0]
             ran, how = f"python -c 'import mujoco; mujoco.MjModel.from_xml_path(\"{path}\")'", "loads the model"
         started = time.monotonic()
-        done = run(ran, folder)
+        try:
+            done = run(ran, folder)
+        except subprocess.TimeoutExpired as exc:  # this command's failure, not the others'
+            out[id(command)] = dict(ran=ran, how=how, code=None, stdout=exc.stdout or "",
+                                    stderr=f"timed out after {TIMEOUT_S} s", seconds=TIMEOUT_S)
+            continue
         out[id(command)] = dict(ran=ran, how=how, code=done.returncode, stdout=done.stdout, stderr=done.stderr,
                                 seconds=time.monotonic() - started)
     return out

@@ -150,6 +150,7 @@ print(json.dumps(out))
 
 
 @pytest.mark.skipif(not ACCELERATED, reason="the kernels are not compiled (numba missing, or IPIR_MUJOCO_JIT=0): one path only")
+@pytest.mark.slow
 def test_compiled_and_python_paths_give_the_same_runs():
     """The same stepper source, compiled by numba here and run as Python in a child process
     (IPIR_MUJOCO_JIT=0): every series column agrees to 1e-12 of its largest value. Both paths do the
@@ -175,6 +176,7 @@ def test_compiled_and_python_paths_give_the_same_runs():
         assert math.isfinite(run.energy["residual_j"])
 
 
+@pytest.mark.slow
 def test_a_short_run_never_loads_numba_and_a_long_one_goes_on_compiled_with_the_same_floats():
     """By default (IPIR_MUJOCO_JIT unset) a process compiles the kernels only once its runs have spent
     accel.LOAD_COST_S in Python: a default simulate (6 ms of work compiled, about 70 ms in Python on an idle

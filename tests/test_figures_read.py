@@ -64,6 +64,7 @@ def _grip_metrics() -> dict:
             "riser": {"mu": 0.5, "needed_n": [41.4, 41.4], "press_n": {"drive_off": [19.6, 19.9]}}}
 
 
+@pytest.mark.slow
 def test_finite_grip_figure_labels_its_log_axis_and_its_table_says_each_runs_time(tmp_path):
     from ipir_mujoco.report import grip_section
     from ipir_mujoco.report.document import Table

@@ -270,6 +270,7 @@ def _lagrange_rows(p: RobotParams, g1, g2):
 
 @pytest.mark.parametrize("mode", [GripMode.REAR_SKIDS, GripMode.FRONT_SKIDS, GripMode.REAR_SKIDS_FRONT_ROLLS,
                                   GripMode.FRONT_SKIDS_REAR_ROLLS, GripMode.BOTH_SKID])
+@pytest.mark.slow
 def test_skid_mode_accelerations_and_holds_match_symbolic_lagrange(mode):
     """Each skid mode's alpha, a1, a2 and standing module's ground force, against Lagrange's equations
     solved with a skidding module's force +G_i, a rolling one's -F_ri and a standing one's hold unknown
@@ -341,12 +342,20 @@ def test_bad_grip_input_is_refused_with_one_line(values, fragment):
 
 @pytest.mark.parametrize("params,clutch,fragment", [
     (RobotParams(mu_wall=0.5), "kinematic", "mu_wall=0.5 with clutch='kinematic'"),
-    (RobotParams(F_n1=30.0), "unilateral", "F_n1=30.0 N needs a finite mu_wall"),
 ])
 def test_the_analytic_engine_refuses_what_it_would_ignore(params, clutch, fragment):
     with pytest.raises(ParameterError, match=fragment) as caught:
         analytic.simulate(params, "exact", clutch, 0.1)
     assert "\n" not in str(caught.value)
+
+
+def test_the_press_is_settable_with_unlimited_grip_and_moves_nothing_there():
+    """F_n1, F_n2 are the wheeled MuJoCo model's leg preload whatever mu_wall is, so they are taken with
+    unlimited grip too; the analytic model's unlimited grip holds any force, so they change none of its figures."""
+    plain = analytic.simulate(RobotParams(), "exact", "unilateral", 0.1)
+    pressed = analytic.simulate(RobotParams(F_n1=30.0, F_n2=80.0), "exact", "unilateral", 0.1)
+    for key in ("x1_final", "x2_final", "revolutions"):
+        assert pressed.summary[key] == plain.summary[key]
 
 
 def test_engines_without_grip_columns_summarize():

@@ -203,10 +203,26 @@ CASES = [
     (["simulate", "--engine", "mujoco", "--mjcf", "/dev/zero"], 2, "is not a regular file"),
     # output folders: a name the command writes, taken by another kind of entry
     (["simulate", "--t-end", "0.01", "--out", "{f}/clash"], 2, "clash/summary.json' is a folder, where"),
+    # round 3: the studies check every option before the first design
+    (["sweep", "--vary", "L=log", "--out", "{f}/s"], 2, "--vary 'L=log' is malformed"),
+    (["sweep", "--vary", "L=0.1:0.2:3:4", "--out", "{f}/s"], 2, "--vary 'L=0.1:0.2:3:4' is malformed"),
+    (["optimize", "--vary", "L=log", "--objective", "max:mean_speed_m_s", "--out", "{f}/o"], 2, "is malformed"),
+    (["sensitivity", "--vary", "L=log", "--metric", "mean_speed_m_s", "--out", "{f}/o"], 2, "is malformed"),
+    (["optimize", "--vary", "L=0.1:0.3", "--objective", "max:drive", "--out", "{f}/o"], 2,
+     "'drive' is not a number"),
+    (["optimize", "--vary", "L=0.1:0.3", "--objective", "max:mean_speed_m_s", "--constraint", "L<0.2",
+      "--out", "{f}/o"], 2, "--constraint 'L<0.2' does not parse"),
+    (["optimize", "--vary", "L=0.1:0.3", "--objective", "max:mean_speed_m_s", "--workers", "0", "--out", "{f}/o"],
+     2, "--workers 0"),
+    (["sensitivity", "--vary", "L=0.1:0.3", "--metric", "feedforward", "--out", "{f}/o"], 2,
+     "'feedforward' is not a number"),
+    (["sweep", "--vary", "L=0.1,0.2", "--resume", "--out", "{f}/swp_garbage/results.csv"], 2, "is not a folder"),
+    (["render", "--t-end", "0.1", "--out", "/sys/ipir-mujoco-test/x.gif"], 2, "cannot write in"),
 ]
 
 
 @pytest.mark.parametrize("argv,code,fragment", CASES, ids=[" ".join(c[0])[:60] for c in CASES])
+@pytest.mark.slow
 def test_bad_input_is_one_line_with_the_right_exit_status_and_creates_nothing(capsys, files, argv, code, fragment):
     before = sorted(p.name for p in files.iterdir())
     got, _, err, caught = run_cli(capsys, [a.format(f=files) for a in argv])
@@ -253,6 +269,7 @@ def test_a_run_killed_while_staging_is_cleaned_by_the_next_run(capsys, tmp_path)
     assert not stale.exists() and live.is_dir() and (tmp_path / "out" / "summary.json").is_file()
 
 
+@pytest.mark.slow
 def test_an_existing_output_folder_keeps_what_the_command_did_not_write(capsys, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
@@ -335,11 +352,77 @@ def test_numbers_of_every_numeric_type_are_numbers(value):
     (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), 3), "out=3"),
     (lambda: registry.run("mujoco-ratchet", RobotParams(), timestep="x"), "timestep='x' is not a number"),
     (lambda: check_step_count(1.0, 1e-12), "would take 1e+12 MuJoCo steps"),
+    # round 3: every public entry point
+    (lambda: registry.run("analytic-approx", None, 0.1), "params=None is not a RobotParams"),
+    (lambda: registry.run("analytic-approx", {"L": 0.2}, 0.1), "params={'L': 0.2} is not a RobotParams"),
+    (lambda: registry.run("mujoco-ratchet", RobotParams(), 0.01, foo=1), "option foo=1 is unknown"),
+    (lambda: registry.run("mujoco-ratchet", RobotParams(), 0.01, every_step="yes"), "every_step='yes' is not a bool"),
+    (lambda: registry.run_batch("mujoco-ratchet", [RobotParams()], 0.01, 1e-3, nthread=0), "nthread=0"),
+    (lambda: registry.run_batch("mujoco-ratchet", RobotParams(), 0.01, 1e-3), "is not a list of RobotParams"),
+    (lambda: _optimize().Constraint("L", "<", 0.2), "Constraint op='<' is not allowed"),
+    (lambda: _optimize().Constraint("L", "<=", float("nan")), "Constraint value=nan"),
+    (lambda: _optimize().Objective("best", "L"), "Objective sense='best'"),
+    (lambda: _optimize().Objective("max", "drive"), "'drive' is not a number"),
+    (lambda: _optimize().Problem("L=0.1:0.3", (_optimize().Objective("max", "revolutions"),)),
+     "Problem axes='L=0.1:0.3' is not a tuple of Axis"),
+    (lambda: _optimize().Problem((parse_vary("L=0.1:0.3"),), "max:revolutions"),
+     "Problem objectives='max:revolutions' is not a tuple of Objective"),
+    (lambda: _optimize().run_optimize(_problem(), "o", workers=0), "workers=0"),
+    (lambda: _optimize().run_optimize(_problem(), "o", resume="yes"), "resume='yes'"),
+    (lambda: _sensitivity().run_sensitivity("L=0.1:0.3", ("revolutions",), "o"), "axes='L=0.1:0.3'"),
+    (lambda: _sensitivity().run_sensitivity((parse_vary("L=0.1:0.3"),), "revolutions", "o"),
+     "metrics='revolutions' is not a tuple"),
+    (lambda: _sensitivity().run_sensitivity((parse_vary("L=0.1:0.3"),), ("revolutions",), "o", workers=0),
+     "workers=0"),
+    (lambda: _bend_study().run_study(RobotParams(), workers=0), "workers=0"),
+    (lambda: _bend_study().run_study(None), "params=None"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", resume="no"), "resume='no'"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", workers=0), "workers=0"),
+    (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", on_row=3), "on_row=3 is not callable"),
 ])
-def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment):
+def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a call that wrongly went ahead would write here, and be seen below
     with pytest.raises(ParameterError) as info:
         call()
     assert fragment in str(info.value) and "\n" not in str(info.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def _optimize():
+    from ipir_mujoco.studies import optimize
+
+    return optimize
+
+
+def _sensitivity():
+    from ipir_mujoco.studies import sensitivity
+
+    return sensitivity
+
+
+def _bend_study():
+    from ipir_mujoco.studies import bend_study
+
+    return bend_study
+
+
+def _problem():
+    o = _optimize()
+    return o.Problem((parse_vary("L=0.1:0.3"),), (o.Objective("max", "revolutions"),), budget=2, verify=None)
+
+
+@pytest.mark.parametrize("call", [
+    lambda: registry.run("analytic-approx", None, 0.1),
+    lambda: registry.run("mujoco-ratchet", RobotParams(), 0.01, foo=1),
+    lambda: _optimize().Problem("L=0.1:0.3", (_optimize().Objective("max", "revolutions"),)),
+    lambda: run_sweep("x", "sweep"),
+])
+def test_a_wrong_type_is_both_a_parameter_error_and_a_type_error(call):
+    """docs/cli.md, 'From Python': one except ValueError catches every bad input; a wrong type is a TypeError
+    too, as Python users expect."""
+    with pytest.raises(ParameterError) as info:
+        call()
+    assert isinstance(info.value, TypeError) and isinstance(info.value, ValueError)
 
 
 @pytest.mark.parametrize("keywords,fragment", [
@@ -382,6 +465,7 @@ def test_mujoco_never_runs_past_t_end_by_a_sample_interval_it_was_not_given():
 
 @settings(max_examples=EXAMPLES)
 @given(st.text(max_size=40))
+@pytest.mark.slow
 def test_vary_parser_accepts_or_refuses_cleanly(text):
     try:
         axis = parse_vary(text)

@@ -38,6 +38,7 @@ def backward_travel_while_skidding(x: np.ndarray, wheels: np.ndarray) -> tuple[f
 
 
 @pytest.mark.parametrize("variant,extra", RUNS)
+@pytest.mark.slow
 def test_every_engine_reads_its_grip_keys_by_the_one_definition(variant, extra):
     params = RobotParams(**SKIDDING, **extra)
     run = registry.run(variant, params, T_END, dt_out=1e-3)

@@ -115,7 +115,7 @@ SWEEP = ["sweep", "--vary", "L=0.1:0.3:10", "--t-end", "0.3"]
     (["--engines", "analytic-unilateral", "--workers", "2"], {}),
     (["--engines", "mujoco-ratchet", "--no-batch", "--workers", "1"], {}),
     (["--engines", "mujoco-ratchet", "--no-batch", "--workers", "1"], {"IPIR_MUJOCO_STEPPER": "python"}),
-], ids=["analytic pool", "mujoco compiled main process", "mujoco python loop"])
+], ids=["analytic pool", "mujoco compiled loop", "mujoco python loop"])
 def test_sweep_interrupted_then_resumed_gives_the_uninterrupted_rows(tmp_path, extra, env, capsys, monkeypatch):
     out, reference = tmp_path / "sweep", tmp_path / "reference"
     code, after, sent = interrupt_after([*SWEEP, *extra, "--out", out], "sweep 3/10", tmp_path, env)

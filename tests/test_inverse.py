@@ -60,6 +60,7 @@ def test_mujoco_servo_needs_the_same_torque(inverse_run):
     assert np.max(np.abs(mj["phi"] - OMEGA * mj["t"])) < 2 * np.abs(expected).max() / servo.kp
 
 
+@pytest.mark.slow
 def test_sampled_motion_of_a_forward_run_needs_its_constant_torque():
     """Round trip: a forward run's phi(t), given as samples, must need the run's own torque M."""
     forward = analytic.simulate(PARAMS, "exact", "kinematic", 0.3, dt_out=1e-4).series
@@ -80,6 +81,7 @@ def test_prescribed_motion_is_validated():
         CrankMotion.from_samples([0, 1], [0, 1])
 
 
+@pytest.mark.slow
 def test_kinetostatics_command(tmp_path, capsys):
     out = tmp_path / "k"
     assert main(["kinetostatics", "--omega", "30", "--clutch", "unilateral", "--out", str(out)]) == 0

@@ -56,6 +56,7 @@ def steady_runs():
 
 
 @pytest.mark.parametrize("clutch", ["kinematic", "unilateral"])
+@pytest.mark.slow
 def test_the_default_motor_reaches_steady_state_and_stops_there(steady_runs, clutch):
     run = steady_runs[clutch]
     s, summary = run.series, run.summary
@@ -78,6 +79,7 @@ def test_the_default_motor_reaches_steady_state_and_stops_there(steady_runs, clu
 
 
 @pytest.mark.parametrize("clutch", ["kinematic", "unilateral"])
+@pytest.mark.slow
 def test_each_revolution_closes_its_energy_audit(steady_runs, clutch):
     """Motor work = friction work + kinetic energy gained, per revolution (core.cycles)."""
     run = steady_runs[clutch]

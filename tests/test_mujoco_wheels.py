@@ -1,15 +1,19 @@
-"""The wheeled MuJoCo model (``--mujoco-model wheels``): MuJoCo's own arrays say the wheels press with F_n, roll
-against F_r and never pull outside their friction cone; in a straight pipe it crawls as the analytic
-finite-grip model does, and skids in a riser as it does.
+"""The wheeled MuJoCo model, a 3-D robot on sprung wheel legs in a round pipe (``--mujoco-model wheels``):
+MuJoCo's own arrays say the legs press the wall with F_n as the weight sags the modules, the wheels roll
+against F_r and never pull outside their friction cone; the closed-form lift-off check matches MuJoCo's legs
+under weight; in a straight pipe it crawls as the analytic finite-grip model does and skids in a riser as it
+does; unlimited grip never skids.
 
-Tolerances are derived where they are used: an arm's static balance (spring against contact), the friction
-cone's own bound, the wheels' rolling inertia (the one mass term the analytic model lacks) plus the
-MuJoCo monitor's 0.1 % target, and MuJoCo's discretization error bounded by the change on halving its step.
+Tolerances are derived where they are used: linear springs on evenly spaced legs (their outward directions sum
+to zero), the friction cone's own bound, the wheels' rolling inertia (the one mass term the analytic model
+lacks) plus the MuJoCo monitor's 0.1 % target, and MuJoCo's discretization error bounded by the change on
+halving its step.
 """
 
 from __future__ import annotations
 
 import json
+import math
 
 import mujoco
 import numpy as np
@@ -17,20 +21,21 @@ import pytest
 
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams
+from ipir_mujoco.core.pipe import leg_direction, lift_check
 from ipir_mujoco.engine.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
 from ipir_mujoco.engine.monitor import RESIDUAL_TOL
-from ipir_mujoco.engine.wheels import WheelRatchet
-from ipir_mujoco.engine.wheels_model import (HUBS, WALLS, WHEEL_NAMES, WHEEL_SHARE, WHEELS_PER_MODULE,
-                                             build_wheels_model, set_wheels_state)
+from ipir_mujoco.engine.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
+                                            leg_stiffness, sag, set_wheels_state)
+from ipir_mujoco.engine.wheels import WheelRatchet, leg_press
 
 from cli_run import run_cli
 
-CRUISE = RobotParams(drive="motor", mu_wall=0.8)  # the acceptance case: F_n = 50 N, grip 40 N per module
+CRUISE = RobotParams(drive="motor", mu_wall=0.5)  # F_n = 50 N, grip 25 N per module
 RISER = RobotParams(drive="motor", mu_wall=0.18, incline=90.0)  # grip 9 N per module against a weight of 9.81 N
 
 
-def by_hand(p: RobotParams, dt: float = 1e-4):
-    model = build_wheels_model(p, SolverSettings(timestep=dt))
+def by_hand(p: RobotParams, dt: float | None = None):
+    model = build_wheels_model(p, None if dt is None else SolverSettings(timestep=dt))
     data = mujoco.MjData(model)
     set_wheels_state(model, data, p)
     data.ctrl[model.actuator(MOTOR).id] = drive_control(p)
@@ -38,160 +43,220 @@ def by_hand(p: RobotParams, dt: float = 1e-4):
     return model, data, WheelRatchet(model, data, p)
 
 
-def module_contacts(model, data) -> tuple[np.ndarray, np.ndarray]:
-    """Per module, the normal forces and tangential force magnitudes [N] of its contacts (mj_contactForce)."""
-    owner = {model.geom(n + "_wheel").id: i for i, names in enumerate(WHEEL_NAMES) for n in names}
-    normal, tangential = np.zeros(2), np.zeros(2)
+def contact_forces(model, data, p) -> np.ndarray:
+    """Each leg's wheel's contact normal force [N] (mj_contactForce), shape (2, 2 wheel_legs), rear first."""
+    legs = leg_names(p)
+    where = {model.geom(n + "_wheel").id: (i, j) for i, names in enumerate(legs) for j, n in enumerate(names)}
+    out = np.zeros((2, len(legs[0])))
     force = np.zeros(6)
     for c in range(data.ncon):
-        con = data.contact[c]
-        i = owner.get(int(con.geom[0]), owner.get(int(con.geom[1])))
-        mujoco.mj_contactForce(model, data, c, force)
-        normal[i] += force[0]
-        tangential[i] += np.hypot(force[1], force[2])
-    return normal, tangential
+        g = data.contact.geom[c]
+        key = where.get(int(g[0]), where.get(int(g[1])))
+        if key is not None:
+            mujoco.mj_contactForce(model, data, c, force)
+            out[key] += force[0]
+    return out
 
 
 def test_the_compiled_model_holds_the_parameters():
-    p = RobotParams(F_n1=40.0, F_n2=60.0, F_r1=1.0, F_r2=2.0, mu_wall=0.6, wheel_radius=0.02, pipe_diameter=0.2)
+    p = RobotParams(F_n1=40.0, F_n2=60.0, F_r1=1.0, F_r2=2.0, mu_wall=0.6, wheel_radius=0.02, pipe_diameter=0.2,
+                    wheel_legs=4, suspension_travel=0.004, ring_spacing=0.12)
     m = build_wheels_model(p)
-    for i, names in enumerate(WHEEL_NAMES):
+    legs = leg_names(p)
+    for i, names in enumerate(legs):
+        assert len(names) == 2 * 4  # two rings of wheel_legs
         arms = [m.joint(n + "_arm").id for n in names]
-        # each arm's spring at the wall (slide at 0): stiffness * springref, together the module's F_n
-        preload = sum(m.jnt_stiffness[j] * m.qpos_spring[m.jnt_qposadr[j]] for j in arms)
-        assert preload == pytest.approx((p.F_n1, p.F_n2)[i], rel=1e-12)
+        # each leg's spring on the wall (slide at 0): stiffness * springref = its preload; together the module's F_n
+        preload = [m.jnt_stiffness[j] * m.qpos_spring[m.jnt_qposadr[j]] for j in arms]
+        assert sum(preload) == pytest.approx((p.F_n1, p.F_n2)[i], rel=1e-12)
+        assert all(m.qpos_spring[m.jnt_qposadr[j]] == pytest.approx(p.suspension_travel) for j in arms)
         hubs = [dof_address(m, n + "_hub") for n in names]
-        assert sum(m.dof_frictionloss[h] for h in hubs) / p.wheel_radius == pytest.approx((p.F_r1, p.F_r2)[i], rel=1e-12)
-        assert len(names) == WHEELS_PER_MODULE
+        assert sum(m.dof_frictionloss[h] for h in hubs) / p.wheel_radius == pytest.approx((p.F_r1, p.F_r2)[i],
+                                                                                             rel=1e-12)
+        xs = sorted({round(float(m.body(n + "_arm").pos[0]), 12) for n in names})
+        assert xs == pytest.approx([-0.06, 0.06])  # the two rings, ring_spacing apart about the module's joint
         for n in names:
             g = m.geom(n + "_wheel")
             assert g.size[0] == p.wheel_radius and g.friction[0] == p.mu_wall and g.condim[0] == 3
-    for k, name in enumerate(WALLS):
-        assert m.geom(name).pos[1] == pytest.approx((0.1, -0.1)[k])
-    # the wheels and arms are part of their module's mass: module 1 + crank + rod, module 2
+    # the legs are part of their module's mass: module 1 + crank + rod, module 2
     assert m.body_subtreemass[m.body("rear_module").id] == pytest.approx(p.m1 + p.rod_mass, rel=1e-12)
     assert m.body_subtreemass[m.body("front_module").id] == pytest.approx(p.m2, rel=1e-12)
-    assert m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC and m.opt.noslip_iterations >= 10
-    # only the hubs have friction, only the walls and wheels collide; every element is named
-    assert set(np.flatnonzero(m.dof_frictionloss)) == {dof_address(m, n) for n in HUBS}
-    for kind, count in ((mujoco.mjtObj.mjOBJ_BODY, m.nbody), (mujoco.mjtObj.mjOBJ_JOINT, m.njnt),
-                        (mujoco.mjtObj.mjOBJ_GEOM, m.ngeom)):
-        assert all(mujoco.mj_id2name(m, kind, i) for i in range(1 if kind == mujoco.mjtObj.mjOBJ_BODY else 0, count))
+    assert m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+    # the rows' time constants are seconds of the model, the same whatever the step
+    for dt in (ROW_TIMES.shortest() / 2, ROW_TIMES.shortest() / 8):
+        m = build_wheels_model(p, SolverSettings(timestep=dt))
+        assert m.eq_solref[m.equality("rod_to_front").id][0] == ROW_TIMES.loop
+        assert m.jnt_solref[m.joint(legs[0][0] + "_hub").id][0] == ROW_TIMES.limit
+        assert m.geom_solref[m.geom(legs[0][0] + "_wheel").id][0] == ROW_TIMES.contact
+    with pytest.raises(ParameterError, match="timestep"):  # MuJoCo's floor: two steps per time constant
+        build_wheels_model(p, SolverSettings(timestep=ROW_TIMES.shortest()))
+    # only the hubs have friction
+    assert set(np.flatnonzero(m.dof_frictionloss)) == {dof_address(m, n + "_hub") for names in legs for n in names}
 
 
-def test_a_robot_that_does_not_fit_its_pipe_is_refused():
-    for bad, word in ((dict(pipe_diameter=0.09), "pipe_diameter"), (dict(wheel_radius=0.041), "wheel_radius")):
-        with pytest.raises(ParameterError, match=word):
-            build_wheels_model(RobotParams(**bad))
-    with pytest.raises(ParameterError, match="wheels' hubs"):
-        registry.from_flags("mujoco", None, "kinematic", None, "wheels")
-    assert registry.from_flags("mujoco", None, None, None, "wheels").name == "mujoco-wheels"
-    assert registry.from_flags("mujoco", None, None, None).name == "mujoco-lock"  # the slide model's default
+@pytest.mark.parametrize("bad,word", [
+    (dict(pipe_diameter=0.09), "pipe_diameter"), (dict(wheel_radius=0.041), "wheel_radius"),
+    (dict(wheel_legs=2), "wheel_legs"), (dict(wheel_legs=3.5), "wheel_legs"),
+    (dict(suspension_travel=0.02), "suspension_travel"), (dict(F_n1=0.0), "F_n1"),
+])
+def test_a_robot_that_does_not_fit_its_pipe_is_refused(bad, word):
+    with pytest.raises(ParameterError, match=word) as caught:
+        build_wheels_model(RobotParams(**bad))
+    assert "\n" not in str(caught.value)
 
 
-def test_the_wheels_press_with_F_n_roll_against_F_r_and_stay_in_their_cone():
-    """Stepped by hand through the default motor's first 0.4 s (both modules roll and stand in turn)."""
-    p = CRUISE
+@pytest.mark.parametrize("legs", [3, 4])
+def test_weight_sags_the_module_and_its_press_stays_F_n(legs):
+    """A robot at rest in a horizontal pipe: its weight sags each module on its legs' springs by the closed
+    form's m g / (n k), the legs under it press harder and those above less, and the module's legs together
+    still press with F_n (read from MuJoCo's contact forces): the outward directions of evenly spaced legs sum
+    to zero, so a linear spring's gain below is another's loss above. The least-pressed leg's force is the
+    closed-form lift-off check's under weight alone. (Equal modules on equal springs: the loop, which holds both
+    modules' ends level, then shares no weight between them but the rod's, 1 % of a module's.)"""
+    p = RobotParams(M=0.0, m1=1.5, m2=1.5, F_n1=40.0, F_n2=40.0, wheel_legs=legs)
     m, d, ctl = by_hand(p)
-    k_arm = [[m.jnt_stiffness[m.joint(n + "_arm").id] for n in names] for names in WHEEL_NAMES]
-    arm_q = [[qpos_address(m, n + "_arm") for n in names] for names in WHEEL_NAMES]
-    arm_v = [[dof_address(m, n + "_arm") for n in names] for names in WHEEL_NAMES]
-    across = [[dof_address(m, n) for n in (f"{module}_lateral", f"{module}_yaw")] for module in ("rear", "front")]
-    carried = [WHEEL_SHARE * 2 * mass for mass in (p.m1, p.m2)]  # an arm with its wheel (ARM_SHARE = WHEEL_SHARE)
-    reach = 0.1 + p.pipe_diameter / 2  # farthest wheel from its module's origin [m]
-    worst_cone, rolled = 0.0, [False, False]
-    for step in range(4000):
+    for _ in range(int(0.1 / m.opt.timestep)):  # 0.1 s: hundreds of the contacts' time constants
         ctl.before_step()
         mujoco.mj_step(m, d)
-        normal, tangential = module_contacts(m, d)
-        # each light arm's balance across the pipe: its contact presses with its spring's force k (springref - q)
-        # less its mass times its acceleration across the pipe (there is no gravity across it), which is bounded
-        # by the arm's own, its module's lateral and yaw accelerations (MuJoCo's qacc)
-        for i in (0, 1):
-            springs = sum(k * (m.qpos_spring[a] - d.qpos[a]) for k, a in zip(k_arm[i], arm_q[i]))
-            lateral, yaw = (abs(d.qacc[v]) for v in across[i])
-            spin = d.qvel[across[i][1]] ** 2  # the centripetal part of the yawing module's acceleration
-            inertia = sum(carried[i] * (abs(d.qacc[v]) + lateral + (yaw + spin) * reach) for v in arm_v[i])
-            # the arms slide along the module's y axis, the walls push along the pipe's: the springs' share
-            # across the pipe is cos(yaw) of their force
-            tilt = springs * (1 / np.cos(d.qpos[qpos_address(m, ("rear_yaw", "front_yaw")[i])]) - 1)
-            # the step's forces are the state's before it, the springs read after it: they moved by k v dt
-            moved = sum(k * abs(d.qvel[v]) * m.opt.timestep for k, v in zip(k_arm[i], arm_v[i]))
-            assert abs(normal[i] - springs) <= inertia + abs(tilt) + moved + 1e-9 * p.F_n1
-            assert abs(springs - (p.F_n1, p.F_n2)[i]) < 0.01 * p.F_n1  # the springs' give: 1 % of the preload
-        # every contact inside its friction cone (the cone's own bound, to round-off)
+    forces = contact_forces(m, d, p)
+    press, _ = leg_press(m, p, d.qpos[None, :])
+    check = lift_check(p)
+    for i in (0, 1):
+        F_n = (p.F_n1, p.F_n2)[i]
+        # to first order in the sag delta; to second, a wheel on the round wall reaches delta^2 (1 - u_z^2) /
+        # (2 rho) less far out than its leg's line (rho the wheel centre's radius), which adds delta^2 / (4 rho
+        # travel) of F_n whatever the number of legs: 1 % here, held to 1e-3 of F_n
+        delta, rho = sag(p, i), 0.5 * p.pipe_diameter - p.wheel_radius
+        expected = F_n * (1 + delta ** 2 / (4 * rho * p.suspension_travel))
+        assert expected > 1.005 * F_n
+        assert forces[i].sum() == pytest.approx(expected, rel=1e-3)
+        assert press[0, i].sum() == pytest.approx(expected, rel=1e-3)  # the springs' press is the contacts'
+        # each leg's: its light arm's weight (3 g) and the wall's normal off its line by delta / rho at most
+        assert np.allclose(press[0, i], forces[i], rtol=delta / rho, atol=1e-3 * F_n)
+        assert forces[i].max() > 1.2 * leg_preload(p, i)  # the weight really is on the lower legs
+        # the module sits lower by the closed form's sag, and its least-pressed leg presses as the closed form's
+        # (the rod's weight, 1 % of a module's, is on top: within 2 % of the sag)
+        z = -d.qpos[qpos_address(m, ("rear_vertical", "front_vertical")[i])]
+        assert z == pytest.approx(sag(p, i), rel=0.02)
+        assert press[0, i].min() == pytest.approx(check["weight_press_n"][i], abs=0.02 * (F_n / 2 - press[0, i].min()))
+
+
+def test_the_wheels_roll_against_F_r_and_stay_in_their_cone():
+    """Stepped by hand through the default motor's first 0.3 s (both modules roll and stand in turn)."""
+    p = CRUISE
+    m, d, ctl = by_hand(p)
+    worst_cone, rolled, stood = 0.0, [False, False], [False, False]
+    force = np.zeros(6)
+    for _ in range(int(0.3 / m.opt.timestep)):
+        ctl.before_step()
+        mujoco.mj_step(m, d)
         for c in range(d.ncon):
-            f = np.zeros(6)
-            mujoco.mj_contactForce(m, d, c, f)
-            worst_cone = max(worst_cone, np.hypot(f[1], f[2]) - p.mu_wall * f[0])
+            mujoco.mj_contactForce(m, d, c, force)
+            worst_cone = max(worst_cone, np.hypot(force[1], force[2]) - p.mu_wall * force[0])
         states, _ = ctl.states()
         for i in (0, 1):
             if states[i] == 1:  # rolling: every hub's friction row at its bound, together F_r at the wall
-                rows = [d.efc_force[d.ne + k] for k in ctl.friction_rows[i]]
+                rows = [d.efc_force[d.ne + k] for k, _ in ctl.friction_rows[i]]
                 assert sum(rows) / p.wheel_radius == pytest.approx(-(p.F_r1, p.F_r2)[i], rel=1e-9)
                 rolled[i] = True
+            stood[i] |= states[i] == 0
     assert worst_cone <= 1e-9 * p.F_n1
-    assert all(rolled)
+    assert all(rolled) and all(stood)
 
 
+def test_the_wheeled_run_reports_its_press_and_the_lift_off_check():
+    run = registry.run("mujoco-wheels", CRUISE, 0.2, dt_out=1e-3)
+    s = run.summary
+    # the springs' press, mean over the run: F_n to the legs' rocking (a few tenths of a percent)
+    assert s["press1_n"] == pytest.approx(CRUISE.F_n1, rel=1e-2) and s["press2_n"] == pytest.approx(CRUISE.F_n2,
+                                                                                                   rel=1e-2)
+    assert s["wheel_off_s"] == 0.0 and s["lift_predicted"] is False
+    # a press below the weight: the upper legs lift, and the closed form says so
+    light = RobotParams(drive="motor", mu_wall=0.8, F_n1=8.0, F_n2=8.0)
+    lifted = registry.run("mujoco-wheels", light, 0.2, dt_out=1e-3).summary
+    assert lift_check(light)["lift_predicted"] and lifted["lift_predicted"]
+    assert lifted["wheel_off_s"] > 0.1
+
+
+@pytest.mark.slow
 def test_straight_pipe_cruise_speed_matches_the_analytic_finite_grip_model():
-    """The acceptance case: default motor, mu_wall 0.8, F_n 50 N, to the periodic steady state.
-
-    What the wheels add to the analytic model's mechanism is their rolling inertia: a rolling module carries
-    its wheels' J / R^2 = m_w / 2 each on top of its mass. Its effect on the steady speed is measured here with
-    the analytic model itself (both modules heavier by that much), and MuJoCo's own accuracy target (the
-    monitor's RESIDUAL_TOL, 0.1 % of the motion) comes on top; the 1 % of the acceptance is the outer bound."""
+    """Default motor, mu_wall 0.5, F_n 50 N, to the periodic steady state. What the wheels add to the analytic
+    model's mechanism is their rolling inertia: a rolling module carries its wheels' J / R^2 = m_w / 2 each on
+    top of its mass. Its effect on the steady speed is measured with the analytic model itself (both modules
+    heavier by that much), and MuJoCo's own accuracy target (the monitor's RESIDUAL_TOL) comes on top."""
     analytic = registry.run("analytic-unilateral", CRUISE, 30.0, dt_out=1e-3, until_steady=True)
-    extra = WHEELS_PER_MODULE * WHEEL_SHARE / 2
+    extra = 2 * int(CRUISE.wheel_legs) * WHEEL_SHARE / 2
     heavier = registry.run("analytic-unilateral", CRUISE.replace(m1=CRUISE.m1 * (1 + extra),
                                                                  m2=CRUISE.m2 * (1 + extra)),
                            30.0, dt_out=1e-3, until_steady=True)
     v_a = analytic.summary["steady_speed_m_s"]
     inertia_effect = abs(heavier.summary["steady_speed_m_s"] / v_a - 1)
-    # 1e-4 s: the automatic step for the motor; the convergence study (mjcf/README.md) shows the cruise converged
-    # there (no skid), so the test takes it rather than the finite-grip cap meant for skids
-    wheels = registry.run("mujoco-wheels", CRUISE, 10.0, dt_out=1e-3, until_steady=True, timestep=1e-4)
+    wheels = registry.run("mujoco-wheels", CRUISE, 10.0, dt_out=1e-3, until_steady=True)
     v_w = wheels.summary["steady_speed_m_s"]
     tolerance = inertia_effect + RESIDUAL_TOL
-    assert tolerance < 0.01
+    assert tolerance < 0.005
     assert abs(v_w / v_a - 1) <= tolerance
     assert wheels.summary["slip1_m"] < 1e-6 and wheels.summary["slip2_m"] < 1e-6  # ample grip: no skid
-    assert wheels.accuracy["ok"]
 
 
+@pytest.mark.slow
 def test_a_riser_with_grip_below_the_weight_skids_down_as_the_analytic_model_does():
-    """Both modules skid down the riser; how far, to within MuJoCo's discretization error, bounded by the
-    change of the skid when the step is doubled (its error falls faster than linearly with the step: the
-    convergence study in mjcf/README.md)."""
-    t_end = 0.5
+    """Both modules skid down the riser. How far: within the acceptance's 5 % + 2 mm of the analytic model's
+    Coulomb skid, and MuJoCo's own discretization error (the change on halving the step) well inside that."""
+    t_end = 0.4
     analytic = registry.run("analytic-unilateral", RISER, t_end, dt_out=1e-3)
-    fine = registry.run("mujoco-wheels", RISER, t_end, dt_out=1e-3)  # the automatic step: the skid cap
-    assert fine.settings["timestep"] <= 2.5e-5
-    coarse = registry.run("mujoco-wheels", RISER, t_end, dt_out=1e-3, timestep=2 * fine.settings["timestep"],
-                          accuracy="warn")  # at twice the step its energy residual grazes the monitor's tolerance
+    run = registry.run("mujoco-wheels", RISER, t_end, dt_out=1e-3)
+    half = registry.run("mujoco-wheels", RISER, t_end, dt_out=1e-3, timestep=run.settings["timestep"] / 2)
     for k in (1, 2):
-        s_a, s_w, s_c = (run.summary[f"slip{k}_m"] for run in (analytic, fine, coarse))
+        s_a, s_w, s_h = (r.summary[f"slip{k}_m"] for r in (analytic, run, half))
         assert s_a > 0.1 and s_w > 0.1  # both skid back, a long way
-        assert fine.summary[f"x{k}_final"] < 0 and analytic.summary[f"x{k}_final"] < 0
-        assert abs(s_w - s_a) <= abs(s_c - s_w)
-    assert fine.accuracy["ok"]
+        assert abs(s_w - s_a) <= 0.05 * s_a + 2e-3
+        assert abs(s_w - s_h) <= 0.01 * s_h  # the default step within 1 % of the skid's converged length
 
 
-def test_render_and_the_viewer_draw_the_pipe_walls_and_the_wheels():
-    """What render and the viewer draw is the wheeled model itself: its walls and wheels are visible geoms, and
-    the viewer steps it with the engine's loop (no screen needed for either check)."""
-    from ipir_mujoco.cli.view import ViewedRobot
-    from ipir_mujoco.video import VideoSettings, _render_model
+def test_unlimited_grip_never_skids():
+    """A heavy robot pressed lightly up a riser under a strong motor: with unlimited grip nothing skids (its
+    modules stand on their locked wheels whatever the load)."""
+    p = RobotParams(drive="motor", M_stall=2.0, m1=4.0, m2=4.0, F_n1=5.0, F_n2=5.0, incline=90.0)
+    run = registry.run("mujoco-wheels", p, 0.3, dt_out=1e-3)
+    assert run.summary["slip1_m"] < 1e-4 and run.summary["slip2_m"] < 1e-4
+    assert run.summary["revolutions"] > 0.2
 
-    drawn = _render_model(CRUISE, VideoSettings(), wheeled=True)
-    for name in WALLS + tuple(n + "_wheel" for names in WHEEL_NAMES for n in names):
-        assert drawn.geom_rgba[drawn.geom(name).id][3] > 0  # drawn, not transparent
-    robot = ViewedRobot(CRUISE, model="wheels", settings=SolverSettings(timestep=1e-4))
-    assert isinstance(robot.controller, WheelRatchet)
-    robot.step(500)
-    assert robot.data.qpos[qpos_address(robot.model, "crank_hinge")] > 0.1  # the crank turns
-    with pytest.raises(ParameterError, match="wheels' hubs"):
-        ViewedRobot(CRUISE, "kinematic", model="wheels")
+
+def test_simulate_runs_the_wheeled_model_and_refuses_what_it_does_not_have(capsys):
+    code, out, err = run_cli(capsys, "simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--drive", "motor",
+                             "--set", "mu_wall=0.8", "--t-end", "0.1", "--json")
+    assert code == 0 and err == ""
+    record = json.loads(out)
+    assert record["settings"]["mujoco_model"] == "wheels"
+    s = record["summary"]
+    assert s["revolutions"] > 0.1 and s["slip1_m"] == 0.0
+    assert {"press1_n", "press2_n", "wheel_off_s"} <= set(s)
+    for argv, word in ((("--engine", "mujoco", "--mujoco-model", "wheels", "--mujoco-clutch", "lock"), "ratchet"),
+                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--set", "clutch_stiffness=1e5"), "rigid"),
+                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--set", "pipe_diameter=0.1"), "2 r")):
+        code, out, err = run_cli(capsys, "simulate", *argv)
+        assert code == 2 and word in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_closed_form_rod_side_force_and_leg_geometry():
+    """The rod's side force T |sin beta| / (r |sin(phi - beta)|) over a turn, sampled, peaks at the closed form's
+    T / (L - r) (the inner dead centre); the legs' outward directions are unit vectors summing to zero, leg 0
+    down."""
+    from ipir_mujoco.core.pipe import rod_side_force
+
+    r, L, T = 0.05, 0.2, 1.0
+    phi = np.linspace(1e-3, math.pi - 1e-6, 20001)
+    beta = np.arcsin(-r * np.sin(phi) / L)
+    side = T * np.abs(np.sin(beta)) / (r * np.abs(np.sin(phi - beta)))
+    assert side.max() <= rod_side_force(T, r, L) * (1 + 1e-9)
+    assert side.max() == pytest.approx(rod_side_force(T, r, L), rel=1e-4)  # approached at the dead centre
+    for n in (3, 4, 5):
+        u = np.array([leg_direction(k, n) for k in range(n)])
+        assert np.allclose(np.linalg.norm(u, axis=1), 1.0) and np.allclose(u.sum(axis=0), 0.0, atol=1e-12)
+        assert np.allclose(u.T @ u, np.diag([0.0, n / 2, n / 2]))  # the ring's stiffness n k / 2 either way
+        assert u[0] == pytest.approx([0.0, 0.0, -1.0])
+    assert leg_stiffness(RobotParams(), 0) == pytest.approx(50.0 / 6 / 0.005)
 
 
 def test_the_closed_form_bend_fit():
@@ -207,35 +272,3 @@ def test_the_closed_form_bend_fit():
     assert bend_max_length(w, 100.0, D) > 10 * length  # a gentle bend passes long modules
     with pytest.raises(ParameterError, match="radius"):
         bend_max_length(w, 0.05, D)
-
-
-def test_simulate_runs_the_wheeled_model_and_refuses_what_it_does_not_have(capsys):
-    import json
-
-    code, out, err = run_cli(capsys, "simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--drive", "motor",
-                             "--set", "mu_wall=0.8", "--t-end", "0.2", "--timestep", "1e-4", "--json")
-    assert code == 0 and err == ""
-    record = json.loads(out)
-    assert record["settings"]["mujoco_model"] == "wheels" and record["settings"]["cone"] == "elliptic"
-    assert record["summary"]["revolutions"] > 0.3 and record["summary"]["slip1_m"] == 0.0
-    for argv, word in ((("--mujoco-model", "wheels"), "--engine mujoco"),
-                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--mujoco-clutch", "lock"), "ratchet"),
-                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--set", "clutch_stiffness=1e5"), "rigid"),
-                       (("--engine", "mujoco", "--mujoco-model", "wheels", "--set", "pipe_diameter=0.1"), "2 r")):
-        code, out, err = run_cli(capsys, "simulate", *argv)
-        assert code == 2 and word in err and len(err.strip().splitlines()) == 1
-
-
-def test_the_wheeled_model_warns_by_default_and_the_slides_stop(capsys):
-    """On wheels the soft contacts take work the audit cannot book (~0.3 % of the motor's under the paper's
-    torque, whatever the step), so the monitor's default there is 'warn'; on the slides it stays 'stop'; a
-    mode given explicitly wins. The default 1 s wheeled run is such a case: its residual passes the 1e-3
-    tolerance at ~0.8 s, which stopped it with exit status 1 while 'stop' was every model's default."""
-    assert registry.run("mujoco-wheels", RobotParams(), 0.01).summary["accuracy"]["mode"] == "warn"
-    assert registry.run("mujoco-ratchet", RobotParams(), 0.01).summary["accuracy"]["mode"] == "stop"
-    given = registry.run("mujoco-wheels", RobotParams(), 0.01, accuracy="stop")
-    assert given.summary["accuracy"]["mode"] == "stop"
-    code, out, err = run_cli(capsys, "simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--json")
-    assert code == 0, err
-    accuracy = json.loads(out)["summary"]["accuracy"]
-    assert accuracy["mode"] == "warn" and not accuracy["ok"] and accuracy["residual_ratio"] > 1e-3

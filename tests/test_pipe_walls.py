@@ -59,6 +59,7 @@ def test_a_ball_touches_the_wall_at_its_exact_distance_from_the_centreline(table
 
 
 @pytest.mark.parametrize("tables", [None, OUT_OF_PLANE])
+@pytest.mark.slow
 def test_a_wheel_carried_along_the_pipe_presses_with_a_constant_force(tables):
     """The rig's three sprung wheels (10 N preload, 3 mm travel) carried at 2 m/s through straights and bends: the
     normal force stays constant (the wall is round; its construction adds no ripple), one contact per wheel."""

@@ -125,6 +125,7 @@ def test_a_run_as_a_dataframe_keeps_every_column_its_units_and_summary():
     assert set(physics.series) <= set(SERIES_UNITS)
 
 
+@pytest.mark.slow
 def test_a_run_draws_the_papers_figures_and_a_sweep_reads_as_one_frame(tmp_path):
     from ipir_mujoco import registry
     from ipir_mujoco.studies.frames import read_sweep

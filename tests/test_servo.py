@@ -27,6 +27,7 @@ def steady():
     return {v: registry.run(v, SERVO, 10.0, dt_out=1e-3, until_steady=True) for v in PAIR}
 
 
+@pytest.mark.slow
 def test_exact_feedforward_holds_the_target_speed_in_both_engines(steady):
     # the issue's acceptance: mean within 1 % of the target, ripple <= 0.05 (the open-loop motor's is ~0.47)
     for run in steady.values():
@@ -41,6 +42,7 @@ def test_exact_feedforward_holds_the_target_speed_in_both_engines(steady):
     assert m["steady_speed_m_s"] == pytest.approx(a["steady_speed_m_s"], rel=3e-3)
 
 
+@pytest.mark.slow
 def test_the_summary_window_is_the_steady_revolutions(steady):
     run = steady["analytic-unilateral"]
     s, series = run.summary, run.series
@@ -203,6 +205,7 @@ def test_a_servo_that_cannot_climb_stalls_as_the_motor_does():
         assert np.all(servo.series["drive_u"] == 1.0)
 
 
+@pytest.mark.slow
 def test_a_sweep_row_carries_the_runs_crank_speed_figures(tmp_path, capsys):
     """sweep (and so optimize and sensitivity) reads the servo's figures: each design's speed_ripple and
     mean_omega_rad_s columns are the registry run's summary values (written with 10 significant digits)."""

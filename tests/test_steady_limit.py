@@ -71,6 +71,7 @@ def design_runs(name: str) -> dict:
 
 @pytest.mark.parametrize("engine", list(VARIANTS))
 @pytest.mark.parametrize("name", list(DESIGNS))
+@pytest.mark.slow
 def test_steady_figures_lie_within_the_stated_accuracy_of_the_periodic_limit(name, engine):
     run, limit = design_runs(name)[engine]
     for key in FIGURES:

@@ -102,6 +102,7 @@ def test_a_failing_design_is_recorded_and_the_sweep_goes_on(tmp_path):
     assert by_id[1]["error"] == "" and float(by_id[1]["mujoco-ratchet:revolutions"]) > 0.3
 
 
+@pytest.mark.slow
 def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
     out = tmp_path / "s"
     command = [sys.executable, "-m", "ipir_mujoco", "sweep", "--vary", "L=0.07:0.4:24", "--engines",
@@ -126,6 +127,7 @@ def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
     assert all(by_id[p["design_id"]] == p for p in partial)  # the rows kept are the rows of the full sweep
 
 
+@pytest.mark.slow
 def test_resume_refuses_another_study_and_a_rerun_without_resume(tmp_path, capsys):
     out = tmp_path / "s"
     base = ["sweep", "--engines", "analytic-approx", "--t-end", "0.2", "--out", str(out)]
@@ -134,6 +136,7 @@ def test_resume_refuses_another_study_and_a_rerun_without_resume(tmp_path, capsy
     assert main([*base, "--vary", "L=0.1,0.3", "--resume"]) == 2 and "another study" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_dask_gives_the_same_results_as_the_local_pool(tmp_path):
     distributed = pytest.importorskip("distributed", reason="Dask is the optional 'dask' extra")
     study = Study((parse_vary("L=0.08,0.2"), parse_vary("m2=0.5,1.5")), engines=("analytic-approx", "mujoco-ratchet"),
@@ -152,6 +155,7 @@ def test_dask_gives_the_same_results_as_the_local_pool(tmp_path):
     assert by_id(local) == by_id(remote) == by_id(rows_of(tmp_path / "cli" / "results.csv"))
 
 
+@pytest.mark.slow
 def test_sweep_command_writes_results_heatmap_and_best_designs(tmp_path, capsys):
     out = tmp_path / "s"
     assert main(["sweep", "--vary", "L=0.08:0.3:3", "--vary", "m2=0.5,1.5", "--engines",
@@ -190,6 +194,7 @@ def _wait_for_rows(path: Path, count: int, process, deadline_s: float = 120.0) -
         time.sleep(0.02)
 
 
+@pytest.mark.slow
 def test_ctrl_c_halfway_through_a_default_engine_sweep_keeps_the_finished_designs(tmp_path):
     """The MuJoCo batch streams by chunks: rows of both engines reach the file before the sweep ends."""
     out = tmp_path / "s"
@@ -218,6 +223,7 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc for the workers' process ids")
+@pytest.mark.slow
 def test_sigkill_of_the_main_process_leaves_no_worker_alive(tmp_path):
     out = tmp_path / "s"
     command = [sys.executable, "-m", "ipir_mujoco", "sweep", "--vary", "L=0.07:0.4:40", "--engines",

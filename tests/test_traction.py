@@ -65,6 +65,7 @@ def test_riser_press_is_the_hand_check():
     assert traction.riser_press(p.replace(F_n1=5.0, F_n2=5.0))["needed_n"] == riser["needed_n"]
 
 
+@pytest.mark.slow
 def test_unlimited_grip_changes_nothing_in_climb(tmp_path):
     from ipir_mujoco.cli import climb
 
@@ -103,6 +104,7 @@ def test_steady_limit_skids_on_the_level_below_the_cruise_demand():
     assert limit["incline_deg"] is None and limit["runs"][0]["steady_slip_m"] > 1e3 * traction.SLIP_TOL
 
 
+@pytest.mark.slow
 def test_grip_section_renders_quick_and_names_the_refusal(tmp_path):
     from ipir_mujoco.report import grip_section
     from ipir_mujoco.report.document import Image, Paragraph, Table

@@ -28,6 +28,7 @@ def quick_validation():
     return validate(RobotParams(), quick=True)
 
 
+@pytest.mark.slow
 def test_paper_checks_at_the_papers_case(quick_validation):
     metrics, _ = quick_validation
     assert metrics["paper_case"] == {"is_paper_case": True, "differences": []}
@@ -69,6 +70,7 @@ def test_the_papers_case_is_the_default_parameter_set():
     assert differences_from_paper(RobotParams(rod_mass=0.05)) == []
 
 
+@pytest.mark.slow
 def test_a_design_that_is_not_the_papers_is_not_judged_by_the_papers_figures():
     """validate --set L=0.3: the report says so and never calls L/r = 6 the paper's."""
     from ipir_mujoco.report.validation import build_blocks, to_markdown
@@ -102,6 +104,7 @@ def test_a_wrong_model_fails_the_paper_checks():
     assert {"revolutions", "peak_speed", "first_contraction_end_s"} <= failed
 
 
+@pytest.mark.slow
 def test_verdict_numbers_are_recomputed_from_independent_runs(quick_validation):
     metrics, _ = quick_validation
     base = RobotParams(rod_mass=0.0, rod_inertia=0.0)
@@ -134,6 +137,7 @@ def test_lr_thresholds_bracket_the_true_crossing():
     assert thresholds(huge)["x1_final"]["5%"] == {"whole_sweep": True, "largest_ratio": ratios[-1]}
 
 
+@pytest.mark.slow
 def test_lr_divergence_is_recomputed_from_independent_runs(quick_validation):
     metrics, _ = quick_validation
     row = metrics["lr_study"]["rows"][2]
@@ -144,6 +148,7 @@ def test_lr_divergence_is_recomputed_from_independent_runs(quick_validation):
     assert row["divergence"]["revolutions"] == pytest.approx((first - exact) / exact, abs=1e-8)
 
 
+@pytest.mark.slow
 def test_lr_study_measures_mujoco_against_the_equations_of_the_same_linkage(quick_validation):
     """MuJoCo needs a rod with mass; set beside the massless exact equations it read the rod's own effect
     (-0.4 % in revolutions at the paper's case) as MuJoCo's disagreement. It is measured against the exact
@@ -157,6 +162,7 @@ def test_lr_study_measures_mujoco_against_the_equations_of_the_same_linkage(quic
         assert abs(row["mujoco_vs_exact"]["revolutions"]) <= 1e-3
 
 
+@pytest.mark.slow
 def test_pull_fraction_grows_with_crank_speed(quick_validation):
     metrics, _ = quick_validation
     strokes = [s for s in metrics["clutch_pull"]["per_stroke"] if s["t_end"] < 0.9]
@@ -168,6 +174,7 @@ def test_pull_fraction_grows_with_crank_speed(quick_validation):
     assert all(s["complete"] for s in metrics["clutch_pull"]["per_stroke"][:-1])
 
 
+@pytest.mark.slow
 def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     from ipir_mujoco.video import RenderUnavailable, gl_backend
 
@@ -188,7 +195,8 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     # the mechanism diagram, Fig. 2, 3, 4, clutch reactions, pull per stroke, the L/r study; one figure per section
     from ipir_mujoco.report.sections import SECTIONS
 
-    assert page.count('src="data:image/png;base64,') == 7 + len(SECTIONS)
+    # the core figures, the opening picture (idealization_costs.png) and one per section
+    assert page.count('src="data:image/png;base64,') == 7 + 1 + len(SECTIONS)
     try:
         gl_backend()
         has_gl = True
@@ -244,6 +252,7 @@ def test_validate_writes_a_self_contained_report(tmp_path, capsys):
     assert "](figures/climbing_ability.png)" in markdown and "**It stalls.**" in markdown
 
 
+@pytest.mark.slow
 def test_report_is_complete_without_opengl(quick_validation, tmp_path, monkeypatch):
     """Where no headless OpenGL exists the report still builds, and says why it has no animation."""
     from ipir_mujoco import video
@@ -270,6 +279,7 @@ def test_validate_bad_parameter_exits_2_and_writes_nothing(tmp_path, capsys):
     assert "L=0.01" in capsys.readouterr().err and not out.exists()
 
 
+@pytest.mark.slow
 def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_validation, tmp_path):
     """The registry the further studies (motor, incline, clutch compliance) plug into."""
     import copy
@@ -301,6 +311,7 @@ def test_a_section_adds_its_metrics_verdict_and_blocks_to_the_report(quick_valid
     assert "](figures/toy.png)" in markdown and "**Is L positive?** Yes" in markdown
 
 
+@pytest.mark.slow
 def test_convergence_evidence_covers_the_envelope_corners(quick_validation):
     """--quick checks the lightest rod and the shortest L/r with the automatic settings: each within the
     envelope's 0.1 % target of the analytic one-way model (the full validate runs every corner)."""
@@ -314,6 +325,7 @@ def test_convergence_evidence_covers_the_envelope_corners(quick_validation):
                                           for r in envelope["rows"])
 
 
+@pytest.mark.slow
 def test_the_timestep_halving_starts_from_each_clutchs_own_automatic_step(quick_validation):
     """The engine chooses 5e-5 s for the locks and 1e-4 s for the ratchet at the paper's case; the halving
     study measured both clutches from 1e-4 s, so the 'halving MuJoCo's timestep from its default' figure
@@ -350,6 +362,7 @@ def test_a_relative_difference_that_rounds_to_zero_is_printed_without_a_sign():
     assert fixed(-1e-4, 2) == "0.00" and fixed(-0.006, 2) == "-0.01" and fixed(3.14159, 1) == "3.1"
 
 
+@pytest.mark.slow
 def test_the_report_opens_with_a_summary_table_that_links_each_verdict_to_its_section(quick_validation):
     """One row per verdict (question, verdict, key figure, where), before the verdicts' paragraphs; each link
     goes to a heading the report has (in HTML, to that heading's id)."""

@@ -104,6 +104,12 @@ def summary_lines(result: dict, atlas) -> list[str]:
                 spent = (f"; {entry['runs']} {entry['measured_by']} runs"
                          + (f" (safe {regions['safe']}, unsafe {regions['unsafe']}, boundary {regions['boundary']})"
                             if regions else ""))
+                if entry.get("missing"):
+                    spent += f"; {entry['missing']} designs gave no value (samples.csv: notes, error)"
+                equations = entry.get("equations")
+                if equations:  # MuJoCo measured it: the equations' answer beside it
+                    eq = next(i for i in equations["by_threshold"] if i["threshold"] == item["threshold"])
+                    spent += f"; the equations: safe in {100 * eq['safe_fraction']:.1f} %"
                 top = top_drivers(entry)
                 lines.append(f"{name:24s} {metric:22s} |cost| < {item['threshold']:g}: {where}{cross}{spent}"
                              + (f"; driven by {top}" if top != "-" else ""))

@@ -231,8 +231,8 @@ def format_traction(traction: dict | None) -> list[str]:
              f"({rest['torque_at_rest_n_m']:g} N m): {at_rest('drive_at_rest')}",
              f"    binds: {names[rest['binds']]}",
              "    a vertical riser needs a press per module of "
-             + " / ".join(f"{f:.4g}" for f in riser["needed_n"]) + " N at this mu_wall ("
-             + "; ".join(f"{names[k]}: " + " / ".join(f"{f:.4g}" for f in riser["press_n"][k]) + " N"
+             + " / ".join(_press(f) for f in riser["needed_n"]) + " N at this mu_wall ("
+             + "; ".join(f"{names[k]}: " + " / ".join(_press(f) for f in riser["press_n"][k]) + " N"
                          for k in ("drive_off", "drive_at_rest")) + f"; {names[riser['binds']]} binds)"]
     for engine, limit in traction["steady"].items():
         if "error" in limit:
@@ -245,3 +245,8 @@ def format_traction(traction: dict | None) -> list[str]:
                     else f"up to {low:.2f} deg (skids or stalls at {high:.2f} deg)")
         lines.append(f"    steady climb with no skid in the steady window, {engine}: {text}")
     return lines
+
+
+def _press(force) -> str:
+    """A riser's press [N] as the table shows it; None: no press holds (mu_wall = 0)."""
+    return "none holds" if force is None else f"{force:.4g}"

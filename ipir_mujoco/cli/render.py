@@ -43,6 +43,7 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..output import check_output_dir
     from ..video import VideoSettings, check_writer, gl_backend, write_video
 
     settings = VideoSettings(width=args.width, height=args.height, fps=args.fps, speed=args.speed)
@@ -62,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     gl_backend()
     if out.is_dir():
         raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
+    check_output_dir(out.parent)  # a folder that cannot be written is refused now, not after every frame
     params = model_params(args)
     variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch, args.mujoco_model)
     t_end = args.t_end if args.t_end is not None else T_END_ROUTE if route is not None else T_END

@@ -100,15 +100,25 @@ class RobotParams:
                                     "back (rubber on steel 0.5-1; the bound 10 is far above any wheel)",
                                     None, 0.0, 10.0, none_word="unlimited",
                                     none_text="a held module's clutch holds any force")
-    F_n1: float = _number("N", "wall-press normal force on module 1's wheels, all together (with finite mu_wall); "
+    F_n1: float = _number("N", "wall-press normal force on module 1's wheels, all together (the grip with a finite "
+                          "mu_wall; the wheeled MuJoCo model's leg preload whatever mu_wall is); "
                           "the default with F_r1 = 1 N is a rolling-resistance coefficient of 0.02, as for hard "
                           "polyurethane wheels on steel", 50.0, 0.0, 1e6)
-    F_n2: float = _number("N", "wall-press normal force on module 2's wheels, all together (with finite mu_wall); "
+    F_n2: float = _number("N", "wall-press normal force on module 2's wheels, all together (as F_n1); "
                           "default as F_n1", 50.0, 0.0, 1e6)
     pipe_diameter: float = _number("m", "inside diameter of the pipe (the wheeled MuJoCo model's walls; must exceed "
                                    "2 r and 4 wheel_radius); the default fits the paper's design", 0.16, 0.0, 10.0,
                                    low_open=True)
     wheel_radius: float = _number("m", "radius of the wheeled MuJoCo model's wheels (below pipe_diameter / 4)", 0.015,
+                                  0.0, 1.0, low_open=True)
+    wheel_legs: float = _number("-", "wheel legs per ring of the wheeled MuJoCo model, evenly spaced about the pipe's "
+                                "axis (two rings per module; a whole number)", 3.0, 3.0, 8.0)
+    suspension_travel: float = _number("m", "each wheel leg's spring deflection at its preload (the wheeled MuJoCo "
+                                       "model: stiffness = preload / suspension_travel; the arm stops at the "
+                                       "spring's free length and at 4 x suspension_travel compression)", 0.005,
+                                       0.0, 0.05, low_open=True)
+    ring_spacing: float = _number("m", "distance along the pipe between a module's two rings of wheel legs (the "
+                                  "wheeled MuJoCo model; it carries the module's pitch and yaw moments)", 0.1,
                                   0.0, 1.0, low_open=True)
 
     omega_target: float = _number("rad/s", "crank speed the speed controller holds (drive = servo; below "
@@ -147,6 +157,9 @@ class RobotParams:
             if not _inside(number, meta):
                 raise ParameterError(f"{f.name}={value!r} is out of range; allowed: {allowed_text(f.name)}")
             object.__setattr__(self, f.name, number)  # one type inside: a plain float
+        if self.wheel_legs != int(self.wheel_legs):
+            raise ParameterError(f"wheel_legs={self.wheel_legs!r} is not a whole number; allowed: "
+                                 f"{allowed_text('wheel_legs')}")
         if not self.L > self.r:
             raise ParameterError(
                 f"L={self.L} m with r={self.r} m: the connecting rod must be longer than the crank "
@@ -251,6 +264,8 @@ def allowed_text(name: str) -> str:
         text = f"0 <= clutch_backlash <= r / 2 {meta['units']}"
     if name in ("F_n1", "F_n2"):
         text += f", and {name} > 0 with a finite mu_wall"
+    if name == "wheel_legs":
+        text += ", a whole number"
     if meta["none_word"]:
         text += f", or '{meta['none_word']}' ({meta['none_text']})"
     return text
@@ -387,16 +402,14 @@ def load_params(
 _ACTS_THROUGH = (
     ("clutch_stiffness", ("clutch_damping", "clutch_backlash"),
      "a finite clutch_stiffness (a rigid clutch has no spring for it to act with)", "rigid", ""),
-    ("mu_wall", ("F_n1", "F_n2"), "a finite mu_wall (with unlimited grip the normal force holds nothing)",
-     "unlimited", " N"),
 )
 
 
 def refuse_idle_parameters(params: RobotParams) -> None:
     """Parameters that act only through another one, given without it, refused in one line (never silently
     ignored), for every engine: the speed controller's (SERVO_FIELDS) need drive=servo; clutch damping and
-    backlash need a clutch with a spring (a finite ``clutch_stiffness``); the wheels' normal forces act only
-    through a finite grip (``mu_wall``)."""
+    backlash need a clutch with a spring (a finite ``clutch_stiffness``). (The wheels' normal forces F_n1, F_n2
+    are not refused with unlimited grip: they are the wheeled MuJoCo model's leg preload whatever mu_wall is.)"""
     defaults = RobotParams()
     if params.drive != "servo":
         for name in SERVO_FIELDS:

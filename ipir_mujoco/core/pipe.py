@@ -101,3 +101,65 @@ def bend_rod_clearance(length: float, rod_radius: float, radius: float, diameter
     if length / 2 >= radius:
         return -math.inf
     return (radius * radius - length * length / 4) ** 0.5 - (radius - diameter / 2) - rod_radius
+
+
+# ----------------------------------------------------------------------------------------------------
+# The round pipe's wheel legs (the wheeled MuJoCo model) and the closed-form lift-off check
+
+def leg_direction(k: int, n: int) -> tuple[float, float, float]:
+    """Leg ``k``'s outward unit vector of ``n`` evenly spaced about the pipe's axis x, leg 0 pointing down (-z in
+    a horizontal pipe): (0, cos a, sin a) with a = -90 deg + 360 deg k / n."""
+    angle = -0.5 * math.pi + 2.0 * math.pi * k / n
+    return (0.0, math.cos(angle), math.sin(angle))
+
+
+def rod_side_force(torque: float, r: float, L: float) -> float:
+    """The largest force [N] across the pipe that a crank torque ``torque`` [N m] puts through the rod on its
+    ends (A on module 1, C on module 2), quasi-static, over a turn: the rod (r crank, L rod [m]) carries
+    F = T / (r |sin(phi - beta)|) along itself, sin beta = -r sin(phi) / L, and its side part F |sin beta| grows
+    from T / (L + r) at the outer dead centre (phi = 0) to T / (L - r) at the inner one (phi = 180 deg)."""
+    return abs(torque) / (L - r)
+
+
+def lift_check(params) -> dict:
+    """The closed-form lift-off check of the wheeled model's legs (docs/model.md, "The round pipe").
+
+    Each module has two rings ``ring_spacing`` = s apart of n = ``wheel_legs`` legs, each pressed on the wall by
+    a linear spring with preload P_i = F_ni / (2 n). A force F across the pipe on a ring moves it by 2 F / (n k)
+    (its legs' outward directions u_k: sum u_k u_k^T = n/2 I), which changes leg k's press by (2 / n) F . u_k:
+    leg k lifts where F . u_k < -F_ni / 4, whatever n and k. The loads per ring, quasi-static: half the
+    module's weight across the pipe, m_i g cos(incline) / 2, down; half the rod's side force at the ring pair's
+    middle (:func:`rod_side_force`, the drive's largest torque: M, or M_stall for the motor); on module 1 the
+    motor's reaction couple T about z as +-T / s on its two rings. The side loads are taken both ways. The
+    wheels' sideways friction can carry side loads while they grip (MuJoCo's wheels do), so the check errs on
+    the side of predicting a lift.
+
+    Returns {'least_press1_n', 'least_press2_n': each module's least-pressed leg's closed-form press [N] (< 0: it
+    lifts), 'lift_predicted': bool, 'weight_press_n': (module 1's, module 2's) least press under weight alone}.
+    """
+    n = int(params.wheel_legs)
+    torque = abs(params.M) if params.drive == "torque" else params.M_stall
+    side = rod_side_force(torque, params.r, params.L)
+    across = math.cos(math.radians(params.incline)) * params.g
+    legs = [leg_direction(k, n) for k in range(n)]
+    out, weight_only = {}, []
+    for i, (m, Fn) in enumerate(((params.m1, params.F_n1), (params.m2, params.F_n2)), start=1):
+        P = Fn / (2 * n)
+        down = 0.5 * m * across
+        couple = torque / params.ring_spacing if i == 1 else 0.0
+        least = math.inf
+        for lateral in (0.5 * side + couple, -(0.5 * side + couple), 0.5 * side - couple, couple - 0.5 * side):
+            for (_, uy, uz) in legs:
+                least = min(least, P + (2.0 / n) * (lateral * uy - down * uz))
+        out[f"least_press{i}_n"] = least
+        weight_only.append(min(P + (2.0 / n) * (-down * uz) for (_, _, uz) in legs))
+    out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
+    out["weight_press_n"] = tuple(weight_only)
+    return out
+
+
+def lift_summary(params) -> dict:
+    """The lift-off check's summary keys of a wheeled run: ``least_press1_n``, ``least_press2_n`` [N] and
+    ``lift_predicted`` (:func:`lift_check`)."""
+    check = lift_check(params)
+    return {key: check[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted")}

@@ -78,6 +78,7 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .errors import ParameterError
 from .params import RobotParams
+from .pipe import lift_summary
 from .steady_test import steady_target
 
 # [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
@@ -214,6 +215,8 @@ class RunResult:
     def summary(self) -> dict[str, Any]:
         """The summary figures of the command-line contract (docs/cli.md)."""
         summary = summarize(self.series, self.energy, self.params.grip)
+        if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
+            summary.update(lift_summary(self.params))
         summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall
@@ -380,6 +383,17 @@ def peak_grip_use(series: dict[str, np.ndarray], grip: tuple[float, float] | Non
     return float(max(c.max() for c in columns)) if columns else None
 
 
+def wheel_keys(series: dict[str, np.ndarray]) -> dict[str, float]:
+    """The wheeled MuJoCo model's wall figures (a run with the ``press1/2`` and ``wheels_off`` columns; {} for
+    others): ``press1_n``, ``press2_n`` [N], each module's mean total wall press over the run's samples;
+    ``wheel_off_s`` [s], how long any wheel was off its wall (the sample intervals that start with one off)."""
+    if "press1" not in series:
+        return {}
+    t, off = np.asarray(series["t"], dtype=float), np.asarray(series["wheels_off"], dtype=float)
+    return {"press1_n": float(np.mean(series["press1"])), "press2_n": float(np.mean(series["press2"])),
+            "wheel_off_s": float(np.sum(np.diff(t)[off[:-1] > 0]))}
+
+
 def summarize(series: dict[str, np.ndarray], energy: dict[str, float],
               grip: tuple[float, float] | None = None) -> dict[str, Any]:
     """The summary figures of a run, computed from its time series; ``grip`` (G1, G2) [N] of finite grip
@@ -397,6 +411,7 @@ def summarize(series: dict[str, np.ndarray], energy: dict[str, float],
         "slip1_m": slip(series, 1),
         "slip2_m": slip(series, 2),
         "peak_grip_use": peak_grip_use(series, grip),
+        **wheel_keys(series),
         "energy": dict(energy),
     }
 

@@ -13,8 +13,8 @@ The kinds:
   compliant, :mod:`.slide_clutches`, :mod:`.compliant`) or velocity-triggered locks; unlimited grip.
 - ``slides`` with a finite ``mu_wall`` (:data:`GRIP_SLIDES`): a carriage per module on the wall, held by
   friction G_i, carries the clutch (:mod:`.grip_model`, :mod:`.grip`, :mod:`.grip_compliant`).
-- ``wheels`` (:data:`WHEELS`): the modules on wheels in a pipe, a ratchet in every hub (:mod:`.wheels_model`,
-  :mod:`.wheels`); routes of straights and bends (:mod:`.route_watch`).
+- ``wheels`` (:data:`WHEELS`): a 3-D robot on sprung wheel legs in a round pipe, a ratchet in every hub
+  (:mod:`.wheels_model`, :mod:`.wheels`); routes of straights and bends (:mod:`.route_watch`).
 
 Adding a kind: subclass :class:`ModelKind`, give it a ``name`` and the methods below that differ from the
 base's, and list it in :data:`KINDS` (``docs/architecture.md``, "Adding a model kind").
@@ -35,11 +35,12 @@ from .grip_compliant import CompliantGrip
 from .grip_model import SKIDS
 from .loop_rows import loop_options
 from .model import SolverSettings, build_model, qpos_address, set_closed_loop_state
-from .route_watch import check_route, planar_fit, route_decorator
+from .route_watch import check_route, pipe_fit
 from .slide_clutches import refuse_grip, slide_controller
 from .timestep import choose_settings
-from .wheels import WheelRatchet, refuse_clutches, wheel_loop_options, wheel_slip, wheels_settings
-from .wheels_model import LATERALS, YAWS, ContactSettings, build_wheels_model, set_wheels_state
+from .wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
+                     wheels_settings)
+from .wheels_model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
 
 
 class ModelKind:
@@ -174,14 +175,13 @@ class GripSlidesKind(ModelKind):
 
 
 class WheelsKind(ModelKind):
-    """The modules on wheels in a pipe, a ratchet in every hub, stepped in Python."""
+    """A 3-D robot on sprung wheel legs in a round pipe, a ratchet in every hub, stepped in Python."""
 
     name = "wheels"
     model = "wheels"
-    # 'warn': its modules rock on their springs and its soft contacts dissipate work the energy audit (the
-    # contacts' tangential rows only) cannot attribute, ~0.1-0.3 % of the motor's whatever the step
-    # (mjcf/README.md, "Wheels in contact"): a term of the model, not the stepping's error, so the residual is
-    # recorded and shown rather than stopping the run (or halving its step, which does not lower it)
+    # 'warn': its soft contacts and rocking legs take work the energy audit (the contacts' tangential rows only)
+    # cannot attribute (mjcf/README.md, "The round pipe"): a term of the model, not the stepping's error, so the
+    # residual is recorded and shown rather than stopping the run (or halving its step, which does not lower it)
     accuracy = "warn"
     skid = True
 
@@ -196,24 +196,21 @@ class WheelsKind(ModelKind):
 
     def settings(self, params, t_end, dt_out, servo=None, implementation="ratchet"):
         chosen, why = super().settings(params, t_end, dt_out, servo, implementation)
-        return wheels_settings(chosen, why, params, dt_out)
+        return wheels_settings(chosen, why, dt_out)
 
     def recorded_settings(self):
-        return {"mujoco_model": self.model, **ContactSettings().as_dict()}
+        return {"mujoco_model": self.model, "cone": "elliptic", "impratio": 1.0,
+                "noslip_iterations": NOSLIP_ITERATIONS, "contact_time_constant_s": ROW_TIMES.contact,
+                "limit_time_constant_s": ROW_TIMES.limit, "loop_time_constant_s": ROW_TIMES.loop}
 
     def build(self, params, settings, *, mjcf=None, implementation="ratchet", route=None, decorate=None):
-        walls = route_decorator(params, route)
-        if walls is not None and decorate is not None:
-            both = lambda spec: (walls(spec), decorate(spec))  # noqa: E731
-        else:
-            both = walls or decorate
-        return build_wheels_model(params, settings, mjcf=mjcf, decorate=both)
+        return build_wheels_model(params, settings, mjcf=mjcf, route=route, decorate=decorate)
 
     def initial_state(self, model, data, params):
         set_wheels_state(model, data, params)
 
     def route_fit(self, route, params):
-        return planar_fit(route, params)
+        return pipe_fit(route, params)
 
     def controller(self, model, data, params, implementation, rule="unilateral"):
         return WheelRatchet(model, data, params)
@@ -223,9 +220,10 @@ class WheelsKind(ModelKind):
 
     def columns(self, model, params, q, scalars, out):
         """slip1/2 [m], each module's backward steps (:func:`.wheels.wheel_slip`); grip_use1/2
-        (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J], the
-        wheels' states wheels1/2; the modules' planar pose y1/2 [m] (lateral slides), yaw1/2 [rad] (hinges about
-        z), which with x1, x2, phi pose the robot for a replay."""
+        (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J],
+        the wheels' states wheels1/2; the legs' press press1/2 [N] and wheels_off (:func:`.wheels.press_columns`);
+        the modules' pose across the pipe y1/2, z1/2 [m], roll1/2, pitch1/2, yaw1/2 [rad]
+        (:func:`.wheels.pose_columns`), which with x1, x2, phi pose the robot for a replay."""
         cols = {}
         for k in (1, 2):
             wheels = scalars[f"wheels{k}"]
@@ -235,8 +233,8 @@ class WheelsKind(ModelKind):
                 cols[f"grip_use{k}"] = grip_use(out[f"lambda{k}"], wheels, G)
             cols[f"wheels{k}"] = wheels.copy()
         cols["skid_work"] = scalars["skid_work"].copy()
-        cols.update({name: q[:, qpos_address(model, joint)].copy()
-                     for name, joint in zip(("y1", "y2", "yaw1", "yaw2"), (*LATERALS, *YAWS))})
+        cols.update(press_columns(model, params, q))
+        cols.update(pose_columns(model, q))
         return cols
 
 

@@ -188,9 +188,10 @@ def _place_floor(spec: mujoco.MjSpec, route: Route, robot_length: float) -> None
                   floor.size[2]]
 
 
-def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_travel: float) -> dict:
-    """The closed-form check of each bend beside MuJoCo's outcome: the rigid housing (2 HOUSING_HALF square)
-    against :func:`.pipe.bend_max_length`, and the spread the wheels of a station (``half_base`` [m] either side
+def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_travel: float,
+                   housing: tuple[float, float] = (2 * HOUSING_HALF, 2 * HOUSING_HALF)) -> dict:
+    """The closed-form check of each bend beside MuJoCo's outcome: the rigid housing (``housing``: its width
+    across the pipe and its length [m]) against :func:`.pipe.bend_max_length`, and the spread the wheels of a station (``half_base`` [m] either side
     of the module's middle) need against their springs' reach (2 ``spring_travel`` [m] per pair: each of the
     pair's springs reaches its free length), :func:`.pipe.bend_wheel_spread`. Returns ``{"bends": [...],
     "predicted": one line}``; a figure with no finite value (the rod's clearance where it is longer than the
@@ -198,12 +199,12 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
     D, Rw = params.pipe_diameter, params.wheel_radius
     bends, worst = [], None
     for k, bend in enumerate(route.bends):
-        rigid = bend_max_length(2 * HOUSING_HALF, bend.radius, D)
+        rigid = bend_max_length(housing[0], bend.radius, D)
         spread = bend_wheel_spread(half_base, Rw, bend.radius, D)
         press = 1.0 - spread / (2 * spring_travel)
         clearance = bend_rod_clearance(params.L, ROD_RADIUS, bend.radius, D)
         bends.append({"bend": k + 1, "radius_m": bend.radius, "R_over_D": bend.radius / D,
-                      "housing_max_length_m": rigid, "housing_fits": rigid >= 2 * HOUSING_HALF,
+                      "housing_max_length_m": rigid, "housing_fits": rigid >= housing[1],
                       "wheel_spread_m": spread, "spring_reach_m": 2 * spring_travel,
                       "wall_press_share": press, "wheels_keep_wall": press > 0,
                       "rod_clearance_m": clearance, "rod_clears": clearance > 0})

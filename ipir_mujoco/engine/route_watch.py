@@ -34,7 +34,6 @@ from ipir_mujoco.core.route import Route
 
 from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, dof_address, qpos_address
 from .route_walls import LEAD_IN
-from .wheels_model import SPRING_TRAVEL
 
 WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
@@ -228,12 +227,12 @@ class RouteWatch:
                 "route_piece_times_s": list(self.mark_times)}
 
 
-def check_route(route, model: str, params, until_steady: bool, planar: bool = True, reach: float | None = None):
+def check_route(route, model: str, params, until_steady: bool, planar: bool = False, reach: float | None = None):
     """``params`` for a run along ``route`` (None: as they are): its incline the route's first straight's;
     ParameterError (one line) for a route on the slide model, with --until-steady, with an incline set apart
     from the route's, or whose first straight is shorter than the robot (it starts in it: ``reach`` [m], how far
-    the robot reaches ahead of its rear module's point A; the planar model's by default); with ``planar`` (the
-    planar model's box walls) one out of the mechanism's plane or whose walls would be too large
+    the robot reaches ahead of its rear module's point A; the round-pipe model's by default); with ``planar`` (the
+    retired planar model's box walls) one out of the mechanism's plane or whose walls would be too large
     (:func:`.route_walls.check_wall_count`). The round pipe's walls (:mod:`.pipe_walls`) take any route: at most
     MAX_SEGMENTS + 2 pieces."""
     from ipir_mujoco.core.errors import ParameterError
@@ -255,10 +254,8 @@ def check_route(route, model: str, params, until_steady: bool, planar: bool = Tr
         from .route_walls import check_wall_count
 
         check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
-    if reach is None:
-        from .wheels_model import HOUSING_OFFSET, STATION_OFFSET
-
-        reach = params.L + params.r + HOUSING_OFFSET + STATION_OFFSET + params.wheel_radius  # A to the front wheels
+    if reach is None:  # the round-pipe model's: A to its front ring's wheels
+        reach = params.L + params.r + 0.5 * params.ring_spacing + params.wheel_radius
     first = route.pieces[0]
     if first.length < reach:
         raise ParameterError(f"{route.source}: segment 1: length={first.length:g} m; the robot starts in it and "
@@ -267,25 +264,18 @@ def check_route(route, model: str, params, until_steady: bool, planar: bool = Tr
     return params.replace(incline=route.incline)
 
 
-def route_decorator(params, route):
-    """``build_wheels_model``'s decorate for the route's walls (:func:`.route_walls.write_route_walls`), or
-    None without a route."""
-    if route is None:
-        return None
-    from .route_walls import write_route_walls
-
-    return lambda spec: write_route_walls(spec, params, route)
-
-
-def planar_fit(route: Route, params) -> dict:
-    """The planar wheeled model's closed-form fit of the route's bends (:func:`.route_walls.fit_prediction`)."""
+def pipe_fit(route: Route, params) -> dict:
+    """The round-pipe model's closed-form fit of the route's bends (:func:`.route_walls.fit_prediction`): its rings
+    ``ring_spacing`` / 2 either side of a module's middle, its legs' springs reaching ``suspension_travel`` beyond
+    their preload, its housing as wide as the ring inside its wheels and as long as its ring spacing."""
     from .route_walls import fit_prediction
-    from .wheels_model import STATION_OFFSET
+    from .wheels_model import housing_radius
 
-    return fit_prediction(route, params, STATION_OFFSET, SPRING_TRAVEL)
+    return fit_prediction(route, params, 0.5 * params.ring_spacing, params.suspension_travel,
+                          housing=(2 * housing_radius(params), params.ring_spacing))
 
 
-def route_watch(route: Route | None, model, recorder, params, dt_out: float, fit=planar_fit) -> RouteWatch | None:
+def route_watch(route: Route | None, model, recorder, params, dt_out: float, fit=pipe_fit) -> RouteWatch | None:
     """The run's RouteWatch (None without a route), with the closed-form fit of the route's bends for this model's
     geometry, ``fit(route, params) -> {"bends": [...], "predicted": one line}`` (the model kind's ``route_fit``)."""
     if route is None:

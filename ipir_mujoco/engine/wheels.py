@@ -1,25 +1,22 @@
-"""The one-way clutches of the wheeled MuJoCo model: a ratchet in every wheel's hub; MuJoCo's rows do the rest.
+"""The one-way clutches of the round-pipe model: a ratchet in every wheel's hub; MuJoCo's rows do the rest.
 
-The model (:mod:`.wheels_model`) puts four wheels on each module, each on a hub hinge whose angle grows as the
-wheel rolls forward (the bottom wall's hubs turn about -z for it). Before every step
-:meth:`WheelRatchet.before_step` raises each hub's lower limit to the running maximum of its angle, one margin
-below it, exactly as the slide model's ratchet does on the slides (:class:`.clutches.Ratchet`): a wheel rolls
+The model (:mod:`.wheels_model`) puts ``2 wheel_legs`` wheels on each module, each on a hub hinge whose angle grows
+as the wheel rolls forward. Before every step :meth:`HubRatchet.before_step` raises each hub's lower limit to the
+running maximum of its angle, one margin below it, as the slide model's ratchet does on the slides: a wheel rolls
 forward freely (against its hub's ``frictionloss``, the rolling resistance) and never back. Everything else is
-MuJoCo's: a held module stands on its locked wheels' contact friction, up to mu_wall times the wall-press
-force, and skids back on them beyond it.
+MuJoCo's: a held module stands on its locked wheels' contact friction, up to mu_wall times its wheels' normal
+forces, and skids back on them beyond it.
 
-Reported per module (:meth:`WheelRatchet.states`): rolling while every hub's friction row slides (at its bound
+Reported per module (:meth:`HubRatchet.states`): rolling while every hub's friction row slides (at its bound
 -tau) and no hub's limit row pushes; otherwise held, and skidding while held and its wheels slide on the wall:
 their contacts' tangential forces together at the friction cone's edge, mu_wall times their normal forces (to
-SLIDING_SHARE; MuJoCo's elliptic cone puts a sliding contact's force on that edge), or, with no contact left,
-while it moves back faster than REST_SPEED. (A held module's speed alone does not tell: it rocks back and
-forth faster than REST_SPEED on its springs and soft contacts as the load comes on.) The clutch's reaction is the clutch's share (:func:`.clutches.clutch_share`) of the module's hold:
-the hubs' limit and friction rows [N m] over the wheel radius. ``excursion`` [m]: the largest give of a hub
-below its running maximum so far, as the arc R (max - angle) on the wall, checked before every step.
+SLIDING_SHARE), or, with no contact left, while it moves back faster than REST_SPEED. A skidding module is not
+held (the analytic model's and the slide model's meaning). The clutch's reaction is the clutch's share
+(:func:`.clutches.clutch_share`) of the module's hold: the hubs' limit and friction rows [N m] over the wheel
+radius. ``excursion`` [m]: the largest give of a hub below its running maximum so far, as the arc R (max - angle).
 
-The work bookkeeping of the stepping loop (:func:`wheel_loop_options`): the rolling resistance's work from the
-hubs' friction rows, and the contacts' work (``skid_work``: every contact row's force times its speed
-J v_{n+1} of its tangential directions: the friction's work against skidding).
+Per sample also (:meth:`HubRatchet.press`): each module's total wall press [N] (its wheels' contacts' normal
+forces, MuJoCo's ``efc_force``; the housing's too) and how many of its wheels have no contact force.
 """
 
 from __future__ import annotations
@@ -38,31 +35,28 @@ from ipir_mujoco.core.results import REST_SPEED
 from .controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
 from .model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
 from .rows import clutch_share, missing_rows
-from .wheels_model import WHEEL_NAMES, contact_friction
+from .wheels_model import HOUSINGS, contact_friction, leg_names, wheels_timestep
 
 LIMIT_JOINT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 SLIDING_SHARE = 1e-6  # a module's contacts slide where their tangential force is within this share of the cone
 
 
 class WheelRatchet(ControllerBase):
-    """The hubs' ratchets (module docstring); ``model`` built by :func:`.wheels_model.build_wheels_model`, called
-    after the initial state is set. ``bounds`` [rad]: each hub's running maximum, rear module's hubs first."""
+    """The hubs' ratchets (module docstring); ``model`` built by :func:`.wheels_model.build_wheels_model`, made after
+    the initial state is set. ``bounds`` [rad]: each hub's running maximum, rear module's hubs first."""
 
     name = "wheel ratchet"
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
         self.model, self.data, self.radius = model, data, params.wheel_radius
         self._states = (math.nan, None)  # (data.time, states()) of the last step read
-        names = [n + "_hub" for module in WHEEL_NAMES for n in module]
-        self.module_of = {}
+        legs = leg_names(params)
+        names = [n + "_hub" for module in legs for n in module]
+        per_module = len(legs[0])
         self.joint_ids = [model.joint(n).id for n in names]
-        for k, j in enumerate(self.joint_ids):
-            self.module_of[j] = 0 if k < len(WHEEL_NAMES[0]) else 1
+        self.module_of = {j: (0 if k < per_module else 1) for k, j in enumerate(self.joint_ids)}
         self.qpos_adr = [qpos_address(model, n) for n in names]
         self.dof_adr = [dof_address(model, n) for n in names]
-        limited = [j for j in range(model.njnt) if model.jnt_limited[j]]
-        if sorted(limited) != sorted(self.joint_ids):
-            raise ValueError("the wheel ratchet needs the hubs, and only them, limited: build the wheeled model")
         self.margins = [float(model.jnt_margin[j]) for j in self.joint_ids]
         self.range = model.jnt_range
         self.limit = RunningBound(self.range, self.joint_ids, [float(data.qpos[a]) for a in self.qpos_adr],
@@ -78,16 +72,18 @@ class WheelRatchet(ControllerBase):
             raise ParameterError("the wheeled MJCF model has frictionloss off the hubs: the engine counts the "
                                  "rolling resistance on the hubs only")
         self.friction_count = len(with_friction)
-        self.friction_rows = [[with_friction.index(self.dof_adr[k]) for k in range(len(names))
+        self.torques = [float(model.dof_frictionloss[self.dof_adr[k]]) for k in range(len(names))]
+        # per module: (its hubs' friction rows after the equality rows, each hub's friction torque [N m])
+        self.friction_rows = [[(with_friction.index(self.dof_adr[k]), self.torques[k]) for k in range(len(names))
                                if self.dof_adr[k] in with_friction and self.module_of[self.joint_ids[k]] == i]
                               for i in (0, 1)]
-        self.torques = [float(model.dof_frictionloss[self.dof_adr[k]]) for k in range(len(names))]
-        per_module = len(WHEEL_NAMES[0])
-        # each module's rolling resistance [N]: its hubs' friction torques over the wheel radius
         self.resistance = [sum(self.torques[i * per_module:(i + 1) * per_module]) / self.radius for i in (0, 1)]
         self.grip = None if params.grip is None else list(params.grip)
         self.mu = contact_friction(params)
-        self.geom_module = {model.geom(n + "_wheel").id: i for i, module in enumerate(WHEEL_NAMES) for n in module}
+        self.wheel_geoms = [[model.geom(n + "_wheel").id for n in module] for module in legs]
+        self.geom_module = {g: i for i, ids in enumerate(self.wheel_geoms) for g in ids}
+        self.geom_module.update({model.geom(h).id: i for i, h in enumerate(HOUSINGS)})
+        self.wheels_per_module = per_module
 
     def before_step(self) -> None:
         """Raise each hub's bound to its running maximum, or note how far (on the wall) it has given."""
@@ -108,41 +104,48 @@ class WheelRatchet(ControllerBase):
         start = ne + d.nf
         for row in range(start, start + d.nl):
             if d.efc_type[row] == LIMIT_JOINT:
-                limits[self.module_of[int(d.efc_id[row])]] += force.item(row)
+                module = self.module_of.get(int(d.efc_id[row]))
+                if module is not None:  # a hub's (an arm's stop is no clutch)
+                    limits[module] += force.item(row)
         friction, sticks = [0.0, 0.0], [False, False]
         for i in (0, 1):
-            for k in self.friction_rows[i]:
+            for k, tau in self.friction_rows[i]:
                 f = force.item(ne + k)
                 friction[i] += f
-                tau = float(self.model.dof_frictionloss[d.efc_id[ne + k]])
                 if f > -tau * (1 - 1e-9):
                     sticks[i] = True
         return limits, friction, sticks
 
-    def _contacts(self) -> tuple[list[float], list[float]]:
-        """Per module of the last step: its wheels' contacts' normal forces and tangential force magnitudes
-        [N], summed (an elliptic contact's rows: normal, then its two tangential directions)."""
+    def contacts(self) -> tuple[list[float], list[float], list[int]]:
+        """Per module of the last step: its contacts' normal forces and tangential force magnitudes [N], summed
+        (an elliptic contact's rows: normal, then its two tangential directions), and how many of its wheels
+        press the wall with no force."""
         d, force = self.data, self.data.efc_force
         normal, tangential = [0.0, 0.0], [0.0, 0.0]
+        touching = set()
         geoms, addresses = d.contact.geom, d.contact.efc_address
         for c in range(d.ncon):
             g1, g2 = int(geoms[c, 0]), int(geoms[c, 1])
-            i = self.geom_module.get(g1, self.geom_module.get(g2))
+            g = g1 if g1 in self.geom_module else g2
+            i = self.geom_module.get(g)
             a = int(addresses[c])
             if i is None or a < 0:
                 continue
-            normal[i] += force.item(a)
+            f = force.item(a)
+            normal[i] += f
             tangential[i] += math.hypot(force.item(a + 1), force.item(a + 2))
-        return normal, tangential
+            if f > 0.0:
+                touching.add(g)
+        off = [sum(1 for g in ids if g not in touching) for ids in self.wheel_geoms]
+        return normal, tangential, off
 
     def states(self) -> tuple[list[int], list[float]]:
         """Per module its wheels' state (+1 rolling, 0 standing, -1 skidding) and its clutch's share of the
-        hold [N], of the last step (module docstring). Computed once per step: a sample reads it twice
-        (:meth:`reactions`, :meth:`wheels`)."""
+        hold [N], of the last step (module docstring); computed once per step."""
         if self._states[0] == self.data.time:
             return self._states[1]
         limits, friction, sticks = self._rows()
-        normal, tangential = self._contacts()
+        normal, tangential, _ = self.contacts()
         states, shares = [], []
         for i in (0, 1):
             if not (limits[i] > 0.0 or sticks[i]):
@@ -160,8 +163,8 @@ class WheelRatchet(ControllerBase):
         return states, shares
 
     def reactions(self) -> tuple[bool, bool, float, float]:
-        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step: held while it
-        stands (:func:`.controller.held`: neither rolling nor skidding)."""
+        """(rear held, front held, rear reaction [N], front reaction [N]) of the last step: held while its clutch
+        carries it and it stands (:func:`.controller.held`: neither rolling nor skidding)."""
         states, shares = self.states()
         return held(True, states[0]), held(True, states[1]), shares[0], shares[1]
 
@@ -169,6 +172,62 @@ class WheelRatchet(ControllerBase):
         """Each module's wheels' state of the last step: +1.0 rolling, 0.0 standing, -1.0 skidding."""
         states, _ = self.states()
         return float(states[0]), float(states[1])
+
+    def press(self) -> tuple[float, float, int]:
+        """(module 1's wall press [N], module 2's, how many wheels of both carry no force) of the last step."""
+        normal, _, off = self.contacts()
+        return normal[0], normal[1], off[0] + off[1]
+
+
+LIFT_SHARE = 0.05  # a leg is off its wall while its spring presses with less than this share of its preload
+
+
+def leg_press(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each leg's spring press [N] from the samples' joint positions ``q`` (n, nq): k (travel - arm slide), 0 at
+    and beyond the spring's free length; shape (n, 2, 2 wheel_legs), rear module first, and each leg's preload
+    [N], shape (2,). A leg's light arm passes its spring's force to its wheel's contact but for its inertia
+    (tests/test_mujoco_wheels.py compares the two over a run), so this is the wall's press on the wheel, read
+    from the state rather than the solver (a sliding wheel's contact flickers on and off by micrometres while
+    its spring stays pressed: the spring's press is the wheel's hold on the wall)."""
+    from .wheels_model import leg_preload, leg_stiffness
+
+    legs = leg_names(params)
+    out = np.empty((q.shape[0], 2, len(legs[0])))
+    for i, names in enumerate(legs):
+        k = leg_stiffness(params, i)
+        for j, n in enumerate(names):
+            out[:, i, j] = np.maximum(k * (params.suspension_travel - q[:, qpos_address(model, n + "_arm")]), 0.0)
+    return out, np.array([leg_preload(params, 0), leg_preload(params, 1)])
+
+
+def pose_columns(model: mujoco.MjModel, q: np.ndarray) -> dict[str, np.ndarray]:
+    """Each module's pose across the pipe from the samples' ``q`` (n, nq): y1/2, z1/2 [m] (its slides across the
+    pipe) and roll1/2, pitch1/2, yaw1/2 [rad] (its ball joint's rotation vector about x, y, z: for the small
+    turns of a module in its pipe, its roll, pitch and yaw), which with x1, x2, phi pose the robot for a replay."""
+    from .wheels_model import LATERALS, TILTS, VERTICALS
+
+    cols = {}
+    for k in (1, 2):
+        cols[f"y{k}"] = q[:, qpos_address(model, LATERALS[k - 1])].copy()
+        cols[f"z{k}"] = q[:, qpos_address(model, VERTICALS[k - 1])].copy()
+        a = qpos_address(model, TILTS[k - 1])
+        quat = q[:, a:a + 4]
+        sign = np.where(quat[:, 0] < 0, -1.0, 1.0)[:, None]
+        w, v = np.clip(sign[:, 0] * quat[:, 0], -1.0, 1.0), sign * quat[:, 1:]
+        norm = np.linalg.norm(v, axis=1)
+        scale = np.where(norm > 1e-12, 2.0 * np.arctan2(norm, w) / np.maximum(norm, 1e-300), 2.0)
+        rot = v * scale[:, None]
+        for j, axis in enumerate(("roll", "pitch", "yaw")):
+            cols[f"{axis}{k}"] = rot[:, j].copy()
+    return cols
+
+
+def press_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> dict[str, np.ndarray]:
+    """press1/2 [N]: each module's legs' total press on the wall (:func:`leg_press`); wheels_off [-]: how many
+    legs of both modules are off their wall (pressing with less than LIFT_SHARE of their preload)."""
+    press, preload = leg_press(model, params, q)
+    off = (press < LIFT_SHARE * preload[None, :, None]).sum(axis=(1, 2)).astype(float)
+    return {"press1": press[:, 0].sum(axis=1), "press2": press[:, 1].sum(axis=1), "wheels_off": off}
 
 
 def wheel_loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
@@ -235,16 +294,13 @@ def refuse_clutches(params: RobotParams, implementation: str) -> None:
                              "hub ratchets are rigid; allowed: clutch_stiffness=rigid, or --mujoco-model slides")
 
 
-# s: the wheeled model's largest automatic timestep with finite grip: a skid's length converges only there
-# (mjcf/README.md, "Wheels in contact": 48 % too long at 1e-4 s, 6 % at 5e-5 s, within 1 % at 2.5e-5 s)
-DT_SKID = 2.5e-5
-
-
-def wheels_settings(chosen: SolverSettings, why: dict, params: RobotParams, dt_out: float):
+def wheels_settings(chosen: SolverSettings, why: dict, dt_out: float):
     """The automatic settings of a wheeled run: ``chosen`` (:func:`.timestep.choose_settings`' SolverSettings
-    and ``why``, its limits [s]) with the step capped at DT_SKID where the grip is finite, a whole fraction
-    of ``dt_out`` [s]; returns (settings, why)."""
-    if params.grip is None or chosen.timestep <= DT_SKID:
+    and ``why``, its limits [s]) with the step at most the model's own (:func:`.wheels_model.wheels_timestep`,
+    half its rows' shortest time constant: mjcf/README.md, "The round pipe: convergence"), a whole fraction of
+    ``dt_out`` [s]; returns (settings, why)."""
+    cap = wheels_timestep()
+    if chosen.timestep <= cap:
         return chosen, why
-    steps = math.ceil(dt_out / DT_SKID * (1 - 1e-12))
-    return replace(chosen, timestep=dt_out / steps), {**why, "skid_s": DT_SKID}
+    steps = math.ceil(dt_out / cap * (1 - 1e-12))
+    return replace(chosen, timestep=dt_out / steps), {**why, "rows_s": cap}

@@ -1,29 +1,34 @@
-"""Build the wheeled MuJoCo model of the robot (``--mujoco-model wheels``) from a parameter set, through MjSpec.
+"""Build the wheeled MuJoCo model of the robot, a 3-D robot in a round pipe (``--mujoco-model wheels``), through MjSpec.
 
-The template ``mjcf/inchworm_wheels.xml`` holds the mechanism of ``inchworm.xml`` (crank on module 1, rod,
-the loop closed on module 2 by an equality ``connect``) with each module free in the mechanism's plane
-(slide x, slide y, hinge z), two walls (planes at y = +-D/2) and per module four wheels: at two stations
-along x (aft and fore of the housing's centre, STATION_OFFSET either side), one on each wall at each station.
-(The walls' forces on a pair at one station are collinear, so the preload makes no couple; two stations hold
-the module's yaw; one station alone would leave it free to turn about that station.) Each wheel is a capsule (axis along z) on a hub hinge, on an arm that slides along the module's y axis, pressed on
-its wall by a preloaded spring. :func:`build_wheels_model` writes the parameters in:
+The template ``mjcf/inchworm_wheels.xml`` holds the mechanism of ``inchworm.xml`` (crank on module 1, rod, the loop
+closed on module 2 by an equality ``connect``) with each module free in 3-D: slides along x (``rear_slide``,
+``front_slide``: the travel every column reads), y (``*_lateral``) and z (``*_vertical``) and a ball joint
+(``*_tilt``). x is the pipe's axis, z is up in a horizontal pipe, the crank turns about z. :func:`build_wheels_spec`
+adds, per module, two rings (``aft``, ``fore``) of ``wheel_legs`` legs each, ``ring_spacing`` apart and centred
+on the module's joint with the linkage (A on module 1, C on module 2: the linkage's forces there make no moment
+about the rings' middle), the legs evenly spaced about the axis with leg 0 at the bottom. A leg:
 
-- the spring: stiffness k = (F_ni / WHEELS_PER_MODULE) / SPRING_TRAVEL with springref SPRING_TRAVEL, so that
-  with the wheel on its wall (the arm slide at 0) it presses with F_ni / WHEELS_PER_MODULE: the module's
-  wheels together press with F_ni (``F_n1``, ``F_n2``); a contact that sinks by p lowers that by p /
-  SPRING_TRAVEL of it;
-- the hub: ``frictionloss`` F_ri R / WHEELS_PER_MODULE [N m], so that the module's wheels rolling on the
-  wall resist with F_ri (the rolling resistance, by construction); a limited hinge, the one-way clutch,
-  whose lower bound the engine raises (:mod:`.wheels`);
-- the contact: friction ``mu_wall`` (condim 3: sliding only; rolling is the hinge's), elliptic cone; with
-  ``mu_wall`` unlimited the friction is MU_UNLIMITED, the parameter's upper bound: a grip of ten times the
-  wall-press force, which no load of the robot comes near (a run reports it, ``peak_grip_use``, as the
-  slide model does not);
-- masses: the wheels and arms are part of their module's mass m_i (each ARM_SHARE and WHEEL_SHARE of it);
-  a wheel is a disc, inertia m_w R^2 / 2 about its axis;
-- geometry: walls at y = +-pipe_diameter / 2, wheel centres at +-(D / 2 - R) from the module's axis.
+- an arm, a slide along the leg's outward radial direction u, pressed outward by a linear spring of stiffness
+  k = P / ``suspension_travel`` and free length ``suspension_travel`` beyond the wall, so that on the wall (slide
+  at 0) it presses with its preload P = F_ni / (2 ``wheel_legs``): a module's legs press the wall with F_ni in
+  all (``F_n1``, ``F_n2``). The arm stops at the spring's free length (slide +travel: a wheel off its wall
+  presses nothing) and at STOP_COMPRESSION travels of compression (slide -(STOP_COMPRESSION - 1) travel);
+- a wheel on a hub hinge about x cross u (forward rolling turns it positively): the one-way clutch (a limited
+  hinge whose lower bound the engine raises, :mod:`.wheels`) and the rolling resistance (``frictionloss``
+  F_ri R / (2 ``wheel_legs``), so that a module's wheels rolling on the wall resist with F_ri);
+- the wheel's contact: a sphere of radius ``wheel_radius`` (one contact point on any wall), friction
+  ``mu_wall`` (condim 3: sliding; the rolling is the hinge's), elliptic cone. With ``mu_wall`` unlimited the
+  friction is MU_UNLIMITED; the engine reports a run whose grip use comes near it.
 
-Element names beyond the slide model's (read by name, never by index) are the constants below.
+For symmetric legs on linear springs the sum of a ring's normal forces does not change as the module moves
+across the pipe (the outward directions sum to zero), so the module's press stays F_ni while its weight sags it;
+the arms' stops and a wheel off its wall end that (:mod:`ipir_mujoco.core.pipe_lift`, the closed-form check).
+
+Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i, inside m_i; the module's
+inertia is a solid cylinder of its mass, as long as its ring spacing, of the radius inside its wheels. The pipe's
+wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat walls along each leg's track let a
+skidding module roll off them: a rolled wheel's normal on a plane has a moment about the axis that rolls it on).
+Every row's time constant is a property of the model in seconds (:class:`RowTimes`), not a multiple of the step.
 """
 
 from __future__ import annotations
@@ -33,65 +38,87 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
+import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.pipe import check_fit
+from ipir_mujoco.core.pipe import leg_direction as core_leg_direction
 
 from ..resources import mjcf_dir
-from .model import (FRONT_SLIDE, LOOP, REAR_SLIDE, SolverSettings, _element, _write_drive, _write_gravity,
-                    _write_mechanism, check_params, compile_spec, load_spec, write_step_options)
+from .model import (CRANK_HINGE, FRONT_SLIDE, INTEGRATORS, LOOP, REAR_SLIDE, ROD_HINGE, SolverSettings, _element,
+                    _write_drive, _write_gravity, _write_mechanism, check_params, compile_spec, dof_address,
+                    load_spec, qpos_address, start_closed_loop)
 
 MODULES = ("rear", "front")
-SIDES = ("top", "bottom")  # the wall at +D/2, the wall at -D/2
-STATIONS = ("aft", "fore")  # the wheel stations along x, behind and ahead of the housing's centre
+RINGS = ("aft", "fore")
 LATERALS = ("rear_lateral", "front_lateral")  # the modules' slides across the pipe (y)
-YAWS = ("rear_yaw", "front_yaw")  # the modules' hinges about z
-WALLS = ("wall_top", "wall_bottom")
-# per module (rear first) its wheels' prefixes, MODULE_SIDE_STATION: + '_arm' (a body and its slide),
-# '_hub' (the wheel's hinge), '_wheel' (the wheel's body and its capsule geom)
-WHEEL_NAMES = tuple(tuple(f"{m}_{s}_{st}" for st in STATIONS for s in SIDES) for m in MODULES)
-ARMS = tuple(f"{n}_arm" for names in WHEEL_NAMES for n in names)
-HUBS = tuple(f"{n}_hub" for names in WHEEL_NAMES for n in names)
-WHEELS = tuple(f"{n}_wheel" for names in WHEEL_NAMES for n in names)
-WHEELS_PER_MODULE = 4
-SPRING_TRAVEL = 1e-4  # m: the arm spring's compression at its preload (k = preload / SPRING_TRAVEL)
+VERTICALS = ("rear_vertical", "front_vertical")  # the modules' slides across the pipe (z)
+TILTS = ("rear_tilt", "front_tilt")  # the modules' ball joints
+HOUSINGS = ("rear_housing", "front_housing")
 ARM_SHARE = 1e-3  # of the module's mass, per arm
 WHEEL_SHARE = 1e-3  # of the module's mass, per wheel
-HALF_WIDTH = 0.005  # m: the capsule's half-length along its axis (z), for drawing and contact
-HOUSING_OFFSET = 0.035  # m: the housing's centre behind A (module 1) and ahead of C (module 2), as inchworm.xml
-STATION_OFFSET = 0.025  # m: each wheel station's distance along x from its housing's centre
-MU_UNLIMITED = 10.0  # the contact friction for mu_wall = unlimited: the parameter's upper bound
-WALL_LENGTH = 3.0  # m: the walls' half-length as drawn (their planes are infinite for collisions)
-
-
-def default_wheels_mjcf() -> Path:
-    """The shipped template of the wheeled model."""
-    return mjcf_dir() / "inchworm_wheels.xml"
+HALF_WIDTH = 0.005  # m: the drawn tyre's half-width along its hub (the contact is the sphere's)
+SEAT = 1e-8  # m: how far the initial state sets each wheel into the wall (its contact then acts from the first step)
+STOP_COMPRESSION = 4.0  # the arm's inner stop, in suspension travels of compression (4 x the preload)
+# the contact friction for mu_wall = unlimited: a grip of 100 times the press, beyond any load the parameters'
+# envelope puts on a module (its largest demand, a 5 kg module on a riser under a 2 N m motor through a 0.02 m
+# crank, is 30 times a 5 N press); mu 10 let such a module skid
+MU_UNLIMITED = 100.0
+NOSLIP_ITERATIONS = 0  # MuJoCo's no-slip pass: off (a held robot creeps ~3e-6 m/s without it; it doubles the cost)
+IMPEDANCE = (0.9999, 0.9999, 0.001, 0.5, 2.0)  # every row's solimp: MuJoCo's largest impedance, as the slides'
 
 
 @dataclass(frozen=True)
-class ContactSettings:
-    """The contact solver's settings of the wheeled model (``mjcf/README.md``, "Wheels in contact", has the
-    convergence study): MuJoCo's friction cone ('elliptic' | 'pyramidal'), ``impratio`` (> 0: how much
-    harder friction is than the normal direction) and ``noslip_iterations`` (>= 0: the post-pass that
-    removes frictional creep)."""
+class RowTimes:
+    """The time constants [s] of the model's soft rows (MuJoCo's solref, damping ratio 1), properties of the
+    model and not of the step (mjcf/README.md, "The round pipe: convergence"): ``contact`` (wheel and housing
+    against the wall), ``limit`` (the hubs' ratchets and friction, the arms' stops), ``loop`` (the rod's pin on
+    module 2). MuJoCo needs each >= 2 steps; :func:`wheels_timestep` picks the step from them."""
 
-    cone: str = "elliptic"
-    impratio: float = 1.0
-    noslip_iterations: int = 10
+    contact: float = 2e-4
+    limit: float = 2e-4
+    loop: float = 2e-4
 
-    def __post_init__(self) -> None:
-        if self.cone not in ("elliptic", "pyramidal"):
-            raise ParameterError(f"cone={self.cone!r} is unknown; allowed: elliptic, pyramidal")
-        if not (math.isfinite(self.impratio) and self.impratio > 0):
-            raise ParameterError(f"impratio={self.impratio} is out of range; allowed: impratio > 0")
-        if not (isinstance(self.noslip_iterations, int) and 0 <= self.noslip_iterations <= 1000):
-            raise ParameterError(f"noslip_iterations={self.noslip_iterations!r} is out of range; allowed: a whole "
-                                 "number 0..1000")
+    def shortest(self) -> float:
+        return min(self.contact, self.limit, self.loop)
 
-    def as_dict(self) -> dict:
-        return {"cone": self.cone, "impratio": self.impratio, "noslip_iterations": self.noslip_iterations}
+
+ROW_TIMES = RowTimes()
+STEPS_PER_TIME_CONSTANT = 2  # the default step: the shortest time constant over this (convergence study)
+
+
+def wheels_timestep(times: RowTimes = ROW_TIMES) -> float:
+    """The default step [s] of the round-pipe model: its shortest row time constant / STEPS_PER_TIME_CONSTANT."""
+    return times.shortest() / STEPS_PER_TIME_CONSTANT
+
+
+def default_wheels_mjcf() -> Path:
+    """The shipped template of the round-pipe model."""
+    return mjcf_dir() / "inchworm_wheels.xml"
+
+
+def leg_count(params: RobotParams) -> int:
+    return int(params.wheel_legs)
+
+
+def leg_names(params: RobotParams) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Per module (rear first) its legs' prefixes MODULE_RING_legK, aft ring first: + '_arm' (the arm's body and
+    slide), '_hub' (the wheel's hinge), '_wheel' (the wheel's body and sphere), '_tyre' (the drawn tyre)."""
+    n = leg_count(params)
+    return tuple(tuple(f"{m}_{ring}_leg{k}" for ring in RINGS for k in range(n)) for m in MODULES)
+
+
+def leg_direction(k: int, n: int) -> np.ndarray:
+    """Leg k's outward unit vector (of n evenly spaced, leg 0 pointing down, -z), shape (3,)
+    (:func:`ipir_mujoco.core.pipe.leg_direction`, the lift-off check's)."""
+    return np.array(core_leg_direction(k, n))
+
+
+def hub_axis(u: np.ndarray) -> np.ndarray:
+    """The hub's axis x cross u for a leg pointing along u: a wheel rolling forward (+x) on the wall at u turns
+    positively about it."""
+    return np.cross([1.0, 0.0, 0.0], u)
 
 
 def contact_friction(params: RobotParams) -> float:
@@ -99,115 +126,181 @@ def contact_friction(params: RobotParams) -> float:
     return MU_UNLIMITED if params.mu_wall is None else params.mu_wall
 
 
+def leg_preload(params: RobotParams, module: int) -> float:
+    """One leg's spring preload P [N] on the wall: F_ni / (2 wheel_legs)."""
+    return (params.F_n1, params.F_n2)[module] / (2 * leg_count(params))
+
+
+def leg_stiffness(params: RobotParams, module: int) -> float:
+    """One leg's spring stiffness [N/m]: preload / suspension_travel."""
+    return leg_preload(params, module) / params.suspension_travel
+
+
 def wheel_mass(params: RobotParams, module: int) -> float:
-    """Mass [kg] of one wheel of module ``module`` (0 rear, 1 front)."""
     return WHEEL_SHARE * (params.m1, params.m2)[module]
 
 
-def wheel_inertia(params: RobotParams, module: int) -> float:
-    """A wheel's inertia about its axis [kg m^2]: a disc, m_w R^2 / 2."""
-    return 0.5 * wheel_mass(params, module) * params.wheel_radius ** 2
+def housing_radius(params: RobotParams) -> float:
+    """The housing's radius [m]: inside the wheels' ring, D/2 - 2 R."""
+    return 0.5 * params.pipe_diameter - 2.0 * params.wheel_radius
 
 
-def build_wheels_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
-                      contact: ContactSettings = ContactSettings(), mjcf: str | Path | None = None) -> mujoco.MjSpec:
-    """The template with ``params`` and the settings written in (not compiled); see the module docstring."""
+def check_wheels_params(params: RobotParams) -> None:
+    """The parameters the round-pipe model needs beyond the shared ranges (ParameterError, one line)."""
     check_params(params)
     check_fit(params)
+    for name in ("F_n1", "F_n2"):
+        if not getattr(params, name) > 0:
+            raise ParameterError(f"{name}={getattr(params, name)!r} N with the wheeled MuJoCo model: its legs' springs "
+                                 f"press the wheels on with it; allowed: 0 < {name} <= 1e+06 N")
+    if not params.suspension_travel < 0.25 * params.pipe_diameter / STOP_COMPRESSION:
+        raise ParameterError(f"suspension_travel={params.suspension_travel:g} m with pipe_diameter="
+                             f"{params.pipe_diameter:g} m: the arm's travel to its stop must fit in the pipe; allowed: "
+                             f"suspension_travel < pipe_diameter / {4 * STOP_COMPRESSION:g}")
+
+
+def build_wheels_spec(params: RobotParams, settings: SolverSettings | None = None, times: RowTimes = ROW_TIMES,
+                    mjcf: str | Path | None = None, route=None) -> mujoco.MjSpec:
+    """The template with ``params`` written in, the legs added and the pipe's wall (:func:`write_pipe_wall`, a
+    straight pipe or along ``route``, a :class:`ipir_mujoco.core.route.Route`), not compiled. ``settings``: the
+    step and integrator (default :func:`wheels_timestep`, implicitfast); the rows' softness is ``times``."""
+    check_wheels_params(params)
+    settings = settings or SolverSettings(timestep=wheels_timestep(times))
+    if settings.timestep > 0.5 * times.shortest() * (1 + 1e-12):
+        raise ParameterError(f"timestep={settings.timestep:g} s with the wheeled model: its rows' shortest time "
+                             f"constant is {times.shortest():g} s; allowed: timestep <= {0.5 * times.shortest():g} s")
     spec = load_spec(mjcf if mjcf is not None else default_wheels_mjcf())
     hint = str(mjcf or default_wheels_mjcf())
     _write_mechanism(spec, params, hint)  # masses, inertias, lengths as the slide model's; resistances below
     _write_drive(spec, params, hint)
     _write_gravity(spec, params, hint)
-    _write_wheels(spec, params, hint)
-    _write_contact_solver(spec, settings, contact, hint)
+    for name in (REAR_SLIDE, FRONT_SLIDE):
+        _element(spec.joint, name, hint).frictionloss = 0.0  # the resistance is the hubs'
+    _write_legs(spec, params, times, hint)
+    write_pipe_wall(spec, params, route, times)
+    spec.option.timestep = settings.timestep
+    spec.option.integrator = INTEGRATORS[settings.integrator]
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = 1.0
+    spec.option.noslip_iterations = NOSLIP_ITERATIONS
+    eq = _element(spec.equality, LOOP, hint)
+    eq.solref, eq.solimp = [times.loop, 1.0], list(IMPEDANCE)
+    for name in HOUSINGS:
+        g = _element(spec.geom, name, hint)
+        g.solref, g.solimp = [times.contact, 1.0], list(IMPEDANCE)
+        g.friction = [contact_friction(params), 0.0, 0.0]
     return spec
 
 
-def _write_wheels(spec: mujoco.MjSpec, params: RobotParams, hint: str) -> None:
-    """Walls, arms, springs, hubs, wheels and the modules' own masses (module docstring)."""
-    R, half = params.wheel_radius, 0.5 * params.pipe_diameter
+def _write_legs(spec: mujoco.MjSpec, params: RobotParams, times: RowTimes, hint: str) -> None:
+    """The modules' masses and inertias, their rings of legs (module docstring)."""
+    n, R, travel = leg_count(params), params.wheel_radius, params.suspension_travel
+    reach = 0.5 * params.pipe_diameter - R  # the wheel's centre from the axis, the arm at 0
     mu = contact_friction(params)
-    for k, name in enumerate(WALLS):
-        wall = _element(spec.geom, name, hint)
-        wall.pos = [0.0, half if k == 0 else -half, 0.0]
-        wall.size = [WALL_LENGTH, 0.05, 0.01]
-        wall.friction = [mu, 0.0, 0.0]
-    masses = (params.m1, params.m2)
-    normals = (params.F_n1, params.F_n2)
-    resistances = (params.F_r1, params.F_r2)
+    masses, resistances = (params.m1, params.m2), (params.F_r1, params.F_r2)
+    contact = dict(solref=[times.contact, 1.0], solimp=list(IMPEDANCE))
+    limit = [times.limit, 1.0]
+    rho, s = housing_radius(params), params.ring_spacing
     for i, module in enumerate(MODULES):
-        direction = -1.0 if i == 0 else 1.0  # the housing sits behind A on module 1, ahead of C on module 2
-        centre = direction * HOUSING_OFFSET
-        preload = normals[i] / WHEELS_PER_MODULE
-        m_arm, m_wheel, J = ARM_SHARE * masses[i], wheel_mass(params, i), wheel_inertia(params, i)
-        for prefix in WHEEL_NAMES[i]:
-            _, side, station = prefix.split("_")
-            outward = 1.0 if side == "top" else -1.0
-            arm = _element(spec.body, prefix + "_arm", hint)
-            arm.pos = [centre + (STATION_OFFSET if station == "fore" else -STATION_OFFSET), 0.0, 0.0]
+        body = _element(spec.body, f"{module}_module", hint)
+        m_arm, m_wheel = ARM_SHARE * masses[i], wheel_mass(params, i)
+        J = 0.5 * m_wheel * R * R
+        k = leg_stiffness(params, i)
+        for prefix in leg_names(params)[i]:
+            ring, leg = prefix.split("_")[1], int(prefix.split("_leg")[1])
+            u = leg_direction(leg, n)
+            x = (-0.5 if ring == "aft" else 0.5) * s
+            arm = body.add_body(name=prefix + "_arm", pos=[x, 0.0, 0.0])
             arm.mass, arm.ipos, arm.inertia = m_arm, [0, 0, 0], [1e-8, 1e-8, 1e-8]
-            slide = _element(spec.joint, prefix + "_arm", hint)
-            slide.stiffness = [preload / SPRING_TRAVEL, 0.0, 0.0]  # a linear spring (MuJoCo 4: a triple)
-            slide.springref = SPRING_TRAVEL
-            wheel = _element(spec.body, prefix + "_wheel", hint)
-            wheel.pos = [0.0, outward * (half - R), 0.0]
-            across = J / 2 + m_wheel * HALF_WIDTH ** 2 / 3  # a disc of width 2 HALF_WIDTH, about a diameter
-            wheel.mass, wheel.ipos, wheel.inertia = m_wheel, [0, 0, 0], [across, across, J]
-            hub = _element(spec.joint, prefix + "_hub", hint)
-            hub.frictionloss = resistances[i] * R / WHEELS_PER_MODULE
+            arm.explicitinertial = True
+            slide = arm.add_joint(name=prefix + "_arm", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=u.tolist())
+            slide.stiffness = [k, 0.0, 0.0]
+            slide.springref = travel
+            slide.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+            slide.range = [-(STOP_COMPRESSION - 1.0) * travel, travel]
+            slide.solref_limit, slide.solimp_limit = limit, list(IMPEDANCE)
+            arm.add_geom(name=prefix + "_strut", type=mujoco.mjtGeom.mjGEOM_CAPSULE, contype=0, conaffinity=0,
+                         group=1, size=[0.003, 0, 0], fromto=[0, 0, 0, *(0.9 * reach * u)], rgba=[0.4, 0.4, 0.45, 1])
+            wheel = arm.add_body(name=prefix + "_wheel", pos=(reach * u).tolist())
+            across = J / 2 + m_wheel * HALF_WIDTH ** 2 / 3
+            a = hub_axis(u)
+            wheel.mass, wheel.ipos = m_wheel, [0, 0, 0]
+            wheel.fullinertia = (J * np.outer(a, a) + across * (np.eye(3) - np.outer(a, a)))[[0, 1, 2, 0, 0, 1],
+                                                                                              [0, 1, 2, 1, 2, 2]]
+            wheel.explicitinertial = True
+            hub = wheel.add_joint(name=prefix + "_hub", type=mujoco.mjtJoint.mjJNT_HINGE, axis=a.tolist())
+            hub.frictionloss = resistances[i] * R / (2 * n)
             hub.limited = mujoco.mjtLimited.mjLIMITED_TRUE
             hub.range = [-1e9, 1e9]  # the engine sets the lower bound before the first step
-            geom = _element(spec.geom, prefix + "_wheel", hint)
-            geom.size = [R, HALF_WIDTH, 0.0]
-            geom.friction = [mu, 0.0, 0.0]
-        body = _element(spec.body, f"{module}_module", hint)
-        body.mass = body.mass - WHEELS_PER_MODULE * (m_arm + m_wheel)  # the module's mass m_i includes them
-    for name in (REAR_SLIDE, FRONT_SLIDE):
-        _element(spec.joint, name, hint).frictionloss = 0.0  # the resistance is the hubs'
+            hub.margin = 1e-9
+            hub.solref_limit, hub.solimp_limit = limit, list(IMPEDANCE)
+            hub.solref_friction, hub.solimp_friction = limit, list(IMPEDANCE)
+            wheel.add_geom(name=prefix + "_wheel", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[R, 0, 0], contype=1,
+                           conaffinity=0, condim=3, friction=[mu, 0.0, 0.0], group=3, rgba=[0.25, 0.25, 0.25, 1],
+                           **contact)
+            wheel.add_geom(name=prefix + "_tyre", type=mujoco.mjtGeom.mjGEOM_CYLINDER, contype=0, conaffinity=0,
+                           group=1, size=[R, 0, 0], fromto=[*(-HALF_WIDTH * a), *(HALF_WIDTH * a)],
+                           rgba=[0.2, 0.2, 0.2, 1])
+        carried = 2 * n * (m_arm + m_wheel)
+        own = body.mass - carried  # the module's mass m_i includes its legs
+        body.mass = own
+        body.ipos = [0, 0, 0]
+        body.inertia = [0.5 * own * rho * rho, own * (3 * rho * rho + s * s) / 12, own * (3 * rho * rho + s * s) / 12]
+        body.explicitinertial = True
+        housing = _element(spec.geom, HOUSINGS[i], hint)
+        housing.size = [rho, 0, 0]
+        housing.fromto = [-0.5 * s, 0, 0, 0.5 * s, 0, 0]
+        housing.contype, housing.conaffinity, housing.condim = 1, 0, 3
 
 
-def _write_contact_solver(spec: mujoco.MjSpec, settings: SolverSettings, contact: ContactSettings,
-                          hint: str) -> None:
-    """Timestep, integrator, cone, impratio, noslip and every row's solref and solimp (the slide model's)."""
-    solref, solimp = write_step_options(spec, settings)
-    spec.option.cone = (mujoco.mjtCone.mjCONE_ELLIPTIC if contact.cone == "elliptic"
-                        else mujoco.mjtCone.mjCONE_PYRAMIDAL)
-    spec.option.impratio = contact.impratio
-    spec.option.noslip_iterations = contact.noslip_iterations
-    for name in HUBS:
-        j = _element(spec.joint, name, hint)
-        j.solref_limit, j.solimp_limit = solref, solimp
-        j.solref_friction, j.solimp_friction = solref, solimp
-    for name in WHEELS + WALLS:
-        g = _element(spec.geom, name, hint)
-        g.solref, g.solimp = solref, solimp
-    eq = _element(spec.equality, LOOP, hint)
-    eq.solref, eq.solimp = solref, solimp
+def write_pipe_wall(spec: mujoco.MjSpec, params: RobotParams, route=None, times: RowTimes = ROW_TIMES) -> list[str]:
+    """The pipe's round wall (:func:`.pipe_walls.add_pipe_walls`: exact contacts with the wheels' spheres and the
+    housings' capsules, no seams or facets), a straight pipe along x or along ``route``, with the wheels'
+    friction (:func:`contact_friction`), the contact time constant and the rows' impedance; returns its geoms'
+    names."""
+    from .pipe_walls import WallContact, add_pipe_walls
+
+    reach = params.r + params.L + 0.5 * params.ring_spacing + 2.0 * params.wheel_radius
+    return add_pipe_walls(spec, route, params.pipe_diameter,
+                          WallContact(contact_friction(params), (times.contact, 1.0), IMPEDANCE), robot_length=reach)
 
 
-def build_wheels_model(params: RobotParams, settings: SolverSettings = SolverSettings(),
-                       contact: ContactSettings = ContactSettings(), mjcf: str | Path | None = None,
-                       decorate=None) -> mujoco.MjModel:
-    """Compile the wheeled robot for ``params`` (:func:`build_wheels_spec`); ``decorate(spec)`` as for
+def build_wheels_model(params: RobotParams, settings: SolverSettings | None = None, times: RowTimes = ROW_TIMES,
+                     mjcf: str | Path | None = None, route=None, decorate=None) -> mujoco.MjModel:
+    """Compile the round-pipe robot for ``params`` (:func:`build_wheels_spec`); ``decorate(spec)`` as for
     :func:`.model.build_model`."""
-    return compile_spec(build_wheels_spec(params, settings, contact, mjcf), decorate, "wheeled MuJoCo model")
+    return compile_spec(build_wheels_spec(params, settings, times, mjcf, route), decorate, "wheeled MuJoCo model")
 
 
-def is_wheeled(model: mujoco.MjModel) -> bool:
-    """Whether ``model`` is the wheeled model (it has the hubs)."""
-    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, HUBS[0]) >= 0
+def sag(params: RobotParams, module: int) -> float:
+    """How far [m] module ``module``'s weight sags it across the pipe on its legs' springs, closed form: the two
+    rings' n legs each stiffen it by n k / 2, so delta = m_i g cos(incline) / (n k) (while no wheel lifts)."""
+    m = (params.m1, params.m2)[module]
+    return m * params.g * math.cos(math.radians(params.incline)) / (leg_count(params) * leg_stiffness(params, module))
 
 
 def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
-    """The loop closed at ``phi0`` with module 1 at 0, both modules on the pipe's axis, every wheel on its wall
-    (arm slides at 0), at rest or with the crank at ``omega0`` (the slide model's rule: the gap rate goes to
-    the module the paper's clutch rule frees, :func:`.model.set_closed_loop_state`)."""
-    from .model import dof_address, start_closed_loop
-
+    """The loop closed at ``phi0`` with module 1 at 0, both modules sagged by their weight on their springs (the
+    mean of the two sags, so that the loop closes, and at most to the lower legs' stops; the springs settle the
+    rest), every wheel on its wall, at rest
+    or with the crank at ``omega0`` (the slide model's rule, :func:`.model.start_closed_loop`)."""
     freed = start_closed_loop(model, data, params)
+    # no further than the lower legs' stops (a module heavier than its press rests on them; a larger drop would
+    # start its housing inside the wall)
+    drop = min(0.5 * (sag(params, 0) + sag(params, 1)), (STOP_COMPRESSION - 1.0) * params.suspension_travel)
+    n = leg_count(params)
+    for i in (0, 1):
+        data.qpos[qpos_address(model, VERTICALS[i])] = -drop
+        for prefix in leg_names(params)[i]:
+            u = leg_direction(int(prefix.split("_leg")[1]), n)
+            # the arm reaches what the module left, and SEAT into the wall: a contact at a distance of exactly 0
+            # is left out of MuJoCo's first step, and the module would drop until its wheels meet the wall
+            lo, hi = model.jnt_range[model.joint(prefix + "_arm").id]
+            data.qpos[qpos_address(model, prefix + "_arm")] = min(max(drop * u[2] + SEAT, lo), hi)
     if freed is not None:  # the wheels of the moving module roll with it
         target, speed = freed
-        for prefix in WHEEL_NAMES[0 if target == REAR_SLIDE else 1]:
+        for prefix in leg_names(params)[0 if target == REAR_SLIDE else 1]:
             data.qvel[dof_address(model, prefix + "_hub")] = speed / params.wheel_radius
     mujoco.mj_forward(model, data)
+
+

@@ -29,7 +29,11 @@ from .document import Heading, Image, Paragraph, Table, fmt
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 RIGID_OFFSET = 0.8  # decades right of the stiffest design where the rigid clutches are drawn
 ENGINE_STYLE = {"analytic": {"ls": "-", "lw": 1.6}, "mujoco": {"ls": "none", "marker": "o", "mfc": "none", "ms": 6}}
-LABEL_OFFSETS = (((8, -14), "left"), ((8, 6), "left"), ((8, -14), "left"))  # [points] for marked designs
+# [points]: where a marked design's name may go, tried in turn (below right, above right, above left, below
+# left, above): the first that covers no data and no other name
+LABEL_OFFSETS = (((8, -14), "left"), ((8, 6), "left"), ((-8, 6), "right"), ((-8, -14), "right"), ((0, 10), "center"),
+                 ((0, -22), "center"), ((8, -28), "left"), ((8, 18), "left"), ((-8, -28), "right"), ((-8, 18), "right"),
+                 ((0, 24), "center"), ((0, -36), "center"))
 RIGID_STYLE = {"analytic": {"marker": "*", "color": "black", "ms": 13},
                "mujoco": {"marker": "X", "color": "dimgrey", "ms": 9}}
 
@@ -51,6 +55,7 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
     axes = fig.subplots(1, len(points), squeeze=False)[0]
     stiffness = np.array(study["stiffness_n_m"])
     rigid_x = stiffness.max() * 10**RIGID_OFFSET
+    labels = []  # (panel, text, (k, force)) of the marked designs, placed once the panels are drawn
     drawn = set()  # what the legend may show: ("backlash", j), "analytic", "mujoco", "rigid:ENGINE", "slope"
     for ax, key in zip(axes, points):
         rows = [r for r in study["rows"] if r["point"] == key]
@@ -84,10 +89,8 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
                 force = row["analytic"]["peak_clutch_force_n"]
                 ax.plot([pair["clutch_stiffness"]], [force], ls="none", marker="D", ms=10, mfc="none", mec="black",
                         mew=1.5, gid=f"pair:{pair['name']}")
-                (dx, dy), align = LABEL_OFFSETS[n % len(LABEL_OFFSETS)]
                 play = f"{1e3 * pair['clutch_backlash']:g} mm play" if pair["clutch_backlash"] else "no play"
-                ax.annotate(f"{pair['name']} ({play})", (pair["clutch_stiffness"], force), xytext=(dx, dy),
-                            ha=align, textcoords="offset points", fontsize="small")
+                labels.append((ax, f"{pair['name']} ({play})", (pair["clutch_stiffness"], force)))
         if _slope_guide(ax, rows, study["backlash_m"]):
             drawn.add("slope")
         ax.axvline(stiffness.max() * 10 ** (RIGID_OFFSET / 2), color="grey", lw=0.8, ls=":")
@@ -118,7 +121,41 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
     if any(a.get_gid() and a.get_gid().startswith("pair:") for ax in axes for a in ax.lines):
         handles.append(Line2D([], [], ls="none", marker="D", mfc="none", mec="black", label="realistic clutches"))
     fig.legend(handles=handles, loc="outside lower center", ncols=min(5, len(handles)), fontsize="small")
+    _place_labels(fig, labels)
     return fig
+
+
+def _place_labels(fig: Figure, labels: list) -> None:
+    """Annotate each marked design at the first of LABEL_OFFSETS where its text covers no data (a line, a
+    marker) and no label placed before it, inside its panel (where none does, the one covering least)."""
+    fig.canvas.draw()  # the layout: the display coordinates the candidates are tested in
+    renderer = fig.canvas.get_renderer()
+    placed = []
+    for ax, text, xy in labels:
+        paths = [(line.get_transform().transform_path(line.get_path()), line.get_linestyle() not in ("None", ""))
+                 for line in ax.lines if len(line.get_xdata())]
+        best = None  # (conflicts, note, box): the candidate covering the least
+        for (dx, dy), align in LABEL_OFFSETS:
+            note = ax.annotate(text, xy, xytext=(dx, dy), ha=align, textcoords="offset points", fontsize="small")
+            box = note.get_window_extent(renderer).expanded(1.02, 1.1)
+            inside = ax.get_window_extent(renderer)
+            conflicts = (sum(bool(np.any((path.vertices[:, 0] > box.x0) & (path.vertices[:, 0] < box.x1)
+                                         & (path.vertices[:, 1] > box.y0) & (path.vertices[:, 1] < box.y1))
+                                  or (drawn_line and path.intersects_bbox(box, filled=False)))
+                             for path, drawn_line in paths)
+                         + 3 * sum(box.overlaps(other) for other in placed)
+                         + 3 * (not (inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0
+                                     and box.y1 <= inside.y1)))
+            if best is None or conflicts < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (conflicts, note, box)
+            else:
+                note.remove()
+            if conflicts == 0:
+                break
+        chosen = best[1:]
+        placed.append(chosen[1])
 
 
 def _slope_guide(ax, rows: list[dict], backlash: list[float]) -> bool:

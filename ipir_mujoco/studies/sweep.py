@@ -56,7 +56,7 @@ from pathlib import Path
 from typing import Callable
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError, SimulationError, StudyInterrupted
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError, StudyInterrupted
 from ipir_mujoco.core.options import check_type
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 
@@ -258,6 +258,11 @@ def run_sweep(study: Study, out: str | Path, *, executor: futures.Executor | Non
     compiled loop is not built."""
     check_type("study", study, Study, "a Study (ipir_mujoco.studies.sweep_space.Study)")
     check_type("out", out, (str, os.PathLike), "the path of the results folder")
+    for name, flag in (("resume", resume), ("progress", progress)):
+        check_type(name, flag, bool, "True or False")
+    check_type("batch_mujoco", batch_mujoco, (bool, type(None)), "True, False or None")
+    if on_row is not None and not callable(on_row):
+        raise ParameterTypeError(f"on_row={on_row!r} is not callable; allowed: a function of a row, or None")
     out = check_sweep_options(out, resume, workers, timeout_per_design, batch_size)
     meta = out / "sweep.json"
     record = {"fingerprint": study.fingerprint(), "study": study.to_json()}

@@ -130,11 +130,16 @@ def riser_press(params: RobotParams, geometry: str = "exact") -> dict:
             holds.append(-value)
             where.append(phi)
         out["hold_n"][key] = holds
-        out["press_n"][key] = [h / params.mu_wall for h in holds]
+        # mu_wall = 0 (no grip at all): no press holds a module that needs a ground force; null in the JSON
+        out["press_n"][key] = [h / params.mu_wall if params.mu_wall > 0 else (math.inf if h > 0 else 0.0)
+                               for h in holds]
         out["phi_rad"][key] = where
     out["needed_n"] = [max(out["press_n"][k][i] for k in DRIVES) for i in (0, 1)]
     out["binds"] = "drive_at_rest" if sum(out["press_n"]["drive_at_rest"]) > sum(out["press_n"]["drive_off"]) \
         else "drive_off"
+    for key in DRIVES:  # no press holds it (mu_wall = 0): None, JSON's null
+        out["press_n"][key] = [None if math.isinf(f) else f for f in out["press_n"][key]]
+    out["needed_n"] = [None if math.isinf(f) else f for f in out["needed_n"]]
     return out
 
 
