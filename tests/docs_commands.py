@@ -23,7 +23,7 @@ What a command is:
 - a command that reads a file the pages do not make (``--data run.csv``) runs its ``--help``;
 - anything else runs as written, with these shortenings (said so in docs/cli.md, "Every documented command
   is tested"): a benchmark (``python bench/NAME.py``) gets ``--smoke``, a command that takes ``--quick``
-  gets it, ``--samples`` above 64 and ``--mujoco-samples`` above 2 are cut to that, and a command that
+  gets it, ``--samples`` above 64 and ``--mujoco-samples`` above 3 are cut to that, and a command that
   leaves ``--samples`` or ``--budget`` (where it has them) at its default runs with ``--samples 16``,
   ``--budget 8``; a shortened command's output is not compared.
 
@@ -228,7 +228,7 @@ def program(command: str) -> list[str]:
 
 
 # counts of draws a command's options set, capped by the test: (option, largest value run)
-CAPS = (("--samples", 64), ("--mujoco-samples", 2))
+CAPS = (("--samples", 64), ("--mujoco-samples", 3))
 # where a command's --help offers these and the command leaves them at their defaults: (option, value run)
 DEFAULT_CAPS = (("--samples", 16), ("--budget", 8))
 
@@ -257,7 +257,7 @@ def shortened(command: str, help_of) -> tuple[str, str]:
         command += " --quick"
         how.append("--quick")
     for option, value in DEFAULT_CAPS:
-        if re.search(rf"(?<![\w-]){option}(?![\w-])", text) and option not in command.split():
+        if re.search(rf"(?<![\w-]){option} N\b", text) and option not in command.split():  # a count, not a file
             command += f" {option} {value}"
             how.append(f"{option} {value}")
     return command, ", ".join(how)
