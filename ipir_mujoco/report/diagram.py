@@ -8,7 +8,6 @@ it; the validation report and docs/model.md show it.
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -129,4 +128,9 @@ def write_mechanism_diagram(path: str | Path, params: RobotParams | None = None,
 
 
 if __name__ == "__main__":  # pragma: no cover
-    write_mechanism_diagram(sys.argv[1] if len(sys.argv) > 1 else "mechanism.png")
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m ipir_mujoco.report.diagram",
+                                     description="Draw the mechanism (the paper's case) as a PNG.")
+    parser.add_argument("path", nargs="?", default="mechanism.png", help="the PNG to write (default mechanism.png)")
+    write_mechanism_diagram(parser.parse_args().path)
