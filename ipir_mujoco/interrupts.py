@@ -100,18 +100,24 @@ def loaded() -> None:
     state.loading = False
 
 
+def _install() -> bool:
+    """Install :func:`handler` if Python's default SIGINT handler is in place (main thread only); True if it did."""
+    if not _main_thread():
+        return False
+    try:
+        if _sig.getsignal(_sig.SIGINT) is _sig.default_int_handler:
+            _sig.signal(_sig.SIGINT, handler)
+            return True
+    except (ValueError, AttributeError):  # pragma: no cover
+        pass
+    return False
+
+
 @contextmanager
 def watching():
     """Count SIGINTs during the block, with :func:`handler` installed if Python's default handler is in place
-    (main thread only); yields the count at the start, for :func:`raise_if_interrupted`."""
-    swapped = False
-    if _main_thread():
-        try:
-            if _sig.getsignal(_sig.SIGINT) is _sig.default_int_handler:
-                _sig.signal(_sig.SIGINT, handler)
-                swapped = True
-        except (ValueError, AttributeError):  # pragma: no cover
-            swapped = False
+    (main thread only); yields the count at the start, for :func:`interrupted_since`."""
+    swapped = _install()
     try:
         yield state.count
     finally:
@@ -119,17 +125,25 @@ def watching():
             _sig.signal(_sig.SIGINT, _sig.default_int_handler)
 
 
+@contextmanager
+def as_keyboard_interrupt():
+    """A block in which a Ctrl-C ends as KeyboardInterrupt, whatever the code it landed in made of it (an error,
+    an error row, or nothing): the run's own outcome is dropped when a SIGINT arrived during the block."""
+    with watching() as since:
+        try:
+            yield
+        except BaseException:
+            if interrupted_since(since):
+                raise KeyboardInterrupt from None
+            raise
+        if interrupted_since(since):
+            raise KeyboardInterrupt
+
+
 def begin_command() -> bool:
     """A command starts: :func:`handler` installed (if Python's default handler is in place; True then) and
     armed. End it with :func:`end_command`."""
-    swapped = False
-    if _main_thread():
-        try:
-            if _sig.getsignal(_sig.SIGINT) is _sig.default_int_handler:
-                _sig.signal(_sig.SIGINT, handler)
-                swapped = True
-        except (ValueError, AttributeError):  # pragma: no cover
-            swapped = False
+    swapped = _install()
     state.armed = state.command = True
     return swapped
 

@@ -258,15 +258,8 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
     if not isinstance(options.get("every_step", False), (bool, type(None))):
         raise ParameterTypeError(f"every_step={options['every_step']!r} is not a bool; allowed: True or False")
     # Ctrl-C during the run is KeyboardInterrupt, whatever the code it landed in made of it (ipir_mujoco.interrupts)
-    with interrupts.watching() as since:
-        try:
-            result = _run(v, params, t_end, options)
-        except BaseException:
-            if interrupts.interrupted_since(since):
-                raise KeyboardInterrupt from None
-            raise
-        if interrupts.interrupted_since(since):
-            raise KeyboardInterrupt
+    with interrupts.as_keyboard_interrupt():
+        result = _run(v, params, t_end, options)
     return result
 
 
@@ -364,15 +357,8 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
     from .engine import batch
 
     steady = {"until_steady": True} if until_steady else {}
-    with interrupts.watching() as since:  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design
-        try:
-            outcomes = batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
-        except BaseException:
-            if interrupts.interrupted_since(since):
-                raise KeyboardInterrupt from None
-            raise
-        if interrupts.interrupted_since(since):
-            raise KeyboardInterrupt
+    with interrupts.as_keyboard_interrupt():  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design
+        outcomes = batch.run_ratchet_batch(list(designs), t_end, dt_out, nthread=nthread, **steady)
     return outcomes
 
 
