@@ -1,13 +1,13 @@
-"""The compiled pieces: the serial MuJoCo engine's stepping loop (ipir_mujoco/engine/_stepper.c) and the round
-pipe's exact wall contacts (ipir_mujoco/engine/_pipewall.c, which the round pipe needs).
+"""The compiled pieces: the serial MuJoCo engine's stepping loop (ipir_mujoco/engine/loop/_stepper.c) and the round
+pipe's exact wall contacts (ipir_mujoco/engine/builders/_pipewall.c, which the round pipe needs).
 
 All package metadata is in pyproject.toml. The extension is compiled against the headers of the mujoco
 installed where it builds (a build requirement: in pip's isolated build environment, the newest mujoco the
 project allows) and linked against that mujoco's libmujoco by its SONAME, with no search path: at import the
-dynamic linker takes the libmujoco the bindings have already loaded, and ipir_mujoco/engine/native.py checks
+dynamic linker takes the libmujoco the bindings have already loaded, and ipir_mujoco/engine/loop/native.py checks
 that its version is the headers'. The extension is optional (``optional=True``: setuptools warns and goes on
 when it cannot be built: no C compiler, no mujoco headers): the engine then steps in Python, with the same
-results (ipir_mujoco/engine/stepper.py).
+results (ipir_mujoco/engine/loop/stepper.py).
 """
 
 import importlib.metadata
@@ -53,7 +53,7 @@ class BuildExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("ipir_mujoco.engine._stepper", ["ipir_mujoco/engine/_stepper.c"], optional=True),
-                 Extension("ipir_mujoco.engine._pipewall", ["ipir_mujoco/engine/_pipewall.c"], optional=True)],
+    ext_modules=[Extension("ipir_mujoco.engine.loop._stepper", ["ipir_mujoco/engine/loop/_stepper.c"], optional=True),
+                 Extension("ipir_mujoco.engine.builders._pipewall", ["ipir_mujoco/engine/builders/_pipewall.c"], optional=True)],
     cmdclass={"build_ext": BuildExt},
 )

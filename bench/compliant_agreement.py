@@ -44,8 +44,8 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.cycles import cycles, travel
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.model import SolverSettings
-from ipir_mujoco.engine.timestep import choose_settings, clutch_rate
+from ipir_mujoco.engine.builders.model import SolverSettings
+from ipir_mujoco.engine.modelkinds.timestep import choose_settings, clutch_rate
 
 
 def figures(run, cruise: bool) -> tuple[float, float, float]:

@@ -29,7 +29,7 @@ from ipir_mujoco import registry
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.cycles import _at, cycle_boundaries
 from ipir_mujoco.engine import SolverSettings, simulate_mujoco
-from ipir_mujoco.engine.grip_model import CARRIAGE_SHARE
+from ipir_mujoco.engine.builders.grip_model import CARRIAGE_SHARE
 
 CRUISE = RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0)
 RISER = RobotParams(drive="motor", M_stall=1.0, incline=90.0, mu_wall=0.3, F_n1=20.0, F_n2=20.0)

@@ -20,7 +20,7 @@ from dataclasses import replace
 
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.stepper import compiled_status
+from ipir_mujoco.engine.loop.stepper import compiled_status
 
 GRIP = dict(mu_wall=0.5, F_n1=10.0, F_n2=10.0)  # 5 N of grip per module: both skid every revolution
 DESIGNS = {

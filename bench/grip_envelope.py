@@ -41,7 +41,7 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
-from ipir_mujoco.engine.skid_check import TRAVEL_FLOOR
+from ipir_mujoco.engine.run.skid_check import TRAVEL_FLOOR
 
 FIXED_TOL, STEADY_TOL = 1e-3, 3e-4
 

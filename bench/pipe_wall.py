@@ -1,5 +1,5 @@
-"""The round pipe's wall (ipir_mujoco.engine.pipe_walls): the normal-force ripple a sprung wheel sees and the
-cost per mj_step, measured on the test rig (ipir_mujoco.engine.pipe_rig).
+"""The round pipe's wall (ipir_mujoco.engine.builders.pipe_walls): the normal-force ripple a sprung wheel sees and the
+cost per mj_step, measured on the test rig (ipir_mujoco.engine.builders.pipe_rig).
 
 Run on demand from the repository root:
 
@@ -29,7 +29,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.route import route_from_tables
-from ipir_mujoco.engine.pipe_rig import build_rig, ripple, roll, roll_on_joints, rolling_rig
+from ipir_mujoco.engine.builders.pipe_rig import build_rig, ripple, roll, roll_on_joints, rolling_rig
 
 ROUTE = [dict(kind="straight", length=0.3), dict(kind="bend", radius=0.4, angle=90, plane=90),
          dict(kind="straight", length=0.2), dict(kind="bend", radius=0.3, angle=-60, plane=30),

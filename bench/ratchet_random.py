@@ -31,7 +31,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
-from ipir_mujoco.engine.model import build_model, set_closed_loop_state
+from ipir_mujoco.engine.builders.model import build_model, set_closed_loop_state
 
 
 def draw(rng: np.random.Generator) -> RobotParams:

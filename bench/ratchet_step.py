@@ -66,10 +66,11 @@ from pathlib import Path
 import mujoco
 
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.engine import simulate_mujoco, stepper
+from ipir_mujoco.engine import simulate_mujoco
+from ipir_mujoco.engine.loop import stepper
 from ipir_mujoco.engine.clutches import clutch_controller
-from ipir_mujoco.engine.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
-from ipir_mujoco.engine.timestep import choose_settings
+from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, build_model, drive_control, set_closed_loop_state
+from ipir_mujoco.engine.modelkinds.timestep import choose_settings
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 COMPLIANT = RobotParams(drive="motor", clutch_stiffness=1e6, clutch_backlash=1e-3)

@@ -17,7 +17,7 @@ ratio to the plain step:
 - control callback (C): a prototype compiled here with ``cc``: the bound
   update and the drive's work in ``mjcb_control``, installed as a ctypes
   handle (called without the GIL), and ``mj_step(m, d, nstep=chunk)``;
-- compiled loop: the engine's stepper (``ipir_mujoco.engine.stepper``),
+- compiled loop: the engine's stepper (``ipir_mujoco.engine.loop.stepper``),
   everything the engine does per step (bounds, excursion, drive work,
   friction work);
 - native one-way damper: no per-step update at all: each slide's clutch
@@ -45,9 +45,9 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.engine import stepper
+from ipir_mujoco.engine.loop import stepper
 from ipir_mujoco.engine.clutches import Ratchet
-from ipir_mujoco.engine.model import (CRANK_HINGE, FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE,
+from ipir_mujoco.engine.builders.model import (CRANK_HINGE, FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE,
                                       SolverSettings, build_model, dof_address, drive_control, qpos_address,
                                       set_closed_loop_state)
 

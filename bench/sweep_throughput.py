@@ -25,9 +25,9 @@ from concurrent import futures
 
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.model import SolverSettings
+from ipir_mujoco.engine.builders.model import SolverSettings
 from ipir_mujoco.studies.sweep import run_sweep
-from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.engine.run.batch import run_ratchet_batch
 from ipir_mujoco.studies.sweep_space import Study, parse_vary
 
 

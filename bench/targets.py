@@ -44,7 +44,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import analytic_speed  # noqa: E402  (bench/ siblings)
 import ratchet_step  # noqa: E402
 
-from ipir_mujoco.engine.timestep import choose_settings  # noqa: E402
+from ipir_mujoco.engine.modelkinds.timestep import choose_settings  # noqa: E402
 from ipir_mujoco.studies.sweep import run_sweep  # noqa: E402
 from ipir_mujoco.studies.sweep_space import Study, parse_vary  # noqa: E402
 
@@ -111,7 +111,7 @@ def sweep_row(plain_step_s: float, repeats: int, n: int = 20, t_end: float = 1.0
             started = time.perf_counter()
             run_sweep(study, Path(folder) / "s", progress=False)
             wall = min(wall, time.perf_counter() - started)
-    from ipir_mujoco.engine.stepper import compiled_status
+    from ipir_mujoco.engine.loop.stepper import compiled_status
 
     how = "serial MuJoCo, compiled loop" if compiled_status()[0] else "mujoco.batch (no compiled loop here)"
     return (f"{n} x {n} sweep (MuJoCo ratchet + analytic one-way, {t_end:g} s; {how})",

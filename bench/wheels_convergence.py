@@ -62,9 +62,9 @@ def time_constants(smoke: bool) -> None:
     """The riser slide at several row time constants (module docstring, ``--time-constants``)."""
     import mujoco
 
-    from ipir_mujoco.engine.model import MOTOR, SolverSettings, drive_control, qpos_address
-    from ipir_mujoco.engine.wheels import WheelRatchet
-    from ipir_mujoco.engine.wheels_model import RowTimes, build_wheels_model, set_wheels_state
+    from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, drive_control, qpos_address
+    from ipir_mujoco.engine.controllers.wheels import WheelRatchet
+    from ipir_mujoco.engine.builders.wheels_model import RowTimes, build_wheels_model, set_wheels_state
 
     params, t_end = RobotParams(M=0.0, mu_wall=0.18, incline=90.0), (0.02 if smoke else 0.3)
     analytic = registry.run("analytic-unilateral", params, t_end, dt_out=1e-3).summary["x1_final"]

@@ -26,7 +26,7 @@ import time
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.engine.stepper import ENV
+from ipir_mujoco.engine.loop.stepper import ENV
 
 
 def once(variant: str, params: RobotParams, t_end: float, python: bool = False) -> float:

@@ -201,12 +201,12 @@ def prepare_for_many(names) -> None:
 
 def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float) -> float | None:
     """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s]: the
-    variant's model kind's (:meth:`ipir_mujoco.engine.kinds.ModelKind.settings`), the step every such run
+    variant's model kind's (:meth:`ipir_mujoco.engine.modelkinds.kinds.ModelKind.settings`), the step every such run
     takes; None for the analytic engines."""
     v = variant(name)
     if not v.is_mujoco:
         return None
-    from .engine.kinds import kind_for
+    from .engine.modelkinds.kinds import kind_for
 
     return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch)[0].timestep
 
@@ -345,7 +345,7 @@ def batched(name: str | Variant) -> bool:
 def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float, dt_out: float, *,
               nthread: int = 1, until_steady: bool = False) -> list[dict]:
     """The variant on many designs at once through ``mujoco.batch`` (:func:`batched` variants only): one
-    outcome per design, as :func:`ipir_mujoco.engine.batch.run_ratchet_batch` gives them."""
+    outcome per design, as :func:`ipir_mujoco.engine.run.batch.run_ratchet_batch` gives them."""
     if not batched(name):
         raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
     if not isinstance(designs, (list, tuple)):
@@ -354,7 +354,7 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
         require_params(params)
     check_whole("nthread", nthread, low=1, high=1024)
     check_type("until_steady", until_steady, bool, "True or False")
-    from .engine import batch
+    from .engine.run import batch
 
     steady = {"until_steady": True} if until_steady else {}
     with interrupts.as_keyboard_interrupt():  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design
@@ -363,15 +363,15 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
 
 
 def batch_models(params: RobotParams) -> bool:
-    """Whether the batched engine models the design (:data:`ipir_mujoco.engine.batch.MODELLED_DRIVES`, rigid
+    """Whether the batched engine models the design (:data:`ipir_mujoco.engine.run.batch.MODELLED_DRIVES`, rigid
     clutches); others run serially."""
-    from .engine import batch
+    from .engine.run import batch
 
     return params.drive in batch.MODELLED_DRIVES and params.clutch_stiffness is None
 
 
 def compiled_status() -> tuple[bool, str]:
     """(whether serial MuJoCo runs step in compiled code, why not if they do not)."""
-    from .engine.stepper import compiled_status as status
+    from .engine.loop.stepper import compiled_status as status
 
     return status()

@@ -2,7 +2,7 @@
 
 The series holds what poses the robot: the crank angle ``phi`` and the modules' travel ``x1``, ``x2``; the
 wheeled model's runs (``mujoco-wheels``) also each module's pose across the pipe, ``y1/2``, ``z1/2`` and its
-turn ``roll1/2``, ``pitch1/2``, ``yaw1/2`` (:func:`ipir_mujoco.engine.wheels.pose_columns`). Values between
+turn ``roll1/2``, ``pitch1/2``, ``yaw1/2`` (:func:`ipir_mujoco.engine.controllers.wheels.pose_columns`). Values between
 samples are interpolated linearly. What the series does not hold follows from it:
 
 - the rod's hinge closes the loop: the rod points from its pin on the crank (B) at module 2's pin (C),
@@ -22,7 +22,7 @@ import numpy as np
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.results import RunResult
 
-from .engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, closed_loop_pose,
+from .engine.builders.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_END, ROD_HINGE, closed_loop_pose,
                            qpos_address)
 
 SLIDES_ACROSS = ("y1", "y2", "z1", "z2")  # the wheeled model's columns beside x1, x2: its modules' slides
@@ -32,7 +32,7 @@ TURNS = ("roll", "pitch", "yaw")  # and their ball joints' rotation vectors, rol
 class SlideReplay:
     """The slide model's pose at a time of ``run`` (``model``: the drawing model, compiled from the run's
     parameters): module 1 at x1, module 2 at its start plus x2, the crank at phi, the rod closing the loop
-    (:func:`ipir_mujoco.engine.model.closed_loop_pose`: the modules stay on the pipe's axis)."""
+    (:func:`ipir_mujoco.engine.builders.model.closed_loop_pose`: the modules stay on the pipe's axis)."""
 
     def __init__(self, model: mujoco.MjModel, run: RunResult):
         self.model, self.params, self.series = model, run.params, run.series
@@ -68,7 +68,7 @@ class WheeledReplay(SlideReplay):
     docstring). ParameterError if the run lacks the pose columns (not a wheeled MuJoCo run)."""
 
     def __init__(self, model: mujoco.MjModel, run: RunResult):
-        from .engine.wheels_model import LATERALS, TILTS, VERTICALS, leg_names
+        from .engine.builders.wheels_model import LATERALS, TILTS, VERTICALS, leg_names
 
         columns = SLIDES_ACROSS + tuple(f"{turn}{k}" for k in (1, 2) for turn in TURNS)
         missing = [c for c in columns if c not in run.series]

@@ -154,11 +154,11 @@ def checker_floor(spec) -> None:
 
 
 def in_pipe(spec, params: RobotParams, facing=None) -> None:
-    """Draw the slide model's round pipe around it (drawing only, :func:`.engine.pipe_drawing.draw_pipe`): with
+    """Draw the slide model's round pipe around it (drawing only, :func:`.engine.builders.pipe_drawing.draw_pipe`): with
     ``facing`` (the camera's view direction) its far half, the near half cut away; without, the whole tube,
     translucent. The floor moves under the pipe."""
-    from .engine.pipe_drawing import RGBA, draw_pipe
-    from .engine.pipe_walls import wall_pieces
+    from .engine.builders.pipe_drawing import RGBA, draw_pipe
+    from .engine.builders.pipe_walls import wall_pieces
 
     D = params.pipe_diameter
     draw_pipe(spec, wall_pieces(None, D, 0.0), D, facing=facing, rgba=RGBA if facing is None else PIPE_RGBA)
@@ -181,12 +181,12 @@ def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: f
 def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = False, route=None):
     """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
     ``wheeled``: the wheeled model (its pipe walls and wheels drawn too); ``route``: its walls along the route,
-    built as the run built them (:func:`ipir_mujoco.engine.wheels_model.build_wheels_spec`)."""
+    built as the run built them (:func:`ipir_mujoco.engine.builders.wheels_model.build_wheels_spec`)."""
 
-    from .engine.model import build_spec
+    from .engine.builders.model import build_spec
 
     if wheeled:
-        from .engine.wheels_model import build_wheels_spec
+        from .engine.builders.wheels_model import build_wheels_spec
 
         spec = build_wheels_spec(params, route=route)
     else:

@@ -19,7 +19,7 @@ from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.monitor import RESIDUAL_TOL
+from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
 from ipir_mujoco.studies import climbing
 
 # MuJoCo with default options against the analytic model of the same mechanism: within 0.1 % in revolutions and

@@ -15,7 +15,7 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.core.results import Mode
-from ipir_mujoco.engine.timestep import clutch_rate
+from ipir_mujoco.engine.modelkinds.timestep import clutch_rate
 from ipir_mujoco.report.clutch_section import study_figure
 from ipir_mujoco.studies.clutch_study import OperatingPoint, run_study
 

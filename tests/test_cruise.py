@@ -17,7 +17,7 @@ from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.cycles import LIMIT_ACCURACY, STEADY_CYCLES, cycles
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
+from ipir_mujoco.engine.loop.monitor import EXCURSION_PER_R, RESIDUAL_TOL
 from ipir_mujoco.studies import cruise
 from ipir_mujoco.studies.compare import compare_runs, format_comparison
 
@@ -28,7 +28,7 @@ CHECKED = ("steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m")
 # The tolerance of MuJoCo against the equations of the same mechanism at steady state, from the tolerances
 # that hold each engine (never from the differences seen, which are ~1e-5):
 # - MuJoCo's accuracy monitor stops a run whose energy residual exceeds RESIDUAL_TOL = 1e-3 of the energy put
-#   through the robot; its calibration (engine/monitor.py) keeps revolutions and travel within 0.1 % of the
+#   through the robot; its calibration (engine/loop/monitor.py) keeps revolutions and travel within 0.1 % of the
 #   converged mechanism then, so speed and distance per revolution are held to 1e-3. At steady state the
 #   cumulative residual ratio tends to the per-revolution one, which holds the energy per metre to it too;
 # - the ratchet's backward excursion, at most EXCURSION_PER_R r per hold, loses at most EXCURSION_PER_R / 2

@@ -2,7 +2,7 @@
 equations (skids on 30 and 60 degree inclines, a riser that climbs while skidding every stroke, a shallow
 downhill on a grip below the rolling resistance), at fixed time (1e-3) and to the steady state (3e-4).
 
-A run on finite grip whose modules skid is verified at half its step (ipir_mujoco.engine.skid_check); a design
+A run on finite grip whose modules skid is verified at half its step (ipir_mujoco.engine.run.skid_check); a design
 the check cannot bring within the tolerance is flagged: stopped with its figure ('stop') or recorded ('warn').
 """
 
@@ -15,9 +15,9 @@ import pytest
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.engine.grip_model import carriage_share
-from ipir_mujoco.engine.monitor import AccuracyError, RESIDUAL_TOL
-from ipir_mujoco.engine.skid_check import SKID_TOL, TRAVEL_FLOOR, differences, skidded, verify_skids
+from ipir_mujoco.engine.builders.grip_model import carriage_share
+from ipir_mujoco.engine.loop.monitor import AccuracyError, RESIDUAL_TOL
+from ipir_mujoco.engine.run.skid_check import SKID_TOL, TRAVEL_FLOOR, differences, skidded, verify_skids
 
 # each skids every stroke (both modules); the riser climbs 0.24 m in 2 s while skidding 0.28 m per module
 CLASSES = {

@@ -111,8 +111,8 @@ def test_the_finder_sees_every_kind_of_import():
     edges to look at), and leaves out TYPE_CHECKING ones."""
     edges = graph()
     assert len(edges) > 100
-    assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.engine.simulate"]  # relative, top level
-    assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
+    assert "ipir_mujoco.engine.modelkinds.kinds" in edges["ipir_mujoco.engine.run.simulate"]  # relative, top level
+    assert "ipir_mujoco.engine.modelkinds.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
     assert "ipir_mujoco.report.plots" in edges["ipir_mujoco.core.results"]  # inside RunResult.plot
     assert "ipir_mujoco.core.results" not in edges["ipir_mujoco.report.plots"]  # TYPE_CHECKING only
     assert "ipir_mujoco.analytic.kinematic_clutch" in edges["ipir_mujoco.analytic"]  # the analytic/ folder
@@ -131,7 +131,32 @@ def test_the_architecture_document_places_every_module_of_the_engine_core_and_an
     """docs/architecture.md names each module of the engine, the core, the analytic model and the package's top
     level (the studies', report's and command line's are placed there by group)."""
     text = (ROOT / "docs" / "architecture.md").read_text()
-    folders = (ROOT / "ipir_mujoco" / "engine", ROOT / "ipir_mujoco" / "core", ROOT / "analytic", ROOT / "ipir_mujoco")
+    engine = ROOT / "ipir_mujoco" / "engine"
+    folders = (engine, *sorted(p for p in engine.iterdir() if (p / "__init__.py").is_file()),
+               ROOT / "ipir_mujoco" / "core", ROOT / "analytic", ROOT / "ipir_mujoco")
     missing = [f"{folder.name}/{file.name}" for folder in folders for file in sorted(folder.glob("*.py"))
                if file.name not in ("__init__.py", "__main__.py") and file.name not in text]
     assert missing == []
+    assert [f"engine/{folder}/" for folder in ENGINE_FOLDERS if f"engine/{folder}/" not in text] == []
+
+
+# the engine's folders from the bottom up: a module imports from its own folder and the folders below only
+ENGINE_FOLDERS = ("builders", "loop", "controllers", "modelkinds", "run")
+
+
+def test_the_engines_folders_import_downward_only():
+    """Each engine module imports only modules of its own folder or of a folder below it (the engine's top level,
+    ``__init__`` and the older path ``clutches``, stands above them all)."""
+    def layer(module: str) -> int | None:
+        parts = module.split(".")
+        if parts[:2] != ["ipir_mujoco", "engine"] or len(parts) < 4:
+            return None
+        return ENGINE_FOLDERS.index(parts[2])
+    upward = [(name, target) for name, targets in graph().items() if layer(name) is not None
+              for target in targets if layer(target) is not None and layer(target) > layer(name)]
+    assert upward == []
+    # every folder of the engine is in the order above, and no module of the engine sits outside them but two
+    found = {p.name for p in (ROOT / "ipir_mujoco" / "engine").iterdir() if (p / "__init__.py").is_file()}
+    assert found == set(ENGINE_FOLDERS)
+    loose = sorted(p.name for p in (ROOT / "ipir_mujoco" / "engine").glob("*.py"))
+    assert loose == ["__init__.py", "clutches.py"]

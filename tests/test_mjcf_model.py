@@ -10,7 +10,7 @@ import pytest
 
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.engine import captured_warnings
-from ipir_mujoco.engine.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_END, ROD_HINGE,
+from ipir_mujoco.engine.builders.model import (CRANK_HINGE, FRONT_SLIDE, LOOP, MOTOR, REAR_SLIDE, ROD_END, ROD_HINGE,
                                       SolverSettings, build_model, closed_loop_pose, default_mjcf, drive_control,
                                       qpos_address, set_closed_loop_state)
 
@@ -180,7 +180,7 @@ def test_the_clutch_actuators_carry_the_clutch_spring_and_damper_and_nothing_els
     """Compliant clutches: per slide a general actuator with force k ctrl - k x - c v, clamped to [0, ...]
     (it never pulls), no mass, armature or damping of its own (the anchor it pulls from is its ctrl, so the
     clutch adds no inertia to the robot); rigid clutches: all zero, no force at any state."""
-    from ipir_mujoco.engine.model import FRONT_CLUTCH, REAR_CLUTCH
+    from ipir_mujoco.engine.builders.model import FRONT_CLUTCH, REAR_CLUTCH
 
     params = RobotParams(clutch_stiffness=3e6, clutch_damping=40.0, clutch_backlash=1e-3)
     for p, k, c in ((params, 3e6, 40.0), (RobotParams(), 0.0, 0.0)):

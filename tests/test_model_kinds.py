@@ -20,9 +20,9 @@ import pytest
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.results import Mode
-from ipir_mujoco.engine import kinds
-from ipir_mujoco.engine.controller import ROLLING, SKIDDING, STANDING, ClutchController
-from ipir_mujoco.engine.run_setup import RunSetup
+from ipir_mujoco.engine.modelkinds import kinds
+from ipir_mujoco.engine.loop.controller import ROLLING, SKIDDING, STANDING, ClutchController
+from ipir_mujoco.engine.run.run_setup import RunSetup
 
 GRIP = dict(mu_wall=0.5, F_n1=10.0, F_n2=10.0)
 COMPLIANT = dict(clutch_stiffness=1e5, clutch_damping=5.0)
@@ -83,7 +83,7 @@ def test_registry_timestep_is_the_step_every_run_takes_and_every_step_samples_ea
     t_end = 0.004
     step = registry.timestep(variant, params, t_end, 1e-3)
     run = registry.run(variant, params, t_end, dt_out=1e-3)
-    # a run whose modules skidded is verified at half its step (engine/skid_check.py) and kept at the finer step
+    # a run whose modules skidded is verified at half its step (engine/run/skid_check.py) and kept at the finer step
     # where the two agree: registry.timestep is the step it starts from, and its halvings are recorded
     halvings = len(run.settings.get("skid_check", []))
     assert run.settings["timestep"] == step / 2**halvings

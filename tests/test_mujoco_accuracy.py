@@ -13,11 +13,11 @@ from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
 from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine import kinds
-from ipir_mujoco.engine import simulate as engine_simulate
-from ipir_mujoco.engine.model import SolverSettings
-from ipir_mujoco.engine.monitor import RESIDUAL_TOL
-from ipir_mujoco.engine.timestep import DT_MAX, DT_MAX_CLUTCH
+from ipir_mujoco.engine.modelkinds import kinds
+from ipir_mujoco.engine.run import simulate as engine_simulate
+from ipir_mujoco.engine.builders.model import SolverSettings
+from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
+from ipir_mujoco.engine.modelkinds.timestep import DT_MAX, DT_MAX_CLUTCH
 
 TARGET = 1e-3  # MuJoCo within 0.1 % of the analytic model of the same mechanism
 
@@ -239,7 +239,7 @@ def test_progress_never_goes_back_across_a_halved_step(monkeypatch):
 def test_a_timestep_below_the_floor_names_the_limit_that_set_it(params, servo, t_end, named):
     """The refusal names what demanded the step (a light rod, a stiff servo, the crank speed), not always
     the crank speed, and the timestep it would need, in one line."""
-    from ipir_mujoco.engine.timestep import DT_MIN, choose_settings
+    from ipir_mujoco.engine.modelkinds.timestep import DT_MIN, choose_settings
 
     with pytest.raises(ParameterError, match=named) as refused:
         choose_settings(params, t_end, 1e-3, servo)
@@ -251,7 +251,7 @@ def test_a_timestep_below_the_floor_names_the_limit_that_set_it(params, servo, t
 def _fed_in_turn(values, times, worst, tolerance, mode, rows=None):
     """The monitor's loop-gap record (or its error) after feeding ``values`` at ``times``: each in turn as the
     per-sample loop did (a value that beats the worst), or only ``rows``."""
-    from ipir_mujoco.engine.monitor import AccuracyError, AccuracyMonitor, Tolerances
+    from ipir_mujoco.engine.loop.monitor import AccuracyError, AccuracyMonitor, Tolerances
 
     monitor = AccuracyMonitor(Tolerances(1.0, tolerance, 1.0), mode)
     monitor.worst["loop_gap_m"] = worst

@@ -8,8 +8,8 @@ import pytest
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.batch import run_ratchet_batch
-from ipir_mujoco.engine.model import INTEGRATORS, SolverSettings
+from ipir_mujoco.engine.run.batch import run_ratchet_batch
+from ipir_mujoco.engine.builders.model import INTEGRATORS, SolverSettings
 
 
 def test_batch_equals_the_serial_engine_with_motor_gravity_and_own_timesteps():
@@ -69,7 +69,7 @@ def test_batch_stops_steady_and_stalled_designs():
 def test_batch_halves_an_automatic_step_that_fails(monkeypatch):
     """As a serial run: an automatic step the monitor stops (4e-4 s, residual -7e-3 at the paper's
     case) is halved for that design only, and the design comes back within the tolerance."""
-    from ipir_mujoco.engine import kinds
+    from ipir_mujoco.engine.modelkinds import kinds
 
     chosen = kinds.choose_settings  # the slide kind's rule, which the batch asks for every design
     def coarse(params, *args):
@@ -115,8 +115,8 @@ def test_rk4_is_refused_by_both_engines_in_one_line():
 def test_a_non_finite_speed_fails_the_design():
     """The health check reads the velocities too: a NaN crank speed with finite positions fails the design
     with the one-line reason, and only that design."""
-    from ipir_mujoco.engine.batch import _Batch
-    from ipir_mujoco.engine.model import build_model
+    from ipir_mujoco.engine.run.batch import _Batch
+    from ipir_mujoco.engine.builders.model import build_model
 
     designs, settings = [RobotParams(), RobotParams(M=0.1)], SolverSettings()
     models = [build_model(p, settings, ratchet=True) for p in designs]

@@ -14,12 +14,12 @@ from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.core.cycles import cycles, travel
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.batch import run_ratchet_batch
-from ipir_mujoco.engine.compliant import CompliantClutches
-from ipir_mujoco.engine.model import (FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE, SolverSettings,
+from ipir_mujoco.engine.run.batch import run_ratchet_batch
+from ipir_mujoco.engine.controllers.compliant import CompliantClutches
+from ipir_mujoco.engine.builders.model import (FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE, SolverSettings,
                                       build_model, dof_address, drive_control, set_closed_loop_state)
-from ipir_mujoco.engine.monitor import RESIDUAL_TOL
-from ipir_mujoco.engine.timestep import CLUTCH_SHARE, choose_settings, clutch_rate
+from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
+from ipir_mujoco.engine.modelkinds.timestep import CLUTCH_SHARE, choose_settings, clutch_rate
 
 EPS = np.finfo(float).eps
 

@@ -14,7 +14,7 @@ from ipir_mujoco.analytic.free_motion import simulate_free
 from ipir_mujoco.core.results import Mode
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.model import SolverSettings
+from ipir_mujoco.engine.builders.model import SolverSettings
 
 FIGURES = ("revolutions", "x1_final", "x2_final")
 

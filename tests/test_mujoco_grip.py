@@ -18,12 +18,12 @@ from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.core.cycles import _at, cycle_boundaries
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.engine.run.batch import run_ratchet_batch
 from ipir_mujoco.engine.clutches import clutch_controller
-from ipir_mujoco.engine.grip_model import BODY_MASS, CARRIAGE_SHARE, CARRIAGES, ROLLS, SKIDS
-from ipir_mujoco.engine.model import (MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
+from ipir_mujoco.engine.builders.grip_model import BODY_MASS, CARRIAGE_SHARE, CARRIAGES, ROLLS, SKIDS
+from ipir_mujoco.engine.builders.model import (MOTOR, SLIDES, SolverSettings, build_model, dof_address, drive_control,
                                       set_closed_loop_state)
-from ipir_mujoco.engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
+from ipir_mujoco.engine.loop.monitor import EXCURSION_PER_R, RESIDUAL_TOL
 
 CRUISE = RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0)  # 5 N of grip against ~12 N of demand
 RISER = RobotParams(drive="motor", M_stall=1.0, incline=90.0, mu_wall=0.3, F_n1=20.0, F_n2=20.0)  # too little grip

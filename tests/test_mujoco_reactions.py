@@ -154,7 +154,7 @@ def test_climbs_mean_clutch_force_is_mujocos_impulse():
 
     Under the paper's rule exactly one module slides at any time, so over whole revolutions of the periodic
     state the momentum balance makes the mean clutch force F_r (F_r1 = F_r2 here), with no sampling error."""
-    from ipir_mujoco.engine.timestep import choose_settings
+    from ipir_mujoco.engine.modelkinds.timestep import choose_settings
     from ipir_mujoco.studies import climbing
 
     params = RobotParams(drive="motor")

@@ -17,10 +17,12 @@ import numpy as np
 import pytest
 
 from ipir_mujoco.analytic import RobotParams, SimulationError
-from ipir_mujoco.engine import CrankServo, native, simulate_mujoco, stepper
-from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.engine import CrankServo, simulate_mujoco
+from ipir_mujoco.engine.loop import native, stepper
+from ipir_mujoco.engine.modelkinds import loop_rows
+from ipir_mujoco.engine.run.batch import run_ratchet_batch
 from ipir_mujoco.engine.clutches import Ratchet
-from ipir_mujoco.engine.model import (MOTOR, SolverSettings, build_model, build_spec, default_mjcf, drive_control,
+from ipir_mujoco.engine.builders.model import (MOTOR, SolverSettings, build_model, build_spec, default_mjcf, drive_control,
                                       set_closed_loop_state)
 
 
@@ -60,7 +62,7 @@ DESIGNS = {
     "grip, motor": (RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0), "unilateral", "ratchet", 0.5, {}),
     "grip, riser": (RobotParams(drive="motor", M_stall=1.0, incline=90.0, mu_wall=0.3, F_n1=20.0, F_n2=20.0),
                     "unilateral", "ratchet", 0.3, {}),
-    # these two skid at every stroke, and the skid check (engine/skid_check.py) stops them at 'stop': they are
+    # these two skid at every stroke, and the skid check (engine/run/skid_check.py) stops them at 'stop': they are
     # here to compare the two loops, which 'warn' does the same as 'stop' up to the check
     "grip below F_r": (RobotParams(mu_wall=0.05, F_n1=10.0, F_n2=10.0), "unilateral", "ratchet", 0.3,
                        {"accuracy": "warn"}),
@@ -152,7 +154,7 @@ def test_mujocos_warning_inside_the_compiled_loop_fails_the_run_as_before(monkey
 
 def loops(model, data, controller):
     """(the engine's choice of loop for this model, data and controller, the options it was given)."""
-    options = stepper.loop_options(model, data)
+    options = loop_rows.loop_options(model, data)
     return stepper.make_steps(model, data, controller, np.zeros((2, model.nv)), **options), options
 
 
@@ -224,7 +226,7 @@ def test_what_does_not_check_out_steps_in_python(monkeypatch):
     with monkeypatch.context() as patch:
         patch.setattr(mujoco.MjData, "_address", property(lambda self, other=other._address: other))
         with pytest.raises(stepper.LayoutError, match=r"MjData._address do not check out: read \("):
-            stepper.CompiledSteps(model, data, ratchet, np.zeros((2, model.nv)), **stepper.loop_options(model, data))
+            stepper.CompiledSteps(model, data, ratchet, np.zeros((2, model.nv)), **loop_rows.loop_options(model, data))
         assert not loops(model, data, ratchet)[0].compiled
     servo = CrankServo(lambda t: 10.0 * t, lambda t: 10.0)
     assert type(stepper.make_steps(model, data, ratchet, np.zeros((2, model.nv)), servo=servo,
@@ -317,7 +319,7 @@ def test_a_libmujoco_that_cannot_be_loaded_or_is_another_is_refused_in_one_line(
 RUN = (  # a short run in a fresh process: which loops recorded, the one line, every column saved to NAME
     "import numpy as np\n"
     "from ipir_mujoco.analytic import RobotParams\n"
-    "from ipir_mujoco.engine import simulate_mujoco, stepper\n"
+    "from ipir_mujoco.engine import simulate_mujoco\nfrom ipir_mujoco.engine.loop import stepper\n"
     "used, python_record = set(), stepper.PythonSteps.record\n"
     "stepper.PythonSteps.record = lambda self, *a: used.add(type(self).__name__) or python_record(self, *a)\n"
     "run = simulate_mujoco(RobotParams(), 'unilateral', 'ratchet', 0.05, dt_out=1e-3)\n"
@@ -369,7 +371,7 @@ def test_a_mujoco_error_fails_only_that_batched_design(monkeypatch, tmp_path):
     """The same starved arena in a batch: mujoco.batch raises for the designs whose ratchet rows do not fit,
     and each of those ends as the serial engine's one-line error for the same model, word for word; a design
     that needs no ratchet rows (no drive torque: it never moves) runs to the end in the same batch."""
-    from ipir_mujoco.engine import kinds
+    from ipir_mujoco.engine.modelkinds import kinds
 
     memory = []
     starved_model(RobotParams(), memory)

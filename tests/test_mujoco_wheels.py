@@ -22,11 +22,11 @@ import pytest
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.core.pipe import leg_direction, lift_check
-from ipir_mujoco.engine.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
-from ipir_mujoco.engine.monitor import RESIDUAL_TOL
-from ipir_mujoco.engine.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
+from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
+from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
+from ipir_mujoco.engine.builders.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
                                             leg_stiffness, sag, set_wheels_state)
-from ipir_mujoco.engine.wheels import WheelRatchet, leg_press
+from ipir_mujoco.engine.controllers.wheels import WheelRatchet, leg_press
 
 from cli_run import run_cli
 

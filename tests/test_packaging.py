@@ -188,8 +188,8 @@ def test_the_wheel_ships_every_document_the_output_names(tmp_path):
                 "mjcf/inchworm.xml"):
         assert f"ipir_mujoco/{doc}" in names, doc
     if shutil.which(sysconfig.get_config_var("CC").split()[0]):  # built against the build env's mujoco
-        assert any(n.startswith("ipir_mujoco/engine/_stepper.") for n in names), sorted(names)
-        assert any(n.startswith("ipir_mujoco/engine/_pipewall.") for n in names), sorted(names)
+        assert any(n.startswith("ipir_mujoco/engine/loop/_stepper.") for n in names), sorted(names)
+        assert any(n.startswith("ipir_mujoco/engine/builders/_pipewall.") for n in names), sorted(names)
     named, misdirected = set(), []
     for path in sorted((REPOSITORY / "ipir_mujoco").rglob("*.py")) + sorted((REPOSITORY / "analytic").rglob("*.py")):
         for text in _printed_text(path):

@@ -1,4 +1,4 @@
-"""The round pipe's walls (ipir_mujoco.engine.pipe_walls): exact contacts in straights and bends, a round wall
+"""The round pipe's walls (ipir_mujoco.engine.builders.pipe_walls): exact contacts in straights and bends, a round wall
 without ripple, routes in 3-D, route files read safely.
 
 Tolerances: contact distances are computed in double precision from a few products and square roots of
@@ -16,8 +16,8 @@ import pytest
 
 from ipir_mujoco.analytic import ParameterError
 from ipir_mujoco.core.route import read_route, route_from_tables
-from ipir_mujoco.engine.pipe_rig import build_rig, ripple, roll
-from ipir_mujoco.engine.pipe_walls import PIPE_BIT, WallContact, add_pipe_walls, touch_wall
+from ipir_mujoco.engine.builders.pipe_rig import build_rig, ripple, roll
+from ipir_mujoco.engine.builders.pipe_walls import PIPE_BIT, WallContact, add_pipe_walls, touch_wall
 
 CONTACT = WallContact(friction=0.5, solref=(1e-3, 1.0))
 OUT_OF_PLANE = [dict(kind="straight", length=0.3), dict(kind="bend", radius=0.4, angle=90, plane=90),
@@ -137,7 +137,7 @@ def test_wheels_rolling_with_friction_see_a_round_wall(radius):
     its mean is the preload but for the wheel's own centripetal load in the bend, m v^2 / R = 0.02 x 0.25 / 0.2 =
     0.025 N spread over the legs by their directions (at most that much off 10 N), and the contact's sinking
     (the spring's 0.1 % of travel at most)."""
-    from ipir_mujoco.engine.pipe_rig import WHEEL_MASS, roll_on_joints, rolling_rig
+    from ipir_mujoco.engine.builders.pipe_rig import WHEEL_MASS, roll_on_joints, rolling_rig
 
     run = roll_on_joints(rolling_rig(bend_radius=radius), 0.5, 0.1, settle=0.2)
     assert run.contacts == 1 and ripple(run) < 1e-6

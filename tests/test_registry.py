@@ -126,7 +126,7 @@ def test_the_public_surface_is_importable_from_the_package_and_documented_in_sec
     import sys
 
     from ipir_mujoco import ParameterError as PE, RobotParams as RP, RunResult, SimulationError, VARIANTS, run
-    from ipir_mujoco.engine.kinds import ModelKind
+    from ipir_mujoco.engine.modelkinds.kinds import ModelKind
 
     assert run is registry.run and VARIANTS is registry.VARIANTS and RP is RobotParams and PE is ParameterError
     assert set(ipir_mujoco.__all__) >= {"run", "RobotParams", "RunResult", "ParameterError", "SimulationError",

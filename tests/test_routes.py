@@ -149,7 +149,7 @@ def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monk
     held module cannot hold the other's resistance, the crank turns and the robot gets nowhere; the run stops
     after the watch's window (shortened here to keep the test fast) with the reason in one line. A riser with a
     grip of a quarter of the weight: the robot slides down and out of the pipe behind the route's start."""
-    from ipir_mujoco.engine import route_watch
+    from ipir_mujoco.engine.modelkinds import route_watch
 
     monkeypatch.setattr(route_watch, "PROGRESS_S", 0.3)
     route = route_from_tables([dict(kind="straight", length=1.0)])
@@ -197,7 +197,7 @@ def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
 def test_the_viewer_builds_the_route_walls():
     """The interactive viewer's robot (no screen needed to build and step it) carries the route's walls."""
     from ipir_mujoco.cli.view import ViewedRobot
-    from ipir_mujoco.engine.model import SolverSettings
+    from ipir_mujoco.engine.builders.model import SolverSettings
 
     robot = ViewedRobot(CRUISE, model="wheels", route=route_from_tables(BEND), settings=SolverSettings(timestep=1e-4))
     names = {robot.model.geom(i).name for i in range(robot.model.ngeom)}
@@ -249,8 +249,8 @@ def test_a_route_whose_planar_walls_would_be_too_large_is_refused_before_buildin
     """40 half turns of 100 m radius: each bend's outer polygon of the planar walls would need ~7,860 boxes
     (corners within 2e-6 m of the circle): the closed-form count refuses them up front; the round pipe builds
     each bend as one piece."""
-    from ipir_mujoco.engine.route_walls import MAX_WALL_BOXES, check_wall_count
-    from ipir_mujoco.engine.wheels_model import build_wheels_model
+    from ipir_mujoco.engine.builders.route_walls import MAX_WALL_BOXES, check_wall_count
+    from ipir_mujoco.engine.builders.wheels_model import build_wheels_model
 
     tables = [dict(kind="straight", length=0.5)] + [dict(kind="bend", radius=100.0, angle=(-1) ** k * 180.0)
                                                      for k in range(40)]

@@ -13,7 +13,7 @@ from ipir_mujoco import registry
 from ipir_mujoco.core.control import FeedforwardTable, SpeedController, default_gains, tick_step
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.engine import servo_drive
+from ipir_mujoco.engine.loop import servo_drive
 
 from cli_run import run_cli
 

@@ -22,7 +22,7 @@ from ipir_mujoco.core.results import COLUMNS, RunResult
 from ipir_mujoco.studies import sweep as sweep_module
 from ipir_mujoco.cli import main
 from ipir_mujoco.studies.sweep import run_sweep
-from ipir_mujoco.engine.batch import run_ratchet_batch
+from ipir_mujoco.engine.run.batch import run_ratchet_batch
 import figure_checks
 from ipir_mujoco.studies.sweep_metrics import batch_metrics, run_metrics
 from ipir_mujoco.report.sweep_plots import best_designs, read_results
@@ -321,7 +321,7 @@ def test_until_steady_and_the_budget_reach_every_engine(tmp_path, monkeypatch, b
     raise unless they get the keywords: pool and batch processes fork with them in place."""
     import ipir_mujoco.analytic as analytic_package
     import ipir_mujoco.engine as engine_package
-    import ipir_mujoco.engine.batch as batch_module
+    import ipir_mujoco.engine.run.batch as batch_module
 
     def fake_analytic(params, geometry, clutch, t_end, **kwargs):
         if not kwargs.get("until_steady") or kwargs.get("wall_budget_s") != 30:
@@ -374,7 +374,7 @@ def test_the_batch_hands_what_it_does_not_model_to_the_serial_engine(monkeypatch
     rigid ratchets only), is neither a silently different robot nor a failure: it runs in the serial engine
     and its row is the serial run's (the batch models the constant torque and the motor: a batch that
     declared only the torque must hand a motor design over). Before, both were failed rows."""
-    from ipir_mujoco.engine import batch
+    from ipir_mujoco.engine.run import batch
     from ipir_mujoco.studies.sweep import engine_metrics, run_batch_chunk
 
     monkeypatch.setattr(batch, "MODELLED_DRIVES", ("torque",), raising=False)
@@ -415,7 +415,7 @@ def test_mujoco_peak_forces_that_measure_the_numerics_are_left_empty():
     the rod, whose peak then changes with the step. The sweep leaves both empty, for the ratchet and the
     locks; a compliant clutch read at every step keeps its (physical) peaks."""
     from ipir_mujoco.engine import simulate_mujoco
-    from ipir_mujoco.engine.model import SolverSettings
+    from ipir_mujoco.engine.builders.model import SolverSettings
 
     params = RobotParams()
     sampled = simulate_mujoco(params, "unilateral", "ratchet", 0.5, dt_out=1e-3)
@@ -502,7 +502,7 @@ def test_a_metric_equal_in_every_design_names_no_best_design():
 def test_the_default_sweep_runs_mujoco_serially_where_its_loop_is_compiled(tmp_path):
     """Where the serial engine steps in C, the default sweep runs the ratchet designs through it: each row
     is the serial run's metrics, not the batch's."""
-    from ipir_mujoco.engine.stepper import compiled_status
+    from ipir_mujoco.engine.loop.stepper import compiled_status
     from ipir_mujoco.studies.sweep import engine_metrics
     from ipir_mujoco.studies.sweep_files import _cell, make_row
 

@@ -158,7 +158,7 @@ def test_lr_study_measures_mujoco_against_the_equations_of_the_same_linkage(quic
         assert row["exact_with_rod"]["revolutions"] == pytest.approx(with_rod["revolutions"], rel=1e-9)
         expected = (row["mujoco"]["revolutions"] - with_rod["revolutions"]) / with_rod["revolutions"]
         assert row["mujoco_vs_exact"]["revolutions"] == pytest.approx(expected, rel=1e-6)
-        # MuJoCo's accuracy monitor keeps revolutions within 0.1 % of the converged mechanism (engine/monitor.py)
+        # MuJoCo's accuracy monitor keeps revolutions within 0.1 % of the converged mechanism (engine/loop/monitor.py)
         assert abs(row["mujoco_vs_exact"]["revolutions"]) <= 1e-3
 
 
@@ -340,7 +340,7 @@ def test_the_timestep_halving_starts_from_each_clutchs_own_automatic_step(quick_
         assert any(r["timestep"] == pytest.approx(step / 2) for r in rows)  # half its own step was tried
         kept = [r for r in rows if r["timestep"] <= step * (1 + 1e-9)]
         for r in kept:  # each clutch against the equations of its own mechanism, within the accuracy
-            # monitor's calibration at the automatic step or finer (0.1 % in revolutions, engine/monitor.py)
+            # monitor's calibration at the automatic step or finer (0.1 % in revolutions, engine/loop/monitor.py)
             assert abs(r["vs_analytic"]["revolutions"]) < 1e-3
         worst = max([worst] + [abs(a[k] - b[k]) / abs(b[k]) for a in kept for b in kept
                                for k in ("revolutions", "x1_final", "x2_final")])

@@ -143,8 +143,8 @@ def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_ru
     """
     import mujoco
 
-    from ipir_mujoco.engine.model import FRONT_SLIDE, ROD_END, closed_loop_pose
-    from ipir_mujoco.engine.wheels_model import build_wheels_model
+    from ipir_mujoco.engine.builders.model import FRONT_SLIDE, ROD_END, closed_loop_pose
+    from ipir_mujoco.engine.builders.wheels_model import build_wheels_model
     from ipir_mujoco.replay import WheeledReplay, replay_for
     from ipir_mujoco.video import _render_model
 
@@ -311,7 +311,7 @@ def test_the_lock_controller_refuses_a_compliant_clutch():
 
     from ipir_mujoco.analytic import ParameterError
     from ipir_mujoco.engine.clutches import clutch_controller
-    from ipir_mujoco.engine.model import build_model
+    from ipir_mujoco.engine.builders.model import build_model
 
     params = RobotParams(clutch_stiffness=1e6)
     model = build_model(params)

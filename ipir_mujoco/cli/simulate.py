@@ -224,9 +224,9 @@ def _energy_line(e: dict) -> str:
 
 
 def save_run_mjcf(args: argparse.Namespace) -> None:
-    """--save-mjcf FILE.xml: the model the run compiles (:func:`ipir_mujoco.engine.export.save_mjcf`), written
+    """--save-mjcf FILE.xml: the model the run compiles (:func:`ipir_mujoco.engine.run.export.save_mjcf`), written
     before the run; refused in one line for the equations or a name that is not an .xml file."""
-    from ipir_mujoco.engine.export import save_mjcf
+    from ipir_mujoco.engine.run.export import save_mjcf
 
     variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch, args.mujoco_model)
     if not variant.is_mujoco:

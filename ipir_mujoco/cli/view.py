@@ -8,7 +8,7 @@ elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.clutches`
 which move a joint limit or switch a lock before every step. This command
 builds the model from a parameter set exactly as ``simulate --engine mujoco``
 does and steps it in a passive viewer loop with the engine's own stepping loop
-(:mod:`ipir_mujoco.engine.stepper`: the same controller, compiled where it can be), in
+(:mod:`ipir_mujoco.engine.loop.stepper`: the same controller, compiled where it can be), in
 real time (or slower with ``--slow``), and starts the run again every
 ``--t-end`` seconds of simulated time (a constant torque accelerates the robot
 without bound). A module's housing turns green while its clutch holds it; the
@@ -38,9 +38,9 @@ from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from ..engine.kinds import kind_for
-from ..engine.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
-from ..engine.run_setup import RunSetup
+from ..engine.modelkinds.kinds import kind_for
+from ..engine.builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
+from ..engine.run.run_setup import RunSetup
 from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
@@ -49,8 +49,8 @@ class ViewedRobot:
     """The model, its data and the engine's clutch controller, stepped by the engine's stepping loop.
 
     Refuses (ParameterError, one line) exactly the parameters and clutch choices ``simulate_mujoco``
-    refuses (the model kind's :meth:`ipir_mujoco.engine.kinds.ModelKind.check`), and builds and starts the
-    robot as a run does (:class:`ipir_mujoco.engine.run_setup.RunSetup`).
+    refuses (the model kind's :meth:`ipir_mujoco.engine.modelkinds.kinds.ModelKind.check`), and builds and starts the
+    robot as a run does (:class:`ipir_mujoco.engine.run.run_setup.RunSetup`).
     """
 
     def __init__(self, params: RobotParams, clutch: str = "unilateral", implementation: str | None = None,

@@ -1,7 +1,7 @@
 """A pipeline route (``--route FILE.toml``): parsing, checking and its centreline in 3-D.
 
 Shared and free of physics: what the route is, where its centreline runs, how far along it a point is; the
-walls MuJoCo builds along it are the engine's (:mod:`ipir_mujoco.engine.pipe_walls`).
+walls MuJoCo builds along it are the engine's (:mod:`ipir_mujoco.engine.builders.pipe_walls`).
 
 A route is a list of ``[[segment]]`` tables, in order:
 

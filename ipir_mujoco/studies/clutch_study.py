@@ -60,7 +60,7 @@ from ipir_mujoco.core.cycles import cycles, steady_window
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams, check_whole
 
-from ..engine.timestep import clutch_rate
+from ..engine.modelkinds.timestep import clutch_rate
 from .pool import map_unordered
 
 

@@ -49,7 +49,7 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import RunResult
 
-from ..engine.monitor import EXCURSION_PER_R, RESIDUAL_TOL
+from ..engine.loop.monitor import EXCURSION_PER_R, RESIDUAL_TOL
 from .compare import STEADY_FIGURES, compare_runs, relative_change
 from .ladder import CROSS_CHECKS, LADDER, Rung
 from .pool import map_unordered
@@ -66,7 +66,7 @@ CHECKED = ("steady_speed_m_s", "distance_per_rev_m", "energy_per_metre_j_m")
 # hold each engine, not from the differences seen:
 # - MuJoCo's accuracy monitor holds the energy residual to RESIDUAL_TOL = 1e-3 of the energy put through
 #   the robot, which keeps revolutions and travel within 0.1 % of the converged mechanism (the monitor's
-#   calibration, engine/monitor.py); at steady state the cumulative residual ratio tends to the per-
+#   calibration, engine/loop/monitor.py); at steady state the cumulative residual ratio tends to the per-
 #   revolution one, so energy per metre is held to it too;
 # - the ratchet's backward excursion, at most EXCURSION_PER_R r, costs at most EXCURSION_PER_R / 2 of the
 #   travel 2 r per stroke;

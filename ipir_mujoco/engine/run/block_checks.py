@@ -12,8 +12,8 @@ from ipir_mujoco.core.steady_test import steady_target
 from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import SimulationError
 
-from .common import rest_since, stall_reason
-from .model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
+from ..modelkinds.common import rest_since, stall_reason
+from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
 
 
 class BlockChecks:

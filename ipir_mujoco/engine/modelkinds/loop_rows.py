@@ -13,10 +13,10 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .grip import GripRows
-from .grip_model import ROLLS, SKIDS
-from .model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
-from .rows import FRICTION_DOF as FRICTION_ROW, FRICTION_TENDON
+from ..controllers.grip import GripRows
+from ..builders.grip_model import ROLLS, SKIDS
+from ..builders.model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
+from ..loop.rows import FRICTION_DOF as FRICTION_ROW, FRICTION_TENDON
 
 
 

@@ -23,8 +23,8 @@ from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
 from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m/s], this long [s] is a stall
 from ipir_mujoco.core.results import stall_reason as core_stall_reason
 
-from .model import check_params
-from .slide_clutches import refuse_compliant, refuse_grip
+from ..builders.model import check_params
+from ..controllers.slide_clutches import refuse_compliant, refuse_grip
 
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often

@@ -25,7 +25,7 @@ import numpy as np
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from ..resources import mjcf_dir
+from ...resources import mjcf_dir
 from .grip_model import scale_grip_rows, write_grip
 
 REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "crank_hinge", "rod_hinge"
@@ -63,7 +63,7 @@ class SolverSettings:
 
     ``timestep`` [s]: 1e-4 is the largest the engine chooses by itself; a run
     given no settings has its step chosen from the motion
-    (:func:`ipir_mujoco.engine.timestep.choose_settings`).
+    (:func:`ipir_mujoco.engine.modelkinds.timestep.choose_settings`).
     ``constraint_time_constant`` [s] (default: 2 timesteps) is the solref time
     constant of every constraint: the loop, clutch limits and locks, and the
     resistances' friction rows. ``solimp`` is MuJoCo's impedance triple, by

@@ -34,7 +34,7 @@ from ipir_mujoco.core.results import COLUMNS, Mode
 from ipir_mujoco.core.results import REST_SPEED
 
 from .controller import NO_WHEELS, held_where
-from .model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
+from ..builders.model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
 from .rows import equality_row
 
 # Columns beyond the shared ones: rod axial force [N, tension > 0] (pin force at C

@@ -1,4 +1,4 @@
-/* The per-step loop of a serial MuJoCo run, compiled, and its sampling: see ipir_mujoco/engine/stepper.py.
+/* The per-step loop of a serial MuJoCo run, compiled, and its sampling: see ipir_mujoco/engine/loop/stepper.py.
  *
  * It does, step for step, what the pure-Python loop (stepper.PythonSteps, the clutch controllers in
  * clutches.py, compliant.py and, on finite grip, grip.py and grip_compliant.py, the recorder in recorder.py)

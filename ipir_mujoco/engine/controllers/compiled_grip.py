@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from .native import LayoutError
+from ..loop.native import LayoutError
 
 
 def _common(ctl, loop, modules: list[int]) -> None:

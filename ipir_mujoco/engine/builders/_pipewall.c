@@ -1,6 +1,6 @@
 /* The round pipe's wall for MuJoCo: exact contacts between a pipe piece and a sphere, capsule or box.
  *
- * See ipir_mujoco/engine/pipe_walls.py. A pipe piece is a CYLINDER geom marked by its user data
+ * See ipir_mujoco/engine/builders/pipe_walls.py. A pipe piece is a CYLINDER geom marked by its user data
  * (geom_user[0] == PIPE_MAGIC; the model's nuser_geom >= PIPE_NUSER):
  *   user[1] = 1: a straight: the bore of radius user[2] [m] about the geom's z axis, z in [-user[3], user[3]);
  *   user[1] = 2: a bend: a torus section: the centreline the circle of radius user[3] [m] about the geom's z

@@ -42,10 +42,10 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_SPEED
 
 from .compiled_grip import load_grip_ratchet
-from .controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
-from .grip_model import ROLLS, SKIDS
-from .model import SLIDES, dof_address, qpos_address
-from .rows import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
+from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
+from ..builders.grip_model import ROLLS, SKIDS
+from ..builders.model import SLIDES, dof_address, qpos_address
+from ..loop.rows import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
 
 __all__ = ["LIMIT_TENDON", "GripRatchet", "GripRows", "lower_bound", "upper_bound"]
 

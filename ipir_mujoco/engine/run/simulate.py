@@ -57,19 +57,19 @@ from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
 from .block_checks import BlockChecks
-from .common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, climb_energy, monotone,
+from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, climb_energy, monotone,
                      mujoco_failure, steps_per_output)
-from .kinds import ModelKind, kind_for
+from ..modelkinds.kinds import ModelKind, kind_for
 from .skid_check import skidded, verify_skids
-from .model import SolverSettings
-from .monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
+from ..builders.model import SolverSettings
+from ..loop.monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
-from .recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
-from .route_watch import route_watch
+from ..loop.recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
+from ..modelkinds.route_watch import route_watch
 from .run_setup import RunSetup
-from .servo_drive import TickedDrive, controller_for
-from .stepper import WARNED
-from .timestep import DT_MIN
+from ..loop.servo_drive import TickedDrive, controller_for
+from ..loop.stepper import WARNED
+from ..modelkinds.timestep import DT_MIN
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK, _SKID_WORK = (SCALARS.index(n) for n in (

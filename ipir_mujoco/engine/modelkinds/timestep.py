@@ -57,9 +57,9 @@ import math
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from .grip_model import COMPLIANT_CARRIAGE_SHARE
-from .model import SolverSettings
-from .monitor import RESIDUAL_TOL
+from ..builders.grip_model import COMPLIANT_CARRIAGE_SHARE
+from ..builders.model import SolverSettings
+from ..loop.monitor import RESIDUAL_TOL
 
 DT_MAX = 1e-4  # s: the default proven at the paper's 1 s case (mjcf/README.md)
 # the locks with the paper's rule stop a module within a step at every engagement: at the paper's 1 s case

@@ -46,9 +46,9 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
-from .controller import ControllerBase
-from .native import LayoutError
-from .model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
+from ..loop.controller import ControllerBase
+from ..loop.native import LayoutError
+from ..builders.model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
 

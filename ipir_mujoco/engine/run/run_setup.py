@@ -12,10 +12,10 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
-from .kinds import ModelKind
-from .model import CRANK_HINGE, MOTOR, SolverSettings, drive_control
-from .servo_drive import TickedDrive
-from .stepper import PythonSteps, make_steps
+from ..modelkinds.kinds import ModelKind
+from ..builders.model import CRANK_HINGE, MOTOR, SolverSettings, drive_control
+from ..loop.servo_drive import TickedDrive
+from ..loop.stepper import PythonSteps, make_steps
 
 
 class RunSetup:

@@ -33,10 +33,10 @@ from ipir_mujoco.core.results import REST_SPEED
 
 from .compiled_grip import load_compliant_grip
 from .compliant import CompliantClutches, check_transmissions
-from .controller import ROLLING, SKIDDING, STANDING, RunningBound
+from ..loop.controller import ROLLING, SKIDDING, STANDING, RunningBound
 from .grip import GripRows
-from .grip_model import ROLLS, SKIDS
-from .model import dof_address, qpos_address
+from ..builders.grip_model import ROLLS, SKIDS
+from ..builders.model import dof_address, qpos_address
 
 
 class CompliantGrip(CompliantClutches):

@@ -33,8 +33,8 @@ import math
 from ipir_mujoco.core.results import RunResult
 from ipir_mujoco.core.steady_test import LIMIT_ACCURACY
 
-from .grip_model import carriage_share
-from .monitor import RESIDUAL_TOL, AccuracyError
+from ..builders.grip_model import carriage_share
+from ..loop.monitor import RESIDUAL_TOL, AccuracyError
 
 HALVINGS = 3  # the most halvings of the step a skid check makes (1e-4 s down to 1.25e-5 s)
 TRAVEL_FLOOR = 0.1  # strokes (2 r): the smallest travel a module's difference is taken relative to

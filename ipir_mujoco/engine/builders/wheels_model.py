@@ -45,7 +45,7 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.pipe import leg_direction as core_leg_direction
 
-from ..resources import mjcf_dir
+from ...resources import mjcf_dir
 from .model import (CRANK_HINGE, FRONT_SLIDE, INTEGRATORS, LOOP, REAR_SLIDE, ROD_HINGE, SolverSettings, _element,
                     _write_drive, _write_gravity, _write_mechanism, check_params, compile_spec, dof_address,
                     load_spec, qpos_address, start_closed_loop)

@@ -30,17 +30,17 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import grip_use
 
 from .common import check_clutch_options
-from .grip import GripRatchet
-from .grip_compliant import CompliantGrip
-from .grip_model import SKIDS
+from ..controllers.grip import GripRatchet
+from ..controllers.grip_compliant import CompliantGrip
+from ..builders.grip_model import SKIDS
 from .loop_rows import loop_options
-from .model import SolverSettings, build_model, qpos_address, set_closed_loop_state
+from ..builders.model import SolverSettings, build_model, qpos_address, set_closed_loop_state
 from .route_watch import check_route, pipe_fit
-from .slide_clutches import refuse_grip, slide_controller
+from ..controllers.slide_clutches import refuse_grip, slide_controller
 from .timestep import choose_settings
-from .wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
+from ..controllers.wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
                      wheels_settings)
-from .wheels_model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
+from ..builders.wheels_model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
 
 
 class ModelKind:

@@ -37,7 +37,6 @@ from operator import itemgetter
 import mujoco
 import numpy as np
 
-from .loop_rows import loop_options  # noqa: F401  (make_steps' options: the viewer imports it from here)
 from .native import LayoutError, compiled, pointers
 from .native import address as array_address
 from .recorder import Recorder

@@ -39,10 +39,10 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
 from .compliant import CompliantClutches
-from .controller import ControllerBase, RunningBound
-from .native import LayoutError
-from .model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
-from .rows import FrictionRows, clutch_share, equality_row, missing_rows
+from ..loop.controller import ControllerBase, RunningBound
+from ..loop.native import LayoutError
+from ..builders.model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
+from ..loop.rows import FrictionRows, clutch_share, equality_row, missing_rows
 
 
 class Ratchet(ControllerBase):
