@@ -68,7 +68,7 @@ class WheeledReplay(SlideReplay):
     docstring). ParameterError if the run lacks the pose columns (not a wheeled MuJoCo run)."""
 
     def __init__(self, model: mujoco.MjModel, run: RunResult):
-        from .engine.builders.wheels_model import LATERALS, TILTS, VERTICALS, leg_names
+        from .engine.builders.wheels_model import LATERALS, ROD_TILT, TILTS, VERTICALS, leg_names
 
         columns = SLIDES_ACROSS + tuple(f"{turn}{k}" for k in (1, 2) for turn in TURNS)
         missing = [c for c in columns if c not in run.series]
@@ -92,6 +92,8 @@ class WheeledReplay(SlideReplay):
         self.rear, self.rod = model.body("rear_module").id, model.body("rod").id
         self.front, self.end = model.body("front_module").id, model.site(ROD_END).id
         self.pin = model.eq_data[model.equality(LOOP).id, 3:6].copy()  # C in module 2's frame
+        tilt = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, ROD_TILT)
+        self.tilt = int(model.jnt_qposadr[tilt]) if tilt >= 0 else None  # the rod's cross pin (wheels template)
 
     def pose(self, data: mujoco.MjData, when: float) -> None:
         a, m = self.address, self.model
@@ -119,6 +121,8 @@ class WheeledReplay(SlideReplay):
         to_c, to_tip = frame.T @ (c - b), frame.T @ (tip - b)
         turn = math.atan2(to_c[1], to_c[0]) - math.atan2(to_tip[1], to_tip[0])
         data.qpos[a[ROD_HINGE]] = math.remainder(turn, 2 * math.pi)
+        if self.tilt is not None:  # and out of it about the universal joint's cross pin (a turn about y lowers +x)
+            data.qpos[self.tilt] = -math.atan2(to_c[2], math.hypot(to_c[0], to_c[1]))
         mujoco.mj_kinematics(m, data)
 
     def lookat(self, data: mujoco.MjData) -> list[float]:

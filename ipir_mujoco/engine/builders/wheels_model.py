@@ -1,7 +1,10 @@
 """Build the wheeled MuJoCo model of the robot, a 3-D robot in a round pipe (``--mujoco-model wheels``), through MjSpec.
 
 The template ``mjcf/inchworm_wheels.xml`` holds the mechanism of ``inchworm.xml`` (crank on module 1, rod, the loop
-closed on module 2 by an equality ``connect``) with each module free in 3-D: slides along x (``rear_slide``,
+closed on module 2 by an equality ``connect``, a ball joint at C) with the rod on a universal joint at the crank pin
+B (``rod_hinge`` about z and ``rod_tilt``, a cross pin about the rod's own y: in a bend module 2's C leaves module 1's
+plane, and a rod hinged about z alone would hold it there, off the pipe's centreline by about L^2 / (2 R)) and each
+module free in 3-D: slides along x (``rear_slide``,
 ``front_slide``: the travel every column reads), y (``*_lateral``) and z (``*_vertical``) and a ball joint
 (``*_tilt``). x is the pipe's axis, z is up in a horizontal pipe, the crank turns about z. :func:`build_wheels_spec`
 adds, per module, two rings (``aft``, ``fore``) of ``wheel_legs`` legs each, ``ring_spacing`` apart and centred
@@ -56,6 +59,7 @@ LATERALS = ("rear_lateral", "front_lateral")  # the modules' slides across the p
 VERTICALS = ("rear_vertical", "front_vertical")  # the modules' slides across the pipe (z)
 TILTS = ("rear_tilt", "front_tilt")  # the modules' ball joints
 HOUSINGS = ("rear_housing", "front_housing")
+ROD_TILT = "rod_tilt"  # the rod's cross pin at B (with rod_hinge a universal joint): the rod leaves the crank's plane
 ARM_SHARE = 1e-3  # of the module's mass, per arm
 WHEEL_SHARE = 1e-3  # of the module's mass, per wheel
 HALF_WIDTH = 0.005  # m: the drawn tyre's half-width along its hub (the contact is the sphere's)
