@@ -92,30 +92,53 @@ def check_input_file(option: str, path: str) -> None:
         raise ParameterError(f"{option} {path!r} is not a regular file (a device or pipe); give a file")
 
 
-def tenths_printer(total: float, text: Callable[[float], str], final_within: float = 0.0) -> Callable[[float], None]:
+WALL_EVERY_S = 10.0  # s of wall time: the longest a long run's progress stays silent in a log file
+
+
+def tenths_printer(total: float, text: Callable[[float], str], final_within: float = 0.0,
+                   every_s: float | None = None) -> Callable[[float], None]:
     """Progress on stderr, ``report(done)`` for ``done`` of ``total`` (any unit): on a terminal one line
     (``text(done)``) rewritten in place, ended once ``done`` is within ``final_within`` of ``total``; in a log
-    file one line per tenth of the total."""
+    file one line per tenth of the total and, with ``every_s`` [s], one at least every ``every_s`` seconds of wall
+    time (a run capped far beyond where it ends, as a route's, would otherwise print nothing for minutes)."""
+    import time
+
     if sys.stderr.isatty():
         def report(done: float) -> None:
             print("\r" + text(done), end="\n" if done >= total - final_within else "", file=sys.stderr, flush=True)
         return report
-    shown = [0]
+    shown, last = [0], [time.monotonic()]
 
     def report_lines(done: float) -> None:
         tenth = min(int(10 * done / total + 1e-9), 10)
-        if tenth > shown[0]:
-            shown[0] = tenth
+        now = time.monotonic()
+        if tenth > shown[0] or (every_s is not None and now - last[0] >= every_s):
+            shown[0], last[0] = max(shown[0], tenth), now
             print(text(done), file=sys.stderr, flush=True)
     return report_lines
 
 
 def progress_printer(t_end: float):
-    """Progress of a run on stderr (:func:`tenths_printer` of the simulated time [s], the callable's argument)
-    for runs long enough to wait for (simulated time > 2 s); None otherwise."""
-    if t_end <= 2.0:
+    """Progress of a run on stderr (:func:`tenths_printer` of the simulated time [s], the callable's argument):
+    per tenth of the simulated time for runs long enough to wait for (simulated time > 2 s), and in a log file at
+    least every WALL_EVERY_S of wall time whatever the length (a wheeled run steps ~20-30 s of wall time per
+    simulated second; a short fast run prints nothing)."""
+    import time
+
+    def text(t: float) -> str:
+        return f"simulated {t:.2f} / {t_end:g} s"
+    if t_end > 2.0:
+        return tenths_printer(t_end, text, final_within=0.05, every_s=WALL_EVERY_S)
+    if sys.stderr.isatty():
         return None
-    return tenths_printer(t_end, lambda t: f"simulated {t:.2f} / {t_end:g} s", final_within=0.05)
+    last = [time.monotonic()]
+
+    def wall_only(t: float) -> None:  # a short run: the wall clock's lines only
+        now = time.monotonic()
+        if now - last[0] >= WALL_EVERY_S:
+            last[0] = now
+            print(text(t), file=sys.stderr, flush=True)
+    return wall_only
 
 
 def wall_progress(total: float, text: Callable[[float], str], after_s: float = 2.0) -> Callable[[float], None]:
