@@ -2,7 +2,7 @@
 
 Run on demand from the repository root (about 15 min on 2 busy cores; ``--smoke``: a few seconds):
 
-    python bench/wheels_convergence.py [--smoke]
+    python bench/wheels_convergence.py [--cases cruise,riser,...] [--smoke]
 
 The model's contact, limit and loop rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
 properties of the model, so halving the step refines one model rather than stiffening it. Four cases, each at
@@ -89,13 +89,19 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="one case, 0.05 s, two steps: the script runs")
     parser.add_argument("--time-constants", action="store_true", help="the riser slide at several time constants")
+    parser.add_argument("--cases", default=",".join(CASES),
+                        help=f"comma-separated cases to run (default all: {','.join(CASES)})")
     args = parser.parse_args(argv)
     if args.time_constants:
         time_constants(args.smoke)
         return 0
     base = registry.timestep("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.5), 1.0, 1e-3)
     factors = (1, 2) if args.smoke else (1, 2, 4, 8)
-    cases = {"cruise": (CASES["cruise"][0], 0.05, None)} if args.smoke else CASES
+    chosen = [c.strip() for c in args.cases.split(",")]
+    unknown = [c for c in chosen if c not in CASES]
+    if unknown:
+        parser.error(f"--cases {unknown[0]!r} is unknown; allowed: {', '.join(CASES)}")
+    cases = {"cruise": (CASES["cruise"][0], 0.05, None)} if args.smoke else {c: CASES[c] for c in chosen}
     print(f"| case | figure | {' | '.join(f'dt {base / f:.3g} s' for f in factors)} | default - finest | within |")
     print("|---|---|" + "---|" * len(factors) + "---|---|")
     worst_ok = True
