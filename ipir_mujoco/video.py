@@ -147,7 +147,7 @@ def checker_floor(spec) -> None:
     material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
     floor = spec.geom("pipe_floor")
     floor.material, floor.rgba = "grid", [1, 1, 1, 1]
-    # far beyond any run, and wider than the view; a route's floor (route_walls: under it all) stays as large
+    # far beyond any run, and wider than the view; a route's floor (under it all) stays as large
     floor.size = [max(100.0, floor.size[0]), max(1.0, floor.size[1]), 0.01]
     spec.visual.headlight.ambient = [0.45, 0.45, 0.45]
     spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]

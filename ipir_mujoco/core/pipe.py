@@ -158,8 +158,84 @@ def lift_check(params) -> dict:
     return out
 
 
-def lift_summary(params) -> dict:
+def hub_tangent(u: tuple[float, float, float]) -> tuple[float, float]:
+    """(y, z) of the wall's circumferential direction x cross u at a leg of outward direction ``u``: the way its
+    wheel slides across the pipe (it rolls only along x)."""
+    return (-u[2], u[1])
+
+
+def scrub_force(params, module: int, toward: tuple[float, float]) -> float:
+    """The sideways friction [N] on each ring of module ``module`` (0 rear, 1 front) while it rolls through a bend
+    turning across the pipe towards the unit (y, z) ``toward``: its wheels roll only along the module's axis, so as
+    the module turns at v / R its two rings' wheels slide across the pipe (the fore ring's towards the bend's inside,
+    the aft ring's out) and each wheel's friction mu_wall P acts along its circumferential direction e_k (its
+    spring takes the radial part of the slide), so a ring feels mu_wall P sum_k |e_k . toward| across the pipe, the
+    two rings opposite ways: a couple the legs' springs carry as a ring load that size (the couple's lever is the
+    ring spacing either way). Quasi-static, Coulomb; 0 for a module at rest, as each is half of every revolution."""
+    n = int(params.wheel_legs)
+    P = (params.F_n1, params.F_n2)[module] / (2 * n)
+    mu = params.mu_wall if params.mu_wall is not None else 1.0  # unlimited grip: the wheels still slide at mu >= 1
+    return mu * P * sum(abs(e[0] * toward[0] + e[1] * toward[1])
+                        for e in (hub_tangent(leg_direction(k, n)) for k in range(n)))
+
+
+def bend_lift_check(params, radius: float, toward: tuple[float, float], across) -> dict:
+    """The lift-off check (:func:`lift_check`) of each module rolling through a bend of centreline radius ``radius``
+    [m] that turns towards the unit (y, z) ``toward`` across the pipe (in the robot's frame at the route's start:
+    y its left, z its up), under gravity's components across the pipe ``across`` [(g_y, g_z), m/s^2] at points
+    along the bend. On top of the straight pipe's loads (half the weight across, here as given; the rod's side
+    force, the motor's couple on module 1) each ring carries
+
+    - the wheels' scrub (:func:`scrub_force`) along +-toward: the bend's own load, mu_wall times a share of the
+      press whatever the radius (at the defaults' 3 legs 2 mu_wall P across a horizontal bend, 1.73 mu_wall P
+      across one turning up);
+    - the rod's push or pull at its angle to the module: the rod is a chord of the bend of length at most r + L,
+      (r + L) / (2 R) off the module's axis, carrying the moving module's rolling resistance and weight (at most
+      max(F_ri + m_i g)) while neither module skids;
+    - the pipe's spread off the ring's plane: the ring's plane cuts the bend obliquely, so the wall is farther by
+      half :func:`bend_wheel_spread` along toward, which unloads leg k by P (u_k . toward)^2 spread / (2 travel).
+
+    Returns {'least_press1_n', 'least_press2_n': the least-pressed leg's press [N] (< 0: it lifts),
+    'lift_predicted': bool, 'scrub_n': (module 1's, module 2's) ring load [N]}."""
+    n = int(params.wheel_legs)
+    torque = abs(params.M) if params.drive == "torque" else params.M_stall
+    side = rod_side_force(torque, params.r, params.L)
+    push = max(params.F_r1 + params.m1 * params.g, params.F_r2 + params.m2 * params.g)
+    chord = push * min(1.0, (params.r + params.L) / (2 * radius))
+    half_base = 0.5 * params.ring_spacing
+    spread = bend_wheel_spread(half_base, params.wheel_radius, radius, params.pipe_diameter)
+    legs = [leg_direction(k, n) for k in range(n)]
+    ty, tz = toward
+    out, scrubs = {}, []
+    for i, (m, Fn) in enumerate(((params.m1, params.F_n1), (params.m2, params.F_n2)), start=1):
+        P = Fn / (2 * n)
+        scrub = scrub_force(params, i - 1, toward)
+        scrubs.append(scrub)
+        couple = torque / params.ring_spacing if i == 1 else 0.0
+        least = math.inf
+        for gy, gz in across:
+            for lateral in (0.5 * side + couple, -(0.5 * side + couple), 0.5 * side - couple, couple - 0.5 * side):
+                for bend_load in (scrub + 0.5 * chord, -(scrub + 0.5 * chord)):
+                    fy = 0.5 * m * gy + lateral + bend_load * ty
+                    fz = 0.5 * m * gz + bend_load * tz
+                    for (_, uy, uz) in legs:
+                        spread_loss = P * (uy * ty + uz * tz) ** 2 * 0.5 * spread / params.suspension_travel
+                        least = min(least, P - spread_loss + (2.0 / n) * (fy * uy + fz * uz))
+        out[f"least_press{i}_n"] = least
+    out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
+    out["scrub_n"] = tuple(scrubs)
+    return out
+
+
+def lift_summary(params, fit: dict | None = None) -> dict:
     """The lift-off check's summary keys of a wheeled run: ``least_press1_n``, ``least_press2_n`` [N] and
-    ``lift_predicted`` (:func:`lift_check`)."""
+    ``lift_predicted`` (:func:`lift_check`); along a route, with its ``fit`` (the run's ``route_fit``, whose bends
+    carry :func:`bend_lift_check`'s least presses), the least over the straight pipe and every bend."""
     check = lift_check(params)
-    return {key: check[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted")}
+    out = {key: check[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted")}
+    for bend in (fit or {}).get("bends", ()):
+        for key in ("least_press1_n", "least_press2_n"):
+            if bend.get(key) is not None:
+                out[key] = min(out[key], bend[key])
+    out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
+    return out

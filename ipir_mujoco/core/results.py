@@ -216,7 +216,7 @@ class RunResult:
         """The summary figures of the command-line contract (docs/cli.md)."""
         summary = summarize(self.series, self.energy, self.params.grip)
         if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
-            summary.update(lift_summary(self.params))
+            summary.update(lift_summary(self.params, (self.route or {}).get("route_fit")))
         summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall

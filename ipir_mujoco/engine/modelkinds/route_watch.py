@@ -33,7 +33,7 @@ import numpy as np
 from ipir_mujoco.core.route import Route
 
 from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, dof_address, qpos_address
-from ..builders.route_walls import LEAD_IN
+from ..builders.pipe_walls import LEAD_IN
 
 WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
@@ -227,14 +227,12 @@ class RouteWatch:
                 "route_piece_times_s": list(self.mark_times)}
 
 
-def check_route(route, model: str, params, until_steady: bool, planar: bool = False, reach: float | None = None):
+def check_route(route, model: str, params, until_steady: bool, reach: float | None = None):
     """``params`` for a run along ``route`` (None: as they are): its incline the route's first straight's;
     ParameterError (one line) for a route on the slide model, with --until-steady, with an incline set apart
     from the route's, or whose first straight is shorter than the robot (it starts in it: ``reach`` [m], how far
-    the robot reaches ahead of its rear module's point A; the round-pipe model's by default); with ``planar`` (the
-    retired planar model's box walls) one out of the mechanism's plane or whose walls would be too large
-    (:func:`.route_walls.check_wall_count`). The round pipe's walls (:mod:`.pipe_walls`) take any route: at most
-    MAX_SEGMENTS + 2 pieces."""
+    the robot reaches ahead of its rear module's point A; the round-pipe model's by default). The round pipe's walls
+    (:mod:`.pipe_walls`) take any route: at most MAX_SEGMENTS + 2 pieces."""
     from ipir_mujoco.core.errors import ParameterError
 
     if route is None:
@@ -250,10 +248,6 @@ def check_route(route, model: str, params, until_steady: bool, planar: bool = Fa
         raise ParameterError(f"incline={params.incline:g} deg with --route: the route's first straight sets the "
                              "incline; allowed: incline=0 (give it in the route)")
     route.check_pipe(params.pipe_diameter)
-    if planar:
-        from ..builders.route_walls import check_wall_count
-
-        check_wall_count(route, params.pipe_diameter)  # bounded before anything is built
     if reach is None:  # the round-pipe model's: A to its front ring's wheels
         reach = params.L + params.r + 0.5 * params.ring_spacing + params.wheel_radius
     first = route.pieces[0]
