@@ -2,7 +2,8 @@
 
 Run on demand from the repository root (about 30-60 min on 2 busy cores; ``--smoke``: 4 designs, a minute):
 
-    python bench/wheels_agreement.py [--designs 100] [--seed 1] [--workers 2] [--wall-budget S] [--skip N] [--smoke]
+    python bench/wheels_agreement.py [--designs 100] [--seed 1] [--workers 2] [--wall-budget S] [--skip N]
+                                     [--only N,M,...] [--smoke]
 
 Each design is drawn over the envelope (log-uniform where a range spans decades): m1, m2 0.2-5 kg; r 0.02-0.07 m
 (the crank fits the 0.16 m pipe); L / r 1.5-6; J_A 1e-4-1e-2 kg m^2; F_r1, F_r2 0.2-5 N; the drive a constant
@@ -116,14 +117,17 @@ def main(argv=None) -> int:
     parser.add_argument("--skip", type=int, default=0, help="draw and skip the first N designs (resume a run)")
     parser.add_argument("--wall-budget", type=float, default=None,
                         help="each MuJoCo run's wall-time budget [s]: a run past it is stopped with that reason")
+    parser.add_argument("--only", default=None, metavar="N,M,...",
+                        help="run only these designs (their numbers as printed; with --skip, these and those after it)")
     parser.add_argument("--smoke", action="store_true", help="4 designs of 0.3 s: the script runs")
     args = parser.parse_args(argv)
+    only = None if args.only is None else {int(k) for k in args.only.split(",")}
     rng = np.random.default_rng(args.seed)
     count = 4 if args.smoke else args.designs
     jobs = []
     for k in range(count):
         params, t_end = design(rng)
-        if k >= args.skip:
+        if (k >= args.skip and only is None) or (only is not None and (k in only or (args.skip and k >= args.skip))):
             jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget))
     counts = {"agree": 0, "lifted": 0, "stopped": 0, "outside": 0}
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
