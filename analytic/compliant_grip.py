@@ -1,6 +1,6 @@
 """Finite grip with compliant clutches: a clutch's force is capped by its wheels' grip, its anchor slides.
 
-A compliant clutch (:mod:`.compliant_clutch`) pushes its module with the force
+A compliant clutch (:mod:`.compliant_model`) pushes its module with the force
 of a spring and damper between the module and the clutch's *anchor*, the
 locked wheels on the wall. The wheels hold at most G_i = mu_wall F_ni; where
 the force k d - c v would exceed that, the anchor slides back (clutch state

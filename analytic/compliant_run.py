@@ -1,6 +1,6 @@
 """Running the compliant-clutch model: the event loop, the sampled series and the energy audit.
 
-The equations and the regime decisions are in :mod:`.compliant_clutch`. Here
+The equations and the regime decisions are in :mod:`.compliant_model`. Here
 each regime is integrated with ``solve_ivp`` until its first event, sampled on
 the output grid (with every segment's ends: an instant where the regime
 changes appears twice; a damped clutch's force maxima are sampled too, so a
@@ -37,7 +37,7 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_TIME, RunResult, stall_reason
 
 from . import accel, compliant_grip, dop853, kernels
-from .compliant_clutch import CompliantModel
+from .compliant_model import CompliantModel
 from .compliant_state import Clutch, Regime
 from .forces import drive_torque
 from .kinematics import Geometry

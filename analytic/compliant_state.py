@@ -1,8 +1,8 @@
 """The discrete state of the compliant one-way clutch model and what a state implies: the clutch states, the
 regime between two events, the motion a state gives, and the tolerances of the model's sign tests and switches.
 
-Shared by the model (:mod:`.compliant_clutch`), its driver (:mod:`.compliant_run`) and its finite-grip
-additions (:mod:`.compliant_grip`), which each import it; the model's equations are in :mod:`.compliant_clutch`.
+Shared by the model (:mod:`.compliant_model`), its driver (:mod:`.compliant_run`) and its finite-grip
+additions (:mod:`.compliant_grip`), which each import it; the model's equations are in :mod:`.compliant_model`.
 """
 
 from __future__ import annotations
@@ -71,7 +71,11 @@ class Motion(NamedTuple):
 # relative tolerances of the sign tests (speeds; forces and accelerations), far above the
 # event-location error (~rtol), far below any physical margin (as in the rigid one-way model)
 _TOL_V, _TOL_F = 1e-8, 1e-7
-_REST_SPEED = 1e-10  # [m/s] below this a module or crank-pin speed counts as rest (far above _HYSTERESIS_SPEED)
+# [m/s] the absolute floor of the regime logic's rest test (|v| <= _TOL_V * v_scale + floor): as the one-way
+# model's _MODE_REST_FLOOR (1e-12), but a hundred times its switches' hysteresis speed (_HYSTERESIS_SPEED, 1e-12),
+# so that a module let go at the hysteresis speed reads as rest, not as moving; far below the series' rest
+# (core.results.REST_SPEED, 1e-6)
+_REGIME_REST_FLOOR = 1e-10
 # [rad] how far on from a dead centre at rest the friction states are decided: the module loads then are
 # O(K' step) = 5e-7 of the stroke's (far above roundoff), the gap has moved O(K' step^2) = 1e-12 of it
 _DEAD_CENTRE_STEP = 1e-5

@@ -4,7 +4,7 @@ The crank follows phi(t) exactly (a constant speed, or samples the user gives);
 the modules follow from the clutch rule. Under the paper's rule the sign of
 K(phi) omega picks the moving module; with one-way clutches the modules have
 their own dynamics (both can slide at once), integrated event by event as in
-:mod:`ipir_mujoco.analytic.unilateral_clutch` but with the crank's motion given instead of
+:mod:`ipir_mujoco.analytic.unilateral_run` but with the crank's motion given instead of
 the torque. At every instant the motor torque is the phi-row of the two-DOF
 equations (:meth:`OneDofDynamics.motor_torque`), and the clutch reactions,
 rod and pin forces follow as in the forward models. Gravity along the pipe
@@ -33,7 +33,7 @@ from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 
 HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False), Mode.BOTH_MOVING: (False, False)}
-_TOL = 1e-7  # relative tolerance of the sign tests (see unilateral_clutch)
+_TOL = 1e-7  # relative tolerance of the sign tests (see unilateral_run)
 
 
 @dataclass(frozen=True)

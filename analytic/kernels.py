@@ -14,7 +14,7 @@ A model's constants travel as one float array ``p`` (:func:`pack`, the
 work]; event k of a mode watches module k: its velocity while it moves, its
 hold margin R_k + F_rk while held), both with :class:`.results.Mode` values as
 modes, :data:`COMPLIANT` (compliant one-way clutches, see below) and :data:`GRIP`
-(one-way clutches on wheels of finite grip, :mod:`.grip`: the one-way model's
+(one-way clutches on wheels of finite grip, :mod:`.grip_model`: the one-way model's
 right-hand sides, its own events).
 Units: rad, rad/s, m, m/s, kg, N, N m, J.
 """
@@ -33,7 +33,7 @@ KINEMATIC, UNILATERAL = 0, 1  # COMPLIANT = 2 and GRIP = 3: see their sections b
 CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # Mode values (BOTH_LOCKED is never integrated)
 (P_M1, P_M2, P_R, P_L, P_JA, P_FR1, P_FR2, P_M, P_ROD_M, P_ROD_I, P_EXACT, P_ROD, P_MOTOR, P_MSTALL, P_WNL,
  P_AG, P_U) = range(17)
-TINY = float(np.finfo(float).tiny)  # what a quiet guard reads at least (see unilateral_clutch.events)
+TINY = float(np.finfo(float).tiny)  # what a quiet guard reads at least (see unilateral_run.events)
 
 
 def pack(dyn: OneDofDynamics) -> np.ndarray:
@@ -219,7 +219,7 @@ def guard_table(model, mode, n_events, p, times, states, out):
             out[k, i] = values[k]
 
 
-# --- compliant one-way clutches (:mod:`.compliant_clutch`) -------------------------------------------
+# --- compliant one-way clutches (:mod:`.compliant_model`) -------------------------------------------
 # state [phi, omega, x1, v1, motor work, friction work, damper work]; the regime and the segment's events
 # travel in ``p`` after the robot's constants (:meth:`.CompliantModel.constants`); the "mode" argument
 # of rhs/guard says whether an event reads its raw value (RAW) or what the root search sees (GUARDED).
@@ -343,7 +343,7 @@ def compliant_guard(guarded, k, t, y, p):
     return value
 
 
-# --- one-way clutches with finite grip (:mod:`.grip`) ------------------------------------------------
+# --- one-way clutches with finite grip (:mod:`.grip_model`) ------------------------------------------------
 # the one-way model's state and right-hand sides; ``p`` is :func:`pack` of the dynamics whose resistance of
 # a module skidding back is -G_i (its grip pushes it forward), then the grips and each module's state
 GRIP = 3

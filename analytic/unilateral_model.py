@@ -1,6 +1,6 @@
 """The one-way-clutch robot's modes: kinematics, accelerations, holding forces, events and the choice of the
 next mode (the complementarity problem), and every series column of a mode's samples. The event-driven run
-loop that integrates it is :mod:`.unilateral_clutch` (whose docstring states the model and its tie rules).
+loop that integrates it is :mod:`.unilateral_run` (whose docstring states the model and its tie rules).
 """
 
 from __future__ import annotations
@@ -23,9 +23,12 @@ HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
 # relative tolerances of the sign tests: far above the event-location and
 # dense-output error (~rtol), far below any physical margin
 _TOL_V, _TOL_A, _TOL_F = 1e-8, 1e-7, 1e-7
-# a speed below this [m/s] (a nanometre in a quarter hour) counts as rest; without a floor a crank
-# started at 1e-12 rad/s with no torque is neither at rest nor able to move in any mode
-_REST_SPEED = 1e-12
+# [m/s] the absolute floor of the mode logic's rest test (|v| <= _TOL_V * v_scale + floor): a speed below it (a
+# nanometre in a quarter hour) is rest to the event logic; without a floor a crank started at 1e-12 rad/s with no
+# torque is neither at rest nor able to move in any mode. A numerical zero, not core.results.REST_SPEED (1e-6 m/s,
+# the series' rest, which reads MuJoCo's soft creep as rest): this model's rest is exact, so its floor sits just
+# above round-off. The compliant model's floor (compliant_state._REGIME_REST_FLOOR) is higher for its hysteresis.
+_MODE_REST_FLOOR = 1e-12
 _TINY = np.finfo(float).tiny  # what a quiet guard reads at least (see events)
 _STATES = ("phi", "omega", "x1", "x2", "state_v1", "motor_work")  # y, as series columns (v1: not in every mode)
 
@@ -165,7 +168,7 @@ class UnilateralModel:
         M = float(self.motor(t, phi, omega))
         v1, v2 = (float(v) for v in velocities)
         v_scale = r * abs(omega) + abs(v1) + abs(v2)
-        at_rest = [abs(v) <= _TOL_V * v_scale + _REST_SPEED for v in (v1, v2)]
+        at_rest = [abs(v) <= _TOL_V * v_scale + _MODE_REST_FLOOR for v in (v1, v2)]
         if not at_rest[0] and v1 < 0 or not at_rest[1] and v2 < 0:
             raise SimulationError(f"a module moves backward (v1={v1:.3g}, v2={v2:.3g} m/s) at phi={phi:.6g}")
         # the static hold (alpha = 0, the 0.0 below) is computed further down, only where it is a candidate
@@ -180,7 +183,7 @@ class UnilateralModel:
         for mode, held in HELD.items():
             if any(h and not z for h, z in zip(held, at_rest)):
                 continue  # a held module must stand still
-            if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + _REST_SPEED
+            if mode is Mode.BOTH_LOCKED and (r * abs(omega) > _TOL_V * v_scale + _MODE_REST_FLOOR
                                              or (abs(self.linkage.transfer(phi).K) <= 1e-12 * r and M != 0)):
                 continue  # a static hold needs the crank at rest, and a torque the linkage can resist
             m = motions[mode] if mode in motions else self.motion(phi, omega, v1, mode, M)

@@ -21,7 +21,7 @@ import time
 from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
 
-ENGINES = ("analytic-unilateral", "mujoco-ratchet")
+VARIANTS = ("analytic-unilateral", "mujoco-ratchet")
 CASES = {"motor": RobotParams(drive="motor"), "servo PI": RobotParams(drive="servo"),
          "servo PI + exact ff": RobotParams(drive="servo", feedforward="exact")}
 
@@ -36,19 +36,19 @@ def main() -> int:
         args.repeats = 1
     for params in CASES.values():
         registry.feedforward_table(params)  # cached: the runs below time the engines, not the table
-        for engine in ENGINES:  # warm: the numba kernels, MuJoCo's import
+        for engine in VARIANTS:  # warm: the numba kernels, MuJoCo's import
             registry.run(engine, params, t_cap, dt_out=1e-3, until_steady=steady)
     best: dict[tuple[str, str], tuple[float, float]] = {}
     for _ in range(args.repeats):
         for name, params in CASES.items():
-            for engine in ENGINES:
+            for engine in VARIANTS:
                 started = time.perf_counter()
                 run = registry.run(engine, params, t_cap, dt_out=1e-3, until_steady=steady)
                 wall = time.perf_counter() - started
                 if (engine, name) not in best or wall < best[(engine, name)][0]:
                     best[(engine, name)] = (wall, run.t_end)
     print(f"{'engine':22s} {'case':22s} {'wall [s]':>9s} {'simulated [s]':>14s} {'wall/sim':>9s} {'/ motor':>8s}")
-    for engine in ENGINES:
+    for engine in VARIANTS:
         motor_rate = best[(engine, "motor")][0] / best[(engine, "motor")][1]
         for name in CASES:
             wall, simulated = best[(engine, name)]

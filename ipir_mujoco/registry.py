@@ -45,7 +45,7 @@ __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep
 # beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
 # the public surface: they may change with them)
 
-ENGINES = ("analytic", "mujoco")
+ENGINES = ("analytic", "mujoco")  # the two engines; a variant (VARIANTS) is one model in one of them
 RULES = ("kinematic", "unilateral")
 
 

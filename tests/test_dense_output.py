@@ -21,7 +21,7 @@ from ipir_mujoco.analytic.dense import DenseSolution, component_at, dense_table,
 from ipir_mujoco.analytic.kinematics import Linkage
 from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.solver_support import graze_signs
-from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
+from ipir_mujoco.analytic.unilateral_model import UnilateralModel
 
 ACCELERATED = accel.accelerate()  # the compiled scans, where numba is installed, against the numpy reference
 RTOL, ATOL = 1e-10, 1e-12

@@ -1,6 +1,7 @@
-"""The engine's modules under their older paths (the engine was one folder; users' scripts import
-``ipir_mujoco.engine.simulate``, ``ipir_mujoco.engine.stepper``, ...): each is the very module at its new place,
-and a run started through the older names steps with the compiled loop and with the Python loop."""
+"""Modules under their older paths (the engine was one folder: users' scripts import
+``ipir_mujoco.engine.simulate``, ``ipir_mujoco.engine.stepper``, ...; the analytic run loops were
+``unilateral_clutch``, ...): each is the very module at its new place, and a run started through the engine's
+older names steps with the compiled loop and with the Python loop."""
 
 from __future__ import annotations
 
@@ -11,13 +12,15 @@ import sys
 
 import pytest
 
+import ipir_mujoco.analytic  # noqa: F401  (registers the analytic model's older paths)
 import ipir_mujoco.engine as engine
+from ipir_mujoco.core.older_paths import OLDER_PATHS
 from ipir_mujoco.engine.loop import stepper
 
-OLDER = sorted(engine.OLDER_PATHS.items())
+OLDER = sorted(OLDER_PATHS.items())
 
 
-@pytest.mark.parametrize(("older", "newer"), OLDER, ids=[older.rsplit(".", 1)[1] for older, _ in OLDER])
+@pytest.mark.parametrize(("older", "newer"), OLDER, ids=[older.removeprefix("ipir_mujoco.") for older, _ in OLDER])
 def test_an_older_path_imports_the_same_module(older, newer):
     if newer.rsplit(".", 1)[1].startswith("_"):  # a compiled part: it may be absent where it was not built
         try:
@@ -27,8 +30,8 @@ def test_an_older_path_imports_the_same_module(older, newer):
     module = importlib.import_module(older)
     assert module is importlib.import_module(newer) is sys.modules[older] is sys.modules[newer]
     assert module.__name__ == newer and module.__spec__.name == newer  # its own spec, not the older path's
-    name = older.rsplit(".", 1)[1]
-    assert getattr(engine, name) is module  # `from ipir_mujoco.engine import stepper` and attribute access
+    parent, _, name = older.rpartition(".")
+    assert getattr(sys.modules[parent], name) is module  # `from ipir_mujoco.engine import stepper`, attributes
 
 
 def test_every_module_of_the_engines_folders_has_its_older_path():
@@ -40,6 +43,7 @@ def test_every_module_of_the_engines_folders_has_its_older_path():
             for file in os.listdir(os.path.join(root, folder))
             if file.endswith((".py", ".c")) and file != "__init__.py"}
     assert held == set(engine.OLDER_PATHS.values())
+    assert all(older in OLDER_PATHS for older in engine.OLDER_PATHS)
 
 
 def test_names_that_are_no_older_path_are_not_found():
@@ -70,3 +74,17 @@ def test_a_run_through_the_older_paths_steps_in_both_loops():
     loop, x1 = compiled.stdout.split()
     assert python.stdout.split() == ["PythonSteps", x1]
     assert loop == ("CompiledSteps" if stepper.compiled_status()[0] else "PythonSteps")
+
+
+def test_older_names_of_the_variant_lists_keep_their_values():
+    """``ENGINES`` names the two engines (registry) only; the studies' variant lists have their own names, the
+    older ones still read."""
+    from ipir_mujoco import registry
+    from ipir_mujoco.studies import climb_limits, climbing, sweep_space
+    from ipir_mujoco.studies.climbing import ENGINES as climbing_engines
+
+    assert registry.ENGINES == ("analytic", "mujoco")
+    assert climbing_engines is climbing.ENGINES is climb_limits.ENGINES is climbing.CLIMB_VARIANTS
+    assert sweep_space.ENGINES is registry.NAMES and sweep_space.DEFAULT_ENGINES is sweep_space.DEFAULT_VARIANTS
+    with pytest.raises(AttributeError):
+        climbing.NO_SUCH_NAME

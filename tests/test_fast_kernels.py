@@ -25,7 +25,7 @@ from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.kinematic_clutch import mode_rhs
 from ipir_mujoco.core.results import Mode
-from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
+from ipir_mujoco.analytic.unilateral_model import UnilateralModel
 
 # compiled for the whole test session where numba is installed (by default a process compiles only once its
 # runs have spent accel.LOAD_COST_S in Python): every test then checks the compiled kernels, and the Python

@@ -1,6 +1,6 @@
 """Finite grip: a held module's locked wheels hold at most G_i = mu_wall F_ni, beyond that it skids back.
 
-The rigid one-way model with grip (analytic/grip.py), the compliant one (analytic/compliant_grip.py),
+The rigid one-way model with grip (analytic/grip_model.py), the compliant one (analytic/compliant_grip.py),
 the summary keys and the parameters. docs/model.md, "Finite grip", has the equations and the hand
 checks these tests repeat.
 """
@@ -16,7 +16,7 @@ import sympy as sp
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, kernels
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
-from ipir_mujoco.analytic.grip import GripMode, GripModel
+from ipir_mujoco.analytic.grip_model import GripMode, GripModel
 from ipir_mujoco.core.params import load_params
 from ipir_mujoco.core.results import COLUMNS
 

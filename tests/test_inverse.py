@@ -10,7 +10,7 @@ import pytest
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams
 from ipir_mujoco.analytic.inverse import CrankMotion, inverse_kinetostatics
-from ipir_mujoco.analytic.unilateral_clutch import simulate_unilateral
+from ipir_mujoco.analytic.unilateral_run import simulate_unilateral
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import CrankServo, simulate_mujoco
 

@@ -14,7 +14,7 @@ from ipir_mujoco.core.cycles import cycles
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.analytic.kinematic_clutch import mode_rhs
 from ipir_mujoco.core.results import Mode
-from ipir_mujoco.analytic.unilateral_clutch import UnilateralModel
+from ipir_mujoco.analytic.unilateral_model import UnilateralModel
 from ipir_mujoco.cli import main
 
 MOTOR = RobotParams(drive="motor")  # the default gearmotor: M_stall 0.5 N m, no-load 30 rad/s

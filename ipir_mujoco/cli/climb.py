@@ -61,10 +61,10 @@ def parse_inclines(text: str) -> tuple[float, ...]:
 
 def parse_engines(text: str | None) -> tuple[str, ...]:
     """The engines (variant names of :mod:`ipir_mujoco.registry`) of ``--engines``, or the study's default."""
-    from ..studies.climbing import ENGINES
+    from ..studies.climbing import CLIMB_VARIANTS
 
     if text is None:
-        return ENGINES
+        return CLIMB_VARIANTS
     names = tuple(dict.fromkeys(e.strip() for e in text.split(",") if e.strip()))
     unknown = [e for e in names if e not in registry.VARIANTS and e not in registry.ALIASES]
     if not names or unknown:

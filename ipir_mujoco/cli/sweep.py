@@ -8,9 +8,10 @@ from pathlib import Path
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.results import write_json
 
+from .. import registry
 from ..labels import significant
 from ..studies.sweep_metrics import METRICS, UNITS
-from ..studies.sweep_space import DEFAULT_ENGINES, ENGINES, T_END_STEADY
+from ..studies.sweep_space import DEFAULT_VARIANTS, T_END_STEADY
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
 from .design_runs import add_scheduler_option, scheduler_executor
 
@@ -25,8 +26,8 @@ def add_parser(commands) -> None:
     swp.add_argument("--sample", type=int, default=None, metavar="N", help="N space-filling (Sobol) designs")
     swp.add_argument("--seed", type=int, default=None, help="seed of the Sobol sample, >= 0 (default 0)")
     swp.add_argument("--engines", default=None, metavar="LIST",
-                     help=f"comma-separated, first one is the reference for divergence; from: {', '.join(ENGINES)} "
-                          f"(default: {','.join(DEFAULT_ENGINES)})")
+                     help=f"comma-separated, first one is the reference for divergence; from: {', '.join(registry.NAMES)} "
+                          f"(default: {','.join(DEFAULT_VARIANTS)})")
     swp.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
                      help="simulated time per design (default 1 s); with --until-steady, the cap (default 10 s)")
     swp.add_argument("--until-steady", action="store_true", default=None,
@@ -65,7 +66,7 @@ def study_from_args(args: argparse.Namespace):
         names = tuple(e.strip() for e in args.engines.split(",") if e.strip())
         if not names:
             raise ParameterError(f"--engines {args.engines!r} names no engine; allowed: a comma-separated list "
-                                 f"from: {', '.join(ENGINES)}")
+                                 f"from: {', '.join(registry.NAMES)}")
         options["engines"] = names
     for key in ("sample", "seed", "t_end", "until_steady"):  # options given on the command line win over the file
         if getattr(args, key) is not None:

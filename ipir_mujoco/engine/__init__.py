@@ -23,13 +23,10 @@ result container, the errors, the per-revolution figures), never
 :mod:`ipir_mujoco.analytic`.
 
 The modules' older paths (``ipir_mujoco.engine.simulate``, ``ipir_mujoco.engine.stepper``, ...: the engine was
-one folder) keep working: :class:`_OlderPaths` imports each as the very module at its new place.
+one folder) keep working: :func:`ipir_mujoco.core.older_paths.keep_older_paths` imports each as the very module at its new place.
 """
 
-import importlib
-import importlib.abc
-import importlib.util
-import sys
+from ipir_mujoco.core.older_paths import keep_older_paths
 
 from .builders.model import SolverSettings, build_model
 from .run.export import compiled_mjcf, save_mjcf
@@ -38,36 +35,19 @@ from .run.simulate import CrankServo, captured_warnings, simulate_mujoco
 __all__ = ["CrankServo", "SolverSettings", "build_model", "captured_warnings", "compiled_mjcf", "save_mjcf",
            "simulate_mujoco"]
 
-# each folder's modules, by the name they had when the engine was one folder (old name = module name)
+# each folder's modules (bottom up)
 FOLDERS = {
     "builders": ("model", "grip_model", "wheels_model", "pipe_walls", "pipe_drawing", "pipe_rig", "route_walls",
                  "_pipewall"),
     "loop": ("stepper", "native", "rows", "recorder", "monitor", "controller", "servo_drive", "_stepper"),
-    "controllers": ("slide_clutches", "compliant", "grip", "grip_compliant", "compiled_grip", "wheels"),
+    "controllers": ("slide_clutches", "compliant", "grip", "compliant_grip", "compiled_grip", "wheels"),
     "modelkinds": ("kinds", "loop_rows", "timestep", "route_watch", "common"),
     "run": ("simulate", "run_setup", "batch", "export", "block_checks", "skid_check"),
 }
-OLDER_PATHS = {f"{__name__}.{module}": f"{__name__}.{folder}.{module}"
+RENAMED = {"compliant_grip": "grip_compliant"}  # a module's name now: its older name (as the analytic model's)
+# older path (the engine was one folder; a renamed module also under its older name in its folder): path now
+OLDER_PATHS = {f"{__name__}.{RENAMED.get(module, module)}": f"{__name__}.{folder}.{module}"
                for folder, modules in FOLDERS.items() for module in modules}
-
-
-class _OlderPaths(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Imports ``ipir_mujoco.engine.<module>`` (an older path) as ``ipir_mujoco.engine.<folder>.<module>``: the same
-    module object under both names, so that a patched or read attribute is the one the engine uses."""
-
-    def find_spec(self, fullname, path=None, target=None):
-        if fullname not in OLDER_PATHS:
-            return None
-        return importlib.util.spec_from_loader(fullname, self)
-
-    def create_module(self, spec):
-        module = importlib.import_module(OLDER_PATHS[spec.name])
-        spec.loader_state = module.__spec__  # the import system sets the older spec on the module: kept to undo it
-        return module
-
-    def exec_module(self, module):
-        module.__spec__ = module.__spec__.loader_state  # the module's own spec again (reload, python -m)
-
-
-if not any(isinstance(finder, _OlderPaths) for finder in sys.meta_path):
-    sys.meta_path.append(_OlderPaths())
+OLDER_PATHS |= {f"{__name__}.{folder}.{RENAMED[module]}": f"{__name__}.{folder}.{module}"
+                for folder, modules in FOLDERS.items() for module in modules if module in RENAMED}
+keep_older_paths(OLDER_PATHS)

@@ -47,7 +47,9 @@ from ipir_mujoco.core.results import REST_SPEED, RunResult  # REST_SPEED: m/s, a
 from .sweep_metrics import mean_speed
 from .sweep_space import DT_OUT as SWEEP_DT_OUT, T_END_STEADY
 
-ENGINES = ("analytic-unilateral", "mujoco-ratchet")  # the exact models with one-way clutches: the default pair
+# the variants a climb study runs by default: the exact models with one-way clutches, one per engine
+CLIMB_VARIANTS = ("analytic-unilateral", "mujoco-ratchet")
+OLDER_NAMES = {"ENGINES": "CLIMB_VARIANTS"}  # see __getattr__
 GRID = 3600  # crank angles per revolution scanned before refining the hardest one
 T_END = T_END_STEADY  # s: cap of a run to steady state
 T_END_TORQUE = 1.0  # s: length of a constant-torque run (the paper's); it accelerates, so a longer one costs more
@@ -300,7 +302,7 @@ def bisect_incline(verdict: Callable[[float], bool], low: float, high: float, to
     return {"incline_deg": low, "bracket": [low, high], "runs": runs}
 
 
-def incline_curve(params: RobotParams, inclines, engines=ENGINES, t_end: float | None = None,
+def incline_curve(params: RobotParams, inclines, engines=CLIMB_VARIANTS, t_end: float | None = None,
                   progress: Progress = lambda _m: None) -> list[dict]:
     """Per incline [deg]: the torque a revolution needs at rest there, and each engine's :func:`measure`."""
     rows = []
@@ -316,3 +318,11 @@ def incline_curve(params: RobotParams, inclines, engines=ENGINES, t_end: float |
                 f"{m['steady_speed_m_s']:.4g} m/s" if m["steady"] else f"{m['revolutions']:.3g} rev"))
         rows.append(row)
     return rows
+
+
+def __getattr__(name: str):
+    """The older names of this module's constants: ``ENGINES`` named variants (the registry's ``ENGINES`` names
+    the two engines, analytic and mujoco)."""
+    if name in OLDER_NAMES:
+        return globals()[OLDER_NAMES[name]]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

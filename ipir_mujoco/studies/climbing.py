@@ -13,19 +13,20 @@ from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams, check_real
 
-from .climb_limits import (DT_OUT, ENGINES, GRID, T_END, T_END_TORQUE, TOLERANCE_DEG, Progress, bisect_incline,
+from . import climb_limits
+from .climb_limits import (CLIMB_VARIANTS, DT_OUT, GRID, T_END, T_END_TORQUE, TOLERANCE_DEG, Progress, bisect_incline,
                            climbs, default_t_end, energy_bound, incline_curve, locked_pull_share, measure,
                            required_torque, restart_limit, run_engine, run_metrics, steady_climb_limit,
                            steady_skid, steady_window, torque_needed)
 from .traction import traction_study
 
-__all__ = ["DT_OUT", "ENGINES", "GRID", "T_END", "T_END_TORQUE", "TOLERANCE_DEG", "Progress", "bisect_incline",
+__all__ = ["CLIMB_VARIANTS", "DT_OUT", "GRID", "T_END", "T_END_TORQUE", "TOLERANCE_DEG", "Progress", "bisect_incline",
            "climb_study", "climbs", "default_t_end", "energy_bound", "incline_curve", "locked_pull_share",
            "measure", "required_torque", "restart_limit", "run_engine", "run_metrics", "steady_climb_limit",
            "steady_skid", "steady_window", "torque_needed"]
 
 
-def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float = TOLERANCE_DEG,
+def climb_study(params: RobotParams, inclines, engines=CLIMB_VARIANTS, tolerance: float = TOLERANCE_DEG,
                 t_end: float | None = None, progress: Progress = lambda _m: None) -> dict:
     """The climbing ability of ``params`` with its drive (JSON-ready).
 
@@ -62,3 +63,8 @@ def climb_study(params: RobotParams, inclines, engines=ENGINES, tolerance: float
             "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "traction": traction,
             "rows": rows, "engines": list(engines), "tolerance_deg": tolerance, "t_end_s": t_end,
             "wall_s": time.perf_counter() - started}
+
+
+def __getattr__(name: str):
+    """Older names (``ENGINES``: :data:`CLIMB_VARIANTS`), as :mod:`.climb_limits` keeps them."""
+    return climb_limits.__getattr__(name)

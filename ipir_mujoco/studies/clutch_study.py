@@ -56,6 +56,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
+from ipir_mujoco.registry import ENGINES
 from ipir_mujoco.core.cycles import cycles, steady_window
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams, check_whole
@@ -80,7 +81,6 @@ POINTS = {
     "startup": OperatingPoint("startup", "the paper's start-up: constant torque M, 1 s from rest", "torque", 1.0,
                               False),
 }
-ENGINES = ("analytic", "mujoco")
 # the variant each engine of the study runs (ipir_mujoco.registry): the exact one-way clutches, compliant where
 # the design has a finite clutch_stiffness
 VARIANTS = {"analytic": "analytic-unilateral", "mujoco": "mujoco-ratchet"}

@@ -47,8 +47,9 @@ from ipir_mujoco.core.options import MAX_T_END, check_run_options, refuse_steady
 from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
                                      read_toml_file, require_params)
 
-ENGINES = registry.NAMES  # every variant (ipir_mujoco.registry); their aliases are accepted too
-DEFAULT_ENGINES = ("mujoco-ratchet", "analytic-unilateral")
+# the variants a sweep runs by default (any of registry.NAMES, or their aliases, may be given)
+DEFAULT_VARIANTS = ("mujoco-ratchet", "analytic-unilateral")
+OLDER_NAMES = {"DEFAULT_ENGINES": "DEFAULT_VARIANTS"}  # see __getattr__ (and ENGINES: registry.NAMES)
 # designs per sweep: hours of work for 1 s runs of the default engines on a few cores (runs to a steady
 # state cost more; bench/targets.py measures the rate), and the grid stays small in memory; split a larger study
 MAX_DESIGNS = 100_000
@@ -136,7 +137,7 @@ class Study:
 
     axes: tuple[Axis, ...]
     base: RobotParams = field(default_factory=RobotParams)
-    engines: tuple[str, ...] = DEFAULT_ENGINES
+    engines: tuple[str, ...] = DEFAULT_VARIANTS
     t_end: float = 1.0
     sample: int | None = None
     seed: int = 0
@@ -155,13 +156,13 @@ class Study:
         set_("base", require_params(self.base))
         if isinstance(self.engines, str):
             raise ParameterError(f"engines={self.engines!r} is a single string; allowed: a list of engine names, "
-                                 f"e.g. [{self.engines!r}], from: {', '.join(ENGINES)}")
+                                 f"e.g. [{self.engines!r}], from: {', '.join(registry.NAMES)}")
         if not isinstance(self.engines, (list, tuple)):
             raise ParameterError(f"engines={self.engines!r} is not a list; allowed: a list of engine names from: "
-                                 f"{', '.join(ENGINES)}")
+                                 f"{', '.join(registry.NAMES)}")
         set_("engines", tuple(self.engines))
         if not self.engines:
-            raise ParameterError(f"engines=[] names no engine; allowed: one or more of {', '.join(ENGINES)}")
+            raise ParameterError(f"engines=[] names no engine; allowed: one or more of {', '.join(registry.NAMES)}")
         # names as given (aliases included) head the results' columns; the variants they name must differ
         variants = [registry.variant(e).name for e in self.engines]
         if len(set(variants)) != len(variants):
@@ -272,3 +273,13 @@ def read_study(path: str | Path, base: RobotParams) -> dict:
     except ParameterError as exc:
         raise ParameterError(f"{where}: {exc}") from None
     return kwargs
+
+
+def __getattr__(name: str):
+    """The older names of this module's constants: ``ENGINES`` (every variant: ``registry.NAMES``) and
+    ``DEFAULT_ENGINES`` named variants (the registry's ``ENGINES`` names the two engines, analytic and mujoco)."""
+    if name == "ENGINES":
+        return registry.NAMES
+    if name in OLDER_NAMES:
+        return globals()[OLDER_NAMES[name]]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -178,7 +178,7 @@ class _Refused(Exception):
     """An engine refused a run of the bisection (the message is the engine's one line)."""
 
 
-def traction_study(params: RobotParams, engines=climbing.ENGINES, steady_climb: dict | None = None,
+def traction_study(params: RobotParams, engines=climbing.CLIMB_VARIANTS, steady_climb: dict | None = None,
                    tolerance: float = climbing.TOLERANCE_DEG, t_end: float | None = None,
                    progress: Progress = lambda _m: None, memo: dict | None = None) -> dict:
     """The traction figures of ``params`` (JSON-ready): {"grip": None, "note": UNLIMITED} with unlimited grip,

@@ -2,7 +2,7 @@
 
 :class:`.stepper.CompiledSteps` asks a controller to copy its state into the C loop's CONFIG (indices) and STATE
 (doubles) arrays before it runs and back after each call (``load_compiled``); the two controllers on finite
-grip, :class:`.grip.GripRatchet` and :class:`.grip_compliant.CompliantGrip`, do it here.
+grip, :class:`.grip.GripRatchet` and :class:`.compliant_grip.CompliantGrip`, do it here.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def load_grip_ratchet(ctl, loop):
 
 
 def load_compliant_grip(ctl, loop):
-    """:class:`.grip_compliant.CompliantGrip`'s layout in ``loop``: returns (its C kind, sync(state values))."""
+    """:class:`.compliant_grip.CompliantGrip`'s layout in ``loop``: returns (its C kind, sync(state values))."""
     _common(ctl, loop, ctl.dof_adr)
     if ctl.dt != loop.model.opt.timestep:
         raise LayoutError("the compliant clutches' timestep is not the model's")

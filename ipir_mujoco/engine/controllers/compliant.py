@@ -117,7 +117,7 @@ class CompliantClutches(ControllerBase):
         self.damper_work = 0.0
         self.before_step()
 
-    # the pieces a compliant clutch on another coordinate replaces (.grip_compliant.CompliantGrip: the roll)
+    # the pieces a compliant clutch on another coordinate replaces (.compliant_grip.CompliantGrip: the roll)
     def attach(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
         """Check that the clutch actuators act on the slides (and set up what else the coordinate needs)."""
         check_transmissions(model, self.act, mujoco.mjtTrn.mjTRN_JOINT, [model.joint(n).id for n in SLIDES], SLIDES)

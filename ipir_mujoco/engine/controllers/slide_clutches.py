@@ -26,7 +26,7 @@ is a change there: its test compares the two bit for bit).
 
 Nothing here uses the analytic model: the lock rules read MuJoCo's state.
 :func:`slide_controller` picks the slide model's controller for a run (the compliant
-clutches' is in :mod:`.compliant`; on finite grip :mod:`.grip`, :mod:`.grip_compliant`).
+clutches' is in :mod:`.compliant`; on finite grip :mod:`.grip`, :mod:`.compliant_grip`).
 """
 
 from __future__ import annotations

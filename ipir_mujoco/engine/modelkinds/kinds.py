@@ -12,7 +12,7 @@ The kinds:
 - ``slides`` (:data:`SLIDES`): the modules on two slides, the clutches a joint-limit ratchet (rigid or
   compliant, :mod:`.slide_clutches`, :mod:`.compliant`) or velocity-triggered locks; unlimited grip.
 - ``slides`` with a finite ``mu_wall`` (:data:`GRIP_SLIDES`): a carriage per module on the wall, held by
-  friction G_i, carries the clutch (:mod:`.grip_model`, :mod:`.grip`, :mod:`.grip_compliant`).
+  friction G_i, carries the clutch (:mod:`.grip_model`, :mod:`.grip`, :mod:`.compliant_grip`).
 - ``wheels`` (:data:`WHEELS`): a 3-D robot on sprung wheel legs in a round pipe, a ratchet in every hub
   (:mod:`.wheels_model`, :mod:`.wheels`); routes of straights and bends (:mod:`.route_watch`).
 
@@ -31,7 +31,7 @@ from ipir_mujoco.core.results import grip_use
 
 from .common import check_clutch_options
 from ..controllers.grip import GripRatchet
-from ..controllers.grip_compliant import CompliantGrip
+from ..controllers.compliant_grip import CompliantGrip
 from ..builders.grip_model import SKIDS
 from .loop_rows import loop_options
 from ..builders.model import SolverSettings, build_model, qpos_address, set_closed_loop_state

@@ -20,7 +20,7 @@ compliant clutch (:mod:`.compliant`): a ratcheting anchor per module and a
 spring and damper from it to the module, MuJoCo actuator forces. With a finite
 ``mu_wall`` the wheels grip the wall with at most G_i: a light carriage per
 module on the wall, held by friction G_i, carries the clutch (:mod:`.grip_model`,
-:mod:`.grip`, :mod:`.grip_compliant`).
+:mod:`.grip`, :mod:`.compliant_grip`).
 
 Energy audit, per step with the velocities v_{n+1} that move the positions
 (q_{n+1} = q_n + dt v_{n+1}): drive work tau * (phi_{n+1} - phi_n) with the

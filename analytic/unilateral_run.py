@@ -96,7 +96,7 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     if params.grip is None:
         model = UnilateralModel(params, geometry, torque)
     else:  # wheels of finite grip: a held module may skid back
-        from .grip import GripModel
+        from .grip_model import GripModel
         model = GripModel(params, geometry, torque)
     n_out = max(1, math.ceil(t_end / dt_out - 1e-9))
     grid = np.linspace(0.0, t_end, n_out + 1)

@@ -54,7 +54,7 @@ from ipir_mujoco.core.results import Mode, grip_use
 
 from . import accel, dop853, kernels
 from .kinematics import Geometry
-from .unilateral_model import _REST_SPEED, _TINY, _TOL_A, _TOL_F, _TOL_V, UnilateralModel, _columns
+from .unilateral_model import _MODE_REST_FLOOR, _TINY, _TOL_A, _TOL_F, _TOL_V, UnilateralModel, _columns
 
 _SKID1, _SKID2 = 4, 8  # GripMode bits: module 1 / 2 skids back
 # |K| below this fraction of r counts as a dead centre for the next-order decision (K = 0 up to roundoff
@@ -148,7 +148,7 @@ class GripModel:
         if mode.kinematics is Mode.BOTH_MOVING:
             v = [float(x) for x in velocities]
             scale = self.linkage.r * abs(float(y[1])) + abs(v[0]) + abs(v[1])
-            rest = [abs(x) <= _TOL_V * scale + _REST_SPEED for x in v]
+            rest = [abs(x) <= _TOL_V * scale + _MODE_REST_FLOOR for x in v]
             K = float(self.linkage.transfer(float(y[0])).K)
             if rest[0]:
                 y[4] = 0.0
@@ -223,8 +223,8 @@ class GripModel:
         M = float(self.motor(t, phi, omega))
         v = tuple(float(x) for x in velocities)
         v_scale = r * abs(omega) + abs(v[0]) + abs(v[1])
-        at_rest = [abs(x) <= _TOL_V * v_scale + _REST_SPEED for x in v]
-        crank_rest = r * abs(omega) <= _TOL_V * v_scale + _REST_SPEED
+        at_rest = [abs(x) <= _TOL_V * v_scale + _MODE_REST_FLOOR for x in v]
+        crank_rest = r * abs(omega) <= _TOL_V * v_scale + _MODE_REST_FLOOR
         tr = self.linkage.transfer(phi)
         K, dK = float(tr.K), float(tr.dK)
         dead_centre = crank_rest and all(at_rest) and abs(K) <= _DEAD_CENTRE_K * r

@@ -63,7 +63,7 @@ from ipir_mujoco.core.params import RobotParams
 
 from . import compliant_grip, kernels
 from .compliant_state import (_DEAD_CENTRE_STEP, _HYSTERESIS_FORCE, _HYSTERESIS_OVERLAP, _HYSTERESIS_SPEED,
-                               _REST_SPEED, _TOL_F, _TOL_V, Clutch, Motion, Regime)
+                               _REGIME_REST_FLOOR, _TOL_F, _TOL_V, Clutch, Motion, Regime)
 from .dynamics import MassTerms, OneDofDynamics
 from .forces import drive_torque, gravity_along_pipe
 from .kinematics import Geometry, Transfer
@@ -253,7 +253,7 @@ class CompliantModel:
         peak = tuple(peak)
         omega = float(y[1])
         v_scale = r * abs(omega) + abs(v[0]) + abs(v[1])
-        rest = [regime.slip[i] == 0 or fired == ("velocity", i) or abs(v[i]) <= _TOL_V * v_scale + _REST_SPEED
+        rest = [regime.slip[i] == 0 or fired == ("velocity", i) or abs(v[i]) <= _TOL_V * v_scale + _REGIME_REST_FLOOR
                 for i in (0, 1)]
         for i in (0, 1):
             overlap = self.overlaps(x, Regime(regime.slip, tuple(clutch), peak))[i]
@@ -261,7 +261,7 @@ class CompliantModel:
                 clutch[i] = Clutch.ENGAGED  # at rest k d - c v = k d > 0
             if rest[i] and clutch[i] is Clutch.FREE and overlap > 0:
                 clutch[i] = Clutch.ENGAGED
-        crank_rest = abs(omega) * r <= _TOL_V * v_scale + _REST_SPEED
+        crank_rest = abs(omega) * r <= _TOL_V * v_scale + _REGIME_REST_FLOOR
         if all(rest) and crank_rest and abs(float(self.linkage.transfer(y[0]).K)) <= 1e-9 * r:
             slip = self._dead_centre_start(t, y, tuple(clutch), peak)
         else:
