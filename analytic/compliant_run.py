@@ -31,6 +31,7 @@ import time
 
 import numpy as np
 
+from ipir_mujoco.core import energy
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
@@ -164,16 +165,9 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
 
 def energy_audit(series: dict[str, np.ndarray]) -> dict[str, float]:
     """Motor work = kinetic + potential energy gained + friction work + clutch spring energy gained
-    + clutch damper work (+ skid work, with finite grip) + residual [J], from a run's cumulative columns."""
-    def gained(column):
-        return float(series[column][-1] - series[column][0])
-    parts = {"motor_work_j": gained("motor_work"), "kinetic_j": gained("kinetic"),
-             "potential_j": gained("potential"), "friction_j": gained("friction_work"),
-             "clutch_spring_j": gained("clutch_spring_energy"), "clutch_damper_j": gained("clutch_damper_work")}
-    if "skid_work" in series:
-        parts["skid_j"] = gained("skid_work")
-    parts["residual_j"] = parts["motor_work_j"] - sum(v for k, v in parts.items() if k != "motor_work_j")
-    return parts
+    + clutch damper work (+ skid work, with finite grip) + residual [J], from a run's cumulative columns
+    (:func:`ipir_mujoco.core.energy.audit`: every term of the table the series has)."""
+    return energy.audit(series)
 
 
 class _Budget:

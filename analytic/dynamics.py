@@ -39,6 +39,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ipir_mujoco.core import energy
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode
 
@@ -224,20 +225,20 @@ class OneDofDynamics:
                 "friction_work": p.F_r1 * x1 + p.F_r2 * x2}
 
     def energy_audit(self, series: dict, motor_work: float | None = None) -> dict[str, float]:
-        """Motor work = kinetic + potential energy gained + friction work + residual [J] over a run.
+        """The run's energy audit [J] ({audit key: J}, :func:`ipir_mujoco.core.energy.audit`): motor work = kinetic
+        + potential energy gained + friction work (+ every other term of the table whose column the series has:
+        clutch springs and dampers, skid) + residual.
 
         Reads the columns ``kinetic``, ``potential``, ``friction_work`` (computed with
         :meth:`energy_columns` where absent) and ``motor_work`` unless ``motor_work`` is given.
         """
-        columns = {c: series[c] for c in ("kinetic", "potential", "friction_work") if c in series}
-        if len(columns) < 3:
+        columns = {t.column: series[t.column] for t in energy.ENERGY_TERMS if t.column in series}
+        if not all(c in columns for c in ("kinetic", "potential", "friction_work")):
             ends = {c: np.asarray(series[c])[[0, -1]] for c in ("phi", "omega", "v1", "x1", "x2")}
-            columns = self.energy_columns(ends)
-        motor = float(series["motor_work"][-1] - series["motor_work"][0]) if motor_work is None else float(motor_work)
-        gained, lifted = (float(columns[c][-1] - columns[c][0]) for c in ("kinetic", "potential"))
-        friction = float(columns["friction_work"][-1] - columns["friction_work"][0])
-        return {"motor_work_j": motor, "kinetic_j": gained, "potential_j": lifted, "friction_j": friction,
-                "residual_j": motor - gained - lifted - friction}
+            columns.update(self.energy_columns(ends))
+        if motor_work is not None:
+            columns["motor_work"] = np.array([0.0, float(motor_work)])
+        return energy.audit(columns)
 
     def motor_torque(self, phi, omega, alpha, a1, front_external):
         """Torque [N m] the motor must apply for crank motion (omega, alpha) and module-1 acceleration a1.

@@ -314,8 +314,6 @@ class GripModel:
         return out
 
     def energy_audit(self, series: dict) -> dict[str, float]:
-        """Motor work = kinetic + potential energy gained + friction work + skid work + residual [J]."""
-        audit = self.dyn.energy_audit(series)
-        skid = float(series["skid_work"][-1] - series["skid_work"][0])
-        residual = audit.pop("residual_j")
-        return {**audit, "skid_j": skid, "residual_j": residual - skid}
+        """Motor work = kinetic + potential energy gained + friction work + skid work + residual [J]
+        (:meth:`.OneDofDynamics.energy_audit`: the table's terms the series has, skid_work among them)."""
+        return self.dyn.energy_audit(series)

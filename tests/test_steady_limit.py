@@ -93,7 +93,7 @@ def test_the_stop_alone_would_miss_the_limit(name):
 
 
 def _cycle(t0: float, period: float, distance: float) -> Cycle:
-    return Cycle(t0, t0 + period, distance, None, None, None, None, None, None, None)
+    return Cycle(t0, t0 + period, distance)
 
 
 def test_limit_motion_recovers_a_geometric_approach_exactly():

@@ -6,6 +6,8 @@ import argparse
 import json
 
 from ipir_mujoco import registry
+from ipir_mujoco.core import energy
+from ipir_mujoco.core.energy import INPUT, RESIDUAL_KEY
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
                                       refuse_steady_without_motor)
@@ -212,15 +214,16 @@ def route_lines(s: dict) -> list[str]:
 
 
 def _energy_line(e: dict) -> str:
-    """motor = kinetic + friction (+ potential, clutch springs and dampers, skid where the run has them) + residual;
-    a term within round-off of zero (1e-12 of the motor's work: a clutch damper of zero damping) is left out."""
-    terms = [f"kinetic {e['kinetic_j']:.6g}", f"friction {e['friction_j']:.6g}"]
-    negligible = 1e-12 * abs(e["motor_work_j"])
-    for key, word in (("potential_j", "potential"), ("clutch_spring_j", "clutch springs"),
-                      ("clutch_damper_j", "clutch dampers"), ("skid_j", "skid")):
-        if key in e and abs(e[key]) > negligible:
-            terms.append(f"{word} {e[key]:.6g}")
-    return f"motor {e['motor_work_j']:.6g} = " + " + ".join(terms) + f" + residual {e['residual_j']:.2e}"
+    """input = each other term of core.energy's table the run has, in the table's order (kinetic, friction,
+    potential, clutch springs and dampers, skid) + residual; a term within round-off of zero (1e-12 of the input:
+    a horizontal run's potential, a clutch damper of zero damping) is left out."""
+    inputs = [term for term in energy.ENERGY_TERMS if term.role == INPUT and term.audit_key in e]
+    put_in = sum(e[term.audit_key] for term in inputs)
+    negligible = 1e-12 * abs(put_in)
+    terms = [f"{term.name} {e[term.audit_key]:.6g}" for term in energy.ENERGY_TERMS
+             if term.role != INPUT and term.audit_key in e and abs(e[term.audit_key]) > negligible]
+    left = " + ".join(f"{term.name} {e[term.audit_key]:.6g}" for term in inputs)
+    return f"{left} = " + " + ".join([*terms, f"residual {e[RESIDUAL_KEY]:.2e}"])
 
 
 def save_run_mjcf(args: argparse.Namespace) -> None:

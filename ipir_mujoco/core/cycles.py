@@ -43,6 +43,8 @@ import numpy as np
 # LIMIT_ACCURACY's old home: studies and benchmarks import it from here
 from .steady_test import LIMIT_ACCURACY, Steady, find_steady, window_uncertainty  # noqa: F401
 from .energy import ENERGY_COLUMNS as _TABLE_COLUMNS
+from . import energy as _energy
+from .energy import RESIDUAL_KEY, by_role, residual, terms_of
 
 STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
 STEADY_CYCLES = 3  # revolutions the spread is measured over
@@ -89,20 +91,46 @@ def _at(t: np.ndarray, values: np.ndarray, when: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Cycle:
-    """One crank revolution. Energies in J over the revolution; None where the run has no such column."""
+    """One crank revolution: its times, travel, peaks and energy audit.
+
+    ``energy``: each energy term's change over the revolution [J] under its audit key (the terms of
+    :data:`.energy.ENERGY_TERMS` whose columns the run has, in the table's order), as (key, J) pairs; read it
+    with :meth:`energy_j` or :attr:`audit`. The named figures below (``motor_work_j``, ...) read it too; None
+    where the run has no such column.
+    """
 
     t_start: float  # s
     t_end: float  # s
     distance_m: float  # travel of the robot (mean of the modules) over the revolution
-    motor_work_j: float | None
-    friction_work_j: float | None
-    kinetic_change_j: float | None
-    potential_change_j: float | None
-    clutch_energy_change_j: float | None  # spring energy stored + damper work, compliant clutches only
-    peak_clutch_force_n: float | None
-    peak_rod_force_n: float | None
-    skid_work_j: float | None = None  # work of the grip against skidding wheels, finite grip only
-    clutch_spring_change_j: float | None = None  # energy stored in the clutch springs, compliant clutches only
+    peak_clutch_force_n: float | None = None
+    peak_rod_force_n: float | None = None
+    energy: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def audit(self) -> dict[str, float]:
+        """{audit key: J} over the revolution, with the residual (:func:`.energy.residual`) where the run has the
+        motor's, the kinetic and the friction terms."""
+        out = dict(self.energy)
+        if self.residual_j is not None:
+            out[RESIDUAL_KEY] = self.residual_j
+        return out
+
+    def energy_j(self, key: str) -> float | None:
+        """The change over the revolution [J] of the term with audit key ``key``; None where the run has none."""
+        return dict(self.energy).get(key)
+
+    motor_work_j = property(lambda self: self.energy_j("motor_work_j"))
+    friction_work_j = property(lambda self: self.energy_j("friction_j"))
+    kinetic_change_j = property(lambda self: self.energy_j("kinetic_j"))
+    potential_change_j = property(lambda self: self.energy_j("potential_j"))
+    skid_work_j = property(lambda self: self.energy_j("skid_j"))  # the grip's work against skidding wheels
+    clutch_spring_change_j = property(lambda self: self.energy_j("clutch_spring_j"))  # compliant clutches only
+
+    @property
+    def clutch_energy_change_j(self) -> float | None:
+        """Spring energy stored + damper work [J], compliant clutches only."""
+        spring, damper = self.energy_j("clutch_spring_j"), self.energy_j("clutch_damper_j")
+        return None if spring is None and damper is None else (spring or 0.0) + (damper or 0.0)
 
     @property
     def period_s(self) -> float:
@@ -114,12 +142,13 @@ class Cycle:
 
     @property
     def residual_j(self) -> float | None:
-        """Motor work - friction and skid work - kinetic, potential and clutch energy gained: the audit's error."""
-        parts = (self.motor_work_j, self.friction_work_j, self.kinetic_change_j)
-        if any(p is None for p in parts):
+        """Input - dissipated - kinetic - stored over the revolution (:func:`.energy.residual`, every term the run
+        has): the audit's error; None without the motor's, the kinetic or the friction term."""
+        present = dict(self.energy)
+        if any(key not in present for key in ("motor_work_j", "kinetic_j", "friction_j")):
             return None
-        residual = parts[0] - parts[1] - parts[2] - (self.potential_change_j or 0.0) - (self.clutch_energy_change_j or 0.0)
-        return residual if self.skid_work_j is None else residual - self.skid_work_j
+        return float(residual(by_role({term: present[term.audit_key] for term in _energy.ENERGY_TERMS
+                                       if term.audit_key in present})))
 
 
 def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
@@ -132,7 +161,7 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
     first = np.concatenate([[0], idx[:-1]])
     edges = np.concatenate([[t[0]], ends])
     pos = _at(t, travel(series), edges)
-    energy = {c: (_at(t, series[c], edges) if c in series else None) for c in ENERGY_COLUMNS}
+    at_edges = {term: _at(t, series[term.column], edges) for term in terms_of(series)}
 
     def peak(columns, lo, hi):
         present = [np.abs(series[c][lo:hi + 1]) if c == "rod_force" else series[c][lo:hi + 1]
@@ -141,15 +170,10 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
 
     out = []
     for j in range(ends.size):
-        def delta(column):
-            values = energy[column]
-            return None if values is None else float(values[j + 1] - values[j])
-        spring, damper = delta("clutch_spring_energy"), delta("clutch_damper_work")
-        clutch = None if spring is None and damper is None else (spring or 0.0) + (damper or 0.0)
+        energy = tuple((term.audit_key, float(values[j + 1] - values[j])) for term, values in at_edges.items())
         out.append(Cycle(float(starts[j]), float(ends[j]), float(pos[j + 1] - pos[j]),
-                         delta("motor_work"), delta("friction_work"), delta("kinetic"), delta("potential"), clutch,
                          peak(("lambda1", "lambda2"), first[j], idx[j]), peak(("rod_force",), first[j], idx[j]),
-                         delta("skid_work"), spring))
+                         energy))
     return out
 
 

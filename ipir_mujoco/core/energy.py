@@ -7,9 +7,13 @@ under which a run's energy audit (``RunResult.energy``) reports its change [J], 
 
 ``input``: the drive's work; ``kinetic``: the kinetic energy; ``stored``: energy held and given back
 (gravity's potential, the compliant clutches' springs); ``dissipated``: work lost (against the resistances,
-in the clutches' dampers, by skidding wheels). A run has the terms whose columns it writes (:func:`terms_of`);
-the per-revolution audit (:mod:`.cycles`), the summary's efficiency and the MuJoCo engine's audit read this
-table; the analytic engines write the same audit keys.
+in the clutches' dampers, by skidding wheels). A run has the terms whose columns it writes (:func:`terms_of`).
+
+Read by: every analytic model's audit (:func:`audit`), the MuJoCo engine's audit and its per-sample accuracy
+monitor (:func:`by_role`, :func:`residual`), the per-revolution audit (:class:`.cycles.Cycle`, keyed by the
+terms' audit keys) and the command line's energy line (``ipir-mujoco simulate``, the terms' ``name``). A new
+effect's energy is one row here (its column written by the engines); ``tests/test_energy_table.py`` holds that a
+row reaches each of them.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ class EnergyTerm:
     Attributes
     ----------
     name : str
-        Its name in words.
+        Its name in words (the command line's energy line).
     column : str
         The series column [J] it is read from.
     audit_key : str
@@ -41,13 +45,13 @@ class EnergyTerm:
     role: str
 
 
-ENERGY_TERMS = (
+ENERGY_TERMS = (  # within a role, the order in which its terms are summed (by_role)
     EnergyTerm("motor", "motor_work", "motor_work_j", INPUT),
-    EnergyTerm("friction", "friction_work", "friction_j", DISSIPATED),
     EnergyTerm("kinetic", "kinetic", "kinetic_j", KINETIC),
+    EnergyTerm("friction", "friction_work", "friction_j", DISSIPATED),
     EnergyTerm("potential", "potential", "potential_j", STORED),
-    EnergyTerm("clutch spring", "clutch_spring_energy", "clutch_spring_j", STORED),
-    EnergyTerm("clutch damper", "clutch_damper_work", "clutch_damper_j", DISSIPATED),
+    EnergyTerm("clutch springs", "clutch_spring_energy", "clutch_spring_j", STORED),
+    EnergyTerm("clutch dampers", "clutch_damper_work", "clutch_damper_j", DISSIPATED),
     EnergyTerm("skid", "skid_work", "skid_j", DISSIPATED),
 )
 ENERGY_COLUMNS = tuple(term.column for term in ENERGY_TERMS)
@@ -82,3 +86,16 @@ def by_role(change: dict) -> dict[str, float]:
 def audit_keys(change: dict) -> dict[str, float]:
     """``change`` ({EnergyTerm: J}) under the terms' audit keys, as floats."""
     return {term.audit_key: float(value) for term, value in change.items()}
+
+
+def residual(total: dict):
+    """The balance's residual, input - dissipated - kinetic - stored [J], of ``total`` ({role: J}, floats or arrays
+    of one shape): the one order every audit subtracts in (so that two audits of one run agree to the bit)."""
+    return total[INPUT] - total[DISSIPATED] - total[KINETIC] - total[STORED]
+
+
+def audit(series: dict, terms=None) -> dict[str, float]:
+    """A run's energy audit ({audit key: J}, ``RunResult.energy``): each term's change over the run (the terms whose
+    columns ``series`` has, or ``terms``) and the residual (:func:`residual`) under :data:`RESIDUAL_KEY`."""
+    change = changes(series, terms)
+    return {**audit_keys(change), RESIDUAL_KEY: float(residual(by_role(change)))}

@@ -57,6 +57,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ipir_mujoco.core import energy
+from ipir_mujoco.core.energy import DISSIPATED, INPUT, KINETIC, STORED
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
 
@@ -89,7 +91,8 @@ def energy_audit(motor_j, dissipated_j, kinetic_gain_j, stored_gain_j, floor_j):
     (a batch's designs). residual = motor - dissipated - kinetic - stored; scale = the largest of |motor|,
     dissipated, |stored| and the floor. Every run's monitor and energy record use this one audit.
     """
-    residual = motor_j - dissipated_j - kinetic_gain_j - stored_gain_j
+    residual = energy.residual({INPUT: motor_j, DISSIPATED: dissipated_j, KINETIC: kinetic_gain_j,
+                                STORED: stored_gain_j})
     scale = np.maximum(np.maximum(np.abs(motor_j), dissipated_j), np.maximum(np.abs(stored_gain_j), floor_j))
     return residual, scale
 

@@ -49,7 +49,8 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.cycles import STEADY_CYCLES, STEADY_TOL
-from ipir_mujoco.core.energy import DISSIPATED, INPUT, KINETIC, RESIDUAL_KEY, STORED, audit_keys, by_role
+from ipir_mujoco.core import energy
+from ipir_mujoco.core.energy import DISSIPATED, ENERGY_COLUMNS, INPUT, KINETIC, RESIDUAL_KEY, STORED, audit_keys, by_role
 from ipir_mujoco.core.energy import changes as energy_changes
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
@@ -72,10 +73,13 @@ from ..loop.stepper import WARNED
 from ..modelkinds.timestep import DT_MIN
 
 # columns of the recorder's arrays the monitor reads
-_TORQUE, _MOTOR_WORK, _FRICTION_WORK, _DAMPER_WORK, _SKID_WORK = (SCALARS.index(n) for n in (
-    "motor_torque", "motor_work", "friction_work", "clutch_damper_work", "skid_work"))
-_KINETIC, _POTENTIAL, _SPRING, _GAP = (DEFERRED.index(n) for n in ("kinetic", "potential", "clutch_spring",
-                                                                    "loop_gap"))
+_TORQUE, _GAP = SCALARS.index("motor_torque"), DEFERRED.index("loop_gap")
+# where the recorder keeps each energy term of core.energy's table while a run goes: (deferred?, index); the
+# per-sample audit reads every term here (a new term's column must be recorded: tests/test_energy_table.py)
+_RECORDED_AS = {"clutch_spring_energy": "clutch_spring"}  # the deferred name of a series column, where it differs
+ENERGY_SLOTS = {column: (False, SCALARS.index(column)) if column in SCALARS
+                else (True, DEFERRED.index(_RECORDED_AS.get(column, column)))
+                for column in ENERGY_COLUMNS if column in SCALARS or _RECORDED_AS.get(column, column) in DEFERRED}
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
@@ -267,8 +271,8 @@ class _Run:
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
         row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=ctl.wheels())
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
-        kinetic, potential, spring = (rec.deferred.item(row, c) for c in (_KINETIC, _POTENTIAL, _SPRING))
-        self.energy0 = (kinetic, potential + spring)  # kinetic; potential with the clutch springs
+        at_start = by_role(self._energy_rows(row, row + 1))
+        self.energy0 = (at_start[KINETIC].item(0), at_start[STORED].item(0))  # the state terms' energy at the start
         self.energy_floor = max(self.energy0[0], 2 * math.pi * abs(torque), climb_energy(m, self.params))
         self._replay((0, 1), (0, 1))
         self._check(messages, 0.0)
@@ -343,16 +347,18 @@ class _Run:
             largest = float(np.max(np.abs(rec.scalars[first:end, _TORQUE])))
             self.energy_floor = max(self.energy_floor, 2 * math.pi * largest)
 
+    def _energy_rows(self, a: int, b: int) -> dict:
+        """{energy term: its recorded values in samples a..b-1} for every term of core.energy's table."""
+        rec = self.recorder
+        return {term: (rec.deferred if deferred else rec.scalars)[a:b, index]
+                for term in energy.ENERGY_TERMS for deferred, index in (ENERGY_SLOTS[term.column],)}
+
     def _audit(self, a: int, b: int, floors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The energy audit's (residual [J], scale [J]) of samples a..b-1 with energy floors ``floors`` [J]:
-        the clutch springs count with the potential energy, their dampers with the friction work."""
-        sc, de = self.recorder.scalars[a:b], self.recorder.deferred[a:b]
-        dissipated = sc[:, _FRICTION_WORK] + sc[:, _DAMPER_WORK]
-        if self.kind.skid:  # and the grips' (the wheels' contacts') work
-            dissipated = dissipated + sc[:, _SKID_WORK]
-        return energy_audit(sc[:, _MOTOR_WORK], dissipated,
-                            de[:, _KINETIC] - self.energy0[0], de[:, _POTENTIAL] + de[:, _SPRING] - self.energy0[1],
-                            floors)
+        """The energy audit's (residual [J], scale [J]) of samples a..b-1 with energy floors ``floors`` [J]: every
+        term of core.energy's table by its role (the state terms, kinetic and stored, as gained since t = 0)."""
+        total = by_role(self._energy_rows(a, b))
+        return energy_audit(total[INPUT], total[DISSIPATED], total[KINETIC] - self.energy0[0],
+                            total[STORED] - self.energy0[1], floors)
 
     def _check(self, messages: list[str], t_good: float) -> None:
         """Raise on a MuJoCo warning or a non-finite state; ``t_good`` [s] is the last sample known good
