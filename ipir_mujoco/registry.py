@@ -199,8 +199,9 @@ def prepare_for_many(names) -> None:
         accel.accelerate()
 
 
-def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float) -> float | None:
-    """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s]: the
+def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float, route=None) -> float | None:
+    """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s] (along
+    ``route``, a :class:`ipir_mujoco.core.route.Route`, for the wheeled model): the
     variant's model kind's (:meth:`ipir_mujoco.engine.modelkinds.kinds.ModelKind.settings`), the step every such run
     takes; None for the analytic engines."""
     v = variant(name)
@@ -208,7 +209,7 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
         return None
     from .engine.modelkinds.kinds import kind_for
 
-    return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch)[0].timestep
+    return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch, route=route)[0].timestep
 
 
 def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options) -> RunResult:

@@ -249,6 +249,19 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
     assert not (tmp_path / "o").exists()
 
 
+def test_the_automatic_step_knows_a_route_with_bends():
+    """A route with a bend steps at a quarter of the rows' shortest time constant (the wheels' sideways scrub in a
+    bend converges only there: mjcf/README.md), a straight route and the straight pipe at half of it."""
+    from ipir_mujoco.engine.builders.wheels_model import ROW_TIMES
+
+    tau = ROW_TIMES.shortest()
+    bend = route_from_tables(BEND, "bend.toml")
+    straight = route_from_tables([dict(kind="straight", length=1.0)], "straight.toml")
+    assert registry.timestep("mujoco-wheels", CRUISE, 1.0, 1e-3, route=bend) == pytest.approx(tau / 4, rel=1e-12)
+    for route in (straight, None):
+        assert registry.timestep("mujoco-wheels", CRUISE, 1.0, 1e-3, route=route) == pytest.approx(tau / 2, rel=1e-12)
+
+
 def test_a_route_of_long_bends_builds_one_piece_per_bend():
     """40 half turns of 100 m radius, in alternating planes: the round pipe builds each bend as one piece, whatever
     its radius or plane (nothing about the walls grows with a bend's size)."""

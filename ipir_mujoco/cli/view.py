@@ -61,7 +61,7 @@ class ViewedRobot:
         params = kind.check(params, self.implementation, clutch, route)  # the route's incline
         self.params, self.wheeled = params, kind.model == "wheels"
         if settings is None:  # the step the engine would choose for a run of t_end [s]
-            settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation)
+            settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation, route=route)
         self.settings = settings
         def decorate(spec):
             if not self.wheeled:  # the slide model in its pipe, whole and translucent: the viewer's camera turns

@@ -294,13 +294,14 @@ def refuse_clutches(params: RobotParams, implementation: str) -> None:
                              "hub ratchets are rigid; allowed: clutch_stiffness=rigid, or --mujoco-model slides")
 
 
-def wheels_settings(chosen: SolverSettings, why: dict, dt_out: float):
+def wheels_settings(chosen: SolverSettings, why: dict, dt_out: float, route=None):
     """The automatic settings of a wheeled run: ``chosen`` (:func:`.timestep.choose_settings`' SolverSettings
     and ``why``, its limits [s]) with the step at most the model's own (:func:`.wheels_model.wheels_timestep`,
-    half its rows' shortest time constant: mjcf/README.md, "The round pipe: convergence"), a whole fraction of
-    ``dt_out`` [s]; returns (settings, why)."""
-    cap = wheels_timestep()
+    half its rows' shortest time constant, a quarter along a ``route`` with bends: mjcf/README.md, "The round
+    pipe: convergence"), a whole fraction of ``dt_out`` [s]; returns (settings, why)."""
+    bends = route is not None and bool(route.bends)
+    cap = wheels_timestep(bends=bends)
     if chosen.timestep <= cap:
         return chosen, why
     steps = math.ceil(dt_out / cap * (1 - 1e-12))
-    return replace(chosen, timestep=dt_out / steps), {**why, "rows_s": cap}
+    return replace(chosen, timestep=dt_out / steps), {**why, ("bends_s" if bends else "rows_s"): cap}

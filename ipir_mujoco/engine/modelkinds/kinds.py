@@ -103,9 +103,10 @@ class ModelKind:
         return params.grip is None
 
     def settings(self, params: RobotParams, t_end: float, dt_out: float, servo=None,
-                 implementation: str = "ratchet") -> tuple[SolverSettings, dict]:
-        """The automatic settings of a run of ``t_end`` [s] sampled every ``dt_out`` [s], and why: (settings,
-        {each limit [s]}) (:func:`.timestep.choose_settings`); every run and ``registry.timestep`` ask this."""
+                 implementation: str = "ratchet", route=None) -> tuple[SolverSettings, dict]:
+        """The automatic settings of a run of ``t_end`` [s] sampled every ``dt_out`` [s] (along ``route``, for
+        the kinds that take one), and why: (settings, {each limit [s]}) (:func:`.timestep.choose_settings`);
+        every run and ``registry.timestep`` ask this."""
         return choose_settings(params, t_end, dt_out, servo, implementation)
 
     def recorded_settings(self) -> dict:
@@ -194,9 +195,9 @@ class WheelsKind(ModelKind):
         check_clutch_options(params, rule, implementation)
         return params
 
-    def settings(self, params, t_end, dt_out, servo=None, implementation="ratchet"):
+    def settings(self, params, t_end, dt_out, servo=None, implementation="ratchet", route=None):
         chosen, why = super().settings(params, t_end, dt_out, servo, implementation)
-        return wheels_settings(chosen, why, dt_out)
+        return wheels_settings(chosen, why, dt_out, route)
 
     def recorded_settings(self):
         return {"mujoco_model": self.model, "cone": "elliptic", "impratio": 1.0,

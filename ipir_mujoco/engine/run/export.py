@@ -75,7 +75,7 @@ def compiled_mjcf(params: RobotParams, clutch: str = "unilateral", implementatio
     kind = kind_for(model, params)
     params = kind.check(params, implementation, clutch, route, False)
     if settings is None:
-        settings, _why = kind.settings(params, t_end, dt_out, None, implementation)
+        settings, _why = kind.settings(params, t_end, dt_out, None, implementation, route=route)
     specs = []
     setup = RunSetup(kind, params, settings, implementation=implementation, rule=clutch, mjcf=mjcf, route=route,
                      decorate=specs.append)

@@ -160,7 +160,7 @@ def simulate_mujoco(
         return result
     verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
     started = time.perf_counter()
-    chosen, why = kind.settings(params, t_end, dt_out, servo, implementation)
+    chosen, why = kind.settings(params, t_end, dt_out, servo, implementation, route=route)
     failures = []
     extra = {"timestep_source": "auto", "timestep_rule": why, "refinements": failures}
     for attempt in range(REFINEMENTS + 1):
