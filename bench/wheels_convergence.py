@@ -6,7 +6,8 @@ Run on demand from the repository root (about 15 min on 2 busy cores; ``--smoke`
 
 The model's contact, limit and loop rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
 properties of the model, so halving the step refines one model rather than stiffening it. Four cases, each at
-the automatic step (1e-4 s: half the shortest time constant, MuJoCo's floor) and at 1/2, 1/4, 1/8 of it:
+1e-4 s (half the shortest time constant, MuJoCo's floor: the straight pipe's automatic step) and at 1/2, 1/4,
+1/8 of it:
 ``cruise`` (the default motor, mu_wall 0.5, F_n 50 N, 1 s: each module's travel, and the speed over the last
 0.5 s); ``riser`` (the default motor up a vertical pipe with mu_wall 0.18, a grip of 9 N per module against a
 weight of 9.81 N, 0.5 s: both skid down); ``incline 30`` (mu_wall 0.15 at 30 deg, 0.5 s: both skid back); ``bend``
