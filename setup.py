@@ -36,6 +36,13 @@ def mujoco_build_paths() -> tuple[str, str]:
     return include, library
 
 
+# the compiled loop (loop/_stepper.c) and its clutch controllers' compiled forms (controllers/_clutch_*.c: one file per
+# family, their table in _clutch_table.c)
+STEPPER_SOURCES = ["ipir_mujoco/engine/loop/_stepper.c"] + [
+    f"ipir_mujoco/engine/controllers/_clutch_{name}.c" for name in ("table", "slides", "grip")]
+STEPPER_HEADERS = ["ipir_mujoco/engine/loop/_stepper.h", "ipir_mujoco/engine/controllers/_clutch_parts.h"]
+
+
 class BuildExt(build_ext):
     """The stepper's MuJoCo headers and library, and its compiler flags, where the compiler takes them."""
 
@@ -47,13 +54,15 @@ class BuildExt(build_ext):
         ext.extra_objects = [library]  # recorded by its SONAME (install name on macOS): no path
         # no fused multiply-add: the C loop must round exactly as the Python loop does
         ext.extra_compile_args = ["-O2", "-ffp-contract=off", "-std=c11"]
-        if sys.platform == "darwin":  # the wheel's install name is @rpath/...: beside an installed mujoco
-            ext.extra_link_args = ["-Wl,-rpath,@loader_path/../../mujoco"]
+        if sys.platform == "darwin":  # the wheel's install name is @rpath/...: beside an installed mujoco (from
+            # ipir_mujoco/engine/<folder>/, where both extensions are)
+            ext.extra_link_args = ["-Wl,-rpath,@loader_path/../../../mujoco"]
         super().build_extension(ext)
 
 
 setup(
-    ext_modules=[Extension("ipir_mujoco.engine.loop._stepper", ["ipir_mujoco/engine/loop/_stepper.c"], optional=True),
+    ext_modules=[Extension("ipir_mujoco.engine.loop._stepper", STEPPER_SOURCES, depends=STEPPER_HEADERS,
+                           optional=True),
                  Extension("ipir_mujoco.engine.builders._pipewall", ["ipir_mujoco/engine/builders/_pipewall.c"], optional=True)],
     cmdclass={"build_ext": BuildExt},
 )

@@ -187,25 +187,36 @@ class CompliantClutches(ControllerBase):
         return self._force.item(self.act[0]), self._force.item(self.act[1])
 
     def load_compiled(self, loop):
-        """Its layout in the compiled loop (:mod:`.controller`): the slides, the clutch actuators, the anchors."""
-        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], slide_v0=self.dof_adr[0],
-                        slide_v1=self.dof_adr[1], act0=self.act[0], act1=self.act[1], implicit=self.implicit)
-        loop.set_state(anchor0=self.anchor[0], anchor1=self.anchor[1], overlap0=self.overlap[0],
-                       overlap1=self.overlap[1], v_before0=self.v_before[0], v_before1=self.v_before[1],
-                       damped0=self.damped[0], damped1=self.damped[1], damper_work=self.damper_work, k=self.k,
-                       c=self.c, backlash=self.backlash)
-        if self.dt != loop.model.opt.timestep:
-            raise LayoutError("the compliant clutches' timestep is not the model's")
-        get = loop.getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0",
-                          "damped1", "damper_work")
-
-        def sync(state) -> None:
-            a0, a1, d0, d1, v0, v1, damped0, damped1, self.damper_work = get(state)
-            self.anchor, self.overlap, self.v_before = [a0, a1], [d0, d1], [v0, v1]
-            self.damped = [damped0 != 0.0, damped1 != 0.0]
-        return "compliant", sync
+        """Its block in the compiled loop (:mod:`.controller`, ``_clutch_slides.c``): the slides, the clutch
+        actuators, the anchors (the compliant part: :func:`load_spring`)."""
+        loop.use("compliant")
+        loop.set_config(x_q0=self.qpos_adr[0], x_q1=self.qpos_adr[1], x_v0=self.dof_adr[0], x_v1=self.dof_adr[1])
+        return load_spring(self, loop)
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear force [N], front force [N]): held while its clutch pushes."""
         f1, f2 = self.forces()
         return f1 > 0.0, f2 > 0.0, f1, f2
+
+
+def load_spring(ctl: CompliantClutches, loop, *also: str):
+    """The compliant part of ``ctl``'s block in the compiled loop ``loop`` (``_clutch_parts.h``: actuators, anchors,
+    overlaps, dampers, k, c, backlash) and its damper work; returns sync(state values), which reads back also the
+    STATE fields ``also`` and passes them to ``ctl.sync_also`` (a controller with more state)."""
+    if ctl.dt != loop.model.opt.timestep:
+        raise LayoutError("the compliant clutches' timestep is not the model's")
+    loop.set_config(act0=ctl.act[0], act1=ctl.act[1], implicit=ctl.implicit)
+    loop.set_state(anchor0=ctl.anchor[0], anchor1=ctl.anchor[1], overlap0=ctl.overlap[0], overlap1=ctl.overlap[1],
+                   v_before0=ctl.v_before[0], v_before1=ctl.v_before[1], damped0=ctl.damped[0], damped1=ctl.damped[1],
+                   tracking0=ctl.tracking[0], tracking1=ctl.tracking[1], damper_work=ctl.damper_work, k=ctl.k, c=ctl.c,
+                   backlash=ctl.backlash)
+    get = loop.getter("anchor0", "anchor1", "overlap0", "overlap1", "v_before0", "v_before1", "damped0", "damped1",
+                      "tracking0", "tracking1", "damper_work", *also)
+
+    def sync(state) -> None:
+        a0, a1, d0, d1, v0, v1, damped0, damped1, t0, t1, ctl.damper_work, *more = get(state)
+        ctl.anchor, ctl.overlap, ctl.v_before = [a0, a1], [d0, d1], [v0, v1]
+        ctl.damped, ctl.tracking = [damped0 != 0.0, damped1 != 0.0], [t0 != 0.0, t1 != 0.0]
+        if more:
+            ctl.sync_also(*more)
+    return sync

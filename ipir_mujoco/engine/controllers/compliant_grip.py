@@ -82,8 +82,13 @@ class CompliantGrip(CompliantClutches):
             self.excursion = give
 
     def load_compiled(self, loop):
-        """Its layout in the compiled loop (:func:`.compiled_grip.load_compliant_grip`)."""
+        """Its block in the compiled loop (:func:`.compiled_grip.load_compliant_grip`)."""
         return load_compliant_grip(self, loop)
+
+    def sync_also(self, lowest0: float, lowest1: float, excursion: float) -> None:
+        """The carriages' running minima and the excursion, read back from the compiled loop."""
+        self.lowest[0], self.lowest[1] = lowest0, lowest1  # in place: the wall's running bound holds this list
+        self.excursion = excursion
 
     def wheels(self) -> tuple[float, float]:
         """Each module's wheels' state of the last step: +1.0 rolling, 0.0 standing, -1.0 skidding."""

@@ -126,11 +126,8 @@ class GripRatchet(ControllerBase):
             if give > self.excursion:
                 self.excursion = give
 
-    def compiled_rows(self) -> tuple[list[int], list[float]]:
-        return [-1, -1], self.resistance
-
     def load_compiled(self, loop):
-        """Its layout in the compiled loop (:func:`.compiled_grip.load_grip_ratchet`)."""
+        """Its block in the compiled loop (:func:`.compiled_grip.load_grip_ratchet`)."""
         return load_grip_ratchet(self, loop)
 
     def _clutch_rows(self) -> list[float]:

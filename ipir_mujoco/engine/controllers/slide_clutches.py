@@ -89,20 +89,20 @@ class Ratchet(ControllerBase):
             if give > self.excursion:
                 self.excursion = give
 
-    def compiled_rows(self) -> tuple[list[int], list[float]]:
-        return self.friction.offsets, self.friction.resistance
-
     def load_compiled(self, loop):
-        """Its layout in the compiled loop (:mod:`.controller`): the slides and their bounds."""
-        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], joint0=self.joint_ids[0],
-                        joint1=self.joint_ids[1])
+        """Its block in the compiled loop (:mod:`.controller`, ``_clutch_slides.c``): the slides, their bounds and
+        their resistance rows."""
+        loop.use("ratchet")
+        (off0, off1), (r0, r1) = self.friction.offsets, self.friction.resistance
+        loop.set_config(x_q0=self.qpos_adr[0], x_q1=self.qpos_adr[1], joint0=self.joint_ids[0],
+                        joint1=self.joint_ids[1], fric_off0=off0, fric_off1=off1)
         loop.set_state(bound0=self.bounds[0], bound1=self.bounds[1], margin0=self.margins[0],
-                       margin1=self.margins[1], excursion=self.excursion)
+                       margin1=self.margins[1], resist0=r0, resist1=r1, excursion=self.excursion)
         get = loop.getter("bound0", "bound1", "excursion")
 
         def sync(state) -> None:
             self.bounds[0], self.bounds[1], self.excursion = get(state)
-        return "ratchet", sync
+        return sync
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
@@ -218,24 +218,24 @@ class Locks(ControllerBase):
                 forces[i] = float(self.data.efc_force[row])
         return forces
 
-    def compiled_rows(self) -> tuple[list[int], list[float]]:
-        return self.friction.offsets, self.friction.resistance
-
     def load_compiled(self, loop):
-        """Its layout in the compiled loop (:mod:`.controller`): the slides, the locks, the linkage's joints."""
-        loop.set_config(slide_q0=self.qpos_adr[0], slide_q1=self.qpos_adr[1], slide_v0=self.dof_adr[0],
-                        slide_v1=self.dof_adr[1], eq0=self.eq_ids[0], eq1=self.eq_ids[1], rod_q=self.rod_q,
-                        rod_v=self.rod_v)
+        """Its block in the compiled loop (:mod:`.controller`, ``_clutch_slides.c``): the slides, the locks, the
+        linkage's joints, the slides' resistance rows."""
         if (self.crank_q, self.crank_v) != (loop.crank_q, loop.crank_v):
             raise LayoutError("the locks' crank joint is not the run's")
+        loop.use("lock_" + self.rule)
+        (off0, off1), (r0, r1) = self.friction.offsets, self.friction.resistance
+        loop.set_config(x_q0=self.qpos_adr[0], x_q1=self.qpos_adr[1], x_v0=self.dof_adr[0], x_v1=self.dof_adr[1],
+                        eq0=self.eq_ids[0], eq1=self.eq_ids[1], rod_q=self.rod_q, rod_v=self.rod_v,
+                        fric_off0=off0, fric_off1=off1)
         loop.set_state(held0=self.held[0], held1=self.held[1], force0=self.forces[0], force1=self.forces[1],
-                       r=self.r, L=self.L, excursion=self.excursion)
+                       r=self.r, L=self.L, resist0=r0, resist1=r1, excursion=self.excursion)
         get = loop.getter("held0", "held1", "force0", "force1", "excursion")
 
         def sync(state) -> None:
             held0, held1, force0, force1, self.excursion = get(state)
             self.held, self.forces = [held0 != 0.0, held1 != 0.0], [force0, force1]
-        return "lock_" + self.rule, sync
+        return sync
 
     def reactions(self) -> tuple[bool, bool, float, float]:
         """(rear held, front held, rear reaction [N], front reaction [N]) of the last step.
@@ -277,7 +277,8 @@ class NoClutch(ControllerBase):
 
     def load_compiled(self, loop):
         """Nothing to load or read back in the compiled loop."""
-        return "none", lambda state: None
+        loop.use("none")
+        return lambda state: None
 
 
 def refuse_compliant(params: RobotParams, implementation: str) -> None:

@@ -74,9 +74,10 @@ class ClutchController(Protocol):
     def wheels(self) -> tuple[float, float]:
         """Each module's wheels of the last step: ROLLING, STANDING or SKIDDING as floats (NO_WHEELS without)."""
 
-    # optional: load_compiled(loop) -> (its kind in _stepper.c, sync(state values)): the controller writes its own
-    # indices and state into the compiled loop's arrays (loop.set_config, loop.set_state, loop.getter) and returns
-    # how to read them back after each call; a controller without it steps in the Python loop
+    # optional: load_compiled(loop) -> sync(state values): the controller chooses its compiled form (loop.use(kind),
+    # a name in the extension's table of controllers, _clutch_table.c), writes its own block of indices and state
+    # into the compiled loop's arrays (loop.set_config, loop.set_state, by its fields' names; loop.getter) and
+    # returns how to read its state back after each call; a controller without it steps in the Python loop
 
 
 class ControllerBase:
@@ -91,11 +92,6 @@ class ControllerBase:
     def wheels(self) -> tuple[float, float]:
         """No wheels: NO_WHEELS."""
         return NO_WHEELS
-
-    def compiled_rows(self) -> tuple[list[int], list[float]]:
-        """What the compiled loop reads for the reactions: each module's resistance row's offset among the
-        friction rows (-1: none read) and its resistance F_ri [N]."""
-        return [-1, -1], [0.0, 0.0]
 
 
 class RunningBound:

@@ -43,8 +43,6 @@ from .recorder import Recorder
 from .rows import EQUALITY_ROWS, missing_rows
 
 ENV = "IPIR_MUJOCO_STEPPER"  # 'python' forces the pure-Python loop
-# the clutch kinds, in the order of _stepper.c's enum
-CLUTCH_KINDS = ("none", "ratchet", "lock_kinematic", "lock_unilateral", "compliant", "grip_ratchet", "compliant_grip")
 DONE, WARNED = 0, 3  # what record() returns: all intervals taken, or MuJoCo warned in the last one (_stepper.c's)
 
 
@@ -175,10 +173,12 @@ class PythonSteps:
 class CompiledSteps(PythonSteps):
     """The same loop in C (``_stepper.c``); same constructor and attributes as :class:`PythonSteps`.
 
-    The controller's state is copied into the C state at construction and back after every
-    :meth:`run`, so the controller reports (``reactions``, ``excursion``, the compliant clutches'
-    overlaps and dissipation) as after the Python loop. Raises :class:`LayoutError` if what the C
-    code relies on does not check out for this model and data.
+    Its two arrays (CONFIG: int64 indices and addresses, STATE: doubles) hold the loop's block and then the
+    clutch controller's own block, which the controller lays out itself (``load_compiled``: :meth:`use` its
+    compiled kind, then :meth:`set_config`, :meth:`set_state` by its fields' names). The controller's state is
+    copied in at construction and back after every :meth:`run`, so the controller reports (``reactions``,
+    ``excursion``, the compliant clutches' overlaps and dissipation) as after the Python loop. Raises
+    :class:`LayoutError` if what the C code relies on does not check out for this model and data.
     """
 
     compiled = True
@@ -186,8 +186,6 @@ class CompiledSteps(PythonSteps):
     def __init__(self, model, data, controller, qvel_before, **options):
         if options.get("servo") is not None:
             raise LayoutError("a crank servo is a Python function of time")
-        if options.get("power") is not None:
-            raise LayoutError("the wheeled model steps in Python")
         super().__init__(model, data, controller, qvel_before, **options)
         stepper = compiled()
         model_address, data_address = pointers(stepper, model, data)
@@ -203,19 +201,14 @@ class CompiledSteps(PythonSteps):
             model=model_address, data=data_address, qvel_before=array_address(qvel_before), motor=self.motor,
             crank_q=self.crank_q, crank_v=self.crank_v, nfric=len(self.friction_dofs), fric_a=self.fric_a,
             fric_b=self.fric_b)
-        if self.grip is not None:  # the rolling resistances' and the grips' rows (grip_layout)
-            g = self.grip
-            self._set_config(grip=1, nfric=g["count"], roll_off0=g["roll"][0], roll_off1=g["roll"][1],
-                             grip_off0=g["grip"][0], grip_off1=g["grip"][1], slide_v0=g["x_dof"][0],
-                             slide_v1=g["x_dof"][1], skid_v0=g["c_dof"][0], skid_v1=g["c_dof"][1],
-                             rolling_tendon=g["rolling_tendon"])
         self._eq_rows = np.array([EQUALITY_ROWS.get(int(t), 1) for t in model.eq_type], dtype=np.int64)
         self._cfg[self.C["eq_rows"]] = array_address(self._eq_rows) if self._eq_rows.size else 0
         self._set_state(dt=model.opt.timestep, slope=self.slope, torque=self.torque,
                         motor_work=0.0, friction_work=0.0, omega_prev=self.omega_prev)
         self._load_controller()
         self._args = (array_address(self._cfg), array_address(self._st))
-        self._common = itemgetter(*(self.S[n] for n in ("torque", "motor_work", "friction_work", "omega_prev")))
+        self._common = itemgetter(*(self.S[n] for n in ("torque", "motor_work", "friction_work", "omega_prev",
+                                                         "skid_work")))
 
     def run(self, nstep: int, row: int = -1) -> None:
         if row >= len(self.qvel_before):
@@ -227,8 +220,7 @@ class CompiledSteps(PythonSteps):
         except LookupError as exc:  # rows the loop reads are absent: the Python loop's error
             raise missing_rows(exc.args[0], self.data.time) from None
         state = self._st.tolist()
-        self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
-        self.skid_work = state[self.S["skid_work"]]
+        self.torque, self.motor_work, self.friction_work, self.omega_prev, self.skid_work = self._common(state)
         self._sync(state)
 
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
@@ -246,24 +238,38 @@ class CompiledSteps(PythonSteps):
         finally:
             rec.count = int(st[S["count"]])
         state = st.tolist()
-        self.torque, self.motor_work, self.friction_work, self.omega_prev = self._common(state)
-        self.skid_work = state[S["skid_work"]]
+        self.torque, self.motor_work, self.friction_work, self.omega_prev, self.skid_work = self._common(state)
         self._sync(state)
         return status, int(state[S["steps_done"]])
 
     def _bind(self, rec: Recorder) -> None:
         """Where the C loop writes ``rec``'s samples (its arrays: C-contiguous float64, qvel_before the
         loop's own) and what it reads for them (the rod end's site, the front module's body, the loop)."""
-        fric_off, resist = self.controller.compiled_rows()
         self._set_config(
-            rod_site=rec.site, front_body=rec.front, loop_eq=rec.loop_id, fric_off0=fric_off[0], fric_off1=fric_off[1], rec_t=array_address(rec.t),
+            rod_site=rec.site, front_body=rec.front, loop_eq=rec.loop_id, rec_t=array_address(rec.t),
             rec_qpos=array_address(rec.qpos), rec_qvel=array_address(rec.qvel),
             rec_scalars=array_address(rec.scalars), rec_deferred=array_address(rec.deferred),
             rec_excursion=array_address(rec.excursion))
         ox, oy, oz = rec.pin_offset
-        self._set_state(resist0=resist[0], resist1=resist[1], pin_x=ox, pin_y=oy, pin_z=oz,
-                        total_mass=rec.total_mass)
+        self._set_state(pin_x=ox, pin_y=oy, pin_z=oz, total_mass=rec.total_mass)
         self._rec = rec
+
+    def use(self, kind: str) -> None:
+        """Append the block of the compiled controller ``kind`` (a name in ``_stepper.CONTROLLERS``) to the
+        arrays; its fields are then set by name. Called once, by the controller's ``load_compiled``."""
+        table = {entry[0]: (index, *entry[1:]) for index, entry in enumerate(self._module.CONTROLLERS)}
+        if kind not in table or self._kind is not None:
+            raise LayoutError(f"no compiled controller {kind!r}, or a second one")
+        index, config, state, self._own_work = table[kind]
+        clash = (set(config) & set(self.C)) | (set(state) & set(self.S))
+        if clash:
+            raise LayoutError(f"the compiled controller {kind!r} repeats the loop's fields {sorted(clash)}")
+        self._cfg = np.concatenate([self._cfg, np.zeros(len(config), dtype=np.int64)])
+        self._st = np.concatenate([self._st, np.zeros(len(state))])
+        self.C.update({name: len(self.C) + i for i, name in enumerate(config)})
+        self.S.update({name: len(self.S) + i for i, name in enumerate(state)})
+        self._kind = kind
+        self._set_config(controller=index)
 
     def _set_config(self, **values) -> None:
         for name, value in values.items():
@@ -274,15 +280,19 @@ class CompiledSteps(PythonSteps):
             self._st[self.S[name]] = float(value)
 
     def _load_controller(self) -> None:
-        """The controller's state and indices into the C arrays, written by the controller itself
-        (``load_compiled(loop)``: its own compiled layout), which returns its C kind and its sync."""
+        """The controller's block, written by the controller itself (``load_compiled(loop)``: :meth:`use`, then
+        its fields), which returns its sync (reading its state back from a list of the state's values). A loop
+        whose work rates come from the controller's rows (``grip``, ``power``) needs a controller that has them."""
         ctl = self.controller
         load = getattr(ctl, "load_compiled", None)
         if load is None:
             raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
-        kind, self._sync = load(self)
-        self._set_config(clutch=CLUTCH_KINDS.index(kind))
-        self._rec = None
+        self._kind, self._rec = None, None
+        self._sync = load(self)
+        if self._kind is None:
+            raise LayoutError(f"{type(ctl).__name__}.load_compiled chose no compiled controller")
+        if self._own_work != (self.grip is not None or self.power is not None):
+            raise LayoutError(f"the compiled {self._kind} controller does not count this loop's work rates")
 
     def getter(self, *names):
         """A function reading the STATE fields ``names`` from a list of the state's values, in that order."""
