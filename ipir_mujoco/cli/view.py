@@ -64,7 +64,7 @@ class ViewedRobot:
             settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation, route=route)
         self.settings = settings
         def decorate(spec):
-            if not self.wheeled:  # the slide model in its pipe, whole and translucent: the viewer's camera turns
+            if not kind.pipe_built:  # the slide model in its pipe, whole and translucent: the viewer's camera turns
                 in_pipe(spec, params)
             checker_floor(spec)
 

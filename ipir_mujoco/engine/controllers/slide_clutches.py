@@ -289,16 +289,6 @@ def refuse_compliant(params: RobotParams, implementation: str) -> None:
                              "--mujoco-clutch ratchet")
 
 
-def refuse_grip(params: RobotParams, implementation: str) -> None:
-    """ParameterError (one line) for a finite ``mu_wall`` with a clutch that has no grip: the locks (an equality
-    holds whatever the load) and no clutch. (Wheel normal forces given with unlimited grip are refused for
-    every engine by :func:`ipir_mujoco.core.params.refuse_idle_parameters`.)"""
-    if params.mu_wall is not None and implementation != "ratchet":
-        raise ParameterError(f"mu_wall={params.mu_wall!r} with the MuJoCo {implementation!r} clutch: only the ratchet "
-                             "is modelled on wheels of finite grip (a lock holds whatever the load); allowed: "
-                             "--mujoco-clutch ratchet, or mu_wall=unlimited")
-
-
 def slide_controller(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, implementation: str,
                      rule: str = "unilateral"):
     """The slide model's clutch controller of a run (unlimited grip), for a model built with

@@ -24,7 +24,7 @@ from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m
 from ipir_mujoco.core.results import stall_reason as core_stall_reason
 
 from ..builders.model import check_params
-from ..controllers.slide_clutches import refuse_compliant, refuse_grip
+from ..controllers.slide_clutches import refuse_compliant
 
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often
@@ -75,7 +75,6 @@ def check_clutch_options(params: RobotParams, clutch: str = "unilateral", implem
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
     refuse_compliant(params, implementation)
-    refuse_grip(params, implementation)
     refuse_idle_parameters(params)
     check_params(params)
 

@@ -36,7 +36,7 @@ from ..builders.grip_model import SKIDS
 from .loop_rows import loop_options
 from ..builders.model import SolverSettings, build_model, qpos_address, set_closed_loop_state
 from .route_watch import check_route, pipe_fit
-from ..controllers.slide_clutches import refuse_grip, slide_controller
+from ..controllers.slide_clutches import slide_controller
 from .timestep import choose_settings
 from ..controllers.wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
                      wheels_settings)
@@ -61,6 +61,8 @@ class ModelKind:
     verifies_skids : bool
         Whether an automatically stepped run whose modules skidded is checked at half its step
         (:mod:`.skid_check`).
+    pipe_built : bool
+        Whether its build puts the pipe's walls in the model (else a viewer draws the slide model in a pipe).
     """
 
     name = "slides"
@@ -68,6 +70,7 @@ class ModelKind:
     accuracy = "stop"
     skid = False
     verifies_skids = False
+    pipe_built = False
 
     def check(self, params: RobotParams, implementation: str, rule: str, route=None,
               until_steady: bool = False) -> RobotParams:
@@ -142,6 +145,34 @@ class ModelKind:
         [...], "predicted": one line}``), for the kinds that take a route (:meth:`check` refuses it here)."""
         raise NotImplementedError(f"the {self.name} model takes no route")
 
+    def between_steps(self, params: RobotParams, implementation: str, rule: str) -> list[str]:
+        """What the kind's controller does to the model between MuJoCo's steps, one sentence each (the header of
+        ``simulate --save-mjcf``'s file, :mod:`.export`)."""
+        controllers = "ipir_mujoco.engine.controllers"
+        if implementation == "ratchet" and params.clutch_stiffness is not None:
+            return ["Before every mj_step each module's clutch anchor is ratcheted: its slide's lower limit is raised "
+                    f"to the anchor's running maximum ({controllers}.compliant); the spring, damper and play between "
+                    "anchor and module are MuJoCo's own, in this file."]
+        if implementation == "ratchet":
+            return ["Before every mj_step a ratchet raises each module's slide lower limit to the module's running "
+                    f"maximum ({controllers}.slide_clutches): a module moves forward and never back. MuJoCo alone "
+                    "keeps the limits this file holds."]
+        if implementation == "lock":
+            return ["Before every mj_step velocity-triggered locks fix a module's slide (both limits at its "
+                    f"position) when it would move back, and release it by the clutch rule '{rule}' "
+                    f"({controllers}.slide_clutches)."]
+        return ["No clutch: nothing changes the model between steps but the drive below."]
+
+
+def refuse_grip(params: RobotParams, implementation: str) -> None:
+    """ParameterError (one line) for a finite ``mu_wall`` with a clutch that has no grip: the locks (an equality
+    holds whatever the load) and no clutch. (Wheel normal forces given with unlimited grip are refused for
+    every engine by :func:`ipir_mujoco.core.params.refuse_idle_parameters`.)"""
+    if params.mu_wall is not None and implementation != "ratchet":
+        raise ParameterError(f"mu_wall={params.mu_wall!r} with the MuJoCo {implementation!r} clutch: only the ratchet "
+                             "is modelled on wheels of finite grip (a lock holds whatever the load); allowed: "
+                             "--mujoco-clutch ratchet, or mu_wall=unlimited")
+
 
 class GripSlidesKind(ModelKind):
     """The slide model on wheels of finite grip: a carriage per module on the wall, held by friction G_i."""
@@ -152,6 +183,16 @@ class GripSlidesKind(ModelKind):
 
     def takes(self, params):
         return params.grip is not None
+
+    def check(self, params, implementation, rule, route=None, until_steady=False):
+        params = super().check(params, implementation, rule, route, until_steady)
+        refuse_grip(params, implementation)
+        return params
+
+    def between_steps(self, params, implementation, rule):
+        return [*super().between_steps(params, implementation, rule),
+                f"Finite grip (mu_wall {params.mu_wall:g}): each module's carriage is ratcheted the same way "
+                "(ipir_mujoco.engine.controllers.grip)."]
 
     def controller(self, model, data, params, implementation, rule="unilateral"):
         refuse_grip(params, implementation)
@@ -185,6 +226,7 @@ class WheelsKind(ModelKind):
     # residual is recorded and shown rather than stopping the run (or halving its step, which does not lower it)
     accuracy = "warn"
     skid = True
+    pipe_built = True
 
     def takes(self, params):
         return True  # unlimited or finite grip alike: the contacts' friction is mu_wall
@@ -215,6 +257,11 @@ class WheelsKind(ModelKind):
 
     def controller(self, model, data, params, implementation, rule="unilateral"):
         return WheelRatchet(model, data, params)
+
+    def between_steps(self, params, implementation, rule):
+        return ["Before every mj_step a ratchet in every wheel hub raises the hub's lower joint limit to the "
+                "running maximum of its angle (ipir_mujoco.engine.controllers.wheels.WheelRatchet): a wheel rolls "
+                "forward and never back. MuJoCo alone keeps the limits this file holds."]
 
     def loop_options(self, model, data):
         return wheel_loop_options(model, data)

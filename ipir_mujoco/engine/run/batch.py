@@ -46,6 +46,7 @@ from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 
 from ..modelkinds.kinds import SLIDES as SLIDE_KIND
+from ..modelkinds.kinds import kind_for
 from ..builders.model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_control, drive_torque_slope,
                     pin_offset, qpos_address)
 from ..loop.monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
@@ -110,7 +111,7 @@ def run_ratchet_batch(designs: Sequence[RobotParams], t_end: float, dt_out: floa
                 raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m: batched runs have rigid "
                                      "ratchets only; allowed: clutch_stiffness=rigid (run compliant clutches "
                                      "serially, with simulate_mujoco)")
-            if params.mu_wall is not None:
+            if kind_for("slides", params) is not SLIDE_KIND:  # finite grip: another kind
                 raise ParameterError(f"mu_wall={params.mu_wall!r}: batched runs have unlimited grip only (a batch "
                                      "cannot read the carriages' friction rows per simulation); allowed: "
                                      "mu_wall=unlimited (run finite grip serially, with simulate_mujoco)")

@@ -29,28 +29,7 @@ KEYFRAME = "run_start"
 
 def between_steps(params: RobotParams, implementation: str, rule: str, model: str) -> list[str]:
     """What the package's Python does between MuJoCo's steps in a run of these options, one sentence each."""
-    out = []
-    if model == "wheels":
-        out.append("Before every mj_step a ratchet in every wheel hub raises the hub's lower joint limit to the "
-                   "running maximum of its angle (ipir_mujoco.engine.controllers.wheels.WheelRatchet): a wheel rolls forward "
-                   "and never back. MuJoCo alone keeps the limits this file holds.")
-    elif implementation == "ratchet" and params.clutch_stiffness is not None:
-        out.append("Before every mj_step each module's clutch anchor is ratcheted: its slide's lower limit is raised "
-                   "to the anchor's running maximum (ipir_mujoco.engine.controllers.compliant); the spring, damper and play "
-                   "between anchor and module are MuJoCo's own, in this file.")
-    elif implementation == "ratchet":
-        out.append("Before every mj_step a ratchet raises each module's slide lower limit to the module's running "
-                   "maximum (ipir_mujoco.engine.controllers.slide_clutches): a module moves forward and never back. MuJoCo "
-                   "alone keeps the limits this file holds.")
-    elif implementation == "lock":
-        out.append("Before every mj_step velocity-triggered locks fix a module's slide (both limits at its "
-                   "position) when it would move back, and release it by the clutch rule "
-                   f"'{rule}' (ipir_mujoco.engine.controllers.slide_clutches).")
-    else:
-        out.append("No clutch: nothing changes the model between steps but the drive below.")
-    if params.grip is not None and model != "wheels":
-        out.append(f"Finite grip (mu_wall {params.mu_wall:g}): each module's carriage is ratcheted the same way "
-                   "(ipir_mujoco.engine.controllers.grip).")
+    out = kind_for(model, params).between_steps(params, implementation, rule)
     drive = {"torque": f"The crank's actuator holds ctrl = M = {params.M:g} N m all run (set once at the start).",
              "motor": "The motor is MuJoCo's own actuator (its gain and bias in this file); ctrl = 1, the full "
                       "voltage, set once at the start.",
