@@ -57,6 +57,28 @@ def test_a_bad_route_is_refused_in_one_line(tables, word):
     assert "\n" not in str(info.value) and "allowed" in str(info.value)
 
 
+def test_the_bend_lift_check_against_hand_cases():
+    """The wheels' scrub per ring with 3 legs (leg 0 down, legs 1, 2 at 30 deg above the horizontal): their
+    circumferential directions x cross u are (0, 1, 0) and (0, -1/2, +-sqrt(3)/2), so across a horizontal bend
+    (toward y) mu P (1 + 1/2 + 1/2) = 2 mu P, across one turning up (toward z) mu P sqrt(3). With no weight, no
+    drive, a bend far wider than the ring spacing (its spread and the rod's angle vanish to 1e-6 of P) and the
+    scrub along z, the least-pressed leg is the one along it, leg 0: P - (2/3) sqrt(3) mu P, which lifts from
+    mu = sqrt(3) / 2."""
+    from ipir_mujoco.core.pipe import bend_lift_check, scrub_force
+
+    p = RobotParams(mu_wall=0.6, F_n1=60.0, F_n2=30.0, wheel_legs=3)
+    P1, P2 = 60.0 / 6, 30.0 / 6
+    assert scrub_force(p, 0, (1.0, 0.0)) == pytest.approx(2 * 0.6 * P1, rel=1e-12)
+    assert scrub_force(p, 1, (0.0, 1.0)) == pytest.approx(math.sqrt(3) * 0.6 * P2, rel=1e-12)
+    quiet = p.replace(drive="torque", M=0.0, F_r1=0.0, F_r2=0.0, m1=1e-9, m2=1e-9)
+    check = bend_lift_check(quiet, 1e6, (0.0, 1.0), [(0.0, 0.0)])
+    for i, P in ((1, P1), (2, P2)):
+        assert check[f"least_press{i}_n"] == pytest.approx(P - 2 / 3 * math.sqrt(3) * 0.6 * P, rel=1e-6)
+    assert check["lift_predicted"] is False
+    for mu, lifts in ((0.85, False), (0.88, True)):  # either side of sqrt(3) / 2 = 0.866
+        assert bend_lift_check(quiet.replace(mu_wall=mu), 1e6, (0.0, 1.0), [(0.0, 0.0)])["lift_predicted"] is lifts
+
+
 def test_the_closed_form_fits_against_hand_cases():
     """Numbers chosen so that the square roots are exact: a station b = 0.3 m off the module's middle, wheel
     centres on circles of 0.5 m (outer: R + D/2 - R_w) and 0.34 m (inner: R - D/2 + R_w), so 0.4 m and
