@@ -2,7 +2,7 @@
 
 Run on demand from the repository root (each case 1-3 min on 2 busy cores):
 
-    python bench/wheels_bend_offset.py [--ratio 2.5] [--planes 0,90] [--t-end 5] [--set NAME=VALUE]...
+    python bench/wheels_bend_offset.py [--ratio 2.5] [--planes 0,90] [--t-end 5] [--set NAME=VALUE]... [--smoke]
 
 The wheeled MuJoCo model (the motor, mu_wall 0.8 unless --set gives one) along a 0.45 m straight, a 90 degree bend
 of R/D ``--ratio`` in each plane of ``--planes`` (0: horizontal, across gravity; 90: turning up, into a riser) and a
@@ -43,7 +43,10 @@ def main(argv=None) -> int:
     parser.add_argument("--planes", default="0,90")
     parser.add_argument("--t-end", type=float, default=5.0)
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    parser.add_argument("--smoke", action="store_true", help="one plane, 0.05 s: the script runs")
     args = parser.parse_args(argv)
+    if args.smoke:
+        args.planes, args.t_end = "0", 0.05
     values = {"drive": "motor", "mu_wall": 0.8}
     for item in args.set:
         name, _, value = item.partition("=")
@@ -67,7 +70,8 @@ def main(argv=None) -> int:
             inside = (along > bend.s0) & (along < bend.s0 + bend.length)
             mean = f"{1e3 * distance[inside].mean():.2f}" if inside.any() else "-"
             most = f"{1e3 * distance[inside].max():.2f}" if inside.any() else "-"
-            print(f"  {name}: off the centreline in the straight at most {1e3 * distance[straight].max():.2f} mm; "
+            first = f"{1e3 * distance[straight].max():.2f}" if straight.any() else "-"
+            print(f"  {name}: off the centreline in the straight at most {first} mm; "
                   f"in the bend mean {mean} mm, at most {most} mm", flush=True)
     return 0
 
