@@ -284,6 +284,28 @@ def test_the_automatic_step_knows_a_route_with_bends():
         assert registry.timestep("mujoco-wheels", CRUISE, 1.0, 1e-3, route=route) == pytest.approx(tau / 2, rel=1e-12)
 
 
+def test_a_stall_line_names_a_module_cocked_in_its_pipe():
+    """A module turned 10 deg about z off a straight pipe's axis is cocked (beyond COCKED_DEG); one turned 2 deg,
+    or the robot as it starts, is not."""
+    import mujoco
+
+    from ipir_mujoco.engine.builders.wheels_model import build_wheels_model, set_wheels_state
+    from ipir_mujoco.engine.modelkinds.route_watch import COCKED_DEG, RouteWatch
+
+    route = route_from_tables([dict(kind="straight", length=1.0)], "straight.toml")
+    model = build_wheels_model(CRUISE, route=route)
+    data = mujoco.MjData(model)
+    set_wheels_state(model, data, CRUISE)
+    watch = RouteWatch(route, model, None, {"bends": [], "predicted": ""}, 1e-3)
+    assert watch.cocked(data.qpos, (0.0, 0.25)) is None
+    adr = model.jnt_qposadr[model.joint("rear_tilt").id]
+    for degrees, words in ((10.0, "module 1 cocked 10 deg off the pipe's axis"), (2.0, None)):
+        assert (degrees > COCKED_DEG) == (words is not None)
+        half = math.radians(degrees) / 2
+        data.qpos[adr:adr + 4] = [math.cos(half), 0.0, 0.0, math.sin(half)]
+        assert watch.cocked(data.qpos, (0.0, 0.25)) == words
+
+
 def test_a_route_of_long_bends_builds_one_piece_per_bend():
     """40 half turns of 100 m radius, in alternating planes: the round pipe builds each bend as one piece, whatever
     its radius or plane (nothing about the walls grows with a bend's size)."""

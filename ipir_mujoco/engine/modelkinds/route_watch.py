@@ -39,6 +39,8 @@ WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
 PROGRESS_M = 0.01  # m: the least progress along the route in PROGRESS_S (a tenth of a stroke, 2 r)
 PROGRESS_S = 2.0  # s: (the default motor makes ~7 revolutions in it)
+COCKED_DEG = 5.0  # deg: a module turned this far off the pipe's axis is cocked (its rings 0.1 m apart then reach
+# 8.7 mm across: beyond the legs' 5 mm of travel to their free length), said in a stall's line
 BACK_OUT = LEAD_IN - 0.1  # m: the rear module this far behind the start has its aft wheels (0.075 m back) at the
 # walls' end
 
@@ -107,6 +109,8 @@ class RouteWatch:
         self.marks = [p.s0 for p in route.pieces] + [route.length]
         self.mark_times: list[float | None] = [None] * len(self.marks)
         self.stop: str | None = None
+        found = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in ("rear_tilt", "front_tilt")]
+        self.tilts = [int(model.jnt_qposadr[j]) for j in found] if min(found) >= 0 else None  # the ball joints
 
     def check(self, newest: int) -> int | None:
         """Feed the samples up to row ``newest``; the row to end the run at, or None to go on."""
@@ -146,6 +150,9 @@ class RouteWatch:
                 turns = (float(q[i, self.crank]) - self.progress_at[2]) / (2 * math.pi)
                 why = (f"the crank turned {turns:.2f} revolutions" if abs(turns) >= 0.05
                        else "the crank stood: the linkage bound, or the drive too weak")
+                cocked = self.cocked(q[i], (s, front))
+                if cocked:
+                    why += f"; {cocked}"
                 if self.lost is not None:
                     why += f"; {self.lost}"
                 self.stop = (f"stalled: less than {PROGRESS_M * 1e3:g} mm of progress in {PROGRESS_S:g} s "
@@ -153,6 +160,23 @@ class RouteWatch:
                 return i
             self._wheels(q[i, self.arms], ti)
         return None
+
+    def cocked(self, q, along: tuple[float, float]) -> str | None:
+        """The modules turned more than COCKED_DEG off the centreline's direction at their points (``along``: A's
+        and C's s [m]), in words, or None: a module cocked across its pipe rests on its legs' stops (its rings
+        ``ring_spacing`` apart reach across the pipe by sin(angle) times that), where its wheels cannot roll it on."""
+        if self.tilts is None:
+            return None
+        words = []
+        for k, (adr, s) in enumerate(zip(self.tilts, along), start=1):
+            quat = np.asarray(q[adr:adr + 4], dtype=float)
+            axis = np.zeros(9)
+            mujoco.mju_quat2Mat(axis, quat / np.linalg.norm(quat))
+            _, direction = self.route.at3(s)
+            angle = math.degrees(math.acos(min(1.0, abs(float(axis.reshape(3, 3)[:, 0] @ direction)))))
+            if angle > COCKED_DEG:
+                words.append(f"module {k} cocked {angle:.0f} deg off the pipe's axis")
+        return ", ".join(words) or None
 
     def along_series(self, series: dict) -> dict:
         """The run's series read along the route: ``x1``, ``x2`` become the rear module's A and the front
