@@ -91,7 +91,12 @@ def plot_safe(idealizations: dict, axes, path: Path, title: str = "Where the pap
 def _plain_log_ticks(axis) -> None:
     """Log-axis labels as plain numbers (0.5, 2, 10), not powers of ten."""
     axis.set_major_formatter(FuncFormatter(lambda v, _p: f"{v:g}"))
-    axis.set_minor_formatter(FuncFormatter(lambda v, _p: f"{v:g}" if str(f"{v:g}")[0] in "25" else ""))
+    axis.set_minor_formatter(FuncFormatter(lambda v, _p: f"{v:g}" if _mantissa(v) in (2, 5) else ""))
+
+
+def _mantissa(v: float) -> int:
+    """The leading digit of v > 0 (0.005 -> 5, 20 -> 2): which minor ticks of a log axis carry a label."""
+    return int(round(v / 10 ** np.floor(np.log10(v)))) if v > 0 else 0
 
 
 def _panels(result: dict, atlas):
@@ -132,6 +137,8 @@ def plot_1d(result: dict, atlas, path: Path) -> Path:
                             xytext=(4, 6), textcoords="offset points", fontsize="x-small", color="darkgoldenrod")
         ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=f"{axis.name}",
                ylabel=f"|cost| of {metric} [%]", title=f"{name}\n(measured by {entry['measured_by']})")
+        if axis.log:
+            _plain_log_ticks(ax.xaxis)
         ax.title.set_fontsize("small")
         _plain_log_ticks(ax.yaxis)
         ax.grid(alpha=0.3, which="both")
@@ -175,6 +182,9 @@ def plot_map(result: dict, atlas, path: Path) -> Path:
                     label=f"MuJoCo designs ({len(U)}, {2 * len(U)} runs)")
         ax.set(xscale="log" if ax_x.log else "linear", yscale="log" if ax_y.log else "linear", xlabel=ax_x.name,
                ylabel=ax_y.name, title=f"{name}: {metric}\n(surrogate of the {fidelity if fidelity == 'equations' else 'MuJoCo'} cost)")
+        for which, axis in ((ax.xaxis, ax_x), (ax.yaxis, ax_y)):
+            if axis.log:
+                _plain_log_ticks(which)
         ax.title.set_fontsize("small")
         ax.legend(fontsize="xx-small", loc="upper right", framealpha=0.8)
     fig.savefig(path, dpi=110)
@@ -204,23 +214,29 @@ def plot_partial(result: dict, atlas, path: Path) -> Path:
                 low = np.array([np.percentile(cost[which == b], 10) for b in range(len(centres))])
                 high = np.array([np.percentile(cost[which == b], 90) for b in range(len(centres))])
                 colour = COLOURS[j % len(COLOURS)]
-                ax.plot(x, np.maximum(mean, floor), color=colour, lw=1.4, label=metric)
+                # a cost below the floor everywhere (e.g. an idealization that leaves a metric unchanged) is drawn
+                # dotted on the floor, so it does not read as a cost of exactly the floor's value
+                below = bool(np.all(high < floor))
+                ax.plot(x, np.maximum(mean, floor), color=colour, lw=1.4, ls=":" if below else "-",
+                        label=f"{metric} (< {floor:g} %)" if below else metric)
                 ax.fill_between(x, np.maximum(low, floor), np.maximum(high, floor), color=colour, alpha=0.15)
             for t in atlas.thresholds:
                 ax.axhline(100 * t, color="grey", ls="--", lw=0.9)
             ax.set(yscale="log", xscale="log" if axis.log else "linear", xlabel=axis.name)
             _plain_log_ticks(ax.yaxis)
+            if axis.log:
+                _plain_log_ticks(ax.xaxis)
             if c == 0:
                 ax.set_ylabel(f"{name}\n|cost| [%] ({'MuJoCo' if fidelity == 'mujoco' else 'equations'})",
                               fontsize="small")
             ax.grid(alpha=0.3, which="both")
-            if r == 0 and c == 0:
+            if c == 0:  # each row's legend: which metrics sit dotted below the floor differs by idealization
                 ax.legend(fontsize="xx-small")
             entry = next(iter(result["idealizations"][name].values()))
             st = entry.get("sensitivity", {}).get(axis.name)
             if isinstance(st, dict) and st.get("ST") is not None:
                 ax.set_title(f"ST {st['ST']:.2f} +- {st['ST_conf']:.2f} ({atlas.metrics[0]})", fontsize="x-small")
     fig.suptitle("Partial dependence of each idealization's |cost| on each parameter (line: mean over the other "
-                 "parameters; band: their 10-90 %; dashed: thresholds)", fontsize="small")
+                 "parameters; band: their 10-90 %; dashed: thresholds;\ndotted: below the axis's floor everywhere)", fontsize="small")
     fig.savefig(path, dpi=100)
     return path
