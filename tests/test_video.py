@@ -181,8 +181,8 @@ def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_ru
             np.testing.assert_allclose(turn, [s[f"{a}{k}"][i] for a in ("roll", "pitch", "yaw")], rtol=0, atol=1e-9)
         c = data.xpos[front] + data.xmat[front].reshape(3, 3) @ pin
         assert np.linalg.norm(data.site_xpos[model.site(ROD_END).id] - c) <= s["loop_gap"][i] + 1e-12
-    # the poses checked include the front module turned and off the axis in the bend (the rigid linkage holds its
-    # pin C on a chord from A, against its legs' springs: it turns slowly into the bend)
+    # the poses checked include the front module turned and off the axis in the bend (its rings follow the
+    # centreline, so its middle C sits inside it, and its wheels' sideways scrub pushes it about)
     assert math.degrees(s["yaw2"][rows[-1]]) > 2 and s["y2"][rows[-1]] > 2e-3
 
 
