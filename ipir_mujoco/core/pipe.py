@@ -174,7 +174,9 @@ def scrub_force(params, module: int, toward: tuple[float, float]) -> float:
     ring spacing either way). Quasi-static, Coulomb; 0 for a module at rest, as each is half of every revolution."""
     n = int(params.wheel_legs)
     P = (params.F_n1, params.F_n2)[module] / (2 * n)
-    mu = params.mu_wall if params.mu_wall is not None else 1.0  # unlimited grip: the wheels still slide at mu >= 1
+    # unlimited grip: no finite coefficient to take; 1 stands for it, a lower bound (the model's wheels then grip
+    # with MU_UNLIMITED, 100, and turn in a bend only as far as their springs let them: a lift whatever this says)
+    mu = params.mu_wall if params.mu_wall is not None else 1.0
     return mu * P * sum(abs(e[0] * toward[0] + e[1] * toward[1])
                         for e in (hub_tangent(leg_direction(k, n)) for k in range(n)))
 
