@@ -2,7 +2,8 @@
 
 Run on demand from the repository root (each case 1-3 min on 2 busy cores):
 
-    python bench/wheels_bend_offset.py [--ratio 2.5] [--planes 0,90] [--t-end 5] [--set NAME=VALUE]... [--smoke]
+    python bench/wheels_bend_offset.py [--ratio 2.5] [--planes 0,90] [--t-end 5] [--set NAME=VALUE]...
+                                       [--timestep S] [--smoke]
 
 The wheeled MuJoCo model (the motor, mu_wall 0.8 unless --set gives one) along a 0.45 m straight, a 90 degree bend
 of R/D ``--ratio`` in each plane of ``--planes`` (0: horizontal, across gravity; 90: turning up, into a riser) and a
@@ -43,6 +44,7 @@ def main(argv=None) -> int:
     parser.add_argument("--planes", default="0,90")
     parser.add_argument("--t-end", type=float, default=5.0)
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    parser.add_argument("--timestep", type=float, default=None, help="the step [s] (default: the automatic one)")
     parser.add_argument("--smoke", action="store_true", help="one plane, 0.05 s: the script runs")
     args = parser.parse_args(argv)
     if args.smoke:
@@ -58,9 +60,11 @@ def main(argv=None) -> int:
                                    dict(kind="bend", radius=radius, angle=90.0, plane=plane),
                                    dict(kind="straight", length=EXIT)], "bend")
         print(f"R/D {args.ratio:g}, plane {plane:g} deg: running", file=sys.stderr, flush=True)
-        run = registry.run("mujoco-wheels", params, args.t_end, dt_out=2e-3, route=route, accuracy="warn")
+        run = registry.run("mujoco-wheels", params, args.t_end, dt_out=2e-3, route=route, accuracy="warn",
+                           **({} if args.timestep is None else {"timestep": args.timestep}))
         summary = run.summary
-        print(f"R/D {args.ratio:g}, plane {plane:g} deg ({', '.join(args.set) or 'defaults'}): "
+        print(f"R/D {args.ratio:g}, plane {plane:g} deg ({', '.join(args.set) or 'defaults'}; step "
+              f"{run.settings['timestep']:g} s): "
               f"{summary['route_stop']}")
         print(f"  a wheel off its wall {summary['route_wheel_off_s']:.3f} s; closed form: "
               f"{summary['route_fit']['predicted']}")
