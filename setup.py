@@ -39,7 +39,7 @@ def mujoco_build_paths() -> tuple[str, str]:
 # the compiled loop (loop/_stepper.c) and its clutch controllers' compiled forms (controllers/_clutch_*.c: one file per
 # family, their table in _clutch_table.c)
 STEPPER_SOURCES = ["ipir_mujoco/engine/loop/_stepper.c"] + [
-    f"ipir_mujoco/engine/controllers/_clutch_{name}.c" for name in ("table", "slides", "grip")]
+    f"ipir_mujoco/engine/controllers/_clutch_{name}.c" for name in ("table", "slides", "grip", "wheels")]
 STEPPER_HEADERS = ["ipir_mujoco/engine/loop/_stepper.h", "ipir_mujoco/engine/controllers/_clutch_parts.h"]
 
 

@@ -75,6 +75,14 @@ DESIGNS = {
                                      "unilateral", "ratchet", 0.12, {}),
     "compliant grip, none, climb": (RobotParams(clutch_stiffness=1e5, mu_wall=0.0, F_n1=20.0, F_n2=20.0,
                                                 incline=10.0), "unilateral", "ratchet", 0.15, {}),
+    # the round pipe's hub ratchets: a straight pipe with unlimited grip; a riser on a grip that cannot carry the
+    # robot (it skids back); the README's finite grip, where a wheel also leaves its wall. (A route's bends are
+    # the same loop: the wall's contacts are MuJoCo's rows like any other.)
+    "wheels, straight pipe": (RobotParams(drive="motor"), "unilateral", "ratchet", 0.1, {"model": "wheels"}),
+    "wheels, riser skids": (RobotParams(drive="motor", mu_wall=0.18, incline=90.0), "unilateral", "ratchet", 0.1,
+                            {"model": "wheels"}),
+    "wheels, grip, a wheel lifts": (RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0), "unilateral",
+                                    "ratchet", 0.1, {"model": "wheels"}),
 }
 
 
@@ -117,6 +125,48 @@ def test_the_compiled_loop_equals_the_python_loop_bit_for_bit(monkeypatch, name)
         assert compiled.stall is not None and compiled.t_end < 1.0
     if name == "coarse step, warned":
         assert not compiled.accuracy["ok"]  # the monitor's crossing, its time and value, alike
+    if name in ("wheels, riser skids", "wheels, grip, a wheel lifts"):  # the skid branches were taken
+        wheels = np.concatenate([compiled.series["wheels1"], compiled.series["wheels2"]])
+        assert (wheels == -1.0).sum() > 10 and compiled.energy["skid_j"] > 1e-3
+    if name == "wheels, grip, a wheel lifts":
+        assert compiled.summary["wheel_off_s"] > 0.0
+
+
+@needs_compiled
+def test_each_compiled_controller_has_its_own_block():
+    """The extension's table of controllers: one entry per name, each block's fields its own (none repeats
+    another of the block or one of the loop's)."""
+    module = native.compiled()
+    names = [entry[0] for entry in module.CONTROLLERS]
+    assert len(set(names)) == len(names) and {"ratchet", "grip_ratchet", "wheel_ratchet"} <= set(names)
+    for name, config, state, work in module.CONTROLLERS:
+        assert len(set(config)) == len(config) and len(set(state)) == len(state), name
+        assert not set(config) & set(module.CONFIG) and not set(state) & set(module.STATE), name
+        assert work == (name in ("grip_ratchet", "compliant_grip", "wheel_ratchet")), name
+
+
+@needs_compiled
+@pytest.mark.parametrize("variant, params, implementation", [
+    ("mujoco-ratchet", RobotParams(), None), ("mujoco-ratchet", RobotParams(), "none"),
+    ("mujoco-ratchet", RobotParams(clutch_stiffness=1e5), None), ("mujoco-lock", RobotParams(), None),
+    ("mujoco-lock-unilateral", RobotParams(), None), ("mujoco-ratchet", RobotParams(mu_wall=0.5), None),
+    ("mujoco-ratchet", RobotParams(mu_wall=0.5, clutch_stiffness=1e5), None), ("mujoco-wheels", RobotParams(), None),
+    ("mujoco-wheels", RobotParams(mu_wall=0.5), None)])
+def test_every_controller_of_every_model_kind_steps_compiled(variant, params, implementation):
+    """No model kind's controller falls back to the Python loop where the compiled one is built."""
+    from ipir_mujoco import registry
+    from ipir_mujoco.engine import kinds
+    from ipir_mujoco.engine.run_setup import RunSetup
+
+    v = registry.variant(variant)
+    kind = kinds.kind_for(v.model, params)
+    implementation = implementation or v.clutch
+    params = kind.check(params, implementation, v.rule)
+    settings, _ = kind.settings(params, 0.01, 1e-3, None, implementation)
+    setup = RunSetup(kind, params, settings, implementation=implementation, rule=v.rule)
+    setup.start()
+    steps, _ = setup.steps(np.empty((2, setup.model.nv)))
+    assert type(steps) is stepper.CompiledSteps
 
 
 @needs_compiled

@@ -3,7 +3,8 @@
  * controller adds its file (its block and its Controller) and one line here. */
 #include "../loop/_stepper.h"
 
-extern const Controller NO_CLUTCH, RATCHET, LOCK_KINEMATIC, LOCK_UNILATERAL, COMPLIANT, GRIP_RATCHET, COMPLIANT_GRIP;
+extern const Controller NO_CLUTCH, RATCHET, LOCK_KINEMATIC, LOCK_UNILATERAL, COMPLIANT, GRIP_RATCHET, COMPLIANT_GRIP,
+    WHEEL_RATCHET;
 
 const Controller *const CONTROLLERS[] = {
     &NO_CLUTCH,       /* slide_clutches.NoClutch (_clutch_slides.c) */
@@ -13,5 +14,6 @@ const Controller *const CONTROLLERS[] = {
     &COMPLIANT,       /* compliant.CompliantClutches */
     &GRIP_RATCHET,    /* grip.GripRatchet (_clutch_grip.c) */
     &COMPLIANT_GRIP,  /* compliant_grip.CompliantGrip */
+    &WHEEL_RATCHET,   /* wheels.WheelRatchet (_clutch_wheels.c) */
 };
 const int N_CONTROLLERS = (int)(sizeof(CONTROLLERS) / sizeof(CONTROLLERS[0]));

@@ -32,13 +32,16 @@ from ipir_mujoco.core.params import RobotParams
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
 from ..builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
-from ..loop.rows import clutch_share, missing_rows
 from ..builders.wheels_model import HOUSINGS, contact_friction, leg_names, wheels_timestep
+from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
+from ..loop.native import LayoutError
+from ..loop.rows import clutch_share, missing_rows
+from .compiled_wheels import load_wheel_ratchet
 
 LIMIT_JOINT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 SLIDING_SHARE = 1e-6  # a module's contacts slide where their tangential force is within this share of the cone
+STICKS = 1 - 1e-9  # a hub's friction row sticks while above -tau STICKS (a sliding row sits at -tau, MuJoCo's bound)
 
 
 class WheelRatchet(ControllerBase):
@@ -80,6 +83,7 @@ class WheelRatchet(ControllerBase):
         self.resistance = [sum(self.torques[i * per_module:(i + 1) * per_module]) / self.radius for i in (0, 1)]
         self.grip = None if params.grip is None else list(params.grip)
         self.mu = contact_friction(params)
+        self.cone = (1.0 - SLIDING_SHARE) * self.mu  # a module skids where its contacts' tangential force reaches it
         self.wheel_geoms = [[model.geom(n + "_wheel").id for n in module] for module in legs]
         self.geom_module = {g: i for i, ids in enumerate(self.wheel_geoms) for g in ids}
         self.geom_module.update({model.geom(h).id: i for i, h in enumerate(HOUSINGS)})
@@ -92,6 +96,13 @@ class WheelRatchet(ControllerBase):
             give = follow(k, q.item(a)) * self.radius
             if give > self.excursion:
                 self.excursion = give
+
+    def load_compiled(self, loop):
+        """Its block in the compiled loop (:func:`.compiled_wheels.load_wheel_ratchet`), with the loop's work rates
+        (:class:`WheelPower`, on this data)."""
+        if not isinstance(loop.power, WheelPower) or loop.power.data is not self.data:
+            raise LayoutError("the wheel ratchet's loop has not the wheels' work rates")
+        return load_wheel_ratchet(self, loop, loop.power, STICKS)
 
     def _rows(self) -> tuple[list[float], list[float], list[bool]]:
         """Per module of the last step: its hubs' limit rows summed [N m], their friction rows summed [N m], and
@@ -112,7 +123,7 @@ class WheelRatchet(ControllerBase):
             for k, tau in self.friction_rows[i]:
                 f = force.item(ne + k)
                 friction[i] += f
-                if f > -tau * (1 - 1e-9):
+                if f > -tau * STICKS:
                     sticks[i] = True
         return limits, friction, sticks
 
@@ -133,7 +144,8 @@ class WheelRatchet(ControllerBase):
                 continue
             f = force.item(a)
             normal[i] += f
-            tangential[i] += math.hypot(force.item(a + 1), force.item(a + 2))
+            t1, t2 = force.item(a + 1), force.item(a + 2)
+            tangential[i] += math.sqrt(t1 * t1 + t2 * t2)  # as _clutch_wheels.c (math.hypot rounds otherwise)
             if f > 0.0:
                 touching.add(g)
         off = [sum(1 for g in ids if g not in touching) for ids in self.wheel_geoms]
@@ -154,7 +166,7 @@ class WheelRatchet(ControllerBase):
                 continue
             hold = (limits[i] + friction[i]) / self.radius
             if normal[i] > 0.0:
-                skids = tangential[i] >= (1.0 - SLIDING_SHARE) * self.mu * normal[i]
+                skids = tangential[i] >= self.cone * normal[i]
             else:
                 skids = self._qvel.item(self.x_dof[i]) < -REST_SPEED
             states.append(SKIDDING if skids else STANDING)
@@ -232,44 +244,52 @@ def press_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> 
 
 def wheel_loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
     """:func:`.stepper.make_steps`' keyword arguments for the wheeled model after ``mj_forward`` on its initial
-    state: as :func:`.loop_rows.loop_options` gives them for the slide model, with ``power(v)``, the work rates
-    [W] after a step (the hubs' friction rows times the hubs' speeds; the contacts' tangential rows times their
-    speeds J v_{n+1}: the friction's work against skidding) in place of the slides' friction rows.
+    state: as :func:`.loop_rows.loop_options` gives them for the slide model, with ``power`` (:class:`WheelPower`)
+    in place of the slides' friction rows."""
+    motor = model.actuator(MOTOR).id
+    return dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
+                slope=drive_torque_slope(model), torque=data.actuator_force.item(motor), friction_dofs=[],
+                power=WheelPower(model, data))
+
+
+class WheelPower:
+    """``power(v)``: the wheeled model's work rates [W] after a step, ``v`` the velocities v_{n+1} as a list:
+    (the hubs' friction rows times the hubs' speeds, the contacts' tangential rows times their speeds J v_{n+1}:
+    the friction's work against skidding), each summed row by row in row order; the compiled wheel ratchet
+    (``_clutch_wheels.c``) sums the same products in the same order, J v from MuJoCo's ``mj_mulJacVec`` in both.
 
     The contacts' normal rows are left out: their force times the step's velocity is no measure of the little
     energy a stiff soft contact stores (on a skid in a riser it booked 1.4 J where MuJoCo's own energy, the
     drive's work and the tangential rows' balance to 1e-3 J without it). With a pyramidal cone (the convergence
-    study only) a contact's rows mix both directions and all of them count."""
-    motor = model.actuator(MOTOR).id
-    hub_dofs = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
-    nv = model.nv
-    elliptic = model.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
-    if elliptic and set(np.unique(model.geom_condim[model.geom_contype + model.geom_conaffinity > 0])) != {3}:
-        raise ParameterError("the wheeled model's contacts must have condim 3 (the work bookkeeping reads their rows "
-                             "as normal, tangent, tangent)")
+    study only) a contact's rows mix both directions and all of them count. ``hub_dofs``: the dofs with
+    frictionloss (the hubs'), whose rows follow the equality rows in dof order; ``elliptic``: the cone."""
 
-    def power(v) -> tuple[float, float]:
-        d = data
-        if d.nf != len(hub_dofs):
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
+        self.model, self.data = model, data
+        self.hub_dofs = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
+        self.elliptic = model.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+        if self.elliptic and set(np.unique(model.geom_condim[model.geom_contype + model.geom_conaffinity > 0])) != {3}:
+            raise ParameterError("the wheeled model's contacts must have condim 3 (the work bookkeeping reads their "
+                                 "rows as normal, tangent, tangent)")
+
+    def __call__(self, v) -> tuple[float, float]:
+        d = self.data
+        if d.nf != len(self.hub_dofs):
             raise missing_rows(2, d.time)
-        ne, nf, force = d.ne, d.nf, d.efc_force
+        ne, nf, nefc, force = d.ne, d.nf, d.nefc, d.efc_force
         rolling = 0.0
-        for k, dof in enumerate(hub_dofs):
+        for k, dof in enumerate(self.hub_dofs):
             rolling += force.item(ne + k) * v[dof]
-        first = ne + nf + d.nl
-        if d.nefc > first:
-            J = d.efc_J[first * nv:d.nefc * nv].reshape(-1, nv)
-            rates = force[first:d.nefc] * (J @ np.asarray(v))
-            if elliptic:  # each contact's rows: its normal, then its tangential directions; the friction's only
-                rates[0::3] = 0.0
-            contact = float(rates.sum())
-        else:
-            contact = 0.0
+        first, contact = ne + nf + d.nl, 0.0
+        if nefc > first:
+            jv = np.empty(nefc)
+            mujoco.mj_mulJacVec(self.model, d, jv, d.qvel)  # d.qvel: v
+            rates = (force[first:nefc] * jv[first:]).tolist()
+            if self.elliptic:  # each contact's rows: its normal, then its tangential directions; the friction's only
+                del rates[0::3]
+            for rate in rates:
+                contact += rate
         return rolling, contact
-
-    return dict(motor=motor, crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                slope=drive_torque_slope(model), torque=data.actuator_force.item(motor), friction_dofs=[],
-                power=power)
 
 
 def wheel_slip(x: np.ndarray) -> np.ndarray:

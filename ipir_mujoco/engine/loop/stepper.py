@@ -271,6 +271,10 @@ class CompiledSteps(PythonSteps):
         self._kind = kind
         self._set_config(controller=index)
 
+    def keep(self, *objects) -> None:
+        """Keep ``objects`` (arrays whose addresses a controller wrote into its block) alive as long as the loop."""
+        self._kept.extend(objects)
+
     def _set_config(self, **values) -> None:
         for name, value in values.items():
             self._cfg[self.C[name]] = int(value)
@@ -287,7 +291,7 @@ class CompiledSteps(PythonSteps):
         load = getattr(ctl, "load_compiled", None)
         if load is None:
             raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
-        self._kind, self._rec = None, None
+        self._kind, self._rec, self._kept = None, None, []
         self._sync = load(self)
         if self._kind is None:
             raise LayoutError(f"{type(ctl).__name__}.load_compiled chose no compiled controller")
