@@ -2,7 +2,7 @@
 
 Run on demand from the repository root (about a minute; ``--smoke``: seconds):
 
-    python bench/wheels_cost.py [--t-end SECONDS] [--repeat N] [--smoke]
+    python bench/wheels_cost.py [--t-end SECONDS] [--repeat N] [--smoke] [--profile]
 
 Each at its defaults for ``--t-end`` simulated seconds, each run ``--repeat`` times, the best kept, the runs
 interleaved so that a busy machine slows both alike:
@@ -10,11 +10,15 @@ interleaved so that a busy machine slows both alike:
 - the slide model (``mujoco-ratchet``) on the default design (the paper's constant torque, unlimited grip) and
   with the default motor, stepped in C (its default) and in Python (``IPIR_MUJOCO_STEPPER=python``);
 - the wheeled model (``mujoco-wheels``: the robot in a round pipe, 38 degrees of freedom, 12 sprung wheels on
-  hub ratchets, stepped in Python) on the same designs, and with the default motor on a finite grip
+  hub ratchets, stepped in C as the slide model) on the same designs, and with the default motor on a finite grip
   (mu_wall 0.5).
 
 Prints wall seconds per simulated second and each wheeled run's ratio to the slide model's C loop on the same
 design (the issue's target: at most 10 at the defaults).
+
+``--profile`` prints instead where a wheeled step's time goes, with the default motor on unlimited grip: the
+compiled loop's cost per step against a bare ``mj_step`` on a copy of the same state (the loop's own share: the
+hub ratchets, the bookkeeping, the samples), and MuJoCo's own timers of those bare steps per stage.
 """
 
 from __future__ import annotations
@@ -23,6 +27,9 @@ import argparse
 import os
 import sys
 import time
+
+import mujoco
+import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
@@ -45,12 +52,45 @@ def once(variant: str, params: RobotParams, t_end: float, python: bool = False) 
             os.environ[ENV] = before
 
 
+def profile(params: RobotParams, nstep: int = 2000) -> None:
+    """Print the wheeled loop's cost per step [us] against a bare mj_step's, and MuJoCo's timers per stage."""
+    from ipir_mujoco.engine.modelkinds import kinds
+    from ipir_mujoco.engine.run.run_setup import RunSetup
+
+    variant = registry.variant("mujoco-wheels")
+    kind = kinds.kind_for(variant.model, params)
+    params = kind.check(params, variant.clutch, variant.rule)
+    settings, _ = kind.settings(params, 1.0, 1e-3, None, variant.clutch)
+    setup = RunSetup(kind, params, settings, implementation=variant.clutch, rule=variant.rule)
+    setup.start()
+    model, data = setup.model, setup.data
+    steps, _ = setup.steps(np.empty((2, model.nv)))
+    steps.run(nstep)  # under way (the start is a transient)
+    for timer in data.timer:  # MuJoCo's timers count inside every mj_step, the compiled loop's too
+        timer.duration, timer.number = 0.0, 0
+    started = time.perf_counter()
+    steps.run(nstep)
+    loop = (time.perf_counter() - started) / nstep
+    step = data.timer[int(mujoco.mjtTimer.mjTIMER_STEP)].duration / nstep
+    print(f"timestep {model.opt.timestep:g} s, nv {model.nv}, {data.ncon} contacts, {data.nefc} constraint rows; "
+          f"{'compiled' if steps.compiled else 'Python'} loop")
+    print(f"{'the loop, per step':34s} {loop * 1e6:8.1f} us")
+    print(f"{'  of which mj_step (its timer)':34s} {step * 1e6:8.1f} us")
+    for i, timer in enumerate(data.timer):
+        if timer.number and i != int(mujoco.mjtTimer.mjTIMER_STEP):
+            print(f"    {mujoco.mjtTimer(i).name[8:].lower():30s} {timer.duration / nstep * 1e6:8.1f} us")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--smoke", action="store_true", help="0.05 s, once: the script runs")
+    parser.add_argument("--profile", action="store_true", help="where a wheeled step's time goes (module docstring)")
     args = parser.parse_args(argv)
+    if args.profile:
+        profile(RobotParams(drive="motor"), nstep=200 if args.smoke else 2000)
+        return 0
     t_end, repeat = (0.05, 1) if args.smoke else (args.t_end, args.repeat)
     rows = [  # (label, variant, params, python loop, the slide row it is compared with)
         ("slides, defaults, C loop", "mujoco-ratchet", RobotParams(), False, None),

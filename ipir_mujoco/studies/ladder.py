@@ -47,8 +47,8 @@ LADDER = (
          "mujoco-ratchet"),
 )
 # The validation report's last rung: MuJoCo's robot on wheels in a pipe (``--mujoco-model wheels``), against the
-# ratchet before it. Not in the cruise study's ladder (:mod:`.cruise`): the wheeled model steps in Python at a
-# fine step, and a run to the motor's steady state costs seconds where the validation report's 1 s costs half
+# ratchet before it. Not in the cruise study's ladder (:mod:`.cruise`): the wheeled model costs 8-10 times the
+# slide model per simulated second (bench/wheels_cost.py), and a run to the motor's steady state costs seconds where the validation report's 1 s costs half
 # a second (unlimited grip: MuJoCo's automatic step).
 # Its accuracy monitor warns rather than stops: under the paper's constant torque the crank reaches ~90 rad/s
 # and the modules 3.7 m/s, they rock on their wheels' springs and the soft contacts dissipate ~0.3 % of the

@@ -217,7 +217,7 @@ class GripSlidesKind(ModelKind):
 
 
 class WheelsKind(ModelKind):
-    """A 3-D robot on sprung wheel legs in a round pipe, a ratchet in every hub, stepped in Python."""
+    """A 3-D robot on sprung wheel legs in a round pipe, a ratchet in every hub."""
 
     name = "wheels"
     model = "wheels"

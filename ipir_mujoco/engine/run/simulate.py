@@ -126,7 +126,7 @@ def simulate_mujoco(
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
     ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
     required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`). ``model``: 'slides' or 'wheels'
-    (on wheels in a pipe, a ratchet in every hub, stepped in Python: :mod:`.wheels_model`, :mod:`.wheels`).
+    (on wheels in a pipe, a ratchet in every hub: :mod:`.wheels_model`, :mod:`.wheels`).
     ``route``: a :class:`ipir_mujoco.core.route.Route` (the wheeled model only): the walls along it, the run
     ended at its end or where the robot jams (:mod:`.route_watch`).
     """
