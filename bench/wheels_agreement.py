@@ -3,7 +3,7 @@
 Run on demand from the repository root (about 30-60 min on 2 busy cores; ``--smoke``: 4 designs, a minute):
 
     python bench/wheels_agreement.py [--designs 100] [--seed 1] [--workers 2] [--wall-budget S] [--skip N]
-                                     [--only N,M,...] [--smoke]
+                                     [--only N,M,...] [--timestep S] [--smoke]
 
 Each design is drawn over the envelope (log-uniform where a range spans decades): m1, m2 0.2-5 kg; r 0.02-0.07 m
 (the crank fits the 0.16 m pipe); L / r 1.5-6; J_A 1e-4-1e-2 kg m^2; F_r1, F_r2 0.2-5 N; the drive a constant
@@ -63,14 +63,18 @@ def within(a: float, b: float, rel: float, floor: float) -> bool:
     return abs(b - a) <= max(rel * abs(a), floor) if floor == TRAVEL_FLOOR else abs(b - a) <= rel * abs(a) + floor
 
 
-def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None) -> dict:
+def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None,
+          timestep: float | None = None) -> dict:
     """Run one design in both engines and classify it (module docstring); ``budget`` [s]: the MuJoCo run's
-    wall-time budget (a run past it stops with that reason)."""
+    wall-time budget (a run past it stops with that reason); ``timestep`` [s]: the MuJoCo run's step (default its
+    automatic one)."""
     row = {"design": index, "params": params, "t_end": t_end}
     try:
         analytic = registry.run("analytic-unilateral", params, t_end, dt_out=1e-3)
         started = time.perf_counter()
         options = {} if budget is None else {"wall_budget_s": budget}
+        if timestep is not None:
+            options["timestep"] = timestep
         wheels = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, **options)
         row["wall_s"] = time.perf_counter() - started
     except (ParameterError, SimulationError) as exc:
@@ -119,6 +123,7 @@ def main(argv=None) -> int:
                         help="each MuJoCo run's wall-time budget [s]: a run past it is stopped with that reason")
     parser.add_argument("--only", default=None, metavar="N,M,...",
                         help="run only these designs (their numbers as printed; with --skip, these and those after it)")
+    parser.add_argument("--timestep", type=float, default=None, help="the MuJoCo runs' step [s] (default: automatic)")
     parser.add_argument("--smoke", action="store_true", help="4 designs of 0.3 s: the script runs")
     args = parser.parse_args(argv)
     only = None if args.only is None else {int(k) for k in args.only.split(",")}
@@ -128,7 +133,7 @@ def main(argv=None) -> int:
     for k in range(count):
         params, t_end = design(rng)
         if (k >= args.skip and only is None) or (only is not None and (k in only or (args.skip and k >= args.skip))):
-            jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget))
+            jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep))
     counts = {"agree": 0, "lifted": 0, "stopped": 0, "outside": 0}
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = [pool.submit(judge, *job) for job in jobs]
