@@ -61,6 +61,13 @@ class Variant:
     label: str  # in words, for figures and reports
     model: str = "slides"  # MuJoCo's model of the robot: 'slides' | 'wheels' (the equations: 'slides')
     clutches: str = ""  # its clutches in words, where its model has only those (for a refused flag's message)
+    mechanism: str = ""  # its clutches' mechanism for a figure's title, where MuJoCo's clutch alone does not say it
+
+    @property
+    def mechanism_words(self) -> str:
+        """The clutches' mechanism in a title's words: MuJoCo's clutch ('ratchet' | 'lock'), or the model's own
+        (``mechanism``: the wheels' hub ratchets)."""
+        return self.mechanism or self.clutch or ""
 
     @property
     def is_mujoco(self) -> bool:
@@ -86,7 +93,7 @@ VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
     Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
     Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels",
-            "one-way ratchets in the wheels' hubs"),
+            "one-way ratchets in the wheels' hubs", "wheels, hub ratchets"),
 )}
 ALIASES = {
     "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",

@@ -139,6 +139,11 @@ def _axial_travel(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(steps)])
 
 
+# the replay of each MuJoCo model (``registry.MUJOCO_MODELS``, a run's ``settings["mujoco_model"]``)
+REPLAYS = {"slides": SlideReplay, "wheels": WheeledReplay}
+
+
 def replay_for(model: mujoco.MjModel, run: RunResult) -> SlideReplay:
-    """The replay of ``run`` on its drawing model: :class:`WheeledReplay` for the wheeled model's runs."""
-    return (WheeledReplay if run.settings.get("mujoco_model") == "wheels" else SlideReplay)(model, run)
+    """The replay of ``run`` on its drawing model (:data:`REPLAYS`): the slide model's for runs that record no
+    MuJoCo model (the slides, the analytic engines)."""
+    return REPLAYS[run.settings.get("mujoco_model", "slides")](model, run)

@@ -167,31 +167,54 @@ def in_pipe(spec, params: RobotParams, facing=None) -> None:
 
 
 def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: float,
-               held: tuple[bool, bool], wheeled: bool = False) -> tuple[str, str]:
+               held: tuple[bool, bool], free: str = "slides") -> tuple[str, str]:
     """The overlay's (labels, values) of the robot's state: crank speed and turns, each module's speed and
-    whether its clutch holds (times [s], angles [rad], speeds [rad/s, m/s]); a module not held slides on its
-    slide, or with ``wheeled`` rolls on its wheels."""
-    words = ("holds (green)", "free, rolls" if wheeled else "slides")
+    whether its clutch holds (times [s], angles [rad], speeds [rad/s, m/s]); ``free``: what a module not held
+    does, the drawing's word (:attr:`SlideDrawing.free`: it slides on its slide, or rolls on its wheels)."""
+    words = ("holds (green)", free)
     values = (f"{fixed(omega, 1)} rad/s, {fixed((phi - phi0) / (2 * math.pi), 2)} rev\n"
               f"{fixed(v1, 2)} m/s, clutch {words[0] if held[0] else words[1]}\n"
               f"{fixed(v2, 2)} m/s, clutch {words[0] if held[1] else words[1]}")
     return "crank\nmodule 1 (rear)\nmodule 2 (front)", values
 
 
-def _render_model(params: RobotParams, settings: VideoSettings, wheeled: bool = False, route=None):
-    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
-    ``wheeled``: the wheeled model (its pipe walls and wheels drawn too); ``route``: its walls along the route,
-    built as the run built them (:func:`ipir_mujoco.engine.builders.wheels_model.build_wheels_spec`)."""
+class SlideDrawing:
+    """How render and the viewer draw MuJoCo's slide model (unlimited or finite grip, and any analytic run):
+    its drawing model in the round pipe, the near half cut away; a module its clutch does not hold slides."""
 
-    from .engine.builders.model import build_spec
+    free = "slides"  # what a module does while its clutch does not hold (the overlay's word)
 
-    if wheeled:
-        from .engine.builders.wheels_model import build_wheels_spec
+    def spec(self, params: RobotParams, route=None):
+        """The drawing model's ``mujoco.MjSpec`` (a slide model takes no route)."""
+        from .engine.builders.model import build_spec
 
-        spec = build_wheels_spec(params, route=route)
-    else:
         spec = build_spec(params)
         in_pipe(spec, params, view_direction(*SIDE_VIEW))  # the near half cut away
+        return spec
+
+
+class WheelsDrawing(SlideDrawing):
+    """How render and the viewer draw the wheeled model: its pipe walls and wheels as its build makes them
+    (along ``route``, built as the run built them); a module its clutch does not hold rolls on its wheels."""
+
+    free = "free, rolls"
+
+    def spec(self, params: RobotParams, route=None):
+        from .engine.builders.wheels_model import build_wheels_spec
+
+        return build_wheels_spec(params, route=route)
+
+
+# the drawing of each MuJoCo model (``registry.MUJOCO_MODELS``, a run's ``settings["mujoco_model"]``)
+DRAWINGS = {"slides": SlideDrawing(), "wheels": WheelsDrawing()}
+
+
+def _render_model(params: RobotParams, settings: VideoSettings, model: str = "slides", route=None):
+    """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
+    ``model``: the MuJoCo model drawn (:data:`DRAWINGS`; the wheeled model's pipe walls and wheels drawn too);
+    ``route``: its walls along the route, built as the run built them
+    (:func:`ipir_mujoco.engine.builders.wheels_model.build_wheels_spec`)."""
+    spec = DRAWINGS[model].spec(params, route)
     checker_floor(spec)
     spec.visual.global_.offwidth = settings.width
     spec.visual.global_.offheight = settings.height
@@ -228,8 +251,8 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
     check_route_run(run, route)
     context = _open_context(settings.width, settings.height)
     params, s = run.params, run.series
-    wheeled = run.settings.get("mujoco_model") == "wheels"
-    model = _render_model(params, settings, wheeled, route)
+    drawn = run.settings.get("mujoco_model", "slides")  # the slide model's drawing for runs that record none
+    model = _render_model(params, settings, drawn, route)
     data = mujoco.MjData(model)
     replay = replay_for(model, run)
     housings = [model.geom(name).id for name in HOUSINGS]
@@ -270,7 +293,7 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
                                f"{title}\nt = {when:.3f} s{along}", f"\n{settings.speed:g}x real time", renderer)
             labels, values = state_text(when, phi, float(s["phi"][0]), float(np.interp(when, t, s["omega"])),
                                         float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held,
-                                        wheeled)
+                                        DRAWINGS[drawn].free)
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels,
                                values, renderer)
             yield _read_frame(settings, viewport, renderer)

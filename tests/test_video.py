@@ -150,7 +150,7 @@ def test_a_route_replay_poses_the_robot_as_recorded_among_the_runs_walls(bend_ru
 
     run, route = bend_run
     settings = VideoSettings(width=96, height=64, fps=10.0, speed=0.1)  # a frame every 0.01 s: every 10th sample
-    model = _render_model(run.params, settings, wheeled=True, route=route)
+    model = _render_model(run.params, settings, "wheels", route=route)
     ran = build_wheels_model(run.params, route=route)
     walls = [ran.geom(i).name for i in range(ran.ngeom) if ran.geom(i).name.startswith(("pipe_straight", "pipe_bend"))]
     assert {"pipe_straight1", "pipe_bend1"} <= set(walls)
@@ -356,10 +356,10 @@ def test_the_viewer_draws_the_checker_floor_and_says_time_and_speeds():
 def test_the_overlay_says_a_free_wheeled_module_rolls():
     """A module whose clutch does not hold slides on its slide, but rolls on its wheels: the overlay's word
     follows the model (render and the viewer share state_text)."""
-    from ipir_mujoco.video import state_text
+    from ipir_mujoco.video import DRAWINGS, state_text
 
     _, slides = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True))
-    _, wheels = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True), wheeled=True)
+    _, wheels = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True), DRAWINGS["wheels"].free)
     assert slides.splitlines()[1].endswith("clutch slides") and wheels.splitlines()[1].endswith("clutch free, rolls")
     assert slides.splitlines()[2] == wheels.splitlines()[2] == "0.00 m/s, clutch holds (green)"
 

@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
     result = registry.run(variant, params, t_end, progress=progress_printer(t_end), **options)
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
-            f"({'wheels, hub ratchets' if variant.model == 'wheels' else variant.clutch})"
+            f"({variant.mechanism_words})"
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(f".{out.name}.partial{out.suffix}")
     try:

@@ -41,7 +41,7 @@ from ipir_mujoco.core.params import RobotParams
 from ..engine.modelkinds.kinds import kind_for
 from ..engine.builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
 from ..engine.run.run_setup import RunSetup
-from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text
+from ..video import DRAWINGS, FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
 
@@ -59,7 +59,7 @@ class ViewedRobot:
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
         kind = kind_for(model, params)
         params = kind.check(params, self.implementation, clutch, route)  # the route's incline
-        self.params, self.wheeled = params, kind.model == "wheels"
+        self.params, self.free = params, DRAWINGS[kind.model].free  # the overlay's word
         if settings is None:  # the step the engine would choose for a run of t_end [s]
             settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation, route=route)
         self.settings = settings
@@ -98,7 +98,7 @@ class ViewedRobot:
         crank, rear, front = (m.joint(n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE))
         labels, values = state_text(d.time, float(d.qpos[crank.qposadr[0]]), self.params.phi0,
                                     float(d.qvel[crank.dofadr[0]]), float(d.qvel[rear.dofadr[0]]),
-                                    float(d.qvel[front.dofadr[0]]), self.held or (False, False), self.wheeled)
+                                    float(d.qvel[front.dofadr[0]]), self.held or (False, False), self.free)
         return f"t = {d.time:.2f} s\n{labels}", f"\n{values}"
 
     def _colour(self) -> None:
