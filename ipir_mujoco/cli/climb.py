@@ -94,36 +94,18 @@ def run(args: argparse.Namespace) -> int:
 
 
 def write_figure(study: dict, params, path: Path) -> None:
-    """climb.png (:func:`ipir_mujoco.report.climb_figure.climb_figure`); with a finite grip also the rest
-    traction limit that binds (dash-dot, speed panel) and each module's grip G_i (dotted, force panel)."""
-    from matplotlib.lines import Line2D
-
+    """climb.png (:func:`ipir_mujoco.report.climb_figure.climb_figure`) with the traction's own marks
+    (:meth:`_FiniteGripOutput.draw`)."""
     from ..report.climb_figure import climb_figure
 
     fig = climb_figure(study, params)
-    traction = study.get("traction") or {}
-    if traction.get("grip") is not None:
-        speed_ax, force_ax = fig.axes[:2]
-        rest = traction["rest"][traction["rest"]["binds"]]
-        added = {speed_ax: [], force_ax: []}
-        if rest["sin"] > -1.0:
-            speed_ax.axvline(rest["incline_deg"], color="darkred", ls="-.", lw=1.2, gid="traction-rest")
-            added[speed_ax].append(Line2D([], [], color="darkred", ls="-.", label=(
-                f"traction limit at rest ({traction['rest']['binds'].replace('_', ' ')}): "
-                f"{rest['incline_deg']:.1f} deg")))
-        for i, G in enumerate(traction["grip"]):
-            force_ax.axhline(G, color="darkred", ls=":" if i else (0, (1, 3)), lw=1.2, gid=f"grip{i + 1}")
-        added[force_ax].append(Line2D([], [], color="darkred", ls=":", label="grip G_i = mu_wall F_ni: " + " / ".join(
-            f"{G:.3g}" for G in traction["grip"]) + " N"))
-        for ax, extra in added.items():
-            legend = ax.get_legend()
-            ax.legend(handles=(list(legend.legend_handles) if legend else []) + extra, fontsize="x-small", loc="best")
+    _traction_output(study).draw(fig)
     fig.savefig(path, dpi=110)
 
 
 def write_csv(path: Path, study: dict) -> None:
     """One row per incline: the torque needed at rest, then ENGINE:KEY for each engine, then the errors."""
-    keys = KEYS + (GRIP_KEYS if study.get("traction", {}).get("grip") is not None else ())
+    keys = KEYS + _traction_output(study).keys
     columns = ["incline_deg", "torque_needed_n_m"] + [f"{e}:{k}" for e in study["engines"] for k in keys] + ["error"]
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
@@ -164,7 +146,7 @@ def format_study(study: dict, params) -> str:
     motor = study["drive"] == "motor"
     drive = (f"motor, M_stall {params.M_stall:g} N m, omega_noload {params.omega_noload:g} rad/s" if motor
              else f"constant torque M = {params.M:g} N m")
-    bound = study["energy_bound"]
+    bound, traction = study["energy_bound"], _traction_output(study)
     lines = [f"climbing ability ({drive}; torque at rest {study['torque_at_rest_n_m']:g} N m)",
              f"  restarts from rest at every crank angle (quasi-static): {_limit(study['restart'])}",
              f"    the paper's model (first order, massless rod):         {_limit(study['restart_paper_model'])}",
@@ -176,12 +158,11 @@ def format_study(study: dict, params) -> str:
     for engine, limit in study["steady_climb"].items():
         low, high = limit["bracket"]
         lines.append(f"  steady climb from rest at phi0, {engine}: " + (
-            (f"not even at {high:.2f} deg" + (f" ({limit['runs'][0]['note']})" if limit["runs"][0]["note"] else "")
-             if study.get("traction", {}).get("grip") is not None else "not even at the restart limit")
+            traction.not_even(limit)
             if limit["incline_deg"] is None else
             f"up to {high:.2f} deg (climbs at all inclines tried)" if low == high else
             f"up to {low:.2f} deg (stalls at {high:.2f} deg)"))
-    lines.extend(format_traction(study.get("traction")))
+    lines.extend(traction.lines())
     speed = "steady speed" if motor else f"mean speed over the last 3 revolutions of {study['t_end_s']:g} s"
     lines.append(f"\nincline [deg], torque needed at rest [N m]; per engine: {speed} [m/s], peak / mean clutch "
                  "reaction [N], climbing efficiency [-]")
@@ -206,45 +187,106 @@ def format_study(study: dict, params) -> str:
 
 
 
+class _UnlimitedGripOutput:
+    """What the climb study's text, CSV and figure show of its traction (:mod:`ipir_mujoco.studies.traction`)
+    with unlimited grip: one note; :class:`_FiniteGripOutput` with a finite grip. Chosen once per study
+    (:func:`_traction_output`)."""
+
+    keys: tuple[str, ...] = ()  # the CSV's columns added per engine
+
+    def __init__(self, traction: dict | None):
+        self.traction = traction
+
+    def lines(self) -> list[str]:
+        """The traction figures as lines of the text."""
+        return [] if self.traction is None else [f"  traction: {self.traction['note']}"]
+
+    def not_even(self, limit: dict) -> str:
+        """The steady-climb line of an engine that climbs at no incline tried (``limit``: its bisection)."""
+        return "not even at the restart limit"
+
+    def draw(self, fig) -> None:
+        """Add the traction's marks to climb.png's figure: none."""
+
+
+class _FiniteGripOutput(_UnlimitedGripOutput):
+    """The traction figures with a finite grip: the limits at rest and on the riser, the steady climb with no
+    skid, the skid columns, and the figure's marks."""
+
+    keys = GRIP_KEYS
+
+    def not_even(self, limit):
+        high, note = limit["bracket"][1], limit["runs"][0]["note"]
+        return f"not even at {high:.2f} deg" + (f" ({note})" if note else "")
+
+    def draw(self, fig):
+        """The rest traction limit that binds (dash-dot, speed panel) and each module's grip G_i (dotted, force
+        panel)."""
+        from matplotlib.lines import Line2D
+
+        traction = self.traction
+        speed_ax, force_ax = fig.axes[:2]
+        rest = traction["rest"][traction["rest"]["binds"]]
+        added = {speed_ax: [], force_ax: []}
+        if rest["sin"] > -1.0:
+            speed_ax.axvline(rest["incline_deg"], color="darkred", ls="-.", lw=1.2, gid="traction-rest")
+            added[speed_ax].append(Line2D([], [], color="darkred", ls="-.", label=(
+                f"traction limit at rest ({traction['rest']['binds'].replace('_', ' ')}): "
+                f"{rest['incline_deg']:.1f} deg")))
+        for i, G in enumerate(traction["grip"]):
+            force_ax.axhline(G, color="darkred", ls=":" if i else (0, (1, 3)), lw=1.2, gid=f"grip{i + 1}")
+        added[force_ax].append(Line2D([], [], color="darkred", ls=":", label="grip G_i = mu_wall F_ni: " + " / ".join(
+            f"{G:.3g}" for G in traction["grip"]) + " N"))
+        for ax, extra in added.items():
+            legend = ax.get_legend()
+            ax.legend(handles=(list(legend.legend_handles) if legend else []) + extra, fontsize="x-small", loc="best")
+
+    def lines(self):
+        traction = self.traction
+        G1, G2 = traction["grip"]
+        rest, riser = traction["rest"], traction["riser"]
+        names = {"drive_off": "drive off", "drive_at_rest": "drive's torque at rest"}
+
+        def at_rest(key: str) -> str:
+            r = rest[key]
+            where = f"module {r['module']} skids first" + (
+                f", at crank angle {math.degrees(r['phi_rad']) % 360:.1f} deg" if key == "drive_off" else
+                " wherever the drive moves the other module (it then holds m g sin + F_r)")
+            return "any incline (90 deg)" if r["any_incline"] else (
+                f"up to {r['incline_deg']:.2f} deg ({where})" if r["sin"] > -1 else f"none ({where})")
+
+        lines = [f"  traction (mu_wall {traction['mu_wall']:g}, F_n {traction['F_n'][0]:g} / {traction['F_n'][1]:g} N: "
+                 f"grip G {G1:.4g} / {G2:.4g} N)",
+                 f"    standing at any crank angle, no skid, {names['drive_off']}: {at_rest('drive_off')}",
+                 f"    standing at any crank angle, no skid, {names['drive_at_rest']} "
+                 f"({rest['torque_at_rest_n_m']:g} N m): {at_rest('drive_at_rest')}",
+                 f"    binds: {names[rest['binds']]}",
+                 "    a vertical riser needs a press per module of "
+                 + " / ".join(_press(f) for f in riser["needed_n"]) + " N at this mu_wall ("
+                 + "; ".join(f"{names[k]}: " + " / ".join(_press(f) for f in riser["press_n"][k]) + " N"
+                             for k in ("drive_off", "drive_at_rest")) + f"; {names[riser['binds']]} binds)"]
+        for engine, limit in traction["steady"].items():
+            if "error" in limit:
+                text = f"refused ({limit['error']})"
+            elif limit["incline_deg"] is None:
+                text = "skids (or stalls) even on the level"
+            else:
+                low, high = limit["bracket"]
+                text = (f"up to {high:.2f} deg (no skid at the steady-climb limit)" if low == high
+                        else f"up to {low:.2f} deg (skids or stalls at {high:.2f} deg)")
+            lines.append(f"    steady climb with no skid in the steady window, {engine}: {text}")
+        return lines
+
+
+def _traction_output(study: dict) -> _UnlimitedGripOutput:
+    """The output of ``study``'s traction figures, by its grip (the one place the climb command asks)."""
+    traction = study.get("traction")
+    return (_UnlimitedGripOutput if traction is None or traction["grip"] is None else _FiniteGripOutput)(traction)
+
+
 def format_traction(traction: dict | None) -> list[str]:
     """The traction figures (:mod:`ipir_mujoco.studies.traction`) as lines; one line with unlimited grip."""
-    if traction is None:
-        return []
-    if traction["grip"] is None:
-        return [f"  traction: {traction['note']}"]
-    G1, G2 = traction["grip"]
-    rest, riser = traction["rest"], traction["riser"]
-    names = {"drive_off": "drive off", "drive_at_rest": "drive's torque at rest"}
-
-    def at_rest(key: str) -> str:
-        r = rest[key]
-        where = f"module {r['module']} skids first" + (
-            f", at crank angle {math.degrees(r['phi_rad']) % 360:.1f} deg" if key == "drive_off" else
-            " wherever the drive moves the other module (it then holds m g sin + F_r)")
-        return "any incline (90 deg)" if r["any_incline"] else (
-            f"up to {r['incline_deg']:.2f} deg ({where})" if r["sin"] > -1 else f"none ({where})")
-
-    lines = [f"  traction (mu_wall {traction['mu_wall']:g}, F_n {traction['F_n'][0]:g} / {traction['F_n'][1]:g} N: "
-             f"grip G {G1:.4g} / {G2:.4g} N)",
-             f"    standing at any crank angle, no skid, {names['drive_off']}: {at_rest('drive_off')}",
-             f"    standing at any crank angle, no skid, {names['drive_at_rest']} "
-             f"({rest['torque_at_rest_n_m']:g} N m): {at_rest('drive_at_rest')}",
-             f"    binds: {names[rest['binds']]}",
-             "    a vertical riser needs a press per module of "
-             + " / ".join(_press(f) for f in riser["needed_n"]) + " N at this mu_wall ("
-             + "; ".join(f"{names[k]}: " + " / ".join(_press(f) for f in riser["press_n"][k]) + " N"
-                         for k in ("drive_off", "drive_at_rest")) + f"; {names[riser['binds']]} binds)"]
-    for engine, limit in traction["steady"].items():
-        if "error" in limit:
-            text = f"refused ({limit['error']})"
-        elif limit["incline_deg"] is None:
-            text = "skids (or stalls) even on the level"
-        else:
-            low, high = limit["bracket"]
-            text = (f"up to {high:.2f} deg (no skid at the steady-climb limit)" if low == high
-                    else f"up to {low:.2f} deg (skids or stalls at {high:.2f} deg)")
-        lines.append(f"    steady climb with no skid in the steady window, {engine}: {text}")
-    return lines
+    return _traction_output({"traction": traction}).lines()
 
 
 def _press(force) -> str:
