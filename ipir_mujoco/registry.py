@@ -62,6 +62,7 @@ class Variant:
     model: str = "slides"  # MuJoCo's model of the robot: 'slides' | 'wheels' (the equations: 'slides')
     clutches: str = ""  # its clutches in words, where its model has only those (for a refused flag's message)
     mechanism: str = ""  # its clutches' mechanism for a figure's title, where MuJoCo's clutch alone does not say it
+    routes: bool = False  # whether it runs along a route of straights and bends (``route=``, ``--route``)
 
     @property
     def mechanism_words(self) -> str:
@@ -93,7 +94,7 @@ VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
     Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
     Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels",
-            "one-way ratchets in the wheels' hubs", "wheels, hub ratchets"),
+            "one-way ratchets in the wheels' hubs", "wheels, hub ratchets", routes=True),
 )}
 ALIASES = {
     "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
@@ -103,6 +104,15 @@ ALIASES = {
 NAMES = tuple(VARIANTS)
 # MuJoCo's models of the robot (``--mujoco-model``): the modules on slides, or on wheels on the pipe walls, ...
 MUJOCO_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.engine == "mujoco"))
+ROUTE_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.routes))  # those that take ``--route``
+
+
+def check_route_flag(route: str | None, model: str) -> None:
+    """ParameterError (one line) for ``--route`` with a ``--mujoco-model`` that runs along no route: the command
+    line's check before any work (the model kind's ``check`` refuses a Python caller's route)."""
+    if route is not None and model not in ROUTE_MODELS:
+        raise ParameterError(f"--route {route}: only the {' or '.join(ROUTE_MODELS)} model runs along a route; "
+                             "allowed: --engine mujoco " + " or ".join(f"--mujoco-model {m}" for m in ROUTE_MODELS))
 
 # the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)

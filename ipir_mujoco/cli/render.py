@@ -53,9 +53,7 @@ def run(args: argparse.Namespace) -> int:
     check_writer(out)
     route = None
     if args.route is not None:
-        if args.mujoco_model != "wheels":
-            raise ParameterError(f"--route {args.route}: only the wheeled model runs along a route; allowed: "
-                                 "--mujoco-model wheels")
+        registry.check_route_flag(args.route, args.mujoco_model)
         from ipir_mujoco.core.route import read_route
 
         check_input_file("--route", args.route)

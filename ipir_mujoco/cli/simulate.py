@@ -100,9 +100,7 @@ FLAGS = {"max_switches": "--max-switches", "mjcf": "--mjcf", "timestep": "--time
 def check_options(args: argparse.Namespace) -> registry.Variant:
     """Every option of ``simulate`` that the engines do not check themselves, before any work; the variant
     the flags name (:func:`ipir_mujoco.registry.from_flags`)."""
-    if args.route is not None and args.mujoco_model != "wheels":
-        raise ParameterError(f"--route {args.route}: only the wheeled model runs along a route; allowed: --engine "
-                             "mujoco --mujoco-model wheels")
+    registry.check_route_flag(args.route, args.mujoco_model)
     if args.route is not None and args.until_steady:
         raise ParameterError("--until-steady with --route: a run along a route ends at the route's end; allowed: "
                              "one of them")
