@@ -178,7 +178,8 @@ def locked_pull_share(run: RunResult) -> float | None:
 
 
 def run_metrics(run: RunResult) -> dict:
-    """What the study keeps of one run (SI units; None where a figure does not exist for the run)."""
+    """What the study keeps of one run (SI units; None where a figure does not exist for the run); with finite
+    grip also "slip_m", "peak_grip_use" and "steady_slip_m" (:func:`steady_skid`)."""
     s, summary = run.series, run.summary
     t0, t1, steady = steady_window(run)
     inside = (s["t"] >= t0) & (s["t"] <= t1)
@@ -203,9 +204,10 @@ def run_metrics(run: RunResult) -> dict:
            "efficiency": summary["efficiency"],
            "pull_share": locked_pull_share(run), "stalled": run.stall is not None, "stall_reason": run.stall,
            "timestep_s": run.settings.get("timestep"), "wall_s": run.wall_time_s}
-    if run.params.grip is not None:  # finite grip: how far the modules skidded back [m], the peak share of G used
+    if run.params.grip is not None:  # finite grip: how far the modules skidded back [m] (in all, and in the
+        # steady window), the peak share of G used
         out.update(slip_m=float((summary.get("slip1_m") or 0.0) + (summary.get("slip2_m") or 0.0)),
-                   peak_grip_use=summary.get("peak_grip_use"))
+                   peak_grip_use=summary.get("peak_grip_use"), steady_slip_m=steady_skid(run))
     if run.stall is not None:  # when and where it stopped, and what the clutches hold there
         moving = np.flatnonzero((run.params.r * np.abs(s["omega"]) > REST_SPEED) | (np.abs(s["v1"]) > REST_SPEED)
                                 | (np.abs(s["v2"]) > REST_SPEED))
@@ -225,7 +227,7 @@ def climbs(metrics: dict, drive: str) -> bool:
 
 def measure(engine: str, params: RobotParams, t_end: float | None = None, every_step: bool = False,
             memo: dict | None = None) -> dict:
-    """:func:`run_metrics` of one run (with finite grip also "steady_slip_m", :func:`steady_skid`), or
+    """:func:`run_metrics` of one run, or
     {"error": one line} for a run that fails (a runaway the paper's rule cannot follow, MuJoCo's accuracy
     monitor, ...): a result of the study, not its end; {"error", "refused": True} where the engine refuses the
     parameters (MuJoCo's locks with finite grip). ``every_step``: as :func:`run_engine` (the curve's runs,
@@ -244,8 +246,6 @@ def measure(engine: str, params: RobotParams, t_end: float | None = None, every_
         out = {"error": " ".join(str(exc).split())}
     else:
         out = run_metrics(run)
-        if run.params.grip is not None:
-            out["steady_slip_m"] = steady_skid(run)
     if memo is not None:
         memo[key] = out
     return out
