@@ -7,6 +7,7 @@ one-way-clutch solver was developed), run with HYPOTHESIS_PROFILE=explore.
 
 import os
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("repeatable", derandomize=True, deadline=None)
@@ -24,3 +25,56 @@ def pytest_sessionstart(session):
                                      ("exact", "unilateral", RobotParams()),
                                      ("exact", "unilateral", RobotParams(clutch_stiffness=1e5))):
         simulate(params, geometry, clutch, 0.02, dt_out=1e-3)
+
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Running in parallel: pyproject.toml's addopts ask for '-n auto --dist loadscope' (pytest-xdist, in the test extra:
+# one worker per core). Each test module goes to one worker whole, so a run that several of its tests read
+# (module-scoped fixtures) is made once; the documented commands are split by their code block (the first word of
+# the test's id), whose commands run in order in one folder. Groups holding slow tests are handed out first, so
+# that no long group starts last. Without pytest-xdist the same options are accepted and the suite runs in this
+# one process, in its usual order.
+
+SPLIT_BY_FIRST_WORD_OF_ID = ("tests/test_docs_commands.py::test_documented_command[",)
+
+
+def scope_of(nodeid: str) -> str:
+    """The group a test runs in: its module, or for a test listed above, the first word of its id."""
+    for prefix in SPLIT_BY_FIRST_WORD_OF_ID:
+        if nodeid.startswith(prefix):
+            return prefix + nodeid[len(prefix):].split(" ", 1)[0]
+    return nodeid.split("::", 1)[0]
+
+
+def pytest_addoption(parser, pluginmanager):
+    if not pluginmanager.hasplugin("xdist"):
+        group = parser.getgroup("xdist", "pytest-xdist is not installed: the tests run in this one process")
+        # _addoption: a lowercase short option is pytest's own (pytest-xdist declares its -n the same way)
+        group._addoption("-n", "--numprocesses", dest="numprocesses", default=None,
+                        help="accepted and ignored (pip install pytest-xdist to run tests in parallel)")
+        group.addoption("--dist", dest="dist", default="no", help="accepted and ignored (see -n)")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """xdist's scheduling by scope with :func:`scope_of`'s groups, in the order the workers collected them."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class Scheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return scope_of(nodeid)
+
+    config.option.loadscopereorder = False  # keep the order below (xdist would sort the groups by their size)
+    return Scheduling(config, log)
+
+
+def pytest_collection_modifyitems(config, items):
+    """In an xdist worker: the groups that hold a slow test first (each group's tests keep their order)."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    units: dict[str, list] = {}
+    for item in items:
+        units.setdefault(scope_of(item.nodeid), []).append(item)
+    ordered = sorted(units.values(), key=lambda unit: not any(i.get_closest_marker("slow") for i in unit))
+    items[:] = [item for unit in ordered for item in unit]

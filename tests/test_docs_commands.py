@@ -121,15 +121,24 @@ def run_group(commands: list[dc.Command], folder: Path) -> dict[int, dict]:
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
-    """Every group of commands, two at a time (the machine's cores), each group in its own scratch folder."""
+    """group name -> {id(command): what it did}. Each group of commands runs once, in its own scratch folder. In
+    one process all groups run at once, two at a time (the machine's cores); under pytest-xdist each group runs
+    where its tests are sent (tests/conftest.py keeps a group on one worker; the other workers run the rest of the
+    suite)."""
     base = tmp_path_factory.mktemp("docs")
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        jobs = [pool.submit(run_group, commands, scratch(base / f"g{i}"))
-                for i, commands in enumerate(GROUPS.values())]
-        merged = {}
-        for job in jobs:
-            merged.update(job.result())
-    return merged
+    done: dict[str, dict] = {}
+
+    def of(group: str) -> dict:
+        if group not in done:
+            if os.environ.get("PYTEST_XDIST_WORKER"):
+                done[group] = run_group(GROUPS[group], scratch(base / f"g{len(done)}"))
+            else:
+                with ThreadPoolExecutor(max_workers=2) as pool:
+                    jobs = {name: pool.submit(run_group, commands, scratch(base / f"g{i}"))
+                            for i, (name, commands) in enumerate(GROUPS.items())}
+                    done.update({name: job.result() for name, job in jobs.items()})
+        return done[group]
+    return of
 
 
 def test_the_docs_show_commands_of_every_kind():
@@ -158,9 +167,10 @@ def test_every_benchmark_has_a_smoke_mode():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("command", COMMANDS, ids=[f"{c.source} {c.text[:60]}" for c in COMMANDS])
+# the id's first word is the command's group (tests/conftest.py runs each group's tests on one worker)
+@pytest.mark.parametrize("command", COMMANDS, ids=[f"{c.group} {c.source} {c.text[:60]}" for c in COMMANDS])
 def test_documented_command(command, results):
-    got = results[id(command)]
+    got = results(command.group)[id(command)]
     where = f"{command.source}: {got['ran']}"
     if command.screen and "mujoco.viewer" not in command.text and got["how"] != "synopsis":
         # without a screen the viewer refuses: one line naming what is missing, exit 2
