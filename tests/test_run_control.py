@@ -53,3 +53,26 @@ def test_progress_comes_every_tenth_of_a_simulated_second_at_most(geometry, clut
 def test_bad_run_options_are_parameter_errors(clutch, option, value, fragment):
     with pytest.raises(ParameterError, match=f"^{fragment.replace('.', '[.]')} .*allowed"):
         analytic.simulate(RobotParams(), "exact", clutch, 0.1, **{option: value})
+
+
+def test_a_long_step_says_it_is_still_running_until_it_ends():
+    """core.options.heartbeat: a line through the report while the step lasts, none once it has ended (the
+    thread is joined on leaving, so nothing can come later); waits on the first line, never on a clock."""
+    import threading
+
+    from ipir_mujoco.core.options import heartbeat
+
+    lines: list[str] = []
+    first = threading.Event()
+
+    def report(message: str) -> None:
+        lines.append(message)
+        first.set()
+
+    with heartbeat(report, "atlas toy (equations)", every_s=0.01):
+        assert first.wait(60), "no heartbeat while the step ran"
+    seen = len(lines)
+    assert lines[0].startswith("atlas toy (equations): still running (") and lines[0].endswith(" s)")
+    with heartbeat(report, "short", every_s=3600):
+        pass  # ends before its first beat: silent
+    assert len(lines) == seen

@@ -166,3 +166,35 @@ def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable
             last[0] = now
             report(t)
     return progress
+
+
+HEARTBEAT_S = 10.0  # s of wall time between two "still running" lines of one long step
+
+
+class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)
+    """``with heartbeat(report, what):`` a long step that prints nothing of its own (a batch of runs, an index's
+    bootstrap) says ``"{what}: still running ({s} s)"`` through ``report`` every ``every_s`` seconds of wall time
+    until it ends; silent when it ends sooner. A daemon thread: it never holds up the process's exit."""
+
+    def __init__(self, report: Callable[[str], None], what: str, every_s: float = HEARTBEAT_S):
+        self.report, self.what, self.every_s = report, what, every_s
+
+    def __enter__(self) -> "heartbeat":
+        import threading
+        import time
+
+        self._stop = threading.Event()
+        started = time.monotonic()
+
+        def beat() -> None:
+            while not self._stop.wait(self.every_s):
+                self.report(f"{self.what}: still running ({time.monotonic() - started:.0f} s)")
+
+        self._thread = threading.Thread(target=beat, name="ipir-heartbeat", daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> bool:
+        self._stop.set()
+        self._thread.join()
+        return False

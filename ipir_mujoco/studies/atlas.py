@@ -42,6 +42,7 @@ from typing import Callable
 import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.options import heartbeat
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
@@ -267,15 +268,16 @@ def _run(atlas: Atlas, out: Path, meta: Path, fingerprint: str, U: np.ndarray, s
             if IDEALIZATIONS[name].equations is None:
                 continue
             progress(f"{name} (equations): {len(designs)} designs")
-            rows = store.evaluate(name, "equations", designs)
-            measured[(name, "equations")] = (U, rows)
-            entry = result["idealizations"].setdefault(name, {})
-            try:
-                fit(name, "equations", U, rows, MAX_POINTS)
-            except ValueError:
-                pass  # no design gave a cost: reported per metric below
-            for m in atlas.metrics:
-                entry[m] = _equations_entry(atlas, name, m, U, rows, saltelli, store, workers)
+            with heartbeat(progress, f"{name} (equations)"):  # the runs, the fits and the indices: tens of s
+                rows = store.evaluate(name, "equations", designs)
+                measured[(name, "equations")] = (U, rows)
+                entry = result["idealizations"].setdefault(name, {})
+                try:
+                    fit(name, "equations", U, rows, MAX_POINTS)
+                except ValueError:
+                    pass  # no design gave a cost: reported per metric below
+                for m in atlas.metrics:
+                    entry[m] = _equations_entry(atlas, name, m, U, rows, saltelli, store, workers)
             for m in atlas.metrics:  # the dense sample and every metric's crossings: the idealization's runs
                 entry[m]["runs"] = 2 * store.count(name, "equations")
 
