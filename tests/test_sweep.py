@@ -102,12 +102,47 @@ def test_a_failing_design_is_recorded_and_the_sweep_goes_on(tmp_path):
     assert by_id[1]["error"] == "" and float(by_id[1]["mujoco-ratchet:revolutions"]) > 0.3
 
 
+# The command line in a child whose designs from L = HOLD_FROM on wait for the interrupt (pool workers fork with
+# the patch): the sweep cannot end before the test's Ctrl-C, however busy the machine (a test that raced a
+# running sweep failed when the sweep won); the designs before it run as the command runs them.
+HELD_SWEEP = """
+import sys, time
+from ipir_mujoco.studies import sweep as sweep_module
+HOLD_FROM = float(sys.argv.pop(1))
+real_engine, real_chunk = sweep_module.run_engine, sweep_module.run_batch_chunk
+
+def wait_for_the_interrupt():
+    while True:
+        time.sleep(1)
+
+def run_engine(engine, params, *args):
+    if params.L >= HOLD_FROM:
+        wait_for_the_interrupt()
+    return real_engine(engine, params, *args)
+
+def run_batch_chunk(values, *args, **kwargs):
+    if any(v["L"] >= HOLD_FROM for v in values):
+        wait_for_the_interrupt()
+    return real_chunk(values, *args, **kwargs)
+
+sweep_module.run_engine, sweep_module.run_batch_chunk = run_engine, run_batch_chunk
+from ipir_mujoco.cli import console
+sys.exit(console())
+"""
+
+
+def held_sweep(hold_from: float, argv: list[str], **popen) -> subprocess.Popen:
+    """``ipir-mujoco sweep ARGV`` in a child whose designs with L >= ``hold_from`` never end (HELD_SWEEP)."""
+    return subprocess.Popen([sys.executable, "-c", HELD_SWEEP, repr(hold_from), "sweep", *argv], **popen)
+
+
 @pytest.mark.slow
 def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
     out = tmp_path / "s"
-    command = [sys.executable, "-m", "ipir_mujoco", "sweep", "--vary", "L=0.07:0.4:24", "--engines",
-               "analytic-unilateral", "--t-end", "1", "--out", str(out), "--workers", "2"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # L = 0.07 + k 0.33/23: designs 0-5 run, 6-23 wait (L >= 0.15) until the Ctrl-C
+    process = held_sweep(0.15, ["--vary", "L=0.07:0.4:24", "--engines", "analytic-unilateral", "--t-end", "1",
+                                "--out", str(out), "--workers", "2"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     results = out / "results.csv"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:  # wait until some designs are written, then interrupt
@@ -199,9 +234,10 @@ def test_ctrl_c_halfway_through_a_default_engine_sweep_keeps_the_finished_design
     """The MuJoCo batch streams by chunks: rows of both engines reach the file before the sweep ends."""
     out = tmp_path / "s"
     designs = 32
-    command = [sys.executable, "-m", "ipir_mujoco", "sweep", "--vary", f"L=0.07:0.4:{designs}", "--t-end", "0.5",
-               "--out", str(out), "--workers", "2", "--batch-size", "4"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # L = 0.07 + k 0.33/31: from design 15 on (L >= 0.22) and the MuJoCo chunks that hold one wait for the Ctrl-C
+    process = held_sweep(0.22, ["--vary", f"L=0.07:0.4:{designs}", "--t-end", "0.5", "--out", str(out),
+                                "--workers", "2", "--batch-size", "4"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     _wait_for_rows(out / "results.csv", 2, process)
     seen = len(rows_of(out / "results.csv"))
     process.send_signal(signal.SIGINT)
@@ -226,9 +262,9 @@ def _alive(pid: int) -> bool:
 @pytest.mark.slow
 def test_sigkill_of_the_main_process_leaves_no_worker_alive(tmp_path):
     out = tmp_path / "s"
-    command = [sys.executable, "-m", "ipir_mujoco", "sweep", "--vary", "L=0.07:0.4:40", "--engines",
-               "analytic-unilateral", "--t-end", "1", "--out", str(out), "--workers", "2"]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # from design 4 on (L >= 0.1) the workers wait: they are alive when the main process is killed
+    process = held_sweep(0.1, ["--vary", "L=0.07:0.4:40", "--engines", "analytic-unilateral", "--t-end", "1",
+                               "--out", str(out), "--workers", "2"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     workers: list[int] = []
     try:
         _wait_for_rows(out / "results.csv", 1, process)
