@@ -2,9 +2,9 @@
 
 The commands come from README.md, docs/*.md, mjcf/README.md, the route files' headers and the modules'
 docstrings (tests/docs_commands.py says how they are found and shortened). They run as a user types them,
-in a scratch folder, through the installed ``ipir-mujoco`` and this interpreter as ``python``, two at a
-time; each must exit 0 with no traceback, a synopsis must match its ``--help``, quoted output must be
-printed. Running them takes minutes: those tests are marked slow; the extraction itself is checked fast.
+in a scratch folder, through the installed ``ipir-mujoco`` and this interpreter as ``python`` (one code block
+after another on each pytest-xdist worker; in one process, two blocks at a time); each must exit 0 with no
+traceback, a synopsis must match its ``--help``, quoted output must be printed. Running them takes minutes: those tests are marked slow; the extraction itself is checked fast.
 """
 
 from __future__ import annotations
