@@ -224,15 +224,16 @@ def test_registry_run_raises_keyboard_interrupt_wherever_the_signal_lands(varian
     for k in range(6):
         timer = _interrupt_soon(0.02 + 0.04 * k)
         try:
-            registry.run(variant, RobotParams(), 2.0)
-            outcomes.add("finished")
-            # the signal lands here if the run ended first: wait for it whatever the load (a timer on a busy
-            # machine fires late), so that none is left to land in a later test
-            timer.join()
+            try:
+                registry.run(variant, RobotParams(), 2.0)
+                outcomes.add("finished")
+            finally:
+                # the signal lands here if the run ended first: wait for it whatever the load (a timer on a busy
+                # machine fires late), inside this try, so that none is left to land outside it or in a later test
+                timer.join()
             time.sleep(0)  # Python runs the handler at the next instruction
         except KeyboardInterrupt:
             outcomes.add("interrupted")
-        timer.join()
     assert "interrupted" in outcomes
     # Python's handler back, or the package's (installed by importing the command line), raising as Python's does
     assert signal.getsignal(signal.SIGINT) in (signal.default_int_handler, interrupts.handler)

@@ -172,23 +172,31 @@ HEARTBEAT_S = 10.0  # s of wall time between two "still running" lines of one lo
 
 
 class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)
-    """``with heartbeat(report, what):`` a long step that prints nothing of its own (a batch of runs, an index's
-    bootstrap) says ``"{what}: still running ({s} s)"`` through ``report`` every ``every_s`` seconds of wall time
-    until it ends; silent when it ends sooner. A daemon thread: it never holds up the process's exit."""
+    """``with heartbeat(report, what) as beat:`` a long step says ``"{what}: still running ({s} s)"`` through
+    ``report`` whenever ``every_s`` seconds of wall time pass with no line; the step's own lines go through
+    ``beat.say(message)`` (to ``report``), each restarting that clock, so a step that reports often adds
+    nothing. Silent when it ends sooner. A daemon thread: it never holds up the process's exit."""
 
     def __init__(self, report: Callable[[str], None], what: str, every_s: float = HEARTBEAT_S):
         self.report, self.what, self.every_s = report, what, every_s
+
+    def say(self, message: str) -> None:
+        import time
+
+        self._last = time.monotonic()
+        self.report(message)
 
     def __enter__(self) -> "heartbeat":
         import threading
         import time
 
         self._stop = threading.Event()
-        started = time.monotonic()
+        self._started = self._last = time.monotonic()
 
         def beat() -> None:
-            while not self._stop.wait(self.every_s):
-                self.report(f"{self.what}: still running ({time.monotonic() - started:.0f} s)")
+            while not self._stop.wait(max(0.0, self._last + self.every_s - time.monotonic())):
+                if time.monotonic() - self._last >= self.every_s:
+                    self.say(f"{self.what}: still running ({time.monotonic() - self._started:.0f} s)")
 
         self._thread = threading.Thread(target=beat, name="ipir-heartbeat", daemon=True)
         self._thread.start()

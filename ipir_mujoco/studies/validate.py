@@ -70,7 +70,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import throttled
+from ipir_mujoco.core.options import heartbeat, throttled
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
@@ -360,7 +360,8 @@ def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Call
     for section in sections:
         started = time.perf_counter()
         progress(f"{section.title} ...")
-        result = section.compute(params, quick, lambda m, s=section: progress(f"{s.title}: {m}"))
+        with heartbeat(progress, section.title) as beat:  # a line at least every 10 s whatever the section does
+            result = section.compute(params, quick, lambda m, s=section: beat.say(f"{s.title}: {m}"))
         metrics["sections"][section.key] = result
         if section.verdict is not None and (verdict := section.verdict(result)) is not None:
             missing = [k for k in VERDICT_KEYS if k not in verdict]
