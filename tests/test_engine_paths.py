@@ -65,13 +65,15 @@ RUN = ("from ipir_mujoco.analytic import RobotParams\n"
        "print(','.join(sorted(used)), run.series['x1'][-1].hex())\n")
 
 
-def test_a_run_through_the_older_paths_steps_in_both_loops():
+def test_a_run_through_the_older_paths_steps_in_both_loops(tmp_path):
     """The same short run in a fresh process, once with the compiled loop (where it is built) and once with
-    IPIR_MUJOCO_STEPPER=python: the same final position, bit for bit (the two loops round alike)."""
+    IPIR_MUJOCO_STEPPER=python: the same final position, bit for bit (the two loops round alike). The processes
+    run in an empty folder: ``python -c`` puts its working folder first on sys.path, and from the repository's
+    root it would import the source tree, which a non-editable install (CI's) leaves without its compiled loop."""
     env = {k: v for k, v in os.environ.items() if k != stepper.ENV}
-    compiled = subprocess.run([sys.executable, "-c", RUN], capture_output=True, text=True, env=env)
+    compiled = subprocess.run([sys.executable, "-c", RUN], capture_output=True, text=True, env=env, cwd=tmp_path)
     python = subprocess.run([sys.executable, "-c", RUN], capture_output=True, text=True,
-                            env={**env, stepper.ENV: "python"})
+                            env={**env, stepper.ENV: "python"}, cwd=tmp_path)
     assert compiled.returncode == python.returncode == 0 and compiled.stderr == python.stderr == ""
     loop, x1 = compiled.stdout.split()
     assert python.stdout.split() == ["PythonSteps", x1]
