@@ -22,7 +22,7 @@ from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.results import Mode
 from ipir_mujoco.engine.modelkinds import kinds
 from ipir_mujoco.engine.loop.controller import ROLLING, SKIDDING, STANDING, ClutchController
-from ipir_mujoco.engine.run.run_setup import RunSetup
+from kind_setup import started_setup
 
 GRIP = dict(mu_wall=0.5, F_n1=10.0, F_n2=10.0)
 COMPLIANT = dict(clutch_stiffness=1e5, clutch_damping=5.0)
@@ -41,20 +41,11 @@ IDS = [f"{v}-{c}-{'grip' if p.mu_wall else 'unlimited'}" for v, p, _, c in CASES
 STATES = {float(ROLLING), float(STANDING), float(SKIDDING)}
 
 
-def _setup(variant: str, params: RobotParams, implementation: str | None = None) -> RunSetup:
-    v = registry.variant(variant)
-    kind = kinds.kind_for(v.model, params)
-    implementation = implementation or v.clutch
-    params = kind.check(params, implementation, v.rule)
-    settings, _ = kind.settings(params, 0.01, 1e-3, None, implementation)
-    setup = RunSetup(kind, params, settings, implementation=implementation, rule=v.rule)
-    setup.start()
-    return setup
 
 
 @pytest.mark.parametrize("variant, params, kind, controller", CASES, ids=IDS)
 def test_each_kind_makes_its_controller_and_it_reports_the_protocols_shapes(variant, params, kind, controller):
-    setup = _setup(variant, params)
+    setup = started_setup(variant, params)
     assert kinds.kind_for(registry.variant(variant).model, params) is kind
     ctl = setup.controller
     assert type(ctl).__name__ == controller
@@ -72,7 +63,7 @@ def test_each_kind_makes_its_controller_and_it_reports_the_protocols_shapes(vari
 
 
 def test_no_clutch_is_a_controller_of_the_slide_kind_too():
-    setup = _setup("mujoco-ratchet", RobotParams(), implementation="none")
+    setup = started_setup("mujoco-ratchet", RobotParams(), implementation="none")
     assert type(setup.controller).__name__ == "NoClutch" and setup.controller.reactions() == (False, False, 0.0, 0.0)
     assert setup.controller.wheels() == (0.0, 0.0)
 
@@ -122,7 +113,7 @@ def test_kinds_are_named_once_and_unknown_models_are_one_line():
     with pytest.raises(ValueError, match="mujoco model 'tracks' is unknown; allowed: slides, wheels"):
         kinds.kind_for("tracks", RobotParams())
     assert [kind.accuracy for kind in (kinds.SLIDES, kinds.GRIP_SLIDES, kinds.WHEELS)] == ["stop", "stop", "warn"]
-    assert isinstance(_setup("mujoco-ratchet", RobotParams()).model, mujoco.MjModel)
+    assert isinstance(started_setup("mujoco-ratchet", RobotParams()).model, mujoco.MjModel)
 
 
 def test_every_engine_audits_the_energy_terms_of_the_one_table():

@@ -19,6 +19,7 @@ import pytest
 from ipir_mujoco.analytic import RobotParams, SimulationError
 from ipir_mujoco.engine import CrankServo, simulate_mujoco
 from ipir_mujoco.engine.loop import native, stepper
+from kind_setup import started_setup
 from ipir_mujoco.engine.modelkinds import loop_rows
 from ipir_mujoco.engine.run.batch import run_ratchet_batch
 from ipir_mujoco.engine.clutches import Ratchet
@@ -154,17 +155,7 @@ def test_each_compiled_controller_has_its_own_block():
     ("mujoco-wheels", RobotParams(mu_wall=0.5), None)])
 def test_every_controller_of_every_model_kind_steps_compiled(variant, params, implementation):
     """No model kind's controller falls back to the Python loop where the compiled one is built."""
-    from ipir_mujoco import registry
-    from ipir_mujoco.engine import kinds
-    from ipir_mujoco.engine.run_setup import RunSetup
-
-    v = registry.variant(variant)
-    kind = kinds.kind_for(v.model, params)
-    implementation = implementation or v.clutch
-    params = kind.check(params, implementation, v.rule)
-    settings, _ = kind.settings(params, 0.01, 1e-3, None, implementation)
-    setup = RunSetup(kind, params, settings, implementation=implementation, rule=v.rule)
-    setup.start()
+    setup = started_setup(variant, params, implementation)
     steps, _ = setup.steps(np.empty((2, setup.model.nv)))
     assert type(steps) is stepper.CompiledSteps
 
