@@ -99,20 +99,61 @@ HEARTBEAT_S = 10.0  # s between two "still compiling" lines
 HEARTBEAT_MAX = 30  # lines at most (5 min): where the cache cannot be written, compiling never shows as done
 
 
+class _Compiles:
+    """numba's compiles under way in this process, from its ``numba:compile`` events (fired only when a kernel
+    is compiled, not when it is loaded from the cache): how many are open, and when the last began or ended
+    (time.monotonic() [s]). numba compiles each kernel at its first call, some of them well after the
+    stepper's, so the heartbeat asks this rather than the cache alone whether compiling goes on."""
+
+    def __init__(self) -> None:
+        self.open = 0
+        self.last = time.monotonic()
+
+    def busy_within(self, seconds: float) -> bool:
+        """True while a compile is open or one began or ended in the last ``seconds``."""
+        return self.open > 0 or time.monotonic() - self.last < seconds
+
+    def listener(self):
+        """A numba event listener counting this process's compiles (numba.core.event.register it)."""
+        from numba.core import event
+
+        compiles = self
+
+        class Counter(event.Listener):
+            def on_start(self, _event) -> None:
+                compiles.open += 1
+                compiles.last = time.monotonic()
+
+            def on_end(self, _event) -> None:
+                compiles.open -= 1
+                compiles.last = time.monotonic()
+
+        return Counter()
+
+
 def _heartbeat() -> None:
-    """While the kernels compile (numba compiles each at its first call, inside the run that follows), say
-    every HEARTBEAT_S that it is still compiling, on logger 'ipir_mujoco', until the compiled stepper's
-    cache index appears (:func:`compilation_pending` turns False). A daemon thread: it never holds up the
-    process's exit."""
+    """While the kernels compile (numba compiles each at its first call, inside the runs that follow), say
+    every HEARTBEAT_S that it is still compiling, on logger 'ipir_mujoco', until the compiled stepper's cache
+    index has appeared (:func:`compilation_pending` turns False) and no kernel has been compiling for a whole
+    HEARTBEAT_S; then say how long it took (up to the last compile's end). A daemon thread: it never holds up
+    the process's exit."""
+    from numba.core import event
+
     started = time.monotonic()
+    compiles = _Compiles()
+    listener = compiles.listener()
+    event.register("numba:compile", listener)
 
     def beat() -> None:
-        for _ in range(HEARTBEAT_MAX):
-            time.sleep(HEARTBEAT_S)
-            if not compilation_pending():
-                log.info(f"kernels compiled ({time.monotonic() - started:.0f} s)")
-                return
-            log.info(f"still compiling the kernels ({time.monotonic() - started:.0f} s so far)")
+        try:
+            for _ in range(HEARTBEAT_MAX):
+                time.sleep(HEARTBEAT_S)
+                if not compilation_pending() and not compiles.busy_within(HEARTBEAT_S):
+                    log.info(f"kernels compiled ({max(compiles.last, started) - started:.0f} s)")
+                    return
+                log.info(f"still compiling the kernels ({time.monotonic() - started:.0f} s so far)")
+        finally:
+            event.unregister("numba:compile", listener)
 
     threading.Thread(target=beat, name="ipir-compile-heartbeat", daemon=True).start()
 

@@ -228,6 +228,7 @@ def test_compiling_is_announced_once_in_one_line_where_it_compiles(tmp_path, mon
     accel.log.addHandler(handler)
     monkeypatch.setattr(accel.log, "level", logging.INFO)
     monkeypatch.setattr(accel, "HEARTBEAT_S", 0.01)  # the heartbeat's period, shortened
+    monkeypatch.setattr(accel, "HEARTBEAT_MAX", 10**9)  # and no cap on its lines, whatever the load
 
     def logged(text: str) -> bool:  # wait (up to 60 s, the heartbeat thread's turn) for a line holding text
         for _ in range(6000):
@@ -238,10 +239,24 @@ def test_compiling_is_announced_once_in_one_line_where_it_compiles(tmp_path, mon
 
     try:
         assert accel.compilation_pending() and accel.accelerate()
-        # while compiling it says so every HEARTBEAT_S, until the compiled stepper's cache index appears
+        # while compiling it says so every HEARTBEAT_S, until the compiled stepper's cache index appears and no
+        # kernel is compiling
         assert logged("still compiling the kernels")
         (tmp_path / "analytic_x").mkdir()
+        # the stepper's cache index is there, but a kernel compiled later (numba compiles each at its first call)
+        # is still compiling: the heartbeat goes on, whatever the timing, until that compile has ended
+        from numba.core import event
+
+        event.start_event("numba:compile")
         (tmp_path / "analytic_x" / "dop853.step-1.py311.nbi").write_bytes(b"")
+        beats = sum("still compiling" in r.getMessage() for r in records)
+        for _ in range(6000):  # two more beats (up to 60 s, the heartbeat thread's turn)
+            if sum("still compiling" in r.getMessage() for r in records) >= beats + 2:
+                break
+            time.sleep(0.01)
+        assert sum("still compiling" in r.getMessage() for r in records) >= beats + 2
+        assert not any("kernels compiled" in r.getMessage() for r in records)
+        event.end_event("numba:compile")
         assert logged("kernels compiled")
         monkeypatch.setattr(accel, "ACCELERATED", False)
         count = len(records)
