@@ -34,10 +34,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"validate: {message}", file=sys.stderr, flush=True)
 
     metrics, rungs = validate(params, quick=args.quick, progress=progress, sections=SECTIONS)
-    progress("writing report ...")
     with staged_output(args.out) as staging:
         write_json(staging / "metrics.json", metrics)
-        write_report(staging, metrics, rungs, SECTIONS)
+        write_report(staging, metrics, rungs, SECTIONS, progress=progress)
     for verdict in metrics["verdicts"]:
         print(f"{verdict['question']}\n  {verdict['answer']}")
     print(f"report: {args.out}/index.html (also report.md, metrics.json, figures/)")

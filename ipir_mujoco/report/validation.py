@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import matplotlib.ticker
 import numpy as np
 
+from ipir_mujoco.core.options import heartbeat
 from ipir_mujoco.core.results import Mode
 
 from ..labels import summary_label
@@ -352,26 +353,33 @@ def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | Non
     return None, settings
 
 
-def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: Sequence = ()) -> None:
+def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: Sequence = (),
+                 progress: Callable[[str], None] = lambda _m: None) -> None:
     """Write figures/, report.md and index.html into ``folder`` (metrics.json is the caller's).
 
     ``sections`` (:class:`ipir_mujoco.report.sections.Section`) draw their parts
     from ``metrics["sections"]``, after the core and before the numerical evidence.
+    ``progress`` hears a line per group of figures, and one at least every 10 s of wall time
+    (the animation takes several seconds).
     """
     figures_dir = folder / "figures"
     figures_dir.mkdir(parents=True, exist_ok=True)
-    drawn = [r for r in rungs if r.name in FIGURE_RUNGS]
-    write_paper_figures([r.run for r in drawn], figures_dir, labels=[r.name for r in drawn])
-    write_mechanism_diagram(figures_dir / "mechanism.png", rungs[0].run.params)
-    figure_clutch_reactions(rungs[0], figures_dir / "clutch_reactions.png")
-    figure_lr_study(metrics["lr_study"], figures_dir / "lr_study.png")
-    figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
-    overview_figure(metrics).savefig(figures_dir / OVERVIEW, dpi=110)
-    physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
-    note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
-    extra = []
-    for section in sections:
-        extra += section.render(metrics["sections"][section.key], figures_dir)
+    with heartbeat(progress, "writing report") as beat:
+        beat.say("writing report: the ladder's figures")
+        drawn = [r for r in rungs if r.name in FIGURE_RUNGS]
+        write_paper_figures([r.run for r in drawn], figures_dir, labels=[r.name for r in drawn])
+        write_mechanism_diagram(figures_dir / "mechanism.png", rungs[0].run.params)
+        figure_clutch_reactions(rungs[0], figures_dir / "clutch_reactions.png")
+        figure_lr_study(metrics["lr_study"], figures_dir / "lr_study.png")
+        figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
+        overview_figure(metrics).savefig(figures_dir / OVERVIEW, dpi=110)
+        beat.say("writing report: the animation")
+        physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
+        note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
+        extra = []
+        for section in sections:
+            beat.say(f"writing report: {section.title}")
+            extra += section.render(metrics["sections"][section.key], figures_dir)
     figures = {p.name: f"figures/{p.name}" for p in figures_dir.iterdir()}
     blocks = build_blocks(metrics, figures, note, animation, extra)
     (folder / "report.md").write_text(to_markdown(blocks))
