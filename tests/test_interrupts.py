@@ -198,9 +198,11 @@ def test_ctrl_c_at_any_moment_is_at_most_one_line(tmp_path, target):
     done = subprocess.run([sys.executable, "-c", CHILD, target, *argv], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300, preexec_fn=_default_sigint)
     assert (tmp_path / "reached").exists(), f"{target} was never imported"
-    assert "Traceback" not in done.stderr and done.stderr.count("\n") <= 1, done.stderr
+    # a run lasting over 2 s of wall time (a loaded machine) says how far it got: progress, not a message
+    said = [line for line in done.stderr.splitlines() if not line.startswith("simulated ")]
+    assert "Traceback" not in done.stderr and len(said) <= 1, done.stderr
     if target == "after":
-        assert done.returncode == 0 and done.stderr == "" and (tmp_path / "out" / "summary.json").is_file()
+        assert done.returncode == 0 and said == [] and (tmp_path / "out" / "summary.json").is_file()
     else:
         assert done.returncode == 130 and done.stderr.strip().endswith("interrupted"), done.stderr
         assert not (tmp_path / "out").exists()

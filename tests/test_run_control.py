@@ -76,3 +76,23 @@ def test_a_long_step_says_it_is_still_running_until_it_ends():
     with heartbeat(report, "short", every_s=3600) as beat:
         beat.say("short: its own line")  # passed on as it is
     assert lines[seen:] == ["short: its own line"]  # and nothing else: it ended before its first beat
+
+
+@pytest.mark.parametrize("t_end", [60.0, 1.0])  # a route's cap (tenths and wall lines), a short run (wall only)
+def test_a_long_run_in_a_log_says_where_it_is_after_2_s_then_every_10_s(t_end, monkeypatch, capsys):
+    """cli.common.progress_printer in a log file (stderr not a terminal), on a made-up clock: nothing while the
+    run is younger than FIRST_WALL_S, a line at it, then one each WALL_EVERY_S (a run finished sooner is silent)."""
+    import time
+
+    from ipir_mujoco.cli import common
+
+    clock = [100.0]
+    monkeypatch.setattr(time, "monotonic", lambda: clock[0])
+    report = common.progress_printer(t_end)
+    printed = []
+    for wall, simulated in [(1.9, 0.01), (2.0, 0.02), (11.9, 0.03), (12.0, 0.04), (15.0, 0.05)]:
+        clock[0] = 100.0 + wall
+        report(simulated)
+        printed += capsys.readouterr().err.splitlines()
+    assert common.FIRST_WALL_S == 2.0 and common.WALL_EVERY_S == 10.0  # the times above are these
+    assert printed == [f"simulated 0.02 / {t_end:g} s", f"simulated 0.04 / {t_end:g} s"]

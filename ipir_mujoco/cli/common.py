@@ -93,6 +93,7 @@ def check_input_file(option: str, path: str) -> None:
 
 
 WALL_EVERY_S = 10.0  # s of wall time: the longest a long run's progress stays silent in a log file
+FIRST_WALL_S = 2.0  # s of wall time before a long run's first such line (work longer than 2 s shows progress)
 
 
 def tenths_printer(total: float, text: Callable[[float], str], final_within: float = 0.0,
@@ -100,14 +101,15 @@ def tenths_printer(total: float, text: Callable[[float], str], final_within: flo
     """Progress on stderr, ``report(done)`` for ``done`` of ``total`` (any unit): on a terminal one line
     (``text(done)``) rewritten in place, ended once ``done`` is within ``final_within`` of ``total``; in a log
     file one line per tenth of the total and, with ``every_s`` [s], one at least every ``every_s`` seconds of wall
-    time (a run capped far beyond where it ends, as a route's, would otherwise print nothing for minutes)."""
+    time (a run capped far beyond where it ends, as a route's, would otherwise print nothing for minutes), the
+    first of them after FIRST_WALL_S."""
     import time
 
     if sys.stderr.isatty():
         def report(done: float) -> None:
             print("\r" + text(done), end="\n" if done >= total - final_within else "", file=sys.stderr, flush=True)
         return report
-    shown, last = [0], [time.monotonic()]
+    shown, last = [0], [time.monotonic() - (every_s or 0.0) + FIRST_WALL_S]
 
     def report_lines(done: float) -> None:
         tenth = min(int(10 * done / total + 1e-9), 10)
@@ -121,8 +123,8 @@ def tenths_printer(total: float, text: Callable[[float], str], final_within: flo
 def progress_printer(t_end: float):
     """Progress of a run on stderr (:func:`tenths_printer` of the simulated time [s], the callable's argument):
     per tenth of the simulated time for runs long enough to wait for (simulated time > 2 s), and in a log file at
-    least every WALL_EVERY_S of wall time whatever the length (a wheeled run steps ~20-30 s of wall time per
-    simulated second; a short fast run prints nothing)."""
+    least every WALL_EVERY_S of wall time whatever the length, the first after FIRST_WALL_S (a wheeled run steps
+    seconds of wall time per simulated second; a run done within FIRST_WALL_S prints nothing)."""
     import time
 
     def text(t: float) -> str:
@@ -131,7 +133,7 @@ def progress_printer(t_end: float):
         return tenths_printer(t_end, text, final_within=0.05, every_s=WALL_EVERY_S)
     if sys.stderr.isatty():
         return None
-    last = [time.monotonic()]
+    last = [time.monotonic() - WALL_EVERY_S + FIRST_WALL_S]
 
     def wall_only(t: float) -> None:  # a short run: the wall clock's lines only
         now = time.monotonic()
