@@ -15,13 +15,23 @@ command's clean-up (killing a pool's workers, sorting a results file) is not cut
 From Python, :func:`watching` installs it for the length of a run where Python's default handler is in
 place, and leaves any handler of the caller's alone.
 
-Imports nothing but the standard library's signal and os: it is loaded before numpy.
+One place a command's KeyboardInterrupt is never raised: inside code run from a string (``exec``/``eval``
+of source text, which namedtuple, dataclasses, numba's generated code and MuJoCo's bindings all do while
+the work goes on). CPython marks a KeyboardInterrupt that leaves such code as unhandled even when the
+program catches it later, and a process started as ``python -m ipir_mujoco`` then kills itself by SIGINT
+when it exits (status -2, after its one "interrupted" line; seen with Python 3.11 to 3.13). There the handler lets
+the signal through again a moment later (:func:`_pass_on`) and raises at the first check outside.
+
+Imports nothing but the interpreter's own modules (signal, _thread, os, threading, time): it is loaded
+before numpy.
 """
 
 from __future__ import annotations
 
+import _thread
 import os
 import threading
+import time
 from contextlib import contextmanager
 
 try:  # the interpreter's own module, loaded at start-up: no import time in which a Ctrl-C could land
@@ -43,6 +53,7 @@ class _State:
     loading = False  # the command line is still importing: a SIGINT ends the process at once
     process = False  # the command line runs as the process (its console entry): ignore SIGINT once it is done
     count = 0  # SIGINTs received while handler() was installed, ever
+    passed_on = False  # the next call is a SIGINT handler() let through again (already counted)
 
 
 state = _State()
@@ -52,13 +63,41 @@ def handler(signum, frame):  # noqa: ARG001 (signal handler signature)
     """The package's SIGINT handler: count the signal; while loading, leave in one line (exit 130); else raise
     KeyboardInterrupt, as Python's default handler does, except that in a command only the first signal
     raises (later ones are only counted, so that the command's clean-up is not cut short)."""
-    state.count += 1
+    if state.passed_on:
+        state.passed_on = False
+    else:
+        state.count += 1
     if state.loading:
         os.write(2, LOADING_LINE)
         os._exit(EXIT_INTERRUPTED)
     if state.armed:
+        if state.process and _in_code_from_a_string(frame):  # see the module's docstring
+            state.passed_on = True
+            _thread.start_new_thread(_pass_on, ())  # not threading's: the main thread may hold its locks
+            return
         state.armed = not state.command
         raise KeyboardInterrupt
+
+
+PASS_ON_S = 0.005  # s before a signal held back is let through again (a string's code runs for microseconds)
+
+
+def _pass_on() -> None:
+    """From another thread: :func:`handler` again in the main thread at its next check (a thread, as the
+    main thread would otherwise run it at once, inside the same code)."""
+    time.sleep(PASS_ON_S)
+    _thread.interrupt_main(_sig.SIGINT)  # does nothing once the command ended (SIGINT ignored)
+
+
+def _in_code_from_a_string(frame) -> bool:
+    """Whether ``frame`` runs inside code that ``exec`` or ``eval`` runs from source text (CPython compiles it
+    as ``<module>`` of ``<string>``); the outermost frame (``python -c``'s own code) does not count."""
+    while frame is not None and frame.f_back is not None:
+        code = frame.f_code
+        if code.co_name == "<module>" and code.co_filename == "<string>":
+            return True
+        frame = frame.f_back
+    return False
 
 
 def count() -> int:
