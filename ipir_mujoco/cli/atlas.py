@@ -11,8 +11,7 @@ from .common import EXIT_OK, add_model_options, model_params, study_progress
 
 
 def add_parser(commands) -> None:
-    from ..studies.atlas import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE
-    from ..studies.atlas_space import NAMES
+    from ..studies.atlas_space import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, NAMES
 
     atl = commands.add_parser(
         "atlas", help="where each of the paper's idealizations costs less than a threshold, over design ranges",

@@ -49,14 +49,12 @@ from ipir_mujoco.core.results import write_json
 from ..output import check_output_dir, study_folder
 from .atlas_adaptive import explore, refine_crossings
 from .atlas_eval import Samples
-from .atlas_space import DEFAULT_METRICS, IDEALIZATIONS, MOTOR_METRICS, NAMES, TORQUE_METRICS, allowed
+from .atlas_space import (DEFAULT_BUDGET, DEFAULT_METRICS, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, IDEALIZATIONS,
+                          MOTOR_METRICS, NAMES, TORQUE_METRICS, allowed)
 from .atlas_surrogate import MAX_POINTS, CostSurrogate, regions, safe_fraction
 from .sweep import refuse_all_invalid
 from .sweep_space import Axis, T_END_STEADY
 
-DEFAULT_BUDGET = 100  # MuJoCo runs (2 per design)
-DEFAULT_SAMPLES = 64  # Saltelli base samples of the equations: 64 (d + 2) designs
-DEFAULT_TOLERANCE = 0.02  # share of the box left undecided at which MuJoCo's exploration stops
 CANDIDATES = 4096  # space-filling designs on which the surrogates are read (safe fractions, placement)
 
 

@@ -41,6 +41,11 @@ from ipir_mujoco.core.results import RunResult
 from .ladder import VALIDATION_LADDER, Rung
 
 RUNGS = {rung.name: rung for rung in VALIDATION_LADDER}
+# the atlas's defaults, here rather than in atlas.py so that the command line's help reads them without loading
+# the surrogate's scipy (half a second of every command's start)
+DEFAULT_BUDGET = 100  # MuJoCo runs (2 per design)
+DEFAULT_SAMPLES = 64  # Saltelli base samples of the equations: 64 (d + 2) designs
+DEFAULT_TOLERANCE = 0.02  # share of the box left undecided at which MuJoCo's exploration stops
 ANALYTIC_WALL_BUDGET_S = 120.0  # s: an analytic run's wall-time budget (they take milliseconds to a second)
 
 # metric: (in words, unit)
