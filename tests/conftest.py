@@ -6,9 +6,14 @@ one-way-clutch solver was developed), run with HYPOTHESIS_PROFILE=explore.
 """
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from docs_commands import SHARED_RUNS  # noqa: E402
 
 settings.register_profile("repeatable", derandomize=True, deadline=None)
 settings.register_profile("explore", derandomize=False, deadline=None, max_examples=300)
@@ -40,11 +45,34 @@ SPLIT_BY_FIRST_WORD_OF_ID = ("tests/test_docs_commands.py::test_documented_comma
 
 
 def scope_of(nodeid: str) -> str:
-    """The group a test runs in: its module, or for a test listed above, the first word of its id."""
+    """The group a test runs in: its module, or for a test listed above, the first word of its id; a documented
+    command whose run other tests read (docs_commands.SHARED_RUNS) goes with their module."""
     for prefix in SPLIT_BY_FIRST_WORD_OF_ID:
         if nodeid.startswith(prefix):
-            return prefix + nodeid[len(prefix):].split(" ", 1)[0]
+            words = nodeid[len(prefix):-1].split(" ", 2)
+            for documented, _ran, reader in SHARED_RUNS:
+                if words[-1] == documented:
+                    return reader
+            return prefix + words[0]
     return nodeid.split("::", 1)[0]
+
+
+@pytest.fixture(scope="session")
+def shared_command(tmp_path_factory):
+    """``shared_command(text)``: ``text`` run once by bash in a folder of its own in this pytest process, as a
+    user types it (cli_run.run_shell); the CompletedProcess with ``.folder`` where it ran. For the runs several
+    tests read (docs_commands.SHARED_RUNS)."""
+    from cli_run import run_shell
+
+    done = {}
+
+    def run(text: str):
+        if text not in done:
+            folder = tmp_path_factory.mktemp("shared")
+            done[text] = run_shell(text, folder)
+            done[text].folder = folder
+        return done[text]
+    return run
 
 
 def pytest_addoption(parser, pluginmanager):

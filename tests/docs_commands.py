@@ -23,9 +23,10 @@ What a command is:
 - a command that reads a file the pages do not make (``--data run.csv``) runs its ``--help``;
 - anything else runs as written, with these shortenings (said so in docs/cli.md, "Every documented command
   is tested"): a benchmark (``python bench/NAME.py``) gets ``--smoke``, a command that takes ``--quick``
-  gets it, ``--samples`` above 64 and ``--mujoco-samples`` above 3 are cut to that, and a command that
-  leaves ``--samples`` or ``--budget`` (where it has them) at its default runs with ``--samples 16``,
-  ``--budget 8``; a shortened command's output is not compared.
+  gets it, ``--samples`` and ``--budget`` above 16 and ``--mujoco-samples`` above 3 are cut to that, a
+  command that leaves ``--samples`` or ``--budget`` (where it has them) at its default runs with
+  ``--samples 16``, ``--budget 8``, and a video (``render``) is made at ``--fps 5``; a shortened command's
+  output is not compared.
 
 Commands of one file run in their order in one scratch folder holding copies of mjcf/ and docs/ and the
 bench/ and tests/ folders (so that ``--out sizing`` then ``python -c ... open('sizing/results.csv')``
@@ -227,18 +228,26 @@ def program(command: str) -> list[str]:
     return words[:2]
 
 
-# counts of draws a command's options set, capped by the test: (option, largest value run)
-CAPS = (("--samples", 64), ("--mujoco-samples", 3))
+# a documented command whose output other tests read: (as documented, as the test runs it, the module that reads
+# it). It runs once in a pytest process (tests/conftest.py's shared_command), and the documented command's test
+# runs with that module (conftest.scope_of): one `validate --quick` for the README's first command and the
+# report's tests, not two.
+SHARED_RUNS = (("ipir-mujoco validate", "ipir-mujoco validate --quick", "tests/test_validate.py"),)
+
+# counts of draws or runs a command's options set, capped by the test: (option, largest value run)
+CAPS = (("--samples", 16), ("--budget", 16), ("--mujoco-samples", 3))
 # where a command's --help offers these and the command leaves them at their defaults: (option, value run)
 DEFAULT_CAPS = (("--samples", 16), ("--budget", 8))
+# a video's frame rate (render: 25 by default, the frames cost most of its time): a fifth of the frames
+VIDEO_FPS = ("--fps", 5)
 
 
 def shortened(command: str, help_of) -> tuple[str, str]:
     """(the command as the test runs it, how it was shortened or ''): benchmarks get --smoke, a command
     whose program takes --quick (``help_of(program(command))`` lists it) gets it, a count of random draws
-    (``--samples N``, ``--mujoco-samples M``) is capped (:data:`CAPS`), and where the program offers
-    ``--samples`` or ``--budget`` and the command leaves them at their defaults they are set small
-    (:data:`DEFAULT_CAPS`)."""
+    or runs (``--samples N``, ``--budget N``, ``--mujoco-samples M``) is capped (:data:`CAPS`), where the
+    program offers ``--samples`` or ``--budget`` and the command leaves them at their defaults they are set
+    small (:data:`DEFAULT_CAPS`), and a video is made at a low frame rate (:data:`VIDEO_FPS`)."""
     if re.search(r"python3? bench/\w+\.py", command):
         if "--smoke" in command.split():
             return command, "--smoke"
@@ -260,6 +269,9 @@ def shortened(command: str, help_of) -> tuple[str, str]:
         if re.search(rf"(?<![\w-]){option} N\b", text) and option not in command.split():  # a count, not a file
             command += f" {option} {value}"
             how.append(f"{option} {value}")
+    if re.search(rf"(?<![\w-]){VIDEO_FPS[0]}\b", text) and VIDEO_FPS[0] not in command.split():
+        command += f" {VIDEO_FPS[0]} {VIDEO_FPS[1]}"
+        how.append(f"{VIDEO_FPS[0]} {VIDEO_FPS[1]}")
     return command, ", ".join(how)
 
 

@@ -27,13 +27,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import docs_commands as dc  # noqa: E402
 
+from cli_run import SHELL_TIMEOUT_S as TIMEOUT_S, run_shell  # noqa: E402
+
 GROUPS = dc.all_commands()
+SHARED = {ran for _documented, ran, _reader in dc.SHARED_RUNS}
 COMMANDS = [command for group in GROUPS.values() for command in group]
-TIMEOUT_S = 900  # per command: a bound on a hung run, far above any documented command's shortened run
-ENV = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}",
-       "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"}
-for _name in ("DISPLAY", "WAYLAND_DISPLAY"):  # no screen: the viewer must refuse in one line
-    ENV.pop(_name, None)
 
 
 def _subcommands() -> dict[str, argparse.ArgumentParser]:
@@ -59,9 +57,7 @@ def needs_arguments(command: dc.Command) -> bool:
                if a.dest != "help")
 
 
-def run(text: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(text, shell=True, executable="/bin/bash", cwd=cwd, env=ENV, capture_output=True,
-                          text=True, timeout=TIMEOUT_S)
+run = run_shell
 
 
 @functools.lru_cache(maxsize=None)
@@ -87,7 +83,9 @@ def scratch(folder: Path) -> Path:
     return folder
 
 
-def run_group(commands: list[dc.Command], folder: Path) -> dict[int, dict]:
+def run_group(commands: list[dc.Command], folder: Path, shared=None) -> dict[int, dict]:
+    """What each command did; a command alone in its group whose output other tests read too
+    (:data:`docs_commands.SHARED_RUNS`) is ``shared(text)``'s one run."""
     out = {}
     for command in commands:
         if command.synopsis or needs_arguments(command):
@@ -109,7 +107,8 @@ def run_group(commands: list[dc.Command], folder: Path) -> dict[int, dict]:
             ran, how = f"python -c 'import mujoco; mujoco.MjModel.from_xml_path(\"{path}\")'", "loads the model"
         started = time.monotonic()
         try:
-            done = run(ran, folder)
+            done = shared(ran) if shared is not None and len(commands) == 1 and ran in SHARED else \
+                run(ran, folder)
         except subprocess.TimeoutExpired as exc:  # this command's failure, not the others'
             out[id(command)] = dict(ran=ran, how=how, code=None, stdout=exc.stdout or "",
                                     stderr=f"timed out after {TIMEOUT_S} s", seconds=TIMEOUT_S)
@@ -120,7 +119,7 @@ def run_group(commands: list[dc.Command], folder: Path) -> dict[int, dict]:
 
 
 @pytest.fixture(scope="module")
-def results(tmp_path_factory):
+def results(tmp_path_factory, shared_command):
     """group name -> {id(command): what it did}. Each group of commands runs once, in its own scratch folder. In
     one process all groups run at once, two at a time (the machine's cores); under pytest-xdist each group runs
     where its tests are sent (tests/conftest.py keeps a group on one worker; the other workers run the rest of the
@@ -131,10 +130,10 @@ def results(tmp_path_factory):
     def of(group: str) -> dict:
         if group not in done:
             if os.environ.get("PYTEST_XDIST_WORKER"):
-                done[group] = run_group(GROUPS[group], scratch(base / f"g{len(done)}"))
+                done[group] = run_group(GROUPS[group], scratch(base / f"g{len(done)}"), shared_command)
             else:
                 with ThreadPoolExecutor(max_workers=2) as pool:
-                    jobs = {name: pool.submit(run_group, commands, scratch(base / f"g{i}"))
+                    jobs = {name: pool.submit(run_group, commands, scratch(base / f"g{i}"), shared_command)
                             for i, (name, commands) in enumerate(GROUPS.items())}
                     done.update({name: job.result() for name, job in jobs.items()})
         return done[group]

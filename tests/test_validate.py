@@ -175,13 +175,15 @@ def test_pull_fraction_grows_with_crank_speed(quick_validation):
 
 
 @pytest.mark.slow
-def test_validate_writes_a_self_contained_report(tmp_path, capsys):
+def test_validate_writes_a_self_contained_report(shared_command):
+    """The README's first command as its test runs it (``ipir-mujoco validate --quick``, one run for both:
+    tests/docs_commands.py's SHARED_RUNS): a report in ./report."""
     from ipir_mujoco.video import RenderUnavailable, gl_backend
 
-    out = tmp_path / "report"
-    assert main(["validate", "--quick", "--out", str(out)]) == 0
-    captured = capsys.readouterr()
-    assert "[7/7]" in captured.err  # progress shown
+    done = shared_command("ipir-mujoco validate --quick")
+    assert done.returncode == 0, done.stderr[-2000:]
+    out = done.folder / "report"
+    assert "[7/7]" in done.stderr  # progress shown
     page = (out / "index.html").read_text()
     markdown = (out / "report.md").read_text()
     assert "<script" not in page and "http://" not in page and "https://" not in page
