@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .errors import ParameterError
 
 
@@ -104,7 +106,7 @@ def bend_rod_clearance(length: float, rod_radius: float, radius: float, diameter
 
 
 # ----------------------------------------------------------------------------------------------------
-# The round pipe's wheel legs (the wheeled MuJoCo model) and the closed-form lift-off check
+# The round pipe's wheel legs (the wheeled MuJoCo model), the closed-form lift-off and sideways-grip checks
 
 def leg_direction(k: int, n: int) -> tuple[float, float, float]:
     """Leg ``k``'s outward unit vector of ``n`` evenly spaced about the pipe's axis x, leg 0 pointing down (-z in
@@ -164,14 +166,12 @@ def hub_tangent(u: tuple[float, float, float]) -> tuple[float, float]:
     return (-u[2], u[1])
 
 
-def scrub_force(params, module: int, toward: tuple[float, float]) -> float:
-    """The sideways friction [N] on each ring of module ``module`` (0 rear, 1 front) while it rolls through a bend
-    turning across the pipe towards the unit (y, z) ``toward``: its wheels roll only along the module's axis, so as
-    the module turns at v / R its two rings' wheels slide across the pipe (the fore ring's towards the bend's inside,
-    the aft ring's out) and each wheel's friction mu_wall P acts along its circumferential direction e_k (its
-    spring takes the radial part of the slide), so a ring feels mu_wall P sum_k |e_k . toward| across the pipe, the
-    two rings opposite ways: a couple the legs' springs carry as a ring load that size (the couple's lever is the
-    ring spacing either way). Quasi-static, Coulomb; 0 for a module at rest, as each is half of every revolution."""
+def ring_side_grip(params, module: int, toward: tuple[float, float]) -> float:
+    """The sideways friction [N] each ring of module ``module`` (0 rear, 1 front) gives along the unit (y, z)
+    ``toward`` across the pipe before its wheels slide: each wheel rolls only along the pipe, so it carries a load
+    across it by friction along its circumferential direction e_k, up to mu_wall P (its spring takes the radial
+    part, and only as it deflects), and a ring gives mu_wall P sum_k |e_k . toward| (at the defaults' 3 legs
+    2 mu_wall P across a horizontal pipe, 1.73 mu_wall P up or down). Coulomb, the legs at their preload P."""
     n = int(params.wheel_legs)
     P = (params.F_n1, params.F_n2)[module] / (2 * n)
     # unlimited grip: no finite coefficient to take; 1 stands for it, a lower bound (the model's wheels then grip
@@ -179,6 +179,50 @@ def scrub_force(params, module: int, toward: tuple[float, float]) -> float:
     mu = params.mu_wall if params.mu_wall is not None else 1.0
     return mu * P * sum(abs(e[0] * toward[0] + e[1] * toward[1])
                         for e in (hub_tangent(leg_direction(k, n)) for k in range(n)))
+
+
+def scrub_force(params, module: int, toward: tuple[float, float]) -> float:
+    """The sideways friction [N] on each ring of module ``module`` (0 rear, 1 front) while it rolls through a bend
+    turning across the pipe towards the unit (y, z) ``toward``: its wheels roll only along the module's axis, so as
+    the module turns at v / R its two rings' wheels slide across the pipe (the fore ring's towards the bend's inside,
+    the aft ring's out) and each wheel's friction mu_wall P acts along its circumferential direction e_k (its
+    spring takes the radial part of the slide), so a ring feels :func:`ring_side_grip` across the pipe, the
+    two rings opposite ways: a couple the legs' springs carry as a ring load that size (the couple's lever is the
+    ring spacing either way). Quasi-static, Coulomb; 0 for a module at rest, as each is half of every revolution."""
+    return ring_side_grip(params, module, toward)
+
+
+def side_grip_check(params, side1, side2, torque, grip_use=(0.0, 0.0)) -> dict:
+    """The closed-form sideways-grip check of the wheeled model's modules, on a run's linkage forces.
+
+    The analytic model holds each module on rails: whatever the linkage pushes across the pipe, the rails carry
+    without moving. The wheeled model's rings carry it by their wheels' sideways friction
+    (:func:`ring_side_grip`, along y: the crank's plane, where the linkage's forces lie); a ring loaded beyond it
+    slides across the pipe until its legs' springs take the rest (the wheels scrub: energy lost, and a sliding
+    wheel's friction points along its slip, so less of it holds the module along the pipe). The ring loads: half
+    the linkage's force across the pipe on the module (``side1`` at A, through the crank's bearing; ``side2`` at
+    C, the rod's pin: :func:`ipir_mujoco.analytic.kinetostatics.pin_forces`, its inertia forces included) and on
+    module 1 the drive's reaction couple ``torque`` about z as +-torque / ring_spacing on its two rings (as in
+    :func:`lift_check`). A module that holds along the pipe with the share u of its grip (``grip_use``, the
+    analytic run's grip_use1/2: 1 while it skids) leaves each wheel sqrt(1 - u^2) of its friction across the
+    pipe (Coulomb's cone, every wheel using the same share), so a skidding module slides across under any side
+    load. The arrays [N], [N m], [-] are a run's samples, shape (n,). The check leaves out the springs' part (they
+    carry a side load only as the ring moves), so it errs on the side of predicting a slide.
+
+    Returns {'side_use1', 'side_use2': each module's largest ring load over what its ring's wheels hold across
+    the pipe (> 1: they slide across it; inf: a load while its wheels skid; 0 with unlimited grip),
+    'scrub_predicted': bool}.
+    """
+    out = {}
+    for i, (side, couple) in enumerate(((side1, torque), (side2, 0.0)), start=1):
+        load = 0.5 * np.abs(np.asarray(side, dtype=float)) + np.abs(np.asarray(couple, dtype=float)) / params.ring_spacing
+        use = np.clip(np.asarray(grip_use[i - 1], dtype=float), 0.0, 1.0)
+        hold = ring_side_grip(params, i - 1, (1.0, 0.0)) * np.sqrt(1.0 - use * use)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(load > 0, load / hold, 0.0)
+        out[f"side_use{i}"] = 0.0 if params.mu_wall is None else float(np.max(ratio))
+    out["scrub_predicted"] = out["side_use1"] > 1 or out["side_use2"] > 1
+    return out
 
 
 def bend_lift_check(params, radius: float, toward: tuple[float, float], across) -> dict:
