@@ -17,6 +17,11 @@ and ``mujoco-wheels`` (its automatic settings) run it, and the design lands in o
   (``lift_predicted``): the constant-press idealization does not hold there, and the run says so;
 - ``stopped``: refused (bad input for a model), stopped (a stall) or flagged by MuJoCo's accuracy monitor (its
   figure beyond tolerance, in the run's summary), with its reason;
+- ``scrubbed``: a module's rings slid across the pipe (their path across it, from the run's pose columns, at
+  least SCRUB_FLOOR: :func:`across_path`) and the closed-form sideways-grip check predicted it
+  (:func:`ipir_mujoco.core.pipe.side_grip_check` on the analytic run's linkage forces: a ring's load across the
+  pipe beyond its wheels' sideways friction). The analytic model's rails carry those loads without moving; the
+  wheels scrub instead (energy lost, and grip along the pipe lost while they slide), which it does not know;
 - ``outside``: none of these (each printed with its figures).
 
 Prints one line per design and the counts per class. The table in mjcf/README.md ("The round pipe") is this
@@ -34,11 +39,21 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from ipir_mujoco import registry
+from ipir_mujoco.analytic.dynamics import OneDofDynamics
+from ipir_mujoco.analytic.forces import drive_torque
+from ipir_mujoco.analytic.kinetostatics import pin_forces
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.pipe import side_grip_check
 
 TRAVEL_REL, TRAVEL_FLOOR = 0.01, 0.01  # the acceptance: travel within 1 % (at least 1 cm)
 SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
+# a ring whose wheels all grip cannot move across the pipe (their circumferential directions span its plane): only
+# the contacts' softness moves it. Designs whose sideways-grip check stays below 1 moved their rings at most 0.12 mm
+# in their 1-2 s (designs 1, 6, 7, 8), those above it 17.9 mm and more (designs 0, 2-5, 9-11, 28, 38, 45, 67, 83, 84,
+# 99; mjcf/README.md, "The round pipe against the analytic finite-grip model"): 1 mm lies a factor 8 above the one
+# and 18 below the other
+SCRUB_FLOOR = 1e-3
 
 
 def log_uniform(rng, lo: float, hi: float) -> float:
@@ -63,6 +78,29 @@ def within(a: float, b: float, rel: float, floor: float) -> bool:
     return abs(b - a) <= max(rel * abs(a), floor) if floor == TRAVEL_FLOOR else abs(b - a) <= rel * abs(a) + floor
 
 
+def across_path(series: dict, params: RobotParams) -> tuple[float, float]:
+    """How far [m] each module's rings moved across the pipe over a wheeled run, from its pose columns (y, z,
+    roll, pitch, yaw; small turns): the longer of its two rings' paths in (y, z) (ring centres ring_spacing / 2 fore
+    and aft of the module's centre) plus its wheels' path round the pipe from its roll (D / 2 |d roll|), sample to
+    sample."""
+    a, out = 0.5 * params.ring_spacing, []
+    for k in (1, 2):
+        y, z, roll, pitch, yaw = (np.asarray(series[f"{c}{k}"], dtype=float) for c in ("y", "z", "roll", "pitch", "yaw"))
+        rings = [np.hypot(np.diff(y + side * a * yaw), np.diff(z - side * a * pitch)) for side in (-1.0, 1.0)]
+        out.append(float(np.sum(np.maximum(*rings) + 0.5 * params.pipe_diameter * np.abs(np.diff(roll)))))
+    return out[0], out[1]
+
+
+def side_check(analytic, params: RobotParams) -> dict:
+    """The closed-form sideways-grip check (:func:`ipir_mujoco.core.pipe.side_grip_check`) on the analytic run's
+    linkage forces across the pipe (module 1's at A, module 2's at C: :func:`.kinetostatics.pin_forces`), its
+    drive's torque and its modules' grip use."""
+    series = analytic.series
+    _, on_rod_y, _, pin_y = pin_forces(series, OneDofDynamics(params, analytic.geometry))
+    return side_grip_check(params, pin_y, on_rod_y, drive_torque(params, series["omega"]),
+                           (series["grip_use1"], series["grip_use2"]))
+
+
 def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None,
           timestep: float | None = None) -> dict:
     """Run one design in both engines and classify it (module docstring); ``budget`` [s]: the MuJoCo run's
@@ -81,7 +119,11 @@ def judge(index: int, params: RobotParams, t_end: float, budget: float | None = 
         return {**row, "class": "stopped", "why": " ".join(str(exc).split())}
     a, w = analytic.summary, wheels.summary
     row.update({k: (a[k], w[k]) for k in ("x1_final", "x2_final", "slip1_m", "slip2_m", "revolutions")})
+    row.update({k: (a["energy"].get(k, 0.0), w["energy"].get(k, 0.0)) for k in ("motor_work_j", "skid_j")})
     row.update(wheel_off_s=w["wheel_off_s"], lift_predicted=w["lift_predicted"], press=(w["press1_n"], w["press2_n"]))
+    side = side_check(analytic, params)
+    row.update(side_use=(side["side_use1"], side["side_use2"]), scrub_predicted=side["scrub_predicted"],
+               across=across_path(wheels.series, params))
     stops = [s for s in (analytic.stall, wheels.stall) if s]
     agree = all(within(a[f"x{k}_final"], w[f"x{k}_final"], TRAVEL_REL, TRAVEL_FLOOR)
                 and abs(w[f"slip{k}_m"] - a[f"slip{k}_m"]) <= SKID_REL * a[f"slip{k}_m"] + SKID_FLOOR for k in (1, 2))
@@ -96,6 +138,8 @@ def judge(index: int, params: RobotParams, t_end: float, budget: float | None = 
         v = violations[0]
         return {**row, "class": "stopped", "why": f"flagged by the accuracy monitor: {v['figure']} {v['value']:.3g} "
                                                   f"(tolerance {v['tolerance']:.3g}) at t = {v['t_s']:.3g} s"}
+    if row["scrub_predicted"] and max(row["across"]) >= SCRUB_FLOOR:
+        return {**row, "class": "scrubbed"}
     return {**row, "class": "outside"}
 
 
@@ -107,9 +151,12 @@ def line(row: dict) -> str:
     if row["class"] == "stopped" and "x1_final" not in row:
         return head + f" | {row['why']}"
     figures = " ".join(f"{k} {a:+.4f}/{w:+.4f}" for k, (a, w) in
-                       ((k, row[k]) for k in ("x1_final", "x2_final", "slip1_m", "slip2_m")))
+                       ((k, row[k]) for k in ("revolutions", "x1_final", "x2_final", "slip1_m", "slip2_m")))
+    figures += " | drive work {:.3f}/{:.3f} J skid work {:.3f}/{:.3f} J".format(*row["motor_work_j"], *row["skid_j"])
     return head + (f" | {figures} | off {row['wheel_off_s']:.3f} s lift predicted {row['lift_predicted']} "
-                   f"press {row['press'][0]:.1f}/{row['press'][1]:.1f} N | {row['wall_s']:.0f} s"
+                   f"press {row['press'][0]:.1f}/{row['press'][1]:.1f} N | side grip use {row['side_use'][0]:.2f}/"
+                   f"{row['side_use'][1]:.2f} across {1e3 * row['across'][0]:.2f}/{1e3 * row['across'][1]:.2f} mm | "
+                   f"{row['wall_s']:.0f} s"
                    + (f" | {row['why']}" if "why" in row else ""))
 
 
@@ -134,7 +181,7 @@ def main(argv=None) -> int:
         params, t_end = design(rng)
         if (k >= args.skip and only is None) or (only is not None and (k in only or (args.skip and k >= args.skip))):
             jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep))
-    counts = {"agree": 0, "lifted": 0, "stopped": 0, "outside": 0}
+    counts = {"agree": 0, "lifted": 0, "stopped": 0, "scrubbed": 0, "outside": 0}
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = [pool.submit(judge, *job) for job in jobs]
         for done, future in enumerate(futures, start=1):
