@@ -25,8 +25,9 @@ from ipir_mujoco.core.pipe import leg_direction, lift_check
 from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
 from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
 from ipir_mujoco.engine.builders.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
-                                            leg_stiffness, sag, set_wheels_state)
+                                            leg_stiffness, sag, set_wheels_state, wheels_timestep)
 from ipir_mujoco.engine.controllers.wheels import WheelRatchet, leg_press
+from ipir_mujoco.engine.run.wheel_skids import TOLERANCE, estimate, skid_floor
 
 from cli_run import run_cli
 
@@ -212,6 +213,45 @@ def test_a_riser_with_grip_below_the_weight_skids_down_as_the_analytic_model_doe
         assert s_a > 0.1 and s_w > 0.1  # both skid back, a long way
         assert abs(s_w - s_a) <= 0.05 * s_a + 2e-3
         assert abs(s_w - s_h) <= 0.01 * s_h  # the default step within 1 % of the skid's converged length
+
+
+def test_a_wheeled_run_that_skids_is_kept_at_the_step_its_skid_check_reached():
+    """A wheeled run whose wheels skid is rerun at half its step until its figures are within the model's accuracy
+    (engine/run/wheel_skids.py): registry.timestep is the step it starts from (the cruise's 1e-4 s), the run kept is
+    that step halved as its check records (at least twice), the same run as one given that step, and the summary's
+    text says the step."""
+    t_end = 0.1
+    start = registry.timestep("mujoco-wheels", RISER, t_end, 1e-3)
+    assert start == registry.timestep("mujoco-wheels", CRUISE, t_end, 1e-3) == wheels_timestep()
+    run = registry.run("mujoco-wheels", RISER, t_end, dt_out=1e-3)
+    history = run.settings["skid_check"]
+    assert len(history) >= 2 and run.settings["timestep"] == start / 2 ** len(history)
+    assert run.accuracy["skid_check"] in ("verified", "failed")
+    error = math.inf if history[-1]["difference"] is None else history[-1]["difference"]  # None: JSON's inf
+    assert (run.accuracy["skid_check"] == "verified") == (error <= TOLERANCE[history[-1]["figure"]])
+    given = registry.run("mujoco-wheels", RISER, t_end, dt_out=1e-3, timestep=run.settings["timestep"])
+    for key in ("x1_final", "x2_final", "slip1_m", "slip2_m", "revolutions"):
+        assert given.summary[key] == run.summary[key]  # deterministic: the step it kept is the step it took
+    assert given.accuracy["skid_check"] == "not verified: timestep given"
+    json.dumps(run.to_json_dict(), allow_nan=False)
+
+
+def test_a_cruise_that_does_not_skid_keeps_the_default_step():
+    run = registry.run("mujoco-wheels", CRUISE, 0.2, dt_out=1e-3)
+    assert run.accuracy["skid_check"] == "no skid" and run.settings["timestep"] == wheels_timestep()
+    assert all(run.summary[f"slip{k}_m"] < skid_floor(run, k) / 10 for k in (1, 2))  # the hubs' give: 1/75 here
+
+
+@pytest.mark.parametrize("before, last, expected", [
+    (2e-3, 1e-3, 1e-3),  # first order (q = 1/2): the finer run's error is the last difference
+    (-9e-3, -3e-3, 1.5e-3),  # q = 1/3: the rest of the geometric series, 3e-3 (1/3) / (2/3)
+    (2e-4, -1e-3, 2e-3),  # a sign change: no trend, both must lie within ACCEPT (1/2) of the accuracy
+    (1e-4, 3e-4, 6e-4),  # growing: the same
+    (0.0, 0.0, 0.0),
+    (math.inf, 1e-3, math.inf),  # a figure that had no difference (one run steady, the other not): no estimate
+])
+def test_the_skid_checks_error_estimate(before, last, expected):
+    assert estimate(before, last) == pytest.approx(expected, rel=1e-12, abs=1e-15)
 
 
 def test_unlimited_grip_never_skids():

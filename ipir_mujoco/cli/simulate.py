@@ -196,6 +196,13 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                                                           "   OUT OF TOLERANCE: " + "; ".join(
                                                               f"{v['figure']} {v['value']:.3g} (tolerance {v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
                                                               for v in accuracy.get("violations", []))))
+    if accuracy.get("skid_check") in ("verified", "failed"):  # the run kept is the skid check's finest
+        last = (run.settings.get("skid_check") or [{}])[-1]
+        error = accuracy.get("skid_difference")
+        lines.append(f"  skid check {accuracy['skid_check']}: the run at timestep {run.settings['timestep']:.3g} s "
+                     f"({len(run.settings.get('skid_check') or [])} halvings); largest estimated error "
+                     f"{last.get('figure')} " + ("n/a" if error is None else f"{error:.2g}")
+                     + f" of it, its accuracy {accuracy['tolerances']['skid_difference']:.2g}")
     return "\n".join(lines)
 
 

@@ -42,7 +42,8 @@ FOLDERS = {
     "loop": ("stepper", "native", "rows", "recorder", "monitor", "controller", "servo_drive", "_stepper"),
     "controllers": ("slide_clutches", "compliant", "grip", "compliant_grip", "compiled_grip", "wheels"),
     "modelkinds": ("kinds", "loop_rows", "timestep", "route_watch", "common"),
-    "run": ("simulate", "run_setup", "batch", "export", "block_checks", "skid_check"),
+    "run": ("simulate", "run_setup", "batch", "export", "block_checks", "skid_check",
+            "wheel_skids"),
 }
 RENAMED = {"compliant_grip": "grip_compliant"}  # a module's name now: its older name (as the analytic model's)
 # older path (the engine was one folder; a renamed module also under its older name in its folder): path now

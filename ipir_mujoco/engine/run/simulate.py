@@ -61,7 +61,8 @@ from .block_checks import BlockChecks
 from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, climb_energy, monotone,
                      mujoco_failure, steps_per_output)
 from ..modelkinds.kinds import ModelKind, kind_for
-from .skid_check import skidded, verify_skids
+from .skid_check import SLIDES_RULE, verify_skids
+from .wheel_skids import WHEELS_RULE
 from ..builders.model import SolverSettings
 from ..loop.monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
@@ -80,6 +81,8 @@ _RECORDED_AS = {"clutch_spring_energy": "clutch_spring"}  # the deferred name of
 ENERGY_SLOTS = {column: (False, SCALARS.index(column)) if column in SCALARS
                 else (True, DEFERRED.index(_RECORDED_AS.get(column, column)))
                 for column in ENERGY_COLUMNS if column in SCALARS or _RECORDED_AS.get(column, column) in DEFERRED}
+
+SKID_RULES = {"slides": SLIDES_RULE, "wheels": WHEELS_RULE}  # a model kind's skid_rule: the rule it names
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
@@ -155,7 +158,7 @@ def simulate_mujoco(
                    kind=kind, feedforward=feedforward, route=route)
     if settings is not None:
         result = _Run(params, settings, **options).result({"timestep_source": "given"})
-        if kind.verifies_skids and skidded(result):
+        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
             result.accuracy["skid_check"] = "not verified: timestep given"
         return result
     verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
@@ -173,7 +176,7 @@ def simulate_mujoco(
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
             chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
     if not verify:
-        if kind.verifies_skids and skidded(result):
+        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
             result.accuracy["skid_check"] = "not verified: compliant clutches"
         return result
     every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
@@ -182,7 +185,7 @@ def simulate_mujoco(
         finer = {**options, "dt_out": dt} if every_step else options
         return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
-    return verify_skids(result, rerun, accuracy, DT_MIN)
+    return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule])
 
 
 class _Run:

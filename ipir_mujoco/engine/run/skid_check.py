@@ -1,5 +1,7 @@
 """Skids verified by the step: a run on finite grip whose modules skidded is run again at half its step until
-two runs agree to the stated accuracy, or the run says it cannot.
+two runs agree to the stated accuracy, or the run says it cannot. :func:`verify_skids` is the loop; a model's
+rule (:data:`SLIDES_RULE` here, the wheels' in :mod:`.wheel_skids`) says when a run skidded, which figures it
+compares and when they agree.
 
 Why: a skid ends and starts where the steps fall, and MuJoCo's one-way limits (the clutch on the wheels'
 roll, the wall's on the carriage) answer a reversal through their soft rows' damping, within a constraint time
@@ -87,12 +89,49 @@ def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, floa
     return "fixed", out
 
 
-def verify_skids(result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
-    """``result`` (an automatically stepped run on finite grip) or a finer run of the same design, verified as
+class SlideSkids:
+    """The slide model's rule (module docstring): its floor (:func:`skidded`), its figures' differences
+    (:func:`differences`) and its acceptance (the last two halvings each within ACCEPT of the tolerance)."""
+
+    name = "slides"
+
+    def skidded(self, result: RunResult) -> bool:
+        return skidded(result)
+
+    def differences(self, coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, float]]:
+        return differences(coarse, fine)
+
+    def judge(self, history: list) -> tuple[bool, str, float, float]:
+        """(passed, the figure that decides, its difference, the share of the tolerance it is held to) after the
+        halvings of ``history`` (each ``{"kind", "differences"}``, the latest last); records each halving's worst
+        figure and difference in it."""
+        last = history[-1]
+        last["figure"] = max(last["differences"], key=last["differences"].get)
+        last["difference"] = last["differences"][last["figure"]]
+        tolerance = ACCEPT * SKID_TOL[last["kind"]]
+        step = max(history[-2:], key=lambda h: h["difference"])  # the halving that keeps the check from passing
+        # two halvings at least, each within ACCEPT of the tolerance: one pair of runs can agree by chance
+        return len(history) >= 2 and step["difference"] <= tolerance, step["figure"], step["difference"], tolerance
+
+    def failure(self, history: list) -> str:
+        """Why the check did not pass, after its last halving (the middle of its one-line message)."""
+        step = max(history[-2:], key=lambda h: h["difference"])
+        tolerance = SKID_TOL[history[-1]["kind"]]
+        return (f"halving the timestep from {step['timestep']:.3g} s to {step['half']:.3g} s moved {step['figure']} "
+                f"by {step['difference']:.2e} of it, more than {ACCEPT:g} of the tolerance {tolerance:.3g} (each of "
+                "the last two halvings must stay within it; the skids' error under the step)")
+
+
+SLIDES_RULE = SlideSkids()
+
+
+def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES_RULE) -> RunResult:
+    """``result`` (an automatically stepped run that may skid) or a finer run of the same design, verified as
     the module docstring says. ``rerun(timestep)`` runs the design again at that step [s] and returns its
     RunResult; ``mode``: the accuracy monitor's ('stop' | 'warn'); ``dt_min`` [s]: the smallest step a run may
-    take (halving stops before it)."""
-    if not skidded(result):
+    take (halving stops before it); ``rule``: the model's floor, figures and acceptance (:data:`SLIDES_RULE`,
+    :data:`ipir_mujoco.engine.run.wheel_skids.WHEELS_RULE`)."""
+    if not rule.skidded(result):
         result.accuracy["skid_check"] = "no skid"
         return result
     coarse, history = result, []
@@ -102,14 +141,11 @@ def verify_skids(result: RunResult, rerun, mode: str, dt_min: float) -> RunResul
         if dt < dt_min:
             break
         fine = rerun(dt)
-        kind, diff = differences(coarse, fine)
-        worst_key = max(diff, key=diff.get)
-        worst, tolerance = diff[worst_key], SKID_TOL[kind]
-        history.append({"timestep": coarse.settings["timestep"], "half": dt, "figure": worst_key,
-                        "difference": worst, "differences": diff})
-        # two halvings at least, each within ACCEPT of the tolerance: one pair of runs can agree by chance
-        if len(history) >= 2 and max(h["difference"] for h in history[-2:]) <= ACCEPT * tolerance:
-            return _verified(fine, history, ACCEPT * tolerance, None)
+        kind, diff = rule.differences(coarse, fine)
+        history.append({"timestep": coarse.settings["timestep"], "half": dt, "kind": kind, "differences": diff})
+        passed, _, _, tolerance = rule.judge(history)
+        if passed:
+            return _verified(fine, history, tolerance, None)
         coarse = fine
     if len(history) < 2:  # the step cannot be halved twice above the smallest a run may take: unverifiable
         message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and their error under "
@@ -118,17 +154,15 @@ def verify_skids(result: RunResult, rerun, mode: str, dt_min: float) -> RunResul
         if mode == "stop":
             raise AccuracyError(message)
         history = history or [{"timestep": result.settings["timestep"], "half": result.settings["timestep"],
-                               "figure": "none", "difference": math.inf, "differences": {}}]
+                               "kind": "fixed", "figure": "none", "difference": math.inf, "differences": {}}]
         return _verified(fine, history, ACCEPT * SKID_TOL["fixed"], message)
-    step = max(history[-2:], key=lambda h: h["difference"])  # the halving that kept the check from passing
-    message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and halving the timestep "
-               f"from {step['timestep']:.3g} s to {step['half']:.3g} s moved {step['figure']} by "
-               f"{step['difference']:.2e} of it, more than {ACCEPT:g} of the tolerance {tolerance:.3g} (each of the "
-               f"last two halvings must stay within it; the skids' error under the step); use a smaller --timestep "
-               f"(e.g. {history[-1]['half'] / 2:.3g}), or --accuracy warn to finish the run and record it")
+    _, _, _, tolerance = rule.judge(history)
+    message = (f"MuJoCo accuracy check failed at t={fine.t_end:.6g} s: the modules skid, and {rule.failure(history)}; "
+               f"use a smaller --timestep (e.g. {history[-1]['half'] / 2:.3g}), or --accuracy warn to finish the run "
+               "and record it")
     if mode == "stop":
         raise AccuracyError(message)
-    return _verified(fine, history, ACCEPT * tolerance, message)
+    return _verified(fine, history, tolerance, message)
 
 
 def _verified(run: RunResult, history: list, tolerance: float, failed: str | None) -> RunResult:
@@ -137,8 +171,9 @@ def _verified(run: RunResult, history: list, tolerance: float, failed: str | Non
     accuracy a halving may move the figures by) and, where the check ``failed`` (its one-line reason), a
     violation."""
     finite = lambda x: float(x) if math.isfinite(x) else None  # noqa: E731  (JSON has no inf: None, not compared)
-    history = [{**h, "difference": finite(h["difference"]),
-                "differences": {k: finite(v) for k, v in h["differences"].items()}} for h in history]
+    clean = lambda v: ({k: finite(x) for k, x in v.items()} if isinstance(v, dict)  # noqa: E731
+                       else finite(v) if isinstance(v, float) else v)
+    history = [{key: clean(value) for key, value in h.items()} for h in history]
     last = history[-1]
     run.settings["skid_check"] = history
     record = run.accuracy
