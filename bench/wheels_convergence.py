@@ -3,25 +3,25 @@
 Run on demand from the repository root (about 25 min on 2 busy cores, most of it the bend; ``--cases``: some of
 them; ``--smoke``: a few seconds):
 
-    python bench/wheels_convergence.py [--cases cruise,riser,...] [--smoke]
+    python bench/wheels_convergence.py [--cases cruise,riser,...] [--down-to STEP] [--smoke]
 
 The model's contact, limit and loop rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
-properties of the model, so halving the step refines one model rather than stiffening it. Four cases:
-``cruise`` (the default motor, mu_wall 0.5, F_n 50 N, 1 s); ``riser`` (the default motor up a vertical pipe with
-mu_wall 0.18, a grip of 9 N per module against a weight of 9.81 N, 0.5 s: both skid down); ``incline 30``
-(mu_wall 0.15 at 30 deg, 0.5 s: both skid back); ``bend`` (a 0.4 m straight, a 30 deg bend of radius 0.8 m
-(R/D 5) and a straight, mu_wall 0.8, 1.5 s). Each is run as a user's run is (the automatic step,
-``registry.timestep``: 1e-4 s, 5e-5 s along a route with bends, and where its wheels skid the skid check's
-halvings, ``engine/run/wheel_skids.py``: the run kept is at the step the check reached) and at fixed steps
-1e-4 s and 1/2, 1/4, 1/8 of it, and down to half the automatic run's step where that is finer (the automatic
-run is the fixed run at its step: not repeated). The figures: each module's travel (along the route on a
-route), the robot's speed over whole crank revolutions spanning at least the last 0.5 s, each module's skid
-(where it passes the check's floor) and the distance along the route. The converged value: from the three
-finest steps, the finest plus the rest of the geometric series of their differences where those shrink with one
-sign, else the finest. The acceptance (issue 32): the automatic run within 0.2 % of it on travel and speed, 1 %
-plus the skid's resolution on skid length (``wheel_skids.skid_resolution``, a length: how closely soft contacts
-of time constant tau define a skid's ends, (revolutions + 1) v_max tau). The table in mjcf/README.md ("The
-round pipe: convergence") is this script's output.
+properties of the model, so halving the step refines one model rather than stiffening it. Four cases: ``cruise``
+(the default motor, mu_wall 0.5, F_n 50 N, 1 s); ``riser`` (the default motor up a vertical pipe with mu_wall 0.18,
+a grip of 9 N per module against a weight of 9.81 N, 0.5 s: both skid down); ``incline 30`` (mu_wall 0.15 at 30
+deg, 0.5 s: both skid back); ``bend`` (a 0.4 m straight, a 30 deg bend of radius 0.8 m (R/D 5) and a straight,
+mu_wall 0.8, 1.5 s). Each is run as a user's run is (the automatic step, ``registry.timestep``: 1e-4 s, 5e-5 s
+along a route with bends, and where its wheels skid the skid check's halvings, ``engine/run/wheel_skids.py``: the
+run kept is at the step the check reached) and at fixed steps 1e-4 s and 1/2, 1/4, 1/8 of it, and down to half the
+automatic run's step where that is finer, or to ``--down-to`` (the automatic run is the fixed run at its step: not
+repeated). The figures: the crank's revolutions, each module's travel (along the route on a route), the robot's
+speed over whole crank revolutions spanning at least the last 0.5 s, each module's skid (where it passes the
+check's floor) and the distance along the route. The converged value: from the three finest steps, the finest plus
+the rest of the geometric series of their differences where those shrink with one sign at least about as fast as
+first order, else the finest (marked: no convergence shown). The acceptance (issue 32): the automatic run within
+0.2 % of it on travel and speed, 1 % plus the skid's resolution on skid length (``wheel_skids.skid_resolution``, a
+length: how closely soft contacts of time constant tau define a skid's ends, (revolutions + 1) v_max tau). The
+table in mjcf/README.md ("The round pipe: convergence") is this script's output.
 
 ``--time-constants``: why 2e-4 s. The robot with the drive off on a riser (mu_wall 0.18: both modules slide down
 from rest at a = (G1 + G2) / (m1 + m2 + m_rod) - g, the analytic model's Coulomb answer) for 0.3 s, stepped by hand
@@ -77,7 +77,8 @@ def figures(run) -> dict[str, tuple[str, float, float]]:
     over whole revolutions, each module's skid (its floor: how closely the model defines a skid,
     :func:`~ipir_mujoco.engine.run.wheel_skids.skid_resolution`), the distance along a route."""
     s = run.summary
-    out = {"x1 [m]": ("travel", s["x1_final"], 0.0), "x2 [m]": ("travel", s["x2_final"], 0.0),
+    out = {"revolutions": ("travel", s["revolutions"], 0.0),
+           "x1 [m]": ("travel", s["x1_final"], 0.0), "x2 [m]": ("travel", s["x2_final"], 0.0),
            "speed, whole revolutions [m/s]": ("speed", revolution_speed(run), 0.0)}
     for k in (1, 2):  # each run's skid, shown where the automatic run's passes the floor
         out[f"skid {k} [m]"] = ("skid", s[f"slip{k}_m"], skid_resolution(run, k))
@@ -86,17 +87,24 @@ def figures(run) -> dict[str, tuple[str, float, float]]:
     return out
 
 
-def converged(values: list[float]) -> float:
-    """The converged value from the three finest steps' values (coarse to fine): where their two differences
-    have one sign and shrink (ratio q < 1), the finest plus the differences still to come, d q / (1 - q) (a
-    geometric series: first order gives q = 1/2); else the finest (no trend to extrapolate)."""
+CONVERGING = 0.55  # the largest ratio of successive differences taken as convergence (first order: 1/2)
+
+
+def converged(values: list[float]) -> tuple[float, bool]:
+    """(the converged value, whether the values show convergence) from the three finest steps' values (coarse
+    to fine): where their two differences have one sign and shrink at least about as fast as first order (ratio
+    q <= CONVERGING), the finest plus the differences still to come, d q / (1 - q) (a geometric series); else the
+    finest, not shown converged (a slower ratio extrapolates into noise: q = 0.99 multiplies the last difference
+    by 99)."""
     if len(values) < 3 or not all(np.isfinite(values[-3:])):
-        return values[-1]
+        return values[-1], False
     d1, d2 = values[-2] - values[-3], values[-1] - values[-2]
-    if d1 * d2 > 0 and abs(d2) < abs(d1):
+    if d2 == 0.0:
+        return values[-1], True
+    if d1 * d2 > 0 and abs(d2) <= CONVERGING * abs(d1):
         q = abs(d2) / abs(d1)
-        return values[-1] + d2 * q / (1 - q)
-    return values[-1]
+        return values[-1] + d2 * q / (1 - q), True
+    return values[-1], False
 
 
 def time_constants(smoke: bool) -> None:
@@ -130,6 +138,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="one case, 0.05 s, two steps: the script runs")
     parser.add_argument("--time-constants", action="store_true", help="the riser slide at several time constants")
+    parser.add_argument("--down-to", type=float, default=None, metavar="STEP",
+                        help="fixed steps down to this [s] too (default: down to half the automatic run's step)")
     parser.add_argument("--cases", default=",".join(CASES),
                         help=f"comma-separated cases to run (default all: {','.join(CASES)})")
     args = parser.parse_args(argv)
@@ -153,8 +163,9 @@ def main(argv=None) -> int:
         auto = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, route=route)  # the step it chooses
         kept = auto.settings["timestep"]
         steps = [base / f for f in factors]
-        while steps[-1] >= kept * (1 + 1e-9) or (not args.smoke and steps[-1] > kept / 2 * (1 + 1e-9)):
-            steps.append(steps[-1] / 2)  # down to half the automatic run's step: a reference finer than it
+        finest = kept if args.smoke else min(kept / 2, args.down_to or kept)
+        while steps[-1] > finest * (1 + 1e-9) or steps[-1] >= kept * (1 + 1e-9):
+            steps.append(steps[-1] / 2)  # down to half the automatic run's step (a reference finer than it)
         rows = []
         for dt in steps:
             if math.isclose(dt, kept, rel_tol=1e-9):
@@ -174,13 +185,14 @@ def main(argv=None) -> int:
                 continue
             values = [r[key][1] if key in r else float("nan") for r in rows]
             floor = rows[-1][key][2] if key in rows[-1] else 0.0
-            limit = converged(values)
+            limit, trend = converged(values)
             diff = (value - limit) / abs(limit) if limit else float("nan")
             ok = abs(value - limit) <= TOLERANCE[kind] * abs(limit) + floor  # a skid: 1 % + its resolution
             worst_ok &= ok
             scale = f" + {floor * 1e3:.2g} mm" if floor else ""
             cells = ", ".join(f"{dt:.3g}: {v:.6g}" for dt, v in zip(steps, values))
-            print(f"| {name} | {key} | {cells} | {kept:.3g}, {check} | {limit:.6g} | {100 * diff:+.3f} % | "
+            print(f"| {name} | {key} | {cells} | {kept:.3g}, {check} | {limit:.6g}{'' if trend else ' (finest)'} | "
+                  f"{100 * diff:+.3f} % | "
                   f"{'yes' if ok else 'NO'} ({100 * TOLERANCE[kind]:g} %{scale}) |", flush=True)
     print(f"every figure within its tolerance: {worst_ok}")
     return 0

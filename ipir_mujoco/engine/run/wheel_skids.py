@@ -14,9 +14,10 @@ measures it: the same run at half the step, and again, and the differences of th
 
 The figures and their accuracy (:data:`TOLERANCE`, issue 32): travel, revolutions and the steady figures
 0.2 % (travel relative to at least a tenth of a stroke, as the slides'), a skid's length 1 % plus its
-resolution (:func:`skid_resolution`: how closely soft contacts define a skid's ends, a length in metres). The finest run is kept once, after two halvings at least, each figure's
-estimated error (:func:`estimate`) is within its accuracy: where the last two differences have one sign and
-shrink (ratio q < 1, the study's 0.3-0.65), the geometric sum of the differences still to come,
+resolution (:func:`skid_resolution`: how closely soft contacts define a skid's ends, a length in metres). The
+finest run is kept once, after two halvings at least, each figure's estimated error (:func:`estimate`) is
+within its accuracy: where the last two differences have one sign and shrink (ratio q < 1; on the riser and
+the 30 deg incline 0.3-0.66), the geometric sum of the differences still to come,
 |d| q / (1 - q) (first order: q = 1/2, the last difference itself); else (differences that grow or change
 sign: a pair of runs can agree by chance, as in a bend) both must lie within ACCEPT of the accuracy, the slide
 model's rule. A run whose wheels skid less than :func:`skid_floor` is not checked.
