@@ -308,6 +308,24 @@ def test_a_stall_line_names_a_module_cocked_in_its_pipe():
         assert watch.cocked(data.qpos, (0.0, 0.25)) == words
 
 
+def test_a_stall_says_what_unlimited_grip_does_only_with_the_robot_in_a_bend():
+    """RouteWatch.in_bend: a bend lying between the rear wheels (A less ring_reach) and the front wheels (C plus it)
+    on bend90.toml's layout (a 0.4 m straight, a bend of 0.8 m radius and 90 deg, 0.3 m straight): the stall line
+    adds what unlimited grip does there only then, and only with unlimited grip."""
+    from ipir_mujoco.engine.builders.wheels_model import build_wheels_model
+    from ipir_mujoco.engine.modelkinds.route_watch import RouteWatch
+
+    route = route_from_tables([dict(kind="straight", length=0.4), dict(kind="bend", radius=0.8, angle=90.0),
+                               dict(kind="straight", length=0.3)], "bend90.toml")
+    bend_end = 0.4 + 0.8 * math.pi / 2
+    model = build_wheels_model(CRUISE, route=route)
+    watch = RouteWatch(route, model, None, {"bends": [], "predicted": ""}, 1e-3, unlimited_grip=True, ring_reach=0.06)
+    assert not watch.in_bend(0.0, 0.33)  # the front wheels 0.39 m along: still in the first straight
+    assert watch.in_bend(0.0, 0.35)  # 0.41 m: in the bend
+    assert watch.in_bend(bend_end + 0.05, bend_end + 0.3)  # the rear wheels 0.01 m before the bend's end
+    assert not watch.in_bend(bend_end + 0.07, bend_end + 0.3)  # all of the robot past it
+
+
 def test_a_route_of_long_bends_builds_one_piece_per_bend():
     """40 half turns of 100 m radius, in alternating planes: the round pipe builds each bend as one piece, whatever
     its radius or plane (nothing about the walls grows with a bend's size)."""

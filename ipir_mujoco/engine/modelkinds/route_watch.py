@@ -86,8 +86,12 @@ class RouteWatch:
     walls, ``recorder`` the run's :class:`.recorder.Recorder`, ``points`` where the modules' reference points
     are (default :class:`ModulePoints`)."""
 
-    def __init__(self, route: Route, model, recorder, prediction: dict, dt_out: float, points=None):
+    def __init__(self, route: Route, model, recorder, prediction: dict, dt_out: float, points=None,
+                 unlimited_grip: bool = False, ring_reach: float = 0.0):
         self.route, self.rec, self.prediction = route, recorder, prediction
+        # a stall with the robot in a bend says what unlimited grip does there; ring_reach [m]: how far a
+        # module's wheels reach beyond its points A and C along the pipe
+        self.unlimited_grip, self.ring_reach = unlimited_grip, ring_reach
         self.points = ModulePoints(model) if points is None else points
         self.s_front = 0.0
         self.crank = qpos_address(model, CRANK_HINGE)
@@ -155,11 +159,21 @@ class RouteWatch:
                     why += f"; {cocked}"
                 if self.lost is not None:
                     why += f"; {self.lost}"
+                if self.unlimited_grip and self.in_bend(s, front):
+                    why += ("; unlimited grip: in a bend the wheels, which roll only along their module's axis, "
+                            "must also slide across the pipe, and mu_wall=unlimited holds them (give a finite "
+                            "mu_wall)")
                 self.stop = (f"stalled: less than {PROGRESS_M * 1e3:g} mm of progress in {PROGRESS_S:g} s "
                              f"({why}), at {self.route.where(self.s_max)}, t = {ti:.4f} s")
                 return i
             self._wheels(q[i, self.arms], ti)
         return None
+
+    def in_bend(self, rear: float, front: float) -> bool:
+        """Whether a bend lies between the rear module's wheels and the front module's (A at ``rear``, C at
+        ``front`` [m] along the centreline, the wheels ring_reach beyond)."""
+        lo, hi = rear - self.ring_reach, front + self.ring_reach
+        return any(p.s0 < hi and p.s0 + p.length > lo for p in self.route.bends)
 
     def cocked(self, q, along: tuple[float, float]) -> str | None:
         """The modules turned more than COCKED_DEG off the centreline's direction at their points (``along``: A's
@@ -298,4 +312,5 @@ def route_watch(route: Route | None, model, recorder, params, dt_out: float, fit
     geometry, ``fit(route, params) -> {"bends": [...], "predicted": one line}`` (the model kind's ``route_fit``)."""
     if route is None:
         return None
-    return RouteWatch(route, model, recorder, fit(route, params), dt_out)
+    return RouteWatch(route, model, recorder, fit(route, params), dt_out, unlimited_grip=params.mu_wall is None,
+                      ring_reach=0.5 * params.ring_spacing + params.wheel_radius)
