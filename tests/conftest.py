@@ -20,6 +20,16 @@ settings.register_profile("explore", derandomize=False, deadline=None, max_examp
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
 
 
+def pytest_configure(config):
+    """A suite started in the background by a shell without job control (``(pytest &)``, a script's ``pytest &``)
+    inherits SIGINT ignored, and so would every command line its tests start: the tests that send Ctrl-C, to
+    this process or to a command they started, get Python's usual handler back, as a terminal gives it."""
+    import signal
+
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def pytest_sessionstart(session):
     """Compile the analytic kernels (numba, where installed) before any test: the first compilation on a
     machine takes about 15 s and the command line then says so on stderr, which the command-line tests
