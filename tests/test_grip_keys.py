@@ -43,7 +43,10 @@ def backward_travel_while_skidding(x: np.ndarray, wheels: np.ndarray) -> tuple[f
 @pytest.mark.slow
 def test_every_engine_reads_its_grip_keys_by_the_one_definition(variant, extra):
     params = RobotParams(**SKIDDING, **extra)
-    run = registry.run(variant, params, T_END, dt_out=1e-3)
+    # the wheeled model at its automatic first step, given: its skid check's reruns (to 2.5e-5 s here) refine the
+    # figures, not what the keys mean
+    options = {"timestep": 1e-4} if variant == "mujoco-wheels" else {}
+    run = registry.run(variant, params, T_END, dt_out=1e-3, **options)
     s, summary = run.series, run.summary
     for k, G in zip((1, 2), params.grip):
         lam, wheels = s[f"lambda{k}"], s[f"wheels{k}"]
