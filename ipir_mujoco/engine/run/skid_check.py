@@ -58,6 +58,21 @@ def skidded(result: RunResult) -> bool:
     return (summary["slip1_m"] or 0.0) > least or (summary["slip2_m"] or 0.0) > least
 
 
+STEADY_FIGURES = (("steady_speed_m_s", "steady_speed_uncertainty_m_s"),
+                  ("energy_per_metre_j_m", "energy_per_metre_uncertainty_j_m"))  # (figure, its own uncertainty)
+
+
+def steady_difference(a: dict, b: dict, key: str, spread: str) -> float | None:
+    """Two summaries' (coarse ``a``, fine ``b``) relative difference a - b of the steady figure ``key``, signed, its
+    magnitude grown by the finer run's own uncertainty ``spread`` where the statistical test found it (what is
+    left to trust is the difference and that together); None where either lacks the figure."""
+    if a[key] is None or b[key] is None:
+        return None
+    scale = max(abs(a[key]), abs(b[key]), 1e-300)
+    own = (b[spread] or 0.0) if b["steady_test"] == "statistical" else 0.0
+    return math.copysign((abs(a[key] - b[key]) + own) / scale, a[key] - b[key])
+
+
 def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, float]]:
     """('steady' | 'fixed', {figure: relative difference}) of two runs of one design at two steps: their steady
     speed and energy per metre where both reached the steady state (inf where only one did; where the finer run
@@ -72,14 +87,11 @@ def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, floa
         if not (a["steady"] and b["steady"]):
             return "steady", {"steady": math.inf}
         out = {}
-        for key, spread in (("steady_speed_m_s", "steady_speed_uncertainty_m_s"),
-                            ("energy_per_metre_j_m", "energy_per_metre_uncertainty_j_m")):
-            if a[key] is not None and b[key] is not None:
-                scale = max(abs(a[key]), abs(b[key]), 1e-300)
-                own = (b[spread] or 0.0) if b["steady_test"] == "statistical" else 0.0
-                moved = abs(b["x1_final"]) + abs(b["x2_final"])
-                bias = share * (b["slip1_m"] + b["slip2_m"]) / moved if moved > 0 else math.inf
-                out[key] = (abs(a[key] - b[key]) + own) / scale + bias
+        moved = abs(b["x1_final"]) + abs(b["x2_final"])
+        bias = share * (b["slip1_m"] + b["slip2_m"]) / moved if moved > 0 else math.inf
+        for key, spread in STEADY_FIGURES:
+            if (d := steady_difference(a, b, key, spread)) is not None:
+                out[key] = abs(d) + bias
         return "steady", out
     floor = TRAVEL_FLOOR * 2 * fine.params.r
     out = {"revolutions": abs(a["revolutions"] - b["revolutions"]) / max(abs(a["revolutions"]), abs(b["revolutions"]),

@@ -30,7 +30,7 @@ import math
 from ipir_mujoco.core.results import RunResult
 
 from ..builders.wheels_model import ROW_TIMES
-from .skid_check import ACCEPT, TRAVEL_FLOOR
+from .skid_check import ACCEPT, STEADY_FIGURES, TRAVEL_FLOOR, steady_difference
 
 # issue 32's accuracy of the wheeled model at its step: travel, revolutions and steady figures 0.2 %, skid 1 %
 TOLERANCE = {"revolutions": 2e-3, "x1_final": 2e-3, "x2_final": 2e-3, "slip1_m": 1e-2, "slip2_m": 1e-2,
@@ -81,12 +81,9 @@ class WheelSkids:
             if not (a["steady"] and b["steady"]):
                 return "steady", {"steady": math.inf}
             out = {}
-            for key, spread in (("steady_speed_m_s", "steady_speed_uncertainty_m_s"),
-                                ("energy_per_metre_j_m", "energy_per_metre_uncertainty_j_m")):
-                if a[key] is not None and b[key] is not None:
-                    own = (b[spread] or 0.0) if b["steady_test"] == "statistical" else 0.0
-                    d = _relative(a[key], b[key], 0.0)
-                    out[key] = math.copysign(abs(d) + own / max(abs(a[key]), abs(b[key]), 1e-300), d)
+            for key, spread in STEADY_FIGURES:
+                if (d := steady_difference(a, b, key, spread)) is not None:
+                    out[key] = d
             return "steady", out
         floor = TRAVEL_FLOOR * 2 * fine.params.r
         out = {"revolutions": _relative(a["revolutions"], b["revolutions"], TRAVEL_FLOOR)}
