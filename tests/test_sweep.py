@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import math
 import json
@@ -131,26 +132,36 @@ sys.exit(console())
 """
 
 
-def held_sweep(hold_from: float, argv: list[str], **popen) -> subprocess.Popen:
-    """``ipir-mujoco sweep ARGV`` in a child whose designs with L >= ``hold_from`` never end (HELD_SWEEP)."""
-    return subprocess.Popen([sys.executable, "-c", HELD_SWEEP, repr(hold_from), "sweep", *argv], **popen)
+@contextlib.contextmanager
+def held_sweep(hold_from: float, argv: list[str], **popen):
+    """``ipir-mujoco sweep ARGV`` in a child whose designs with L >= ``hold_from`` never end (HELD_SWEEP), in a
+    session of its own: whatever the test's outcome (a timeout included), the child and its pool's workers, which
+    would otherwise wait for ever, are killed on the way out."""
+    process = subprocess.Popen([sys.executable, "-c", HELD_SWEEP, repr(hold_from), "sweep", *argv],
+                               start_new_session=True, **popen)
+    try:
+        yield process
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
 
 
 @pytest.mark.slow
 def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
     out = tmp_path / "s"
     # L = 0.07 + k 0.33/23: designs 0-5 run, 6-23 wait (L >= 0.15) until the Ctrl-C
-    process = held_sweep(0.15, ["--vary", "L=0.07:0.4:24", "--engines", "analytic-unilateral", "--t-end", "1",
-                                "--out", str(out), "--workers", "2"],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    results = out / "results.csv"
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline:  # wait until some designs are written, then interrupt
-        if results.exists() and len(results.read_text().splitlines()) >= 4:
-            break
-        time.sleep(0.05)
-    process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=120)
+    with held_sweep(0.15, ["--vary", "L=0.07:0.4:24", "--engines", "analytic-unilateral", "--t-end", "1",
+                           "--out", str(out), "--workers", "2"],
+                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        results = out / "results.csv"
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:  # wait until some designs are written, then interrupt
+            if results.exists() and len(results.read_text().splitlines()) >= 4:
+                break
+            time.sleep(0.05)
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=120)
     assert process.returncode == 130 and "--resume" in err
     partial = rows_of(results)  # readable after the interrupt
     assert 3 <= len(partial) < 24
@@ -235,13 +246,13 @@ def test_ctrl_c_halfway_through_a_default_engine_sweep_keeps_the_finished_design
     out = tmp_path / "s"
     designs = 32
     # L = 0.07 + k 0.33/31: from design 15 on (L >= 0.22) and the MuJoCo chunks that hold one wait for the Ctrl-C
-    process = held_sweep(0.22, ["--vary", f"L=0.07:0.4:{designs}", "--t-end", "0.5", "--out", str(out),
-                                "--workers", "2", "--batch-size", "4"],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    _wait_for_rows(out / "results.csv", 2, process)
-    seen = len(rows_of(out / "results.csv"))
-    process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=120)
+    with held_sweep(0.22, ["--vary", f"L=0.07:0.4:{designs}", "--t-end", "0.5", "--out", str(out),
+                           "--workers", "2", "--batch-size", "4"],
+                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        _wait_for_rows(out / "results.csv", 2, process)
+        seen = len(rows_of(out / "results.csv"))
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=120)
     kept = rows_of(out / "results.csv")
     assert process.returncode == 130 and "--resume" in err and "Traceback" not in err
     assert seen >= 2 and seen <= len(kept) < designs
@@ -263,10 +274,9 @@ def _alive(pid: int) -> bool:
 def test_sigkill_of_the_main_process_leaves_no_worker_alive(tmp_path):
     out = tmp_path / "s"
     # from design 4 on (L >= 0.1) the workers wait: they are alive when the main process is killed
-    process = held_sweep(0.1, ["--vary", "L=0.07:0.4:40", "--engines", "analytic-unilateral", "--t-end", "1",
-                               "--out", str(out), "--workers", "2"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    workers: list[int] = []
-    try:
+    with held_sweep(0.1, ["--vary", "L=0.07:0.4:40", "--engines", "analytic-unilateral", "--t-end", "1",
+                          "--out", str(out), "--workers", "2"],
+                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) as process:
         _wait_for_rows(out / "results.csv", 1, process)
         workers = [int(p) for p in Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text().split()]
         assert workers, "the sweep started no worker"
@@ -276,10 +286,6 @@ def test_sigkill_of_the_main_process_leaves_no_worker_alive(tmp_path):
         while time.monotonic() < deadline and any(_alive(p) for p in workers):
             time.sleep(0.05)
         assert not [p for p in workers if _alive(p)]
-    finally:
-        for pid in workers:  # never leave one behind, whatever the outcome
-            if _alive(pid):
-                os.kill(pid, signal.SIGKILL)
 
 
 def test_two_runs_of_one_study_write_the_same_bytes(tmp_path):
