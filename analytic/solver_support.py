@@ -133,6 +133,13 @@ PROGRESS_EVERY_S = 0.1  # simulated seconds between two progress calls, at least
 # mode switches a run of the rigid-clutch models may make unless told otherwise (a work budget for designs that
 # chatter; the compliant model, whose clutches engage and release within each stroke, sets its own)
 MAX_SWITCHES = 100_000
+# a run whose mode switches stop advancing time is stuck (Zeno chatter, or a design at a degenerate limit such as
+# r = 5e-324 m, where each switch leaves the state where it was): STUCK_SWITCHES switches in a row within
+# STUCK_TIME (relative to 1 + t) of the first of them end it with that reason, rather than after spending
+# MAX_SWITCHES (15 s of wall time). 1e-12 s is about 4500 roundings of t at t ~ 1 s; no stroke of a robot that
+# moves switches its clutches a thousand times in it
+STUCK_SWITCHES = 1000
+STUCK_TIME = 1e-12
 # a run stopped at its steady state ends on the first sample at or after the steady revolution's end less this
 # (relative to 1 + t): the steady test interpolates that end between samples and may place it a rounding error
 # past the revolution event's own sample, which must then be the last one kept
@@ -162,6 +169,7 @@ class RunMonitor:
         self.wall_budget_s, self.progress, self.until_steady = (options.wall_budget_s, options.progress,
                                                                 options.until_steady)
         self.switches = 0
+        self._stuck_at, self._stuck_count = -math.inf, 0  # the first switch of the latest run of stuck switches
         accel.run_started()
         self.started = self._clock = time.perf_counter()
         self.next_report = PROGRESS_EVERY_S
@@ -232,6 +240,16 @@ class RunMonitor:
     def after_switch(self, t: float, switches: int, phi: float) -> None:
         """Budget checks and progress at a mode switch at time t [s] (the ``switches``-th) at crank angle phi."""
         self.switches = switches
+        if t - self._stuck_at <= STUCK_TIME * (1.0 + abs(t)):
+            self._stuck_count += 1
+            if self._stuck_count >= STUCK_SWITCHES:
+                raise SimulationError(
+                    f"the run is stuck: {self._stuck_count} mode switches in a row within {STUCK_TIME:g} s of "
+                    f"t={self._stuck_at:.6g} s of {self.t_end:g} s (crank at "
+                    f"{(phi - self.phi0) / (2 * math.pi):.4g} revolutions): the clutches chatter without the "
+                    "motion advancing; check the design's parameters near their limits")
+        else:
+            self._stuck_at, self._stuck_count = t, 0
         if switches > self.max_switches:
             raise SimulationError(
                 f"the work budget max_switches={self.max_switches} is spent at t={t:.6g} s of {self.t_end:g} s "

@@ -23,6 +23,17 @@ def test_the_switch_budget_stops_a_run_with_its_name_and_remedy(geometry, clutch
         analytic.simulate(RobotParams(), geometry, clutch, 1.0, max_switches=5)
 
 
+def test_switches_that_stop_advancing_time_end_the_run_long_before_the_switch_budget():
+    """At r = 5e-324 m (the table's smallest crank) the paper's model switches its clutches at t = 0 without
+    moving: the run stops after STUCK_SWITCHES such switches with that reason, not after MAX_SWITCHES."""
+    from ipir_mujoco.analytic.solver_support import MAX_SWITCHES, STUCK_SWITCHES
+
+    with pytest.raises(SimulationError, match=rf"stuck: {STUCK_SWITCHES} mode switches in a row within 1e-12 s "
+                                              r"of t=0 s of 0.02 s"):
+        analytic.simulate(RobotParams(r=5e-324), "approx", "kinematic", 0.02)
+    assert STUCK_SWITCHES * 50 <= MAX_SWITCHES
+
+
 @pytest.mark.parametrize("geometry,clutch", [("exact", "kinematic"), ("exact", "unilateral")])
 def test_the_wall_clock_budget_stops_a_runaway_design(geometry, clutch):
     # checked between segments, each a few ms here: the run stops soon after 0.2 s of wall time,
