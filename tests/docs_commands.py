@@ -25,8 +25,9 @@ What a command is:
   is tested"): a benchmark (``python bench/NAME.py``) gets ``--smoke``, a command that takes ``--quick``
   gets it, ``--samples`` and ``--budget`` above 16 and ``--mujoco-samples`` above 3 are cut to that, a
   command that leaves ``--samples`` or ``--budget`` (where it has them) at its default runs with
-  ``--samples 16``, ``--budget 8``, and a video (``render``) is made at ``--fps 5``; a shortened command's
-  output is not compared.
+  ``--samples 16``, ``--budget 8``, a video (``render``) is made at ``--fps 5``, and in a block that quotes
+  no output a grid (``--vary NAME=LO:HI:N``) of more than 8 points runs with 8; a shortened command's output
+  is not compared.
 
 Commands of one file run in their order in one scratch folder holding copies of mjcf/ and docs/ and the
 bench/ and tests/ folders (so that ``--out sizing`` then ``python -c ... open('sizing/results.csv')``
@@ -240,20 +241,31 @@ CAPS = (("--samples", 16), ("--budget", 16), ("--mujoco-samples", 3))
 DEFAULT_CAPS = (("--samples", 16), ("--budget", 8))
 # a video's frame rate (render: 25 by default, the frames cost most of its time): a fifth of the frames
 VIDEO_FPS = ("--fps", 5)
+# the points of a grid (--vary NAME=LO:HI:N) in a block that quotes no output: enough for a line and its ends
+GRID_CAP = 8
 
 
-def shortened(command: str, help_of) -> tuple[str, str]:
+def shortened(command: str, help_of, grids: bool = True) -> tuple[str, str]:
     """(the command as the test runs it, how it was shortened or ''): benchmarks get --smoke, a command
     whose program takes --quick (``help_of(program(command))`` lists it) gets it, a count of random draws
     or runs (``--samples N``, ``--budget N``, ``--mujoco-samples M``) is capped (:data:`CAPS`), where the
     program offers ``--samples`` or ``--budget`` and the command leaves them at their defaults they are set
-    small (:data:`DEFAULT_CAPS`), and a video is made at a low frame rate (:data:`VIDEO_FPS`)."""
+    small (:data:`DEFAULT_CAPS`), a video is made at a low frame rate (:data:`VIDEO_FPS`), and with ``grids``
+    (a block that quotes no output: no printed figure depends on the grid) a grid's count of points
+    (``--vary NAME=LO:HI:N``) is capped (:data:`GRID_CAP`)."""
     if re.search(r"python3? bench/\w+\.py", command):
         if "--smoke" in command.split():
             return command, "--smoke"
         new = re.sub(r"(python3? bench/\w+\.py(?:\s+(?![|>&])\S+)*)", r"\1 --smoke", command)
         return new, "--smoke"
     how = []
+    if grids and command.startswith("ipir-mujoco "):
+        def cap(match):
+            if int(match.group(3)) <= GRID_CAP:
+                return match.group(0)
+            how.append(f"{match.group(1)} {GRID_CAP} points")
+            return f"{match.group(1)}={match.group(2)}:{GRID_CAP}"
+        command = re.sub(r"(?<=--vary )([\w-]+)=([-\d.e]+:[-\d.e]+):(\d+)\b", cap, command)
     for option, cap in CAPS:
         match = re.search(rf"{option} (\d+)\b", command)
         if match and int(match.group(1)) > cap and command.startswith("ipir-mujoco "):

@@ -87,6 +87,7 @@ def run_group(commands: list[dc.Command], folder: Path, shared=None) -> dict[int
     """What each command did; a command alone in its group whose output other tests read too
     (:data:`docs_commands.SHARED_RUNS`) is ``shared(text)``'s one run."""
     out = {}
+    quoting = any(command.output for command in commands)  # a printed figure may depend on a grid's points
     for command in commands:
         if command.synopsis or needs_arguments(command):
             prog = dc.program(command.text)
@@ -101,7 +102,7 @@ def run_group(commands: list[dc.Command], folder: Path, shared=None) -> dict[int
             out[id(command)] = dict(ran=" ".join(prog) + " --help", how=f"needs {', '.join(missing)}", code=code,
                                     stdout=text, stderr="")
             continue
-        ran, how = dc.shortened(command.text, help_of)
+        ran, how = dc.shortened(command.text, help_of, grids=not quoting)
         if "mujoco.viewer" in command.text:  # MuJoCo's own viewer needs a screen: load the file it opens
             path = command.text.split("--mjcf", 1)[1].split()[0]
             ran, how = f"python -c 'import mujoco; mujoco.MjModel.from_xml_path(\"{path}\")'", "loads the model"
