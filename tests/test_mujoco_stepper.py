@@ -78,12 +78,14 @@ DESIGNS = {
                                                 incline=10.0), "unilateral", "ratchet", 0.15, {}),
     # the round pipe's hub ratchets: a straight pipe with unlimited grip; a riser on a grip that cannot carry the
     # robot (it skids back); the README's finite grip, where a wheel also leaves its wall. (A route's bends are
-    # the same loop: the wall's contacts are MuJoCo's rows like any other.)
+    # the same loop: the wall's contacts are MuJoCo's rows like any other.) The skidding ones at the automatic
+    # step given (1e-4 s): the wheels' skid check would rerun each at finer steps, 7-15 times the work, in the
+    # same loop
     "wheels, straight pipe": (RobotParams(drive="motor"), "unilateral", "ratchet", 0.1, {"model": "wheels"}),
     "wheels, riser skids": (RobotParams(drive="motor", mu_wall=0.18, incline=90.0), "unilateral", "ratchet", 0.1,
-                            {"model": "wheels"}),
+                            {"model": "wheels", "settings": SolverSettings(timestep=1e-4)}),
     "wheels, grip, a wheel lifts": (RobotParams(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0), "unilateral",
-                                    "ratchet", 0.1, {"model": "wheels"}),
+                                    "ratchet", 0.1, {"model": "wheels", "settings": SolverSettings(timestep=1e-4)}),
 }
 
 
