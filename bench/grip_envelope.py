@@ -3,7 +3,7 @@
 Run on demand (not part of the test suite; CPU-heavy, one design at a time):
 
     python bench/grip_envelope.py [--designs 200] [--seed 33] [--t-end 1] [--cap 10] [--budget 300]
-    python bench/grip_envelope.py --smoke      # 6 short designs, seconds to a minute
+    python bench/grip_envelope.py --smoke      # 6 short designs, seconds
 
 Designs (numpy's ``default_rng(seed)``; rigid one-way clutches, the robot from rest):
 log-uniform m1, m2 in [0.3, 3] kg, r in [0.02, 0.08] m, J_A in [2e-4, 1e-2] kg m^2, F_r1, F_r2 in [0.2, 5] N;
@@ -127,10 +127,10 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=1.0, help="fixed-time runs' simulated time [s]")
     parser.add_argument("--cap", type=float, default=10.0, help="runs to the steady state: the cap [s]")
     parser.add_argument("--budget", type=float, default=300.0, help="wall-time budget per run [s]")
-    parser.add_argument("--smoke", action="store_true", help="6 designs, 0.3 s, steady cap 3 s")
+    parser.add_argument("--smoke", action="store_true", help="6 designs, 0.3 s, steady cap 1 s")
     args = parser.parse_args()
     if args.smoke:
-        args.designs, args.t_end, args.cap = 6, 0.3, 3.0
+        args.designs, args.t_end, args.cap = 6, 0.3, 1.0
     rng = np.random.default_rng(args.seed)
     designs = [draw(rng) for _ in range(args.designs)]
     counts: dict[tuple[str, str], int] = {}
