@@ -3,7 +3,7 @@
 Run on demand from the repository root (about 25 min on 2 busy cores, most of it the bend; ``--cases``: some of
 them; ``--smoke``: a few seconds):
 
-    python bench/wheels_convergence.py [--cases cruise,riser,...] [--down-to STEP] [--smoke]
+    python bench/wheels_convergence.py [--cases cruise,riser,...] [--down-to STEP] [--solver-iterations] [--smoke]
 
 The model's contact, limit and loop rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
 properties of the model, so halving the step refines one model rather than stiffening it. Four cases: ``cruise``
@@ -22,6 +22,9 @@ first order, else the finest (marked: no convergence shown). The acceptance (iss
 0.2 % of it on travel and speed, 1 % plus the skid's resolution on skid length (``wheel_skids.skid_resolution``, a
 length: how closely soft contacts of time constant tau define a skid's ends, (revolutions + 1) v_max tau). The
 table in mjcf/README.md ("The round pipe: convergence") is this script's output.
+
+``--solver-iterations``: the bend at 2.5e-5 and 1.25e-5 s with the model's solver settings and with ten times
+the iterations (a minute): whether its drift with the step is the solver's or the discretization's.
 
 ``--time-constants``: why 2e-4 s. The robot with the drive off on a riser (mu_wall 0.18: both modules slide down
 from rest at a = (G1 + G2) / (m1 + m2 + m_rod) - g, the analytic model's Coulomb answer) for 0.3 s, stepped by hand
@@ -134,10 +137,46 @@ def time_constants(smoke: bool) -> None:
               flush=True)
 
 
+def solver_iterations(smoke: bool) -> None:
+    """The bend at two fixed steps with the model's solver settings (iterations 100, line-search 50, tolerance
+    1e-12) and with ten and four times the iterations (``--solver-iterations``): whether the bend's drift with
+    the step is MuJoCo's solver stopping short of convergence (the figures would move with the iterations) or
+    the discretization itself (they would not)."""
+    from ipir_mujoco.engine.modelkinds import kinds
+
+    params, t_end, tables = CASES["bend"]
+    route = route_from_tables(tables, "bend.toml")
+    t_end, steps = (0.05, (1e-4,)) if smoke else (t_end, (2.5e-5, 1.25e-5))
+    build = kinds.build_wheels_model
+    print("| step [s] | iterations / line search | revolutions | x1 [m] | x2 [m] | along the route [m] |")
+    print("|---|---|---|---|---|---|")
+    try:
+        for dt in steps:
+            for iterations, line in ((None, None), (1000, 200)):
+                def more(spec, decorate=None):
+                    if decorate is not None:
+                        decorate(spec)
+                    if iterations is not None:
+                        spec.option.iterations, spec.option.ls_iterations = iterations, line
+
+                def built(params, settings, *, mjcf=None, route=None, decorate=None):
+                    return build(params, settings, mjcf=mjcf, route=route,
+                                 decorate=lambda spec: more(spec, decorate))
+                kinds.build_wheels_model = built  # the one place the wheeled kind compiles its model
+                s = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, timestep=dt, route=route).summary
+                shown = "the model's (100 / 50)" if iterations is None else f"{iterations} / {line}"
+                print(f"| {dt:g} | {shown} | {s['revolutions']:.6g} | {s['x1_final']:.6g} | {s['x2_final']:.6g} | "
+                      f"{s['route_s_m']:.6g} |", flush=True)
+    finally:
+        kinds.build_wheels_model = build
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="one case, 0.05 s, two steps: the script runs")
     parser.add_argument("--time-constants", action="store_true", help="the riser slide at several time constants")
+    parser.add_argument("--solver-iterations", action="store_true",
+                        help="the bend at 2.5e-5 and 1.25e-5 s with 100 and 1000 solver iterations")
     parser.add_argument("--down-to", type=float, default=None, metavar="STEP",
                         help="fixed steps down to this [s] too (default: down to half the automatic run's step)")
     parser.add_argument("--cases", default=",".join(CASES),
@@ -145,6 +184,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.time_constants:
         time_constants(args.smoke)
+        return 0
+    if args.solver_iterations:
+        solver_iterations(args.smoke)
         return 0
     base = registry.timestep("mujoco-wheels", RobotParams(drive="motor", mu_wall=0.5), 1.0, 1e-3)
     factors = (1, 2) if args.smoke else (1, 2, 4, 8)

@@ -302,11 +302,13 @@ def test_a_compliant_clutchs_force_is_capped_by_the_grip_and_its_anchor_slides()
         v_before = data.qvel[c_dof].copy()
         clutch.before_step()
         mujoco.mj_step(model, data)
-        kinds, ids, force = data.efc_type.astype(int), data.efc_id, data.efc_force
+        friction = data.efc_type == FRICTION[0]
         for k in (0, 1):
             a_c = (data.qvel[c_dof[k]] - v_before[k]) / dt
             assert data.actuator_force[acts[k]] <= p.grip[k] + m_c[k] * abs(a_c) + 1e-9
-            grip = sum(f for kind, i, f in zip(kinds, ids, force) if kind == FRICTION[0] and i == c_dof[k])
+            rows = data.efc_force[friction & (data.efc_id == c_dof[k])]
+            assert rows.size <= 1  # the carriage's one friction row (its sum below is that row's force, exactly)
+            grip = float(rows.sum())
             assert grip <= p.grip[k]
             if data.qvel[c_dof[k]] < -1e-4:
                 assert grip == p.grip[k]
