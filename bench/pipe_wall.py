@@ -54,7 +54,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--smoke", action="store_true", help="a short roll and few steps (seconds)")
     args = parser.parse_args()
-    speed, steps = (2.0, 2000) if args.smoke else (0.5, 20000)
+    speed, steps = (2.0, 500) if args.smoke else (0.5, 20000)
     route = route_from_tables(ROUTE)
     cases = [("3 planes tangent at the tracks (straight)", None, "plane"), ("exact pipe, straight", None, "pipe"),
              ("exact pipe, route with 2 bends in 3-D", route, "pipe")]
@@ -66,7 +66,7 @@ def main() -> None:
         print(f"{label:44s} {ripple(run):16.2e} {ptp:15.2e} {step_cost(model, steps):8.2f} {run.contacts:15d}")
     model = build_rig(route_from_tables(LONG))
     print(f"{'exact pipe, 40 bends of R 100 m in the model':44s} {'':16s} {'':15s} {step_cost(model, steps):8.2f}")
-    duration = 0.2 if args.smoke else 1.0
+    duration = 0.1 if args.smoke else 1.0
     for label, radius in (("rolling (mu 0.5), straight", None), ("rolling (mu 0.5), in a bend of R/D 2.5", 0.4),
                           ("rolling (mu 0.5), in a bend of R/D 1.25", 0.2)):
         within = duration if radius is None else min(duration, 0.8 * (math.pi * radius - 0.3 * 0.5) / 0.5)

@@ -23,7 +23,8 @@ from ipir_mujoco.core.params import RobotParams
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--smoke", action="store_true", help="0.2 s runs, no steady state: the script runs")
+    parser.add_argument("--smoke", action="store_true", help="0.2 s runs at a given 1e-4 s step (no skid check's "
+                        "reruns), no steady state: the script runs")
     args = parser.parse_args(argv)
     cap = 0.2 if args.smoke else 20.0
     print("| F_n [N] | analytic [m/s] | MuJoCo wheels [m/s] | difference | press 1 / 2 [N] | wheel off [s] | "
@@ -33,7 +34,8 @@ def main(argv=None) -> int:
         params = RobotParams(drive="motor", mu_wall=0.5, F_n1=F_n, F_n2=F_n)
         print(f"F_n {F_n:g} N", file=sys.stderr, flush=True)
         a = registry.run("analytic-unilateral", params, cap, dt_out=1e-3, until_steady=not args.smoke)
-        w = registry.run("mujoco-wheels", params, cap, dt_out=1e-3, until_steady=not args.smoke)
+        w = registry.run("mujoco-wheels", params, cap, dt_out=1e-3, until_steady=not args.smoke,
+                         **({"timestep": 1e-4} if args.smoke else {}))
         key = "steady_speed_m_s" if not args.smoke else "x1_final"
         va, vw = a.summary[key], w.summary[key]
         s = w.summary
