@@ -5,6 +5,7 @@ same examples every run. To explore new random examples (as done when the
 one-way-clutch solver was developed), run with HYPOTHESIS_PROFILE=explore.
 """
 
+import math
 import os
 import sys
 from pathlib import Path
@@ -30,31 +31,54 @@ def pytest_configure(config):
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+KERNELS_READY = "IPIR_TEST_KERNELS_READY"  # the compile process's ready file, for the workers (tests/kernel_warmup.py)
+
+
 def pytest_sessionstart(session):
-    """Compile the analytic kernels (numba, where installed) before any test: the first compilation on a
-    machine takes about 15-40 s and the command line then says so on stderr, which the command-line tests
-    read; every later process loads the cached code. The compile's heartbeat (analytic/accel.py), a thread that
-    says "still compiling" / "kernels compiled" every HEARTBEAT_S while numba works, is put to sleep for good
-    here: its lines would land in whichever test's stderr runs when it wakes (a cold cache in CI: "kernels
-    compiled (27 s)" inside tests/test_clutch_study.py). tests/test_fast_kernels.py tests it with its own period."""
-    from ipir_mujoco.analytic import RobotParams, accel, simulate
+    """The analytic kernels compiled before any test (tests/kernel_warmup.py): here, in one process; under
+    pytest-xdist (the controller runs the session's dsession plugin) by a process of its own, started now, while
+    the workers start and collect; they wait for it before their first test (:func:`pytest_collection_finish`)."""
+    import subprocess
+    import tempfile
 
-    period = accel.HEARTBEAT_S
-    accel.HEARTBEAT_S = 1e9  # read once as the thread goes to sleep: a thread started now never wakes to log
-    try:
-        accel.accelerate()  # compile now (or load the cache) whatever the runs below spend
-        _warm_up(RobotParams, simulate)
-    finally:
-        accel.HEARTBEAT_S = period
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        if os.environ.get(KERNELS_READY):  # no compiling while the controller's compile runs (a module's run at
+            from ipir_mujoco.analytic import accel  # import would start one after LOAD_COST_S of Python)
+
+            session.config._load_cost, accel.LOAD_COST_S = accel.LOAD_COST_S, math.inf
+        return
+    if not session.config.pluginmanager.has_plugin("dsession"):
+        from kernel_warmup import warm_up
+
+        warm_up()
+        return
+    ready = Path(tempfile.mkdtemp(prefix="ipir-kernels-")) / "ready"
+    os.environ[KERNELS_READY] = str(ready)  # the workers, started after this hook, inherit it
+    session.config._kernels = subprocess.Popen(  # its stderr: a failed compile says why, as a process would
+        [sys.executable, str(Path(__file__).with_name("kernel_warmup.py")), str(ready)], stdout=subprocess.DEVNULL)
 
 
-def _warm_up(RobotParams, simulate) -> None:
-    """Short runs of each analytic engine: numba compiles each kernel at its first call."""
-    for geometry, clutch, params in (("approx", "kinematic", RobotParams()), ("exact", "kinematic", RobotParams()),
-                                     ("exact", "unilateral", RobotParams()),
-                                     ("exact", "unilateral", RobotParams(clutch_stiffness=1e5))):
-        simulate(params, geometry, clutch, 0.02, dt_out=1e-3)
+def pytest_collection_finish(session):
+    """In a pytest-xdist worker: wait for the controller's compile, then load the cached kernels here."""
+    if os.environ.get("PYTEST_XDIST_WORKER") and os.environ.get(KERNELS_READY):
+        from ipir_mujoco.analytic import accel
+        from kernel_warmup import wait_for, warm_up
 
+        wait_for(Path(os.environ[KERNELS_READY]))
+        accel.LOAD_COST_S = session.config._load_cost
+        warm_up()
+
+
+def pytest_sessionfinish(session):
+    """The controller: the compile process ended (killed if a short session outran it), its folder removed."""
+    import shutil
+
+    process = getattr(session.config, "_kernels", None)
+    if process is not None:
+        if process.poll() is None:
+            process.kill()
+        process.wait()
+        shutil.rmtree(Path(os.environ[KERNELS_READY]).parent, ignore_errors=True)
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -23,7 +23,14 @@ from ipir_mujoco.core.results import Mode
 from ipir_mujoco.analytic.solver_support import graze_signs
 from ipir_mujoco.analytic.unilateral_model import UnilateralModel
 
-ACCELERATED = accel.accelerate()  # the compiled scans, where numba is installed, against the numpy reference
+# the compiled scans, where numba is installed, against the numpy reference (compiled before the first test, not
+# at import: tests/test_fast_kernels.py says why)
+ACCELERATED = accel.available()
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _compiled():
+    accel.accelerate()
 RTOL, ATOL = 1e-10, 1e-12
 PARAMS = RobotParams(drive="motor", incline=10.0, rod_mass=0.2)
 

@@ -29,8 +29,15 @@ from ipir_mujoco.analytic.unilateral_model import UnilateralModel
 
 # compiled for the whole test session where numba is installed (by default a process compiles only once its
 # runs have spent accel.LOAD_COST_S in Python): every test then checks the compiled kernels, and the Python
-# source is checked against them in child processes
-ACCELERATED = accel.accelerate()
+# source is checked against them in child processes. Decided at import, compiled before the first test
+# (tests/conftest.py compiles the kernels once for the session; at import a pytest-xdist worker collects while
+# that compile runs)
+ACCELERATED = accel.available()
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _compiled():
+    accel.accelerate()
 RTOL, ATOL = 1e-10, 1e-12
 DESIGNS = {
     "paper": RobotParams(),
