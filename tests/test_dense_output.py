@@ -31,6 +31,8 @@ ACCELERATED = accel.available()
 @pytest.fixture(autouse=True, scope="module")
 def _compiled():
     accel.accelerate()
+
+
 RTOL, ATOL = 1e-10, 1e-12
 PARAMS = RobotParams(drive="motor", incline=10.0, rod_mass=0.2)
 

@@ -38,6 +38,8 @@ ACCELERATED = accel.available()
 @pytest.fixture(autouse=True, scope="module")
 def _compiled():
     accel.accelerate()
+
+
 RTOL, ATOL = 1e-10, 1e-12
 DESIGNS = {
     "paper": RobotParams(),
