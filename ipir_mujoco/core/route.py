@@ -24,6 +24,7 @@ a straight whose direction is +-up: for a level start, a bend of ``angle = 90, p
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,23 +96,55 @@ class Piece:
         axis, phi = self.axis, u / self.radius
         return np.array([_rotate(row, axis, phi) for row in self.frame])
 
-    def nearest3(self, p: np.ndarray) -> tuple[float, float]:
-        """(distance [m] from the point ``p`` (3,) to the piece's centreline, u [m] along it of the nearest
-        point)."""
-        t = self.frame[0]
+    @functools.cached_property
+    def _floats(self) -> tuple:
+        """The piece's constants as Python floats, for :meth:`nearest_xyz` (a run's route watch projects two points
+        per recorded sample: numpy's per-call cost on 3-vectors was most of a route run's time): (point, t, d, c,
+        axis) each (x, y, z) [m or -], d and c a bend's :attr:`toward` and :attr:`centre3` (zeros for a
+        straight)."""
+        t = tuple(float(v) for v in self.frame[0])
+        straight = self.kind == "straight"
+        return (tuple(float(v) for v in self.point), t,
+                (0.0, 0.0, 0.0) if straight else tuple(float(v) for v in self.toward),
+                (0.0, 0.0, 0.0) if straight else tuple(float(v) for v in self.centre3),
+                (0.0, 0.0, 0.0) if straight else tuple(float(v) for v in self.axis))
+
+    def nearest_xyz(self, px: float, py: float, pz: float) -> tuple[float, float]:
+        """(distance [m] from the point (px, py, pz) [m] to the piece's centreline, u [m] along it of the nearest
+        point), in Python floats."""
+        (ox, oy, oz), (tx, ty, tz), (dx, dy, dz), (cx, cy, cz), (ax, ay, az) = self._floats
         if self.kind == "straight":
-            u = min(max(float((p - self.point) @ t), 0.0), self.length)
+            u = min(max((px - ox) * tx + (py - oy) * ty + (pz - oz) * tz, 0.0), self.length)
+            qx, qy, qz = ox + u * tx, oy + u * ty, oz + u * tz
         else:
-            c, d, axis = self.centre3, self.toward, self.axis
-            v = p - c
-            v = v - axis * float(v @ axis)  # into the bend's plane
-            turned = math.atan2(float(v @ t), float(v @ -d)) % (2 * math.pi)
+            vx, vy, vz = px - cx, py - cy, pz - cz
+            k = vx * ax + vy * ay + vz * az
+            vx, vy, vz = vx - ax * k, vy - ay * k, vz - az * k  # into the bend's plane
+            turned = math.atan2(vx * tx + vy * ty + vz * tz, -(vx * dx + vy * dy + vz * dz)) % (2 * math.pi)
             a = abs(self.angle)
             if turned > a:  # beyond the bend's end: clamp to the nearer end
                 turned = a if turned - a < 2 * math.pi - turned else 0.0
             u = turned * self.radius
-        q, _ = self.at3(u)
-        return float(np.linalg.norm(p - q)), u
+            r = self.radius
+            phi = u / r  # as at3 computes it
+            sin, cos_1 = math.sin(phi), 1.0 - math.cos(phi)
+            qx, qy, qz = (ox + r * (sin * tx + cos_1 * dx), oy + r * (sin * ty + cos_1 * dy),
+                          oz + r * (sin * tz + cos_1 * dz))
+        return math.sqrt((px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2), u
+
+    def direction_xyz(self, u: float) -> tuple[float, float, float]:
+        """The centreline's unit direction ``u`` [m] along the piece, in Python floats (:meth:`at3`'s second)."""
+        _, t, d, _, _ = self._floats
+        if self.kind == "straight":
+            return t
+        phi = u / self.radius
+        c, s = math.cos(phi), math.sin(phi)
+        return c * t[0] + s * d[0], c * t[1] + s * d[1], c * t[2] + s * d[2]
+
+    def nearest3(self, p: np.ndarray) -> tuple[float, float]:
+        """(distance [m] from the point ``p`` (3,) to the piece's centreline, u [m] along it of the nearest
+        point)."""
+        return self.nearest_xyz(float(p[0]), float(p[1]), float(p[2]))
 
     # the mechanism's plane (z = 0), for the planar model's walls: valid while every bend turns in it
     @property
@@ -203,32 +236,38 @@ class Route:
     def project3(self, p, near: float | None = None) -> float:
         """How far along the centreline [m] the point ``p`` [m] (3,) is: its nearest centreline point's s; with
         ``near`` [m], of the pieces within 0.5 m of that s only (a route that passes near itself)."""
-        p = np.asarray(p, dtype=float)
+        px, py, pz = (float(v) for v in p)
         best = (math.inf, 0.0)
         for piece in self.pieces:
             if near is not None and not (piece.s0 - 0.5 <= near <= piece.s0 + piece.length + 0.5):
                 continue
-            distance, u = piece.nearest3(p)
+            distance, u = piece.nearest_xyz(px, py, pz)
             if distance < best[0]:
                 best = (distance, piece.s0 + u)
         return best[1]
 
     def project(self, x: float, y: float, near: float | None = None) -> float:
         """:meth:`project3` of the point (x, y, 0)."""
-        return self.project3(np.array([x, y, 0.0]), near)
+        return self.project3((x, y, 0.0), near)
 
     def along(self, p, near: float) -> float:
         """A point's distance along the route [m] (near ``near`` [m]), beyond its end along the exit straight
-        and before its start (negative) along the first straight."""
-        p = np.asarray(p, dtype=float)
-        s = self.project3(p, near=near)
+        and before its start (negative) along the first straight; ``p`` [m] (3,), any sequence of numbers."""
+        px, py, pz = (float(v) for v in p)
+        s = self.project3((px, py, pz), near=near)
         if s <= 0.0:  # behind the start: along the first straight, backwards
-            first = self.pieces[0]
-            return min(0.0, float((p - first.point) @ first.frame[0]))
+            (ox, oy, oz), (tx, ty, tz) = self.pieces[0]._floats[:2]
+            return min(0.0, (px - ox) * tx + (py - oy) * ty + (pz - oz) * tz)
         if s >= self.length:
             end, t = self.at3(self.length)
-            s = self.length + max(0.0, float((p - end) @ t))
+            s = self.length + max(0.0, float((np.array([px, py, pz]) - end) @ t))
         return s
+
+    def direction_xyz(self, s: float) -> tuple[float, float, float]:
+        """The centreline's unit direction at ``s`` [m] (clamped to 0..length), in Python floats (:meth:`at3`'s
+        second, without numpy's per-call cost: a route run reads it at every sample)."""
+        piece, u = self._piece(s)
+        return piece.direction_xyz(u)
 
     def piece_at(self, s: float) -> int:
         """Index of the piece at ``s`` [m] (the last for s beyond the end)."""

@@ -63,12 +63,19 @@ class ModulePoints:
 
     @staticmethod
     def _read(values, addresses, base) -> np.ndarray:
-        return base + np.array([0.0 if a is None else float(values[a]) for a in addresses])
+        values = np.asarray(values, dtype=float)
+        out = np.broadcast_to(base, values.shape[:-1] + (3,)).copy()
+        for k, a in enumerate(addresses):
+            if a is not None:
+                out[..., k] += values[..., a]
+        return out
 
     def positions(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """(A, C) [m] of the state ``q`` (nq,), each (3,), or of the rows of ``q`` (n, nq), each (n, 3)."""
         return self._read(q, self.q[0], self.base[0]), self._read(q, self.q[1], self.base[1])
 
     def velocities(self, v) -> tuple[np.ndarray, np.ndarray]:
+        """(vA, vC) [m/s] of ``v`` (nv,) or of its rows (n, nv), as :meth:`positions`."""
         zero = np.zeros(3)
         return self._read(v, self.v[0], zero), self._read(v, self.v[1], zero)
 
@@ -117,18 +124,26 @@ class RouteWatch:
         self.tilts = [int(model.jnt_qposadr[j]) for j in found] if min(found) >= 0 else None  # the ball joints
 
     def check(self, newest: int) -> int | None:
-        """Feed the samples up to row ``newest``; the row to end the run at, or None to go on."""
+        """Feed the samples up to row ``newest``; the row to end the run at, or None to go on. The block's points
+        and wheel states are read from the samples at once (numpy), the checks run sample by sample."""
         rec = self.rec
-        rows = range(self.fed, newest + 1)
+        first = self.fed
         self.fed = newest + 1
+        if newest < first:
+            return None
         q, t = rec.qpos, rec.t
+        block = np.asarray(q[first:newest + 1], dtype=float)
+        rears, aheads = (points.tolist() for points in self.points.positions(block))
+        arms = block[:, self.arms]
+        reach = (arms / self.free).max(axis=1).tolist()
+        off = (arms > (1.0 - LOST_SHARE) * self.free).tolist()
+        times = np.asarray(t[first:newest + 1], dtype=float).tolist()
         length = self.route.length
-        for i in rows:
-            ti = float(t[i])
-            rear, ahead = self.points.positions(q[i])
-            s = self.route.along(rear, self.s_last)
+        for j, ti in enumerate(times):
+            i = first + j
+            s = self.route.along(rears[j], self.s_last)
             t0 = float(t[i - 1]) if i > 0 else ti
-            front = self.route.along(ahead, self.s_front)
+            front = self.route.along(aheads[j], self.s_front)
             self.along.append((s, front))
             centre, before = 0.5 * (s + front), 0.5 * (self.s_last + self.s_front)
             self.s_front = front
@@ -166,7 +181,7 @@ class RouteWatch:
                 self.stop = (f"stalled: less than {PROGRESS_M * 1e3:g} mm of progress in {PROGRESS_S:g} s "
                              f"({why}), at {self.route.where(self.s_max)}, t = {ti:.4f} s")
                 return i
-            self._wheels(q[i, self.arms], ti)
+            self._wheels(off[j], reach[j], ti)
         return None
 
     def in_bend(self, rear: float, front: float) -> bool:
@@ -203,7 +218,8 @@ class RouteWatch:
         rec = self.rec
         out = dict(series)
         along = list(self.along[:n])
-        world = np.array([np.concatenate(self.points.positions(rec.qpos[i])) for i in range(n)])
+        world = np.concatenate(self.points.positions(np.asarray(rec.qpos[:n], dtype=float)), axis=1).reshape(n, 6)
+        velocities = self.points.velocities(np.asarray(rec.qvel[:n], dtype=float))
         for i in range(len(along), n):  # samples after the last check (the run's end)
             before = along[-1] if along else (0.0, 0.0)
             along.append((self.route.along(world[i, :3], before[0]), self.route.along(world[i, 3:], before[1])))
@@ -212,26 +228,27 @@ class RouteWatch:
             s = along[:, k]
             out[f"x{column}_world"], out[f"y{column}_world"], out[f"z{column}_world"] = world[:, 3 * k:3 * k + 3].T
             out[f"x{column}"] = s - s[0]
-            speed = np.empty(n)
-            for i in range(n):
-                _, direction = self.route.at3(float(s[i]))
-                speed[i] = float(self.points.velocities(rec.qvel[i])[k] @ direction)
+            directions = np.array([self.route.direction_xyz(float(si)) for si in s]).reshape(n, 3)
+            speed = np.einsum("ij,ij->i", velocities[k].reshape(n, 3), directions)
             out[f"v{column}"] = speed
             out[f"a{column}"] = np.gradient(speed, series["t"]) if n > 1 else np.zeros(n)
         return out
 
-    def _wheels(self, arms: np.ndarray, t: float) -> None:
-        """Note which wheels press with less than LOST_SHARE of their preload at one sample (``arms``: the arm
-        slides [m]; the spring presses with 1 - q / free of its preload, the light arm's contact with as much but
-        for the arm's inertia)."""
-        self.reach = max(self.reach, float((arms / self.free).max()))
-        off = arms > (1.0 - LOST_SHARE) * self.free
-        if off.any():
+    def _wheels(self, off: list[bool], reach: float, t: float) -> None:
+        """Note which wheels press with less than LOST_SHARE of their preload at one sample: ``off`` per arm
+        slide, whether it reaches beyond 1 - LOST_SHARE of its spring's free length (the spring presses with
+        1 - q / free of its preload, the light arm's contact with as much but for the arm's inertia); ``reach``
+        the sample's largest q / free."""
+        self.reach = max(self.reach, reach)
+        if any(off):
             self.off_time += self.dt
-        half = len(self.arms) // 2
-        if off[:half].all() or off[half:].all():
-            self.module_off_time += self.dt
-        for k in np.flatnonzero(off):
+            half = len(off) // 2
+            if all(off[:half]) or all(off[half:]):
+                self.module_off_time += self.dt
+        for k, wheel_off in enumerate(off):
+            if not wheel_off:
+                self.off_since[k] = None
+                continue
             since = self.off_since[k]
             if since is None:
                 self.off_since[k] = t
@@ -239,8 +256,6 @@ class RouteWatch:
                 self.lost = (f"wheel {self.arm_names[k][:-4]} lost its wall (pressing with < {100 * LOST_SHARE:g} % of "
                              f"its preload for {WALL_LOSS_S:g} s) from t = {since:.4f} s, at "
                              f"{self.route.where(self.s_max)}")
-        for k in np.flatnonzero(~off):
-            self.off_since[k] = None
 
     def record(self, t_end: float, stall: str | None) -> dict:
         """The summary's route keys: ``route_done``, ``route_time_s`` [s] or None, ``route_s_m`` [m] (the furthest the
