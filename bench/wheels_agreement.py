@@ -18,7 +18,8 @@ and ``mujoco-wheels`` (its automatic settings) run it, and the design lands in o
 - ``stopped``: refused (bad input for a model), stopped (a stall) or flagged by MuJoCo's accuracy monitor (its
   figure beyond tolerance, in the run's summary), with its reason;
 - ``scrubbed``: a module's rings slid across the pipe (their path across it, from the run's pose columns, at
-  least SCRUB_FLOOR: :func:`across_path`) and the closed-form sideways-grip check predicted it
+  least SCRUB_FLOOR: the run summary's ``across1_m``, ``across2_m``, :func:`ipir_mujoco.core.pipe.across_paths`)
+  and the closed-form sideways-grip check predicted it
   (:func:`ipir_mujoco.core.pipe.side_grip_check` on the analytic run's linkage forces: a ring's load across the
   pipe beyond its wheels' sideways friction). The analytic model's rails carry those loads without moving; the
   wheels scrub instead (energy lost, and grip along the pipe lost while they slide), which it does not know;
@@ -44,16 +45,10 @@ from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.kinetostatics import pin_forces
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.pipe import side_grip_check
+from ipir_mujoco.core.pipe import SCRUB_FLOOR, side_grip_check
 
 TRAVEL_REL, TRAVEL_FLOOR = 0.01, 0.01  # the acceptance: travel within 1 % (at least 1 cm)
 SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
-# a ring whose wheels all grip cannot move across the pipe (their circumferential directions span its plane): only
-# the contacts' softness moves it. Designs whose sideways-grip check stays below 1 in both modules and no wheel lifts
-# moved their rings at most 0.12 mm in their 1-2 s (designs 1, 6-8, 13, 21, 24), those above it 17.1 mm and more
-# (designs 0, 2-5, 9-12, 14-16, 18-20, 22, 23, 25-28, 38, 45, 67, 83, 84, 99; mjcf/README.md, "The round pipe
-# against the analytic finite-grip model"): 1 mm lies a factor 8 above the one and 17 below the other
-SCRUB_FLOOR = 1e-3
 
 
 def log_uniform(rng, lo: float, hi: float) -> float:
@@ -76,19 +71,6 @@ def design(rng) -> tuple[RobotParams, float]:
 
 def within(a: float, b: float, rel: float, floor: float) -> bool:
     return abs(b - a) <= max(rel * abs(a), floor) if floor == TRAVEL_FLOOR else abs(b - a) <= rel * abs(a) + floor
-
-
-def across_path(series: dict, params: RobotParams) -> tuple[float, float]:
-    """How far [m] each module's rings moved across the pipe over a wheeled run, from its pose columns (y, z,
-    roll, pitch, yaw; small turns): the longer of its two rings' paths in (y, z) (ring centres ring_spacing / 2 fore
-    and aft of the module's centre) plus its wheels' path round the pipe from its roll (D / 2 |d roll|), sample to
-    sample."""
-    a, out = 0.5 * params.ring_spacing, []
-    for k in (1, 2):
-        y, z, roll, pitch, yaw = (np.asarray(series[f"{c}{k}"], dtype=float) for c in ("y", "z", "roll", "pitch", "yaw"))
-        rings = [np.hypot(np.diff(y + side * a * yaw), np.diff(z - side * a * pitch)) for side in (-1.0, 1.0)]
-        out.append(float(np.sum(np.maximum(*rings) + 0.5 * params.pipe_diameter * np.abs(np.diff(roll)))))
-    return out[0], out[1]
 
 
 def side_check(analytic, params: RobotParams) -> dict:
@@ -123,7 +105,7 @@ def judge(index: int, params: RobotParams, t_end: float, budget: float | None = 
     row.update(wheel_off_s=w["wheel_off_s"], lift_predicted=w["lift_predicted"], press=(w["press1_n"], w["press2_n"]))
     side = side_check(analytic, params)
     row.update(side_use=(side["side_use1"], side["side_use2"]), scrub_predicted=side["scrub_predicted"],
-               across=across_path(wheels.series, params))
+               across=(w["across1_m"], w["across2_m"]))
     stops = [s for s in (analytic.stall, wheels.stall) if s]
     agree = all(within(a[f"x{k}_final"], w[f"x{k}_final"], TRAVEL_REL, TRAVEL_FLOOR)
                 and abs(w[f"slip{k}_m"] - a[f"slip{k}_m"]) <= SKID_REL * a[f"slip{k}_m"] + SKID_FLOOR for k in (1, 2))

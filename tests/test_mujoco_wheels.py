@@ -21,7 +21,8 @@ import pytest
 
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams
-from ipir_mujoco.core.pipe import leg_direction, lift_check
+from ipir_mujoco.core.pipe import SCRUB_FLOOR, leg_direction, lift_check
+from ipir_mujoco.core.route import route_from_tables
 from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
 from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
 from ipir_mujoco.engine.builders.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
@@ -177,6 +178,36 @@ def test_the_wheeled_run_reports_its_press_and_the_lift_off_check():
     lifted = registry.run("mujoco-wheels", light, 0.2, dt_out=1e-3).summary
     assert lift_check(light)["lift_predicted"] and lifted["lift_predicted"]
     assert lifted["wheel_off_s"] > 0.1
+
+
+def test_the_wheeled_run_reports_the_sideways_grip_check_beside_its_rings_slide():
+    """The summary's sideways-grip check (core.pipe.side_summary) by hand for the default 3 legs: a ring's wheels
+    hold mu_wall P (1 + 2 sin 30 deg) = 2 mu_wall P across the pipe (P = F_ni / 6); module 1's ring carries half
+    the rod's largest side force T / (L - r) and the motor's couple T / ring_spacing, module 2's the half only.
+    Beside it MuJoCo's outcome: in the cruise (check below 1, no skid, no wheel off) every wheel grips and only the
+    contacts' softness moves the rings (0.008 mm in 1 s measured), far below the 1 mm that counts as a slide; with
+    mu_wall 0.2 under a constant 0.3 N m (check 1.2 on module 1, which also skids along the pipe: its wheels'
+    friction then holds nothing across it) the rings slide millimetres (5.2 mm in 0.3 s measured)."""
+    s = registry.run("mujoco-wheels", CRUISE, 0.2, dt_out=1e-3).summary
+    T, p = CRUISE.M_stall, CRUISE
+    side = T / (p.L - p.r)
+    assert s["side_use1"] == pytest.approx((0.5 * side + T / p.ring_spacing) / (2 * p.mu_wall * p.F_n1 / 6), rel=1e-12)
+    assert s["side_use2"] == pytest.approx(0.5 * side / (2 * p.mu_wall * p.F_n2 / 6), rel=1e-12)
+    assert s["side_use1"] < 1 and s["scrub_predicted"] is False
+    assert s["slip1_m"] < 1e-6 and s["wheel_off_s"] == 0.0
+    assert max(s["across1_m"], s["across2_m"]) < 0.1 * SCRUB_FLOOR and s["scrubbed"] is False
+    low = RobotParams(drive="torque", M=0.3, mu_wall=0.2)
+    s = registry.run("mujoco-wheels", low, 0.3, dt_out=1e-3, timestep=1e-4).summary
+    assert s["side_use1"] > 1 and s["scrub_predicted"] is True
+    assert s["across1_m"] > SCRUB_FLOOR and s["scrubbed"] is True
+    from ipir_mujoco.cli.simulate import wall_lines  # what simulate prints for it without --json
+
+    printed = "\n".join(wall_lines(s))
+    assert "(slid: the wheels scrubbed)" in printed and "a slide predicted" in printed
+    assert f"{1e3 * s['across1_m']:.3g} mm" in printed and f"check {s['side_use1']:.3g} / " in printed
+    # a route's bends carry their own fit (route_fit's scrub_n); the straight-pipe check is not given there
+    assert all(key not in registry.run("mujoco-wheels", CRUISE, 0.05, dt_out=1e-3, route=route_from_tables(
+        [{"kind": "straight", "length": 1.0}])).summary for key in ("side_use1", "across1_m", "scrubbed"))
 
 
 @pytest.mark.slow

@@ -185,6 +185,8 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         lines.append(f"  wheels' grip {run.params.grip[0]:.4g} N / {run.params.grip[1]:.4g} N: skidded back "
                      f"{fixed(s['slip1_m'], 4)} m (rear), {fixed(s['slip2_m'], 4)} m (front); peak clutch load "
                      + ("none" if use is None else f"{use:.3g} of the grip"))
+    if "across1_m" in s:  # the wheeled model in a straight pipe: the wall's closed-form checks beside MuJoCo's outcome
+        lines += wall_lines(s, unlimited_grip=run.params.mu_wall is None)
     if s["stalled"]:
         lines.append(f"  stalled: {s['stall_reason']}")
     if "route_done" in s:
@@ -204,6 +206,24 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      f"{last.get('figure')} " + ("n/a" if error is None else f"{error:.2g}")
                      + f" of it, its accuracy {accuracy['tolerances']['skid_difference']:.2g}")
     return "\n".join(lines)
+
+
+def wall_lines(s: dict, unlimited_grip: bool = False) -> list[str]:
+    """The wheels on their wall in words: MuJoCo's press, wheels off and rings' slide across the pipe, each beside
+    its closed-form check (lift-off: the least-pressed leg's press; sideways grip: the largest ring load over what
+    the ring holds across the pipe, none with ``unlimited_grip``)."""
+    lift = "a wheel lifts" if s["lift_predicted"] else "no wheel lifts"
+    if unlimited_grip:
+        check = "unlimited grip: the wheels hold across the pipe"
+    else:
+        check = (f"sideways-grip check {s['side_use1']:.3g} / {s['side_use2']:.3g} ("
+                 + ("a slide predicted" if s["scrub_predicted"] else "held")
+                 + "; a module that skids or lifts a wheel holds nothing across)")
+    return [f"  wall press {s['press1_n']:.4g} N / {s['press2_n']:.4g} N (mean), a wheel off its wall "
+            f"{s['wheel_off_s']:.3f} s; lift-off check: least-pressed leg {s['least_press1_n']:.3g} N / "
+            f"{s['least_press2_n']:.3g} N ({lift})",
+            f"  rings moved across the pipe {1e3 * s['across1_m']:.3g} mm / {1e3 * s['across2_m']:.3g} mm"
+            + (" (slid: the wheels scrubbed)" if s["scrubbed"] else "") + f"; {check}"]
 
 
 def route_lines(s: dict) -> list[str]:

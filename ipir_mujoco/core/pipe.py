@@ -285,3 +285,47 @@ def lift_summary(params, fit: dict | None = None) -> dict:
                 out[key] = min(out[key], bend[key])
     out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
     return out
+
+
+# a ring whose wheels all grip cannot move across the pipe (their circumferential directions span its plane): only
+# the contacts' softness moves it. In the wheeled model's agreement benchmark (mjcf/README.md, "The round pipe
+# against the analytic finite-grip model"), designs whose sideways-grip check on the analytic run's forces stayed
+# below 1 with no wheel off moved their rings at most 0.12 mm in 1-2 s, those above it 17.1 mm and more: 1 mm lies a
+# factor 8 above the one and 17 below the other
+SCRUB_FLOOR = 1e-3  # m
+
+
+def across_paths(series: dict, params) -> tuple[float, float]:
+    """How far [m] each module's rings moved across the pipe over a wheeled run, from its pose columns (``y``,
+    ``z``, ``roll``, ``pitch``, ``yaw`` and 1 or 2; small turns): the longer of its two rings' paths in (y, z)
+    (ring centres ``ring_spacing`` / 2 fore and aft of the module's point) plus its wheels' path round the pipe
+    from its roll (D / 2 |d roll|), sample to sample. (module 1's, module 2's)."""
+    a, out = 0.5 * params.ring_spacing, []
+    for k in (1, 2):
+        y, z, roll, pitch, yaw = (np.asarray(series[f"{c}{k}"], dtype=float) for c in ("y", "z", "roll", "pitch", "yaw"))
+        rings = [np.hypot(np.diff(y + side * a * yaw), np.diff(z - side * a * pitch)) for side in (-1.0, 1.0)]
+        out.append(float(np.sum(np.maximum(*rings) + 0.5 * params.pipe_diameter * np.abs(np.diff(roll)))))
+    return out[0], out[1]
+
+
+def side_summary(params, series: dict) -> dict:
+    """The sideways-grip keys of a wheeled run's summary: the closed-form check beside MuJoCo's outcome.
+
+    - ``side_use1``, ``side_use2``: :func:`side_grip_check` on the drive's loads, quasi-static as
+      :func:`lift_check` takes them (the rod's largest side force :func:`rod_side_force` at the drive's largest
+      torque, M or M_stall, on both modules; the motor's reaction couple on module 1), with the modules holding
+      along the pipe (no skid): each module's largest ring load across the pipe over what its ring's wheels hold
+      across it. Above 1 the rings slide across the pipe; a module that skids along the pipe holds nothing across
+      it whatever this says (its wheels' friction is all along the pipe), nor does a lifted wheel.
+    - ``scrub_predicted``: either above 1.
+    - ``across1_m``, ``across2_m`` [m]: how far MuJoCo's rings moved across the pipe (:func:`across_paths`); a
+      slide where above SCRUB_FLOOR.
+    - ``scrubbed``: either above SCRUB_FLOOR: the wheels slid across the pipe, a loss the equations' rails lack.
+    """
+    torque = abs(params.M) if params.drive == "torque" else params.M_stall
+    side = rod_side_force(torque, params.r, params.L)
+    check = side_grip_check(params, [side], [side], [torque])
+    across = across_paths(series, params)
+    return {"side_use1": check["side_use1"], "side_use2": check["side_use2"],
+            "scrub_predicted": check["scrub_predicted"], "across1_m": across[0], "across2_m": across[1],
+            "scrubbed": max(across) >= SCRUB_FLOOR}

@@ -78,7 +78,7 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .errors import ParameterError
 from .params import RobotParams
-from .pipe import lift_summary
+from .pipe import lift_summary, side_summary
 from .steady_test import steady_target
 
 # [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
@@ -217,6 +217,8 @@ class RunResult:
         summary = summarize(self.series, self.energy, self.params.grip)
         if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
             summary.update(lift_summary(self.params, (self.route or {}).get("route_fit")))
+            if not self.route:  # and the sideways-grip check (a route's bends have theirs in route_fit)
+                summary.update(side_summary(self.params, self.series))
         summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall
