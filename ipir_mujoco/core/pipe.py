@@ -319,8 +319,8 @@ def side_summary(params, series: dict) -> dict:
       it whatever this says (its wheels' friction is all along the pipe), nor does a lifted wheel.
     - ``scrub_predicted``: either above 1.
     - ``across1_m``, ``across2_m`` [m]: how far MuJoCo's rings moved across the pipe (:func:`across_paths`); a
-      slide where above SCRUB_FLOOR.
-    - ``scrubbed``: either above SCRUB_FLOOR: the wheels slid across the pipe, a loss the equations' rails lack.
+      slide from SCRUB_FLOOR on.
+    - ``scrubbed``: either at least SCRUB_FLOOR: the wheels slid across the pipe, a loss the equations' rails lack.
     """
     torque = abs(params.M) if params.drive == "torque" else params.M_stall
     side = rod_side_force(torque, params.r, params.L)

@@ -217,7 +217,8 @@ class RunResult:
         summary = summarize(self.series, self.energy, self.params.grip)
         if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
             summary.update(lift_summary(self.params, (self.route or {}).get("route_fit")))
-            if not self.route:  # and the sideways-grip check (a route's bends have theirs in route_fit)
+            if not self.route and "yaw2" in self.series:  # and the sideways-grip check, where the run has its
+                # pose columns (a route's bends have theirs in route_fit)
                 summary.update(side_summary(self.params, self.series))
         summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
