@@ -34,6 +34,7 @@ SHARED = {ran for _documented, ran, _reader in dc.SHARED_RUNS}
 COMMANDS = [command for group in GROUPS.values() for command in group]
 
 
+@functools.lru_cache(maxsize=1)
 def _subcommands() -> dict[str, argparse.ArgumentParser]:
     from ipir_mujoco.cli import build_parser
 

@@ -82,12 +82,7 @@ class Piece:
 
     def at3(self, u: float) -> tuple[np.ndarray, np.ndarray]:
         """(point [m] (3,), unit direction (3,)) a distance ``u`` [m] (0..length) along the piece."""
-        t = self.frame[0]
-        if self.kind == "straight":
-            return self.point + u * t, t.copy()
-        phi, d = u / self.radius, self.toward
-        return (self.point + self.radius * (math.sin(phi) * t + (1 - math.cos(phi)) * d),
-                math.cos(phi) * t + math.sin(phi) * d)
+        return np.array(self.point_xyz(u)), np.array(self.direction_xyz(u))
 
     def frame_at(self, u: float) -> np.ndarray:
         """The pipe's frame (rows t, n, b) ``u`` [m] along the piece (transported along a bend)."""
@@ -98,7 +93,8 @@ class Piece:
 
     @functools.cached_property
     def _floats(self) -> tuple:
-        """The piece's constants as Python floats, for :meth:`nearest_xyz` (a run's route watch projects two points
+        """The piece's constants as Python floats, for :meth:`point_xyz`, :meth:`direction_xyz` and :meth:`at3`
+        built on them (a run's route watch projects two points
         per recorded sample: numpy's per-call cost on 3-vectors was most of a route run's time): (point, t, d, c,
         axis) each (x, y, z) [m or -], d and c a bend's :attr:`toward` and :attr:`centre3` (zeros for a
         straight)."""
@@ -115,7 +111,7 @@ class Piece:
         (ox, oy, oz), (tx, ty, tz), (dx, dy, dz), (cx, cy, cz), (ax, ay, az) = self._floats
         if self.kind == "straight":
             u = min(max((px - ox) * tx + (py - oy) * ty + (pz - oz) * tz, 0.0), self.length)
-            qx, qy, qz = ox + u * tx, oy + u * ty, oz + u * tz
+            qx, qy, qz = self.point_xyz(u)
         else:
             vx, vy, vz = px - cx, py - cy, pz - cz
             k = vx * ax + vy * ay + vz * az
@@ -125,15 +121,21 @@ class Piece:
             if turned > a:  # beyond the bend's end: clamp to the nearer end
                 turned = a if turned - a < 2 * math.pi - turned else 0.0
             u = turned * self.radius
-            r = self.radius
-            phi = u / r  # as at3 computes it
-            sin, cos_1 = math.sin(phi), 1.0 - math.cos(phi)
-            qx, qy, qz = (ox + r * (sin * tx + cos_1 * dx), oy + r * (sin * ty + cos_1 * dy),
-                          oz + r * (sin * tz + cos_1 * dz))
+            qx, qy, qz = self.point_xyz(u)
         return math.sqrt((px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2), u
 
+    def point_xyz(self, u: float) -> tuple[float, float, float]:
+        """The centreline's point [m] ``u`` [m] (0..length) along the piece, in Python floats."""
+        (ox, oy, oz), (tx, ty, tz), (dx, dy, dz), _, _ = self._floats
+        if self.kind == "straight":
+            return ox + u * tx, oy + u * ty, oz + u * tz
+        r = self.radius
+        phi = u / r
+        sin, cos_1 = math.sin(phi), 1 - math.cos(phi)
+        return ox + r * (sin * tx + cos_1 * dx), oy + r * (sin * ty + cos_1 * dy), oz + r * (sin * tz + cos_1 * dz)
+
     def direction_xyz(self, u: float) -> tuple[float, float, float]:
-        """The centreline's unit direction ``u`` [m] along the piece, in Python floats (:meth:`at3`'s second)."""
+        """The centreline's unit direction ``u`` [m] along the piece, in Python floats."""
         _, t, d, _, _ = self._floats
         if self.kind == "straight":
             return t
