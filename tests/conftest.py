@@ -110,14 +110,14 @@ def shared_command(tmp_path_factory):
     """``shared_command(text)``: ``text`` run once by bash in a folder of its own in this pytest process, as a
     user types it (cli_run.run_shell); the CompletedProcess with ``.folder`` where it ran. For the runs several
     tests read (docs_commands.SHARED_RUNS)."""
-    from cli_run import run_shell
+    from cli_run import run_command
 
     done = {}
 
     def run(text: str):
         if text not in done:
             folder = tmp_path_factory.mktemp("shared")
-            done[text] = run_shell(text, folder)
+            done[text] = run_command(text, folder)
             done[text].folder = folder
         return done[text]
     return run

@@ -3,7 +3,9 @@
 The commands come from README.md, docs/*.md, mjcf/README.md, the route files' headers and the modules'
 docstrings (tests/docs_commands.py says how they are found and shortened). They run as a user types them,
 in a scratch folder, through the installed ``ipir-mujoco`` and this interpreter as ``python`` (one code block
-after another on each pytest-xdist worker; in one process, two blocks at a time); each must exit 0 with no
+after another on each pytest-xdist worker; in one process, two blocks at a time): a command of plain words in a
+child forked from the test's process, which has the libraries imported already, the others by bash
+(tests/cli_run.py's run_command says what the child resets to be a new process); each must exit 0 with no
 traceback, a synopsis must match its ``--help``, quoted output must be printed. Running them takes minutes: those tests are marked slow; the extraction itself is checked fast.
 """
 
@@ -27,7 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import docs_commands as dc  # noqa: E402
 
-from cli_run import SHELL_TIMEOUT_S as TIMEOUT_S, run_shell  # noqa: E402
+from cli_run import SHELL_TIMEOUT_S as TIMEOUT_S, forked_entry, run_command, run_shell  # noqa: E402
 
 GROUPS = dc.all_commands()
 SHARED = {ran for _documented, ran, _reader in dc.SHARED_RUNS}
@@ -58,7 +60,7 @@ def needs_arguments(command: dc.Command) -> bool:
                if a.dest != "help")
 
 
-run = run_shell
+run = run_command
 
 
 @functools.lru_cache(maxsize=None)
@@ -84,6 +86,23 @@ def test_in_process_help_is_what_the_command_prints(capsys):
         prog = ("ipir-mujoco", name) if name else ("ipir-mujoco",)
         code, out, err = run_cli(capsys, *prog[1:], "--help")
         assert (code, out + err) == help_text(prog), prog
+
+
+def test_a_forked_command_does_what_the_same_command_does_in_a_new_process(tmp_path):
+    """run_command's forked child gives what bash's new process gives: exit status, standard output, standard error
+    (a run, a refusal, a python script's warning and traceback), and leaves shell syntax to bash."""
+    (tmp_path / "boom.py").write_text("import warnings\nwarnings.warn('careful')\nprint('out')\nraise KeyError(3)\n")
+    for text in ("ipir-mujoco simulate --t-end 0.05 --set M=0.3", "ipir-mujoco simulate --set m1=-1",
+                 "python boom.py"):
+        assert forked_entry(text) is not None, text
+        forked, new = run_command(text, tmp_path), run_shell(text, tmp_path)
+        wall = re.compile(r"[\d.]+ s wall")  # the run's wall time, the one figure that may differ
+        assert (forked.returncode, wall.sub("", forked.stdout)) == (new.returncode, wall.sub("", new.stdout)), text
+        # a traceback names the frames that ran: the forked child's own (cli_run, runpy) are extra
+        assert [line for line in forked.stderr.splitlines() if not line.startswith("  ")][-3:] == \
+            [line for line in new.stderr.splitlines() if not line.startswith("  ")][-3:], text
+    for text in ("ipir-mujoco params | head -3", "python bench/x.py > out.txt", "A=1 ipir-mujoco params"):
+        assert forked_entry(text) is None, text
 
 
 def help_of(prog) -> str:
