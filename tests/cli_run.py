@@ -2,21 +2,19 @@
 
 from __future__ import annotations
 
-import functools
-import io
+import atexit
 import json
-import logging
+import math
 import os
 import re
-import runpy
+import select
 import shlex
 import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
-import traceback
-import warnings
 from pathlib import Path
 
 from ipir_mujoco.cli import main
@@ -51,20 +49,16 @@ def run_cli(capsys, *argv):
     return code, out, err
 
 
-# A documented command that is one program with plain words (no pipe, redirection or other shell syntax) runs in a
-# child forked from this test process rather than in a new interpreter: the same entry point with the same
-# arguments, folder, environment, standard streams and exit status, without importing numpy, MuJoCo, matplotlib and
-# the package again for each of them (about 1-2 s of a new process). The child resets what a test process changed
-# and a fresh one has not: warnings shown on stderr with Python's default filters, no logging handlers, Python's
-# SIGINT handler. Anything else runs by bash (run_shell).
+
+# A command of plain words (no pipe, redirection or other shell syntax) runs in a child forked by a process that has
+# the libraries imported (tests/command_zygote.py), one per thread of the tests; anything else runs by bash.
 _SHELL_SYNTAX = re.compile(r"[|&;<>()$`*?{}\[\]~\\]|^\w+=")  # pipes, redirections, expansions, VAR=value
-_DEFAULT_WARNINGS = (("ignore", ResourceWarning), ("ignore", ImportWarning), ("ignore", PendingDeprecationWarning),
-                     ("ignore", DeprecationWarning))  # a process's filters without -W or -X dev (first one last)
+ZYGOTE = Path(__file__).with_name("command_zygote.py")
 
 
 def forked_entry(text: str):
     """``(kind, target, argv)`` for a command :func:`run_command` runs in a forked child, or None: ``ipir-mujoco
-    ARGS`` ('console'), ``python FILE.py ARGS`` ('path') and ``python -m MODULE ARGS`` ('module')."""
+    ARGS`` ('console'), ``python FILE.py ARGS`` ('path') and ``python -m ipir_mujoco...`` ('module')."""
     if _SHELL_SYNTAX.search(text):
         return None
     words = shlex.split(text)
@@ -78,97 +72,60 @@ def forked_entry(text: str):
     return None
 
 
-@functools.lru_cache(maxsize=1)
-def _interpreter_path() -> list[str]:
-    """This interpreter's module path as a new process has it, without its first entry (the script's folder), and
-    without what pytest and the tests added to this one."""
-    done = subprocess.run([sys.executable, "-c", "import json, sys; print(json.dumps(sys.path[1:]))"],
-                          capture_output=True, text=True, check=True, env=SHELL_ENV, cwd=tempfile.gettempdir())
-    return json.loads(done.stdout)
+class _Zygote:
+    """tests/command_zygote.py as a process, started at this thread's first command, ended with this process."""
+
+    def __init__(self):
+        self.process = subprocess.Popen([sys.executable, str(ZYGOTE)], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=SHELL_ENV,
+                                        cwd=tempfile.gettempdir())
+        self.pending = b""
+        atexit.register(self.process.stdin.close)  # its end of input: it ends
+
+    def answer(self, deadline: float) -> dict | None:
+        """The next answer line, or None at ``deadline`` (time.monotonic())."""
+        fd = self.process.stdout.fileno()
+        while b"\n" not in self.pending:
+            wait = None if deadline == math.inf else max(0.0, deadline - time.monotonic())
+            ready, _, _ = select.select([fd], [], [], wait)
+            if not ready:
+                return None
+            chunk = os.read(fd, 4096)
+            if not chunk:
+                raise RuntimeError(f"the command process {ZYGOTE.name} ended (exit {self.process.wait()})")
+            self.pending += chunk
+        line, self.pending = self.pending.split(b"\n", 1)
+        return json.loads(line)
+
+    def run(self, entry, text: str, cwd, timeout: float) -> subprocess.CompletedProcess:
+        kind, target, argv = entry
+        with tempfile.NamedTemporaryFile() as out, tempfile.NamedTemporaryFile() as err:
+            request = dict(kind=kind, target=target, argv=argv, cwd=str(Path(cwd).resolve()), env=SHELL_ENV,
+                           stdout=out.name, stderr=err.name)
+            self.process.stdin.write((json.dumps(request) + "\n").encode())
+            self.process.stdin.flush()
+            deadline = time.monotonic() + timeout
+            pid = self.answer(math.inf)["pid"]
+            done = self.answer(deadline)
+            if done is None:
+                os.kill(pid, signal.SIGKILL)
+                self.answer(math.inf)
+                raise subprocess.TimeoutExpired(text, timeout, output=Path(out.name).read_text(errors="replace"))
+            texts = [Path(f.name).read_text(errors="replace") for f in (out, err)]
+        return subprocess.CompletedProcess(text, done["status"], *texts)
 
 
-def _child(kind: str, target, argv: list[str], cwd, out: int, err: int) -> int:
-    """In the forked child: the command as a new process runs it; its exit status."""
-    os.chdir(cwd)
-    os.environ.clear()
-    os.environ.update(SHELL_ENV)
-    null = os.open(os.devnull, os.O_RDONLY)
-    os.dup2(null, 0)
-    os.dup2(out, 1)
-    os.dup2(err, 2)
-    sys.stdin = sys.__stdin__ = io.TextIOWrapper(io.FileIO(0, "r", closefd=False))
-    sys.stdout = sys.__stdout__ = io.TextIOWrapper(io.FileIO(1, "w", closefd=False), write_through=True)
-    sys.stderr = sys.__stderr__ = io.TextIOWrapper(io.FileIO(2, "w", closefd=False), write_through=True,
-                                                   errors="backslashreplace")
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    warnings.resetwarnings()
-    for action, category in _DEFAULT_WARNINGS:
-        warnings.filterwarnings(action, category=category)
-    warnings.filterwarnings("default", category=DeprecationWarning, module="__main__")
-    warnings.showwarning = warnings._showwarning_orig  # pytest records warnings: a process prints them
-    warnings._showwarnmsg_impl = lambda message: sys.stderr.write(warnings._formatwarnmsg(message))
-    logging.root.handlers.clear()
-    logging.root.setLevel(logging.WARNING)
-    sys.argv = list(argv)
-    try:
-        if kind == "console":  # the installed script's own lines (its folder first on the path)
-            sys.path[:] = [str(Path(sys.executable).parent), *_interpreter_path()]
-            from ipir_mujoco.cli import console
-
-            return console()
-        if kind == "module":
-            sys.path[:] = [str(cwd), *_interpreter_path()]
-            runpy.run_module(target, run_name="__main__", alter_sys=True)
-        else:
-            script = Path(cwd, target).resolve()  # as Python 3.9+ names a script run by path: absolute
-            sys.path[:] = [str(script.parent), *_interpreter_path()]
-            runpy.run_path(str(script), run_name="__main__")
-        return 0
-    except SystemExit as exc:
-        if exc.code is None or isinstance(exc.code, int):
-            return exc.code or 0
-        print(exc.code, file=sys.stderr)
-        return 1
-    except BaseException:  # noqa: B902 (as the interpreter does: the traceback, exit status 1)
-        traceback.print_exc()
-        return 1
+_zygotes = threading.local()
 
 
 def run_command(text: str, cwd, timeout: float = SHELL_TIMEOUT_S) -> subprocess.CompletedProcess:
-    """``text`` run as a user types it in ``cwd``, output captured: in a child forked from this process where
-    :func:`forked_entry` says it can, else by bash (:func:`run_shell`). Raises subprocess.TimeoutExpired after
-    ``timeout`` s (the child killed)."""
+    """``text`` run as a user types it in ``cwd``, output captured: a command :func:`forked_entry` accepts in a
+    child of tests/command_zygote.py (the same entry point, arguments, folder, environment and streams, without a
+    new interpreter's imports), anything else by bash (:func:`run_shell`). Raises subprocess.TimeoutExpired after
+    ``timeout`` s (the command killed)."""
     entry = forked_entry(text)
     if entry is None:
         return run_shell(text, cwd)
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        pid = os.fork()
-        if pid == 0:  # the child: never returns into pytest
-            code = 1
-            try:
-                code = _child(*entry, cwd, out.fileno(), err.fileno())
-            finally:
-                for stream in (sys.stdout, sys.stderr):
-                    try:
-                        stream.flush()
-                    except BaseException:  # noqa: B902 (a closed stream: nothing more to say)
-                        pass
-                os._exit(code if isinstance(code, int) and 0 <= code < 256 else 1)
-        deadline = time.monotonic() + timeout
-        while True:
-            done, status = os.waitpid(pid, os.WNOHANG)
-            if done:
-                break
-            if time.monotonic() > deadline:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-                out.seek(0)
-                raise subprocess.TimeoutExpired(text, timeout, output=out.read().decode(errors="replace"))
-            time.sleep(0.01)
-        texts = []
-        for stream in (out, err):
-            stream.seek(0)
-            texts.append(stream.read().decode(errors="replace"))
-    return subprocess.CompletedProcess(text, os.waitstatus_to_exitcode(status), *texts)
+    if getattr(_zygotes, "zygote", None) is None:
+        _zygotes.zygote = _Zygote()
+    return _zygotes.zygote.run(entry, text, cwd, timeout)

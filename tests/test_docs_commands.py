@@ -4,8 +4,8 @@ The commands come from README.md, docs/*.md, mjcf/README.md, the route files' he
 docstrings (tests/docs_commands.py says how they are found and shortened). They run as a user types them,
 in a scratch folder, through the installed ``ipir-mujoco`` and this interpreter as ``python`` (one code block
 after another on each pytest-xdist worker; in one process, two blocks at a time): a command of plain words in a
-child forked from the test's process, which has the libraries imported already, the others by bash
-(tests/cli_run.py's run_command says what the child resets to be a new process); each must exit 0 with no
+child forked by a process that has the libraries imported (tests/command_zygote.py), the others by bash;
+each must exit 0 with no
 traceback, a synopsis must match its ``--help``, quoted output must be printed. Running them takes minutes: those tests are marked slow; the extraction itself is checked fast.
 """
 
@@ -90,10 +90,11 @@ def test_in_process_help_is_what_the_command_prints(capsys):
 
 def test_a_forked_command_does_what_the_same_command_does_in_a_new_process(tmp_path):
     """run_command's forked child gives what bash's new process gives: exit status, standard output, standard error
-    (a run, a refusal, a python script's warning and traceback), and leaves shell syntax to bash."""
+    (a run, a refusal, a python script's warning and traceback, a module run with -m), and leaves shell syntax to
+    bash."""
     (tmp_path / "boom.py").write_text("import warnings\nwarnings.warn('careful')\nprint('out')\nraise KeyError(3)\n")
     for text in ("ipir-mujoco simulate --t-end 0.05 --set M=0.3", "ipir-mujoco simulate --set m1=-1",
-                 "python boom.py"):
+                 "python boom.py", "python -m ipir_mujoco.report.diagram robot.png"):
         assert forked_entry(text) is not None, text
         forked, new = run_command(text, tmp_path), run_shell(text, tmp_path)
         wall = re.compile(r"[\d.]+ s wall")  # the run's wall time, the one figure that may differ
