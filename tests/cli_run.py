@@ -76,8 +76,9 @@ class _Zygote:
     """tests/command_zygote.py as a process, started at this thread's first command, ended with this process."""
 
     def __init__(self):
+        self.errors = tempfile.TemporaryFile()  # its own failure, if it fails: the test says why
         self.process = subprocess.Popen([sys.executable, str(ZYGOTE)], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=SHELL_ENV,
+                                        stdout=subprocess.PIPE, stderr=self.errors, env=SHELL_ENV,
                                         cwd=tempfile.gettempdir())
         self.pending = b""
         atexit.register(self.process.stdin.close)  # its end of input: it ends
@@ -92,7 +93,9 @@ class _Zygote:
                 return None
             chunk = os.read(fd, 4096)
             if not chunk:
-                raise RuntimeError(f"the command process {ZYGOTE.name} ended (exit {self.process.wait()})")
+                self.errors.seek(0)
+                raise RuntimeError(f"the command process {ZYGOTE.name} ended (exit {self.process.wait()}):\n"
+                                   + self.errors.read().decode(errors="replace")[-2000:])
             self.pending += chunk
         line, self.pending = self.pending.split(b"\n", 1)
         return json.loads(line)
