@@ -160,7 +160,7 @@ print(json.dumps(out))
 
 @pytest.mark.skipif(not ACCELERATED, reason="the kernels are not compiled (numba missing, or IPIR_MUJOCO_JIT=0): one path only")
 @pytest.mark.slow
-def test_compiled_and_python_paths_give_the_same_runs():
+def test_compiled_and_python_paths_give_the_same_runs(tmp_path):
     """The same stepper source, compiled by numba here and run as Python in a child process
     (IPIR_MUJOCO_JIT=0): every series column agrees to 1e-12 of its largest value. Both paths do the
     same IEEE operations (numba without fast-math; np.dot through the same BLAS routine), so only a
@@ -169,8 +169,10 @@ def test_compiled_and_python_paths_give_the_same_runs():
     spec = {name: (params.as_dict(), geometry, clutch, t_end) for name, (params, geometry, clutch, t_end)
             in CASES.items()}
     env = dict(os.environ, IPIR_MUJOCO_JIT="0")
+    # the children run in an empty folder: `python -c` puts its working folder first on sys.path, and from the
+    # repository's root would import the source tree, not the installed package (whose kernels this one compiled)
     done = subprocess.run([sys.executable, "-c", _RUN, json.dumps(spec)], capture_output=True, text=True, env=env,
-                          check=True)
+                          check=True, cwd=tmp_path)
     python = json.loads(done.stdout)
     assert python.pop("accelerated") is False and python.pop("numba_loaded") is False
     python.pop("spent")
@@ -186,7 +188,7 @@ def test_compiled_and_python_paths_give_the_same_runs():
 
 
 @pytest.mark.slow
-def test_a_short_run_never_loads_numba_and_a_long_one_goes_on_compiled_with_the_same_floats():
+def test_a_short_run_never_loads_numba_and_a_long_one_goes_on_compiled_with_the_same_floats(tmp_path):
     """By default (IPIR_MUJOCO_JIT unset) a process compiles the kernels only once its runs have spent
     accel.LOAD_COST_S in Python: a default simulate (6 ms of work compiled, about 70 ms in Python on an idle
     machine) imports numba only if its Python time reached that (the rule, checked on the time the child
@@ -198,7 +200,7 @@ def test_a_short_run_never_loads_numba_and_a_long_one_goes_on_compiled_with_the_
     env = {k: v for k, v in os.environ.items() if k != "IPIR_MUJOCO_JIT"}
     short = {"paper": (RobotParams().as_dict(), "approx", "kinematic", 1.0)}
     done = subprocess.run([sys.executable, "-c", _RUN, json.dumps(short)], capture_output=True, text=True, env=env,
-                          check=True)
+                          check=True, cwd=tmp_path)
     result = json.loads(done.stdout)
     compiled = result["spent"] >= accel.LOAD_COST_S
     assert result["accelerated"] is compiled and result["numba_loaded"] is compiled
@@ -207,7 +209,7 @@ def test_a_short_run_never_loads_numba_and_a_long_one_goes_on_compiled_with_the_
     runs = {}
     for mode in ("auto", "0"):
         done = subprocess.run([sys.executable, "-c", _RUN, json.dumps(long)], capture_output=True, text=True,
-                              env=dict(env, IPIR_MUJOCO_JIT=mode), check=True)
+                              env=dict(env, IPIR_MUJOCO_JIT=mode), check=True, cwd=tmp_path)
         runs[mode] = json.loads(done.stdout)
     assert runs["auto"]["accelerated"] is True and runs["0"]["accelerated"] is False
     assert runs["auto"]["motor"] == runs["0"]["motor"]  # every column, every float

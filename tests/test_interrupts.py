@@ -309,11 +309,11 @@ def test_an_interruption_a_library_swallowed_is_still_raised(monkeypatch):
     assert interrupts.state.armed
 
 
-def test_the_command_line_catches_ctrl_c_from_its_first_statement():
+def test_the_command_line_catches_ctrl_c_from_its_first_statement(tmp_path):
     """The guard is installed before the heavy imports start, and once loaded raises KeyboardInterrupt as
     Python's own handler does."""
     code = ("import signal, sys; import ipir_mujoco.cli as c; from ipir_mujoco import interrupts; "
             "print(signal.getsignal(signal.SIGINT) is interrupts.handler, c._loading_guard)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                          preexec_fn=_default_sigint)
+                          preexec_fn=_default_sigint, cwd=tmp_path)
     assert done.stdout.split() == ["True", "True"]

@@ -118,7 +118,7 @@ def test_studies_cli_and_report_reach_the_engines_only_through_the_registry():
     assert set(found) <= STEPS_ITS_OWN, found
 
 
-def test_the_public_surface_is_importable_from_the_package_and_documented_in_sections():
+def test_the_public_surface_is_importable_from_the_package_and_documented_in_sections(tmp_path):
     """``from ipir_mujoco import run, RobotParams, RunResult, ParameterError, SimulationError, VARIANTS``: the
     names a script needs, listed in ``__all__``, each with numpydoc sections; importing them loads no engine."""
     import inspect
@@ -140,5 +140,6 @@ def test_the_public_surface_is_importable_from_the_package_and_documented_in_sec
             assert f"\n{section}\n{'-' * len(section)}\n" in doc, (thing, section)
     assert all(f"\n    {f} : " in RP.__doc__ for f in ("m1", "mu_wall", "speed_ki"))  # every field, from its metadata
     code = "import sys, ipir_mujoco; print(sorted(m for m in ('mujoco', 'scipy', 'ipir_mujoco.engine') if m in sys.modules))"
-    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                            cwd=tmp_path).stdout
     assert loaded.strip() == "[]"

@@ -137,6 +137,9 @@ def held_sweep(hold_from: float, argv: list[str], **popen):
     """``ipir-mujoco sweep ARGV`` in a child whose designs with L >= ``hold_from`` never end (HELD_SWEEP), in a
     session of its own: whatever the test's outcome (a timeout included), the child and its pool's workers, which
     would otherwise wait for ever, are killed on the way out."""
+    # run beside its --out folder: `python -c` puts its working folder first on sys.path, and from the repository's
+    # root that would import the source tree rather than the installed package (and compile its kernels afresh)
+    popen.setdefault("cwd", Path(argv[argv.index("--out") + 1]).parent)
     process = subprocess.Popen([sys.executable, "-c", HELD_SWEEP, repr(hold_from), "sweep", *argv],
                                start_new_session=True, **popen)
     try:
