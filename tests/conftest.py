@@ -107,9 +107,9 @@ def scope_of(nodeid: str) -> str:
 
 @pytest.fixture(scope="session")
 def shared_command(tmp_path_factory):
-    """``shared_command(text)``: ``text`` run once by bash in a folder of its own in this pytest process, as a
-    user types it (cli_run.run_shell); the CompletedProcess with ``.folder`` where it ran. For the runs several
-    tests read (docs_commands.SHARED_RUNS)."""
+    """``shared_command(text)``: ``text`` run once in a folder of its own for this pytest process, as a user types
+    it (cli_run.run_command); the CompletedProcess with ``.folder`` where it ran. For the runs several tests read
+    (docs_commands.SHARED_RUNS)."""
     from cli_run import run_command
 
     done = {}

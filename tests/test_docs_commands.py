@@ -4,9 +4,9 @@ The commands come from README.md, docs/*.md, mjcf/README.md, the route files' he
 docstrings (tests/docs_commands.py says how they are found and shortened). They run as a user types them,
 in a scratch folder, through the installed ``ipir-mujoco`` and this interpreter as ``python`` (one code block
 after another on each pytest-xdist worker; in one process, two blocks at a time): a command of plain words in a
-child forked by a process that has the libraries imported (tests/command_zygote.py), the others by bash;
-each must exit 0 with no
-traceback, a synopsis must match its ``--help``, quoted output must be printed. Running them takes minutes: those tests are marked slow; the extraction itself is checked fast.
+child forked by a process that has the libraries imported (tests/command_zygote.py), the others by bash. Each
+must exit 0 with no traceback, a synopsis must match its ``--help``, quoted output must be printed. Running them
+takes minutes: those tests are marked slow; the extraction itself is checked fast.
 """
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ def test_a_forked_command_does_what_the_same_command_does_in_a_new_process(tmp_p
         forked, new = run_command(text, tmp_path), run_shell(text, tmp_path)
         wall = re.compile(r"[\d.]+ s wall")  # the run's wall time, the one figure that may differ
         assert (forked.returncode, wall.sub("", forked.stdout)) == (new.returncode, wall.sub("", new.stdout)), text
-        # a traceback names the frames that ran: the forked child's own (cli_run, runpy) are extra
+        # a traceback names the frames that ran: the forked child's own (command_zygote, runpy) are extra
         assert [line for line in forked.stderr.splitlines() if not line.startswith("  ")][-3:] == \
             [line for line in new.stderr.splitlines() if not line.startswith("  ")][-3:], text
     for text in ("ipir-mujoco params | head -3", "python bench/x.py > out.txt", "A=1 ipir-mujoco params"):
