@@ -97,8 +97,8 @@ def test_a_forked_command_does_what_the_same_command_does_in_a_new_process(tmp_p
                  "python boom.py", "python -m ipir_mujoco.report.diagram robot.png"):
         assert forked_entry(text) is not None, text
         forked, new = run_command(text, tmp_path), run_shell(text, tmp_path)
-        wall = re.compile(r"[\d.]+ s wall")  # the run's wall time, the one figure that may differ
-        assert (forked.returncode, wall.sub("", forked.stdout)) == (new.returncode, wall.sub("", new.stdout)), text
+        wall = dc.WALL.sub  # the run's wall time, the one figure that may differ
+        assert (forked.returncode, wall("", forked.stdout)) == (new.returncode, wall("", new.stdout)), text
         # a traceback names the frames that ran: the forked child's own (command_zygote, runpy) are extra
         assert [line for line in forked.stderr.splitlines() if not line.startswith("  ")][-3:] == \
             [line for line in new.stderr.splitlines() if not line.startswith("  ")][-3:], text
