@@ -21,11 +21,11 @@ import pytest
 
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import ParameterError, RobotParams
-from ipir_mujoco.core.pipe import SCRUB_FLOOR, leg_direction, lift_check
+from ipir_mujoco.core.pipe import ARM_SHARE, SCRUB_FLOOR, WHEEL_SHARE, leg_direction, lift_check
 from ipir_mujoco.core.route import route_from_tables
 from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, dof_address, drive_control, qpos_address
 from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
-from ipir_mujoco.engine.builders.wheels_model import (ROW_TIMES, WHEEL_SHARE, build_wheels_model, leg_names, leg_preload,
+from ipir_mujoco.engine.builders.wheels_model import (ROW_TIMES, build_wheels_model, leg_names, leg_preload,
                                             leg_stiffness, sag, set_wheels_state, wheels_timestep)
 from ipir_mujoco.engine.controllers.wheels import WheelRatchet, leg_press
 from ipir_mujoco.engine.run.wheel_skids import TOLERANCE, estimate, skid_floor, skid_resolution
@@ -133,8 +133,11 @@ def test_weight_sags_the_module_and_its_press_stays_F_n(legs):
         assert expected > 1.005 * F_n
         assert forces[i].sum() == pytest.approx(expected, rel=1e-3)
         assert press[0, i].sum() == pytest.approx(expected, rel=1e-3)  # the springs' press is the contacts'
-        # each leg's: its light arm's weight (3 g) and the wall's normal off its line by delta / rho at most
-        assert np.allclose(press[0, i], forces[i], rtol=delta / rho, atol=1e-3 * F_n)
+        # each leg's: its spring's press plus its arm's and wheel's weight along its line (16.5 g each here:
+        # core.pipe.ARM_SHARE, WHEEL_SHARE; leg 0 down), the wall's normal off that line by delta / rho at most
+        legs_down = np.array([-leg_direction(k, legs)[2] for k in range(legs)] * 2)
+        own = (ARM_SHARE + WHEEL_SHARE) * (p.m1, p.m2)[i] * p.g * legs_down
+        assert np.allclose(press[0, i] + own, forces[i], rtol=delta / rho, atol=1e-3 * F_n)
         assert forces[i].max() > 1.2 * leg_preload(p, i)  # the weight really is on the lower legs
         # the module sits lower by the closed form's sag, and its least-pressed leg presses as the closed form's
         # (the rod's weight, 1 % of a module's, is on top: within 2 % of the sag)

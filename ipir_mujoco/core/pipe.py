@@ -108,6 +108,23 @@ def bend_rod_clearance(length: float, rod_radius: float, radius: float, diameter
 # ----------------------------------------------------------------------------------------------------
 # The round pipe's wheel legs (the wheeled MuJoCo model), the closed-form lift-off and sideways-grip checks
 
+# Each leg's masses, shares of its module's mass m_i (inside m_i): its arm (the slider and axle the spring presses
+# out) and its wheel. The wheel is light: a rolling module carries its wheels' spin, J / R^2 = m_w / 2 each, the
+# one mass term the analytic model lacks. The arm is ten times heavier: at 1e-3 the scrubbing wheels of a bend were
+# resolved only below 3e-6 s (a R/D 5 bend's revolutions fell 0.4-0.6 % a halving from 2.5e-5 s); at 1e-2 they
+# converge from 5e-5 s, a bend's step (mjcf/README.md, "The round pipe: convergence"). Both ride with their module
+# along the pipe, so a straight pipe's travel does not change with them (the cruise's to 5 digits).
+ARM_SHARE = 1e-2
+WHEEL_SHARE = 1e-3
+
+
+def sprung_mass(params, module: int) -> float:
+    """The mass [kg] of module ``module`` (0 rear, 1 front) that its legs' springs carry: m_i less its 2 n legs'
+    arms and wheels, whose weight goes to the wall through their own wheels."""
+    m = (params.m1, params.m2)[module]
+    return m * (1.0 - 2 * int(params.wheel_legs) * (ARM_SHARE + WHEEL_SHARE))
+
+
 def leg_direction(k: int, n: int) -> tuple[float, float, float]:
     """Leg ``k``'s outward unit vector of ``n`` evenly spaced about the pipe's axis x, leg 0 pointing down (-z in
     a horizontal pipe): (0, cos a, sin a) with a = -90 deg + 360 deg k / n."""
@@ -130,7 +147,8 @@ def lift_check(params) -> dict:
     a linear spring with preload P_i = F_ni / (2 n). A force F across the pipe on a ring moves it by 2 F / (n k)
     (its legs' outward directions u_k: sum u_k u_k^T = n/2 I), which changes leg k's press by (2 / n) F . u_k:
     leg k lifts where F . u_k < -F_ni / 4, whatever n and k. The loads per ring, quasi-static: half the
-    module's weight across the pipe, m_i g cos(incline) / 2, down; half the rod's side force at the ring pair's
+    weight its springs carry across the pipe, :func:`sprung_mass` g cos(incline) / 2, down (each leg's own arm
+    and wheel bear on the wall through its wheel); half the rod's side force at the ring pair's
     middle (:func:`rod_side_force`, the drive's largest torque: M, or M_stall for the motor); on module 1 the
     motor's reaction couple T about z as +-T / s on its two rings. The side loads are taken both ways. The
     wheels' sideways friction can carry side loads while they grip (MuJoCo's wheels do), so the check errs on
@@ -145,7 +163,8 @@ def lift_check(params) -> dict:
     across = math.cos(math.radians(params.incline)) * params.g
     legs = [leg_direction(k, n) for k in range(n)]
     out, weight_only = {}, []
-    for i, (m, Fn) in enumerate(((params.m1, params.F_n1), (params.m2, params.F_n2)), start=1):
+    for i, Fn in enumerate((params.F_n1, params.F_n2), start=1):
+        m = sprung_mass(params, i - 1)
         P = Fn / (2 * n)
         down = 0.5 * m * across
         couple = torque / params.ring_spacing if i == 1 else 0.0

@@ -27,7 +27,8 @@ For symmetric legs on linear springs the sum of a ring's normal forces does not 
 across the pipe (the outward directions sum to zero), so the module's press stays F_ni while its weight sags it;
 the arms' stops and a wheel off its wall end that (:mod:`ipir_mujoco.core.pipe_lift`, the closed-form check).
 
-Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i, inside m_i; the module's
+Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i (:mod:`ipir_mujoco.core.pipe`,
+which says why), inside m_i; the module's
 inertia is a solid cylinder of its mass, as long as its ring spacing, of the radius inside its wheels. The pipe's
 wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat walls along each leg's track let a
 skidding module roll off them: a rolled wheel's normal on a plane has a moment about the axis that rolls it on).
@@ -45,7 +46,7 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.pipe import check_fit
+from ipir_mujoco.core.pipe import ARM_SHARE, WHEEL_SHARE, check_fit, sprung_mass
 from ipir_mujoco.core.pipe import leg_direction as core_leg_direction
 
 from ...resources import mjcf_dir
@@ -60,8 +61,6 @@ VERTICALS = ("rear_vertical", "front_vertical")  # the modules' slides across th
 TILTS = ("rear_tilt", "front_tilt")  # the modules' ball joints
 HOUSINGS = ("rear_housing", "front_housing")
 ROD_TILT = "rod_tilt"  # the rod's cross pin at B (with rod_hinge a universal joint): the rod leaves the crank's plane
-ARM_SHARE = 1e-3  # of the module's mass, per arm
-WHEEL_SHARE = 1e-3  # of the module's mass, per wheel
 HALF_WIDTH = 0.005  # m: the drawn tyre's half-width along its hub (the contact is the sphere's)
 SEAT = 1e-8  # m: how far the initial state sets each wheel into the wall (its contact then acts from the first step)
 STOP_COMPRESSION = 4.0  # the arm's inner stop, in suspension travels of compression (4 x the preload)
@@ -284,9 +283,9 @@ def build_wheels_model(params: RobotParams, settings: SolverSettings | None = No
 
 def sag(params: RobotParams, module: int) -> float:
     """How far [m] module ``module``'s weight sags it across the pipe on its legs' springs, closed form: the two
-    rings' n legs each stiffen it by n k / 2, so delta = m_i g cos(incline) / (n k) (while no wheel lifts)."""
-    m = (params.m1, params.m2)[module]
-    return m * params.g * math.cos(math.radians(params.incline)) / (leg_count(params) * leg_stiffness(params, module))
+    rings' n legs each stiffen it by n k / 2, so delta = m g cos(incline) / (n k), m the mass its springs carry
+    (:func:`~ipir_mujoco.core.pipe.sprung_mass`: m_i less its legs), while no wheel lifts."""
+    return sprung_mass(params, module) * params.g * math.cos(math.radians(params.incline)) / (leg_count(params) * leg_stiffness(params, module))
 
 
 def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
