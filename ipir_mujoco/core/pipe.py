@@ -248,7 +248,7 @@ def bend_lift_check(params, radius: float, toward: tuple[float, float], across) 
     """The lift-off check (:func:`lift_check`) of each module rolling through a bend of centreline radius ``radius``
     [m] that turns towards the unit (y, z) ``toward`` across the pipe (in the robot's frame at the route's start:
     y its left, z its up), under gravity's components across the pipe ``across`` [(g_y, g_z), m/s^2] at points
-    along the bend. On top of the straight pipe's loads (half the weight across, here as given; the rod's side
+    along the bend. On top of the straight pipe's loads (half the sprung weight across, here as given; the rod's side
     force, the motor's couple on module 1) each ring carries
 
     - the wheels' scrub (:func:`scrub_force`) along +-toward: the bend's own load, mu_wall times a share of the
@@ -272,7 +272,8 @@ def bend_lift_check(params, radius: float, toward: tuple[float, float], across) 
     legs = [leg_direction(k, n) for k in range(n)]
     ty, tz = toward
     out, scrubs = {}, []
-    for i, (m, Fn) in enumerate(((params.m1, params.F_n1), (params.m2, params.F_n2)), start=1):
+    for i, Fn in enumerate((params.F_n1, params.F_n2), start=1):
+        m = sprung_mass(params, i - 1)  # across the pipe the springs carry the module less its legs
         P = Fn / (2 * n)
         scrub = scrub_force(params, i - 1, toward)
         scrubs.append(scrub)
