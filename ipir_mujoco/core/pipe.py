@@ -248,8 +248,8 @@ def bend_lift_check(params, radius: float, toward: tuple[float, float], across) 
     """The lift-off check (:func:`lift_check`) of each module rolling through a bend of centreline radius ``radius``
     [m] that turns towards the unit (y, z) ``toward`` across the pipe (in the robot's frame at the route's start:
     y its left, z its up), under gravity's components across the pipe ``across`` [(g_y, g_z), m/s^2] at points
-    along the bend. On top of the straight pipe's loads (half the sprung weight across, here as given; the rod's side
-    force, the motor's couple on module 1) each ring carries
+    along the bend. On top of the straight pipe's loads (half the sprung weight across, here as given; the rod's
+    side force, the motor's couple on module 1) each ring carries
 
     - the wheels' scrub (:func:`scrub_force`) along +-toward: the bend's own load, mu_wall times a share of the
       press whatever the radius (at the defaults' 3 legs 2 mu_wall P across a horizontal bend, 1.73 mu_wall P

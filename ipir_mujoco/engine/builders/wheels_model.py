@@ -25,13 +25,13 @@ about the rings' middle), the legs evenly spaced about the axis with leg 0 at th
 
 For symmetric legs on linear springs the sum of a ring's normal forces does not change as the module moves
 across the pipe (the outward directions sum to zero), so the module's press stays F_ni while its weight sags it;
-the arms' stops and a wheel off its wall end that (:mod:`ipir_mujoco.core.pipe_lift`, the closed-form check).
+the arms' stops and a wheel off its wall end that (the closed-form check: :func:`ipir_mujoco.core.pipe.lift_check`).
 
 Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i (:mod:`ipir_mujoco.core.pipe`,
-which says why), inside m_i; the module's
-inertia is a solid cylinder of its mass, as long as its ring spacing, of the radius inside its wheels. The pipe's
-wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat walls along each leg's track let a
-skidding module roll off them: a rolled wheel's normal on a plane has a moment about the axis that rolls it on).
+which says why), inside m_i; the module's inertia is a solid cylinder of its mass, as long as its ring spacing, of
+the radius inside its wheels. The pipe's wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat
+walls along each leg's track let a skidding module roll off them: a rolled wheel's normal on a plane has a moment
+about the axis that rolls it on).
 Every row's time constant is a property of the model in seconds (:class:`RowTimes`), not a multiple of the step.
 """
 
@@ -285,7 +285,8 @@ def sag(params: RobotParams, module: int) -> float:
     """How far [m] module ``module``'s weight sags it across the pipe on its legs' springs, closed form: the two
     rings' n legs each stiffen it by n k / 2, so delta = m g cos(incline) / (n k), m the mass its springs carry
     (:func:`~ipir_mujoco.core.pipe.sprung_mass`: m_i less its legs), while no wheel lifts."""
-    return sprung_mass(params, module) * params.g * math.cos(math.radians(params.incline)) / (leg_count(params) * leg_stiffness(params, module))
+    weight = sprung_mass(params, module) * params.g * math.cos(math.radians(params.incline))
+    return weight / (leg_count(params) * leg_stiffness(params, module))
 
 
 def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
