@@ -5,13 +5,14 @@ uncertainty covers the true limit; a run that settles exactly keeps the exact te
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
 
 from ipir_mujoco.core.cycles import cycle_summary, steady_at_end, steady_index
 from ipir_mujoco.core.steady_test import (COVERAGE, LIMIT_ACCURACY, STATISTICAL_MIN, find_steady, line_fit,
-                                          statistical_at_end, steady_target, student_quantile)
+                                          speed_estimate, statistical_at_end, steady_target, student_quantile)
 from ipir_mujoco.core.steady_watch import SteadyWatch
 
 PERIOD = 0.2  # s per revolution of the synthetic runs
@@ -125,3 +126,59 @@ def test_an_exact_steady_states_the_engines_accuracy_as_its_uncertainty():
 def test_without_a_target_the_summary_is_the_exact_tests_alone():
     summary = cycle_summary(run_of(noisy(60)), 1e-4, 3)
     assert not summary["steady"] and "steady_test" not in summary
+
+
+def test_a_run_too_scattered_to_be_steady_still_estimates_its_speed_without_its_start_up():
+    # 1 % scatter (a tipping wheeled module's) after a five-revolution start-up: never steady to 3e-4, but the
+    # summary's estimate leaves the start-up out (a window holding it has a larger U) and its U is the window's
+    u = noisy(120, rel=1e-2, seed=3)
+    u[:5] = 0.2 * np.array([0.2, 0.5, 0.7, 0.85, 0.93])
+    summary = cycle_summary(run_of(u), 1e-4, 3, target=3e-4)
+    assert not summary["steady"]
+    w = summary["speed_estimate_revolutions"]
+    assert STATISTICAL_MIN <= w <= u.size - 5
+    window = u[-w:]
+    assert summary["speed_estimate_m_s"] == pytest.approx(window.mean(), rel=1e-9)  # equal periods: the plain mean
+    _, slope, se_mean, _, dof = line_fit(window)
+    spread = float(student_quantile(0.995, dof)) * se_mean + abs(slope) * (w - 1) / 2
+    assert summary["speed_estimate_uncertainty_m_s"] == pytest.approx(spread, rel=1e-9)
+    # 1 % scatter over about 100 revolutions: U about 2.6 x 1e-2 / sqrt(100) of the speed, far above 3e-4
+    assert 3e-4 < summary["speed_estimate_uncertainty_m_s"] / 0.2 < 1e-2
+    assert abs(summary["speed_estimate_m_s"] / 0.2 - 1) <= summary["speed_estimate_uncertainty_m_s"] / 0.2
+
+
+def test_the_estimate_is_left_out_where_steady_and_where_no_window_fits():
+    steady = cycle_summary(run_of(noisy(60)), 1e-4, 3, target=3e-4)
+    assert steady["steady"] and steady["speed_estimate_m_s"] is None
+    short = cycle_summary(run_of(noisy(STATISTICAL_MIN - 1, rel=1e-2)), 1e-4, 3, target=3e-4)
+    assert not short["steady"] and short["speed_estimate_m_s"] is None
+    # a speed still climbing by 1 % per revolution: every window's trend is significant
+    assert speed_estimate(0.2 * (1 + 1e-2 * np.arange(40))) is None
+
+
+def test_simulate_says_what_a_run_that_never_became_steady_averaged():
+    from ipir_mujoco.cli.simulate import format_summary
+    from ipir_mujoco.core.params import RobotParams
+    from ipir_mujoco.core.results import RunResult
+
+    u = noisy(120, rel=1e-2, seed=3)
+    series = run_of(u)
+    n = series["t"].size
+    for column in ("omega", "alpha", "v1", "v2", "a1", "a2", "S", "S_dot", "lambda1", "lambda2", "mode"):
+        series.setdefault(column, np.zeros(n))
+    series["omega"] = np.full(n, 2 * math.pi / PERIOD)
+    run = RunResult("mujoco", "exact", "unilateral", RobotParams(), float(series["t"][-1]), series,
+                    {"motor_work_j": 0.0, "kinetic_j": 0.0, "friction_j": 0.0, "residual_j": 0.0},
+                    settings={"steady_tol": 1e-4, "steady_cycles": 3})
+    s = run.summary
+    assert not s["steady"] and s["speed_estimate_m_s"] is not None
+    line = next(x for x in format_summary(run, until_steady=True).splitlines() if "not reached" in x)
+    assert f"its last {s['speed_estimate_revolutions']} revolutions average" in line
+    shown = re.search(r"average ([0-9.]+) \+- ([0-9.e-]+) m/s \(([0-9.]+) %; steady asks ([0-9.]+) %\)", line)
+    assert shown, line
+    mean, spread, share, asked = map(float, shown.groups())
+    # printed to 5 and 2 significant figures and the shares to 2: equal to the keys within that rounding
+    assert mean == pytest.approx(s["speed_estimate_m_s"], rel=1e-4)
+    assert spread == pytest.approx(s["speed_estimate_uncertainty_m_s"], rel=5e-2)
+    assert share == pytest.approx(100 * s["speed_estimate_uncertainty_m_s"] / s["speed_estimate_m_s"], rel=5e-2)
+    assert asked == pytest.approx(100 * LIMIT_ACCURACY["mujoco"])

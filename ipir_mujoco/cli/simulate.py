@@ -148,6 +148,17 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
         raise
 
 
+def _estimate_text(run: RunResult) -> str:
+    """What a run that did not become steady still says of its speed (the summary's speed_estimate keys)."""
+    s = run.summary
+    if s.get("speed_estimate_m_s") is None:
+        return ""
+    mean, spread = s["speed_estimate_m_s"], s["speed_estimate_uncertainty_m_s"]
+    return (f"; its last {s['speed_estimate_revolutions']} revolutions average {significant(mean, 5)} "
+            f"+- {significant(spread, 2)} m/s ({100 * spread / mean:.2g} %; steady asks "
+            f"{100 * run.steady_target:.2g} %)")
+
+
 def format_summary(run: RunResult, until_steady: bool = False) -> str:
     """The human-readable summary ``simulate`` prints (``until_steady``: the run was asked to stop there)."""
     s = run.summary
@@ -172,7 +183,7 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      f"{significant(s['distance_per_rev_m'], 5)} m per revolution, "
                      f"{significant(s['energy_per_metre_j_m'], 5)} J/m, efficiency {significant(s['efficiency'], 5)}")
     elif until_steady:
-        lines.append(f"  steady state            not reached by {run.t_end:g} s")
+        lines.append(f"  steady state            not reached by {run.t_end:g} s" + _estimate_text(run))
     if s["mean_omega_rad_s"] is not None:
         over = "over the steady revolutions" if s["steady"] else "over the run"
         drive = "" if s["peak_drive_u"] is None else (f", peak torque {significant(s['peak_motor_torque_n_m'], 4)} "

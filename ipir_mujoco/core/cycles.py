@@ -23,7 +23,7 @@ Steady state: the run is at its periodic steady state at the end of cycle k
 when the mean speeds of the last ``cycles`` revolutions (k - cycles + 1 .. k)
 all lie within ``tol`` * |mean of them| of each other, that mean is > 0, and
 the speed's remaining drift, extrapolated from the last two changes, is within
-``tol`` * mean as well (see :func:`steady_at_end`): a heavy flywheel settles so
+``tol`` * mean as well (see :func:`.steady_test.steady_at_end`): a heavy flywheel settles so
 slowly that three revolutions can agree within ``tol`` while the speed is still
 many times ``tol`` short of its final value.
 The steady *window* is those revolutions. The steady figures state the periodic
@@ -40,14 +40,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# LIMIT_ACCURACY's old home: studies and benchmarks import it from here
-from .steady_test import LIMIT_ACCURACY, Steady, find_steady, window_uncertainty  # noqa: F401
+# LIMIT_ACCURACY's, STEADY_TOL's and the exact test's old home: studies, benchmarks and tests import them from here
+from .steady_test import (LIMIT_ACCURACY, STEADY_CYCLES, STEADY_TOL, Steady, find_steady,  # noqa: F401
+                          remaining_drift, speed_estimate, steady_at_end, steady_index, window_uncertainty)
 from .energy import ENERGY_COLUMNS as _TABLE_COLUMNS
 from . import energy as _energy
 from .energy import RESIDUAL_KEY, by_role, residual, terms_of
 
-STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
-STEADY_CYCLES = 3  # revolutions the spread is measured over
 _WHOLE_TOL = 1e-9  # revolutions: see cycle_boundaries
 ENERGY_COLUMNS = _TABLE_COLUMNS  # the energy terms' columns (core.energy's table)
 
@@ -177,54 +176,11 @@ def cycles(series: dict[str, np.ndarray]) -> list[Cycle]:
     return out
 
 
-_DRIFT_FLOOR = 1e-3  # of tol: a change per revolution this small counts as settled whatever its trend
-
-
-def remaining_drift(speeds: list[float] | np.ndarray) -> float:
-    """How far [m/s] the per-revolution mean speed still moves after its last value, extrapolated from its
-    last two changes d1, d2 as a geometric approach (ratio d2 / d1): |d2| rho / (1 - rho).
-
-    0 where the changes alternate in sign or one is zero (an oscillation the spread bounds); inf where they
-    do not shrink (a drift that does not die out, e.g. a constant torque accelerating for ever); inf with
-    fewer than three speeds.
-    """
-    if len(speeds) < 3:
-        return math.inf
-    d1, d2 = float(speeds[-2] - speeds[-3]), float(speeds[-1] - speeds[-2])
-    if d1 * d2 <= 0:
-        return 0.0
-    rho = d2 / d1
-    return abs(d2) * rho / (1.0 - rho) if rho < 1 else math.inf
-
-
-def steady_at_end(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> bool:
-    """Whether the last ``n`` per-revolution mean speeds [m/s] (of ``speeds``, in order) are the periodic
-    steady state: their mean > 0, their spread <= tol * mean, and the :func:`remaining_drift` <= tol * mean
-    (or the last change below _DRIFT_FLOOR * tol * mean, settled whatever its trend)."""
-    u = np.asarray(speeds, dtype=float)
-    if u.size < n:
-        return False
-    window = u[-n:]
-    mean = float(window.mean())
-    if not (mean > 0 and float(window.max() - window.min()) <= tol * mean):
-        return False
-    return abs(float(u[-1] - u[-2])) <= _DRIFT_FLOOR * tol * mean or remaining_drift(u) <= tol * mean
-
-
-def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> int | None:
-    """Index of the first revolution at whose end the run is at steady state (:func:`steady_at_end`); or None."""
-    u = np.asarray(speeds, dtype=float)
-    for k in range(n - 1, u.size):
-        if steady_at_end(u[:k + 1], tol, n):
-            return k
-    return None
-
-
 def steady_window(found: list, tol: float = STEADY_TOL, n: int = STEADY_CYCLES,
                   target: float | None = None) -> list | None:
     """The whole revolutions (of :func:`cycles`) at whose end the run first is at steady state, or None: the
     window every steady-state figure is taken over. ``target``: the statistical test's (None: the exact test
-    alone, :func:`steady_index`'s ``n`` revolutions); see :mod:`.steady_test`."""
+    alone, :func:`.steady_test.steady_index`'s ``n`` revolutions); see :mod:`.steady_test`."""
     found_steady = find_steady([c.mean_speed_m_s for c in found], tol, n, target, steady_at_end)
     return None if found_steady is None else found[found_steady.start:found_steady.end + 1]
 
@@ -349,7 +305,10 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     steady window when steady, else over the whole run. ``target``: the statistical steady test's
     (:mod:`.steady_test`; None: the exact test alone). With it, where steady: ``steady_test`` ('exact' or
     'statistical'), ``steady_revolutions`` (the window's length), ``steady_speed_uncertainty_m_s`` and
-    ``energy_per_metre_uncertainty_j_m`` (:func:`steady_uncertainties`); None where not steady.
+    ``energy_per_metre_uncertainty_j_m`` (:func:`steady_uncertainties`); None where not steady. Where not
+    steady, with a target: ``speed_estimate_m_s``, ``speed_estimate_uncertainty_m_s`` and
+    ``speed_estimate_revolutions``, the last revolutions' mean speed and its U
+    (:func:`.steady_test.speed_estimate`; None where no window fits, and where steady).
     """
     found = cycles(series)
     steady = find_steady([c.mean_speed_m_s for c in found], tol, n, target, steady_at_end)
@@ -358,7 +317,12 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
            "cycles": len(found)}
     if target is not None:
         out.update(steady_test=None, steady_revolutions=None, steady_speed_uncertainty_m_s=None,
-                   energy_per_metre_uncertainty_j_m=None)
+                   energy_per_metre_uncertainty_j_m=None, speed_estimate_m_s=None,
+                   speed_estimate_uncertainty_m_s=None, speed_estimate_revolutions=None)
+        estimate = None if window is not None else speed_estimate([c.mean_speed_m_s for c in found])
+        if estimate is not None:
+            out.update(speed_estimate_revolutions=estimate[0], speed_estimate_m_s=estimate[1],
+                       speed_estimate_uncertainty_m_s=estimate[2])
     residuals = [abs(c.residual_j) for c in found if c.residual_j is not None]
     out["cycle_energy_residual_j"] = max(residuals) if residuals else None
     if window is not None:

@@ -5,7 +5,7 @@ Every engine's run stops (``--until-steady``) and every summary reads its steady
 read off it afterwards (:func:`.cycles.cycle_summary`) find the same revolution. Two tests, the first that
 passes wins:
 
-- **exact** (:func:`.cycles.steady_at_end`): the last ``n`` means agree within ``tol`` of their mean and the
+- **exact** (:func:`steady_at_end`): the last ``n`` means agree within ``tol`` of their mean and the
   drift their last changes extrapolate to is as small. A run whose revolutions converge to one limit cycle
   (the equations; MuJoCo without skids, whose wobble from revolution to revolution is a few 1e-5) passes
   it, and its figures are the limit extrapolated from the last revolutions (:func:`.cycles.limit_motion`).
@@ -51,6 +51,8 @@ import numpy as np
 # per-revolution figures are smooth to their integration tolerance, so the extrapolation leaves a second-order
 # error; MuJoCo's wobble from revolution to revolution by a few 1e-5 (where its steps fall in a revolution),
 # which no extrapolation removes. The statistical test's target (:func:`steady_target`).
+STEADY_TOL = 1e-4  # relative spread of the per-revolution mean speed that counts as settled
+STEADY_CYCLES = 3  # revolutions the spread is measured over
 LIMIT_ACCURACY = {"analytic": 2e-5, "mujoco": 3e-4}
 STATISTICAL_MIN = 8  # revolutions: the fewest a statistical window fits a trend and a scatter to (6 dof)
 # two-sided, of the mean's and the trend's intervals: 0.99, so that over the choice of window and the stop at the
@@ -132,10 +134,10 @@ def _windows(u: np.ndarray) -> tuple[np.ndarray, ...]:
     return w, mean_dev + u[-1], slope, s / np.sqrt(w), s / np.sqrt(sxx)
 
 
-def statistical_at_end(speeds, target: float) -> tuple[int, float] | None:
-    """(W, U [m/s]) of the statistical window (module docstring) ending at the last of ``speeds`` [m/s] if its
-    uncertainty U is within ``target`` of its mean, else None."""
-    u = np.asarray(speeds, dtype=float)
+def _trend_free(u: np.ndarray) -> tuple[np.ndarray, ...] | None:
+    """(W, mean, U) of every window of the last W >= STATISTICAL_MIN of ``u`` (K,) whose mean is > 0 and whose
+    trend is not significant (module docstring), arrays in the order of W; None where the last
+    STATISTICAL_MIN are not all finite."""
     if u.size < STATISTICAL_MIN or not np.all(np.isfinite(u[-STATISTICAL_MIN:])):
         return None
     w, mean, slope, se_mean, se_slope = _windows(u)
@@ -144,16 +146,88 @@ def statistical_at_end(speeds, target: float) -> tuple[int, float] | None:
     q = student_quantile(0.5 + 0.5 * CONFIDENCE, w - 2.0)
     spread = q * se_mean + np.abs(slope) * (w - 1.0) / 2.0
     with np.errstate(invalid="ignore"):
-        good = np.flatnonzero((np.abs(slope) <= q * se_slope) & (mean > 0) & (spread <= target * mean))
+        good = (np.abs(slope) <= q * se_slope) & (mean > 0)
+    return w[good], mean[good], spread[good]
+
+
+def statistical_at_end(speeds, target: float) -> tuple[int, float] | None:
+    """(W, U [m/s]) of the statistical window (module docstring) ending at the last of ``speeds`` [m/s] if its
+    uncertainty U is within ``target`` of its mean, else None."""
+    windows = _trend_free(np.asarray(speeds, dtype=float))
+    if windows is None:
+        return None
+    w, mean, spread = windows
+    good = np.flatnonzero(spread <= target * mean)
     if good.size == 0:
         return None
     i = good[-1]  # the longest window that passes
     return int(w[i]), float(spread[i])
 
 
+def speed_estimate(speeds) -> tuple[int, float, float] | None:
+    """(W, mean [m/s], U [m/s]) of a run that never became steady: of the windows ending at its last
+    revolution (``speeds`` [m/s], per-revolution means in order) with no significant trend and W >=
+    STATISTICAL_MIN, the one of the smallest U (module docstring), whatever U is; None where there is none.
+
+    Why: a run whose revolutions differ by more than any target allows (a wheeled module that tips as its
+    wheels lift and land every stroke) still has a mean speed, known to U; the start-up's revolutions, far
+    off it, raise a window's U, so the window of the smallest U leaves them out. Chosen for the smallest U, U
+    covers the limit less often than :data:`COVERAGE` (0.86-0.91 of runs in the measurements of the module docstring): an
+    estimate, not a steady figure."""
+    windows = _trend_free(np.asarray(speeds, dtype=float))
+    if windows is None or windows[0].size == 0:
+        return None
+    w, mean, spread = windows
+    i = int(np.argmin(spread))
+    return int(w[i]), float(mean[i]), float(spread[i])
+
+
+_DRIFT_FLOOR = 1e-3  # of tol: a change per revolution this small counts as settled whatever its trend
+
+
+def remaining_drift(speeds: list[float] | np.ndarray) -> float:
+    """How far [m/s] the per-revolution mean speed still moves after its last value, extrapolated from its
+    last two changes d1, d2 as a geometric approach (ratio d2 / d1): |d2| rho / (1 - rho).
+
+    0 where the changes alternate in sign or one is zero (an oscillation the spread bounds); inf where they
+    do not shrink (a drift that does not die out, e.g. a constant torque accelerating for ever); inf with
+    fewer than three speeds.
+    """
+    if len(speeds) < 3:
+        return math.inf
+    d1, d2 = float(speeds[-2] - speeds[-3]), float(speeds[-1] - speeds[-2])
+    if d1 * d2 <= 0:
+        return 0.0
+    rho = d2 / d1
+    return abs(d2) * rho / (1.0 - rho) if rho < 1 else math.inf
+
+
+def steady_at_end(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> bool:
+    """Whether the last ``n`` per-revolution mean speeds [m/s] (of ``speeds``, in order) are the periodic
+    steady state: their mean > 0, their spread <= tol * mean, and the :func:`remaining_drift` <= tol * mean
+    (or the last change below _DRIFT_FLOOR * tol * mean, settled whatever its trend)."""
+    u = np.asarray(speeds, dtype=float)
+    if u.size < n:
+        return False
+    window = u[-n:]
+    mean = float(window.mean())
+    if not (mean > 0 and float(window.max() - window.min()) <= tol * mean):
+        return False
+    return abs(float(u[-1] - u[-2])) <= _DRIFT_FLOOR * tol * mean or remaining_drift(u) <= tol * mean
+
+
+def steady_index(speeds: list[float] | np.ndarray, tol: float = STEADY_TOL, n: int = STEADY_CYCLES) -> int | None:
+    """Index of the first revolution at whose end the run is at steady state (:func:`steady_at_end`); or None."""
+    u = np.asarray(speeds, dtype=float)
+    for k in range(n - 1, u.size):
+        if steady_at_end(u[:k + 1], tol, n):
+            return k
+    return None
+
+
 def find_steady(speeds, tol: float, n: int, target: float | None, exact) -> Steady | None:
     """The first revolution of ``speeds`` [m/s] (per-revolution means, in order) at whose end the run is
-    steady, by the exact test ``exact(speeds_so_far, tol, n)`` (:func:`.cycles.steady_at_end`) or, with a
+    steady, by the exact test ``exact(speeds_so_far, tol, n)`` (:func:`steady_at_end`) or, with a
     ``target``, the statistical one; None where neither passes. The exact one wins a revolution both pass."""
     u = np.asarray(speeds, dtype=float)
     for k in range(n - 1, u.size):

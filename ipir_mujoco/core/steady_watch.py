@@ -8,8 +8,7 @@ import math
 
 import numpy as np
 
-from .cycles import STEADY_CYCLES, STEADY_TOL, steady_at_end
-from .steady_test import steady_at
+from .steady_test import STEADY_CYCLES, STEADY_TOL, steady_at, steady_at_end
 from .errors import ParameterError
 from .params import as_real
 
