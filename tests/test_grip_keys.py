@@ -17,19 +17,14 @@ from ipir_mujoco.core.results import grip_use, peak_grip_use
 SKIDDING = dict(drive="motor", mu_wall=0.5, F_n1=10.0, F_n2=10.0)
 COMPLIANT = dict(clutch_stiffness=1e5, clutch_damping=50.0)
 T_END = 0.5  # s: three strokes, each module skids in each
+# the wheeled model skids on the same 5 N of grip with its legs pressing 50 N (mu_wall 0.1): at 10 N, below a
+# module's weight with the motor's couple, its wheels lift (0.42 s of the 0.5 s) and it tips on the legs left on
+# the wall, where the analytic model's constant press, and with it the grip keys' common meaning, no longer
+# holds (a tipping module's centre moves back while its wheels stand, and its slip counts that: docs/cli.md)
+WHEELED = dict(drive="motor", mu_wall=0.1, F_n1=50.0, F_n2=50.0)
 RUNS = [("analytic-unilateral", {}), ("analytic-approx-unilateral", {}), ("analytic-unilateral", COMPLIANT),
         ("mujoco-ratchet", {}), ("mujoco-ratchet", COMPLIANT),
-        # the wheeled model's slip (every backward step of a module's centre) can exceed the backward travel its
-        # skidding samples show, by more than the samples leave undecided: 10 N is below a module's weight with the
-        # motor's couple, so its wheels lift (0.42 s of the 0.5 s) and it tips on the legs left on the wall (pitch
-        # up to 0.17 rad), its centre moving back while its wheels stand; module 2 then moved back 1.9e-3 m more
-        # than its skidding samples against 2.2e-3 m undecided (it passes here by that margin; with the arms at 1e-3
-        # of the module's mass 2.4e-3 m against 1.4e-3 m). Where no wheel lifts (mu_wall 0.1, F_n 50 N, the same
-        # grip) the excess is the soft contacts' creep as a skid begins, 1.1e-5 m against 1.3e-5 m. Open in the
-        # round-pipe issue: a wheeled slip read at the wheels' contacts, not at the module's centre
-        pytest.param("mujoco-wheels", {}, marks=[pytest.mark.slow, pytest.mark.xfail(
-            reason="wheeled model: a lifted module tips back on its legs, which its slip counts as a skid",
-            strict=False)])]
+        pytest.param("mujoco-wheels", WHEELED, marks=pytest.mark.slow)]
 REFUSING = ["analytic-approx", "analytic-exact", "mujoco-lock", "mujoco-lock-unilateral"]
 
 
@@ -46,7 +41,8 @@ def backward_travel_while_skidding(x: np.ndarray, wheels: np.ndarray) -> tuple[f
 @pytest.mark.parametrize("variant,extra", RUNS)
 @pytest.mark.slow
 def test_every_engine_reads_its_grip_keys_by_the_one_definition(variant, extra):
-    params = RobotParams(**SKIDDING, **extra)
+    params = RobotParams(**{**SKIDDING, **extra})
+    assert params.grip == (5.0, 5.0)  # every variant on the same grip
     # the wheeled model at its automatic first step, given: its skid check's reruns (to 2.5e-5 s here) refine the
     # figures, not what the keys mean
     options = {"timestep": 1e-4} if variant == "mujoco-wheels" else {}
@@ -61,10 +57,12 @@ def test_every_engine_reads_its_grip_keys_by_the_one_definition(variant, extra):
         assert np.all(s[f"grip_use{k}"][wheels == -1.0] == 1.0) and s[f"grip_use{k}"].max() <= 1.0
         slip = summary[f"slip{k}_m"]
         assert slip == max(float(s[f"slip{k}"][-1] - s[f"slip{k}"][0]), 0.0) and slip > 0
-        if not extra:  # rigid clutches: the module's locked wheels skid with it (compliant: its anchor's slide)
-            travel, undecided = backward_travel_while_skidding(s[f"x{k}"], wheels)
+        if "clutch_stiffness" not in extra:  # rigid clutches: the locked wheels skid with their module
+            travel, undecided = backward_travel_while_skidding(s[f"x{k}"], wheels)  # (compliant: its anchor's slide)
             # a MuJoCo module stands on soft rows that creep ~1e-9 m per revolution (mjcf/README.md): 1e-8 m more
             assert abs(slip - travel) <= undecided + 1e-8
+    if variant == "mujoco-wheels":  # the design keeps every wheel on its wall: the constant press holds
+        assert summary["wheel_off_s"] == 0.0
     # skidded: 1, by the same definition for every engine, and the summary is read off the columns
     assert summary["peak_grip_use"] == peak_grip_use(s, params.grip) == 1.0
 
