@@ -11,6 +11,7 @@ import pytest
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
 from ipir_mujoco.core.cycles import travel
+from ipir_mujoco.core.options import RepeatProgress
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
 from ipir_mujoco.engine.modelkinds import kinds
@@ -209,9 +210,10 @@ def test_progress_every_tenth_of_a_second_and_the_wall_budget():
         simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.5, dt_out=1e-3, wall_budget_s=1e-9)
 
 
-def test_progress_never_goes_back_across_a_halved_step(monkeypatch):
-    """The first attempt at 4e-4 s reports progress until the monitor stops it; the repeat at half the
-    step reports again only past that point, so a user's progress is increasing, and still reaches the end."""
+def test_progress_never_goes_back_across_a_halved_step_and_the_repeat_says_where_it_is(monkeypatch):
+    """The first attempt at 4e-4 s reports progress until the monitor stops it; the repeat at half the step
+    reports all along, as RepeatProgress values that never go below what was reported (a user's progress never
+    goes back) and carry the repeat's own time, step and attempt; it still reaches the end."""
     chosen = kinds.choose_settings  # the slide kind's timestep rule, which every run asks
     monkeypatch.setattr(kinds, "choose_settings",
                         lambda *args: (SolverSettings(timestep=4e-4), chosen(*args)[1]))
@@ -226,8 +228,16 @@ def test_progress_never_goes_back_across_a_halved_step(monkeypatch):
     monkeypatch.setattr(engine_simulate, "_Run", Counted)
     run = simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.8, dt_out=4e-4, progress=seen.append)
     assert run.settings["refinements"] and len(attempts) >= 2 and attempts[1] >= 2  # reported, then repeated
-    assert all(b > a for a, b in zip(seen, seen[1:])), seen
-    assert seen[-1] == pytest.approx(0.8, abs=4e-4)
+    assert all(b >= a for a, b in zip(seen, seen[1:])), seen
+    first, repeat = seen[:attempts[1]], seen[attempts[1]:]
+    assert all(b > a for a, b in zip(first, first[1:])) and not any(isinstance(t, RepeatProgress) for t in first)
+    assert repeat and all(isinstance(t, RepeatProgress) and t.attempt == 2 and t.timestep == 2e-4 for t in repeat)
+    own = [t.t for t in repeat]
+    # the repeat's own time from its start (every 0.1 s of it, within one output interval), not from the first
+    # attempt's last report: it is heard from before it passes that point
+    assert own[0] < first[-1] and all(b > a for a, b in zip(own, own[1:]))
+    assert all(float(t) == max(first[-1], t.t) for t in repeat)
+    assert seen[-1] == pytest.approx(0.8, abs=4e-4) and repeat[-1].t == pytest.approx(0.8, abs=4e-4)
 
 
 @pytest.mark.parametrize("params, servo, t_end, named", [

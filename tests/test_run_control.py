@@ -107,3 +107,36 @@ def test_a_long_run_in_a_log_says_where_it_is_after_2_s_then_every_10_s(t_end, m
         printed += capsys.readouterr().err.splitlines()
     assert common.FIRST_WALL_S == 2.0 and common.WALL_EVERY_S == 10.0  # the times above are these
     assert printed == [f"simulated 0.02 / {t_end:g} s", f"simulated 0.04 / {t_end:g} s"]
+
+
+def test_a_run_repeated_at_a_finer_step_goes_on_saying_where_it_is(monkeypatch, capsys):
+    """A wheeled run's skid check repeats the run at half its step, minutes on a long run: through the engine's
+    PassProgress the repeat is heard every WALL_EVERY_S in a log file, its lines saying it is a repeat, at which
+    step and how far it is, while the time a plain callable sees never goes back."""
+    import time
+
+    from ipir_mujoco.cli import common
+    from ipir_mujoco.engine.modelkinds.common import PassProgress
+
+    clock = [100.0]
+    monkeypatch.setattr(time, "monotonic", lambda: clock[0])
+    printed, plain = [], []
+    report = common.progress_printer(5.0)
+    passes = PassProgress(lambda t: (plain.append(float(t)), report(t)))
+    passes.begin(5e-5)
+    for wall, simulated in [(3.0, 2.5), (6.0, 3.07)]:  # the first attempt: stopped at 3.07 s (a stall, say)
+        clock[0] = 100.0 + wall
+        passes(simulated)
+    passes.begin(2.5e-5)  # the skid check's repeat from t = 0
+    for wall, simulated in [(12.0, 0.4), (17.0, 0.9), (22.0, 1.5), (60.0, 3.0), (71.0, 3.2)]:
+        clock[0] = 100.0 + wall
+        passes(simulated)
+    printed = capsys.readouterr().err.splitlines()
+    assert plain == sorted(plain) and plain[-1] == 3.2  # never back; past the first attempt, the repeat's own time
+    again = [line for line in printed if "again" in line]
+    assert printed[:2] == ["simulated 2.50 / 5 s", "simulated 3.07 / 5 s"]
+    # the first attempt's tenths printed at 3 and 6 s of wall time; then wall lines only (the time reported stays
+    # in its sixth tenth): at 17 s (11 s after the last line; 12 s was 6 s after), 60 and 71 s, none at 22 s
+    assert again == ["simulated 0.90 / 5 s again, at a 2.5e-05 s step (attempt 2: the accuracy check)",
+                     "simulated 3.00 / 5 s again, at a 2.5e-05 s step (attempt 2: the accuracy check)",
+                     "simulated 3.20 / 5 s again, at a 2.5e-05 s step (attempt 2: the accuracy check)"]

@@ -8,6 +8,7 @@ import sys
 from typing import Callable
 
 from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.options import progress_text
 from ipir_mujoco.core.params import DRIVES, FEEDFORWARDS, RobotParams, load_params
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
@@ -106,8 +107,9 @@ def tenths_printer(total: float, text: Callable[[float], str], final_within: flo
     import time
 
     if sys.stderr.isatty():
-        def report(done: float) -> None:
-            print("\r" + text(done), end="\n" if done >= total - final_within else "", file=sys.stderr, flush=True)
+        def report(done: float) -> None:  # a repeat's own time (RepeatProgress.t) decides where its line ends
+            own = getattr(done, "t", done)
+            print("\r" + text(done), end="\n" if own >= total - final_within else "", file=sys.stderr, flush=True)
         return report
     shown, last = [0], [time.monotonic() - (every_s or 0.0) + FIRST_WALL_S]
 
@@ -124,11 +126,12 @@ def progress_printer(t_end: float):
     """Progress of a run on stderr (:func:`tenths_printer` of the simulated time [s], the callable's argument):
     per tenth of the simulated time for runs long enough to wait for (simulated time > 2 s), and in a log file at
     least every WALL_EVERY_S of wall time whatever the length, the first after FIRST_WALL_S (a wheeled run steps
-    seconds of wall time per simulated second; a run done within FIRST_WALL_S prints nothing)."""
+    seconds of wall time per simulated second; a run done within FIRST_WALL_S prints nothing). A run repeated at a
+    finer step (the accuracy checks) says so in its lines (:func:`ipir_mujoco.core.options.progress_text`)."""
     import time
 
     def text(t: float) -> str:
-        return f"simulated {t:.2f} / {t_end:g} s"
+        return progress_text(t, t_end)
     if t_end > 2.0:
         return tenths_printer(t_end, text, final_within=0.05, every_s=WALL_EVERY_S)
     if sys.stderr.isatty():

@@ -152,6 +152,27 @@ def check_type(name: str, value: Any, types: type | tuple[type, ...], allowed: s
     return value
 
 
+class RepeatProgress(float):
+    """What a run's ``progress`` callable is given while the run is repeated at a finer step (an accuracy check's
+    refinement, the wheeled model's skid check, which may take minutes): a float, the simulated time [s] the run
+    had already reported (so that the times a callable sees never go back), carrying ``t`` [s], the repeat's own
+    simulated time, ``attempt`` (2, 3, ...) and ``timestep`` [s], the repeat's step."""
+
+    def __new__(cls, value: float, t: float, attempt: int, timestep: float):
+        self = super().__new__(cls, value)
+        self.t, self.attempt, self.timestep = float(t), int(attempt), float(timestep)
+        return self
+
+
+def progress_text(t: float, t_end: float) -> str:
+    """A run's progress as a line says it: "simulated T / T_END s", and in a repeat (:class:`RepeatProgress`)
+    the repeat's own time, with its step and attempt."""
+    if isinstance(t, RepeatProgress):
+        return (f"simulated {t.t:.2f} / {t_end:g} s again, at a {t.timestep:.3g} s step (attempt {t.attempt}: "
+                "the accuracy check)")
+    return f"simulated {t:.2f} / {t_end:g} s"
+
+
 def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable[[float], None]:
     """A run's ``progress=`` callable that passes the simulated time [s] on to ``report`` at most once every
     ``every_s`` seconds of wall time (the first after ``every_s``): a heartbeat inside a long run of a study,

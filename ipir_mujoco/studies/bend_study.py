@@ -41,6 +41,7 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError
+from ipir_mujoco.core.options import progress_text
 from ipir_mujoco.core.params import RobotParams, check_whole, require_params
 from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
@@ -147,7 +148,7 @@ def run_case(params: RobotParams, item: tuple[str, float, float]) -> dict:
     what = f"R/D {ratio:g} " + (f"bend in plane {plane:g} deg" if kind == "bend" else kind)
     try:
         run = registry.run("mujoco-wheels", params, t_cap, dt_out=DT_OUT, route=route, accuracy="warn",
-                           progress=_quiet_printer(what, started))
+                           progress=_quiet_printer(what, started, t_cap))
     except SimulationError as exc:
         return {"kind": kind, "R_over_D": ratio, "error": str(exc), "passed": False,
                 "wall_s": time.perf_counter() - started}
@@ -157,16 +158,18 @@ def run_case(params: RobotParams, item: tuple[str, float, float]) -> dict:
     return out
 
 
-def _quiet_printer(what: str, started: float, every: float = PROGRESS_EVERY_S):
+def _quiet_printer(what: str, started: float, t_cap: float, every: float = PROGRESS_EVERY_S):
     """A run's progress callback (simulated time [s]) printing on stderr at most every ``every`` seconds of wall
-    time, from the run's worker: a case's run takes minutes, and its end alone would leave the study silent."""
+    time, from the run's worker: a case's run takes minutes, and its end alone would leave the study silent (its
+    skid check's repeats at finer steps too: they say so). ``t_cap`` [s]: the run's cap."""
     last = [started]
 
     def progress(t: float) -> None:
         now = time.perf_counter()
         if now - last[0] >= every:
             last[0] = now
-            print(f"bend-study: {what}: simulated {t:.2f} s ({now - started:.0f} s wall)", file=sys.stderr, flush=True)
+            print(f"bend-study: {what}: {progress_text(t, t_cap)} ({now - started:.0f} s wall)", file=sys.stderr,
+                  flush=True)
     return progress
 
 

@@ -25,7 +25,7 @@ from typing import Callable, Sequence
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.cycles import travel
-from ipir_mujoco.core.options import throttled
+from ipir_mujoco.core.options import progress_text, throttled
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams
 
@@ -116,7 +116,7 @@ def envelope_study(quick: bool = False, progress: Callable[[str], None] = lambda
             reference = registry.run(PAIRS[implementation][1], params, t_end, dt_out=1e-3)
             analytic_wall = time.perf_counter() - started
             beat = throttled(lambda t, label=label, implementation=implementation, t_end=t_end: progress(
-                f"{label}, {implementation}: {t:.2f} / {t_end:g} s simulated"))
+                f"{label}, {implementation}: " + progress_text(t, t_end)))
             try:
                 run = registry.run(PAIRS[implementation][0], params, t_end, dt_out=1e-3, progress=beat)
             except SimulationError as exc:  # default options: a run the monitor stops is a finding, not a crash

@@ -70,7 +70,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import heartbeat, throttled
+from ipir_mujoco.core.options import heartbeat, progress_text, throttled
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
@@ -108,7 +108,7 @@ def run_ladder(params: RobotParams, t_end: float, dt_out: float, rtol: float, at
         tolerances = ({"accuracy": rung.accuracy} if registry.variant(rung.variant).is_mujoco
                       else {"rtol": rtol, "atol": atol})
         beat = throttled(lambda t, i=i, rung=rung: progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: "
-                                                            f"{t:.2f} / {t_end:g} s simulated"))
+                                                            + progress_text(t, t_end)))
         run = registry.run(rung.variant, rung.params(params), t_end, dt_out=dt_out, progress=beat, **tolerances)
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: {run.summary['revolutions']:.3f} rev "
                  f"({time.perf_counter() - started:.2f} s)")

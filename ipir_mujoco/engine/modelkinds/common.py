@@ -19,6 +19,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.options import RepeatProgress
 from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
 from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m/s], this long [s] is a stall
 from ipir_mujoco.core.results import stall_reason as core_stall_reason
@@ -88,18 +89,32 @@ def steps_per_output(dt_out: float, timestep: float) -> int:
     return steps
 
 
-def monotone(progress: Callable[[float], None] | None) -> Callable[[float], None] | None:
-    """``progress`` called only with times beyond every time it was given before: a run repeated at a
-    smaller timestep (after a failed accuracy check) reports again only once it passes the first attempt."""
-    if progress is None:
-        return None
-    reached = [-math.inf]
+class PassProgress:
+    """A run's ``progress`` across its attempts: the first attempt's simulated times [s] passed on as they come;
+    each repeat at a finer step (:meth:`begin`; a failed accuracy check, the wheels' skid check) passes on
+    :class:`ipir_mujoco.core.options.RepeatProgress` values, never below the time already reported: the times a
+    user's callable sees never go back, and a repeat that takes minutes is not silent."""
 
-    def report(t: float) -> None:
-        if t > reached[0]:
-            reached[0] = t
-            progress(t)
-    return report
+    def __init__(self, progress: Callable[[float], None]):
+        self.progress, self.reached, self.attempt, self.timestep = progress, -math.inf, 0, math.nan
+
+    def begin(self, timestep: float) -> None:
+        """An attempt at ``timestep`` [s] starts (the first is the run itself)."""
+        self.attempt, self.timestep = self.attempt + 1, float(timestep)
+
+    def __call__(self, t: float) -> None:
+        if self.attempt <= 1:
+            if t > self.reached:
+                self.reached = t
+                self.progress(t)
+            return
+        self.reached = max(self.reached, t)
+        self.progress(RepeatProgress(self.reached, t, self.attempt, self.timestep))
+
+
+def monotone(progress: Callable[[float], None] | None) -> PassProgress | None:
+    """``progress`` (or None) as a :class:`PassProgress`."""
+    return None if progress is None else PassProgress(progress)
 
 
 def climb_energy(model: mujoco.MjModel, params: RobotParams) -> float:

@@ -8,8 +8,9 @@ bit as its pure-Python form). Every output interval the run records a sample
 (:mod:`.recorder`) and feeds the accuracy monitor (:mod:`.monitor`). Every
 0.05 s of simulated time it checks the wall-time budget, the periodic steady
 state and a stall, and reports progress about every 0.1 s of it (never going
-back: a run repeated at a halved timestep reports again only past the first
-attempt's last report).
+back: a run repeated at a halved timestep, which may take minutes, reports
+:class:`ipir_mujoco.core.options.RepeatProgress` values, its own time with
+the time already reported: :class:`ipir_mujoco.engine.modelkinds.common.PassProgress`).
 MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
 turn into a :class:`SimulationError` with the time and MuJoCo's message, as
 do a non-finite state and a MuJoCo error (``mujoco.FatalError``).
@@ -125,7 +126,7 @@ def simulate_mujoco(
     (:attr:`.kinds.ModelKind.accuracy`: 'stop' on the slides, 'warn' on wheels).
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
-    simulated time about every 0.1 s of it; ``wall_budget_s`` [s] caps the wall
+    simulated time about every 0.1 s of it (in a repeat at a finer step with a RepeatProgress); ``wall_budget_s`` [s] caps the wall
     time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
     ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
     required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`). ``model``: 'slides' or 'wheels'
@@ -196,6 +197,8 @@ class _Run:
                  route=None, started=None):
         self.params, self.settings, self.clutch, self.implementation = params, settings, clutch, implementation
         self.t_end, self.dt_out, self.progress, self.servo = t_end, dt_out, progress, servo
+        if progress is not None:
+            progress.begin(settings.timestep)  # a repeat's progress says so (PassProgress)
         self.until_steady, self.steady_tol, self.steady_cycles = until_steady, steady_tol, steady_cycles
         self.wall_budget_s = wall_budget_s
         self.started = time.perf_counter() if started is None else started
