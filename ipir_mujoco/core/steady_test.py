@@ -172,8 +172,8 @@ def speed_estimate(speeds) -> tuple[int, float, float] | None:
     Why: a run whose revolutions differ by more than any target allows (a wheeled module that tips as its
     wheels lift and land every stroke) still has a mean speed, known to U; the start-up's revolutions, far
     off it, raise a window's U, so the window of the smallest U leaves them out. Chosen for the smallest U, U
-    covers the limit less often than :data:`COVERAGE` (0.86-0.91 of runs in the measurements of the module docstring): an
-    estimate, not a steady figure."""
+    covers the limit less often than :data:`COVERAGE` (0.86-0.91 of runs in the module docstring's
+    measurements): an estimate, not a steady figure."""
     windows = _trend_free(np.asarray(speeds, dtype=float))
     if windows is None or windows[0].size == 0:
         return None

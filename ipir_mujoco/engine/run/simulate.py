@@ -126,8 +126,8 @@ def simulate_mujoco(
     (:attr:`.kinds.ModelKind.accuracy`: 'stop' on the slides, 'warn' on wheels).
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
-    simulated time about every 0.1 s of it (in a repeat at a finer step with a RepeatProgress); ``wall_budget_s`` [s] caps the wall
-    time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
+    simulated time about every 0.1 s of it (in a repeat at a finer step, a RepeatProgress);
+    ``wall_budget_s`` [s] caps the wall time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
     ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
     required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`). ``model``: 'slides' or 'wheels'
     (on wheels in a pipe, a ratchet in every hub: :mod:`.wheels_model`, :mod:`.wheels`).
