@@ -210,6 +210,20 @@ def test_progress_every_tenth_of_a_second_and_the_wall_budget():
         simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.5, dt_out=1e-3, wall_budget_s=1e-9)
 
 
+def test_a_run_slower_than_its_progress_wall_time_reports_at_every_check(monkeypatch):
+    """Where 0.1 s of simulated time takes longer than PROGRESS_WALL_S of wall time (a wheeled run at a fine
+    step), progress comes at every check (every BLOCK_TIME of simulated time) past it: here, with the wall time
+    set to 0, at every check."""
+    from ipir_mujoco.engine.modelkinds.common import BLOCK_TIME
+    from ipir_mujoco.engine.run import block_checks
+
+    monkeypatch.setattr(block_checks, "PROGRESS_WALL_S", 0.0)
+    seen: list[float] = []
+    simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.3, dt_out=1e-3, progress=seen.append)
+    # a check at each output sample at or after every BLOCK_TIME (0.05 s), the last at the end
+    np.testing.assert_allclose(seen, BLOCK_TIME * np.arange(1, 7), atol=1e-3 + 1e-9)
+
+
 def test_progress_never_goes_back_across_a_halved_step_and_the_repeat_says_where_it_is(monkeypatch):
     """The first attempt at 4e-4 s reports progress until the monitor stops it; the repeat at half the step
     reports all along, as RepeatProgress values that never go below what was reported (a user's progress never

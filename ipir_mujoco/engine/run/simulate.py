@@ -7,7 +7,8 @@ steps run in :mod:`.stepper`, compiled where it can be (same numbers bit for
 bit as its pure-Python form). Every output interval the run records a sample
 (:mod:`.recorder`) and feeds the accuracy monitor (:mod:`.monitor`). Every
 0.05 s of simulated time it checks the wall-time budget, the periodic steady
-state and a stall, and reports progress about every 0.1 s of it (never going
+state and a stall, and reports progress about every 0.1 s of it or every
+second of wall time, whichever comes first (never going
 back: a run repeated at a halved timestep, which may take minutes, reports
 :class:`ipir_mujoco.core.options.RepeatProgress` values, its own time with
 the time already reported: :class:`ipir_mujoco.engine.modelkinds.common.PassProgress`).
@@ -126,8 +127,9 @@ def simulate_mujoco(
     (:attr:`.kinds.ModelKind.accuracy`: 'stop' on the slides, 'warn' on wheels).
     ``until_steady`` stops at the end of the revolution where the periodic
     steady state is reached (``t_end`` caps it). ``progress`` is called with the
-    simulated time about every 0.1 s of it (in a repeat at a finer step, a RepeatProgress);
-    ``wall_budget_s`` [s] caps the wall time. ``servo`` replaces the drive by a crank servo (:class:`CrankServo`). ``feedforward``: with
+    simulated time about every 0.1 s of it or second of wall time (in a repeat, a RepeatProgress);
+    ``wall_budget_s`` [s] caps the wall time. ``servo`` replaces the drive by a crank servo
+    (:class:`CrankServo`). ``feedforward``: with
     ``params.drive = 'servo'``, the speed controller's table (:class:`ipir_mujoco.core.control.FeedforwardTable`,
     required unless ``params.feedforward`` is 'none'; :mod:`.servo_drive`). ``model``: 'slides' or 'wheels'
     (on wheels in a pipe, a ratchet in every hub: :mod:`.wheels_model`, :mod:`.wheels`).
