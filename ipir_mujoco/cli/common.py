@@ -93,7 +93,7 @@ def check_input_file(option: str, path: str) -> None:
         raise ParameterError(f"{option} {path!r} is not a regular file (a device or pipe); give a file")
 
 
-WALL_EVERY_S = 10.0  # s of wall time: the longest a long run's progress stays silent in a log file
+WALL_EVERY_S = 10.0  # s of wall time: how long a long run's progress stays silent in a log file, to its next report
 FIRST_WALL_S = 2.0  # s of wall time before a long run's first such line (work longer than 2 s shows progress)
 
 
@@ -101,9 +101,9 @@ def tenths_printer(total: float, text: Callable[[float], str], final_within: flo
                    every_s: float | None = None) -> Callable[[float], None]:
     """Progress on stderr, ``report(done)`` for ``done`` of ``total`` (any unit): on a terminal one line
     (``text(done)``) rewritten in place, ended once ``done`` is within ``final_within`` of ``total``; in a log
-    file one line per tenth of the total and, with ``every_s`` [s], one at least every ``every_s`` seconds of wall
-    time (a run capped far beyond where it ends, as a route's, would otherwise print nothing for minutes), the
-    first of them after FIRST_WALL_S."""
+    file one line per tenth of the total and, with ``every_s`` [s], one at the first report at least ``every_s``
+    seconds of wall time after the last line (a run capped far beyond where it ends, as a route's, would otherwise
+    print nothing for minutes), the first of them after FIRST_WALL_S."""
     import time
 
     if sys.stderr.isatty():

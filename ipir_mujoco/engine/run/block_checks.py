@@ -18,7 +18,8 @@ from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
 
 # s of wall time: a run whose 0.1 s of simulated time takes longer (a wheeled run at a finer step: 3-4 s at
 # 1.25e-5 s beside another job) reports at the first check past it too, so that a printer that wants a line every
-# 10 s of wall time (ipir_mujoco.cli.common.WALL_EVERY_S) is called often enough to keep it within about 11 s
+# 10 s of wall time (ipir_mujoco.cli.common.WALL_EVERY_S) is called often enough to print within 10 s plus one
+# check's wall time (the README's bend90 route at 1.25e-5 s, idle: 1.45 s; its longest gap 11.8 s)
 PROGRESS_WALL_S = 1.0
 
 
