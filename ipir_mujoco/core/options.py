@@ -168,9 +168,9 @@ def progress_text(t: float, t_end: float) -> str:
     """A run's progress as a line says it: "simulated T / T_END s", and in a repeat (:class:`RepeatProgress`)
     the repeat's own time, with its step and attempt."""
     if isinstance(t, RepeatProgress):
-        return (f"simulated {t.t:.2f} / {t_end:g} s again, at a {t.timestep:.3g} s step (attempt {t.attempt}: "
+        return (f"simulated {t.t:.2f} / {t_end:.4g} s again, at a {t.timestep:.3g} s step (attempt {t.attempt}: "
                 "the accuracy check)")
-    return f"simulated {t:.2f} / {t_end:g} s"
+    return f"simulated {t:.2f} / {t_end:.4g} s"
 
 
 def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable[[float], None]:
