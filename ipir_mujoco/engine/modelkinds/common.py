@@ -112,11 +112,6 @@ class PassProgress:
         self.progress(RepeatProgress(self.reached, t, self.attempt, self.timestep))
 
 
-def monotone(progress: Callable[[float], None] | None) -> PassProgress | None:
-    """``progress`` (or None) as a :class:`PassProgress`."""
-    return None if progress is None else PassProgress(progress)
-
-
 def climb_energy(model: mujoco.MjModel, params: RobotParams) -> float:
     """Potential energy of raising the whole robot by one stroke 2 r along the pipe [J]: with the drive's
     2 pi |torque|, one revolution's energy scale, the floor of the monitor's energy scale."""

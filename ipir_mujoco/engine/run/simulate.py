@@ -60,8 +60,8 @@ from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
 from .block_checks import BlockChecks
-from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, captured_warnings, climb_energy, monotone,
-                     mujoco_failure, steps_per_output)
+from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
+                                 climb_energy, mujoco_failure, steps_per_output)
 from ..modelkinds.kinds import ModelKind, kind_for
 from .skid_check import SLIDES_RULE, verify_skids
 from .wheel_skids import WHEELS_RULE
@@ -155,8 +155,9 @@ def simulate_mujoco(
                                  f"1 / control_rate = {1 / params.control_rate:g} s; allowed: a timestep of at most "
                                  "that (or none: the engine then chooses one)")
 
+    passes = None if run.progress is None else PassProgress(run.progress)  # one across the attempts
     options = dict(clutch=clutch, implementation=implementation, t_end=t_end, dt_out=dt_out, mjcf=mjcf,
-                   progress=monotone(run.progress), servo=servo, accuracy=accuracy, until_steady=run.until_steady,
+                   progress=passes, servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
                    kind=kind, feedforward=feedforward, route=route)
     if settings is not None:
