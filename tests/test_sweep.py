@@ -697,3 +697,30 @@ def test_the_first_metric_spellings_still_name_their_metrics():
     assert check_plot_metric(None, False) == "mean_speed_m_s"
     with pytest.raises(ParameterError, match="--plot-metric 'speed' is unknown"):
         check_plot_metric("speed", False)
+
+
+def _sleep_long(seconds: float) -> float:  # a pool task still running when its pool is ended
+    time.sleep(seconds)
+    return seconds
+
+
+def test_a_pool_ended_at_once_has_its_workers_killed_and_its_manager_thread_ended(monkeypatch):
+    """studies.pool.end_pool after Ctrl-C: the workers (deep in a 60 s task) killed, the pending task cancelled,
+    and the pool's manager thread ended before it returns, so that Python's exit hook never wakes a manager still
+    closing its pipe (a traceback after the one-line message). Joined without a time limit here: the test holds
+    what end_pool waits for, not how long it takes."""
+    from concurrent import futures
+
+    from ipir_mujoco.studies import pool as pool_module
+
+    monkeypatch.setattr(pool_module, "MANAGER_JOIN_S", None)
+    pool = futures.ProcessPoolExecutor(max_workers=1, initializer=pool_module.worker_init, initargs=(os.getpid(),))
+    running, pending = pool.submit(_sleep_long, 60.0), pool.submit(_sleep_long, 60.0)
+    while not running.running():
+        time.sleep(0.01)
+    workers = list(pool._processes.values())
+    manager = pool._executor_manager_thread
+    pool_module.end_pool(pool, kill=True)
+    assert not manager.is_alive()
+    assert all(w.exitcode is not None for w in workers)  # killed, not left to finish their minute
+    assert pending.cancelled() or isinstance(pending.exception(timeout=0), futures.process.BrokenProcessPool)

@@ -20,7 +20,7 @@ from ipir_mujoco.core.errors import StudyInterrupted
 from ipir_mujoco.core.params import RobotParams
 
 from .atlas_space import IDEALIZATIONS, measure
-from .pool import kill_workers, worker_init
+from .pool import end_pool, worker_init
 from .sweep_files import Progress, ResultsFile, _cell
 
 CHUNK = 8  # analytic pairs per pool task: a pair costs tens of ms, a task's round trip about one
@@ -83,9 +83,7 @@ class Samples:
 
     def __exit__(self, kind, exc, tb):
         if self.pool is not None:
-            if kind is not None:
-                kill_workers(self.pool)
-            self.pool.shutdown(wait=kind is None, cancel_futures=True)
+            end_pool(self.pool, kill=kind is not None)
         self.file.close()
         if kind is None:
             self.file.sort()

@@ -24,7 +24,7 @@ from pathlib import Path
 from ipir_mujoco.core.errors import ParameterError, StudyInterrupted
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams
 
-from .pool import kill_workers, worker_init
+from .pool import end_pool, worker_init
 from .sweep import run_design
 from .sweep_files import Progress, ResultsFile, _cell
 from .sweep_metrics import METRICS
@@ -112,9 +112,7 @@ class Evaluator:
     def __exit__(self, kind, exc, tb):
         interrupted = kind is not None
         if self.pool is not None and self.own_pool:  # a caller's executor is the caller's to end
-            if interrupted:
-                kill_workers(self.pool)
-            self.pool.shutdown(wait=not interrupted, cancel_futures=True)
+            end_pool(self.pool, kill=interrupted)
         self.file.close()
         if not interrupted:
             self.file.sort()  # in eval_id order: two runs of one study give the same bytes

@@ -1,7 +1,7 @@
 """Run a study's independent tasks on all cores: process pools whose workers die with the caller.
 
-:func:`worker_init` and :func:`kill_workers` are what every pool of the package shares (the sweep's two
-pools, :func:`map_unordered`'s); :func:`map_unordered` runs independent tasks and hands back each result as
+:func:`worker_init`, :func:`kill_workers` and :func:`end_pool` are what every pool of the package shares (the
+sweep's two pools, :func:`map_unordered`'s, the design and atlas evaluators'); :func:`map_unordered` runs independent tasks and hands back each result as
 it finishes.
 """
 
@@ -53,6 +53,24 @@ def kill_workers(pool: futures.ProcessPoolExecutor) -> None:
         process.kill()
 
 
+MANAGER_JOIN_S = 5.0  # s: the most a killed pool's manager thread is waited for (it ends as soon as it sees them dead)
+
+
+def end_pool(pool: futures.ProcessPoolExecutor, kill: bool) -> None:
+    """Shut a process pool down: at once with its workers killed (``kill``: Ctrl-C, a stuck task), or after its
+    running tasks; its pending tasks cancelled. Either way its manager thread has ended when this returns (after
+    a kill, within MANAGER_JOIN_S). Why: Python 3.11's exit hook wakes every pool's manager thread through a pipe
+    which that thread closes as it ends, without a lock between the two; a manager still ending at exit had the
+    hook print a traceback (``OSError: [Errno 9] Bad file descriptor``) after a sweep's one-line Ctrl-C message
+    (tests/test_interrupts.py, once in CI)."""
+    manager = getattr(pool, "_executor_manager_thread", None)  # shutdown() forgets it
+    if kill:
+        kill_workers(pool)
+    pool.shutdown(wait=not kill, cancel_futures=True)
+    if manager is not None and manager.is_alive():
+        manager.join(MANAGER_JOIN_S)
+
+
 def map_unordered(task: Callable[[Item], object], items: Iterable[Item], workers: int,
                   on_result: Callable[[Item, object], None]) -> None:
     """Call ``task(item)`` for every item and ``on_result(item, result)`` here as each finishes.
@@ -75,6 +93,4 @@ def map_unordered(task: Callable[[Item], object], items: Iterable[Item], workers
             on_result(pending[future], future.result())
         complete = True
     finally:
-        if not complete:
-            kill_workers(pool)
-        pool.shutdown(wait=complete, cancel_futures=True)
+        end_pool(pool, kill=not complete)

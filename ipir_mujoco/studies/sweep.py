@@ -63,7 +63,7 @@ from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
 from ..output import check_output_dir, study_folder
-from .pool import kill_workers, worker_init
+from .pool import end_pool, worker_init
 from .sweep_files import Progress, ResultsFile, _cell, header_for, make_row
 from .sweep_metrics import batch_metrics, run_metrics
 from .sweep_space import Study
@@ -391,10 +391,8 @@ def _run_designs(study: Study, designs: list[dict], out: Path, results_file: Res
     finally:
         interrupted = bool(partial)
         for own, kill in ((pool if own_pool else None, interrupted or abandoned), (batch_pool, interrupted)):
-            if own is not None:
-                if kill:  # workers ignore Ctrl-C and may be deep in a long design: end them now
-                    kill_workers(own)
-                own.shutdown(wait=not kill, cancel_futures=True)
+            if own is not None:  # workers ignore Ctrl-C and may be deep in a long design: killed then
+                end_pool(own, kill=kill)
         if executor is not None:
             for future in running:
                 future.cancel()
