@@ -1,8 +1,8 @@
 """Run a study's independent tasks on all cores: process pools whose workers die with the caller.
 
 :func:`worker_init`, :func:`kill_workers` and :func:`end_pool` are what every pool of the package shares (the
-sweep's two pools, :func:`map_unordered`'s, the design and atlas evaluators'); :func:`map_unordered` runs independent tasks and hands back each result as
-it finishes.
+sweep's two pools, :func:`map_unordered`'s, the design and atlas evaluators'); :func:`map_unordered` runs
+independent tasks and hands back each result as it finishes.
 """
 
 from __future__ import annotations

@@ -47,13 +47,12 @@ class BlockChecks:
         run, rec = self.run, self.run.recorder
         t = float(rec.t[newest])
         run._check(messages, float(rec.t[max(newest - 1, 0)]))
-        if run.progress is not None:
-            now = time.perf_counter()
-            if t >= self.next_report - 1e-12 or now - self.reported_at >= PROGRESS_WALL_S:
-                run.progress(t)
-                self.reported_at = now
-                self.next_report = 0.1 * (math.floor(t / 0.1 + 1e-9) + 1)
-        if run.wall_budget_s is not None and time.perf_counter() - run.started > run.wall_budget_s:
+        now = time.perf_counter()
+        if run.progress is not None and (t >= self.next_report - 1e-12 or now - self.reported_at >= PROGRESS_WALL_S):
+            run.progress(t)
+            self.reported_at = now
+            self.next_report = 0.1 * (math.floor(t / 0.1 + 1e-9) + 1)
+        if run.wall_budget_s is not None and now - run.started > run.wall_budget_s:
             raise SimulationError(f"the run exceeded its wall-time budget of {run.wall_budget_s:g} s at "
                                   f"t={t:.6g} s (simulated)")
         if self.watch is not None:
