@@ -294,7 +294,7 @@ def texts_beyond_panel(fig) -> list[str]:
     page = fig.bbox
     titles = [t for ax in fig.axes for t in (ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label)
               if t.get_visible() and t.get_text().strip()]
-    for item in [t for t in fig.texts if t.get_visible() and t.get_text().strip()] + titles + list(fig.legends):
+    for item in [t for t in fig.texts if t.get_visible() and t.get_text().strip()] + titles + legends(fig):
         box = item.get_window_extent(renderer)
         if box.x0 < page.x0 - 1 or box.x1 > page.x1 + 1 or box.y0 < page.y0 - 1 or box.y1 > page.y1 + 1:
             found.append(f"{item.get_text()[:40] if isinstance(item, Text) else 'legend'!r} beyond the figure")
@@ -374,10 +374,20 @@ def overlapping_labels(fig) -> list[str]:
     items = [t for ax in fig.axes for t in (ax.title, ax._left_title, ax._right_title, ax.xaxis.label,
                                             ax.yaxis.label)]
     items += [t for t in fig.texts] + ([fig._suptitle] if fig._suptitle is not None else [])
-    items = list({id(t): t for t in items if t.get_visible() and t.get_text().strip()}.values())
+    items = list({id(t): t for t in items if t.get_visible() and t.get_text().strip()}.values()) + legends(fig)
     boxes = [(t, t.get_window_extent(renderer)) for t in items]
-    return [f"{a.get_text()[:30]!r} over {b.get_text()[:30]!r}" for i, (a, box_a) in enumerate(boxes)
-            for b, box_b in boxes[i + 1:] if box_a.overlaps(box_b)]
+
+    def name(item) -> str:
+        return repr(item.get_text()[:30]) if isinstance(item, Text) else "a legend"
+    found = [f"{name(a)} over {name(b)}" for i, (a, box_a) in enumerate(boxes) for b, box_b in boxes[i + 1:]
+             if box_a.overlaps(box_b)]
+    # a legend placed outside its panel must not lie on another panel
+    for legend in legends(fig):
+        box = legend.get_window_extent(renderer)
+        for ax in fig.axes:
+            if ax is not legend.axes and ax.get_visible() and box.overlaps(ax.get_window_extent(renderer)):
+                found.append(f"a legend over the panel {ax.get_title()[:30]!r}")
+    return found
 
 
 def faults(fig) -> dict[str, list[str]]:

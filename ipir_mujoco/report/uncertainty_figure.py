@@ -78,13 +78,14 @@ def uncertainty_figure(result: dict, words: dict | None = None) -> Figure:
             _band(hist, entry["quantiles"][q], entry["quantile_intervals"][q], "#2ca02c",
                   "5 and 95 % quantiles, 95 % intervals" if q == "5" else None)
         hist.set_xlabel(_label(name, unit))
-        hist.set_ylabel("probability density" + (f" [1/({unit})]" if unit and unit != "-" else " [-]"))
+        per = f"({unit})" if any(c in unit for c in "/ ^") else unit  # 1/m, 1/(J/m)
+        hist.set_ylabel("probability density" + (f" [1/{per}]" if unit and unit != "-" else " [-]"))
         std = entry["std"]
         shown_unit = f" {unit}" if unit and unit != "-" else ""
         hist.set_title(f"{name}: mean {entry['mean']:.4g}{shown_unit}, SD {std:.3g}{shown_unit}" if std is not None
                        else name, fontsize=10)
         # below the panel: inside, it would cover the histogram
-        hist.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)
+        hist.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=1, frameon=False)
         ecdf = fig.add_subplot(grid[k, 1])
         for values, colour, engine in ((g, EQUATIONS, cheap_name), (f, MUJOCO, faithful_name)):
             if values.size:
@@ -100,9 +101,9 @@ def uncertainty_figure(result: dict, words: dict | None = None) -> Figure:
         ecdf.set_ylabel("share of samples at most x [-]")
         ecdf.set_ylim(-0.02, 1.02)
         ecdf.grid(True, alpha=0.3)
-        ecdf.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)
+        ecdf.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=1, frameon=False)
         if entry.get("variance_reduction"):
-            ecdf.set_title(f"variance reduction {entry['variance_reduction']:.3g}x (correlation "
+            ecdf.set_title(f"variance reduction {entry['variance_reduction']:.3g}x\n(correlation "
                            f"{entry['correlation']:.4f}, {entry['mujoco_samples']} MuJoCo runs)", fontsize=10)
     if events:
         ax = fig.add_subplot(grid[n_rows - 1, :])
