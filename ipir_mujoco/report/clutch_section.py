@@ -130,10 +130,13 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
     handles += [Line2D([], [], **style) for kind, style in kinds if kind in drawn]
     if any(a.get_gid() and a.get_gid().startswith("pair:") for ax in axes for a in ax.lines):
         handles.append(Line2D([], [], ls="none", marker="D", mfc="none", mec="black", label="realistic clutches"))
-    # as many columns as the figure's width holds (about 2.4 inches an entry): a one-panel figure's legend used
-    # to run past its edges
-    fig.legend(handles=handles, loc="outside lower center", fontsize="small",
-               ncols=max(1, min(5, len(handles), int(fig.get_figwidth() / 2.4))))
+    # as many columns as the figure's width holds: a one-panel figure's legend used to run past its edges
+    for ncols in range(min(5, len(handles)), 0, -1):
+        legend = fig.legend(handles=handles, loc="outside lower center", fontsize="small", ncols=ncols)
+        fig.canvas.draw()
+        if legend.get_window_extent().width <= fig.bbox.width or ncols == 1:
+            break
+        legend.remove()
     _place_labels(fig, labels)
     return fig
 

@@ -29,7 +29,7 @@ EXACT = ("analytic-unilateral", "mujoco-ratchet")  # the two exact models with o
 PAPER_RULE = ("analytic-exact", "analytic-approx")  # the paper's rule: exact geometry, and the paper's own model
 INCLINES = {False: (0, 10, 20, 30, 40, 50, 60, 70, 75, 80, 90), True: (0, 30, 60, 90)}  # the figure's inclines [deg], full / quick
 # bracket of the steady-climb limit [deg], full / quick: ``climb``'s own (climbing.TOLERANCE_DEG), so that the report
-# and ``ipir-mujoco climb`` bisect to the same bracket (two more runs per engine than a 0.5 deg bracket: ~1 s)
+# and ``ipir-mujoco climb`` bisect to the same bracket (three more runs per engine than a 0.5 deg bracket)
 TOLERANCE = {False: climbing.TOLERANCE_DEG, True: climbing.TOLERANCE_DEG}
 TORQUE_STEP = 0.01  # N m: the stronger motor is the torque needed at rest rounded up to this (a catalogue step)
 
