@@ -54,7 +54,7 @@ def render(metrics: dict, figures_dir: Path) -> list:
           "paper's idealizations is removed alone, as in the ladder, and its cost on a metric is (idealized - real) "
           "/ |real|, in the equations over a quasi-random sample of "
         + f"{metrics['samples'] * (len(axes) + 2)} designs ({metrics['runs']} runs). The safe share is the "
-          "sample's share of designs where |cost| stays below the threshold (Wilson's 95 % interval); what drives "
+          "sample's share of designs where the cost stays within +- the threshold (Wilson's 95 % interval); what drives "
           "the cost: its largest total Sobol indices (ST, 95 % interval). MuJoCo's side and other ranges: "
           "ipir-mujoco atlas (docs/cli.md).")]
     rows = []
@@ -65,7 +65,7 @@ def render(metrics: dict, figures_dir: Path) -> list:
                 lo, hi = item["safe_fraction_interval"]
                 cells.append(f"{100 * item['safe_fraction']:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]")
             rows.append(cells + [top_drivers(entry)])
-    blocks.append(Table(["idealization", "metric"] + [f"safe share, |cost| < {100 * t:g} %"
+    blocks.append(Table(["idealization", "metric"] + [f"safe share, cost within +-{100 * t:g} %"
                                                       for t in metrics["thresholds"]] + ["driven by"], rows))
     plot_safe(metrics["idealizations"], axes, Path(figures_dir) / "atlas_safe.png",
               title="Safe share of the design's +-50 % neighbourhood")

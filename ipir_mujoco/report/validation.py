@@ -261,8 +261,8 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
         "(first order - exact) / |exact|; the gap S and its rate at the same crank angle by their largest "
         "difference over the run, as a share of the stroke 2r and of the largest |dS/dt|. Each threshold is "
         "bracketed by two neighbouring ratios of the sweep; the crank revolutions' thresholds are then narrowed on "
-        "the equations to 0.002 in L/r by the root-finding of ipir-mujoco atlas (its first-order-kinematics "
-        "crossing is the same number)."))
+        "the equations to 0.002 in L/r by the root-finding of ipir-mujoco atlas, which finds the same crossing "
+        "over L."))
     blocks.append(Image(figures["lr_study.png"], "Divergence of the first-order model from the exact linkage "
                                                  "against L/r (log axes)."))
     angle_labels = {"S_at_angle": "gap S at the same crank angle (share of 2r)",
