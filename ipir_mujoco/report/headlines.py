@@ -7,14 +7,14 @@ control's ripples. Each is read here from the one entry of the metrics record th
 cost) and the text the report shows. tests/test_headlines.py holds the report, the README and the docs to them.
 
 Every cost is the report's convention: (the model with the idealization - the model without it) / |the model
-without it| (:func:`ipir_mujoco.studies.validate.cost`).
+without it| (:func:`ipir_mujoco.studies.compare.cost`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..studies.validate import cost
+from ..studies.compare import cost
 from . import control_section, cruise_section
 from .document import pct
 

@@ -78,7 +78,7 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
 from .. import __version__
-from .compare import relative_change
+from .compare import cost, relative_change
 from .convergence import convergence_evidence
 from .ladder import VALIDATION_LADDER
 from .lr_study import RATIOS_FULL, RATIOS_QUICK, describe_threshold, lr_study
@@ -151,13 +151,6 @@ def _percent(x: float | None) -> str:
 def _magnitude(x: float | None) -> str:
     """An agreement's size, without a sign: '0.02 %'."""
     return "n/a" if x is None else f"{100 * abs(x):.2f} %"
-
-
-def cost(idealized: float, real: float) -> float | None:
-    """An idealization's cost: (the model with it - the model without it) / |the model without it|, the sign
-    convention of every cost in the report (the atlas's, :func:`.atlas_space.signed_cost`; the L/r study's; the
-    ladder's brackets; the opening figure's)."""
-    return relative_change(idealized, real)
 
 
 def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> dict:
