@@ -171,8 +171,10 @@ def test_report_section_where_the_paper_model_holds(tmp_path):
     table = next(b for b in blocks if isinstance(b, Table))
     assert len(table.rows) == 3 * 2  # idealizations x metrics
     verdict = atlas_section.verdict(metrics)
-    assert verdict["short"] == "least safe: locking-clutches" and "revolutions" in verdict["answer"]
+    assert verdict["short"] == "least safe: locking clutches" and "crank revolutions" in verdict["answer"]
     assert "Where the paper's model holds" in to_markdown(blocks)
+    # no '|cost|' in the table's header: its bars split the Markdown table's cells
+    assert "|cost|" not in to_markdown(blocks) and table.header[2] == "safe share, cost within +-1 %"
 
 
 def test_a_folder_another_run_is_writing_is_refused(tmp_path):

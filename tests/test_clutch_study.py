@@ -219,23 +219,22 @@ def test_the_figure_draws_the_rows_of_both_engines_and_the_rigid_limit(first_eng
 
 @pytest.mark.slow
 def test_the_figure_reads_right_its_legend_lists_only_what_is_drawn(first_engagements, cruise):
-    """Every legend entry has a drawn artist of its look, axes have units, no note lies over data: on the
-    full grid with marked designs, and where a backlash has one design only (a colour without a curve is
-    left out of the legend and the design named where it is drawn, with its play)."""
+    """Every legend entry has a drawn artist of its look and every mark drawn an entry, axes have units, no
+    note lies over data: on the full grid with marked designs, and where a backlash has one design only (its
+    colour keyed by its marker, not a line: an orange marker used to have no entry)."""
     highlight = [{"name": "sprag", "clutch_stiffness": 1e6, "clutch_backlash": 0.0}]
     fig = study_figure(first_engagements, highlight)
-    assert not figure_checks.undrawn_legend_entries(fig)
-    assert not figure_checks.bad_axis_labels(fig)
-    assert not figure_checks.texts_over_data(fig)
+    figure_checks.assert_reads_right(fig)
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "backlash 1 mm" in labels and "realistic clutches" in labels
     assert any(t.get_text() == "sprag (no play)" for t in fig.axes[0].texts)
-    # the cruise study: one design (1e6 N/m, 1 mm): no curve, so no backlash colour and no analytic line
+    # the cruise study: one design (1e6 N/m, 1 mm): no curve, so its colour keyed by a marker, no analytic line
     fig = study_figure(cruise)
-    labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert not any(label.startswith("backlash") for label in labels), labels
-    assert "analytic compliant clutch (lines)" not in labels and "MuJoCo compliant ratchet (markers)" in labels
-    assert not figure_checks.undrawn_legend_entries(fig)
+    figure_checks.assert_reads_right(fig)
+    legend = fig.legends[0]
+    keys = {t.get_text(): h for t, h in zip(legend.get_texts(), legend.legend_handles)}
+    assert keys["backlash 1 mm"].get_marker() == "o" and keys["backlash 1 mm"].get_linestyle() == "None"
+    assert "analytic compliant clutch (lines)" not in keys and "MuJoCo compliant ratchet (markers)" in keys
 
 
 

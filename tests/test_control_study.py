@@ -91,9 +91,7 @@ def test_files_and_figure(study, tmp_path):
             "profile-force:analytic-unilateral", "profile-energy:mujoco-ratchet"} <= gids
     assert all(ax.get_ylabel() for ax in fig.axes)
     # legends off the data (a legend used to cover the bars), every entry drawn, axes with units
-    assert not figure_checks.texts_over_data(fig)
-    assert not figure_checks.undrawn_legend_entries(fig)
-    assert not figure_checks.bad_axis_labels(fig)
+    figure_checks.assert_reads_right(fig)
     text = format_table(study)
     assert "ripple [-]" in text and "dead-centre profile" in text
 

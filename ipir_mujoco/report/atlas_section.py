@@ -17,7 +17,7 @@ from ipir_mujoco.core.params import RobotParams
 
 from ..studies.atlas import Atlas, run_atlas, top_drivers
 from ..studies.sweep_space import Axis
-from .atlas_plots import plot_safe
+from .atlas_plots import idealization_words, metric_words, plot_safe
 from .document import Heading, Image, Paragraph, Table
 
 SPAN = 0.5  # each parameter from (1 - SPAN) to (1 + SPAN) times the design's
@@ -54,18 +54,18 @@ def render(metrics: dict, figures_dir: Path) -> list:
           "paper's idealizations is removed alone, as in the ladder, and its cost on a metric is (idealized - real) "
           "/ |real|, in the equations over a quasi-random sample of "
         + f"{metrics['samples'] * (len(axes) + 2)} designs ({metrics['runs']} runs). The safe share is the "
-          "sample's share of designs where |cost| stays below the threshold (Wilson's 95 % interval); what drives "
+          "sample's share of designs where the cost stays within +- the threshold (Wilson's 95 % interval); what drives "
           "the cost: its largest total Sobol indices (ST, 95 % interval). MuJoCo's side and other ranges: "
           "ipir-mujoco atlas (docs/cli.md).")]
     rows = []
     for name, per in metrics["idealizations"].items():
         for metric, entry in per.items():
-            cells = [name, metric]
+            cells = [idealization_words(name), metric_words(metric)[0]]
             for item in entry["by_threshold"]:
                 lo, hi = item["safe_fraction_interval"]
                 cells.append(f"{100 * item['safe_fraction']:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]")
             rows.append(cells + [top_drivers(entry)])
-    blocks.append(Table(["idealization", "metric"] + [f"safe share, |cost| < {100 * t:g} %"
+    blocks.append(Table(["idealization", "metric"] + [f"safe share, cost within +-{100 * t:g} %"
                                                       for t in metrics["thresholds"]] + ["driven by"], rows))
     plot_safe(metrics["idealizations"], axes, Path(figures_dir) / "atlas_safe.png",
               title="Safe share of the design's +-50 % neighbourhood")
@@ -80,13 +80,13 @@ def verdict(metrics: dict) -> dict | None:
     for name, per in metrics["idealizations"].items():
         item = per[first]["by_threshold"][0]
         frac = item["safe_fraction"]
-        parts.append(f"{name} within {100 * item['threshold']:g} % in {100 * frac:.0f} % of it (driven by "
-                     f"{top_drivers(per[first])})")
+        parts.append(f"{idealization_words(name)} within {100 * item['threshold']:g} % in {100 * frac:.0f} % of it "
+                     f"(driven by {top_drivers(per[first])})")
         if worst is None or frac < worst[1]:
             worst = (name, frac)
     if worst is None:
         return None
     return {"question": "Over designs near this one (+-50 %), where does each idealization hold?",
-            "answer": f"In {first} over the neighbourhood: " + "; ".join(parts) + ".",
-            "evidence": "sections.model_holds", "short": f"least safe: {worst[0]}",
+            "answer": f"In {metric_words(first)[0]} over the neighbourhood: " + "; ".join(parts) + ".",
+            "evidence": "sections.model_holds", "short": f"least safe: {idealization_words(worst[0])}",
             "key": f"{100 * worst[1]:.0f} % of the neighbourhood within {100 * metrics['thresholds'][0]:g} %"}

@@ -4,7 +4,9 @@ Top panel: the steady speed (motor; a constant torque has no steady state while 
 the mean speed over the last three revolutions of the run), one line per engine (the first engine
 solid, the others as open markers over it), the inclines where an engine stalled as crosses at zero
 speed, and the limits of :mod:`ipir_mujoco.studies.climbing` as vertical lines: the restart limit
-(dashed) and each engine's steady-climb limit (dotted). Bottom panel: the peak clutch reaction
+(dashed) and the steady-climb limit (dotted, at the last incline seen to climb; the legend gives the bisection's
+bracket, climbs-stalls, as ``climb`` prints it: black where the engines share it, else one line per engine in its
+colour). Bottom panel: the peak clutch reaction
 (over the steady window, or the whole run; none for MuJoCo's rigid clutches, whose peak is set by its
 step) and the mean total clutch reaction over the steady window, with the weight along the pipe,
 (m1 + m2 + m_rod) g sin(incline), that the clutches hold on average beside the moving module's
@@ -56,7 +58,9 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
         speed_ax.plot(x, np.where(stalled, np.nan, speed), color=colour, gid=f"speed:{engine}", **style)
         peak = _column(rows, engine, "peak_clutch_force_n")
         force_ax.plot(x, np.where(stalled, np.nan, peak), color=colour, gid=f"peak:{engine}", **style)
-        force_ax.plot(x, _column(rows, engine, "mean_clutch_force_n"), color=colour, lw=1.0, ls="--",
+        # dashes offset per engine: engines that agree (their lines on each other) show both colours in turn
+        dashes = (3 * j, (3, 3 * len(study["engines"]) - 3))
+        force_ax.plot(x, _column(rows, engine, "mean_clutch_force_n"), color=colour, lw=1.0, ls=dashes,
                       gid=f"mean:{engine}")
         if stalled.any():
             cross = {"ls": "none", "marker": "x", "ms": 10 - 3 * j, "mew": 2, "color": colour}
@@ -66,28 +70,30 @@ def climb_figure(study: dict, params: RobotParams) -> Figure:
         if np.isfinite(peak).any():  # MuJoCo's rigid clutches give none (module docstring)
             force_handles.append(Line2D([], [], color=colour, label=f"peak, {label}", **style))
         if np.isfinite(_column(rows, engine, "mean_clutch_force_n")).any():  # drawn dashed in the engine's colour
-            force_handles.append(Line2D([], [], color=colour, lw=1.0, ls="--",
+            force_handles.append(Line2D([], [], color=colour, lw=1.0, ls=dashes,
                                         label=f"mean over the steady window, {label}"))
-        limit = study["steady_climb"].get(engine, {}).get("incline_deg")
-        if limit is not None:
-            # dashes offset per engine: lines at one incline show both colours in turn
-            speed_ax.axvline(limit, color=colour, ls=(2 * j, (2, 2 * len(study["engines"]) - 2)), lw=1.6,
-                             gid=f"steady-limit:{engine}")
-            limits.setdefault(round(limit, 6), []).append(label)
+        limit = study["steady_climb"].get(engine, {})
+        if limit.get("incline_deg") is not None:
+            limits.setdefault(tuple(round(v, 6) for v in limit["bracket"]), []).append((label, colour, engine))
     restart = study["restart"]["incline_deg"]
     if restart is not None:
         speed_ax.axvline(restart, color="grey", ls="--", lw=1.2, gid="restart")
         speed_handles.append(Line2D([], [], color="grey", ls="--",
                                     label=f"restart limit (restarts at every crank angle): {restart:.1f} deg"))
-    for limit, names in limits.items():
-        speed_handles.append(Line2D([], [], color="black", ls=(0, (2, 2)),
-                                    label=f"steady-climb limit from rest: {limit:.1f} deg ({', '.join(names)})"))
+    for (low, high), engines in limits.items():
+        # engines with one bracket share one black dotted line; an engine with its own bracket has its colour
+        colour = "black" if len(engines) > 1 or len(study["engines"]) == 1 else engines[0][1]
+        speed_ax.axvline(low, color=colour, ls=":", lw=1.6, gid="steady-limit:" + ",".join(e for _l, _c, e in engines))
+        bracket = f"{high:.2f} deg" if low == high else f"{low:.2f}-{high:.2f} deg"
+        speed_handles.append(Line2D([], [], color=colour, ls=":", lw=1.6,
+                                    label=f"steady-climb limit from rest: {bracket} "
+                                          f"({', '.join(name for name, _c, _e in engines)})"))
     speed_handles.append(Line2D([], [], ls="none", marker="x", mew=2, color="black", label="stalled"))
     fine = np.linspace(min(x.min(), 0.0), x.max(), 200)
     mass = params.m1 + params.m2 + params.rod_mass
     force_ax.plot(fine, mass * params.g * np.sin(np.radians(fine)), color="grey", lw=2.5, alpha=0.5, gid="weight")
     force_handles += [Line2D([], [], color="grey", lw=2.5, alpha=0.5,
-                             label="weight along the pipe, (m1 + m2 + m_rod) g sin(incline)"),
+                             label="weight along the pipe, (m1 + m2 + rod mass) g sin(incline)"),
                       Line2D([], [], ls="none", marker="x", mew=2, color="black",
                              label="stalled: peak over the run, then held at rest")]
     drive = (f"motor: M_stall {params.M_stall:g} N m, no-load {params.omega_noload:g} rad/s" if motor

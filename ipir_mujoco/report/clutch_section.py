@@ -34,6 +34,10 @@ ENGINE_STYLE = {"analytic": {"ls": "-", "lw": 1.6}, "mujoco": {"ls": "none", "ma
 LABEL_OFFSETS = (((8, -14), "left"), ((8, 6), "left"), ((-8, 6), "right"), ((-8, -14), "right"), ((0, 10), "center"),
                  ((0, -22), "center"), ((8, -28), "left"), ((8, 18), "left"), ((-8, -28), "right"), ((-8, 18), "right"),
                  ((0, 24), "center"), ((0, -36), "center"))
+# beyond those, farther out in 16 directions, joined to their design by a thin line
+FAR_OFFSETS = tuple(((round(r * np.cos(a)), round(r * np.sin(a))), "left" if np.cos(a) > 0.3 else
+                     "right" if np.cos(a) < -0.3 else "center")
+                    for r in (30, 48, 66) for a in np.linspace(0, 2 * np.pi, 16, endpoint=False))
 RIGID_STYLE = {"analytic": {"marker": "*", "color": "black", "ms": 13},
                "mujoco": {"marker": "X", "color": "dimgrey", "ms": 9}}
 
@@ -56,7 +60,8 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
     stiffness = np.array(study["stiffness_n_m"])
     rigid_x = stiffness.max() * 10**RIGID_OFFSET
     labels = []  # (panel, text, (k, force)) of the marked designs, placed once the panels are drawn
-    drawn = set()  # what the legend may show: ("backlash", j), "analytic", "mujoco", "rigid:ENGINE", "slope"
+    drawn = set()  # what the legend may show: ("backlash", j, "curve"|"point"), "analytic", "mujoco", "rigid:ENGINE",
+    # "slope"
     for ax, key in zip(axes, points):
         rows = [r for r in study["rows"] if r["point"] == key]
         for j, b in enumerate(study["backlash_m"]):
@@ -69,8 +74,7 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
                         continue
                     ax.plot(x, y, color=COLOURS[j % len(COLOURS)], gid=f"{engine}:{b!r}", **style)
                     drawn.add(engine)
-                    if len(data) > 1:  # a colour in the legend is a curve (a lone design is named where drawn)
-                        drawn.add(("backlash", j))
+                    drawn.add(("backlash", j, "curve" if len(data) > 1 else "point"))
         missing = []
         for engine, style in RIGID_STYLE.items():
             ref = study["rigid"][key][engine]
@@ -94,6 +98,7 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
         if _slope_guide(ax, rows, study["backlash_m"]):
             drawn.add("slope")
         ax.axvline(stiffness.max() * 10 ** (RIGID_OFFSET / 2), color="grey", lw=0.8, ls=":")
+        drawn.add("break")
         decades = 10.0 ** np.arange(np.floor(np.log10(stiffness.min())), np.floor(np.log10(stiffness.max())) + 1)
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -110,17 +115,28 @@ def study_figure(study: dict, highlight: Sequence[dict] = ()) -> Figure:
         ax.title.set_fontsize("medium")
         ax.grid(alpha=0.3, which="major")
     # the legend lists only what is drawn: a colour with a curve, each kind of mark present
+    # a backlash with a curve is keyed by a line; one drawn as lone designs only, by its marker
     handles = [Line2D([], [], color=COLOURS[j % len(COLOURS)], lw=3, label=f"backlash {1e3 * b:g} mm")
-               for j, b in enumerate(study["backlash_m"]) if ("backlash", j) in drawn]
+               if ("backlash", j, "curve") in drawn else
+               Line2D([], [], color=COLOURS[j % len(COLOURS)], **ENGINE_STYLE["mujoco"], label=f"backlash {1e3 * b:g} mm")
+               for j, b in enumerate(study["backlash_m"])
+               if ("backlash", j, "curve") in drawn or ("backlash", j, "point") in drawn]
     kinds = (("analytic", dict(color="black", label="analytic compliant clutch (lines)", **ENGINE_STYLE["analytic"])),
              ("mujoco", dict(color="black", label="MuJoCo compliant ratchet (markers)", **ENGINE_STYLE["mujoco"])),
              ("rigid:analytic", dict(ls="none", label="rigid one-way model (analytic)", **RIGID_STYLE["analytic"])),
              ("rigid:mujoco", dict(ls="none", label="rigid ratchet (MuJoCo)", **RIGID_STYLE["mujoco"])),
-             ("slope", dict(color="grey", ls="--", lw=1, label="slope 1/2: an impact, F ~ sqrt(k)")))
+             ("slope", dict(color="grey", ls="--", lw=1, label="slope 1/2: an impact, F ~ sqrt(k)")),
+             ("break", dict(color="grey", ls=":", lw=0.8, label="axis break: rigid clutches (k -> infinity) right")))
     handles += [Line2D([], [], **style) for kind, style in kinds if kind in drawn]
     if any(a.get_gid() and a.get_gid().startswith("pair:") for ax in axes for a in ax.lines):
         handles.append(Line2D([], [], ls="none", marker="D", mfc="none", mec="black", label="realistic clutches"))
-    fig.legend(handles=handles, loc="outside lower center", ncols=min(5, len(handles)), fontsize="small")
+    # as many columns as the figure's width holds: a one-panel figure's legend used to run past its edges
+    for ncols in range(min(5, len(handles)), 0, -1):
+        legend = fig.legend(handles=handles, loc="outside lower center", fontsize="small", ncols=ncols)
+        fig.canvas.draw()
+        if legend.get_window_extent().width <= fig.bbox.width or ncols == 1:
+            break
+        legend.remove()
     _place_labels(fig, labels)
     return fig
 
@@ -135,8 +151,9 @@ def _place_labels(fig: Figure, labels: list) -> None:
         paths = [(line.get_transform().transform_path(line.get_path()), line.get_linestyle() not in ("None", ""))
                  for line in ax.lines if len(line.get_xdata())]
         best = None  # (conflicts, note, box): the candidate covering the least
-        for (dx, dy), align in LABEL_OFFSETS:
+        for (dx, dy), align in LABEL_OFFSETS + FAR_OFFSETS:
             note = ax.annotate(text, xy, xytext=(dx, dy), ha=align, textcoords="offset points", fontsize="small")
+            note.set_in_layout(False)  # else the layout, redone at saving, resizes the panels under the placed names
             box = note.get_window_extent(renderer).expanded(1.02, 1.1)
             inside = ax.get_window_extent(renderer)
             conflicts = (sum(bool(np.any((path.vertices[:, 0] > box.x0) & (path.vertices[:, 0] < box.x1)
@@ -154,8 +171,15 @@ def _place_labels(fig: Figure, labels: list) -> None:
                 note.remove()
             if conflicts == 0:
                 break
-        chosen = best[1:]
-        placed.append(chosen[1])
+        conflicts, note, box = best
+        dx, dy = note.xyann
+        if dx * dx + dy * dy > 30 ** 2:  # far from its design: a thin line to it
+            note.remove()
+            note = ax.annotate(text, xy, xytext=(dx, dy), ha=note.get_ha(), textcoords="offset points",
+                               fontsize="small", arrowprops={"arrowstyle": "-", "color": "0.4", "lw": 0.6,
+                                                             "shrinkA": 1, "shrinkB": 6})
+            note.set_in_layout(False)
+        placed.append(box)
 
 
 def _slope_guide(ax, rows: list[dict], backlash: list[float]) -> bool:

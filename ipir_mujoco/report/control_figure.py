@@ -19,6 +19,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 CONTROLLER_COLOURS = {"open-loop": "tab:grey", "pi": "tab:blue", "pi+paper": "tab:orange", "pi+exact": "tab:green"}
+# the controllers in words (their code names are the study's and the servo's --feedforward choices)
+CONTROLLER_WORDS = {"open-loop": "open loop", "pi": "PI alone", "pi+paper": "PI + paper's feedforward",
+                    "pi+exact": "PI + exact feedforward"}
 VARIANT_STYLE = {"analytic-approx-unilateral": {"hatch": "//", "label": "paper's geometry (its promise)"},
                  "analytic-unilateral": {"hatch": "", "label": "exact equations"},
                  "mujoco-ratchet": {"hatch": "..", "label": "MuJoCo"}}
@@ -53,10 +56,11 @@ def study_figure(study: dict) -> Figure:
             if c == "open-loop":  # tens of percent: off the servo's scale, said in words
                 off_scale.append(f"open loop: {deviation.min():+.0f} % .. {deviation.max():+.0f} % (off scale)")
                 continue
-            ax_trace.plot(phi[order], deviation, color=CONTROLLER_COLOURS[c], lw=1.4, label=c, gid=f"trace:{c}")
+            ax_trace.plot(phi[order], deviation, color=CONTROLLER_COLOURS[c], lw=1.4, label=CONTROLLER_WORDS.get(c, c),
+                          gid=f"trace:{c}")
         ax_trace.axhline(0.0, color="black", ls=":", lw=1.0, label="target")
         for dc in (0, 180, 360):
-            ax_trace.axvline(dc, color="lightgrey", lw=0.8, zorder=0)
+            ax_trace.axvline(dc, color="lightgrey", lw=0.8, zorder=0, label="dead centres" if dc == 0 else None)
         ax_trace.set_xlim(0, 360)
         ax_trace.set_xticks(range(0, 361, 45))
         ax_trace.set_title(f"(a) crank speed over a steady revolution, {fastest:g} rad/s target (MuJoCo)")
@@ -83,7 +87,7 @@ def study_figure(study: dict) -> Figure:
                           hatch=VARIANT_STYLE[v]["hatch"], label=VARIANT_STYLE[v]["label"])
             for bar in bars:
                 bar.set_gid(f"{'ripple' if key == 'speed_ripple' else 'force'}:{v}")
-        ax.set_xticks(x, [f"{c}\n{w:g} rad/s" for w, c in groups], fontsize=8)
+        ax.set_xticks(x, [f"{CONTROLLER_WORDS.get(c, c)}\n{w:g} rad/s" for w, c in groups], fontsize=8)
         if log:
             ax.set_yscale("log")
         ax.set_title(title)

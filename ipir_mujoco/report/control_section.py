@@ -74,17 +74,17 @@ def render(metrics: dict, figures_dir) -> list:
     rows = []
     for r in metrics["runs"]:
         if "error" in r:
-            rows.append([r["controller"], LABELS[r["variant"]], "n/a: " + r["error"], "", "", "", ""])
+            rows.append([CONTROLLERS[r["controller"]], LABELS[r["variant"]], "n/a: " + r["error"], "", "", "", ""])
             continue
-        rows.append([r["controller"], LABELS[r["variant"]],
+        rows.append([CONTROLLERS[r["controller"]], LABELS[r["variant"]],
                      "n/a" if r["speed_ripple"] is None else fmt(100 * r["speed_ripple"], 3),
                      fmt(r["mean_omega_rad_s"], 6), fmt(r["peak_clutch_force_n"], 4),
                      fmt(r["energy_per_metre_j_m"], 4), fmt(r["peak_drive_u"], 3)])
     blocks.append(Table(header, rows))
     write_figure(metrics, Path(figures_dir) / "speed_control.png")
     blocks.append(Image("figures/speed_control.png", f"The crank speed's deviation from its {w:g} rad/s target over "
-                        "one steady revolution, per controller: the exact equations (solid), MuJoCo (dotted), the "
-                        "paper's geometry under the paper's feedforward (dashed: what it promises)."))
+                        "one steady revolution, per controller: the exact equations (solid), MuJoCo (dotted), and as a "
+                        "wide pale band what the paper's feedforward promises on the paper's own geometry."))
     blocks.append(Paragraph(
         f"The paper's feedforward promises a ripple of {_ripple(metrics, 'pi+paper', PROMISE)} on its own model and "
         f"delivers {_ripple(metrics, 'pi+paper', EXACT)} on the exact equations "
@@ -101,36 +101,47 @@ def render(metrics: dict, figures_dir) -> list:
 
 
 COLOURS = {"pi": "tab:blue", "pi+paper": "tab:orange", "pi+exact": "tab:green"}
-STYLES = {EXACT: "-", MUJOCO: ":", PROMISE: "--"}
+STYLES = {EXACT: "-", MUJOCO: ":", PROMISE: "-"}
+# the controllers in words (the table's and the figure's; the code names are the servo's --feedforward choices)
+CONTROLLERS = {"pi": "PI alone", "pi+paper": "PI + the paper's feedforward", "pi+exact": "PI + the exact feedforward"}
+PROMISE_WIDTH = 7.0  # points: what the paper's model promises, a wide pale band under the thin delivered lines
 
 
 def write_figure(metrics: dict, path: Path) -> None:
-    """The crank speed over a steady revolution, as a deviation from the target [%], per run."""
+    speed_figure(metrics).savefig(path, dpi=110)
+
+
+def speed_figure(metrics: dict):
+    """The crank speed over a steady revolution, as a deviation from the target [%], per run: the delivered runs
+    as thin lines (exact equations solid, MuJoCo dotted), the paper's promise as a wide pale band beneath them, the
+    target as a grey line; the legend below the panel."""
     import math
 
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.subplots()
     w = metrics["speed_rad_s"]
-    for r in metrics["runs"]:
+    ax.axhline(0.0, color="0.45", lw=0.9, zorder=1.5, label=f"target, {w:g} rad/s")
+    for r in sorted(metrics["runs"], key=lambda r: r["variant"] != PROMISE):  # the promise first, underneath
         if "error" in r or not r["trace"]["phi_rad"]:
             continue
         phi = np.degrees(np.mod(r["trace"]["phi_rad"], 2 * math.pi))
         order = np.argsort(phi)
         deviation = 100 * (np.asarray(r["trace"]["omega_rad_s"])[order] / w - 1)
-        ax.plot(phi[order], deviation, color=COLOURS[r["controller"]], ls=STYLES[r["variant"]], lw=1.3,
-                label=f"{r['controller']}, {LABELS[r['variant']]}")
-    ax.axhline(0.0, color="black", lw=0.8)
+        promise = r["variant"] == PROMISE
+        ax.plot(phi[order], deviation, color=COLOURS[r["controller"]], ls=STYLES[r["variant"]],
+                lw=PROMISE_WIDTH if promise else 1.3, alpha=0.35 if promise else 1.0, zorder=1 if promise else 2,
+                solid_capstyle="butt", label=f"{CONTROLLERS[r['controller']]}, {LABELS[r['variant']]}")
     ax.set_xlim(0, 360)
     ax.set_xticks(range(0, 361, 45))
     ax.set_xlabel("crank angle phi [deg] (dead centres at 0 and 180)")
     ax.set_ylabel("crank speed - target [% of target]")
-    ax.legend(fontsize=7, loc="best")
-    fig.savefig(path, dpi=110)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2, frameon=False)
+    return fig
 
 
 def verdict(metrics: dict) -> dict | None:

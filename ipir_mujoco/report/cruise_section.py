@@ -103,9 +103,11 @@ def _motor_text(metrics: dict) -> str:
 
 
 def _rung_table(metrics: dict) -> Table:
-    header = ["rung", "removes", summary_label("t_steady_s"), summary_label("steady_speed_m_s") + " (vs paper)",
+    header = ["rung", "removes", summary_label("t_steady_s"),
+              summary_label("steady_speed_m_s") + " (the paper's model against it)",
               summary_label("distance_per_rev_m"), summary_label("energy_per_metre_j_m"), "efficiency [-]",
-              "mean crank speed [rad/s]", "mean crank torque [N m] (vs paper)", "peak clutch reaction [N]"]
+              "mean crank speed [rad/s]", "mean crank torque [N m] (the paper's model against it)",
+              "peak clutch reaction [N]"]
     rows = []
     for r in metrics["rungs"]:
         if "error" in r:
@@ -115,10 +117,11 @@ def _rung_table(metrics: dict) -> Table:
             why = r["stall_reason"] or f"not steady by {metrics['t_cap_s']:g} s"
             rows.append([r["name"], r["isolates"], why] + [""] * 7)
             continue
-        change = r["change_vs_paper"]
+        rungs = _rungs(metrics)
 
-        def vs(key):
-            return f" ({pct(change[key])})" if change[key] and r["name"] != PAPER else ""
+        def vs(key):  # the report's convention: (the paper's model - this rung) / |this rung|
+            error = _change(rungs, PAPER, key, r["name"])
+            return f" ({pct(error)})" if error and r["name"] != PAPER else ""
 
         rows.append([r["name"], r["isolates"], fmt(r["t_steady_s"], 4), fmt(r["steady_speed_m_s"], 5) + vs(
             "steady_speed_m_s"), fmt(r["distance_per_rev_m"], 5), fmt(r["energy_per_metre_j_m"], 5),
@@ -167,10 +170,31 @@ def _peak_table(metrics: dict) -> Table | None:
 
 
 def _change(rungs: dict, name: str, key: str, against: str = PAPER) -> float | None:
+    """(rung ``name`` - rung ``against``) / |``against``| of a figure; None where either did not settle."""
     a, b = rungs.get(against), rungs.get(name)
     if not (_ok(a) and _ok(b)) or not a[key]:
         return None
     return (b[key] - a[key]) / abs(a[key])
+
+
+def paper_error(metrics: dict) -> float | None:
+    """The paper's model's error in cruise speed: (paper's model - one-way clutches) / |one-way clutches|, every
+    idealization at once (the section's verdict, and the README's)."""
+    return _change(_rungs(metrics), PAPER, "steady_speed_m_s", ONE_WAY)
+
+
+def locks_cost(metrics: dict) -> float | None:
+    """The paper's locks' cost in cruise speed: (with rod mass - one-way clutches) / |one-way clutches|, the same
+    mechanism with and without them (the opening figure's bar, report/overview.py)."""
+    return _change(_rungs(metrics), ROD, "steady_speed_m_s", ONE_WAY)
+
+
+def paper_error_text(metrics: dict) -> str:
+    return pct(paper_error(metrics))
+
+
+def locks_cost_text(metrics: dict) -> str:
+    return pct(locks_cost(metrics)) + " in steady speed"
 
 
 def _findings(metrics: dict) -> list[str]:
@@ -186,25 +210,25 @@ def _findings(metrics: dict) -> list[str]:
     lift = (p["m1"] + p["m2"]) * p["g"] * math.sin(math.radians(p["incline"]))
     energies = [r["energy_per_metre_j_m"] for r in metrics["rungs"] if _ok(r)]
     spread = max(abs(e / load - 1) for e in energies)
-    speed = _change(rungs, ONE_WAY, "steady_speed_m_s")
     low, high = paper["crank_speed_range_rad_s"]
     # under the paper's rule the resting module is started at each dead centre with the crank pin's
     # acceleration r omega^2 (first order) while the other module's clutch holds: m r omega^2 + F_r
     started = min(p["m1"], p["m2"]) * p["r"] * high**2 + min(p["F_r1"], p["F_r2"])
     return [
         f"**Steady speed.** The paper's model cruises at {paper['steady_speed_m_s']:.4g} m/s, reached after "
-        f"{paper['t_steady_s']:.3g} s. The exact geometry changes that by "
-        f"{pct(_change(rungs, EXACT, 'steady_speed_m_s'))}, the rod's mass by a further "
-        f"{pct(_change(rungs, ROD, 'steady_speed_m_s', EXACT))}: under the paper's rule each revolution advances the "
-        f"robot exactly 2r = {2 * p['r']:g} m whatever the geometry, so these change only the crank speed. One-way "
-        f"clutches change it by {pct(_change(rungs, ONE_WAY, 'steady_speed_m_s', ROD))} against the same mechanism "
-        f"with the paper's locks, to {one_way['steady_speed_m_s']:.4g} m/s (reached after "
+        f"{paper['t_steady_s']:.3g} s. Each cost here is (the model with the idealization - the model without it) "
+        "/ |the model without it|. First-order kinematics costs "
+        f"{pct(_change(rungs, PAPER, 'steady_speed_m_s', EXACT))} in steady speed, the massless rod a further "
+        f"{pct(_change(rungs, EXACT, 'steady_speed_m_s', ROD))}: under the paper's rule each revolution advances the "
+        f"robot exactly 2r = {2 * p['r']:g} m whatever the geometry, so these change only the crank speed. The "
+        f"paper's locks cost {locks_cost_text(metrics)} against one-way clutches on the same mechanism (with the "
+        f"rod), which cruise at {one_way['steady_speed_m_s']:.4g} m/s (reached after "
         f"{one_way['t_steady_s']:.3g} s): a module that is no longer pushed coasts on against its resistance instead "
         f"of being stopped by its lock, so each revolution carries the robot {fmt(one_way['distance_per_rev_m'])} m "
         f"instead of {fmt(rod['distance_per_rev_m'])} m, while the crank turns at nearly the same mean speed "
         f"({one_way['crank_speed_rad_s']:.4g} against {rod['crank_speed_rad_s']:.4g} rad/s). Altogether the "
-        f"paper's model is {pct(-speed / (1 + speed) if speed is not None else None)} off the cruising speed of "
-        "the robot with one-way clutches.",
+        f"paper's model is {paper_error_text(metrics)} off the cruising speed of the robot with one-way clutches "
+        "((paper's model - one-way clutches) / |one-way clutches|).",
         (f"**Energy per metre.** {min(energies):.4f} to {max(energies):.4f} J/m in every rung: F_r1 + F_r2 = "
          f"{load:g} N to within {100 * spread:.2g} % (the kinetic energy still gained over the steady window). Rigid "
          "clutches engage at zero relative speed and dissipate nothing, so at cruise all the work the motor does at "
@@ -217,8 +241,8 @@ def _findings(metrics: dict) -> list[str]:
          "energy per metre only by the rod's weight. ")
         + "They change the mean crank torque the motor must give, "
         f"{paper['crank_torque_n_m']:.3g} N m in the paper's model against {one_way['crank_torque_n_m']:.3g} N m "
-        f"with one-way clutches ({pct(_change(rungs, ONE_WAY, 'crank_torque_n_m'))}: the same work per metre over a "
-        "longer distance per revolution), and with it the motor's current.",
+        f"with one-way clutches ({pct(_change(rungs, PAPER, 'crank_torque_n_m', ONE_WAY))}: the same work per metre "
+        "over a shorter distance per revolution), and with it the motor's current.",
         f"**Clutch loads.** The peak clutch reaction at cruise is {paper['peak_clutch_force_n']:.4g} N in the "
         f"paper's model, {exact['peak_clutch_force_n']:.4g} N with the exact geometry and "
         f"{one_way['peak_clutch_force_n']:.4g} N with one-way clutches: the paper's lock carries "
@@ -289,8 +313,8 @@ def verdict(metrics: dict) -> dict | None:
         f"Under a gearmotor of {metrics['params']['M_stall']:g} N m stall torque and "
         f"{metrics['params']['omega_noload']:g} rad/s no-load speed, the paper's model cruises at "
         f"{paper['steady_speed_m_s']:.4g} m/s where the robot with one-way clutches cruises at "
-        f"{one_way['steady_speed_m_s']:.4g} m/s{mj}: "
-        f"{pct((paper['steady_speed_m_s'] - one_way['steady_speed_m_s']) / one_way['steady_speed_m_s'])}, because its "
+        f"{one_way['steady_speed_m_s']:.4g} m/s{mj}: {paper_error_text(metrics)} ((paper's model - one-way "
+        f"clutches) / |one-way clutches|), because its "
         f"locks stop each module instead of letting it coast ({fmt(paper['distance_per_rev_m'])} against "
         f"{fmt(one_way['distance_per_rev_m'])} m per revolution). Energy per metre is set by the load, not by the "
         "model: "
@@ -299,7 +323,6 @@ def verdict(metrics: dict) -> dict | None:
         + ": rigid clutches dissipate nothing); the peak clutch reaction at cruise is "
         f"{paper['peak_clutch_force_n']:.3g} N "
         f"against {one_way['peak_clutch_force_n']:.3g} N.")
-    change = (paper['steady_speed_m_s'] - one_way['steady_speed_m_s']) / one_way['steady_speed_m_s']
     return {"question": "What does the paper's model get wrong at cruise, under a real motor?", "answer": answer,
             "evidence": "sections.cruise", "short": "its cruise speed; energy per metre it gets right",
-            "key": f"{pct(change)} in steady speed"}
+            "key": f"{paper_error_text(metrics)} in steady speed (paper's model against one-way clutches)"}

@@ -62,52 +62,88 @@ def idealization_costs(metrics: dict) -> dict:
     return {"costs": costs, "error": error}
 
 
+BAND_PX = 3.0  # display pixels: a numerical-error band narrower than this is said in the title, not drawn
+
+
 def overview_figure(metrics: dict) -> Figure:
-    """Bars of each idealization's cost [%], one panel per figure, the numerical error as a grey band."""
+    """Bars of each idealization's cost [%], one panel per figure, the numerical error as a grey band where it is
+    wide enough to see (else said in the panel's title only); each value beyond its bar's end, inside the panel."""
     data = idealization_costs(metrics)
     fig = Figure(figsize=(10.0, 3.3), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(PANELS), sharey=True)
     names = [name for name, _ in data["costs"]]
+    notes, bands = [], []  # (panel, annotation) of every value; (panel, error) of every band
     for ax, (key, title) in zip(axes, PANELS):
         values = [costs.get(key) for _, costs in data["costs"]]
         shown = [(i, 100 * v) for i, v in enumerate(values) if v is not None]
         err = 100 * data["error"].get(key, 0.0)
-        if err:
-            ax.axvspan(-err, err, color="0.85", zorder=0)
         for i, v in shown:
             ax.barh(i, v, color="tab:red" if v > 0 else "tab:blue", height=0.6, zorder=2)
         reach = max([abs(v) for _, v in shown] + [err, 0.1])
-        ax.set_xlim(-1.9 * reach, 1.9 * reach)  # room for the values beyond the bars' ends
+        ax.set_xlim(-1.25 * reach, 1.25 * reach)  # widened below until every value fits
         for i, v in shown:  # the value beyond the bar's end, on the side it points
-            ax.annotate(f"{v:+.2f} %", (v, i), xytext=(4 if v >= 0 else -4, 0), textcoords="offset points",
-                        ha="left" if v >= 0 else "right", va="center", fontsize="small")
+            notes.append((ax, ax.annotate(f"{v:+.2f} %", (v, i), xytext=(4 if v >= 0 else -4, 0),
+                                          textcoords="offset points", ha="left" if v >= 0 else "right",
+                                          va="center", fontsize="small")))
         for i in set(range(len(values))) - {i for i, _ in shown}:
-            ax.annotate("n/a", (0, i), xytext=(4, 0), textcoords="offset points", va="center", fontsize="small",
-                        color="0.4")
+            notes.append((ax, ax.annotate("n/a", (0, i), xytext=(4, 0), textcoords="offset points", va="center",
+                                          fontsize="small", color="0.4")))
         ax.axvline(0.0, color="black", lw=0.8)
-        # the band is often thinner than a line: its width is said in the title too
-        ax.set_title(title + (f"\nnumerical error \u00b1{err:.2g} %" if err else "\nnumerical error: n/a"),
-                     fontsize="medium")
-        ax.set_xlabel("change the idealization makes [%]")
+        bands.append((ax, key, title, err))
+        ax.set_xlabel("cost: (with it - without it) / without it [%]", fontsize="small")
         ax.grid(axis="x", alpha=0.3)
     axes[0].set_yticks(range(len(names)), names)
     axes[0].invert_yaxis()
     handles = [Patch(color="tab:red", label="the idealization overstates"),
                Patch(color="tab:blue", label="the idealization understates")]
-    if data["error"]:
-        handles.append(Patch(color="0.85", label="numerical error: MuJoCo against the equations, same linkage"))
     fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize="small")
+    _fit_notes(fig, notes)
+    drawn = False
+    for ax, key, title, err in bands:
+        scale = ax.get_window_extent().width / (ax.get_xlim()[1] - ax.get_xlim()[0])  # pixels per %
+        if err and 2 * err * scale >= BAND_PX:
+            # the panel's full height (a background, not a bar: values may be written over it)
+            ax.fill_betweenx([0, 1], -err, err, color="0.8", zorder=0, lw=0, transform=ax.get_xaxis_transform())
+            drawn = True
+        # the band is often thinner than a line: its width is said in the title too
+        ax.set_title(title + (f"\nnumerical error \u00b1{err:.2g} %" if err else "\nnumerical error: n/a")
+                     + ("" if not err or 2 * err * scale >= BAND_PX else "\n(too narrow to draw)"), fontsize="medium")
+    if drawn:
+        handles.append(Patch(color="0.8", label="numerical error: MuJoCo against the equations, same linkage"))
+        fig.legends[0].remove()
+        fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize="small")
     return fig
+
+
+def _fit_notes(fig: Figure, notes: list) -> None:
+    """Widen each panel's x range (symmetrically, the panels keep their zero in the middle) until every
+    annotation lies inside its panel; all panels get the same share of their range for the bars."""
+    for _ in range(8):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        worst = 1.0
+        for ax, note in notes:
+            frame, box = ax.get_window_extent(renderer), note.get_window_extent(renderer)
+            half = frame.width / 2
+            centre = frame.x0 + half
+            reach = max(box.x1 - centre, centre - box.x0) + 4  # pixels from the zero line, with a margin
+            worst = max(worst, reach / half)
+        if worst <= 1.0:
+            return
+        for ax in {id(ax): ax for ax, _ in notes}.values():
+            low, high = ax.get_xlim()
+            ax.set_xlim(low * worst * 1.02, high * worst * 1.02)
 
 
 def overview_caption(metrics: dict) -> str:
     data = idealization_costs(metrics)
     worst = max((abs(v), name) for name, costs in data["costs"] for v in costs.values()) if data["costs"] else None
-    text = ("What each idealization of the paper's model changes at this design: the model with it against the "
-            "model without it, in the first second from rest and at the motor's cruise. The grey band is the "
-            "numerical error (the engines' largest disagreement on the same linkage): a bar inside it is not "
-            "resolved.")
+    text = ("What each idealization of the paper's model costs at this design, in the first second from rest and "
+            "at the motor's cruise: (the model with it - the model without it) / |the model without it|, the "
+            "convention of every cost in this report. Each panel's title gives the numerical error (the engines' "
+            "largest disagreement on the same linkage), drawn as a grey band where it is wide enough to see: a bar "
+            "inside it is not resolved.")
     if worst:
         text += f" The largest: {worst[1]}, {100 * worst[0]:.1f} %."
     return text
@@ -189,13 +225,14 @@ def accuracy_flag(name: str, accuracy: dict | None) -> str:
 
 
 def ladder_change(value, before, relative, key: str) -> str:
-    """The change of a ladder figure against the rung before: a signed percentage, or, where the figure
-    reaches zero or changes sign (a clutch reaction from -1371 N, a pull, to 0: '+100 %' would read as a
-    doubling), the difference in the figure's unit ('+1371 N'); '' for the first rung."""
-    if relative is None or before is None or value is None:
+    """``value`` against ``before``: the signed percentage ``relative``, or, where the figure reaches zero or
+    changes sign (a clutch reaction from -1371 N, a pull, to 0: '+100 %' would read as a doubling), the
+    difference in the figure's unit ('+1371 N'); '' where either is missing (the first rung). The ladder's table
+    gives each idealization's cost: ``value`` the rung before (with it), ``before`` the rung (without it)."""
+    if before is None or value is None:
         return ""
-    if value == 0 or before == 0 or (value > 0) != (before > 0):
+    if (value == 0) != (before == 0) or (value * before < 0):
         unit = SUMMARY.get(key, (key, ""))[1]
         return f"{value - before:+.4g}" + (f" {unit}" if unit and unit != "-" else "")
-    return pct(relative)
+    return "" if relative is None else pct(relative)
 

@@ -28,7 +28,9 @@ from .document import Heading, Image, Paragraph, Table, fmt
 EXACT = ("analytic-unilateral", "mujoco-ratchet")  # the two exact models with one-way clutches
 PAPER_RULE = ("analytic-exact", "analytic-approx")  # the paper's rule: exact geometry, and the paper's own model
 INCLINES = {False: (0, 10, 20, 30, 40, 50, 60, 70, 75, 80, 90), True: (0, 30, 60, 90)}  # the figure's inclines [deg], full / quick
-TOLERANCE = {False: 0.5, True: 2.0}  # bracket of the steady-climb limit [deg], full / quick
+# bracket of the steady-climb limit [deg], full / quick: ``climb``'s own (climbing.TOLERANCE_DEG), so that the report
+# and ``ipir-mujoco climb`` bisect to the same bracket (three more runs per engine than a 0.5 deg bracket)
+TOLERANCE = {False: climbing.TOLERANCE_DEG, True: climbing.TOLERANCE_DEG}
 TORQUE_STEP = 0.01  # N m: the stronger motor is the torque needed at rest rounded up to this (a catalogue step)
 
 
@@ -100,8 +102,9 @@ def render(metrics: dict, figures_dir: Path) -> list:
         "the paper's rule. Gravity pulls every body back along the pipe; the resistances F_r1, F_r2 stay the "
         "wall-press rolling resistance, which does not depend on it.")]
     blocks.append(Paragraph(_stall_text(metrics)))
-    header = ["model", "outcome", "at rest from [s]", "crank angle", "lambda1 [N]", "lambda2 [N]",
-              "statics: lambda1, lambda2 [N]", "statics: resistance holding module 1, 2 [N]"]
+    header = ["model", "outcome", "at rest from [s]", "crank angle", "clutch reaction, module 1 [N]",
+              "clutch reaction, module 2 [N]", "statics: clutch reactions, modules 1, 2 [N]",
+              "statics: resistance holding module 1, 2 [N]"]
     rows = []
     for engine, m in default.items():
         if "error" in m:
@@ -206,13 +209,13 @@ def _caption(metrics: dict) -> str:
     return ("Climbing ability under the motor against the pipe's incline: steady speed (top; crosses: stalled) "
             "and clutch reactions (bottom: peak and mean over the steady window, with the weight along the pipe); "
             "analytic one-way clutches (line) and MuJoCo's ratchet (open circles); the restart limit (dashed) and "
-            "each engine's steady-climb limit from rest (dotted)" + (" (quick run: four inclines)." if metrics["quick"]
-                                                                     else "."))
+            "the steady-climb limit from rest (dotted; black where both engines find it in the same bracket)"
+            + (" (quick run: four inclines)." if metrics["quick"] else "."))
 
 
 def _limits_text(study: dict) -> str:
     restart, bound = study["restart"], study["energy_bound"]
-    limits = [f"{registry.variant(e).label} {lim['bracket'][0]:.1f}-{lim['bracket'][1]:.1f} deg"
+    limits = [f"{registry.variant(e).label} {lim['bracket'][0]:.2f}-{lim['bracket'][1]:.2f} deg"
               for e, lim in study["steady_climb"].items() if lim["incline_deg"] is not None]
     where = ("at no incline" if restart["incline_deg"] is None else f"up to {restart['incline_deg']:.1f} deg")
     return (f"Limits of the motor: it restarts from rest at every crank angle {where} "

@@ -61,7 +61,7 @@ def figure_clutch_reactions(rung: LadderRun, path: Path) -> None:
 
 LR_CURVES = (("revolutions", "crank revolutions"), ("x1_final", "module 1 travel"), ("v2_max", "peak speed, module 2"),
              ("first_contraction_end_s", "end of first contraction"), ("S_at_angle", "gap S at same crank angle"),
-             ("S_dot_at_angle", "gap rate S_dot at same crank angle"))
+             ("S_dot_at_angle", "gap rate dS/dt at same crank angle"))
 
 
 def figure_lr_study(study: dict, path: Path) -> None:
@@ -230,15 +230,19 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
     blocks += _paper_section(metrics, figures)
 
     blocks.append(Heading("The model ladder"))
-    blocks.append(Paragraph("Each rung removes one idealization; the change against the rung before (in brackets) "
-                            "is what that idealization costs."))
+    blocks.append(Paragraph("Each rung removes one idealization. In brackets, what that idealization costs: (the "
+                            "rung before, which has it - this rung) / |this rung|, the model with it against the "
+                            "model without it, the convention of every cost in this report (for a MuJoCo rung: the "
+                            "equations against MuJoCo). A figure that changes sign or reaches zero is given as a "
+                            "difference in its unit."))
     header = ["rung", "removes"] + [summary_label(k) for k in LADDER_FIGURES]
     rows, previous = [], None
     for rung in metrics["ladder"]:
         cells = [rung["name"], rung["isolates"]]
         for key in LADDER_FIGURES:
-            change = ladder_change(rung["summary"][key], None if previous is None else previous["summary"][key],
-                                   rung["change_vs_previous"][key], key)
+            # the rung before (with the idealization) against this one: value and reference swapped
+            change = ladder_change(None if previous is None else previous["summary"][key], rung["summary"][key],
+                                   rung["cost_vs_previous"][key] if previous is not None else None, key)
             cells.append(fmt(rung["summary"][key]) + (f" ({change})" if change else ""))
         rows.append(cells)
         previous = rung
@@ -255,12 +259,14 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
         "alone) and MuJoCo's real linkage beside the exact equations of that same linkage, with its rod (MuJoCo "
         "needs a rod with mass), all under the paper's clutch rule. Summary figures diverge by "
         "(first order - exact) / |exact|; the gap S and its rate at the same crank angle by their largest "
-        "difference over the run, as a share of the stroke 2r and of the largest |S_dot|. Each threshold is "
-        "bracketed by two neighbouring ratios of the sweep: that bracket is its resolution."))
+        "difference over the run, as a share of the stroke 2r and of the largest |dS/dt|. Each threshold is "
+        "bracketed by two neighbouring ratios of the sweep; the crank revolutions' thresholds are then narrowed on "
+        "the equations to 0.002 in L/r by the root-finding of ipir-mujoco atlas, which finds the same crossing "
+        "over L."))
     blocks.append(Image(figures["lr_study.png"], "Divergence of the first-order model from the exact linkage "
                                                  "against L/r (log axes)."))
     angle_labels = {"S_at_angle": "gap S at the same crank angle (share of 2r)",
-                    "S_dot_at_angle": "gap rate S_dot at the same crank angle (share of max |S_dot|)"}
+                    "S_dot_at_angle": "gap rate dS/dt at the same crank angle (share of max |dS/dt|)"}
     blocks.append(Table(["figure", "off by more than 1 %", "off by more than 5 %"],
                         [[angle_labels.get(key) or summary_label(key),
                           describe_threshold(study["thresholds"][key]["1%"]),

@@ -56,6 +56,13 @@ def relative_change(new: float | None, old: float | None) -> float | None:
     return (new - old) / abs(old)
 
 
+def cost(idealized: float | None, real: float | None) -> float | None:
+    """An idealization's cost: (the model with it - the model without it) / |the model without it|, the sign
+    convention of every cost in the validation report (the atlas's, :func:`.atlas_space.signed_cost`; the L/r
+    study's; the ladder's brackets; the opening figure's)."""
+    return relative_change(idealized, real)
+
+
 def load_run(folder: str | Path) -> RunResult:
     """A run written by ``simulate --out`` (timeseries.csv and summary.json).
 

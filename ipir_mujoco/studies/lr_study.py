@@ -15,7 +15,12 @@ the largest |S_dot|).
 
 A threshold "off by more than 1 % below L/r = X" is bracketed by the sweep: X
 lies between the largest ratio where the divergence exceeds the level and the
-next ratio of the grid, so the grid spacing is the threshold's resolution.
+next ratio of the grid, so the grid spacing is the threshold's resolution. For
+crank revolutions (:data:`REFINED`), the report's headline, the bracket is then
+narrowed on the equations themselves to :data:`CROSSING_TOL` in L/r by the
+atlas's own root-finding (:func:`.atlas_adaptive.refine_crossings`, on the same
+pair of runs as the atlas's ``first-order-kinematics``), so that the report and
+``ipir-mujoco atlas --vary L=...`` state one crossing.
 """
 
 from __future__ import annotations
@@ -33,6 +38,8 @@ from .compare import compare_runs, relative_change
 FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 ANGLE_FIGURES = ("S_at_angle", "S_dot_at_angle")
 LEVELS = (0.01, 0.05)
+REFINED = ("revolutions",)  # figures whose thresholds are narrowed past the grid's bracket
+CROSSING_TOL = 2e-3  # L/r: the narrowed bracket's width (3 significant digits of a crossing near 5)
 RATIOS_FULL = tuple(float(x) for x in np.geomspace(1.05, 20.0, 14))
 RATIOS_QUICK = tuple(float(x) for x in np.geomspace(1.05, 20.0, 5))
 
@@ -63,7 +70,44 @@ def lr_study(params: RobotParams, ratios: Sequence[float] = RATIOS_FULL, t_end: 
         progress(f"L/r {i}/{len(ratios)}: L/r = {ratio:.3g}, first order off by "
                  f"{100 * row['divergence']['revolutions']:+.2f} % in revolutions "
                  f"({time.perf_counter() - started:.1f} s)")
-    return {"ratios": list(ratios), "rows": rows, "thresholds": thresholds(rows)}
+    found = thresholds(rows)
+    for figure in REFINED:
+        for key, entry in found[figure].items():
+            if "between" in entry:
+                started = time.perf_counter()
+                entry.update(refine_threshold(massless, figure, float(key.rstrip("%")) / 100, entry["between"],
+                                              t_end, dt_out))
+                progress(f"L/r: first order off by {key} in {figure} below L/r = {entry['crossing']:.4g} "
+                         f"({time.perf_counter() - started:.1f} s)")
+    return {"ratios": list(ratios), "rows": rows, "thresholds": found}
+
+
+def divergence(params: RobotParams, ratio: float, figure: str, t_end: float, dt_out: float) -> float:
+    """(first order - exact) / |exact| of a summary figure at L = ratio r (``params``: the massless rod's)."""
+    L = ratio * params.r
+    first = registry.run("analytic-approx", params.replace(L=L), t_end, dt_out=dt_out).summary[figure]
+    exact = registry.run("analytic-exact", params.replace(L=L), t_end, dt_out=dt_out).summary[figure]
+    return relative_change(first, exact)
+
+
+def refine_threshold(params: RobotParams, figure: str, level: float, between: Sequence[float], t_end: float,
+                     dt_out: float, tol: float = CROSSING_TOL) -> dict:
+    """The crossing |divergence| = ``level`` inside the grid's bracket ``between`` [L/r], narrowed to ``tol`` by
+    :func:`.atlas_adaptive.refine_crossings` (the atlas's k-section): {"crossing": L/r, "crossing_interval": [lo,
+    hi], "crossing_L_m": L at the crossing}. ``params``: the massless rod's design."""
+    from .atlas_adaptive import refine_crossings
+
+    lo, hi = map(float, between)
+    ends = np.array([divergence(params, x, figure, t_end, dt_out) for x in (lo, hi)])
+
+    def evaluate(U: np.ndarray) -> list:
+        return [divergence(params, float(x), figure, t_end, dt_out) for x in U[:, 0]]
+
+    found = refine_crossings(np.array([lo, hi]), ends, level, evaluate, workers=1, tol=tol)
+    if not found:  # the grid's bracket does not cross on a second look (cannot happen for a smooth divergence)
+        return {}
+    x, a, b = found[-1]
+    return {"crossing": x, "crossing_interval": [a, b], "crossing_L_m": x * params.r}
 
 
 def thresholds(rows: list[dict]) -> dict:
@@ -93,10 +137,13 @@ def thresholds(rows: list[dict]) -> dict:
 
 
 def describe_threshold(entry: dict) -> str:
-    """'L/r < 2.4 (between 1.9 and 2.9)' style text for one threshold entry."""
+    """'below L/r = 5.09 (L = 0.254 m)' for a narrowed threshold, 'below an L/r between 6.44 and 8.08' for one
+    the grid brackets only (no midpoint: the bracket is all the grid knows)."""
+    if "crossing" in entry:
+        return f"below L/r = {entry['crossing']:.3g} (L = {entry['crossing_L_m']:.3g} m)"
     if "between" in entry:
         lo, hi = entry["between"]
-        return f"below L/r ~ {np.sqrt(lo * hi):.2g} (between {lo:.3g} and {hi:.3g})"
+        return f"below an L/r between {lo:.3g} and {hi:.3g}"
     if entry.get("below_sweep"):
         return f"never in the sweep (L/r >= {entry['smallest_ratio']:.3g})"
     return f"at every L/r of the sweep (up to {entry['largest_ratio']:.3g})"

@@ -57,6 +57,35 @@ KEY_UNITS = {**{k: u for k, (_, u) in SUMMARY.items()}, **UNITS, "x1_final": "m"
              "v2_max": "m/s", "slip1_m": "m", "slip2_m": "m", "peak_grip_use": "-", "motor_work_j": "J",
              "kinetic_j": "J", "friction_j": "J", "residual_j": "J", "wheel_off_s": "s", "press1_n": "N",
              "press2_n": "N", "route_time_s": "s", "travel_m": "m", "skid_m": "m"}
+# every key in words, for the figure: the summary's and the sweep's names, and those of the keys only a run has
+_WORDS = {"slip1_m": "backward skid, module 1", "slip2_m": "backward skid, module 2", "peak_grip_use": "peak grip use",
+          "motor_work_j": "motor work", "kinetic_j": "kinetic energy", "friction_j": "work of the resistances",
+          "residual_j": "energy residual", "wheel_off_s": "time a wheel is off the wall",
+          "press1_n": "wall press, module 1", "press2_n": "wall press, module 2", "route_time_s": "time along the route",
+          "route_done": "route completed", "travel_m": "travel (mean of the modules)",
+          "skid_m": "larger backward skid", "cycles": "crank cycles", "cycle_energy_residual_j":
+          "energy residual over the cycles", "mean_speed_mps": "mean forward speed",
+          "accel_jump_mps2": "acceleration jump at a clutch switch"}
+NAMED_WORDS = {"stall": "stalls", "no-steady-state": "no steady state", "slides-back": "slides back (travel < 0 m)"}
+
+
+def key_words(key: str) -> tuple[str, str]:
+    """(words, unit) of a metric key: ('energy per metre', 'J/m') for 'energy_per_metre_j_m'."""
+    from .sweep_metrics import DESCRIBED
+
+    words = DESCRIBED.get(key, SUMMARY.get(key, (_WORDS.get(key, key.replace("_", " ")), "")))[0]
+    return _WORDS.get(key, words), KEY_UNITS.get(key, "-")
+
+
+def event_words(text: str) -> str:
+    """An event in words: 'slides back (travel < 0 m)', 'larger backward skid > 0.05 m' for 'skid_m>0.05'."""
+    event = parse_event(text)
+    if event.text in NAMED_WORDS:
+        return NAMED_WORDS[event.text]
+    words, unit = key_words(event.key)
+    return f"{words} {event.op} {event.value:g}" + ("" if unit in ("-", "0/1") else f" {unit}")
+
+
 NAMED_EVENTS = {"stall": ("stalled", ">", 0.5), "no-steady-state": ("steady", "<", 0.5),
                 "slides-back": ("travel_m", "<", 0.0)}
 OPERATORS = {">=": operator.ge, "<=": operator.le, ">": operator.gt, "<": operator.lt}
@@ -333,7 +362,11 @@ def write_files(out: str | Path, result: dict) -> Path:
             writer.writeheader()
             writer.writerows({k: _cell(v) for k, v in r.items()} for r in rows)
         write_json(staging / "uncertainty.json", {k: v for k, v in result.items() if k != "rows"})
-        plot_uncertainty(staging / "uncertainty.png", result, KEY_UNITS)
+        words = {"metrics": {k: key_words(k) for k in result["metrics"]},
+                 "events": {e: event_words(e) for e in result["events"]},
+                 "engines": {e: registry.variant(e).label for e in (result["study"]["engine"],
+                                                                     result["study"]["mujoco_engine"]) if e}}
+        plot_uncertainty(staging / "uncertainty.png", result, words)
     return Path(out) / "uncertainty.png"
 
 

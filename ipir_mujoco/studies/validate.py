@@ -27,10 +27,13 @@ compares every rung with the paper's model at that design (the first rung).
     identities            list of {key, label, reported, expected, value, units, holds}:
                           S_min = L - r and S_max = L + r, true by construction
     ladder                list of {name, engine, geometry, clutch, isolates, params,
-                          summary, change_vs_previous}; summary as in docs/cli.md;
-                          change_vs_previous maps each ladder figure to the
+                          summary, change_vs_previous, cost_vs_previous}; summary as in
+                          docs/cli.md; change_vs_previous maps each ladder figure to the
                           relative change (new - old) / |old| against the rung
-                          before (null for the first rung or a zero reference)
+                          before (null for the first rung or a zero reference);
+                          cost_vs_previous to the cost of the idealization the rung
+                          removes, (old - new) / |new| (the model with it against the
+                          model without it: the report's convention, which it shows)
     clutch_pull           {fraction_of_time, min_reaction_n, per_stroke: [{mode, t_start,
                           t_end, mean_crank_speed, pull_fraction, complete}]}: how much of the
                           paper-model run (and of each stroke) has a locked clutch
@@ -75,7 +78,7 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
 from .. import __version__
-from .compare import relative_change
+from .compare import cost, relative_change
 from .convergence import convergence_evidence
 from .ladder import VALIDATION_LADDER
 from .lr_study import RATIOS_FULL, RATIOS_QUICK, describe_threshold, lr_study
@@ -145,6 +148,11 @@ def _percent(x: float | None) -> str:
     return "n/a" if x is None else f"{100 * x:+.2f} %"
 
 
+def _magnitude(x: float | None) -> str:
+    """An agreement's size, without a sign: '0.02 %'."""
+    return "n/a" if x is None else f"{100 * abs(x):.2f} %"
+
+
 def _paper_verdict(checks: list[dict], identities: list[dict], case: dict) -> dict:
     question = "Does the paper's model, as implemented here, give the figures the paper reports?"
     if not case["is_paper_case"]:
@@ -198,18 +206,18 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
         "question": "Do MuJoCo and the equations agree when both describe the same linkage under the paper's "
                     "clutch rule?",
         "answer": ("Yes" if worst < 0.2 * smallest else "No") + ": with locks switched by the paper's rule, "
-                  "MuJoCo's linkage (exact geometry, the same rod) matches the exact-geometry equations to "
-                  f"{_percent(relative_change(locks['revolutions'], rod['revolutions']))} in crank revolutions, "
-                  f"{_percent(relative_change(locks['x1_final'], rod['x1_final']))} and "
-                  f"{_percent(relative_change(locks['x2_final'], rod['x2_final']))} in the module travels "
+                  "MuJoCo's linkage (exact geometry, the same rod) and the exact-geometry equations agree to "
+                  f"{_magnitude(cost(rod['revolutions'], locks['revolutions']))} in crank revolutions, "
+                  f"{_magnitude(cost(rod['x1_final'], locks['x1_final']))} and "
+                  f"{_magnitude(cost(rod['x2_final'], locks['x2_final']))} in the module travels "
                   f"(halving MuJoCo's timestep moves them by up to {100 * convergence['mujoco_default_error']:.3f} %; "
                   f"the smallest modelling effect in the ladder, {smallest_name}, is {100 * smallest:.2f} %). "
-                  "Against the paper's first-order equations MuJoCo differs by "
-                  f"{_percent(relative_change(locks['revolutions'], paper['revolutions']))} in revolutions: the cost "
-                  "of L >> r and of the rod, not of the engine.",
+                  "The paper's first-order equations differ from MuJoCo by "
+                  f"{_percent(cost(paper['revolutions'], locks['revolutions']))} in revolutions ((paper - MuJoCo) / "
+                  "|MuJoCo|): the cost of L >> r and of the rod, not of the engine.",
         "evidence": "ladder, convergence", "section": "The model ladder",
         "short": "Yes" if worst < 0.2 * smallest else "No",
-        "key": f"{_percent(relative_change(locks['revolutions'], rod['revolutions']))} in revolutions",
+        "key": f"{_magnitude(cost(rod['revolutions'], locks['revolutions']))} in revolutions",
     }
     p = rungs[0].run.params
     ratio = (f"At the paper's L/r = {p.L / p.r:g}" if case["is_paper_case"]
@@ -217,29 +225,33 @@ def verdicts(checks: list[dict], identities: list[dict], case: dict, rungs: list
     costs = {
         "question": "What do the idealizations cost?",
         "answer": (
+            "Each cost below is (the model with the idealization - the model without it) / |the model without "
+            "it|. "
             f"First-order kinematics is off by more than 1 % in crank revolutions "
             f"{describe_threshold(study['thresholds']['revolutions']['1%'])} and by more than 5 % "
             f"{describe_threshold(study['thresholds']['revolutions']['5%'])}; module 1's travel is more sensitive "
             f"(1 % {describe_threshold(study['thresholds']['x1_final']['1%'])}). "
-            f"{ratio} the exact slider-crank changes crank revolutions by "
-            f"{_percent(relative_change(exact['revolutions'], paper['revolutions']))}, "
-            f"module 1 travel by {_percent(relative_change(exact['x1_final'], paper['x1_final']))} and the "
-            f"end of the first contraction by {_percent(relative_change(exact['first_contraction_end_s'], paper['first_contraction_end_s']))}. "
-            f"The rod's mass ({rungs[2].run.params.rod_mass:g} kg) changes revolutions "
-            f"by a further {_percent(relative_change(rod['revolutions'], exact['revolutions']))}. "
+            f"{ratio} first-order kinematics costs "
+            f"{_percent(cost(paper['revolutions'], exact['revolutions']))} in crank revolutions, "
+            f"{_percent(cost(paper['x1_final'], exact['x1_final']))} in module 1's travel and "
+            f"{_percent(cost(paper['first_contraction_end_s'], exact['first_contraction_end_s']))} in the end of "
+            "the first contraction. "
+            f"The massless rod (against a rod of {rungs[2].run.params.rod_mass:g} kg) costs a further "
+            f"{_percent(cost(exact['revolutions'], rod['revolutions']))} in revolutions. "
             f"Ideal locks: in {100 * pull['fraction_of_time']:.1f} % of the paper-model run a locked clutch would "
-            f"have to pull, with up to {-pull['min_reaction_n']:.0f} N; a one-way clutch cannot. One-way "
-            f"clutches (MuJoCo's ratchet) change crank revolutions by {_percent(relative_change(ratchet['revolutions'], locks['revolutions']))} "
-            f"and the modules' travel by {_percent(relative_change(ratchet['x1_final'], locks['x1_final']))} "
-            f"(rear) and {_percent(relative_change(ratchet['x2_final'], locks['x2_final']))} (front) against the "
-            "same physics with the paper's locks. The one-way-clutch equations "
-            f"agree with that physics to {_percent(relative_change(ratchet['revolutions'], one_way['revolutions']))} "
-            "in revolutions." + _contact_sentence(rungs)
+            f"have to pull, with up to {-pull['min_reaction_n']:.0f} N; a one-way clutch cannot. The paper's locks "
+            f"(MuJoCo with the paper's rule against MuJoCo's ratchet) cost "
+            f"{_percent(cost(locks['revolutions'], ratchet['revolutions']))} in crank revolutions and "
+            f"{_percent(cost(locks['x1_final'], ratchet['x1_final']))} (rear) and "
+            f"{_percent(cost(locks['x2_final'], ratchet['x2_final']))} (front) in the modules' travel. The "
+            "one-way-clutch equations and that physics agree to "
+            f"{_magnitude(cost(one_way['revolutions'], ratchet['revolutions']))} in revolutions."
+            + _contact_sentence(rungs)
         ),
         "evidence": "ladder, clutch_pull, lr_study", "section": "Where L >> r breaks down",
         "short": "first-order kinematics off by > 1 % in revolutions "
                  + describe_threshold(study["thresholds"]["revolutions"]["1%"]).split(" (")[0],
-        "key": f"{_percent(relative_change(exact['revolutions'], paper['revolutions']))} at this L/r",
+        "key": f"{_percent(cost(paper['revolutions'], exact['revolutions']))} at this L/r",
     }
     numerical = max(convergence["mujoco_default_error"], convergence["equations_default_error"])
     trust = {
@@ -262,10 +274,10 @@ def _contact_sentence(rungs: list[LadderRun]) -> str:
     if "wheels in contact" not in named:
         return ""
     wheels, ratchet = named["wheels in contact"], named["MuJoCo ratchet"]
-    return (" On wheels pressed on the pipe's walls (MuJoCo's contacts, a ratchet in every hub) the robot changes "
-            f"crank revolutions by {_percent(relative_change(wheels['revolutions'], ratchet['revolutions']))} and "
-            f"module 1's travel by {_percent(relative_change(wheels['x1_final'], ratchet['x1_final']))} against the "
-            "ratchet on slides (the rocking modules' wheels briefly leave the wall; MuJoCo's energy residual "
+    return (" The slides (against wheels pressed on the pipe's walls: MuJoCo's contacts, a ratchet in every hub) "
+            f"cost {_percent(cost(ratchet['revolutions'], wheels['revolutions']))} in crank revolutions and "
+            f"{_percent(cost(ratchet['x1_final'], wheels['x1_final']))} in module 1's travel (the rocking "
+            "modules' wheels briefly leave the wall; MuJoCo's energy residual "
             f"{_residual(named['wheels in contact'])}).")
 
 
@@ -305,9 +317,10 @@ def build_metrics(params: RobotParams, rungs: list[LadderRun], settings: dict, s
     for rung in rungs:
         summary = rung.run.summary
         change = {k: (None if previous is None else relative_change(summary[k], previous[k])) for k in LADDER_FIGURES}
+        costs = {k: (None if previous is None else cost(previous[k], summary[k])) for k in LADDER_FIGURES}
         ladder.append({"name": rung.name, "engine": rung.run.engine, "geometry": rung.run.geometry,
                        "clutch": rung.run.clutch, "isolates": rung.isolates, "params": rung.run.params.as_dict(),
-                       "summary": summary, "change_vs_previous": change})
+                       "summary": summary, "change_vs_previous": change, "cost_vs_previous": costs})
         previous = summary
     return {
         "schema_version": 2,
