@@ -226,7 +226,7 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
     v = variant(name)
     if not v.is_mujoco:
         return None
-    from .engine.modelkinds.kinds import kind_for
+    from .engine.kinds.kinds import kind_for
 
     return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch, route=route)[0].timestep
 

@@ -68,7 +68,7 @@ class WheeledReplay(SlideReplay):
     docstring). ParameterError if the run lacks the pose columns (not a wheeled MuJoCo run)."""
 
     def __init__(self, model: mujoco.MjModel, run: RunResult):
-        from .engine.builders.wheels_model import LATERALS, ROD_TILT, TILTS, VERTICALS, leg_names
+        from .engine.kinds.wheels.model import LATERALS, ROD_TILT, TILTS, VERTICALS, leg_names
 
         columns = SLIDES_ACROSS + tuple(f"{turn}{k}" for k in (1, 2) for turn in TURNS)
         missing = [c for c in columns if c not in run.series]

@@ -200,7 +200,7 @@ class WheelsDrawing(SlideDrawing):
     free = "free, rolls"
 
     def spec(self, params: RobotParams, route=None):
-        from .engine.builders.wheels_model import build_wheels_spec
+        from .engine.kinds.wheels.model import build_wheels_spec
 
         return build_wheels_spec(params, route=route)
 

@@ -111,8 +111,8 @@ def test_the_finder_sees_every_kind_of_import():
     edges to look at), and leaves out TYPE_CHECKING ones."""
     edges = graph()
     assert len(edges) > 100
-    assert "ipir_mujoco.engine.modelkinds.kinds" in edges["ipir_mujoco.engine.run.simulate"]  # relative, top level
-    assert "ipir_mujoco.engine.modelkinds.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
+    assert "ipir_mujoco.engine.kinds.kinds" in edges["ipir_mujoco.engine.run.simulate"]  # relative, top level
+    assert "ipir_mujoco.engine.kinds.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
     assert "ipir_mujoco.report.plots" in edges["ipir_mujoco.core.results"]  # inside RunResult.plot
     assert "ipir_mujoco.core.results" not in edges["ipir_mujoco.report.plots"]  # TYPE_CHECKING only
     assert "ipir_mujoco.analytic.kinematic_clutch" in edges["ipir_mujoco.analytic"]  # the analytic/ folder
@@ -141,7 +141,7 @@ def test_the_architecture_document_places_every_module_of_the_engine_core_and_an
 
 
 # the engine's folders from the bottom up: a module imports from its own folder and the folders below only
-ENGINE_FOLDERS = ("builders", "loop", "controllers", "modelkinds", "run")
+ENGINE_FOLDERS = ("builders", "loop", "controllers", "kinds", "run")
 
 
 def test_the_engines_folders_import_downward_only():

@@ -38,7 +38,7 @@ from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from ..engine.modelkinds.kinds import kind_for
+from ..engine.kinds.kinds import kind_for
 from ..engine.builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
 from ..engine.run.run_setup import RunSetup
 from ..video import DRAWINGS, FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text

@@ -45,14 +45,14 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 
-from ..modelkinds.kinds import SLIDES as SLIDE_KIND
-from ..modelkinds.kinds import kind_for
+from ..kinds.kinds import SLIDES as SLIDE_KIND
+from ..kinds.kinds import kind_for
 from ..builders.model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_control, drive_torque_slope,
                     pin_offset, qpos_address)
 from ..loop.monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from ..modelkinds.common import (BLOCK_TIME, REFINEMENTS, captured_warnings, climb_energy, mujoco_failure,
+from ..kinds.common import (BLOCK_TIME, REFINEMENTS, captured_warnings, climb_energy, mujoco_failure,
                      rest_since, stall_reason, steps_per_output)
-from ..modelkinds.timestep import DT_MIN
+from ..kinds.timestep import DT_MIN
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
 MODELLED_DRIVES = ("torque", "motor")  # each design's own actuator gain and bias (checked against the serial engine)

@@ -12,7 +12,7 @@ from ipir_mujoco.core.steady_test import steady_target
 from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import SimulationError
 
-from ..modelkinds.common import rest_since, stall_reason
+from ..kinds.common import rest_since, stall_reason
 from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
 
 

@@ -60,20 +60,20 @@ from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
 from .block_checks import BlockChecks
-from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
+from ..kinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
                                  climb_energy, mujoco_failure, steps_per_output)
-from ..modelkinds.kinds import ModelKind, kind_for
-from .skid_check import SLIDES_RULE, verify_skids
-from .wheel_skids import WHEELS_RULE
+from ..kinds.kinds import ModelKind, kind_for
+from ..kinds.skid_check import SLIDES_RULE, verify_skids
+from ..kinds.wheels.skids import WHEELS_RULE
 from ..builders.model import SolverSettings
 from ..loop.monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
 from ..loop.recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
-from ..modelkinds.route_watch import route_watch
+from ..kinds.wheels.route_watch import route_watch
 from .run_setup import RunSetup
 from ..loop.servo_drive import TickedDrive, controller_for
 from ..loop.stepper import WARNED
-from ..modelkinds.timestep import DT_MIN
+from ..kinds.timestep import DT_MIN
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _GAP = SCALARS.index("motor_torque"), DEFERRED.index("loop_gap")

@@ -38,11 +38,11 @@ import mujoco
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from .compliant import CompliantClutches
-from ..loop.controller import ControllerBase, RunningBound
-from ..loop.native import LayoutError
-from ..builders.model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
-from ..loop.rows import FrictionRows, clutch_share, equality_row, missing_rows
+from ...controllers.compliant import CompliantClutches
+from ...loop.controller import ControllerBase, RunningBound
+from ...loop.native import LayoutError
+from ...builders.model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
+from ...loop.rows import FrictionRows, clutch_share, equality_row, missing_rows
 
 
 class Ratchet(ControllerBase):

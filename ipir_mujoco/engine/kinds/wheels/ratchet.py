@@ -32,12 +32,12 @@ from ipir_mujoco.core.params import RobotParams
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from ..builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
-from ..builders.wheels_model import HOUSINGS, contact_friction, leg_names, wheels_timestep
-from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
-from ..loop.native import LayoutError
-from ..loop.rows import clutch_share, missing_rows
-from .compiled_wheels import load_wheel_ratchet
+from ...builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
+from .model import HOUSINGS, contact_friction, leg_names, wheels_timestep
+from ...loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
+from ...loop.native import LayoutError
+from ...loop.rows import clutch_share, missing_rows
+from .compiled import load_wheel_ratchet
 
 LIMIT_JOINT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 SLIDING_SHARE = 1e-6  # a module's contacts slide where their tangential force is within this share of the cone
@@ -201,7 +201,7 @@ def leg_press(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> tupl
     (tests/test_mujoco_wheels.py compares the two over a run), so this is the wall's press on the wheel, read
     from the state rather than the solver (a sliding wheel's contact flickers on and off by micrometres while
     its spring stays pressed: the spring's press is the wheel's hold on the wall)."""
-    from ..builders.wheels_model import leg_preload, leg_stiffness
+    from .model import leg_preload, leg_stiffness
 
     legs = leg_names(params)
     out = np.empty((q.shape[0], 2, len(legs[0])))
@@ -216,7 +216,7 @@ def pose_columns(model: mujoco.MjModel, q: np.ndarray) -> dict[str, np.ndarray]:
     """Each module's pose across the pipe from the samples' ``q`` (n, nq): y1/2, z1/2 [m] (its slides across the
     pipe) and roll1/2, pitch1/2, yaw1/2 [rad] (its ball joint's rotation vector about x, y, z: for the small
     turns of a module in its pipe, its roll, pitch and yaw), which with x1, x2, phi pose the robot for a replay."""
-    from ..builders.wheels_model import LATERALS, TILTS, VERTICALS
+    from .model import LATERALS, TILTS, VERTICALS
 
     cols = {}
     for k in (1, 2):

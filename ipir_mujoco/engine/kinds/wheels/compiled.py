@@ -13,8 +13,8 @@ import numpy as np
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from ..loop.native import LayoutError
-from ..loop.native import address as array_address
+from ...loop.native import LayoutError
+from ...loop.native import address as array_address
 
 
 def load_wheel_ratchet(ctl, loop, power, sticks: float):

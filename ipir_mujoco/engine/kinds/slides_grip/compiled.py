@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from .compliant import load_spring
-from ..loop.native import LayoutError
+from ...controllers.compliant import load_spring
+from ...loop.native import LayoutError
 
 
 def _carriages(ctl, loop, kind: str, x_adr: list[int], x_dof: list[int]) -> None:

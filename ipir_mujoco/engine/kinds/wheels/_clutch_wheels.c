@@ -2,7 +2,7 @@
  * and the wheeled loop's work rates (wheels.WheelPower), step for step as there: the same double arithmetic in
  * the same order, the contacts' J v from MuJoCo's mj_mulJacVec in both (tests/test_mujoco_stepper.py holds the two
  * equal bit for bit). The per-hub, per-joint and per-geom arrays are compiled_wheels.py's, by their addresses. */
-#include "../loop/_stepper.h"
+#include "../../loop/_stepper.h"
 
 #define WHEELS_CONFIG(X, P)                                                                                     \
   X(P, nhub) X(P, per_module) X(P, friction_count) X(P, x_v0) X(P, x_v1) X(P, elliptic) X(P, ngeom) X(P, hub_q) \

@@ -25,7 +25,7 @@ from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m
 from ipir_mujoco.core.results import stall_reason as core_stall_reason
 
 from ..builders.model import check_params
-from ..controllers.slide_clutches import refuse_compliant
+from .slides.clutches import refuse_compliant
 
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often

@@ -13,10 +13,10 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ..controllers.grip import GripRows
-from ..builders.grip_model import ROLLS, SKIDS
-from ..builders.model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
-from ..loop.rows import FRICTION_DOF as FRICTION_ROW, FRICTION_TENDON
+from ..slides_grip.ratchet import GripRows
+from ...builders.grip_model import ROLLS, SKIDS
+from ...builders.model import CRANK_HINGE, MOTOR, SLIDES, dof_address, drive_torque_slope, qpos_address
+from ...loop.rows import FRICTION_DOF as FRICTION_ROW, FRICTION_TENDON
 
 
 

@@ -41,11 +41,11 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_SPEED
 
-from .compiled_grip import load_grip_ratchet
-from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
-from ..builders.grip_model import ROLLS, SKIDS
-from ..builders.model import SLIDES, dof_address, qpos_address
-from ..loop.rows import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
+from .compiled import load_grip_ratchet
+from ...loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
+from ...builders.grip_model import ROLLS, SKIDS
+from ...builders.model import SLIDES, dof_address, qpos_address
+from ...loop.rows import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
 
 __all__ = ["LIMIT_TENDON", "GripRatchet", "GripRows", "lower_bound", "upper_bound"]
 

@@ -1,7 +1,7 @@
 /* The slide model's clutch controllers, compiled (see _stepper.h): NoClutch, Ratchet, Locks (two rules) in
  * slide_clutches.py and CompliantClutches in compliant.py, step for step as there (the same double arithmetic in
  * the same order: tests/test_mujoco_stepper.py holds the two equal bit for bit). */
-#include "_clutch_parts.h"
+#include "../../controllers/_clutch_parts.h"
 
 /* ---- NoClutch: nothing to do, no reactions ---- */
 #define NONE_CONFIG(X, P)

@@ -30,17 +30,17 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import grip_use
 
 from .common import check_clutch_options
-from ..controllers.grip import GripRatchet
-from ..controllers.compliant_grip import CompliantGrip
+from .slides_grip.ratchet import GripRatchet
+from .slides_grip.compliant import CompliantGrip
 from ..builders.grip_model import SKIDS
-from .loop_rows import loop_options
+from .slides.loop_rows import loop_options
 from ..builders.model import SolverSettings, build_model, qpos_address, set_closed_loop_state
-from .route_watch import check_route, pipe_fit
-from ..controllers.slide_clutches import slide_controller
+from .wheels.route_watch import check_route, pipe_fit
+from .slides.clutches import slide_controller
 from .timestep import choose_settings
-from ..controllers.wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
+from .wheels.ratchet import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
                      wheels_settings)
-from ..builders.wheels_model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
+from .wheels.model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
 
 
 class ModelKind:

@@ -1,7 +1,7 @@
 /* The finite-grip clutch controllers, compiled (see _stepper.h): GripRatchet (grip.py) and CompliantGrip
  * (compliant_grip.py), step for step as there. Each block starts with the carriages' part (GRIP_PART,
  * _clutch_parts.h); their work rates are the grip rows' (grip_work). */
-#include "_clutch_parts.h"
+#include "../../controllers/_clutch_parts.h"
 
 /* ---- GripRatchet: the roll's lower limit follows its running maximum, the carriage's upper its minimum ---- */
 #define GRIP_RATCHET_CONFIG(X, P) GRIP_CONFIG(X, P) X(P, roll_t0) X(P, roll_t1)
