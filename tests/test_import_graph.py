@@ -111,8 +111,8 @@ def test_the_finder_sees_every_kind_of_import():
     edges to look at), and leaves out TYPE_CHECKING ones."""
     edges = graph()
     assert len(edges) > 100
-    assert "ipir_mujoco.engine.kinds.kinds" in edges["ipir_mujoco.engine.run.simulate"]  # relative, top level
-    assert "ipir_mujoco.engine.kinds.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
+    assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.engine.run.simulate"]  # relative, top level
+    assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
     assert "ipir_mujoco.report.plots" in edges["ipir_mujoco.core.results"]  # inside RunResult.plot
     assert "ipir_mujoco.core.results" not in edges["ipir_mujoco.report.plots"]  # TYPE_CHECKING only
     assert "ipir_mujoco.analytic.kinematic_clutch" in edges["ipir_mujoco.analytic"]  # the analytic/ folder

@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -20,7 +21,7 @@ import pytest
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.results import Mode
-from ipir_mujoco.engine.modelkinds import kinds
+from ipir_mujoco.engine import kinds
 from ipir_mujoco.engine.loop.controller import ROLLING, SKIDDING, STANDING, ClutchController
 from kind_setup import started_setup
 
@@ -108,8 +109,17 @@ def test_a_skidding_module_is_never_held_in_any_variant(variant, params):
 
 
 def test_kinds_are_named_once_and_unknown_models_are_one_line():
-    assert set(kinds.KINDS.values()) == {kinds.SLIDES, kinds.GRIP_SLIDES, kinds.WHEELS}
+    """Every folder of engine/kinds/ with an __init__.py is a kind, named as its folder, registered once; its
+    variants are the registry's."""
+    folders = sorted(p.parent.name for p in Path(kinds.__file__).parent.glob("*/__init__.py"))
+    assert [name.replace("-", "_") for name in kinds.KINDS] == folders
+    assert {kinds.SLIDES, kinds.GRIP_SLIDES, kinds.WHEELS} <= set(kinds.KINDS.values())
     assert set(kinds.MODELS) == set(registry.MUJOCO_MODELS)
+    for kind in kinds.KINDS.values():
+        assert kind.template().is_file(), kind.name  # its MJCF template, in the repository's mjcf/ folder
+        for row in kind.variants:
+            v = registry.variant(row["name"])
+            assert (v.engine, v.model, v.clutch, v.rule) == ("mujoco", kind.model, row["clutch"], row["rule"])
     with pytest.raises(ValueError, match="mujoco model 'tracks' is unknown; allowed: slides, wheels"):
         kinds.kind_for("tracks", RobotParams())
     assert [kind.accuracy for kind in (kinds.SLIDES, kinds.GRIP_SLIDES, kinds.WHEELS)] == ["stop", "stop", "warn"]
@@ -135,3 +145,50 @@ def test_every_engine_audits_the_energy_terms_of_the_one_table():
         closed = total["input"] - total["dissipated"] - total["kinetic"] - total["stored"]
         # the residual is the balance of the table's roles (to the last ulps of the summed terms)
         assert run.energy[energy.RESIDUAL_KEY] == pytest.approx(closed, abs=1e-12 * abs(total["input"]))
+
+
+def test_a_kind_that_leaves_out_a_required_member_fails_where_it_is_defined():
+    """ModelKind is abstract: a subclass without every required member is a TypeError naming them at its
+    definition (not the slide model's behaviour at its first run); a base declared abstract may leave them out,
+    and neither it nor ModelKind can be made."""
+    with pytest.raises(TypeError, match=r"model kind Tracks leaves out .*mjcf.*build, initial_state"):
+        class Tracks(kinds.ModelKind):  # noqa: F841  (the definition is the test)
+            name, model, free, variants = "tracks", "tracks", "crawls", ()
+
+    class Half(kinds.ModelKind, abstract=True):
+        name = "half"
+
+    for base in (kinds.ModelKind, Half):
+        with pytest.raises(TypeError, match="abstract"):
+            base()
+    # a copy of a concrete kind that overrides nothing is a kind (the slides on finite grip are one such subclass)
+    assert isinstance(type("Copy", (type(kinds.SLIDES),), {"name": "copy"})(), kinds.ModelKind)
+
+
+# what its params must be for each kind to take them (the first case of each kind)
+KIND_PARAMS = {kind.name: params for _, params, kind, _ in reversed(CASES)}
+
+
+@pytest.mark.parametrize("name", sorted(kinds.KINDS))
+def test_every_kinds_model_meets_the_joint_and_body_contract(name):
+    """The elements the shared run path reads by name (kinds.base.CONTRACT, docs/architecture.md "The joint and
+    body contract"): each kind's built model has each, of its type; and the contract's joints are the recorder's
+    and the run setup's (the crank's hinge, the rod's, each module's slide along the pipe), single-dof joints."""
+    from ipir_mujoco.engine.builders.model import SolverSettings
+    from ipir_mujoco.engine.kinds.base import CONTRACT
+
+    kind = kinds.KINDS[name]
+    params = KIND_PARAMS.get(name, RobotParams())
+    assert kind.takes(params)
+    model = kind.build(params, SolverSettings(timestep=5e-5))
+    types = {"joint": mujoco.mjtObj.mjOBJ_JOINT, "body": mujoco.mjtObj.mjOBJ_BODY, "site": mujoco.mjtObj.mjOBJ_SITE,
+             "equality": mujoco.mjtObj.mjOBJ_EQUALITY, "actuator": mujoco.mjtObj.mjOBJ_ACTUATOR,
+             "geom": mujoco.mjtObj.mjOBJ_GEOM}
+    missing = [(what, n) for what, names in CONTRACT.items() for n in names
+               if mujoco.mj_name2id(model, types[what], n) < 0]
+    assert missing == []
+    singles = {int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)}
+    assert all(int(model.joint(n).type[0]) in singles for n in CONTRACT["joint"])
+    assert int(model.joint("rear_slide").type[0]) == int(model.joint("front_slide").type[0]) \
+        == int(mujoco.mjtJoint.mjJNT_SLIDE)
+    assert int(model.equality("rod_to_front").type[0]) == int(mujoco.mjtEq.mjEQ_CONNECT)

@@ -14,7 +14,7 @@ from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.core.options import RepeatProgress
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.modelkinds import kinds
+from ipir_mujoco.engine import kinds
 from ipir_mujoco.engine.run import simulate as engine_simulate
 from ipir_mujoco.engine.builders.model import SolverSettings
 from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL

@@ -414,14 +414,14 @@ def test_a_mujoco_error_fails_only_that_batched_design(monkeypatch, tmp_path):
     """The same starved arena in a batch: mujoco.batch raises for the designs whose ratchet rows do not fit,
     and each of those ends as the serial engine's one-line error for the same model, word for word; a design
     that needs no ratchet rows (no drive torque: it never moves) runs to the end in the same batch."""
-    from ipir_mujoco.engine.modelkinds import kinds
+    from ipir_mujoco.engine.builders import model as builder
 
     memory = []
     starved_model(RobotParams(), memory)
     path = tmp_path / "starved.xml"
     path.write_text(edited_template('<compiler ', f'<size memory="{memory[0]}"/>\n  <compiler '))
-    build = kinds.build_model  # the slide kind's builder, which the batch builds every design with
-    monkeypatch.setattr(kinds, "build_model", lambda params, settings, mjcf=None, ratchet=False, decorate=None:
+    build = builder.build_model  # the slide kind's builder, which the batch builds every design with
+    monkeypatch.setattr(builder, "build_model", lambda params, settings, mjcf=None, ratchet=False, decorate=None:
                         build(params, settings, path, ratchet, decorate))
     designs = [RobotParams(), RobotParams(M=0.1), RobotParams(M=0.0)]
     outcomes = run_ratchet_batch(designs, 0.1, dt_out=1e-3, settings=SolverSettings(), nthread=1)

@@ -1,7 +1,7 @@
 """Shim: the slide model's clutches moved to :mod:`.controllers.slide_clutches`, the constraint rows to :mod:`.loop.rows` and the
 choice of a controller to the model kinds (:mod:`.modelkinds.kinds`); kept so that older imports keep working."""
 
-from .kinds.kinds import clutch_controller, refuse_grip
+from .kinds import clutch_controller, refuse_grip
 from .loop.rows import (EQUALITY_ROWS, FRICTION_DOF, FRICTION_TENDON, MISSING_ROWS, FrictionRows, clutch_share,
                    equality_row, missing_rows)
 from .kinds.slides.clutches import Locks, NoClutch, Ratchet, refuse_compliant

@@ -84,7 +84,7 @@ def case_route(params: RobotParams, ratio: float, plane: float = 0.0):
 def check_planes(planes: Sequence[float], params: RobotParams, ratio: float) -> None:
     """ParameterError (one line) for a plane out of -180..180 deg, or one the wheeled model cannot run (the
     model's own route check on the first case, before any run)."""
-    from ipir_mujoco.engine.kinds.kinds import kind_for
+    from ipir_mujoco.engine.kinds import kind_for
 
     if not planes:
         raise ParameterError("--planes is empty; allowed: one or more angles, -180..180 deg")

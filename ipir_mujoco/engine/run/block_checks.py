@@ -62,7 +62,7 @@ class BlockChecks:
             self.fed = newest + 1
             if steady:
                 return int(np.searchsorted(rec.t[:newest + 1], self.watch.steady_at - 1e-12, side="left"))
-        if run.route_watch is not None and (stop := run.route_watch.check(newest)) is not None:
+        if (stop := run.route_watch.check(newest)) is not None:  # a route's end or jam
             return stop
         if self.stall_watch:
             return self._stall(newest, t)

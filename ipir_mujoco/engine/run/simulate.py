@@ -62,14 +62,11 @@ from ipir_mujoco.core.results import RunResult
 from .block_checks import BlockChecks
 from ..kinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
                                  climb_energy, mujoco_failure, steps_per_output)
-from ..kinds.kinds import ModelKind, kind_for
-from ..kinds.skid_check import SLIDES_RULE, verify_skids
-from ..kinds.wheels.skids import WHEELS_RULE
+from ..kinds import ModelKind, kind_for
 from ..builders.model import SolverSettings
 from ..loop.monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
 from ..loop.recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
-from ..kinds.wheels.route_watch import route_watch
 from .run_setup import RunSetup
 from ..loop.servo_drive import TickedDrive, controller_for
 from ..loop.stepper import WARNED
@@ -84,7 +81,6 @@ ENERGY_SLOTS = {column: (False, SCALARS.index(column)) if column in SCALARS
                 else (True, DEFERRED.index(_RECORDED_AS.get(column, column)))
                 for column in ENERGY_COLUMNS if column in SCALARS or _RECORDED_AS.get(column, column) in DEFERRED}
 
-SKID_RULES = {"slides": SLIDES_RULE, "wheels": WHEELS_RULE}  # a model kind's skid_rule: the rule it names
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
@@ -160,12 +156,9 @@ def simulate_mujoco(
                    progress=passes, servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
                    kind=kind, feedforward=feedforward, route=route)
+    rule = kind.skid_rule(params)  # the kind's skid check (kinds/skid_check.py)
     if settings is not None:
-        result = _Run(params, settings, **options).result({"timestep_source": "given"})
-        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            result.accuracy["skid_check"] = "not verified: timestep given"
-        return result
-    verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
+        return rule.given(_Run(params, settings, **options).result({"timestep_source": "given"}))
     started = time.perf_counter()
     chosen, why = kind.settings(params, t_end, dt_out, servo, implementation, route=route)
     failures = []
@@ -179,17 +172,13 @@ def simulate_mujoco(
                 raise
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
             chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
-    if not verify:
-        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            result.accuracy["skid_check"] = "not verified: compliant clutches"
-        return result
     every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
 
     def rerun(dt: float) -> RunResult:
         finer = {**options, "dt_out": dt} if every_step else options
         return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
-    return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule])
+    return rule.verify(result, rerun, accuracy, DT_MIN)
 
 
 class _Run:
@@ -234,8 +223,7 @@ class _Run:
                 raise SimulationError(mujoco_failure(t, str(exc))) from None
         rec = self.recorder
         series = rec.series(last)
-        if self.route_watch is not None:  # x and v along the route's centreline (world positions kept)
-            series = self.route_watch.along_series(series)
+        series = self.route_watch.along_series(series)  # along a route: x and v along its centreline
         if self.ticked is not None:
             series["drive_u"] = self.ticked.u_column(series["t"])
         change = energy_changes(series)  # every energy term the series has (core.energy's table)
@@ -253,7 +241,7 @@ class _Run:
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.kind.recorded_settings()},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
-            route=self.route_watch and self.route_watch.record(self.t_end, self.stall),
+            route=self.route_watch.record(self.t_end, self.stall),
         )
 
     def _setup(self):
@@ -262,8 +250,7 @@ class _Run:
         m, d = self.model, self.data
         self.controller, self.loop = setup.controller, setup.loop
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2, self.controller, self.kind)
-        # None without a route
-        self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out, self.kind.route_fit)
+        self.route_watch = self.kind.route_watch(self.route, m, self.recorder, p, self.dt_out)
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
