@@ -52,6 +52,9 @@ def test_each_kind_makes_its_controller_and_it_reports_the_protocols_shapes(vari
     assert type(ctl).__name__ == controller
     for name in ClutchController.__annotations__:  # every attribute the protocol names
         assert hasattr(ctl, name), name
+    methods = [name for name, value in vars(ClutchController).items() if callable(value) and not name.startswith("_")]
+    assert {"load_compiled", "deferred_values", "clutch_columns", "modes", "after_step"} <= set(methods)
+    assert all(callable(getattr(ctl, name, None)) for name in methods)  # every method: the loop tests none
     steps, _ = setup.steps(np.empty((2, setup.model.nv)))
     for _ in range(3):  # a few steps of the run's own loop, then read what a sample reads
         steps.run(20)

@@ -63,7 +63,7 @@ PLACES = {
                  "_pipewall": "builders._pipewall"},
     "loop": {name: f"loop.{name}" for name in ("stepper", "native", "rows", "recorder", "monitor", "controller",
                                                "servo_drive", "_stepper")},
-    "controllers": {"slide_clutches": "kinds.slides.clutches", "compliant": "controllers.compliant",
+    "controllers": {"slide_clutches": "kinds.slides.clutches", "compliant": "kinds.slides.compliant",
                     "grip": "kinds.slides_grip.ratchet", "compliant_grip": "kinds.slides_grip.compliant",
                     "compiled_grip": "kinds.slides_grip.compiled", "wheels": "kinds.wheels.ratchet",
                     "compiled_wheels": "kinds.wheels.compiled"},

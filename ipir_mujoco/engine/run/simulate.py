@@ -197,7 +197,6 @@ class _Run:
         dt = settings.timestep
         self.steps_per_sample = steps_per_output(dt_out, dt)
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
-        self.compliant = params.clutch_stiffness is not None
         self.kind = kind
         self.route = route
         self.setup = RunSetup(kind, params, settings, implementation=implementation, rule=clutch, mjcf=mjcf,
@@ -236,7 +235,7 @@ class _Run:
             engine="mujoco", geometry="exact", clutch=label, params=self.params, t_end=float(series["t"][-1]),
             series=series, energy=energy, wall_time_s=time.perf_counter() - self.started,
             settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch,
-                      "clutch_model": "compliant" if self.compliant else "rigid", "dt_out": self.dt_out,
+                      "clutch_model": self.controller.clutch_model, "dt_out": self.dt_out,
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.kind.recorded_settings()},
             stall=self.stall,
@@ -265,7 +264,7 @@ class _Run:
         torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
-        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=ctl.wheels())
+        row = rec.sample(torque, 0.0, 0.0, ctl.sampled_reactions(), excursion=ctl.excursion, wheels=ctl.wheels())
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
         at_start = by_role(self._energy_rows(row, row + 1))
         self.energy0 = (at_start[KINETIC].item(0), at_start[STORED].item(0))  # the state terms' energy at the start
@@ -293,9 +292,7 @@ class _Run:
                 last = checks.check(pending, messages)
                 if last is not None:
                     break
-        if self.compliant:
-            # the anchors and dampers for the final state, whose clutch forces the last sample holds
-            ctl.before_step()
+        ctl.finish()  # (the compliant clutches: the anchors and dampers for the final state)
         mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
         if pending >= 1:
             rec.fill_deferred(pending)

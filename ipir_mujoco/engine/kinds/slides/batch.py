@@ -49,6 +49,7 @@ from . import KIND as SLIDE_KIND
 from .. import kind_for
 from ...builders.model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_control, drive_torque_slope,
                     pin_offset, qpos_address)
+from ...loop.controller import follow
 from ...loop.monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
 from ..common import (BLOCK_TIME, REFINEMENTS, captured_warnings, climb_energy, mujoco_failure,
                      rest_since, stall_reason, steps_per_output)
@@ -238,9 +239,9 @@ class _Batch:
             dt = np.where(stepping, self.dt, 0.0)
             torque = None  # stays None if MuJoCo fails every simulation in the first substep
             for j in range(substeps):
-                q = self.qpos[:, slides_q]
-                np.maximum(self.excursion, np.max(self.bounds - q, axis=1), out=self.excursion)
-                np.maximum(self.bounds, q, out=self.bounds)
+                # each slide's running maximum, the serial ratchet's rule (follow) for every design at once
+                self.bounds, give = follow(self.bounds, self.qpos[:, slides_q])
+                np.maximum(self.excursion, np.max(give, axis=1), out=self.excursion)
                 self.jnt_range[:, joints, 0] = self.bounds - self.margins
                 omega_prev = self.qvel[:, crank_v].copy()
                 if uniform:

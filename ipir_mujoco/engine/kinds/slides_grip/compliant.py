@@ -32,9 +32,9 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_SPEED
 
 from .compiled import load_compliant_grip
-from ...controllers.compliant import CompliantClutches, check_transmissions
+from ..slides.compliant import CompliantClutches, check_transmissions
 from ...loop.controller import ROLLING, SKIDDING, STANDING, RunningBound
-from .ratchet import GripRows
+from ..slides.loop_rows import GripRows
 from ...builders.grip_model import ROLLS, SKIDS
 from ...builders.model import dof_address, qpos_address
 

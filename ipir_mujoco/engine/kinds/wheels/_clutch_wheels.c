@@ -25,11 +25,11 @@ static void wheels_before(const int64_t *cfg, double *st) {
   const double radius = s[WS_radius];
   for (int64_t k = 0; k < w[WC_nhub]; k++) {
     const double angle = qpos[hub_q[k]];
-    if (angle > bound[k]) {
-      bound[k] = angle;
+    const double back = follow(&bound[k], angle, 0);
+    if (back < 0.0) {
       range[2 * joint[k]] = lower_bound(angle, margin[k]);
     } else {
-      const double give = (bound[k] - angle) * radius;
+      const double give = back * radius;
       if (give > st[S_excursion]) st[S_excursion] = give;
     }
   }
@@ -127,4 +127,5 @@ static int wheels_reactions(const int64_t *cfg, const double *st, double out[N_R
 }
 
 const Controller WHEEL_RATCHET = {"wheel_ratchet", BLOCK_NAMES(WHEELS_CONFIG, WC, WHEELS_STATE, WS),
-                                  .before_step = wheels_before, .work = wheels_work, .reactions = wheels_reactions};
+                                  .before_step = wheels_before, .after_step = no_after_step, .work = wheels_work,
+                                  .reactions = wheels_reactions, .deferred = no_deferred};
