@@ -37,17 +37,18 @@ from typing import Any, Callable, Sequence
 from . import interrupts
 from .core.control import FeedforwardTable
 from .core.errors import ParameterError, ParameterTypeError
+from .core.options import CLUTCH_RULES as RULES  # the clutch rules (--clutch)
 from .core.options import check_type
 from .core.params import RobotParams, check_real, check_whole, require_params
 from .core.results import RunResult
 from .engine.kinds import KINDS  # the model kinds' declarations (no MuJoCo: engine/kinds/__init__.py)
+from .engine.kinds.base import MUJOCO_CLUTCHES  # the MuJoCo clutches a variant names (--mujoco-clutch)
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
 # beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
 # the public surface: they may change with them)
 
 ENGINES = ("analytic", "mujoco")  # the two engines; a variant (VARIANTS) is one model in one of them
-RULES = ("kinematic", "unilateral")
 
 
 @dataclass(frozen=True)
@@ -164,8 +165,8 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     if clutch == "ratchet" and rule == "kinematic":
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
-    if clutch not in ("ratchet", "lock"):
-        raise ParameterError(f"--mujoco-clutch {clutch!r} is unknown; allowed: ratchet, lock")
+    if clutch not in MUJOCO_CLUTCHES:
+        raise ParameterError(f"--mujoco-clutch {clutch!r} is unknown; allowed: {', '.join(MUJOCO_CLUTCHES)}")
     return _find(engine, rule, "exact", clutch)
 
 

@@ -34,11 +34,11 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode, RunResult
 
+from .engine.kinds.base import HOUSINGS  # the modules' housings, coloured by their clutches (every kind's model)
 from .labels import fixed
 
 HELD_RGBA = (0.15, 0.7, 0.3, 1.0)  # the clutch holds the module to the pipe
 FREE_RGBA = (0.6, 0.68, 0.85, 1.0)  # the module slides forward (grey-blue)
-HOUSINGS = ("rear_housing", "front_housing")
 OVERLAY_MIN_WIDTH = 320  # px: narrower frames show the robot without the text
 ROUTE_VIEW_DISTANCE = 0.9  # m: the camera above the plane along a route (fovy 45 deg: 0.75 m of it in a frame's
 # height, 0.41 m between the texts: the robot, 0.4 m long, and its pipe, 0.16 m wide by default, fit there)

@@ -114,7 +114,7 @@ def build_parser() -> Parser:
                                 "(the engine's own clutch controller runs in the viewer loop).")
     parser.add_argument("--clutch", choices=("unilateral", "kinematic"), default="unilateral",
                         help="unilateral: one-way clutches (default); kinematic: the paper's rule")
-    parser.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+    parser.add_argument("--mujoco-clutch", choices=registry.MUJOCO_CLUTCHES, default=None,
                         help="ratchet (default with unilateral) or lock (default with kinematic)")
     parser.add_argument("--mujoco-model", choices=("slides", "wheels"), default="slides",
                         help="slides: the modules on slide joints (default); wheels: on wheels in the pipe")

@@ -52,6 +52,7 @@ CONTRACT = {
     "geom": ("rear_housing", "front_housing"),
 }
 HOUSINGS = CONTRACT["geom"]  # the modules' housings, rear first
+MUJOCO_CLUTCHES = ("ratchet", "lock")  # the MuJoCo clutches a variant names (kinds' variants, --mujoco-clutch)
 
 # the members a concrete kind must give (the class attributes, then the methods)
 REQUIRED = ("name", "model", "mjcf", "free", "variants", "check", "takes", "settings", "build", "initial_state",
