@@ -2,7 +2,7 @@
 
 The series holds what poses the robot: the crank angle ``phi`` and the modules' travel ``x1``, ``x2``; the
 wheeled model's runs (``mujoco-wheels``) also each module's pose across the pipe, ``y1/2``, ``z1/2`` and its
-turn ``roll1/2``, ``pitch1/2``, ``yaw1/2`` (:func:`ipir_mujoco.engine.controllers.wheels.pose_columns`). Values between
+turn ``roll1/2``, ``pitch1/2``, ``yaw1/2`` (:func:`ipir_mujoco.engine.kinds.wheels.ratchet.pose_columns`). Values between
 samples are interpolated linearly. What the series does not hold follows from it:
 
 - the rod's hinge closes the loop: the rod points from its pin on the crank (B) at module 2's pin (C),

@@ -4,7 +4,7 @@ The one entry point beside the registry that steps the MuJoCo engine itself: the
 model and data between steps, which a finished run does not give.
 
 The shipped MJCF alone does not crawl: its one-way clutches are not MJCF
-elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.clutches`),
+elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.kinds`),
 which move a joint limit or switch a lock before every step. This command
 builds the model from a parameter set exactly as ``simulate --engine mujoco``
 does and steps it in a passive viewer loop with the engine's own stepping loop

@@ -1,5 +1,5 @@
-"""Shim: the slide model's clutches moved to :mod:`.controllers.slide_clutches`, the constraint rows to :mod:`.loop.rows` and the
-choice of a controller to the model kinds (:mod:`.modelkinds.kinds`); kept so that older imports keep working."""
+"""Shim: the slide model's clutches moved to :mod:`.kinds.slides.clutches`, the constraint rows to :mod:`.loop.rows` and the
+choice of a controller to the model kinds (:mod:`.kinds`); kept so that older imports keep working."""
 
 from .kinds import clutch_controller, refuse_grip
 from .loop.rows import (EQUALITY_ROWS, FRICTION_DOF, FRICTION_TENDON, MISSING_ROWS, FrictionRows, clutch_share,

@@ -8,7 +8,7 @@ robot's centre (midway between A and C along the route) L / 2 before the bend (t
 2 after it (the rear module leaving it): a centreline length L + pi R / 2. (The centre moves more evenly than either
 module, which stands half of each revolution; its crossing times still carry about r / 2 / v, 0.05 s, of the
 stroke's ripple.) Its time and the motor's work over it come from the wheeled MuJoCo run (``mujoco-wheels`` with the
-route, the rear module's progress along the centreline, :mod:`ipir_mujoco.engine.modelkinds.route_watch`), with how it ended
+route, the rear module's progress along the centreline, :mod:`ipir_mujoco.engine.kinds.wheels.route_watch`), with how it ended
 (done, or where and why it stopped), the closed-form fit beside it, and how long wheels were off their walls.
 
 The references over the same length: the analytic finite-grip model's (``analytic-unilateral``) periodic

@@ -192,7 +192,7 @@ def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES
     the module docstring says. ``rerun(timestep)`` runs the design again at that step [s] and returns its
     RunResult; ``mode``: the accuracy monitor's ('stop' | 'warn'); ``dt_min`` [s]: the smallest step a run may
     take (halving stops before it); ``rule``: the model's floor, figures and acceptance (:data:`SLIDES_RULE`,
-    :data:`ipir_mujoco.engine.run.wheel_skids.WHEELS_RULE`)."""
+    :data:`ipir_mujoco.engine.kinds.wheels.skids.WHEELS_RULE`)."""
     if not rule.skidded(result):
         result.accuracy["skid_check"] = "no skid"
         return result

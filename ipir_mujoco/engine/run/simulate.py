@@ -11,7 +11,7 @@ state and a stall, and reports progress about every 0.1 s of it or every
 second of wall time, whichever comes first (never going
 back: a run repeated at a halved timestep, which may take minutes, reports
 :class:`ipir_mujoco.core.options.RepeatProgress` values, its own time with
-the time already reported: :class:`ipir_mujoco.engine.modelkinds.common.PassProgress`).
+the time already reported: :class:`ipir_mujoco.engine.kinds.common.PassProgress`).
 MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
 turn into a :class:`SimulationError` with the time and MuJoCo's message, as
 do a non-finite state and a MuJoCo error (``mujoco.FatalError``).

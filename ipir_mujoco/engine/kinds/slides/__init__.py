@@ -1,7 +1,7 @@
 """The slide model's kind: the modules on two slides along the pipe, unlimited grip.
 
 Its clutches (:mod:`.clutches`): a joint-limit ratchet on each slide (rigid, or with a finite ``clutch_stiffness``
-the compliant clutches of :mod:`ipir_mujoco.engine.controllers.compliant`), velocity-triggered locks or none; their
+the compliant clutches of :mod:`ipir_mujoco.engine.kinds.slides.compliant`), velocity-triggered locks or none; their
 compiled forms in ``_clutch_slides.c``. Its builder is the mechanism's, :mod:`ipir_mujoco.engine.builders.model`
 (from ``mjcf/inchworm.xml``); the loop counts the work against the resistances from its slides' friction rows
 (:mod:`.loop_rows`); its batched runs: :mod:`.batch`; its drawing and replay: :mod:`.drawing`. The slides on finite
@@ -71,7 +71,7 @@ class SlidesKind(ModelKind):
         return loop_options(model, data)
 
     def between_steps(self, params, implementation, rule):
-        compliant = "ipir_mujoco.engine.controllers.compliant"
+        compliant = "ipir_mujoco.engine.kinds.slides.compliant"
         if implementation == "ratchet" and params.clutch_stiffness is not None:
             return ["Before every mj_step each module's clutch anchor is ratcheted: its slide's lower limit is raised "
                     f"to the anchor's running maximum ({compliant}); the spring, damper and play between "
