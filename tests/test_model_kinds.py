@@ -22,7 +22,7 @@ from ipir_mujoco import registry
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.core.results import Mode
 from ipir_mujoco.engine import kinds
-from ipir_mujoco.engine.loop.controller import ROLLING, SKIDDING, STANDING, ClutchController
+from ipir_mujoco.engine.loop.controller import ROLLING, SKID_SPEED, SKIDDING, STANDING, ClutchController
 from kind_setup import started_setup
 
 GRIP = dict(mu_wall=0.5, F_n1=10.0, F_n2=10.0)
@@ -109,6 +109,36 @@ def test_a_skidding_module_is_never_held_in_any_variant(variant, params):
         skidding += int(skids.sum())
         assert not np.any(held & skids), f"module {k}: {int((held & skids).sum())} held samples while skidding"
     assert skidding > 0  # the design skids in this variant: the check above had something to check
+    if params.clutch_stiffness is None:  # rigid clutches: a held module stands (docs/cli.md, "held")
+        assert not np.any(held_moving_back(run.series))
+
+
+def held_moving_back(series: dict) -> np.ndarray:
+    """The user's check of *held* (docs/cli.md), per sample: whether the mode holds a module whose v is below
+    -SKID_SPEED."""
+    held = [np.array([getattr(Mode(int(m)), locked) for m in series["mode"]], dtype=bool)
+            for locked in ("rear_locked", "front_locked")]
+    return (held[0] & (series["v1"] < -SKID_SPEED)) | (held[1] & (series["v2"] < -SKID_SPEED))
+
+
+# the issue's skidding design on the wheels (motor, mu_wall 0.5, F_n 5 N): its hubs hold while its body tips and
+# slides back; 0.3 s holds its first skids
+ISSUE_51 = RobotParams(drive="motor", mu_wall=0.5, F_n1=5.0, F_n2=5.0)
+
+
+@pytest.mark.slow
+def test_a_held_module_stands_on_the_wheels_as_on_the_slides():
+    """Held means one thing a user can check: no sample reads a module held while its speed along the pipe is below
+    -SKID_SPEED (the wheeled model read 171 of 1000 samples so on the issue's design, 1 s); and the module's wheels
+    read skidding there (the mode and wheels1/2 agree)."""
+    run = registry.run("mujoco-wheels", ISSUE_51, 0.3, dt_out=1e-3, accuracy="warn")
+    s = run.series
+    back = (s["v1"] < -SKID_SPEED) | (s["v2"] < -SKID_SPEED)
+    assert back.sum() > 10  # the design moves back: the check below has something to check
+    assert not np.any(held_moving_back(s))
+    for k in (1, 2):  # a module moving back that its hubs hold is skidding (its rolling forward is v > 0)
+        holding = (s[f"wheels{k}"] != 1.0) & (s[f"v{k}"] < -SKID_SPEED)
+        assert np.all(s[f"wheels{k}"][holding] == SKIDDING)
 
 
 def test_kinds_are_named_once_and_unknown_models_are_one_line():

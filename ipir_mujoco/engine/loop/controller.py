@@ -9,10 +9,13 @@ for its columns and its modes (:meth:`ClutchController.clutch_columns`, :meth:`C
 loop asks it to lay out its compiled form (:meth:`ClutchController.load_compiled`). Everything the loop and the
 recorder do differently for one controller is a member here, so they hold no test on which controller runs.
 
-Held, one definition for every controller (and the analytic model's): a module is *held* while its clutch
-carries it and it stands. A module whose wheels skid back on the wall is not held, even though its clutch
-pushes (it carries the grip, G_i, while the module slides); a module that rolls or slides forward is not held.
-:func:`held` says it for one module, :func:`held_where` for a column of samples.
+Held, one definition for every controller (and the analytic model's; docs/cli.md says what a user reads): a
+module is *held* while its clutch carries it and it stands, its wheels neither rolling forward nor skidding back.
+A module whose wheels skid back on the wall is not held, even though its clutch pushes (it carries the grip, G_i,
+while the module slides): its grip at its limit, or its module moving back faster than SKID_SPEED; a module that
+rolls or slides forward is not held. (A compliant clutch's module moving back on its spring while the clutch
+pushes is held: the clutch's own travel, not a skid.) :func:`held` says it for one module, :func:`held_where` for
+a column of samples.
 
 The ratchets' running bound (:func:`follow`, :class:`RunningBound`): a one-way limit that follows the running
 maximum (or minimum) of a coordinate, one margin from it, and the largest give below (above) it so far. The slide
@@ -30,6 +33,11 @@ import numpy as np
 
 # a module's wheels, as the controllers report them (wheels1/2 columns): rolling forward, standing, skidding back
 ROLLING, STANDING, SKIDDING = 1, 0, -1
+# m/s: a module whose clutch carries it and that moves back faster than this skids, whatever its wheels' forces say
+# (docs/cli.md, "held"): far above the creep of a held module on its soft rows and contacts (at most 1e-6 m/s,
+# REST_SPEED), far below a stroke's speeds (0.1-0.5 m/s). The wheeled model's hubs hold while its body tips and
+# slides on its legs, its contacts inside their cone: 171 of 1000 samples read held so before (issue 51)
+SKID_SPEED = 1e-3
 NO_WHEELS = (0.0, 0.0)  # the wheels' states a controller without wheels reports (none are written)
 
 

@@ -8,7 +8,7 @@
   X(P, nhub) X(P, per_module) X(P, friction_count) X(P, x_v0) X(P, x_v1) X(P, elliptic) X(P, ngeom) X(P, hub_q) \
   X(P, hub_joint) X(P, hub_row) X(P, joint_module) X(P, geom_module) X(P, work_dofs) X(P, stick) X(P, margin)  \
   X(P, bound)
-#define WHEELS_STATE(X, P) X(P, radius) X(P, cone) X(P, rest_speed) X(P, resist0) X(P, resist1)
+#define WHEELS_STATE(X, P) X(P, radius) X(P, cone) X(P, rest_speed) X(P, skid_speed) X(P, resist0) X(P, resist1)
 FIELDS(WHEELS_CONFIG, WC)
 FIELDS(WHEELS_STATE, WS)
 
@@ -116,6 +116,7 @@ static int wheels_reactions(const int64_t *cfg, const double *st, double out[N_R
       } else {
         skids = d->qvel[w[WC_x_v0 + i]] < -s[WS_rest_speed];
       }
+      skids = skids || d->qvel[w[WC_x_v0 + i]] < -s[WS_skid_speed]; /* held modules stand (SKID_SPEED) */
       state = skids ? -1.0 : 0.0;
       share = clutch_share(hold, s[WS_resist0 + i]);
     }

@@ -10,8 +10,10 @@ forces, and skids back on them beyond it.
 Reported per module (:meth:`HubRatchet.states`): rolling while every hub's friction row slides (at its bound
 -tau) and no hub's limit row pushes; otherwise held, and skidding while held and its wheels slide on the wall:
 their contacts' tangential forces together at the friction cone's edge, mu_wall times their normal forces (to
-SLIDING_SHARE), or, with no contact left, while it moves back faster than REST_SPEED. A skidding module is not
-held (the analytic model's and the slide model's meaning). The clutch's reaction is the clutch's share
+SLIDING_SHARE), or, with no contact left, while it moves back faster than REST_SPEED; and, whatever its contacts
+say, while it moves back faster than SKID_SPEED (its hubs hold while its body tips and slides on its legs, its
+contacts inside their cone). A skidding module is not held (:mod:`ipir_mujoco.engine.loop.controller`'s one
+meaning: held modules stand). The clutch's reaction is the clutch's share
 (:func:`.clutches.clutch_share`) of the module's hold: the hubs' limit and friction rows [N m] over the wheel
 radius. ``excursion`` [m]: the largest give of a hub below its running maximum so far, as the arc R (max - angle).
 
@@ -34,7 +36,7 @@ from ipir_mujoco.core.results import REST_SPEED
 
 from ...builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
 from .model import HOUSINGS, contact_friction, leg_names, wheels_timestep
-from ...loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
+from ...loop.controller import SKID_SPEED, ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
 from ...loop.native import LayoutError
 from ...loop.rows import clutch_share, missing_rows
 from .compiled import load_wheel_ratchet
@@ -165,10 +167,12 @@ class WheelRatchet(ControllerBase):
                 shares.append(0.0)
                 continue
             hold = (limits[i] + friction[i]) / self.radius
+            speed = self._qvel.item(self.x_dof[i])  # along the pipe (its slide along x)
             if normal[i] > 0.0:
                 skids = tangential[i] >= self.cone * normal[i]
             else:
-                skids = self._qvel.item(self.x_dof[i]) < -REST_SPEED
+                skids = speed < -REST_SPEED
+            skids = skids or speed < -SKID_SPEED  # held modules stand (.controller.SKID_SPEED)
             states.append(SKIDDING if skids else STANDING)
             shares.append(clutch_share(hold, self.resistance[i]))
         self._states = (self.data.time, (states, shares))
