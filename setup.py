@@ -38,8 +38,9 @@ def mujoco_build_paths() -> tuple[str, str]:
 
 # the compiled loop (loop/_stepper.c) and its clutch controllers' compiled forms (controllers/_clutch_*.c: one file per
 # family, their table in _clutch_table.c)
-STEPPER_SOURCES = ["ipir_mujoco/engine/loop/_stepper.c"] + [
-    f"ipir_mujoco/engine/controllers/_clutch_{name}.c" for name in ("table", "slides", "grip", "wheels")]
+STEPPER_SOURCES = ["ipir_mujoco/engine/loop/_stepper.c", "ipir_mujoco/engine/controllers/_clutch_table.c"] + [
+    f"ipir_mujoco/engine/kinds/{kind}/_clutch_{name}.c"
+    for kind, name in (("slides", "slides"), ("slides_grip", "grip"), ("wheels", "wheels"))]
 STEPPER_HEADERS = ["ipir_mujoco/engine/loop/_stepper.h", "ipir_mujoco/engine/controllers/_clutch_parts.h"]
 
 

@@ -12,6 +12,7 @@ inverse kinetostatics.
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.older_paths import keep_older_paths
+from ipir_mujoco.core.options import CLUTCH_RULES
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, refuse_idle_parameters, require_params
 from ipir_mujoco.core.results import COLUMNS, MODE_NAMES, Mode, RunResult
 
@@ -20,7 +21,6 @@ from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
 from .unilateral_run import simulate_unilateral
 
-CLUTCH_RULES = ("kinematic", "unilateral")
 
 # a model's modes or regimes are in *_model.py, the loop that runs it in *_run.py; their older names:
 keep_older_paths({f"{__name__}.{older}": f"{__name__}.{now}" for older, now in (

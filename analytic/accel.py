@@ -29,6 +29,8 @@ import threading
 import time
 from pathlib import Path
 
+from ipir_mujoco.core.options import HEARTBEAT_S  # s between two "still compiling" lines
+
 MODES = ("auto", "1", "0")
 MODE = os.environ.get("IPIR_MUJOCO_JIT", "auto").strip().lower() or "auto"
 if MODE not in MODES:  # an unknown value means what it would mean to numba users: leave the default
@@ -95,7 +97,6 @@ def accelerate() -> bool:
     return True
 
 
-HEARTBEAT_S = 10.0  # s between two "still compiling" lines
 HEARTBEAT_MAX = 30  # lines at most (5 min): where the cache cannot be written, compiling never shows as done
 
 

@@ -44,16 +44,13 @@ from .forces import drive_torque
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
 from .roots import brentq
-from .solver_support import RunMonitor, check_finite, check_tolerances, sample_times, truncate
+from .solver_support import MAX_REGIME_CHANGES, RunMonitor, check_finite, check_tolerances, sample_times, truncate
 
 # DOP853 by measurement (paper's case, 1 s): 3-5x faster than Radau at k = 1e5..1e7 N/m, also with
 # near-critical damping; LSODA's event location let the stick/slip states chatter, so it is not offered
 METHODS = ("DOP853", "Radau")
 # more zero-length segments in a row than this is chatter, not motion
 _MAX_STALLED_SEGMENTS = 50
-# regime changes a run may make unless told otherwise: the clutches engage, clamp and release within every
-# stroke, and stick/slip states change at each, so ten times the rigid models' budget
-MAX_SWITCHES = 1_000_000
 _BUDGET_CHECK_EVERY = 2000  # right-hand-side calls between wall-clock checks
 
 
@@ -66,7 +63,7 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
     clutch springs' oscillations are undamped or lightly damped, so they must be resolved, which
     an explicit method does cheapest). ``run``: the run options every engine takes
     (:class:`ipir_mujoco.core.options.RunOptions`; ``max_switches`` counts regime changes,
-    default :data:`MAX_SWITCHES`; the wall-time budget is checked between segments and within long
+    default :data:`.solver_support.MAX_REGIME_CHANGES`; the wall-time budget is checked between segments and within long
     ones), run by :class:`.solver_support.RunMonitor` as in the other analytic models. Initial
     module velocities from (phi0, omega0): module 1 at rest unless the gap shrinks, as in the
     other engines.
@@ -79,7 +76,7 @@ def simulate_compliant(params: RobotParams, geometry: Geometry | str = Geometry.
                              "allowed: 0 < clutch_stiffness <= 1e12 N/m")
     if method not in METHODS:
         raise ParameterError(f"method={method!r} is unknown; allowed: {', '.join(METHODS)}")
-    monitor = RunMonitor(options, params.phi0, MAX_SWITCHES)
+    monitor = RunMonitor(options, params.phi0, MAX_REGIME_CHANGES)
     model = CompliantModel(params, geometry)
     budget = _Budget(monitor)
     grid = np.linspace(0.0, t_end, max(1, math.ceil(t_end / dt_out - 1e-9)) + 1)

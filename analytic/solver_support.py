@@ -131,8 +131,11 @@ def graze_signs(sol, guards) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 PROGRESS_EVERY_S = 0.1  # simulated seconds between two progress calls, at least
 # mode switches a run of the rigid-clutch models may make unless told otherwise (a work budget for designs that
-# chatter; the compliant model, whose clutches engage and release within each stroke, sets its own)
+# chatter)
 MAX_SWITCHES = 100_000
+# regime changes a run of the compliant model may make unless told otherwise: its clutches engage, clamp and release
+# within every stroke, and stick/slip states change at each, so ten times the rigid models' budget
+MAX_REGIME_CHANGES = 10 * MAX_SWITCHES
 # a run whose mode switches stop advancing time is stuck (Zeno chatter, or a design at a degenerate limit such as
 # r = 5e-324 m, where each switch leaves the state where it was): STUCK_SWITCHES switches in a row within
 # STUCK_TIME (relative to 1 + t) of the first of them end it with that reason, rather than after spending

@@ -142,12 +142,12 @@ def solver_iterations(smoke: bool) -> None:
     1e-12) and with ten and four times the iterations (``--solver-iterations``): whether the bend's drift with
     the step is MuJoCo's solver stopping short of convergence (the figures would move with the iterations) or
     the discretization itself (they would not)."""
-    from ipir_mujoco.engine.modelkinds import kinds
+    from ipir_mujoco.engine.kinds.wheels import model as wheels_model
 
     params, t_end, tables = CASES["bend"]
     route = route_from_tables(tables, "bend.toml")
     t_end, steps = (0.05, (1e-4,)) if smoke else (t_end, (2.5e-5, 1.25e-5))
-    build = kinds.build_wheels_model
+    build = wheels_model.build_wheels_model
     print("| step [s] | iterations / line search | revolutions | x1 [m] | x2 [m] | along the route [m] |")
     print("|---|---|---|---|---|---|")
     try:
@@ -162,13 +162,13 @@ def solver_iterations(smoke: bool) -> None:
                 def built(params, settings, *, mjcf=None, route=None, decorate=None):
                     return build(params, settings, mjcf=mjcf, route=route,
                                  decorate=lambda spec: more(spec, decorate))
-                kinds.build_wheels_model = built  # the one place the wheeled kind compiles its model
+                wheels_model.build_wheels_model = built  # the one place the wheeled kind compiles its model
                 s = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, timestep=dt, route=route).summary
                 shown = "the model's (100 / 50)" if iterations is None else f"{iterations} / {line}"
                 print(f"| {dt:g} | {shown} | {s['revolutions']:.6g} | {s['x1_final']:.6g} | {s['x2_final']:.6g} | "
                       f"{s['route_s_m']:.6g} |", flush=True)
     finally:
-        kinds.build_wheels_model = build
+        wheels_model.build_wheels_model = build
 
 
 def main(argv=None) -> int:

@@ -37,16 +37,18 @@ from typing import Any, Callable, Sequence
 from . import interrupts
 from .core.control import FeedforwardTable
 from .core.errors import ParameterError, ParameterTypeError
+from .core.options import CLUTCH_RULES as RULES  # the clutch rules (--clutch)
 from .core.options import check_type
 from .core.params import RobotParams, check_real, check_whole, require_params
 from .core.results import RunResult
+from .engine.kinds import KINDS  # the model kinds' declarations (no MuJoCo: engine/kinds/__init__.py)
+from .engine.kinds.base import MUJOCO_CLUTCHES  # the MuJoCo clutches a variant names (--mujoco-clutch)
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
 # beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
 # the public surface: they may change with them)
 
 ENGINES = ("analytic", "mujoco")  # the two engines; a variant (VARIANTS) is one model in one of them
-RULES = ("kinematic", "unilateral")
 
 
 @dataclass(frozen=True)
@@ -90,11 +92,9 @@ VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("analytic-approx-unilateral", "analytic", "unilateral", "approx", None,
             "analytic first order, one-way clutches"),
     Variant("analytic-unilateral", "analytic", "unilateral", "exact", None, "analytic one-way clutches"),
-    Variant("mujoco-lock", "mujoco", "kinematic", "exact", "lock", "MuJoCo, paper's rule"),
-    Variant("mujoco-lock-unilateral", "mujoco", "unilateral", "exact", "lock", "MuJoCo one-way locks"),
-    Variant("mujoco-ratchet", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo ratchet"),
-    Variant("mujoco-wheels", "mujoco", "unilateral", "exact", "ratchet", "MuJoCo wheels in contact", "wheels",
-            "one-way ratchets in the wheels' hubs", "wheels, hub ratchets", routes=True),
+    # MuJoCo's: each model kind declares its own (engine/kinds/<kind>/__init__.py), in the kinds' order
+    *(Variant(engine="mujoco", geometry="exact", model=kind.model, **row) for kind in KINDS.values()
+      for row in kind.variants),
 )}
 ALIASES = {
     "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
@@ -165,8 +165,8 @@ def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str 
     if clutch == "ratchet" and rule == "kinematic":
         raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
                              "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
-    if clutch not in ("ratchet", "lock"):
-        raise ParameterError(f"--mujoco-clutch {clutch!r} is unknown; allowed: ratchet, lock")
+    if clutch not in MUJOCO_CLUTCHES:
+        raise ParameterError(f"--mujoco-clutch {clutch!r} is unknown; allowed: {', '.join(MUJOCO_CLUTCHES)}")
     return _find(engine, rule, "exact", clutch)
 
 
@@ -219,14 +219,14 @@ def prepare_for_many(names) -> None:
 def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: float, route=None) -> float | None:
     """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s] (along
     ``route``, a :class:`ipir_mujoco.core.route.Route`, for the wheeled model): the
-    variant's model kind's (:meth:`ipir_mujoco.engine.modelkinds.kinds.ModelKind.settings`), the step every such run
+    variant's model kind's (:meth:`ipir_mujoco.engine.kinds.base.ModelKind.settings`), the step every such run
     starts from; a run whose modules skid (finite grip on the slides, the wheels) is kept at this step halved as
     many times as its skid check records (``RunResult.settings['skid_check']``, one entry a halving; its
     ``settings['timestep']`` is the step kept); None for the analytic engines."""
     v = variant(name)
     if not v.is_mujoco:
         return None
-    from .engine.modelkinds.kinds import kind_for
+    from .engine.kinds import kind_for
 
     return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch, route=route)[0].timestep
 
@@ -365,7 +365,7 @@ def batched(name: str | Variant) -> bool:
 def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float, dt_out: float, *,
               nthread: int = 1, until_steady: bool = False) -> list[dict]:
     """The variant on many designs at once through ``mujoco.batch`` (:func:`batched` variants only): one
-    outcome per design, as :func:`ipir_mujoco.engine.run.batch.run_ratchet_batch` gives them."""
+    outcome per design, as :func:`ipir_mujoco.engine.kinds.slides.batch.run_ratchet_batch` gives them."""
     if not batched(name):
         raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
     if not isinstance(designs, (list, tuple)):
@@ -374,7 +374,7 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
         require_params(params)
     check_whole("nthread", nthread, low=1, high=1024)
     check_type("until_steady", until_steady, bool, "True or False")
-    from .engine.run import batch
+    from .engine.kinds.slides import batch
 
     steady = {"until_steady": True} if until_steady else {}
     with interrupts.as_keyboard_interrupt():  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design
@@ -383,9 +383,9 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
 
 
 def batch_models(params: RobotParams) -> bool:
-    """Whether the batched engine models the design (:data:`ipir_mujoco.engine.run.batch.MODELLED_DRIVES`, rigid
+    """Whether the batched engine models the design (:data:`ipir_mujoco.engine.kinds.slides.batch.MODELLED_DRIVES`, rigid
     clutches); others run serially."""
-    from .engine.run import batch
+    from .engine.kinds.slides import batch
 
     return params.drive in batch.MODELLED_DRIVES and params.clutch_stiffness is None
 

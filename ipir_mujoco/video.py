@@ -34,16 +34,15 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import Mode, RunResult
 
+from .engine.kinds.base import HOUSINGS  # the modules' housings, coloured by their clutches (every kind's model)
 from .labels import fixed
 
 HELD_RGBA = (0.15, 0.7, 0.3, 1.0)  # the clutch holds the module to the pipe
 FREE_RGBA = (0.6, 0.68, 0.85, 1.0)  # the module slides forward (grey-blue)
-HOUSINGS = ("rear_housing", "front_housing")
 OVERLAY_MIN_WIDTH = 320  # px: narrower frames show the robot without the text
 ROUTE_VIEW_DISTANCE = 0.9  # m: the camera above the plane along a route (fovy 45 deg: 0.75 m of it in a frame's
 # height, 0.41 m between the texts: the robot, 0.4 m long, and its pipe, 0.16 m wide by default, fit there)
 SIDE_VIEW = (90.0, -50.0)  # deg: the camera's azimuth and elevation without a route
-PIPE_RGBA = (0.35, 0.45, 0.6, 0.55)  # the slide model's pipe, cut away: more opaque than a whole translucent tube
 LIBRARIES = {"egl": ("EGL", "EGL (Debian: apt-get install libegl1)"),
              "osmesa": ("OSMesa", "OSMesa (Debian: apt-get install libosmesa6)")}
 
@@ -153,24 +152,11 @@ def checker_floor(spec) -> None:
     spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]
 
 
-def in_pipe(spec, params: RobotParams, facing=None) -> None:
-    """Draw the slide model's round pipe around it (drawing only, :func:`.engine.builders.pipe_drawing.draw_pipe`): with
-    ``facing`` (the camera's view direction) its far half, the near half cut away; without, the whole tube,
-    translucent. The floor moves under the pipe."""
-    from .engine.builders.pipe_drawing import RGBA, draw_pipe
-    from .engine.builders.pipe_walls import wall_pieces
-
-    D = params.pipe_diameter
-    draw_pipe(spec, wall_pieces(None, D, 0.0), D, facing=facing, rgba=RGBA if facing is None else PIPE_RGBA)
-    floor = spec.geom("pipe_floor")
-    floor.pos = [floor.pos[0], floor.pos[1], -0.5 * D - 0.01]
-
-
 def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: float,
                held: tuple[bool, bool], free: str = "slides") -> tuple[str, str]:
     """The overlay's (labels, values) of the robot's state: crank speed and turns, each module's speed and
     whether its clutch holds (times [s], angles [rad], speeds [rad/s, m/s]); ``free``: what a module not held
-    does, the drawing's word (:attr:`SlideDrawing.free`: it slides on its slide, or rolls on its wheels)."""
+    does, the drawing's word (the model kind's ``free``: it slides on its slide, or rolls on its wheels)."""
     words = ("holds (green)", free)
     values = (f"{fixed(omega, 1)} rad/s, {fixed((phi - phi0) / (2 * math.pi), 2)} rev\n"
               f"{fixed(v1, 2)} m/s, clutch {words[0] if held[0] else words[1]}\n"
@@ -178,43 +164,15 @@ def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: f
     return "crank\nmodule 1 (rear)\nmodule 2 (front)", values
 
 
-class SlideDrawing:
-    """How render and the viewer draw MuJoCo's slide model (unlimited or finite grip, and any analytic run):
-    its drawing model in the round pipe, the near half cut away; a module its clutch does not hold slides."""
-
-    free = "slides"  # what a module does while its clutch does not hold (the overlay's word)
-
-    def spec(self, params: RobotParams, route=None):
-        """The drawing model's ``mujoco.MjSpec`` (a slide model takes no route)."""
-        from .engine.builders.model import build_spec
-
-        spec = build_spec(params)
-        in_pipe(spec, params, view_direction(*SIDE_VIEW))  # the near half cut away
-        return spec
-
-
-class WheelsDrawing(SlideDrawing):
-    """How render and the viewer draw the wheeled model: its pipe walls and wheels as its build makes them
-    (along ``route``, built as the run built them); a module its clutch does not hold rolls on its wheels."""
-
-    free = "free, rolls"
-
-    def spec(self, params: RobotParams, route=None):
-        from .engine.builders.wheels_model import build_wheels_spec
-
-        return build_wheels_spec(params, route=route)
-
-
-# the drawing of each MuJoCo model (``registry.MUJOCO_MODELS``, a run's ``settings["mujoco_model"]``)
-DRAWINGS = {"slides": SlideDrawing(), "wheels": WheelsDrawing()}
-
-
 def _render_model(params: RobotParams, settings: VideoSettings, model: str = "slides", route=None):
     """The robot's MuJoCo model for drawing only: a 5 cm checker floor, an offscreen buffer of the frame size;
-    ``model``: the MuJoCo model drawn (:data:`DRAWINGS`; the wheeled model's pipe walls and wheels drawn too);
-    ``route``: its walls along the route, built as the run built them
-    (:func:`ipir_mujoco.engine.builders.wheels_model.build_wheels_spec`)."""
-    spec = DRAWINGS[model].spec(params, route)
+    ``model``: the MuJoCo model drawn (its model kind's drawing, :meth:`ModelKind.drawing
+    <ipir_mujoco.engine.kinds.base.ModelKind.drawing>`: the slide model in its pipe, seen from the side, the near
+    half cut away; the wheeled model's pipe walls and wheels); ``route``: its walls along the route, built as the
+    run built them."""
+    from .engine.kinds import drawn
+
+    spec = drawn(model).drawing(params, route, view_direction(*SIDE_VIEW))
     checker_floor(spec)
     spec.visual.global_.offwidth = settings.width
     spec.visual.global_.offheight = settings.height
@@ -251,6 +209,8 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
     check_route_run(run, route)
     context = _open_context(settings.width, settings.height)
     params, s = run.params, run.series
+    from .engine.kinds import drawn as drawn_kind
+
     drawn = run.settings.get("mujoco_model", "slides")  # the slide model's drawing for runs that record none
     model = _render_model(params, settings, drawn, route)
     data = mujoco.MjData(model)
@@ -293,7 +253,7 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
                                f"{title}\nt = {when:.3f} s{along}", f"\n{settings.speed:g}x real time", renderer)
             labels, values = state_text(when, phi, float(s["phi"][0]), float(np.interp(when, t, s["omega"])),
                                         float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held,
-                                        DRAWINGS[drawn].free)
+                                        drawn_kind(drawn).free)
             mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels,
                                values, renderer)
             yield _read_frame(settings, viewport, renderer)

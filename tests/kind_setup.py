@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ipir_mujoco import registry
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.engine.modelkinds import kinds
+from ipir_mujoco.engine import kinds
 from ipir_mujoco.engine.run.run_setup import RunSetup
 
 

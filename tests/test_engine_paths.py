@@ -43,7 +43,8 @@ ONE_FOLDER = ("batch", "block_checks", "common", "compiled_grip", "compliant", "
 
 
 def test_every_module_of_the_one_folder_engine_has_its_older_path():
-    missing = [name for name in ONE_FOLDER if f"{engine.__name__}.{name}" not in engine.OLDER_PATHS]
+    # kinds: a module then, the kinds' package now (which keeps its names)
+    missing = [name for name in ONE_FOLDER if f"{engine.__name__}.{name}" not in engine.OLDER_PATHS and name != "kinds"]
     assert missing == []
     assert all(older in OLDER_PATHS for older in engine.OLDER_PATHS)
 

@@ -14,7 +14,8 @@ from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.core.options import RepeatProgress
 from ipir_mujoco.cli import main
 from ipir_mujoco.engine import simulate_mujoco
-from ipir_mujoco.engine.modelkinds import kinds
+from ipir_mujoco.engine import kinds
+from ipir_mujoco.engine.kinds import timestep
 from ipir_mujoco.engine.run import simulate as engine_simulate
 from ipir_mujoco.engine.builders.model import SolverSettings
 from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
@@ -94,8 +95,8 @@ def test_the_monitor_stops_a_coarse_run_and_warn_records_it(capsys, tmp_path, mo
 def test_an_automatic_step_that_fails_the_monitor_is_halved(monkeypatch):
     """Whatever the motion bounds miss is caught: a step of 4e-4 s (residual -5e-3 at the paper's case)
     fails, and the engine repeats the run at half the step until it passes."""
-    chosen = kinds.choose_settings  # the slide kind's timestep rule, which every run asks
-    monkeypatch.setattr(kinds, "choose_settings",
+    chosen = timestep.choose_settings  # the slide kind's timestep rule, which every run asks
+    monkeypatch.setattr(timestep, "choose_settings",
                         lambda *args: (SolverSettings(timestep=4e-4), chosen(*args)[1]))
     run = simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.8, dt_out=4e-4)
     failed = run.settings["refinements"]
@@ -228,8 +229,8 @@ def test_progress_never_goes_back_across_a_halved_step_and_the_repeat_says_where
     """The first attempt at 4e-4 s reports progress until the monitor stops it; the repeat at half the step
     reports all along, as RepeatProgress values that never go below what was reported (a user's progress never
     goes back) and carry the repeat's own time, step and attempt; it still reaches the end."""
-    chosen = kinds.choose_settings  # the slide kind's timestep rule, which every run asks
-    monkeypatch.setattr(kinds, "choose_settings",
+    chosen = timestep.choose_settings  # the slide kind's timestep rule, which every run asks
+    monkeypatch.setattr(timestep, "choose_settings",
                         lambda *args: (SolverSettings(timestep=4e-4), chosen(*args)[1]))
     attempts, seen = [], []
     real = engine_simulate._Run

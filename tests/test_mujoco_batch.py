@@ -69,13 +69,13 @@ def test_batch_stops_steady_and_stalled_designs():
 def test_batch_halves_an_automatic_step_that_fails(monkeypatch):
     """As a serial run: an automatic step the monitor stops (4e-4 s, residual -7e-3 at the paper's
     case) is halved for that design only, and the design comes back within the tolerance."""
-    from ipir_mujoco.engine.modelkinds import kinds
+    from ipir_mujoco.engine.kinds import timestep
 
-    chosen = kinds.choose_settings  # the slide kind's rule, which the batch asks for every design
+    chosen = timestep.choose_settings  # the slide kind's rule, which the batch asks for every design
     def coarse(params, *args):
         return (SolverSettings(timestep=4e-4), {}) if params.M > 0.2 else chosen(params, *args)
 
-    monkeypatch.setattr(kinds, "choose_settings", coarse)
+    monkeypatch.setattr(timestep, "choose_settings", coarse)
     fast, gentle = run_ratchet_batch([RobotParams(), RobotParams(M=0.1)], 0.8, dt_out=4e-3, nthread=1)
     assert [h["timestep"] for h in fast["settings"]["refinements"]][0] == 4e-4
     assert fast["settings"]["timestep"] < 4e-4 and fast["accuracy"]["ok"] and "error" not in fast

@@ -11,7 +11,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.engine import compiled_mjcf, simulate_mujoco
 from ipir_mujoco.engine.run.export import KEYFRAME
-from ipir_mujoco.engine.modelkinds.kinds import kind_for
+from ipir_mujoco.engine.kinds import kind_for
 from ipir_mujoco.engine.run.run_setup import RunSetup
 
 from cli_run import run_cli

@@ -356,10 +356,11 @@ def test_the_viewer_draws_the_checker_floor_and_says_time_and_speeds():
 def test_the_overlay_says_a_free_wheeled_module_rolls():
     """A module whose clutch does not hold slides on its slide, but rolls on its wheels: the overlay's word
     follows the model (render and the viewer share state_text)."""
-    from ipir_mujoco.video import DRAWINGS, state_text
+    from ipir_mujoco.engine.kinds import drawn
+    from ipir_mujoco.video import state_text
 
     _, slides = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True))
-    _, wheels = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True), DRAWINGS["wheels"].free)
+    _, wheels = state_text(0.1, 1.0, 0.0, 20.0, 0.5, 0.0, (False, True), drawn("wheels").free)
     assert slides.splitlines()[1].endswith("clutch slides") and wheels.splitlines()[1].endswith("clutch free, rolls")
     assert slides.splitlines()[2] == wheels.splitlines()[2] == "0.00 m/s, clutch holds (green)"
 

@@ -23,7 +23,7 @@ def add_parser(commands) -> None:
                      help="video file, .gif (default inchworm.gif) or .mp4 (pip install 'ipir-mujoco[video]')")
     ren.add_argument("--clutch", choices=registry.RULES, default="unilateral",
                      help="unilateral: one-way clutches (default); kinematic: the paper's rule (locks)")
-    ren.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+    ren.add_argument("--mujoco-clutch", choices=registry.MUJOCO_CLUTCHES, default=None,
                      help="ratchet (default with unilateral) or lock (default with kinematic)")
     ren.add_argument("--mujoco-model", choices=registry.MUJOCO_MODELS, default="slides",
                      help="MuJoCo's model: slides (default) or wheels (the robot on wheels in its pipe, walls and "

@@ -32,7 +32,7 @@ def add_parser(commands) -> None:
                      help="kinematic: the paper's rule, lock by the sign of S_dot (default); "
                           "unilateral: one-way clutches that can only push (the default and only choice with "
                           "--mujoco-model wheels)")
-    sim.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+    sim.add_argument("--mujoco-clutch", choices=registry.MUJOCO_CLUTCHES, default=None,
                      help="MuJoCo clutch implementation: joint-limit ratchet (default with --clutch unilateral) "
                           "or velocity-triggered lock (default with --clutch kinematic)")
     sim.add_argument("--mujoco-model", choices=registry.MUJOCO_MODELS, default="slides",

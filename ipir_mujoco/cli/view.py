@@ -4,7 +4,7 @@ The one entry point beside the registry that steps the MuJoCo engine itself: the
 model and data between steps, which a finished run does not give.
 
 The shipped MJCF alone does not crawl: its one-way clutches are not MJCF
-elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.clutches`),
+elements but the engine's Python controllers (:mod:`ipir_mujoco.engine.kinds`),
 which move a joint limit or switch a lock before every step. This command
 builds the model from a parameter set exactly as ``simulate --engine mujoco``
 does and steps it in a passive viewer loop with the engine's own stepping loop
@@ -38,10 +38,10 @@ from ipir_mujoco.core.control import SpeedController
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from ..engine.modelkinds.kinds import kind_for
+from ..engine.kinds import kind_for
 from ..engine.builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, SolverSettings
 from ..engine.run.run_setup import RunSetup
-from ..video import DRAWINGS, FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, in_pipe, state_text
+from ..video import FREE_RGBA, HELD_RGBA, HOUSINGS, checker_floor, state_text
 from .common import EXIT_BAD_INPUT, EXIT_OK, Parser, add_model_options, model_params
 
 
@@ -49,7 +49,7 @@ class ViewedRobot:
     """The model, its data and the engine's clutch controller, stepped by the engine's stepping loop.
 
     Refuses (ParameterError, one line) exactly the parameters and clutch choices ``simulate_mujoco``
-    refuses (the model kind's :meth:`ipir_mujoco.engine.modelkinds.kinds.ModelKind.check`), and builds and starts the
+    refuses (the model kind's :meth:`ipir_mujoco.engine.kinds.base.ModelKind.check`), and builds and starts the
     robot as a run does (:class:`ipir_mujoco.engine.run.run_setup.RunSetup`).
     """
 
@@ -59,13 +59,12 @@ class ViewedRobot:
         self.implementation = implementation or ("lock" if clutch == "kinematic" else "ratchet")
         kind = kind_for(model, params)
         params = kind.check(params, self.implementation, clutch, route)  # the route's incline
-        self.params, self.free = params, DRAWINGS[kind.model].free  # the overlay's word
+        self.params, self.free = params, kind.free  # the overlay's word
         if settings is None:  # the step the engine would choose for a run of t_end [s]
             settings, _ = kind.settings(params, t_end, 1e-3, None, self.implementation, route=route)
         self.settings = settings
         def decorate(spec):
-            if not kind.pipe_built:  # the slide model in its pipe, whole and translucent: the viewer's camera turns
-                in_pipe(spec, params)
+            kind.dress(spec, params)  # the slide model in its pipe, whole and translucent: the viewer's camera turns
             checker_floor(spec)
 
         self.setup = RunSetup(kind, params, settings, implementation=self.implementation, rule=clutch, route=route,
@@ -115,7 +114,7 @@ def build_parser() -> Parser:
                                 "(the engine's own clutch controller runs in the viewer loop).")
     parser.add_argument("--clutch", choices=("unilateral", "kinematic"), default="unilateral",
                         help="unilateral: one-way clutches (default); kinematic: the paper's rule")
-    parser.add_argument("--mujoco-clutch", choices=("ratchet", "lock"), default=None,
+    parser.add_argument("--mujoco-clutch", choices=registry.MUJOCO_CLUTCHES, default=None,
                         help="ratchet (default with unilateral) or lock (default with kinematic)")
     parser.add_argument("--mujoco-model", choices=("slides", "wheels"), default="slides",
                         help="slides: the modules on slide joints (default); wheels: on wheels in the pipe")

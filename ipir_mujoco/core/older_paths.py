@@ -38,4 +38,6 @@ def keep_older_paths(table: dict[str, str]) -> None:
     """Make each older dotted name of ``table`` import the module named by its value (installs the finder once)."""
     OLDER_PATHS.update(table)
     if not any(isinstance(finder, _OlderPaths) for finder in sys.meta_path):
-        sys.meta_path.append(_OlderPaths())
+        # first: an older package path (``engine.modelkinds``) is a package now under another name, whose folder
+        # the path finder would search for the older path's modules and load a second copy of each
+        sys.meta_path.insert(0, _OlderPaths())

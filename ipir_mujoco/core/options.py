@@ -189,7 +189,11 @@ def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable
     return progress
 
 
-HEARTBEAT_S = 10.0  # s of wall time between two "still running" lines of one long step
+# the clutch rules every engine takes: the paper's (its locks switch by the sign of the gap's rate S_dot) and
+# one-way clutches (they only push)
+CLUTCH_RULES = ("kinematic", "unilateral")
+# s of wall time between two "still running" lines of one long step (and of the compiling analytic kernels')
+HEARTBEAT_S = 10.0
 
 
 class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)

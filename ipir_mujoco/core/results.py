@@ -143,7 +143,7 @@ class RunResult:
     ``accuracy`` is the engine's own accuracy record (MuJoCo: at least
     ``residual_ratio`` and ``loop_gap_m``), or None. ``route`` is None, or a
     run along a route's summary keys (``route_done``, ``route_time_s``,
-    ``route_stop``, ...: ``ipir_mujoco.engine.modelkinds.route_watch``).
+    ``route_stop``, ...: ``ipir_mujoco.engine.kinds.wheels.route_watch``).
 
     Parameters
     ----------

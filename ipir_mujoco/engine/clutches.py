@@ -1,10 +1,10 @@
-"""Shim: the slide model's clutches moved to :mod:`.controllers.slide_clutches`, the constraint rows to :mod:`.loop.rows` and the
-choice of a controller to the model kinds (:mod:`.modelkinds.kinds`); kept so that older imports keep working."""
+"""Shim: the slide model's clutches moved to :mod:`.kinds.slides.clutches`, the constraint rows to :mod:`.loop.rows` and the
+choice of a controller to the model kinds (:mod:`.kinds`); kept so that older imports keep working."""
 
-from .modelkinds.kinds import clutch_controller, refuse_grip
+from .kinds import clutch_controller, refuse_grip
 from .loop.rows import (EQUALITY_ROWS, FRICTION_DOF, FRICTION_TENDON, MISSING_ROWS, FrictionRows, clutch_share,
                    equality_row, missing_rows)
-from .controllers.slide_clutches import Locks, NoClutch, Ratchet, refuse_compliant
+from .kinds.slides.clutches import Locks, NoClutch, Ratchet, refuse_compliant
 
 __all__ = ["EQUALITY_ROWS", "FRICTION_DOF", "FRICTION_TENDON", "MISSING_ROWS", "FrictionRows", "Locks", "NoClutch",
            "Ratchet", "clutch_controller", "clutch_share", "equality_row", "missing_rows", "refuse_compliant",

@@ -75,7 +75,7 @@ def figure_crank(runs: Sequence[RunResult], labels: Sequence[str] | None = None)
 
 def figure_modules(runs: Sequence[RunResult], labels: Sequence[str] | None = None) -> Figure:
     """Paper's Fig. 3: module displacements (a), velocities (b), accelerations (c); along the route's
-    centreline (s) for runs along a route (their x and v columns are, :meth:`ipir_mujoco.engine.modelkinds.route_watch.RouteWatch.along_series`)."""
+    centreline (s) for runs along a route (their x and v columns are, :meth:`ipir_mujoco.engine.kinds.wheels.route_watch.RouteWatch.along_series`)."""
     fig, axes = new_figure(3)
     along = any(run.route is not None for run in runs)
     if along:

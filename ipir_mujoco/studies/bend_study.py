@@ -8,7 +8,7 @@ robot's centre (midway between A and C along the route) L / 2 before the bend (t
 2 after it (the rear module leaving it): a centreline length L + pi R / 2. (The centre moves more evenly than either
 module, which stands half of each revolution; its crossing times still carry about r / 2 / v, 0.05 s, of the
 stroke's ripple.) Its time and the motor's work over it come from the wheeled MuJoCo run (``mujoco-wheels`` with the
-route, the rear module's progress along the centreline, :mod:`ipir_mujoco.engine.modelkinds.route_watch`), with how it ended
+route, the rear module's progress along the centreline, :mod:`ipir_mujoco.engine.kinds.wheels.route_watch`), with how it ended
 (done, or where and why it stopped), the closed-form fit beside it, and how long wheels were off their walls.
 
 The references over the same length: the analytic finite-grip model's (``analytic-unilateral``) periodic
@@ -84,7 +84,7 @@ def case_route(params: RobotParams, ratio: float, plane: float = 0.0):
 def check_planes(planes: Sequence[float], params: RobotParams, ratio: float) -> None:
     """ParameterError (one line) for a plane out of -180..180 deg, or one the wheeled model cannot run (the
     model's own route check on the first case, before any run)."""
-    from ipir_mujoco.engine.modelkinds.kinds import kind_for
+    from ipir_mujoco.engine.kinds import kind_for
 
     if not planes:
         raise ParameterError("--planes is empty; allowed: one or more angles, -180..180 deg")

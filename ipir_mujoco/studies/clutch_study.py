@@ -61,7 +61,7 @@ from ipir_mujoco.core.cycles import cycles, steady_window
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams, check_whole
 
-from ..engine.modelkinds.timestep import clutch_rate
+from ..engine.kinds.timestep import clutch_rate
 from .pool import map_unordered
 
 

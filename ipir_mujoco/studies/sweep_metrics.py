@@ -204,7 +204,7 @@ def run_metrics(run) -> dict[str, float]:
 
 
 def batch_metrics(outcome: dict, steady_tol: float | None = None, steady_cycles: int | None = None) -> dict[str, float]:
-    """Metrics of one design of :func:`ipir_mujoco.engine.run.batch.run_ratchet_batch` (its ``series``,
+    """Metrics of one design of :func:`ipir_mujoco.engine.kinds.slides.batch.run_ratchet_batch` (its ``series``,
     ``motor_work_j``, ``friction_work_j`` and, where the batch gives them, ``accuracy`` and ``stall``)."""
     series = outcome["series"]
     options = {k: v for k, v in (("tol", steady_tol), ("n", steady_cycles)) if v is not None}

@@ -50,6 +50,8 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
+from . import RANGE_FAR  # m: a bound that never acts (the other side of each one-way limit)
+
 CARRIAGES = ("rear_carriage", "front_carriage")  # bodies
 SKIDS = ("rear_skid", "front_skid")  # the carriages' slides: c_i
 ROLLS = ("rear_roll", "front_roll")  # tendons L_i = x_i - c_i
@@ -60,7 +62,6 @@ CARRIAGE_SHARE = 3e-4
 COMPLIANT_CARRIAGE_SHARE = 1e-3  # compliant clutches: the spring on it sets the step (timestep.clutch_rate)
 BODY_MASS = 1e-12  # kg, inertia 1e-12 kg m^2: the carriage body's own (MuJoCo needs > 1e-15 on a moving body)
 MARGIN = 1e-9  # m: the one-way limits' margin, as the ratchet's (clutches.Ratchet)
-RANGE_FAR = 1e6  # m: a bound that never acts (the other side of each one-way limit)
 
 
 def carriage_share(params: RobotParams) -> float:

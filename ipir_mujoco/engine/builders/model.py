@@ -26,6 +26,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
 from ...resources import mjcf_dir
+from . import RANGE_FAR  # the slides' range beyond any run: only the lower bound ever acts
 from .grip_model import scale_grip_rows, write_grip
 
 REAR_SLIDE, FRONT_SLIDE, CRANK_HINGE, ROD_HINGE = "rear_slide", "front_slide", "crank_hinge", "rod_hinge"
@@ -36,8 +37,6 @@ SLIDES = (REAR_SLIDE, FRONT_SLIDE)  # the modules' slides, rear first
 # Share of m1 carried by the crank body; the rest is the module body. Both
 # translate with module 1, so the split changes nothing but must keep each > 0.
 CRANK_MASS_SHARE = 0.01
-# Slide range far beyond any run (1000 km): only the lower bound ever acts.
-RANGE_FAR = 1e6
 # A clutch actuator's force range is [0, this] N: it never pulls; the upper bound is MuJoCo's largest
 # state value (mjMAXVAL), far beyond any clutch force a run survives.
 CLUTCH_FORCE_MAX = 1e10

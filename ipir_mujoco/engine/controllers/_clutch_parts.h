@@ -25,12 +25,9 @@ static inline void compliant_before(const int64_t *cfg, const int64_t *p, double
                                     double speed) {
   mjtNum *ctrl = DATA(cfg)->ctrl, *biasprm = MODEL(cfg)->actuator_biasprm;
   const int64_t act = p[CPC_act0 + i];
-  const int tracking = coord - ps[CPS_backlash] > ps[CPS_anchor0 + i];
+  const int tracking = follow(&ps[CPS_anchor0 + i], coord - ps[CPS_backlash], 0) < 0.0; /* the anchor's running max */
   ps[CPS_tracking0 + i] = tracking ? 1.0 : 0.0;
-  if (tracking) {
-    ps[CPS_anchor0 + i] = coord - ps[CPS_backlash];
-    ctrl[act] = ps[CPS_anchor0 + i];
-  }
+  if (tracking) ctrl[act] = ps[CPS_anchor0 + i];
   const double d = ps[CPS_anchor0 + i] - coord;
   ps[CPS_overlap0 + i] = d;
   ps[CPS_v_before0 + i] = speed;
@@ -87,11 +84,11 @@ FIELDS(GRIP_STATE, GPS)
 static inline void carriage_ratchet(const int64_t *cfg, double *st, int i, double c) {
   const int64_t *g = BLOCK_CONFIG(cfg);
   double *gs = BLOCK_STATE(st);
-  if (c < gs[GPS_cmin0 + i]) {
-    gs[GPS_cmin0 + i] = c;
+  const double give = follow(&gs[GPS_cmin0 + i], c, 1);
+  if (give < 0.0) {
     MODEL(cfg)->jnt_range[2 * g[GPC_skid_j0 + i] + 1] = upper_bound(c, gs[GPS_cmargin0 + i]);
-  } else if (c - gs[GPS_cmin0 + i] > st[S_excursion]) {
-    st[S_excursion] = c - gs[GPS_cmin0 + i];
+  } else if (give > st[S_excursion]) {
+    st[S_excursion] = give;
   }
 }
 

@@ -41,6 +41,7 @@ enum { SCALAR_FIELDS(AS_ENUM) N_SCALARS };
 enum { DEFERRED_FIELDS(AS_ENUM) N_DEFERRED };
 #undef AS_ENUM
 _Static_assert((int)D_clutch_force1 == (int)DEFERRED_CLUTCH, "a controller's deferred part starts at clutch_force1");
+_Static_assert((int)N_DEFERRED == (int)DEFERRED_CLUTCH + (int)DEFERRED_VALUES, "a controller's deferred part ends the row");
 
 /* what record() returns besides STEPS_DONE: MuJoCo raised a warning in the last sample's interval */
 enum { RECORD_WARNED = 3 };
@@ -80,38 +81,23 @@ static int steps(const int64_t *cfg, double *st, long long nstep, double *dest) 
   mjData *d = DATA(cfg);
   const Controller *ctl = CONTROLLER(cfg);
   const mjtNum *qvel = d->qvel, *force = d->actuator_force;
-  const int64_t motor = cfg[C_motor], crank_v = cfg[C_crank_v], nfric = cfg[C_nfric];
-  const int64_t fa = cfg[C_fric_a], fb = cfg[C_fric_b];
+  const int64_t motor = cfg[C_motor], crank_v = cfg[C_crank_v];
   const double dt = st[S_dt], slope = st[S_slope];
   double torque = st[S_torque], wm = st[S_motor_work], wf = st[S_friction_work], omega_prev = st[S_omega_prev];
   double ws = st[S_skid_work];
   for (long long n = 0; n < nstep; n++) {
-    if (ctl->before_step != NULL) ctl->before_step(cfg, st);
+    ctl->before_step(cfg, st);
     if (n == nstep - 1 && dest != NULL) memcpy(dest, qvel, (size_t)m->nv * sizeof(mjtNum));
     mj_step(m, d);
-    int status = ctl->after_step != NULL ? ctl->after_step(cfg, st) : STEPS_DONE;
+    int status = ctl->after_step(cfg, st);
     if (status != STEPS_DONE) return status;
     double omega = qvel[crank_v];
     torque = force[motor] + slope * (omega - omega_prev);
     wm += torque * omega * dt;
-    if (ctl->work != NULL) { /* PythonSteps._friction_power: the controller's rows (finite grip, the wheels) */
-      double rolling, skidding;
-      if ((status = ctl->work(cfg, st, &rolling, &skidding)) != STEPS_DONE) return status;
-      wf -= rolling * dt;
-      ws -= skidding * dt;
-    } else {
-      /* the slides' frictionloss rows follow the ne equality rows, one per dof with friction: read only if there */
-      const mjtNum *efc_force = d->efc_force;
-      const int ne = d->ne;
-      if (nfric > 0 && d->nf != nfric) {
-        return MISSING_FRICTION_ROWS;
-      } else if (nfric == 2) {
-        double f0 = efc_force[ne], f1 = efc_force[ne + 1];
-        wf -= (f0 * qvel[fa] + f1 * qvel[fb]) * dt;
-      } else if (nfric == 1) {
-        wf -= efc_force[ne] * qvel[fa] * dt;
-      }
-    }
+    double rolling, skidding; /* the loop's work rates (PythonSteps' power): the resistances', against skidding */
+    if ((status = ctl->work(cfg, st, &rolling, &skidding)) != STEPS_DONE) return status;
+    wf -= rolling * dt;
+    ws -= skidding * dt;
     omega_prev = omega;
   }
   st[S_torque] = torque;
@@ -153,8 +139,9 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
   return STEPS_DONE;
 }
 
-/* Recorder.fill_deferred: MuJoCo's values at the start of the step just taken; with compliant clutches also
- * their forces, the overlaps their before_step set for that state and CompliantClutches.stepped_spring_energy */
+/* Recorder.fill_deferred: MuJoCo's values at the start of the step just taken and the controller's deferred values
+ * (ClutchController.deferred_values: the compliant clutches' forces, the overlaps their before_step set for that
+ * state and CompliantClutches.stepped_spring_energy; zeros for the others) */
 static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   const mjModel *m = MODEL(cfg);
   mjData *d = DATA(cfg);
@@ -168,10 +155,7 @@ static void fill_deferred(const int64_t *cfg, int64_t row, const double *st) {
   out[D_momentum] = d->subtree_linvel[0] * st[S_total_mass];
   out[D_potential] = d->energy[0];
   out[D_kinetic] = d->energy[1];
-  out[D_clutch_force1] = out[D_clutch_force2] = out[D_clutch_overlap1] = out[D_clutch_overlap2] = 0.0;
-  out[D_clutch_spring] = 0.0;
-  const Controller *ctl = CONTROLLER(cfg);
-  if (ctl->deferred != NULL) ctl->deferred(cfg, st, out + D_clutch_force1);
+  CONTROLLER(cfg)->deferred(cfg, st, out + D_clutch_force1);
 }
 
 /* how many warnings MuJoCo has raised on this mjData so far */
@@ -325,15 +309,13 @@ static PyObject *names(const char *const *list, int n) {
   return tuple;
 }
 
-/* the table of controllers: per controller (name, its CONFIG names, its STATE names, whether it has work rates
- * of its own), in their order */
+/* the table of controllers: per controller (name, its CONFIG names, its STATE names), in their order */
 static PyObject *controllers(void) {
   PyObject *table = PyTuple_New(N_CONTROLLERS);
   if (table == NULL) return NULL;
   for (int i = 0; i < N_CONTROLLERS; i++) {
     const Controller *c = CONTROLLERS[i];
-    PyObject *entry = Py_BuildValue("(sNNN)", c->name, names(c->config, c->n_config), names(c->state, c->n_state),
-                                    PyBool_FromLong(c->work != NULL));
+    PyObject *entry = Py_BuildValue("(sNN)", c->name, names(c->config, c->n_config), names(c->state, c->n_state));
     if (entry == NULL) {
       Py_DECREF(table);
       return NULL;

@@ -61,15 +61,15 @@ enum { STEPS_DONE = 0, MISSING_LOCK_ROW = 1, MISSING_FRICTION_ROWS = 2 };
  * states (+1.0 rolling, 0.0 standing, -1.0 skidding; 0.0 without wheels) */
 enum { N_REACTIONS = 6 };
 
-/* A clutch controller's compiled form: what the loop calls, and its block's names.
+/* A clutch controller's compiled form: what the loop calls, and its block's names; every function is given (the
+ * loop tests none of them: no_before_step, no_after_step and no_deferred below stand for nothing to do).
  *
- * before_step: the clutch update before each mj_step (NULL: none). after_step: its bookkeeping after the step
- * (NULL: none). work: its rows' work rates after the step [W], the resistances' (rolling) and the grips' or
- * contacts' against skidding (skidding), NULL where the slides' friction rows the loop is given are the only
- * ones (the controllers with work take the loop's grip or power options: stepper.py checks). reactions: the
- * sample's N_REACTIONS values. deferred: its clutch forces, overlaps and stepped spring energy at the start of
- * the next step into the recorder's deferred row (NULL: none, left 0). The int functions return STEPS_DONE or a
- * MISSING_* code. */
+ * before_step: the clutch update before each mj_step. after_step: its bookkeeping after the step. work: the work
+ * rates after the step [W] (the loop's option power: its load_compiled checks that it is the one this counts), the
+ * resistances' (rolling) and the grips' or contacts' against skidding (skidding). reactions: the sample's
+ * N_REACTIONS values. deferred: its clutch forces, overlaps and stepped spring energy at the start of the next step
+ * into the recorder's deferred row (ClutchController.deferred_values: DEFERRED_VALUES of them). The int functions
+ * return STEPS_DONE or a MISSING_* code. */
 typedef struct {
   const char *name;
   const char *const *config;
@@ -92,8 +92,27 @@ typedef struct {
 extern const Controller *const CONTROLLERS[];
 extern const int N_CONTROLLERS;
 
-/* what the recorder's deferred row holds after the loop's four values (_stepper.c's DEFERRED_FIELDS) */
-enum { DEFERRED_CLUTCH = 4 }; /* clutch_force1, clutch_force2, clutch_overlap1, clutch_overlap2, clutch_spring */
+/* what the recorder's deferred row holds after the loop's four values (_stepper.c's DEFERRED_FIELDS): the
+ * controller's DEFERRED_VALUES, clutch_force1, clutch_force2, clutch_overlap1, clutch_overlap2, clutch_spring */
+enum { DEFERRED_CLUTCH = 4, DEFERRED_VALUES = 5 };
+
+/* a table entry's functions where a controller has nothing to do: before a step, after it, no deferred values */
+static inline void no_before_step(const int64_t *cfg, double *st) {
+  (void)cfg;
+  (void)st;
+}
+
+static inline int no_after_step(const int64_t *cfg, double *st) {
+  (void)cfg;
+  (void)st;
+  return STEPS_DONE;
+}
+
+static inline void no_deferred(const int64_t *cfg, const double *st, double *out) {
+  (void)cfg;
+  (void)st;
+  for (int i = 0; i < DEFERRED_VALUES; i++) out[i] = 0.0;
+}
 
 /* first constraint row of equality eq (active): the active equalities' rows come first, in id order */
 static inline int64_t equality_row(const int64_t *cfg, int64_t eq) {
@@ -111,6 +130,15 @@ static inline double clutch_share(double hold, double resistance) {
   double bounded = -resistance > hold ? -resistance : hold;
   double pushed = 0.0 < bounded ? 0.0 : bounded;
   return hold - pushed;
+}
+
+/* controller.follow: a coordinate's running maximum (upper: minimum) *extreme after its new value; returns the
+ * value's give, how far it lies behind the extreme it had (> 0 where it went back), < 0 where it passed it (and
+ * *extreme is value now). The one rule of every ratchet: the controllers' compiled forms all follow through it. */
+static inline double follow(double *extreme, double value, int upper) {
+  const double give = upper ? value - *extreme : *extreme - value;
+  if (give < 0.0) *extreme = value;
+  return give;
 }
 
 /* controller.lower_bound / upper_bound: one margin below (above) value, moved by ulps until MuJoCo's distance

@@ -23,14 +23,11 @@ import importlib.util
 import mujoco
 import numpy as np
 
+from .controller import LayoutError  # noqa: F401  (the compiled loop's error: what it relies on does not hold)
 from .recorder import DEFERRED, SCALARS
 
 EXTENSION = f"{__package__}._stepper"
 REBUILD = "reinstall ipir-mujoco with pip's --no-build-isolation to build it against the running mujoco"
-
-
-class LayoutError(RuntimeError):
-    """What the compiled loop relies on does not hold here (the pure-Python loop is used instead)."""
 
 
 def address(array: np.ndarray) -> int:

@@ -16,9 +16,12 @@ force at the start of a step, from the anchor the controller has just set for
 that state, so a sample's ``lambda1``/``lambda2`` and ``clutch_overlap1``/
 ``clutch_overlap2`` describe the sample's own state.
 
-``mode`` comes from the clutch controller's held flags (a module stands); with
+``mode`` comes from the clutch controller's held flags (a module stands), which
+the controller may relabel (:meth:`.controller.ClutchController.modes`: with
 rigid clutches a sample where both stand while the crank turns is a passage
-through a dead centre and takes the mode it leads to (:func:`_dead_centre_passages`).
+through a dead centre and takes the mode it leads to). What differs by
+controller is the controller's to say (its sampled reactions, deferred values,
+columns and modes): the recorder holds no test on which controller runs.
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ from ipir_mujoco.core.results import COLUMNS, Mode
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from .controller import NO_WHEELS, held_where
+from .controller import NO_WHEELS
 from ..builders.model import CRANK_HINGE, FRONT_SLIDE, LOOP, REAR_SLIDE, ROD_HINGE, dof_address, pin_offset, qpos_address
 from .rows import equality_row
 
@@ -49,39 +52,9 @@ EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_g
 # the order against _stepper.c's)
 SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
            "friction_work", "clutch_damper_work", "skid_work", "wheels1", "wheels2")
-_NO_REACTIONS = (0.0, 0.0, 0.0, 0.0)  # a compliant clutch's sample, until its deferred forces (as _stepper.c)
 # MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
 DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
             "clutch_overlap2", "clutch_spring")
-
-
-def _dead_centre_passages(mode: np.ndarray, both: np.ndarray, turning: np.ndarray, *also: np.ndarray):
-    """``mode`` with each sample where both modules are held while the crank turns (at it or at the next
-    sample) given the mode of the next sample that is not such (arrays of shape (n,); both, turning: bool).
-    Arrays in ``also`` (of shape (n,): the wheels' states with finite grip) are relabeled alike, and then
-    returned after the mode, as a tuple.
-
-    With rigid clutches both modules stand still only where the crank is at rest, or for an instant as it
-    passes a dead centre (dS/dphi = 0): where one module stops just as the other starts, the equations
-    switch at once, and MuJoCo's step may order the two events a step apart, with both modules held for
-    that step. Such a passage belongs to the mode it leads to; so does the last sample at rest before the
-    crank turns (a start from rest, where the equations' module slides at once). A run that ends so keeps
-    its samples.
-    """
-    turning = turning | np.concatenate([turning[1:], turning[-1:]])
-    passing = both & turning
-    if not passing.any():
-        return (mode, *also) if also else mode
-    n = mode.size
-    # index of the first sample at or after each that is not a passage (n where none is)
-    following = np.minimum.accumulate(np.where(passing, n, np.arange(n))[::-1])[::-1]
-    relabel = passing & (following < n)
-    outs = []
-    for values in (mode, *also):
-        out = values.copy()
-        out[relabel] = values[following[relabel]]
-        outs.append(out)
-    return tuple(outs) if also else outs[0]
 
 
 class Recorder:
@@ -91,9 +64,8 @@ class Recorder:
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams, capacity: int,
                  controller, kind):
         self.model, self.data, self.params = model, data, params
-        # a controller whose forces are MuJoCo's at the sample's own state (the compliant clutches), or None
-        self.clutch = controller if controller.deferred else None
-        self.kind = kind  # the model kind (.kinds): its own columns
+        self.controller = controller  # its deferred values, columns and modes
+        self.kind = kind  # the model kind (ipir_mujoco.engine.kinds): its own columns
         self.qa = {n: qpos_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.va = {n: dof_address(model, n) for n in (CRANK_HINGE, REAR_SLIDE, FRONT_SLIDE, ROD_HINGE)}
         self.loop_id = model.equality(LOOP).id
@@ -119,10 +91,10 @@ class Recorder:
 
         ``torque`` [N m]: the drive's torque over the last step; ``motor_work``,
         ``friction_work``, ``damper_work`` (the compliant clutches' dampers) [J]:
-        cumulative; ``reactions``: the clutch controller's (rear held, front
-        held, rear reaction [N], front reaction [N]; a compliant clutch's are
-        read from its forces at the sample's own state, a step later, so they
-        are stored as none here); ``excursion`` [m]: its backward excursion so
+        cumulative; ``reactions``: the clutch controller's sampled reactions
+        (rear held, front held, rear reaction [N], front reaction [N]: none
+        where they are read from its deferred forces, a step later,
+        :meth:`.controller.ClutchController.sampled_reactions`); ``excursion`` [m]: its backward excursion so
         far; with finite grip ``skid_work`` [J]: the grips' cumulative work against skidding, and ``wheels``:
         each module's wheels (+1.0 rolling, 0.0 standing, -1.0 skidding).
         """
@@ -132,17 +104,15 @@ class Recorder:
         self.qvel[i] = d.qvel
         row = equality_row(self.model, d, self.loop_id)
         fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
-        if self.clutch is not None:
-            reactions = _NO_REACTIONS
         self.scalars[i] = (torque, fx, fy, *reactions, motor_work, friction_work, damper_work, skid_work, *wheels)
         self.excursion[i] = excursion
         self.count += 1
         return i
 
     def fill_deferred(self, i: int) -> None:
-        """Energies, loop gap, momentum, compliant clutch forces and overlaps and the springs' energy as the step
-        conserves it (:meth:`.compliant.CompliantClutches.stepped_spring_energy`) of sample ``i`` from MuJoCo's
-        current (start of step) values."""
+        """Energies, loop gap, momentum and the clutch controller's deferred values (its forces, overlaps and
+        springs' energy as the step conserves it: :meth:`.controller.ClutchController.deferred_values`) of sample
+        ``i`` from MuJoCo's current (start of step) values."""
         sx, sy, sz = self._rod_end.tolist()
         bx, by, bz = self._front_pos.tolist()
         ox, oy, oz = self.pin_offset
@@ -151,12 +121,7 @@ class Recorder:
         mujoco.mj_subtreeVel(self.model, self.data)
         momentum = self._subtree_linvel.item(0) * self.total_mass
         potential, kinetic = self._energy.tolist()
-        if self.clutch is None:
-            self.deferred[i] = (kinetic, potential, gap, momentum, 0.0, 0.0, 0.0, 0.0, 0.0)
-        else:
-            (f1, f2), (d1, d2) = self.clutch.forces(), self.clutch.overlap
-            self.deferred[i] = (kinetic, potential, gap, momentum, f1, f2, d1, d2,
-                                self.clutch.stepped_spring_energy())
+        self.deferred[i] = (kinetic, potential, gap, momentum, *self.controller.deferred_values())
 
     def series(self, last: int | None = None) -> dict[str, np.ndarray]:
         """Every column, for the samples 0..``last`` (default: all)."""
@@ -170,17 +135,14 @@ class Recorder:
         accel = (v - vb) / dt
         phi, omega = q[:, c], v[:, cv]
         beta = phi + q[:, rod]
-        if self.clutch is not None:  # a compliant clutch carries while it pushes, at the sample's own state
-            sc["lambda1"], sc["lambda2"] = de["clutch_force1"], de["clutch_force2"]
-            for k in ("1", "2"):  # held: carried and not skidding (.controller.held)
-                sc["held" + k] = held_where(de["clutch_force" + k] > 0, sc["wheels" + k]).astype(float)
+        clutch = self.controller.clutch_columns(sc, de)  # (deferred forces: its reactions and held flags into sc)
         held1, held2 = sc["held1"] > 0.5, sc["held2"] > 0.5
         mode = np.where(held1 & held2, int(Mode.BOTH_LOCKED),
                         np.where(held2, int(Mode.CONTRACTION),
                                  np.where(held1, int(Mode.EXPANSION), int(Mode.BOTH_MOVING))))
-        if self.clutch is None:  # rigid clutches: the wheels' states pass through a dead centre with the mode
-            mode, sc["wheels1"], sc["wheels2"] = _dead_centre_passages(
-                mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED, sc["wheels1"], sc["wheels2"])
+        # the wheels' states pass through a dead centre with the mode
+        mode, sc["wheels1"], sc["wheels2"] = self.controller.modes(
+            mode, held1 & held2, p.r * np.abs(omega) > REST_SPEED, sc["wheels1"], sc["wheels2"])
         out = {
             "t": self.t[:n].copy(), "phi": phi.copy(), "omega": omega.copy(), "alpha": accel[:, cv],
             "x1": q[:, r1] - q[0, r1], "x2": q[:, f2] - q[0, f2], "v1": v[:, r1v].copy(), "v2": v[:, f2v].copy(),
@@ -194,12 +156,7 @@ class Recorder:
             "motor_work": sc["motor_work"].copy(), "friction_work": sc["friction_work"].copy(),
             "kinetic": de["kinetic"].copy(), "potential": de["potential"] - de["potential"][0],
         }
-        if self.clutch is not None:
-            d1, d2 = de["clutch_overlap1"], de["clutch_overlap2"]
-            out.update({"clutch_overlap1": d1.copy(), "clutch_overlap2": d2.copy(),
-                        "clutch_spring_energy": 0.5 * self.clutch.k * (np.maximum(d1, 0.0) ** 2
-                                                                       + np.maximum(d2, 0.0) ** 2),
-                        "clutch_damper_work": sc["clutch_damper_work"].copy()})
+        out.update(clutch)
         out.update(self.kind.columns(self.model, p, q, sc, out))
         assert set(COLUMNS) <= set(out)
         return out

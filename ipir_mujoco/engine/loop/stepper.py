@@ -1,11 +1,12 @@
 """The stepping loop of a serial MuJoCo run: compiled (C) where it can be, the same loop in Python otherwise.
 
 Between two output samples a run takes k steps, and each step the engine
-updates the clutches before ``mj_step`` (:mod:`.clutches`, :mod:`.compliant`,
-:mod:`.grip`), does the clutches' bookkeeping after it and adds the drive's work
-and the work against the resistances (with finite grip also the grips' work
-against skidding; the rows it reads: :mod:`.loop_rows`); then it records the
-sample (:mod:`.recorder`).
+updates the clutches before ``mj_step`` (the model kind's clutch controller,
+:mod:`.controller`), does the clutches' bookkeeping after it and adds the drive's
+work and the work against the resistances and, where the model has any, against
+skidding (the work rates ``power(v)`` the model kind gives the loop: its rows'
+forces times their speeds); then it records the sample (:mod:`.recorder`). It
+holds no test on which model kind or controller runs.
 :class:`PythonSteps` is that loop in Python: :meth:`PythonSteps.record` takes a
 block of output intervals and records each. :class:`CompiledSteps` hands the
 block to ``_stepper.c`` (a C extension built at install time), which calls the
@@ -51,36 +52,38 @@ class PythonSteps:
 
     ``qvel_before`` (n_samples, nv): the recorder's array; before the last step of a call to
     :meth:`run` the velocities are copied into the row it names. ``torque`` [N m]: the drive's torque
-    from the initial ``mj_forward``. After each call: ``torque`` (over the last step) [N m],
-    cumulative ``motor_work`` and ``friction_work`` [J].
+    from the initial ``mj_forward``. ``power(v)``: the work rates after a step, ``v`` the velocities as a
+    list: (the resistances' rows' force times their speed, the rows' against skidding: a finite grip's, the
+    wheels' contacts') [W] (the model kind's, :meth:`ipir_mujoco.engine.kinds.base.ModelKind.loop_options`).
+    ``friction_dofs``: the dofs with friction whose rows follow the equality rows (the slides'; none where
+    ``power`` reads other rows), which the compiled loop and the slide controllers read. After each call:
+    ``torque`` (over the last step) [N m], cumulative ``motor_work``, ``friction_work`` and ``skid_work`` [J].
     """
 
     compiled = False
 
     def __init__(self, model, data, controller, qvel_before, *, motor, crank_q, crank_v, slope, friction_dofs,
-                 torque, servo=None, grip=None, power=None):
+                 torque, power, servo=None):
         self.model, self.data, self.controller, self.qvel_before = model, data, controller, qvel_before
         self.motor, self.crank_q, self.crank_v, self.slope = motor, crank_q, crank_v, slope
         self.friction_dofs, self.servo = list(friction_dofs), servo
         self.fric_a, self.fric_b = (self.friction_dofs + [0, 0])[:2]  # the slides' dofs (0: no row)
         self.torque, self.motor_work, self.friction_work = torque, 0.0, 0.0
         self.omega_prev = data.qvel.item(crank_v)
-        self.grip = grip  # a finite-grip model's friction rows (grip_layout), or None
-        self.skid_work = 0.0  # the grips' cumulative work against skidding [J] (finite grip)
-        # the wheeled model's work rates (.wheels.wheel_loop_options), in place of the slides' rows
+        self.skid_work = 0.0  # the cumulative work against skidding [J] (a finite grip's, the wheels' contacts')
         self.power = power
 
     def run(self, nstep: int, row: int = -1) -> None:
         """``nstep`` steps; the velocities before the last one go to ``qvel_before[row]`` (row >= 0).
 
         The inner loop works on Python floats (one ``tolist`` per array read). The work against the
-        resistances (and, with finite grip, the grips' work against skidding) is the friction rows' force
-        times the speed they act at after the step (:meth:`_friction_power`)."""
+        resistances (and against skidding) is the rows' force times the speed they act at after the step
+        (``power``)."""
         m, d, ctl = self.model, self.data, self.controller
         dt, qvel, qpos, ctrl = m.opt.timestep, d.qvel, d.qpos, d.ctrl
         step, before, after, servo = mujoco.mj_step, ctl.before_step, ctl.after_step, self.servo
         motor, cq, cv, slope = self.motor, self.crank_q, self.crank_v, self.slope
-        power = self._friction_power()
+        power = self.power
         torque, wm, wf, ws = self.torque, self.motor_work, self.friction_work, self.skid_work
         omega_prev = self.omega_prev
         for j in range(nstep):
@@ -90,8 +93,7 @@ class PythonSteps:
             if j == nstep - 1 and row >= 0:
                 self.qvel_before[row] = qvel
             step(m, d)
-            if after is not None:
-                after()
+            after()
             v = qvel.tolist()
             omega = v[cv]
             torque = d.actuator_force.item(motor) + slope * (omega - omega_prev)
@@ -102,45 +104,6 @@ class PythonSteps:
             omega_prev = omega
         self.torque, self.motor_work, self.friction_work, self.omega_prev = torque, wm, wf, omega_prev
         self.skid_work = ws
-
-    def _friction_power(self):
-        """``power(v)`` after a step, ``v`` the velocities as a list: (the resistances' rows' force times their
-        speed, the grips' rows' force times the carriages' speed) [W], as _stepper.c sums them. Without grip
-        the frictionloss rows follow the ne equality rows, one per slide; with finite grip the rolling
-        resistance acts at the roll's speed v_x - v_c (rigid clutches: a tendon) or the slide's v_x
-        (compliant ones), the grip at the carriage's v_c. A missing row is an error, not a zero."""
-        d = self.data
-        if self.power is not None:
-            return self.power
-        if self.grip is not None:
-            g = self.grip
-            count, tendon = g["count"], g["rolling_tendon"]
-            per_module = tuple(zip(g["roll"], g["grip"], g["x_dof"], g["c_dof"]))
-
-            def with_grip(v):
-                if d.nf != count:
-                    raise missing_rows(2, d.time)
-                ne, force, rolling, skidding = d.ne, d.efc_force, 0.0, 0.0  # the rows move in MuJoCo's arena
-                for roll, grip, x, c in per_module:
-                    if roll >= 0:
-                        rolling += force.item(ne + roll) * ((v[x] - v[c]) if tendon else v[x])
-                    if grip >= 0:
-                        skidding += force.item(ne + grip) * v[c]
-                return rolling, skidding
-            return with_grip
-        nfric, fa, fb = len(self.friction_dofs), self.fric_a, self.fric_b
-
-        def slides(v):
-            if nfric and d.nf != nfric:
-                raise missing_rows(2, d.time)
-            if nfric == 2:
-                ne = d.ne
-                f0, f1 = d.efc_force[ne:ne + 2].tolist()
-                return f0 * v[fa] + f1 * v[fb], 0.0
-            if nfric == 1:
-                return d.efc_force.item(d.ne) * v[fa], 0.0
-            return 0.0, 0.0
-        return slides
 
     def record(self, rec: Recorder, nsamples: int, sps: int, remaining: int, pending: int,
                messages: list[str]) -> tuple[int, int]:
@@ -165,8 +128,8 @@ class PythonSteps:
             taken += k
             if len(messages) != warned:  # the state may be MuJoCo's reset: nothing to record
                 return WARNED, taken
-            pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.reactions(), ctl.damper_work,
-                                 ctl.excursion, self.skid_work, ctl.wheels())
+            pending = rec.sample(self.torque, self.motor_work, self.friction_work, ctl.sampled_reactions(),
+                                 ctl.damper_work, ctl.excursion, self.skid_work, ctl.wheels())
         return DONE, taken
 
 
@@ -260,7 +223,7 @@ class CompiledSteps(PythonSteps):
         table = {entry[0]: (index, *entry[1:]) for index, entry in enumerate(self._module.CONTROLLERS)}
         if kind not in table or self._kind is not None:
             raise LayoutError(f"no compiled controller {kind!r}, or a second one")
-        index, config, state, self._own_work = table[kind]
+        index, config, state = table[kind]
         clash = (set(config) & set(self.C)) | (set(state) & set(self.S))
         if clash:
             raise LayoutError(f"the compiled controller {kind!r} repeats the loop's fields {sorted(clash)}")
@@ -285,18 +248,13 @@ class CompiledSteps(PythonSteps):
 
     def _load_controller(self) -> None:
         """The controller's block, written by the controller itself (``load_compiled(loop)``: :meth:`use`, then
-        its fields), which returns its sync (reading its state back from a list of the state's values). A loop
-        whose work rates come from the controller's rows (``grip``, ``power``) needs a controller that has them."""
+        its fields, after checking that the loop's work rates ``power`` are the ones its compiled form counts),
+        which returns its sync (reading its state back from a list of the state's values)."""
         ctl = self.controller
-        load = getattr(ctl, "load_compiled", None)
-        if load is None:
-            raise LayoutError(f"no compiled form of the clutch controller {type(ctl).__name__}")
         self._kind, self._rec, self._kept = None, None, []
-        self._sync = load(self)
+        self._sync = ctl.load_compiled(self)
         if self._kind is None:
             raise LayoutError(f"{type(ctl).__name__}.load_compiled chose no compiled controller")
-        if self._own_work != (self.grip is not None or self.power is not None):
-            raise LayoutError(f"the compiled {self._kind} controller does not count this loop's work rates")
 
     def getter(self, *names):
         """A function reading the STATE fields ``names`` from a list of the state's values, in that order."""

@@ -12,7 +12,7 @@ from ipir_mujoco.core.steady_test import steady_target
 from ipir_mujoco.core.steady_watch import SteadyWatch
 from ipir_mujoco.core.errors import SimulationError
 
-from ..modelkinds.common import rest_since, stall_reason
+from ..kinds.common import rest_since, stall_reason
 from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
 
 
@@ -62,7 +62,7 @@ class BlockChecks:
             self.fed = newest + 1
             if steady:
                 return int(np.searchsorted(rec.t[:newest + 1], self.watch.steady_at - 1e-12, side="left"))
-        if run.route_watch is not None and (stop := run.route_watch.check(newest)) is not None:
+        if (stop := run.route_watch.check(newest)) is not None:  # a route's end or jam
             return stop
         if self.stall_watch:
             return self._stall(newest, t)

@@ -20,7 +20,7 @@ import mujoco
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams, require_params
 
-from ..modelkinds.kinds import kind_for
+from ..kinds import kind_for
 from ..builders.model import SolverSettings
 from .run_setup import RunSetup
 

@@ -12,7 +12,7 @@ import mujoco
 
 from ipir_mujoco.core.params import RobotParams
 
-from ..modelkinds.kinds import ModelKind
+from ..kinds import ModelKind
 from ..builders.model import CRANK_HINGE, MOTOR, SolverSettings, drive_control
 from ..loop.servo_drive import TickedDrive
 from ..loop.stepper import PythonSteps, make_steps

@@ -11,7 +11,7 @@ state and a stall, and reports progress about every 0.1 s of it or every
 second of wall time, whichever comes first (never going
 back: a run repeated at a halved timestep, which may take minutes, reports
 :class:`ipir_mujoco.core.options.RepeatProgress` values, its own time with
-the time already reported: :class:`ipir_mujoco.engine.modelkinds.common.PassProgress`).
+the time already reported: :class:`ipir_mujoco.engine.kinds.common.PassProgress`).
 MuJoCo warnings are intercepted (nothing is written to ``MUJOCO_LOG.TXT``) and
 turn into a :class:`SimulationError` with the time and MuJoCo's message, as
 do a non-finite state and a MuJoCo error (``mujoco.FatalError``).
@@ -60,20 +60,17 @@ from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
 from .block_checks import BlockChecks
-from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
+from ..kinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
                                  climb_energy, mujoco_failure, steps_per_output)
-from ..modelkinds.kinds import ModelKind, kind_for
-from .skid_check import SLIDES_RULE, verify_skids
-from .wheel_skids import WHEELS_RULE
+from ..kinds import ModelKind, kind_for
 from ..builders.model import SolverSettings
 from ..loop.monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
                       rising as _rising)
 from ..loop.recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
-from ..modelkinds.route_watch import route_watch
 from .run_setup import RunSetup
 from ..loop.servo_drive import TickedDrive, controller_for
 from ..loop.stepper import WARNED
-from ..modelkinds.timestep import DT_MIN
+from ..kinds.timestep import DT_MIN
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _GAP = SCALARS.index("motor_torque"), DEFERRED.index("loop_gap")
@@ -84,7 +81,6 @@ ENERGY_SLOTS = {column: (False, SCALARS.index(column)) if column in SCALARS
                 else (True, DEFERRED.index(_RECORDED_AS.get(column, column)))
                 for column in ENERGY_COLUMNS if column in SCALARS or _RECORDED_AS.get(column, column) in DEFERRED}
 
-SKID_RULES = {"slides": SLIDES_RULE, "wheels": WHEELS_RULE}  # a model kind's skid_rule: the rule it names
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
 
@@ -160,12 +156,9 @@ def simulate_mujoco(
                    progress=passes, servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
                    kind=kind, feedforward=feedforward, route=route)
+    rule = kind.skid_rule(params)  # the kind's skid check (kinds/skid_check.py)
     if settings is not None:
-        result = _Run(params, settings, **options).result({"timestep_source": "given"})
-        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            result.accuracy["skid_check"] = "not verified: timestep given"
-        return result
-    verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
+        return rule.given(_Run(params, settings, **options).result({"timestep_source": "given"}))
     started = time.perf_counter()
     chosen, why = kind.settings(params, t_end, dt_out, servo, implementation, route=route)
     failures = []
@@ -179,17 +172,13 @@ def simulate_mujoco(
                 raise
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
             chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
-    if not verify:
-        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            result.accuracy["skid_check"] = "not verified: compliant clutches"
-        return result
     every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
 
     def rerun(dt: float) -> RunResult:
         finer = {**options, "dt_out": dt} if every_step else options
         return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
-    return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule])
+    return rule.verify(result, rerun, accuracy, DT_MIN)
 
 
 class _Run:
@@ -208,7 +197,6 @@ class _Run:
         dt = settings.timestep
         self.steps_per_sample = steps_per_output(dt_out, dt)
         self.n_steps = math.floor(t_end / dt * (1 + 1e-12))  # never past t_end
-        self.compliant = params.clutch_stiffness is not None
         self.kind = kind
         self.route = route
         self.setup = RunSetup(kind, params, settings, implementation=implementation, rule=clutch, mjcf=mjcf,
@@ -234,8 +222,7 @@ class _Run:
                 raise SimulationError(mujoco_failure(t, str(exc))) from None
         rec = self.recorder
         series = rec.series(last)
-        if self.route_watch is not None:  # x and v along the route's centreline (world positions kept)
-            series = self.route_watch.along_series(series)
+        series = self.route_watch.along_series(series)  # along a route: x and v along its centreline
         if self.ticked is not None:
             series["drive_u"] = self.ticked.u_column(series["t"])
         change = energy_changes(series)  # every energy term the series has (core.energy's table)
@@ -248,12 +235,12 @@ class _Run:
             engine="mujoco", geometry="exact", clutch=label, params=self.params, t_end=float(series["t"][-1]),
             series=series, energy=energy, wall_time_s=time.perf_counter() - self.started,
             settings={"mujoco_clutch": self.implementation, "clutch_rule": self.clutch,
-                      "clutch_model": "compliant" if self.compliant else "rigid", "dt_out": self.dt_out,
+                      "clutch_model": self.controller.clutch_model, "dt_out": self.dt_out,
                       "mujoco_version": mujoco.__version__, **self.settings.as_dict(), **extra_settings,
                       "steady_tol": self.steady_tol, "steady_cycles": self.steady_cycles, **self.kind.recorded_settings()},
             stall=self.stall,
             accuracy=self.monitor.record(residual_ratio(residual, scale)),
-            route=self.route_watch and self.route_watch.record(self.t_end, self.stall),
+            route=self.route_watch.record(self.t_end, self.stall),
         )
 
     def _setup(self):
@@ -262,8 +249,7 @@ class _Run:
         m, d = self.model, self.data
         self.controller, self.loop = setup.controller, setup.loop
         self.recorder = Recorder(m, d, p, self.n_steps // self.steps_per_sample + 2, self.controller, self.kind)
-        # None without a route
-        self.route_watch = route_watch(self.route, m, self.recorder, p, self.dt_out, self.kind.route_fit)
+        self.route_watch = self.kind.route_watch(self.route, m, self.recorder, p, self.dt_out)
 
     def _integrate(self, messages: list[str]) -> int:
         """Step to t_end (or the steady state, or a stall); returns the last sample's row.
@@ -278,7 +264,7 @@ class _Run:
         torque = self.loop["torque"]
         # so that the first sample's acceleration is MuJoCo's qacc
         rec.qvel_before[0] = d.qvel - m.opt.timestep * d.qacc
-        row = rec.sample(torque, 0.0, 0.0, ctl.reactions(), excursion=ctl.excursion, wheels=ctl.wheels())
+        row = rec.sample(torque, 0.0, 0.0, ctl.sampled_reactions(), excursion=ctl.excursion, wheels=ctl.wheels())
         rec.fill_deferred(row)  # the initial state's energies are MuJoCo's from mj_forward
         at_start = by_role(self._energy_rows(row, row + 1))
         self.energy0 = (at_start[KINETIC].item(0), at_start[STORED].item(0))  # the state terms' energy at the start
@@ -306,9 +292,7 @@ class _Run:
                 last = checks.check(pending, messages)
                 if last is not None:
                     break
-        if self.compliant:
-            # the anchors and dampers for the final state, whose clutch forces the last sample holds
-            ctl.before_step()
+        ctl.finish()  # (the compliant clutches: the anchors and dampers for the final state)
         mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
         if pending >= 1:
             rec.fill_deferred(pending)

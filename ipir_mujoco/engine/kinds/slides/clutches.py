@@ -39,10 +39,11 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
 from .compliant import CompliantClutches
-from ..loop.controller import ControllerBase, RunningBound
-from ..loop.native import LayoutError
-from ..builders.model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
-from ..loop.rows import FrictionRows, clutch_share, equality_row, missing_rows
+from ...loop.controller import ControllerBase, RunningBound
+from ...loop.native import LayoutError
+from ...builders.model import CRANK_HINGE, FRONT_LOCK, REAR_LOCK, ROD_HINGE, SLIDES, dof_address, qpos_address
+from ...loop.rows import FrictionRows, clutch_share, equality_row, missing_rows
+from .loop_rows import require_friction_power
 
 
 class Ratchet(ControllerBase):
@@ -92,6 +93,7 @@ class Ratchet(ControllerBase):
     def load_compiled(self, loop):
         """Its block in the compiled loop (:mod:`.controller`, ``_clutch_slides.c``): the slides, their bounds and
         their resistance rows."""
+        require_friction_power(loop)
         loop.use("ratchet")
         (off0, off1), (r0, r1) = self.friction.offsets, self.friction.resistance
         loop.set_config(x_q0=self.qpos_adr[0], x_q1=self.qpos_adr[1], joint0=self.joint_ids[0],
@@ -169,7 +171,7 @@ class Locks(ControllerBase):
         if rule == "kinematic":
             s_dot = self.gap_rate()
             self._apply([s_dot >= 0, s_dot <= 0])
-            self.after_step = None  # the paper's rule needs no forces between samples
+            self.after_step = super().after_step  # the paper's rule needs no forces between samples: nothing
         else:
             self._apply([data.qvel[a] <= 0 for a in self.dof_adr])
 
@@ -223,6 +225,7 @@ class Locks(ControllerBase):
         linkage's joints, the slides' resistance rows."""
         if (self.crank_q, self.crank_v) != (loop.crank_q, loop.crank_v):
             raise LayoutError("the locks' crank joint is not the run's")
+        require_friction_power(loop)
         loop.use("lock_" + self.rule)
         (off0, off1), (r0, r1) = self.friction.offsets, self.friction.resistance
         loop.set_config(x_q0=self.qpos_adr[0], x_q1=self.qpos_adr[1], x_v0=self.dof_adr[0], x_v1=self.dof_adr[1],
@@ -277,6 +280,7 @@ class NoClutch(ControllerBase):
 
     def load_compiled(self, loop):
         """Nothing to load or read back in the compiled loop."""
+        require_friction_power(loop)
         loop.use("none")
         return lambda state: None
 

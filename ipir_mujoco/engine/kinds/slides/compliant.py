@@ -43,12 +43,14 @@ stepping included) and the soft constraints.
 from __future__ import annotations
 
 import mujoco
+import numpy as np
 
 from ipir_mujoco.core.params import RobotParams
 
-from ..loop.controller import ControllerBase
-from ..loop.native import LayoutError
-from ..builders.model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
+from ...loop.controller import NO_REACTIONS, ControllerBase, follow, held_where
+from ...loop.native import LayoutError
+from .loop_rows import require_friction_power
+from ...builders.model import FRONT_CLUTCH, REAR_CLUTCH, SLIDES, dof_address, implicit_damping, qpos_address
 
 CLUTCHES = (REAR_CLUTCH, FRONT_CLUTCH)
 
@@ -92,6 +94,7 @@ class CompliantClutches(ControllerBase):
     """
 
     name = "compliant"
+    clutch_model = "compliant"
     deferred = True  # its forces are MuJoCo's at the sample's own state, a step later (the recorder reads them)
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams):
@@ -138,9 +141,9 @@ class CompliantClutches(ControllerBase):
         backlash, anchor, overlap = self.backlash, self.anchor, self.overlap
         for i, act in self._modules:  # this runs before every step: plain floats only
             x = self.coordinate(i)
-            self.tracking[i] = tracking = x - backlash > anchor[i]
+            anchor[i], give = follow(anchor[i], x - backlash)  # the anchor's running maximum
+            self.tracking[i] = tracking = give < 0.0
             if tracking:
-                anchor[i] = x - backlash
                 self._ctrl[act] = anchor[i]
             d = anchor[i] - x
             overlap[i] = d
@@ -189,6 +192,7 @@ class CompliantClutches(ControllerBase):
     def load_compiled(self, loop):
         """Its block in the compiled loop (:mod:`.controller`, ``_clutch_slides.c``): the slides, the clutch
         actuators, the anchors (the compliant part: :func:`load_spring`)."""
+        require_friction_power(loop)
         loop.use("compliant")
         loop.set_config(x_q0=self.qpos_adr[0], x_q1=self.qpos_adr[1], x_v0=self.dof_adr[0], x_v1=self.dof_adr[1])
         return load_spring(self, loop)
@@ -197,6 +201,39 @@ class CompliantClutches(ControllerBase):
         """(rear held, front held, rear force [N], front force [N]): held while its clutch pushes."""
         f1, f2 = self.forces()
         return f1 > 0.0, f2 > 0.0, f1, f2
+
+    # the recorder's part (ClutchController): a sample's clutch forces are MuJoCo's at the sample's own state, which
+    # it computes at the start of the next step, from the anchor before_step has just set for that state
+    def sampled_reactions(self) -> tuple[bool, bool, float, float]:
+        """None at the step: its forces are deferred (:meth:`deferred_values`)."""
+        return NO_REACTIONS
+
+    def deferred_values(self) -> tuple[float, float, float, float, float]:
+        """The clutch forces [N] and overlaps [m] at the start of the step, and the springs' energy as the step
+        conserves it [J] (:meth:`stepped_spring_energy`)."""
+        (f1, f2), (d1, d2) = self.forces(), self.overlap
+        return f1, f2, d1, d2, self.stepped_spring_energy()
+
+    def clutch_columns(self, scalars: dict, deferred: dict) -> dict:
+        """Writes each sample's reaction lambda1/2 (its clutch force at its own state) and held flags (carried
+        while it pushes, and not skidding: :func:`.controller.held_where`) into ``scalars``; returns the
+        overlaps clutch_overlap1/2 [m], the springs' energy clutch_spring_energy [J] (the physical 1/2 k d^2 of
+        the compressed clutches) and the dampers' cumulative work clutch_damper_work [J]."""
+        scalars["lambda1"], scalars["lambda2"] = deferred["clutch_force1"], deferred["clutch_force2"]
+        for k in ("1", "2"):
+            scalars["held" + k] = held_where(deferred["clutch_force" + k] > 0, scalars["wheels" + k]).astype(float)
+        d1, d2 = deferred["clutch_overlap1"], deferred["clutch_overlap2"]
+        return {"clutch_overlap1": d1.copy(), "clutch_overlap2": d2.copy(),
+                "clutch_spring_energy": 0.5 * self.k * (np.maximum(d1, 0.0) ** 2 + np.maximum(d2, 0.0) ** 2),
+                "clutch_damper_work": scalars["clutch_damper_work"].copy()}
+
+    def modes(self, mode, both, turning, wheels1, wheels2) -> tuple:
+        """As held: a compliant clutch passes no dead centre with both modules held."""
+        return mode, wheels1, wheels2
+
+    def finish(self) -> None:
+        """The anchors and dampers for the final state, whose clutch forces the last sample holds."""
+        self.before_step()
 
 
 def load_spring(ctl: CompliantClutches, loop, *also: str):

@@ -31,12 +31,12 @@ from ipir_mujoco.core.params import RobotParams
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from .compiled_grip import load_compliant_grip
-from .compliant import CompliantClutches, check_transmissions
-from ..loop.controller import ROLLING, SKIDDING, STANDING, RunningBound
-from .grip import GripRows
-from ..builders.grip_model import ROLLS, SKIDS
-from ..builders.model import dof_address, qpos_address
+from .compiled import load_compliant_grip
+from ..slides.compliant import CompliantClutches, check_transmissions
+from ...loop.controller import ROLLING, SKIDDING, STANDING, RunningBound
+from ..slides.loop_rows import GripRows
+from ...builders.grip_model import ROLLS, SKIDS
+from ...builders.model import dof_address, qpos_address
 
 
 class CompliantGrip(CompliantClutches):

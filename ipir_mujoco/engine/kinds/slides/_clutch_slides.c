@@ -1,7 +1,27 @@
 /* The slide model's clutch controllers, compiled (see _stepper.h): NoClutch, Ratchet, Locks (two rules) in
  * slide_clutches.py and CompliantClutches in compliant.py, step for step as there (the same double arithmetic in
  * the same order: tests/test_mujoco_stepper.py holds the two equal bit for bit). */
-#include "_clutch_parts.h"
+#include "../../controllers/_clutch_parts.h"
+
+/* the slide model's work rates (loop_rows.FrictionPower, the loop's power): the slides' frictionloss rows follow
+ * the ne equality rows, one per dof with friction (the loop's friction_dofs), read only if there; no skidding */
+static int friction_work(const int64_t *cfg, double *st, double *rolling, double *skidding) {
+  (void)st;
+  const mjData *d = DATA(cfg);
+  const mjtNum *efc_force = d->efc_force, *qvel = d->qvel;
+  const int64_t nfric = cfg[C_nfric];
+  const int ne = d->ne;
+  *skidding = 0.0;
+  if (nfric > 0 && d->nf != nfric) return MISSING_FRICTION_ROWS;
+  if (nfric == 2) {
+    *rolling = efc_force[ne] * qvel[cfg[C_fric_a]] + efc_force[ne + 1] * qvel[cfg[C_fric_b]];
+  } else if (nfric == 1) {
+    *rolling = efc_force[ne] * qvel[cfg[C_fric_a]];
+  } else {
+    *rolling = 0.0;
+  }
+  return STEPS_DONE;
+}
 
 /* ---- NoClutch: nothing to do, no reactions ---- */
 #define NONE_CONFIG(X, P)
@@ -17,7 +37,9 @@ static int no_reactions(const int64_t *cfg, const double *st, double out[N_REACT
   return STEPS_DONE;
 }
 
-const Controller NO_CLUTCH = {"none", BLOCK_NAMES(NONE_CONFIG, NC, NONE_STATE, NS), .reactions = no_reactions};
+const Controller NO_CLUTCH = {"none", BLOCK_NAMES(NONE_CONFIG, NC, NONE_STATE, NS), .before_step = no_before_step,
+                              .after_step = no_after_step, .work = friction_work, .reactions = no_reactions,
+                              .deferred = no_deferred};
 
 /* ---- Ratchet: each slide's lower limit follows its running maximum ---- */
 #define RATCHET_CONFIG(X, P) X(P, x_q0) X(P, x_q1) X(P, joint0) X(P, joint1) X(P, fric_off0) X(P, fric_off1)
@@ -32,11 +54,11 @@ static void ratchet_before(const int64_t *cfg, double *st) {
   mjtNum *range = MODEL(cfg)->jnt_range;
   for (int i = 0; i < 2; i++) {
     double x = qpos[c[RC_x_q0 + i]];
-    if (x > s[RS_bound0 + i]) {
-      s[RS_bound0 + i] = x;
+    const double give = follow(&s[RS_bound0 + i], x, 0);
+    if (give < 0.0) {
       range[2 * c[RC_joint0 + i]] = x - s[RS_margin0 + i];
-    } else if (s[RS_bound0 + i] - x > st[S_excursion]) {
-      st[S_excursion] = s[RS_bound0 + i] - x;
+    } else if (give > st[S_excursion]) {
+      st[S_excursion] = give;
     }
   }
 }
@@ -79,7 +101,8 @@ static int ratchet_reactions(const int64_t *cfg, const double *st, double out[N_
 }
 
 const Controller RATCHET = {"ratchet", BLOCK_NAMES(RATCHET_CONFIG, RC, RATCHET_STATE, RS),
-                            .before_step = ratchet_before, .reactions = ratchet_reactions};
+                            .before_step = ratchet_before, .after_step = no_after_step, .work = friction_work,
+                            .reactions = ratchet_reactions, .deferred = no_deferred};
 
 /* ---- Locks: a joint-equality lock per module, by the paper's rule or the one-way rule ---- */
 #define LOCKS_CONFIG(X, P)                                                                                     \
@@ -200,10 +223,13 @@ static int lock_unilateral_reactions(const int64_t *cfg, const double *st, doubl
 }
 
 const Controller LOCK_KINEMATIC = {"lock_kinematic", BLOCK_NAMES(LOCKS_CONFIG, LC, LOCKS_STATE, LS),
-                                   .before_step = lock_kinematic_before, .reactions = lock_kinematic_reactions};
+                                   .before_step = lock_kinematic_before, .after_step = no_after_step,
+                                   .work = friction_work, .reactions = lock_kinematic_reactions,
+                                   .deferred = no_deferred};
 const Controller LOCK_UNILATERAL = {"lock_unilateral", BLOCK_NAMES(LOCKS_CONFIG, LC, LOCKS_STATE, LS),
                                     .before_step = lock_unilateral_before, .after_step = lock_unilateral_after,
-                                    .reactions = lock_unilateral_reactions};
+                                    .work = friction_work, .reactions = lock_unilateral_reactions,
+                                    .deferred = no_deferred};
 
 /* ---- CompliantClutches: the compliant part on the slides ---- */
 #define COMPLIANT_SLIDES_CONFIG(X, P) COMPLIANT_CONFIG(X, P) X(P, x_q0) X(P, x_q1) X(P, x_v0) X(P, x_v1)
@@ -232,4 +258,4 @@ static void compliant_slides_deferred(const int64_t *cfg, const double *st, doub
 
 const Controller COMPLIANT = {"compliant", BLOCK_NAMES(COMPLIANT_SLIDES_CONFIG, CC, COMPLIANT_STATE, CS),
                               .before_step = compliant_slides_before, .after_step = compliant_slides_after,
-                              .reactions = no_reactions, .deferred = compliant_slides_deferred};
+                              .work = friction_work, .reactions = no_reactions, .deferred = compliant_slides_deferred};

@@ -32,8 +32,8 @@ import numpy as np
 
 from ipir_mujoco.core.route import Route
 
-from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, dof_address, qpos_address
-from ..builders.pipe_walls import LEAD_IN
+from ...builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE, dof_address, qpos_address
+from ...builders.pipe_walls import LEAD_IN
 
 WALL_LOSS_S = 0.05  # s: a wheel off its wall this long without a break has lost it (a skid's bounces last < 1 ms)
 LOST_SHARE = 0.1  # a wheel pressing with less than this share of its preload is off its wall
@@ -315,8 +315,8 @@ def pipe_fit(route: Route, params) -> dict:
     """The round-pipe model's closed-form fit of the route's bends (:func:`.route_walls.fit_prediction`): its rings
     ``ring_spacing`` / 2 either side of a module's middle, its legs' springs reaching ``suspension_travel`` beyond
     their preload, its housing as wide as the ring inside its wheels and as long as its ring spacing."""
-    from ..builders.route_walls import fit_prediction
-    from ..builders.wheels_model import housing_radius
+    from .route_walls import fit_prediction
+    from .model import housing_radius
 
     return fit_prediction(route, params, 0.5 * params.ring_spacing, params.suspension_travel,
                           housing=(2 * housing_radius(params), params.ring_spacing))

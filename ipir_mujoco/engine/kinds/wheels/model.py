@@ -49,8 +49,9 @@ from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.pipe import ARM_SHARE, WHEEL_SHARE, check_fit, sprung_mass
 from ipir_mujoco.core.pipe import leg_direction as core_leg_direction
 
-from ...resources import mjcf_dir
-from .model import (CRANK_HINGE, FRONT_SLIDE, INTEGRATORS, LOOP, REAR_SLIDE, ROD_HINGE, SolverSettings, _element,
+from ....resources import mjcf_dir
+from ..base import HOUSINGS
+from ...builders.model import (CRANK_HINGE, FRONT_SLIDE, INTEGRATORS, LOOP, REAR_SLIDE, ROD_HINGE, SolverSettings, _element,
                     _write_drive, _write_gravity, _write_mechanism, check_params, compile_spec, dof_address,
                     load_spec, qpos_address, start_closed_loop)
 
@@ -59,7 +60,6 @@ RINGS = ("aft", "fore")
 LATERALS = ("rear_lateral", "front_lateral")  # the modules' slides across the pipe (y)
 VERTICALS = ("rear_vertical", "front_vertical")  # the modules' slides across the pipe (z)
 TILTS = ("rear_tilt", "front_tilt")  # the modules' ball joints
-HOUSINGS = ("rear_housing", "front_housing")
 ROD_TILT = "rod_tilt"  # the rod's cross pin at B (with rod_hinge a universal joint): the rod leaves the crank's plane
 HALF_WIDTH = 0.005  # m: the drawn tyre's half-width along its hub (the contact is the sphere's)
 SEAT = 1e-8  # m: how far the initial state sets each wheel into the wall (its contact then acts from the first step)
@@ -267,7 +267,7 @@ def write_pipe_wall(spec: mujoco.MjSpec, params: RobotParams, route=None, times:
     housings' capsules, no seams or facets), a straight pipe along x or along ``route``, with the wheels'
     friction (:func:`contact_friction`), the contact time constant and the rows' impedance; returns its geoms'
     names."""
-    from .pipe_walls import WallContact, add_pipe_walls
+    from ...builders.pipe_walls import WallContact, add_pipe_walls
 
     reach = params.r + params.L + 0.5 * params.ring_spacing + 2.0 * params.wheel_radius
     return add_pipe_walls(spec, route, params.pipe_diameter,

@@ -41,37 +41,16 @@ import mujoco
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import REST_SPEED
 
-from .compiled_grip import load_grip_ratchet
-from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
-from ..builders.grip_model import ROLLS, SKIDS
-from ..builders.model import SLIDES, dof_address, qpos_address
-from ..loop.rows import FRICTION_DOF, FRICTION_TENDON, FrictionRows, clutch_share
+from .compiled import load_grip_ratchet
+from ...loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held, lower_bound, upper_bound
+from ...builders.grip_model import ROLLS, SKIDS
+from ...builders.model import SLIDES, dof_address, qpos_address
+from ...loop.rows import clutch_share
+from ..slides.loop_rows import GripRows
 
-__all__ = ["LIMIT_TENDON", "GripRatchet", "GripRows", "lower_bound", "upper_bound"]
+__all__ = ["LIMIT_TENDON", "GripRatchet", "GripRows", "lower_bound", "upper_bound"]  # GripRows: an older place
 
 LIMIT_TENDON = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON)
-
-
-class GripRows:
-    """Where each module's friction rows sit among MuJoCo's friction rows (:class:`.clutches.FrictionRows`): the
-    carriage's (the grip) and the rolling resistance's (the roll tendon with rigid clutches, the module slide
-    with compliant ones). ``grip``, ``roll``: offsets among them per module (-1: no row, a zero grip or
-    resistance); ``count``: how many; ``grips``, ``resistances`` [N].
-    """
-
-    def __init__(self, model: mujoco.MjModel, roll_on_tendon: bool):
-        skids = [(FRICTION_DOF, dof_address(model, n)) for n in SKIDS]
-        rolls = ([(FRICTION_TENDON, model.tendon(n).id) for n in ROLLS] if roll_on_tendon
-                 else [(FRICTION_DOF, dof_address(model, n)) for n in SLIDES])
-        self.rows = FrictionRows(model, skids + rolls)
-        self.count = self.rows.count
-        self.grip, self.roll = self.rows.offsets[:2], self.rows.offsets[2:]
-        self.grips, self.resistances = self.rows.resistance[:2], self.rows.resistance[2:]
-
-    def forces(self, data: mujoco.MjData) -> tuple[list[float], list[float]]:
-        """(grip rows, roll rows) [N] of the last step, per module (0.0 where a module has no row)."""
-        forces = self.rows.forces(data)
-        return forces[:2], forces[2:]
 
 
 class GripRatchet(ControllerBase):

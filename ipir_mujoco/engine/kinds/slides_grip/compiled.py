@@ -11,16 +11,21 @@ from __future__ import annotations
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from .compliant import load_spring
-from ..loop.native import LayoutError
+from ..slides.compliant import load_spring
+from ...loop.native import LayoutError
 
 
 def _carriages(ctl, loop, kind: str, x_adr: list[int], x_dof: list[int]) -> None:
-    """Choose the compiled ``kind`` and write the carriages' part: the loop's grip rows (``loop.grip``:
-    :func:`.loop_rows.grip_layout`), after checking that the controller's dofs are the loop's, the slides' and
-    carriages' addresses, the wall's running bound and the grips."""
-    grip = loop.grip
-    if grip is None or [x_dof, ctl.c_dof] != [grip["x_dof"], grip["c_dof"]]:
+    """Choose the compiled ``kind`` and write the carriages' part: the loop's grip rows (its work rates
+    ``loop.power``, a :class:`ipir_mujoco.engine.kinds.slides.loop_rows.GripPower`, on
+    :func:`~ipir_mujoco.engine.kinds.slides.loop_rows.grip_layout`), after checking that the controller's dofs are
+    the loop's, the slides' and carriages' addresses, the wall's running bound and the grips."""
+    from ..slides.loop_rows import GripPower
+
+    if not isinstance(loop.power, GripPower):
+        raise LayoutError("the grip controllers' compiled forms count the grips' rows, not this loop's work rates")
+    grip = loop.power.layout
+    if [x_dof, ctl.c_dof] != [grip["x_dof"], grip["c_dof"]]:
         raise LayoutError("the grip controller's dofs are not the loop's")
     loop.use(kind)
     loop.set_config(count=grip["count"], roll_off0=grip["roll"][0], roll_off1=grip["roll"][1],

@@ -2,13 +2,13 @@
  * and the wheeled loop's work rates (wheels.WheelPower), step for step as there: the same double arithmetic in
  * the same order, the contacts' J v from MuJoCo's mj_mulJacVec in both (tests/test_mujoco_stepper.py holds the two
  * equal bit for bit). The per-hub, per-joint and per-geom arrays are compiled_wheels.py's, by their addresses. */
-#include "../loop/_stepper.h"
+#include "../../loop/_stepper.h"
 
 #define WHEELS_CONFIG(X, P)                                                                                     \
   X(P, nhub) X(P, per_module) X(P, friction_count) X(P, x_v0) X(P, x_v1) X(P, elliptic) X(P, ngeom) X(P, hub_q) \
   X(P, hub_joint) X(P, hub_row) X(P, joint_module) X(P, geom_module) X(P, work_dofs) X(P, stick) X(P, margin)  \
   X(P, bound)
-#define WHEELS_STATE(X, P) X(P, radius) X(P, cone) X(P, rest_speed) X(P, resist0) X(P, resist1)
+#define WHEELS_STATE(X, P) X(P, radius) X(P, cone) X(P, rest_speed) X(P, skid_speed) X(P, resist0) X(P, resist1)
 FIELDS(WHEELS_CONFIG, WC)
 FIELDS(WHEELS_STATE, WS)
 
@@ -25,11 +25,11 @@ static void wheels_before(const int64_t *cfg, double *st) {
   const double radius = s[WS_radius];
   for (int64_t k = 0; k < w[WC_nhub]; k++) {
     const double angle = qpos[hub_q[k]];
-    if (angle > bound[k]) {
-      bound[k] = angle;
+    const double back = follow(&bound[k], angle, 0);
+    if (back < 0.0) {
       range[2 * joint[k]] = lower_bound(angle, margin[k]);
     } else {
-      const double give = (bound[k] - angle) * radius;
+      const double give = back * radius;
       if (give > st[S_excursion]) st[S_excursion] = give;
     }
   }
@@ -116,6 +116,7 @@ static int wheels_reactions(const int64_t *cfg, const double *st, double out[N_R
       } else {
         skids = d->qvel[w[WC_x_v0 + i]] < -s[WS_rest_speed];
       }
+      skids = skids || d->qvel[w[WC_x_v0 + i]] < -s[WS_skid_speed]; /* held modules stand (SKID_SPEED) */
       state = skids ? -1.0 : 0.0;
       share = clutch_share(hold, s[WS_resist0 + i]);
     }
@@ -127,4 +128,5 @@ static int wheels_reactions(const int64_t *cfg, const double *st, double out[N_R
 }
 
 const Controller WHEEL_RATCHET = {"wheel_ratchet", BLOCK_NAMES(WHEELS_CONFIG, WC, WHEELS_STATE, WS),
-                                  .before_step = wheels_before, .work = wheels_work, .reactions = wheels_reactions};
+                                  .before_step = wheels_before, .after_step = no_after_step, .work = wheels_work,
+                                  .reactions = wheels_reactions, .deferred = no_deferred};

@@ -10,8 +10,10 @@ forces, and skids back on them beyond it.
 Reported per module (:meth:`HubRatchet.states`): rolling while every hub's friction row slides (at its bound
 -tau) and no hub's limit row pushes; otherwise held, and skidding while held and its wheels slide on the wall:
 their contacts' tangential forces together at the friction cone's edge, mu_wall times their normal forces (to
-SLIDING_SHARE), or, with no contact left, while it moves back faster than REST_SPEED. A skidding module is not
-held (the analytic model's and the slide model's meaning). The clutch's reaction is the clutch's share
+SLIDING_SHARE), or, with no contact left, while it moves back faster than REST_SPEED; and, whatever its contacts
+say, while it moves back faster than SKID_SPEED (its hubs hold while its body tips and slides on its legs, its
+contacts inside their cone). A skidding module is not held (:mod:`ipir_mujoco.engine.loop.controller`'s one
+meaning: held modules stand). The clutch's reaction is the clutch's share
 (:func:`.clutches.clutch_share`) of the module's hold: the hubs' limit and friction rows [N m] over the wheel
 radius. ``excursion`` [m]: the largest give of a hub below its running maximum so far, as the arc R (max - angle).
 
@@ -32,12 +34,12 @@ from ipir_mujoco.core.params import RobotParams
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from ..builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
-from ..builders.wheels_model import HOUSINGS, contact_friction, leg_names, wheels_timestep
-from ..loop.controller import ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
-from ..loop.native import LayoutError
-from ..loop.rows import clutch_share, missing_rows
-from .compiled_wheels import load_wheel_ratchet
+from ...builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
+from .model import HOUSINGS, contact_friction, leg_names, wheels_timestep
+from ...loop.controller import SKID_SPEED, ROLLING, SKIDDING, STANDING, ControllerBase, RunningBound, held
+from ...loop.native import LayoutError
+from ...loop.rows import clutch_share, missing_rows
+from .compiled import load_wheel_ratchet
 
 LIMIT_JOINT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT)
 SLIDING_SHARE = 1e-6  # a module's contacts slide where their tangential force is within this share of the cone
@@ -165,10 +167,12 @@ class WheelRatchet(ControllerBase):
                 shares.append(0.0)
                 continue
             hold = (limits[i] + friction[i]) / self.radius
+            speed = self._qvel.item(self.x_dof[i])  # along the pipe (its slide along x)
             if normal[i] > 0.0:
                 skids = tangential[i] >= self.cone * normal[i]
             else:
-                skids = self._qvel.item(self.x_dof[i]) < -REST_SPEED
+                skids = speed < -REST_SPEED
+            skids = skids or speed < -SKID_SPEED  # held modules stand (.controller.SKID_SPEED)
             states.append(SKIDDING if skids else STANDING)
             shares.append(clutch_share(hold, self.resistance[i]))
         self._states = (self.data.time, (states, shares))
@@ -201,7 +205,7 @@ def leg_press(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> tupl
     (tests/test_mujoco_wheels.py compares the two over a run), so this is the wall's press on the wheel, read
     from the state rather than the solver (a sliding wheel's contact flickers on and off by micrometres while
     its spring stays pressed: the spring's press is the wheel's hold on the wall)."""
-    from ..builders.wheels_model import leg_preload, leg_stiffness
+    from .model import leg_preload, leg_stiffness
 
     legs = leg_names(params)
     out = np.empty((q.shape[0], 2, len(legs[0])))
@@ -216,7 +220,7 @@ def pose_columns(model: mujoco.MjModel, q: np.ndarray) -> dict[str, np.ndarray]:
     """Each module's pose across the pipe from the samples' ``q`` (n, nq): y1/2, z1/2 [m] (its slides across the
     pipe) and roll1/2, pitch1/2, yaw1/2 [rad] (its ball joint's rotation vector about x, y, z: for the small
     turns of a module in its pipe, its roll, pitch and yaw), which with x1, x2, phi pose the robot for a replay."""
-    from ..builders.wheels_model import LATERALS, TILTS, VERTICALS
+    from .model import LATERALS, TILTS, VERTICALS
 
     cols = {}
     for k in (1, 2):

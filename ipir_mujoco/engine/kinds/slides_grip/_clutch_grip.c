@@ -1,7 +1,7 @@
 /* The finite-grip clutch controllers, compiled (see _stepper.h): GripRatchet (grip.py) and CompliantGrip
  * (compliant_grip.py), step for step as there. Each block starts with the carriages' part (GRIP_PART,
  * _clutch_parts.h); their work rates are the grip rows' (grip_work). */
-#include "_clutch_parts.h"
+#include "../../controllers/_clutch_parts.h"
 
 /* ---- GripRatchet: the roll's lower limit follows its running maximum, the carriage's upper its minimum ---- */
 #define GRIP_RATCHET_CONFIG(X, P) GRIP_CONFIG(X, P) X(P, roll_t0) X(P, roll_t1)
@@ -18,11 +18,11 @@ static void grip_ratchet_before(const int64_t *cfg, double *st) {
   for (int i = 0; i < 2; i++) {
     double c = qpos[g[GC_c_q0 + i]];
     double roll = qpos[g[GC_x_q0 + i]] - c;
-    if (roll > s[GS_lmax0 + i]) {
-      s[GS_lmax0 + i] = roll;
+    const double give = follow(&s[GS_lmax0 + i], roll, 0);
+    if (give < 0.0) {
       tendon_range[2 * g[GC_roll_t0 + i]] = lower_bound(roll, s[GS_tmargin0 + i]);
-    } else if (s[GS_lmax0 + i] - roll > st[S_excursion]) {
-      st[S_excursion] = s[GS_lmax0 + i] - roll;
+    } else if (give > st[S_excursion]) {
+      st[S_excursion] = give;
     }
     carriage_ratchet(cfg, st, i, c);
   }
@@ -63,8 +63,8 @@ static int grip_ratchet_reactions(const int64_t *cfg, const double *st, double o
 }
 
 const Controller GRIP_RATCHET = {"grip_ratchet", BLOCK_NAMES(GRIP_RATCHET_CONFIG, GC, GRIP_RATCHET_STATE, GS),
-                                 .before_step = grip_ratchet_before, .work = grip_work,
-                                 .reactions = grip_ratchet_reactions};
+                                 .before_step = grip_ratchet_before, .after_step = no_after_step,
+                                 .work = grip_work, .reactions = grip_ratchet_reactions, .deferred = no_deferred};
 
 /* ---- CompliantGrip: the compliant part on the roll L_i = x_i - c_i, the carriages' running bound ---- */
 #define COMPLIANT_GRIP_CONFIG(X, P) GRIP_CONFIG(X, P) COMPLIANT_CONFIG(X, P)

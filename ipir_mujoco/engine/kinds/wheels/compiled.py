@@ -13,8 +13,9 @@ import numpy as np
 
 from ipir_mujoco.core.results import REST_SPEED
 
-from ..loop.native import LayoutError
-from ..loop.native import address as array_address
+from ...loop.controller import SKID_SPEED
+from ...loop.native import LayoutError
+from ...loop.native import address as array_address
 
 
 def load_wheel_ratchet(ctl, loop, power, sticks: float):
@@ -47,8 +48,8 @@ def load_wheel_ratchet(ctl, loop, power, sticks: float):
     loop.set_config(nhub=nhub, per_module=per_module, friction_count=ctl.friction_count, x_v0=ctl.x_dof[0],
                     x_v1=ctl.x_dof[1], elliptic=power.elliptic, ngeom=model.ngeom,
                     **{name: array_address(values) for name, values in arrays.items()})
-    loop.set_state(radius=ctl.radius, cone=ctl.cone, rest_speed=REST_SPEED, resist0=ctl.resistance[0],
-                   resist1=ctl.resistance[1], excursion=ctl.excursion)
+    loop.set_state(radius=ctl.radius, cone=ctl.cone, rest_speed=REST_SPEED, skid_speed=SKID_SPEED,
+                   resist0=ctl.resistance[0], resist1=ctl.resistance[1], excursion=ctl.excursion)
     loop.keep(arrays)  # alive as long as the loop
     bound, get = arrays["bound"], loop.getter("excursion")
 

@@ -101,7 +101,57 @@ def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, floa
     return "fixed", out
 
 
-class SlideSkids:
+class SkidRule:
+    """What a run does with a skid rule (a subclass gives its floor ``skidded(result)``, its figures
+    ``differences(coarse, fine)``, its acceptance ``judge(history)`` and ``failure(history)``): a model kind gives
+    its own (:meth:`ipir_mujoco.engine.kinds.base.ModelKind.skid_rule`)."""
+
+    def given(self, result: RunResult) -> RunResult:
+        """``result``, of a run whose timestep was given: not rerun; its accuracy record says so where it
+        skidded."""
+        if self.skidded(result):
+            result.accuracy["skid_check"] = "not verified: timestep given"
+        return result
+
+    def verify(self, result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+        """``result`` (an automatically stepped run) or a finer run of the same design, verified by this rule
+        (:func:`verify_skids`)."""
+        return verify_skids(result, rerun, mode, dt_min, self)
+
+
+class NoSkids(SkidRule):
+    """The rule of a kind whose modules cannot skid (unlimited grip): nothing is checked, nothing recorded."""
+
+    name = "none"
+
+    def skidded(self, result: RunResult) -> bool:
+        return False
+
+    def verify(self, result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+        return result
+
+
+class Unverified(SkidRule):
+    """A rule whose runs are not rerun (``why``: compliant clutches, whose skid is the anchor's slide on the
+    spring, not a limit's reversal, and whose spring already sets a step of a few microseconds): a run that
+    skidded (by ``rule``'s floor) says so in its accuracy record."""
+
+    def __init__(self, rule: SkidRule, why: str):
+        self.rule, self.why, self.name = rule, why, rule.name
+
+    def skidded(self, result: RunResult) -> bool:
+        return self.rule.skidded(result)
+
+    def verify(self, result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+        if self.skidded(result):
+            result.accuracy["skid_check"] = f"not verified: {self.why}"
+        return result
+
+
+NO_SKIDS = NoSkids()
+
+
+class SlideSkids(SkidRule):
     """The slide model's rule (module docstring): its floor (:func:`skidded`), its figures' differences
     (:func:`differences`) and its acceptance (the last two halvings each within ACCEPT of the tolerance)."""
 
@@ -142,7 +192,7 @@ def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES
     the module docstring says. ``rerun(timestep)`` runs the design again at that step [s] and returns its
     RunResult; ``mode``: the accuracy monitor's ('stop' | 'warn'); ``dt_min`` [s]: the smallest step a run may
     take (halving stops before it); ``rule``: the model's floor, figures and acceptance (:data:`SLIDES_RULE`,
-    :data:`ipir_mujoco.engine.run.wheel_skids.WHEELS_RULE`)."""
+    :data:`ipir_mujoco.engine.kinds.wheels.skids.WHEELS_RULE`)."""
     if not rule.skidded(result):
         result.accuracy["skid_check"] = "no skid"
         return result

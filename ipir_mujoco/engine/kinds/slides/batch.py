@@ -1,14 +1,14 @@
 """Many ratcheted MuJoCo designs at once, stepped by ``mujoco.batch`` on C threads.
 
 Each design's model is checked, compiled and started by the slide model's kind as a single run
-(:data:`ipir_mujoco.engine.modelkinds.kinds.SLIDES`: its checks, build and initial state), with the timestep it
+(:data:`ipir_mujoco.engine.kinds.SLIDES`: its checks, build and initial state), with the timestep it
 chooses for that design unless settings are given; the batch runs one model with per-simulation copies of
 every field in which the designs differ (timestep, gravity, drive included),
 so the builder stays the only place that turns parameters into a model. All
 designs share the output times (multiples of ``dt_out``); a design with a
 smaller timestep takes more substeps between them. Between substeps the
 ratchet raises each simulation's lower slide bounds (the rule of
-:class:`ipir_mujoco.engine.clutches.Ratchet`), in one vectorized write.
+:class:`ipir_mujoco.engine.kinds.slides.clutches.Ratchet`), in one vectorized write.
 
 What a batch can measure is the state and MuJoCo's energies: positions and
 speeds, the drive's work (from MuJoCo's actuator force, as the serial engine),
@@ -45,14 +45,15 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.options import RunOptions
 from ipir_mujoco.core.params import RobotParams
 
-from ..modelkinds.kinds import SLIDES as SLIDE_KIND
-from ..modelkinds.kinds import kind_for
-from ..builders.model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_control, drive_torque_slope,
+from . import KIND as SLIDE_KIND
+from .. import kind_for
+from ...builders.model import (CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_control, drive_torque_slope,
                     pin_offset, qpos_address)
-from ..loop.monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
-from ..modelkinds.common import (BLOCK_TIME, REFINEMENTS, captured_warnings, climb_energy, mujoco_failure,
+from ...loop.controller import follow
+from ...loop.monitor import AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio
+from ..common import (BLOCK_TIME, REFINEMENTS, captured_warnings, climb_energy, mujoco_failure,
                      rest_since, stall_reason, steps_per_output)
-from ..modelkinds.timestep import DT_MIN
+from ..timestep import DT_MIN
 
 OPTION_FIELDS = ("timestep", "gravity", "integrator")
 MODELLED_DRIVES = ("torque", "motor")  # each design's own actuator gain and bias (checked against the serial engine)
@@ -238,9 +239,9 @@ class _Batch:
             dt = np.where(stepping, self.dt, 0.0)
             torque = None  # stays None if MuJoCo fails every simulation in the first substep
             for j in range(substeps):
-                q = self.qpos[:, slides_q]
-                np.maximum(self.excursion, np.max(self.bounds - q, axis=1), out=self.excursion)
-                np.maximum(self.bounds, q, out=self.bounds)
+                # each slide's running maximum, the serial ratchet's rule (follow) for every design at once
+                self.bounds, give = follow(self.bounds, self.qpos[:, slides_q])
+                np.maximum(self.excursion, np.max(give, axis=1), out=self.excursion)
                 self.jnt_range[:, joints, 0] = self.bounds - self.margins
                 omega_prev = self.qvel[:, crank_v].copy()
                 if uniform:

@@ -29,8 +29,8 @@ import math
 
 from ipir_mujoco.core.results import RunResult
 
-from ..builders.wheels_model import ROW_TIMES
-from .skid_check import ACCEPT, STEADY_FIGURES, TRAVEL_FLOOR, steady_difference
+from .model import ROW_TIMES
+from ..skid_check import ACCEPT, STEADY_FIGURES, TRAVEL_FLOOR, SkidRule, steady_difference
 
 # issue 32's accuracy of the wheeled model at its step: travel, revolutions and steady figures 0.2 %, skid 1 %
 TOLERANCE = {"revolutions": 2e-3, "x1_final": 2e-3, "x2_final": 2e-3, "slip1_m": 1e-2, "slip2_m": 1e-2,
@@ -65,7 +65,7 @@ def _relative(a: float, b: float, floor: float) -> float:
     return (a - b) / max(abs(a), abs(b), floor, 1e-300)
 
 
-class WheelSkids:
+class WheelSkids(SkidRule):
     """The wheeled model's rule for :func:`.skid_check.verify_skids` (module docstring)."""
 
     name = "wheels"

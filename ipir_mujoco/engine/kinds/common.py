@@ -19,18 +19,19 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.options import CLUTCH_RULES as RULES  # the clutch rules
 from ipir_mujoco.core.options import RepeatProgress
 from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
 from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m/s], this long [s] is a stall
 from ipir_mujoco.core.results import stall_reason as core_stall_reason
 
 from ..builders.model import check_params
-from ..controllers.slide_clutches import refuse_compliant
+from .base import MUJOCO_CLUTCHES
+from .slides.clutches import refuse_compliant
 
 BLOCK_TIME = 0.05  # s of simulated time between progress, budget, steady-state and stall checks
 REFINEMENTS = 2  # an automatically chosen timestep that fails the accuracy monitor is halved at most this often
-IMPLEMENTATIONS = ("ratchet", "lock", "none")  # the MuJoCo clutches
-RULES = ("kinematic", "unilateral")  # the clutch rules
+IMPLEMENTATIONS = (*MUJOCO_CLUTCHES, "none")  # the MuJoCo clutches: a variant's, or none (checks such as momentum)
 
 
 @dataclass(frozen=True)
