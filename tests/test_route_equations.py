@@ -22,7 +22,7 @@ import sympy as sp
 
 from ipir_mujoco.analytic.grip_model import GripMode
 from ipir_mujoco.analytic.route_geometry import centreline, module_pose, piece_at
-from ipir_mujoco.analytic.route_kernels import Q_COUNT, Q_PIECES
+from ipir_mujoco.analytic.route_kernels import LOOP_TOL, Q_COUNT, Q_PIECES
 from ipir_mujoco.analytic.route_model import RouteModel, transverse_inertia
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.route import route_from_tables
@@ -242,10 +242,12 @@ def loop_gap(station1: float, station2: float, phi: float) -> float:
 
 def closed(model: RouteModel, station: float, phi: float) -> float:
     """Module 2's station [m] with module 1's at ``station`` and the crank at phi: the kernel's Newton solve (from
-    the straight pipe's gap), checked against the definitions: |C - B|^2 - L^2 within round-off (1e-15 m^2)."""
+    the straight pipe's gap), checked against the definitions: |C - B|^2 - L^2 within what the kernel counts as
+    closed (LOOP_TOL L (L + s1 + s2), a few roundings of the points' coordinates), twice that for this side's own
+    round-off."""
     y = np.array([phi, 0.0, station, station + PARAMS.L + PARAMS.r * math.cos(phi), 0.0, 0.0, 0.0])
     s2v = model.state(y, GripMode.EXPANSION)[1]
-    assert abs(loop_gap(station, s2v, phi)) < 1e-15
+    assert abs(loop_gap(station, s2v, phi)) <= 2 * LOOP_TOL * PARAMS.L * (PARAMS.L + station + s2v)
     return s2v
 
 
