@@ -28,7 +28,7 @@ keep_older_paths({f"{__name__}.{older}": f"{__name__}.{now}" for older, now in (
 
 
 def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinematic",
-             t_end: float = 1.0, **options) -> RunResult:
+             t_end: float = 1.0, route=None, **options) -> RunResult:
     """Run the analytic model; ``options`` go to the chosen solver.
 
     ``geometry``: 'approx' (the paper's first order) or 'exact'.
@@ -37,6 +37,8 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     ``params.clutch_stiffness`` the compliant clutch model, which also models
     clutch damping and backlash; with a finite ``params.mu_wall`` the wheels
     grip the wall with at most mu_wall F_ni, and a held module may skid back).
+    ``route``: a :class:`ipir_mujoco.core.route.Route` to run along (:func:`.route_run.simulate_route`: the exact
+    geometry, rigid clutches, the torque or the motor), or None (a straight pipe).
     ``options``: ``dt_out``, ``rtol``, ``atol``, ``until_steady``, ``steady_tol``,
     ``steady_cycles``, ``progress``, ``max_switches``, ``wall_budget_s``, ``torque``
     (see :func:`simulate_kinematic`, :func:`simulate_unilateral` and :func:`simulate_compliant`), and with
@@ -54,6 +56,12 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         raise ParameterError(f"mu_wall={params.mu_wall!r} with clutch={clutch!r}: the paper's rule locks its "
                              "modules whatever the load; allowed: clutch='unilateral' or mu_wall=unlimited")
     refuse_idle_parameters(params)
+    if route is not None:
+        from .route_run import check_route_run, simulate_route
+
+        params = check_route_run(params, route, geometry, clutch, options)
+        options.pop("feedforward", None)  # (None: the servo is refused along a route)
+        return simulate_route(params, route, clutch, t_end, **options)
     if params.drive == "servo":
         _check_servo(params, options)
     elif options.get("feedforward") is not None:

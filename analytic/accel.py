@@ -38,7 +38,8 @@ if MODE not in MODES:  # an unknown value means what it would mean to numba user
 LOAD_COST_S = 0.5  # s of Python-mode integration after which a process compiles (about numba's load cost)
 
 ACCELERATED = False  # True once the kernels run compiled in this process (read it as accel.ACCELERATED)
-_COMPILED_MODULES = ("kernels", "dense", "dop853")  # the modules whose functions are compiled and call each other
+# the modules whose functions are compiled and call each other
+_COMPILED_MODULES = ("kernel_base", "route_geometry", "route_kernels", "kernels", "dense", "dop853")
 _FUNCTIONS: list = []  # every @jit function, in definition order
 _spent = 0.0  # s of analytic integration run in Python so far (auto mode)
 _refused = False  # numba is missing, disabled, or failed to compile: never try again

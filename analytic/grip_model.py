@@ -225,14 +225,15 @@ class GripModel:
         v_scale = r * abs(omega) + abs(v[0]) + abs(v[1])
         at_rest = [abs(x) <= _TOL_V * v_scale + _MODE_REST_FLOOR for x in v]
         crank_rest = r * abs(omega) <= _TOL_V * v_scale + _MODE_REST_FLOOR
-        tr = self.linkage.transfer(phi)
-        K, dK = float(tr.K), float(tr.dK)
+        K, dK = self._transfer(y)
         dead_centre = crank_rest and all(at_rest) and abs(K) <= _DEAD_CENTRE_K * r
-        options = [(1, 0, -1) if at_rest[i] else ((1,) if v[i] > 0 else (-1,)) for i in (0, 1)]
+        # a module at rest may roll, stand or skid (not with unlimited grip: a route's one-way clutches, RouteModel)
+        options = [((1, 0, -1) if self.grip[i] < math.inf else (1, 0)) if at_rest[i] else ((1,) if v[i] > 0 else (-1,))
+                   for i in (0, 1)]
         candidates = [mode for mode in GripMode if all(s in options[i] for i, s in enumerate(mode.states))]
         if GripMode.BOTH_LOCKED in candidates and (not crank_rest or (abs(K) <= 1e-12 * r and M != 0)):
             candidates.remove(GripMode.BOTH_LOCKED)  # a static hold needs the crank at rest and a torque it resists
-        motions = {mode: self.motion(phi, omega, v[0], mode, M) for mode in candidates}
+        motions = {mode: self._motion(y, v, mode, M) for mode in candidates}
         alpha_max = max([0.0] + [abs(float(m["alpha"])) for m in motions.values()])
         a_scale = r * (omega**2 + alpha_max) + (p.F_r1 + p.F_r2 + abs(M) / r) / min(p.m1, p.m2) + abs(self.dyn.a_g)
         a_scale = max(a_scale, 1e-300)  # nothing drives the robot at all: every test is 0 / tiny = 0
@@ -249,7 +250,7 @@ class GripModel:
             if kind == "velocity":
                 want = 0  # a module that stops stands, where it can
             else:  # a standing module's margin reached a limit: it leaves through that limit
-                R = float(self.motion(phi, omega, v[0], previous, M)["R1" if i == 0 else "R2"])
+                R = float(self._motion(y, v, previous, M)["R1" if i == 0 else "R2"])
                 want = 1 if R + self.F[i] <= self.grip[i] - R else -1
             consistent = [mode for mode in consistent if mode.states[i] == want] or consistent
         if not consistent:
@@ -258,6 +259,16 @@ class GripModel:
                 f"v1={v[0]:.3g}, v2={v[1]:.3g} m/s (margins {({m.name: f'{x:.3g}' for m, x in margins.items()})})")
         # remaining ties hold their conditions with equality: the largest margin is the one the motion enters
         return max(consistent, key=lambda mode: margins[mode])
+
+    def _transfer(self, y) -> tuple[float, float]:
+        """(K, dK/dphi) at state ``y``: the gap's rate per crank speed with module 1 held [m/rad] and its
+        derivative [m/rad^2] (the dead-centre tests of :meth:`choose`)."""
+        tr = self.linkage.transfer(float(y[0]))
+        return float(tr.K), float(tr.dK)
+
+    def _motion(self, y, v: tuple[float, float], mode: GripMode, M: float) -> dict:
+        """:meth:`motion` at state ``y`` with module velocities ``v`` under torque M (what :meth:`choose` asks)."""
+        return self.motion(float(y[0]), float(y[1]), v[0], mode, M)
 
     def _margin(self, mode, m, at_rest, dead_centre, dK, a_scale, f_scale) -> float:
         """Smallest scaled condition of candidate ``mode`` with motion ``m`` (>= 0: consistent)."""

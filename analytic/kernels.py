@@ -26,14 +26,14 @@ import math
 import numpy as np
 
 from .accel import jit
+from .kernel_base import (P_AG, P_EXACT, P_FR1, P_FR2, P_JA, P_L, P_M, P_M1, P_M2, P_MOTOR,  # noqa: F401 (the
+                          P_MSTALL, P_R, P_ROD, P_ROD_I, P_ROD_M, P_U, P_WNL, TINY, drive_torque)  # layout's names)
 from .dynamics import OneDofDynamics
 from .forces import gravity_along_pipe
+from .route_kernels import ROUTE, route_guards, route_rhs
 
-KINEMATIC, UNILATERAL = 0, 1  # COMPLIANT = 2 and GRIP = 3: see their sections below
+KINEMATIC, UNILATERAL = 0, 1  # COMPLIANT = 2 and GRIP = 3: see their sections below; ROUTE = 4: .route_kernels
 CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # Mode values (BOTH_LOCKED is never integrated)
-(P_M1, P_M2, P_R, P_L, P_JA, P_FR1, P_FR2, P_M, P_ROD_M, P_ROD_I, P_EXACT, P_ROD, P_MOTOR, P_MSTALL, P_WNL,
- P_AG, P_U) = range(17)
-TINY = float(np.finfo(float).tiny)  # what a quiet guard reads at least (see unilateral_run.events)
 
 
 def pack(dyn: OneDofDynamics) -> np.ndarray:
@@ -47,14 +47,6 @@ def pack(dyn: OneDofDynamics) -> np.ndarray:
                      float(dyn.geometry.value == "exact"), float(dyn.include_rod), float(motor),
                      p.M_stall if motor else 0.0, p.omega_noload if motor else 1.0, gravity_along_pipe(p), 1.0],
                     dtype=float)
-
-
-@jit
-def drive_torque(p, omega):
-    """The drive's torque [N m] at crank speed omega (:func:`.forces.drive_torque`; u = p[P_U])."""
-    if p[P_MOTOR] != 0.0:
-        return p[P_MSTALL] * (p[P_U] - omega / p[P_WNL])
-    return p[P_M]
 
 
 @jit
@@ -142,6 +134,9 @@ def rhs(model, mode, t, y, p, out):
     if model == COMPLIANT:
         compliant_rhs(y, p, out)
         return
+    if model == ROUTE:
+        route_rhs(mode, y, p, out)
+        return
     M = drive_torque(p, omega)
     out[0] = omega
     if model == KINEMATIC:
@@ -173,6 +168,10 @@ def guard(model, mode, k, t, y, p, quiet):
     if model == GRIP:
         value = grip_guard(mode, k, y, p)
         return value if t > quiet[k] else max(value, TINY)
+    if model == ROUTE:
+        values = np.empty(3)
+        route_guards(mode, y, p, values)
+        return values[k] if t > quiet[k] else max(values[k], TINY)
     if model == KINEMATIC:
         return mass_terms(p, phi)[5] * omega
     if mode == BOTH_MOVING:
@@ -203,6 +202,9 @@ def guards_at(model, mode, n_events, t, y, p, never, out):
             out[0], out[1] = -K * omega, hold + p[P_FR1] + p[P_FR2]
         else:
             out[0], out[1] = hold + p[P_FR2] + p[P_FR1], K * omega
+        return
+    if model == ROUTE and abs(phi) < 1e300 and abs(omega) < 1e300:  # every event from one evaluation of the state
+        route_guards(mode, y, p, out)
         return
     for k in range(n_events):
         out[k] = guard(model, mode, k, t, y, p, never)

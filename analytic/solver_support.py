@@ -281,12 +281,55 @@ class RunMonitor:
             self.next_report = t + PROGRESS_EVERY_S
 
 
+def integrate_segment(model, mode, integrate, t: float, stop: float, y: np.ndarray, first_step: float | None,
+                      t_end: float, monitor: RunMonitor, grid: np.ndarray, names: tuple[str, ...], early: int = 0):
+    """One segment of a rigid-clutch model's run loop (the one-way clutches' and the route's): ``mode`` integrated
+    from (t [s], y) to ``stop`` [s] or its first event by ``integrate(model, mode, events, t0, t1, y0, first_step,
+    quiet=None)``, again with a guard quiet where it crossed only spuriously at the start (:func:`spurious_start`),
+    the crossing the integrator missed (:func:`missed_crossing`) and the segment's samples (:func:`raw_piece`,
+    columns ``names``); ``early``: :func:`spurious_start`'s. ``model``: its ``events``, ``guards`` and ``graze_scan``. Returns (events, sol, t_stop [s],
+    the next segment's first step [s], the missed crossing (t, event index, state) or None, the piece)."""
+    events = model.events(mode)
+    sol = integrate(model, mode, events, t, stop, y, first_step)
+    spurious = spurious_start(sol, lambda ts, ys: model.guards(ts, ys, mode), early=early)
+    if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
+        events = model.events(mode, quiet=dict([spurious]))
+        sol = integrate(model, mode, events, t, stop, y, first_step, dict([spurious]))
+    t_stop, first_step = float(sol.t[-1]), restart_step(sol, first_step, t_end)
+    grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events],
+                             model.graze_scan(sol, mode))
+    if grazed is not None:
+        t_stop = grazed[0]
+    piece = raw_piece(mode, monitor.samples(t, t_stop, grid, steps_until(sol.t, t_stop), sol.sol), sol.sol, names)
+    return events, sol, t_stop, first_step, grazed, piece
+
+
+def first_event(sol, events, grazed) -> tuple[float, int, np.ndarray]:
+    """(time [s], index, state) of the event that ended a segment (:func:`integrate_segment`): the missed crossing
+    ``grazed`` where there is one, else the earliest of ``events`` the integrator found."""
+    if grazed is not None:
+        return grazed
+    hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
+    return float(sol.t_events[hit][0]), hit, sol.y_events[hit][0]
+
+
+def switch_mode(model, mode, t: float, y_event: np.ndarray, fired, monitor: RunMonitor, switches: int):
+    """The mode switch at an event (``fired``, its meaning) at time t [s] and state ``y_event`` of a rigid-clutch
+    model's run: the next mode (``model.choose``), the state projected onto it, the switch counted and the
+    budgets checked (:meth:`RunMonitor.after_switch`). Returns (mode, state, switches)."""
+    velocities = model.velocities(y_event, mode)
+    new = model.choose(t, y_event, velocities, fired, previous=mode)
+    y = model.project(y_event, new, velocities)
+    monitor.after_switch(t, switches + 1, float(y[0]))
+    return new, y, switches + 1
+
+
 def raw_piece(mode: int, times: np.ndarray, dense, names: tuple[str, ...]) -> dict[str, np.ndarray]:
     """A segment's integrated states at ``times`` (n,) from its dense output, as columns ``names``, and its mode."""
     return {"t": times, **dict(zip(names, dense(times))), "mode": np.full(times.shape, int(mode))}
 
 
-def spurious_start(sol, guards, points: int = 32):
+def spurious_start(sol, guards, points: int = 32, early: int = 0):
     """(event index, time [s]) if the integrator put a crossing at the segment's start that is not one, else None.
 
     ``guards(t (n,), Y (d, n))``: every event function at once, array (n_events, n). A mode
@@ -296,7 +339,9 @@ def spurious_start(sol, guards, points: int = 32):
     microseconds later) gives a first step that starts at 0 and ends below it; the root search
     then sticks in the roundoff next to the start, and the run would restart there, forever. If
     the guard is clearly positive in that first step before it is clearly negative, the crossing
-    at the start is spurious: returned is where it has risen.
+    at the start is spurious: returned is where it has risen. ``early``: as many more points, at
+    2^-early .. 2^-1 of the step, for a rise that ends before the first of the evenly spaced ones (a
+    module that skids back from rest for 5e-5 s of a 3 ms step and turns: the route model's).
     """
     if sol.status != 1:
         return None
@@ -305,7 +350,8 @@ def spurious_start(sol, guards, points: int = 32):
     if sol.t_events[k][0] - t0 > 1e-12 * (1.0 + abs(t0)):
         return None
     step = sol.sol.interpolants[0]  # the whole first step's dense output, also past the event
-    times = step.t_old + (step.t - step.t_old) * np.arange(1, points + 1) / points
+    fractions = np.concatenate([2.0 ** -np.arange(early, 0, -1), np.arange(1, points + 1) / points])
+    times = step.t_old + (step.t - step.t_old) * fractions
     values = guards(times, step(times))[k]
     threshold = 1e-9 * max(np.abs(values).max(), 1e-300)
     rising, falling = np.flatnonzero(values > threshold), np.flatnonzero(values < -threshold)

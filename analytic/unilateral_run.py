@@ -59,8 +59,8 @@ from ipir_mujoco.core.results import REST_TIME, Mode, RunResult, stall_reason
 from . import dop853
 from .kinematics import Geometry
 from .kinetostatics import add_kinetostatics
-from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, missed_crossing,
-                             raw_piece, restart_step, spurious_start, steps_until, truncate, with_drive_u)
+from .solver_support import (MAX_SWITCHES, RunMonitor, assemble, check_finite, check_tolerances, first_event,
+                             integrate_segment, raw_piece, switch_mode, truncate, with_drive_u)
 from .unilateral_model import _STATES, _TOL_F, _TOL_V, HELD, UnilateralModel  # the tests import it from here too
 
 # more zero-length segments in a row than this is chatter, not motion
@@ -110,6 +110,10 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
     mode = model.choose(0.0, y, (v1_0, v1_0 + S_dot0))
     y = model.project(y, mode, (v1_0, v1_0 + S_dot0))
     t, pieces, switches, short_run, stall, h0 = 0.0, [], 0, 0, None, None
+
+    def integrate(model, mode, events, t0, t1, y0, first_step, quiet=None):
+        return integrate_mode(model, mode, events, t0, t1, y0, rtol, atol, first_step, quiet)
+
     while True:
         stop = t_end if speed is None else min(t_end, speed.next_tick)  # a segment ends at the next tick
         if mode == Mode.BOTH_LOCKED and speed is not None and model.u < 1.0:  # at rest until the next tick
@@ -133,19 +137,8 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
                              lambda ts: np.repeat(y[:, None], np.size(ts), axis=1), _STATES)
             pieces.append(rest if speed is None else with_drive_u(rest, model.u))
             break
-        events = model.events(mode)
-        sol = _integrate(model, mode, events, t, stop, y, rtol, atol, h0)
-        spurious = spurious_start(sol, lambda ts, ys: model.guards(ts, ys, mode))
-        if spurious is not None:  # integrate again, that guard quiet until it has clearly risen
-            events = model.events(mode, quiet=dict([spurious]))
-            sol = _integrate(model, mode, events, t, stop, y, rtol, atol, h0, dict([spurious]))
-        t_stop, h0 = float(sol.t[-1]), restart_step(sol, h0, t_end)
-        grazed = missed_crossing(sol, lambda ts, ys: model.guards(ts, ys, mode), [e for e, _ in events],
-                                 model.graze_scan(sol, mode))
-        if grazed is not None:
-            t_stop, hit, y_grazed = grazed
-        piece = raw_piece(mode, monitor.samples(t, t_stop, grid, steps_until(sol.t, t_stop), sol.sol), sol.sol,
-                          _STATES)
+        events, sol, t_stop, h0, grazed, piece = integrate_segment(model, mode, integrate, t, stop, y, h0, t_end,
+                                                                  monitor, grid, _STATES)
         if speed is not None:
             piece = with_drive_u(piece, model.u)
         steady_at = monitor.observe(piece)
@@ -156,17 +149,11 @@ def simulate_unilateral(params: RobotParams, geometry: Geometry | str = Geometry
             continue
         if steady_at is not None or grazed is None and sol.status != 1:
             break
-        if grazed is None:
-            hit = min((k for k in range(len(events)) if sol.t_events[k].size), key=lambda k: sol.t_events[k][0])
         short_run = short_run + 1 if t_stop - t <= 1e-12 * (1.0 + t) else 0
         if short_run > _MAX_STALLED_SEGMENTS:
             raise SimulationError(f"the clutch modes chatter at t={t:.6g} s (phi={y[0]:.6g} rad)")
-        t, y_event = (t_stop, y_grazed) if grazed is not None else (float(sol.t_events[hit][0]), sol.y_events[hit][0])
-        velocities = model.velocities(y_event, mode)
-        mode = model.choose(t, y_event, velocities, events[hit][1], previous=mode)
-        y = model.project(y_event, mode, velocities)
-        switches += 1
-        monitor.after_switch(t, switches, float(y[0]))
+        t, hit, y_event = first_event(sol, events, grazed)
+        mode, y, switches = switch_mode(model, mode, t, y_event, events[hit][1], monitor, switches)
         if t >= t_end:
             break
 
@@ -205,8 +192,9 @@ def _tick(model: UnilateralModel, speed, monitor: RunMonitor, t: float, y: np.nd
     return new, model.project(y, new, velocities)
 
 
-def _integrate(model, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
-    """Integrate ``mode`` from t0 [s] until one of ``events`` or t_end.
+def integrate_mode(model, mode: Mode, events, t0, t_end, y0, rtol, atol, first_step, quiet=None):
+    """Integrate ``mode`` of ``model`` (its ``kernel_call``, ``torque``, ``rhs``; the route's too) from t0 [s] until
+    one of ``events`` or t_end.
 
     The drive of ``params`` runs on the scalar kernels (:mod:`.kernels`: the same events, event k
     quiet until ``quiet[k]`` [s]); a ``torque`` profile, a Python function, on solve_ivp: the same method.

@@ -88,10 +88,11 @@ class Variant:
 # every variant by its canonical name: {name: Variant}; ``run(name, ...)`` runs one
 VARIANTS: dict[str, Variant] = {v.name: v for v in (
     Variant("analytic-approx", "analytic", "kinematic", "approx", None, "paper's model"),
-    Variant("analytic-exact", "analytic", "kinematic", "exact", None, "analytic, paper's rule"),
+    Variant("analytic-exact", "analytic", "kinematic", "exact", None, "analytic, paper's rule", routes=True),
     Variant("analytic-approx-unilateral", "analytic", "unilateral", "approx", None,
             "analytic first order, one-way clutches"),
-    Variant("analytic-unilateral", "analytic", "unilateral", "exact", None, "analytic one-way clutches"),
+    Variant("analytic-unilateral", "analytic", "unilateral", "exact", None, "analytic one-way clutches",
+            routes=True),
     # MuJoCo's: each model kind declares its own (engine/kinds/<kind>/__init__.py), in the kinds' order
     *(Variant(engine="mujoco", geometry="exact", model=kind.model, **row) for kind in KINDS.values()
       for row in kind.variants),
@@ -104,22 +105,36 @@ ALIASES = {
 NAMES = tuple(VARIANTS)
 # MuJoCo's models of the robot (``--mujoco-model``): the modules on slides, or on wheels on the pipe walls, ...
 MUJOCO_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.engine == "mujoco"))
-ROUTE_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.routes))  # those that take ``--route``
+# MuJoCo's models that take ``--route``, and every variant that does (the exact equations, MuJoCo's wheels)
+ROUTE_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.routes and v.is_mujoco))
+ROUTE_VARIANTS = tuple(v.name for v in VARIANTS.values() if v.routes)
+ANALYTIC_ROUTES = tuple(name for name in ROUTE_VARIANTS if not VARIANTS[name].is_mujoco)
 
 
-def check_route_flag(route: str | None, model: str) -> None:
-    """ParameterError (one line) for ``--route`` with a ``--mujoco-model`` that runs along no route: the command
-    line's check before any work (the model kind's ``check`` refuses a Python caller's route)."""
-    if route is not None and model not in ROUTE_MODELS:
-        raise ParameterError(f"--route {route}: only the {' or '.join(ROUTE_MODELS)} model runs along a route; "
-                             "allowed: --engine mujoco " + " or ".join(f"--mujoco-model {m}" for m in ROUTE_MODELS))
+def check_route_flag(route: str | None, model: "str | Variant") -> None:
+    """ParameterError (one line) for ``--route`` with a variant, or MuJoCo's ``--mujoco-model``, that runs along no
+    route: the command line's check before any work (:func:`run` refuses a Python caller's route)."""
+    if route is None or isinstance(model, Variant) and model.routes:
+        return
+    wheels = " or ".join(f"--mujoco-model {m}" for m in ROUTE_MODELS)
+    if isinstance(model, Variant) and not model.is_mujoco:
+        raise ParameterError(f"--route {route} with {model.name}: the paper's first-order geometry has no linkage to "
+                             f"span a bend's chord; allowed: --geometry exact ({', '.join(ANALYTIC_ROUTES)}), or "
+                             f"--engine mujoco {wheels}")
+    if (model.model if isinstance(model, Variant) else model) not in ROUTE_MODELS:
+        raise ParameterError(f"--route {route}: of MuJoCo's models only the {' or '.join(ROUTE_MODELS)} model runs "
+                             f"along a route; allowed: --engine mujoco {wheels}, or the equations: --engine analytic "
+                             "--geometry exact")
+
 
 # the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
 ANALYTIC_OPTIONS = ("rtol", "atol", "max_switches", "method", "torque")
-MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step", "route")
-# what every engine takes: RunOptions' fields but t_end and max_switches (analytic), and the servo's table
-COMMON_OPTIONS = ("dt_out", "until_steady", "steady_tol", "steady_cycles", "progress", "wall_budget_s", "feedforward")
+MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_step")
+# what every engine takes: RunOptions' fields but t_end and max_switches (analytic), the servo's table, and a route
+# (the variants whose ``routes`` says so: :data:`ROUTE_VARIANTS`)
+COMMON_OPTIONS = ("dt_out", "until_steady", "steady_tol", "steady_cycles", "progress", "wall_budget_s", "feedforward",
+                  "route")
 _WHY_NOT = {"analytic": "the analytic engines hold their solver tolerance and have no timestep, clutch "
                         "implementation or MJCF",
             "mujoco": "MuJoCo's cost is its step count, t_end / timestep, and its accuracy its own monitor's"}
@@ -245,10 +260,11 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         Simulated time [s]; with ``until_steady`` the cap.
     **options
         Every engine: ``dt_out`` [s], ``until_steady``, ``steady_tol``, ``steady_cycles``, ``progress``,
-        ``wall_budget_s`` [s] (:class:`ipir_mujoco.core.options.RunOptions`). The analytic engines also
+        ``wall_budget_s`` [s] (:class:`ipir_mujoco.core.options.RunOptions`); the variants of
+        :data:`ROUTE_VARIANTS` ``route`` (a :class:`ipir_mujoco.core.route.Route`). The analytic engines also
         ``rtol``, ``atol``, ``max_switches``, ``method`` (compliant clutches) and ``torque`` (a torque
         profile); MuJoCo ``settings`` (:class:`ipir_mujoco.engine.SolverSettings`), ``timestep`` [s] (short for
-        settings with that step), ``mjcf``, ``accuracy`` ('stop' | 'warn'), ``servo``, ``route`` and
+        settings with that step), ``mjcf``, ``accuracy`` ('stop' | 'warn'), ``servo`` and
         ``every_step`` (sample at every step of the timestep MuJoCo chooses, :func:`timestep`: a sample holds
         its step's force, so a mean over a window is the impulse and no engagement peak falls between
         samples). With ``params.drive = 'servo'`` the speed controller's ``feedforward`` table
@@ -275,6 +291,9 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         known = (*COMMON_OPTIONS, *(MUJOCO_OPTIONS if v.is_mujoco else ANALYTIC_OPTIONS))
         raise ParameterTypeError(f"option {unknown[0]}={options[unknown[0]]!r} is unknown to {v.name}; "
                                  f"allowed: {', '.join(known)}")
+    if options.get("route") is not None and not v.routes:
+        raise ParameterError(f"route: {v.name} runs along no route; allowed: {', '.join(ROUTE_VARIANTS)} (the exact "
+                             "equations, MuJoCo's wheeled model)")
     if not isinstance(options.get("every_step", False), (bool, type(None))):
         raise ParameterTypeError(f"every_step={options['every_step']!r} is not a bool; allowed: True or False")
     # Ctrl-C during the run is KeyboardInterrupt, whatever the code it landed in made of it (ipir_mujoco.interrupts)

@@ -35,6 +35,10 @@ def warm_up() -> None:
                                          ("exact", "unilateral", RobotParams()),
                                          ("exact", "unilateral", RobotParams(clutch_stiffness=1e5))):
             simulate(params, geometry, clutch, 0.02, dt_out=1e-3)
+        from ipir_mujoco.core.route import route_from_tables  # and along a route (its kernels' first calls)
+
+        bend = route_from_tables([dict(kind="straight", length=0.4), dict(kind="bend", radius=0.5, angle=30.0)])
+        simulate(RobotParams(drive="motor"), "exact", "unilateral", 0.02, route=bend, dt_out=1e-3)
     finally:
         accel.HEARTBEAT_S = period
 

@@ -194,7 +194,7 @@ def test_a_robot_that_makes_no_progress_or_slides_out_stops_with_the_reason(monk
     assert run.params.incline == 90.0 and run.series["x1"][-1] < -route_watch.BACK_OUT + 1e-12
 
 
-def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
+def test_only_the_wheeled_model_and_the_exact_equations_take_a_route(capsys, tmp_path):
     from cli_run import run_cli
 
     good = tmp_path / "r.toml"
@@ -209,7 +209,7 @@ def test_only_the_wheeled_model_takes_a_route(capsys, tmp_path):
                      'angle = 90\n')
     wheels = ("--engine", "mujoco", "--mujoco-model", "wheels")
     for argv, word in ((("--engine", "mujoco", "--route", good), "--mujoco-model wheels"),
-                       (("--route", good), "--mujoco-model wheels"),
+                       (("--geometry", "approx", "--route", good), "--geometry exact"),
                        ((*wheels, "--route", bad), "a straight first"),
                        ((*wheels, "--route", tight), "radius > pipe_diameter / 2"),
                        ((*wheels, "--route", tmp_path / "none.toml"), "does not exist"),

@@ -40,9 +40,9 @@ def add_parser(commands) -> None:
                           "friction (default); wheels = the modules free in the plane on wheels pressed on the pipe's "
                           "walls by springs, a ratchet in every hub, friction mu_wall at the contacts (mjcf/README.md)")
     sim.add_argument("--route", metavar="FILE.toml", default=None,
-                     help="with --mujoco-model wheels: a pipeline of [[segment]] tables (straights and bends, "
-                          "docs/cli.md); the run ends at the route's end or where the robot stops (default --t-end "
-                          f"{T_END_ROUTE:g} s then)")
+                     help="a pipeline of [[segment]] tables (straights and bends, docs/cli.md), for the exact "
+                          "equations (--geometry exact, its default with --route) or --mujoco-model wheels; the run "
+                          f"ends at the route's end or where the robot stops (default --t-end {T_END_ROUTE:g} s then)")
     sim.add_argument("--timestep", type=float, default=None, metavar="SECONDS",
                      help="MuJoCo timestep [s] (default: chosen from the motion, by the rule in mjcf/README.md, "
                           "installed with the package: see 'ipir-mujoco --help')")
@@ -100,7 +100,6 @@ FLAGS = {"max_switches": "--max-switches", "mjcf": "--mjcf", "timestep": "--time
 def check_options(args: argparse.Namespace) -> registry.Variant:
     """Every option of ``simulate`` that the engines do not check themselves, before any work; the variant
     the flags name (:func:`ipir_mujoco.registry.from_flags`)."""
-    registry.check_route_flag(args.route, args.mujoco_model)
     if args.route is not None and args.until_steady:
         raise ParameterError("--until-steady with --route: a run along a route ends at the route's end; allowed: "
                              "one of them")
@@ -117,7 +116,10 @@ def check_options(args: argparse.Namespace) -> registry.Variant:
                              "> 0, or inf (no limit)")
     if args.max_switches is not None:
         check_whole("--max-switches", args.max_switches, low=1)
+    if args.route is not None and args.engine == "analytic" and args.geometry is None:
+        args.geometry = "exact"  # the equations along a route: the exact linkage spans a bend's chord
     variant = registry.from_flags(args.engine, args.geometry, args.clutch, args.mujoco_clutch, args.mujoco_model)
+    registry.check_route_flag(args.route, variant)
     engine_options = {"max_switches": args.max_switches, "mjcf": args.mjcf, "timestep": args.timestep,
                       "accuracy": None if args.accuracy in (None, "stop") else args.accuracy}
     registry.check_options(variant, engine_options, FLAGS.get)
@@ -242,10 +244,11 @@ def route_lines(s: dict) -> list[str]:
     done = (f"route done in {s['route_time_s']:.4f} s" if s["route_done"] else
             f"route NOT done: {s['route_s_m']:.3f} of {s['route_length_m']:.3f} m")
     lines = [f"  {done}: {s['route_stop']}"]
-    if s["route_wall_loss"] is not None:
+    if s.get("route_wall_loss") is not None:  # MuJoCo's wheels (the equations' stay on their walls)
         lines.append(f"  wheels off their walls {s['route_wheel_off_s']:.3f} s in all (a whole module "
                      f"{s['route_module_off_s']:.3f} s); first: {s['route_wall_loss']}")
-    lines.append(f"  closed-form fit: {s['route_fit']['predicted']}")
+    if "route_fit" in s:
+        lines.append(f"  closed-form fit: {s['route_fit']['predicted']}")
     return lines
 
 
@@ -253,10 +256,10 @@ def _energy_line(e: dict) -> str:
     """input = each other term of core.energy's table the run has, in the table's order (kinetic, friction,
     potential, clutch springs and dampers, skid) + residual; a term within round-off of zero (1e-12 of the input:
     a horizontal run's potential, a clutch damper of zero damping) is left out."""
-    inputs = [term for term in energy.ENERGY_TERMS if term.role == INPUT and term.audit_key in e]
+    inputs = [term for term in energy.all_terms() if term.role == INPUT and term.audit_key in e]
     put_in = sum(e[term.audit_key] for term in inputs)
     negligible = 1e-12 * abs(put_in)
-    terms = [f"{term.name} {e[term.audit_key]:.6g}" for term in energy.ENERGY_TERMS
+    terms = [f"{term.name} {e[term.audit_key]:.6g}" for term in energy.all_terms()
              if term.role != INPUT and term.audit_key in e and abs(e[term.audit_key]) > negligible]
     left = " + ".join(f"{term.name} {e[term.audit_key]:.6g}" for term in inputs)
     return f"{left} = " + " + ".join([*terms, f"residual {e[RESIDUAL_KEY]:.2e}"])

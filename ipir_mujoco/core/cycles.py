@@ -146,7 +146,7 @@ class Cycle:
         present = dict(self.energy)
         if any(key not in present for key in ("motor_work_j", "kinetic_j", "friction_j")):
             return None
-        return float(residual(by_role({term: present[term.audit_key] for term in _energy.ENERGY_TERMS
+        return float(residual(by_role({term: present[term.audit_key] for term in _energy.all_terms()
                                        if term.audit_key in present})))
 
 

@@ -55,12 +55,21 @@ ENERGY_TERMS = (  # within a role, the order in which its terms are summed (by_r
     EnergyTerm("skid", "skid_work", "skid_j", DISSIPATED),
 )
 ENERGY_COLUMNS = tuple(term.column for term in ENERGY_TERMS)
+# terms only runs along a route have, after the table's (the wheels' scrub in a bend: the analytic route model
+# books it, zero until its closed form is in, analytic/route_kernels.scrub_force); MuJoCo's per-sample monitor
+# records the table above, every engine's run writes its columns, a route run these too
+ROUTE_TERMS = (EnergyTerm("scrub", "scrub_work", "scrub_j", DISSIPATED),)
 RESIDUAL_KEY = "residual_j"  # the audit's residual: input - kinetic - stored - dissipated [J]
+
+
+def all_terms() -> tuple[EnergyTerm, ...]:
+    """Every term a run may have: the table's, then a route run's (read when called: a test may extend the table)."""
+    return (*ENERGY_TERMS, *ROUTE_TERMS)
 
 
 def terms_of(columns) -> tuple[EnergyTerm, ...]:
     """The terms of a run whose series has ``columns`` (any container of names), in the table's order."""
-    return tuple(term for term in ENERGY_TERMS if term.column in columns)
+    return tuple(term for term in all_terms() if term.column in columns)
 
 
 def changes(series: dict, terms=None) -> dict[EnergyTerm, float]:
@@ -75,7 +84,7 @@ def by_role(change: dict) -> dict[str, float]:
     ({EnergyTerm: J}); residual = input - dissipated - kinetic - stored."""
     out = {}
     for role in (INPUT, KINETIC, STORED, DISSIPATED):
-        values = [change[t] for t in ENERGY_TERMS if t in change and t.role == role]
+        values = [change[t] for t in all_terms() if t in change and t.role == role]
         total = values[0] if values else 0.0
         for value in values[1:]:
             total = total + value

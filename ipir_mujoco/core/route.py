@@ -38,6 +38,10 @@ MAX_LENGTH = 100.0  # m: a straight's length and a bend's radius at most
 INCLINE_MATCH = 1e-6  # deg: how closely a later straight's given incline must match its heading's
 MAX_ROUTE_BYTES = 1_000_000  # bytes of a route file: 100 segments take ~10 kB; a bound on what is read
 MAX_ROUTE_DEPTH = 8  # how deep a route file's tables and arrays may nest ([[segment]] tables are 2 deep)
+# a robot along a route that gets less than PROGRESS_M [m] further in PROGRESS_S [s] has stalled (a tenth of a
+# stroke 2 r; the default motor makes ~7 revolutions in it): the analytic route model's stop
+# (analytic/route_run.py), the wheeled MuJoCo model's route watch's
+PROGRESS_M, PROGRESS_S = 0.01, 2.0
 
 
 def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
