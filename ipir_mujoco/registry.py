@@ -32,14 +32,15 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from . import interrupts
-from .core.control import FeedforwardTable
 from .core.errors import ParameterError, ParameterTypeError
-from .core.options import check_type
 from .core.params import RobotParams, check_real, check_whole, require_params
-from .core.results import RunResult
+
+if TYPE_CHECKING:  # annotations only: the names, flags and checks above load without numpy (``--help``)
+    from .core.control import FeedforwardTable
+    from .core.results import RunResult
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
 # beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
@@ -327,7 +328,7 @@ def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
 @functools.lru_cache(maxsize=64)
 def _table(params: RobotParams) -> FeedforwardTable:
     from .analytic.inverse import CrankMotion, inverse_kinetostatics
-    from .core.control import TABLE_POINTS, reference_motion
+    from .core.control import TABLE_POINTS, FeedforwardTable, reference_motion
 
     omega, dip = params.omega_target, params.speed_dip
     if dip == 0.0:
@@ -373,8 +374,10 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
     for params in designs:
         require_params(params)
     check_whole("nthread", nthread, low=1, high=1024)
-    check_type("until_steady", until_steady, bool, "True or False")
+    from .core.options import check_type
     from .engine.run import batch
+
+    check_type("until_steady", until_steady, bool, "True or False")
 
     steady = {"until_steady": True} if until_steady else {}
     with interrupts.as_keyboard_interrupt():  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design

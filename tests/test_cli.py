@@ -120,6 +120,19 @@ def test_every_subcommand_has_help(capsys):
     assert "NAME=VALUE" in capsys.readouterr().out
 
 
+def test_help_and_params_start_without_the_numerics(tmp_path):
+    """`--help` (the command list, every subcommand's parser built), `params` and a subcommand's --help load
+    neither numpy nor the engines: the start-up a user waits for most often is the interpreter and the parsers
+    (bench/startup.py times it against `python -c "import numpy"`). Each in a fresh interpreter."""
+    heavy = ("numpy", "scipy", "matplotlib", "mujoco", "numba", "ipir_mujoco.analytic", "ipir_mujoco.engine")
+    for argv in (["--help"], ["params"], ["params", "--json"], ["sweep", "--help"], ["atlas", "--help"]):
+        code = ("import sys; from ipir_mujoco.cli import main\n"
+                f"try:\n    main({argv!r})\nexcept SystemExit:\n    pass\n"
+                f"print(sorted(m for m in {heavy!r} if m in sys.modules), file=sys.stderr)")
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+        assert done.returncode == 0 and done.stdout and done.stderr.strip() == "[]", (argv, done.stderr)
+
+
 def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
     from ipir_mujoco.core.params import PARAMETER_NAMES
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.limits import check_run_options
 from ipir_mujoco.core.params import check_real
 
 from ..labels import significant

@@ -8,7 +8,6 @@ import sys
 from typing import Callable
 
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import progress_text
 from ipir_mujoco.core.params import DRIVES, FEEDFORWARDS, RobotParams, load_params
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
@@ -129,6 +128,8 @@ def progress_printer(t_end: float):
     seconds of wall time per simulated second; a run done within FIRST_WALL_S prints nothing). A run repeated at a
     finer step (the accuracy checks) says so in its lines (:func:`ipir_mujoco.core.options.progress_text`)."""
     import time
+
+    from ipir_mujoco.core.options import progress_text
 
     def text(t: float) -> str:
         return progress_text(t, t_end)

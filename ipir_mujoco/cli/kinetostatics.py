@@ -7,9 +7,8 @@ import math
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import MAX_T_END, check_run_options
+from ipir_mujoco.core.limits import MAX_T_END, check_run_options
 from ipir_mujoco.core.params import check_real, read_text_file
-from ipir_mujoco.core.results import write_json
 
 from ..labels import signed
 from ..output import check_output_dir, staged_output
@@ -77,6 +76,7 @@ MIN_SAMPLES = 4  # rows of --samples: the cubic spline through them needs 4
 
 def run(args: argparse.Namespace) -> int:
     from ipir_mujoco.analytic.inverse import CrankMotion, inverse_kinetostatics
+    from ipir_mujoco.core.results import write_json
 
     from ..report.plots import figure_kinetostatics
 

@@ -4,19 +4,21 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
 from ipir_mujoco import registry
 from ipir_mujoco.core import energy
 from ipir_mujoco.core.energy import INPUT, RESIDUAL_KEY
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
-                                      refuse_steady_without_motor)
+from ipir_mujoco.core.limits import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
+                                     refuse_steady_without_motor)
 from ipir_mujoco.core.params import check_real, check_whole
-from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
 from ..labels import fixed, significant
-from ..output import check_output_dir, staged_output
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
+
+if TYPE_CHECKING:  # the parser loads without numpy (``ipir-mujoco --help``); a run loads the results with it
+    from ipir_mujoco.core.results import RunResult
 
 
 def add_parser(commands) -> None:
@@ -286,6 +288,10 @@ def save_run_mjcf(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.core.results import write_json, write_mode_changes
+
+    from ..output import check_output_dir, staged_output
+
     check_options(args)
     # bad parameters are reported before the output folder is looked at
     refuse_steady_without_motor(model_params(args).drive, args.until_steady)

@@ -6,7 +6,6 @@ import argparse
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.results import write_json
 
 from .. import registry
 from ..labels import significant
@@ -78,6 +77,8 @@ def study_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.core.results import write_json
+
     from ..report.sweep_plots import (LARGER_IS_BETTER, best_designs, check_plot_metric, plot_sweep, rankings,
                                       read_results)
     from ..studies.sweep import check_sweep_options, run_sweep

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ipir_mujoco.core.results import write_json
 
 from ..output import check_output_dir, staged_output
 from .common import EXIT_OK, add_model_options, model_params
@@ -23,6 +22,8 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.core.results import write_json
+
     from ..report.sections import SECTIONS
     from ..report.validation import write_report
     from ..studies.validate import validate

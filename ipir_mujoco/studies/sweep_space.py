@@ -39,11 +39,9 @@ import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import MAX_T_END, check_run_options, refuse_steady_without_motor
+from ipir_mujoco.core.limits import MAX_T_END, check_run_options, refuse_steady_without_motor
 from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
                                      read_toml_file, require_params)
 
@@ -119,6 +117,8 @@ def parse_vary(text: str) -> Axis:
         if count > MAX_DESIGNS:
             raise ParameterError(f"--vary {text!r}: N={count:g} points would need {count * 8:.3g} bytes for the "
                                  f"axis alone; allowed: N <= {MAX_DESIGNS} (designs per sweep)")
+        import numpy as np  # here only: the command line's parsers read this module's defaults without numpy
+
         spaced = np.geomspace if log else np.linspace
         return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))), log=log)
     raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N[:log], NAME=A,B,C or "
