@@ -170,9 +170,26 @@ def test_report_section_where_the_paper_model_holds(tmp_path):
     assert any(isinstance(b, Image) and b.path == "figures/atlas_safe.png" for b in blocks)
     table = next(b for b in blocks if isinstance(b, Table))
     assert len(table.rows) == 3 * 2  # idealizations x metrics
+    # SALib comes with the package: the indices are computed, and the locks' cost is driven by named parameters
+    assert table.header[-1] == "driven by" and all(" (ST " in row[-1] for row in table.rows[-2:]), table.rows
     verdict = atlas_section.verdict(metrics)
     assert verdict["short"] == "least safe: locking-clutches" and "revolutions" in verdict["answer"]
     assert "Where the paper's model holds" in to_markdown(blocks)
+
+
+def test_indices_not_computed_say_why_and_what_adds_them_in_place():
+    """Where the Sobol indices were skipped (SALib removed after the install, designs without a value), the
+    "driven by" answer says so and why, with the command that adds what is missing: never a bare '-'."""
+    from ipir_mujoco.studies.atlas import top_drivers
+    from ipir_mujoco.studies.sensitivity import SALIB_MISSING
+
+    said = top_drivers({"sensitivity": {"skipped": SALIB_MISSING}})
+    assert said.startswith("not computed: needs SALib") and "pip install 'SALib>=1.6,<1.7'" in said
+    assert top_drivers({"sensitivity": {"of": "equations", "skipped": "3 designs gave no value"}}) == \
+        "not computed: 3 designs gave no value"
+    ranked = {"of": "equations", "L": {"S1": 0.5, "S1_conf": 0.1, "ST": 0.9, "ST_conf": 0.1},
+              "m2": {"S1": 0.0, "S1_conf": 0.1, "ST": 0.05, "ST_conf": 0.1}}  # m2's interval includes 0
+    assert top_drivers({"sensitivity": ranked}) == "L (ST 0.90 +- 0.10)"
 
 
 def test_a_folder_another_run_is_writing_is_refused(tmp_path):
