@@ -67,9 +67,10 @@ def add_study_options(parser: argparse.ArgumentParser, command: str, set_help: s
 def model_params(args: argparse.Namespace) -> RobotParams:
     """The parameter set a command's options describe: defaults, --config, --set, then --drive and
     --feedforward (refused in one line with a drive other than servo)."""
-    params = load_params(args.config, args.overrides)
-    if getattr(args, "drive", None) is not None:
-        params = params.replace(drive=args.drive)
+    drive = getattr(args, "drive", None)
+    # --drive as the last --set, not a replace(): a drive's parameters given with another drive are refused by
+    # the run (core.params.refuse_idle_parameters), where replace() would quietly reset them
+    params = load_params(args.config, [*args.overrides, *([f"drive={drive}"] if drive is not None else [])])
     feedforward = getattr(args, "feedforward", None)
     if feedforward is not None:
         if params.drive != "servo":

@@ -171,6 +171,7 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
     lines = [
         f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
         f"({run.wall_time_s:.2f} s wall)",
+        f"  drive                    {drive_text(run.params)}",
         f"  crank revolutions        {s['revolutions']:.4f}",
         f"  module 1 (rear) moved    {fixed(s['x1_final'], 4)} m{along}   peak speed {fixed(s['v1_max'], 3)} m/s",
         f"  module 2 (front) moved   {fixed(s['x2_final'], 4)} m{along}   peak speed {fixed(s['v2_max'], 3)} m/s",
@@ -219,6 +220,16 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      f"{last.get('figure')} " + ("n/a" if error is None else f"{error:.2g}")
                      + f" of it, its accuracy {accuracy['tolerances']['skid_difference']:.2g}")
     return "\n".join(lines)
+
+
+def drive_text(params) -> str:
+    """What turns the crank, in words with the parameters it acts through (core.params.DRIVE_FIELDS)."""
+    motor = f"M_stall {params.M_stall:g} N m, no-load {params.omega_noload:g} rad/s"
+    if params.drive == "torque":
+        return f"constant torque M {params.M:g} N m (the paper's)"
+    if params.drive == "motor":
+        return f"DC gearmotor at full voltage, {motor}"
+    return f"speed controller holding {params.omega_target:g} rad/s, gearmotor {motor}"
 
 
 def wall_lines(s: dict, unlimited_grip: bool = False) -> list[str]:

@@ -36,6 +36,7 @@ def neighbourhood(params: RobotParams) -> tuple[Axis, ...]:
 
 
 def compute(params: RobotParams, quick: bool, progress) -> dict:
+    params = params.replace(drive=params.drive)  # without another drive's parameters (the sections' motor's)
     axes = neighbourhood(params)
     atlas = Atlas(axes, params, budget=0, samples=SAMPLES[quick], thresholds=THRESHOLDS)
     with tempfile.TemporaryDirectory(prefix="ipir-atlas-") as folder:

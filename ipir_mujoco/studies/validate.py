@@ -338,13 +338,16 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
     """
     settings = {"t_end_s": 1.0, "quick": quick, "dt_out_s": 1e-3 if quick else 1e-4, "rtol": 1e-10, "atol": 1e-12,
                 "mujoco": registry.mujoco_defaults()}
-    rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
+    # the ladder's runs under the design's drive, without another drive's parameters (the motor's, given for the
+    # sections that run the motor: each names its drive): a run refuses what its drive does not use
+    own = params.replace(drive=params.drive)
+    rungs = run_ladder(own, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
     # MuJoCo's settings are chosen per run from the motion: record what each MuJoCo rung used
     settings["mujoco_runs"] = {r.name: {k: r.run.settings[k] for k in ("timestep", "integrator",
                                                                          "constraint_time_constant", "solimp")}
                                for r in rungs if r.run.engine == "mujoco"}
-    study = lr_study(params, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
-    convergence = convergence_evidence(params, quick, lambda m: progress(f"convergence: {m}"))
+    study = lr_study(own, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
+    convergence = convergence_evidence(own, quick, lambda m: progress(f"convergence: {m}"))
     metrics = build_metrics(params, rungs, settings, study, convergence)
     run_sections(metrics, params, quick, progress, sections)
     return metrics, rungs
