@@ -72,6 +72,22 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     return simulate_kinematic(params, geometry, t_end, **options)
 
 
+def compile_kernels() -> bool:
+    """Compile the analytic kernels now (numba, where it may: :mod:`.accel`, which says so on logger
+    'ipir_mujoco' when it compiles rather than loads them) and call every model once briefly, as numba compiles
+    each kernel at its first call: for a command about to run many designs, before its pool starts, so that
+    the kernels are compiled once and its workers load them from numba's cache. True if they run compiled."""
+    from . import accel
+
+    if not accel.accelerate():
+        return False
+    for geometry, clutch, params in (("approx", "kinematic", RobotParams()), ("exact", "kinematic", RobotParams()),
+                                     ("exact", "unilateral", RobotParams()),
+                                     ("exact", "unilateral", RobotParams(clutch_stiffness=1e5))):
+        simulate(params, geometry, clutch, 0.02, dt_out=1e-3)
+    return True
+
+
 def _check_servo(params: RobotParams, options: dict) -> None:
     """What the speed controller runs on, refused in one line elsewhere: rigid clutches (the paper's rule or
     one-way) with unlimited grip, either geometry, without a torque profile (both would set the torque)."""

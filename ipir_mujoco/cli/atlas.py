@@ -7,7 +7,7 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params, study_progress
+from .common import EXIT_OK, add_model_options, compile_first, model_params, study_progress
 
 
 def add_parser(commands) -> None:
@@ -67,12 +67,13 @@ def atlas_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.atlas_plots import plot_atlas
-    from ..studies.atlas import run_atlas
-
     atlas = atlas_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    compile_first()  # before the pool: compiled once, said at once
+    from ..report.atlas_plots import plot_atlas
+    from ..studies.atlas import run_atlas
+
     result = run_atlas(atlas, args.out, resume=args.resume, workers=args.workers, progress=study_progress("atlas"))
     figures = plot_atlas(result, atlas, args.out)
     for line in summary_lines(result, atlas):

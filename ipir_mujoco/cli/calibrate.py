@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_OK, add_model_options, check_input_file, model_params, study_progress
+from .common import EXIT_OK, add_model_options, check_input_file, compile_first, model_params, study_progress
 
 
 def add_parser(commands) -> None:
@@ -38,6 +38,7 @@ def run(args: argparse.Namespace) -> int:
     fits = [parse_fit(f) for f in args.fit]
     base = model_params(args)
     measured = read_measured(args.data)
+    compile_first((args.engine,))
     result = calibrate(measured, fits, base=base, engine=args.engine, progress=study_progress("calibrate"))
     figure = write_files(args.out, result, measured)
     print(format_result(result))

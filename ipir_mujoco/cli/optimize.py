@@ -7,7 +7,7 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, model_params
 from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
@@ -62,6 +62,7 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    compile_first((problem.engine,))  # before the pool: compiled once, said at once
     from ..report.optimize_plots import plot_pareto
 
     drawn = []

@@ -6,7 +6,7 @@ import argparse
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, model_params
 from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
@@ -36,6 +36,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")
     axes = tuple(parse_vary(v) for v in args.vary)
     metrics = tuple(check_key(m, f"--metric {m!r}") for m in args.metric)
+    compile_first((args.engine or "analytic-unilateral",))  # before the pool: compiled once, said at once
     drawn = []
     with scheduler_executor(args.scheduler) as executor:
         indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),

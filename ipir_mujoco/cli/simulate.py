@@ -14,6 +14,7 @@ from ipir_mujoco.core.limits import (DEFAULT_WALL_BUDGET_S, check_run_options, c
                                      refuse_steady_without_motor)
 from ipir_mujoco.core.params import check_real, check_whole
 
+from .. import terminal
 from ..labels import fixed, significant
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
 
@@ -148,6 +149,8 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
         if "budget" in str(exc) and "wall" in str(exc):  # say which option raises it
             raise SimulationError(f"{exc} (--wall-budget {args.wall_budget:g} s; raise it, or 'inf')") from None
         raise
+    finally:
+        terminal.end_status()  # a run that ended before its t_end (steady, a route's end) leaves it standing
 
 
 def _estimate_text(run: RunResult) -> str:

@@ -11,7 +11,7 @@ from .. import registry
 from ..labels import significant
 from ..studies.sweep_metrics import METRICS, UNITS
 from ..studies.sweep_space import DEFAULT_VARIANTS, T_END_STEADY
-from .common import EXIT_OK, add_model_options, check_input_file, model_params
+from .common import EXIT_OK, add_model_options, check_input_file, compile_first, model_params
 from .design_runs import add_scheduler_option, scheduler_executor
 
 
@@ -91,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
     if args.no_batch and args.batch_size is not None:
         raise ParameterError(f"--batch-size {args.batch_size} with --no-batch: the batch size is for mujoco.batch; "
                              "allowed: one of the two")
+    compile_first(study.engines)  # before the pool: compiled once, said at once
     with scheduler_executor(args.scheduler) as executor:
         results = run_sweep(study, args.out, executor=executor, batch_mujoco=False if args.no_batch else None,
                             resume=args.resume, workers=args.workers, timeout_per_design=args.timeout_per_design,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, model_params
 from .design_runs import add_design_run_options, design_t_end
 
 
@@ -55,6 +55,7 @@ def run(args: argparse.Namespace) -> int:
     dists = combine([parse_dist(d) for d in args.dist], from_file)
     metrics = tuple(dict.fromkeys(check_metric(m) for m in args.metric))
     events = tuple(parse_event(e) for e in args.event)
+    compile_first()  # before the pool: compiled once, said at once (the equations run every sample)
     result = run_uncertainty(dists, metrics, events, base=base, engine=args.engine, samples=args.samples,
                              mujoco_samples=args.mujoco_samples, t_end=design_t_end(args),
                              until_steady=bool(args.until_steady), seed=0 if args.seed is None else args.seed,

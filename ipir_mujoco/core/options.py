@@ -143,16 +143,26 @@ def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable
     return progress
 
 
-HEARTBEAT_S = 10.0  # s of wall time between two "still running" lines of one long step
+HEARTBEAT_S = 5.0  # s of wall time between two "still running" lines of one long step (a log's: at least so often)
+LIVE_HEARTBEAT_S = 1.0  # s: the same for a printer that shows them as a terminal's status line (``report.live``)
+
+
+class Status(str):
+    """A progress message that a printer may show as its status line, in place of the last one (a terminal's
+    single line rewritten: "still running (12 s)"), rather than as a line of its own (:mod:`ipir_mujoco.terminal`)."""
 
 
 class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)
-    """``with heartbeat(report, what) as beat:`` a long step says ``"{what}: still running ({s} s)"`` through
-    ``report`` whenever ``every_s`` seconds of wall time pass with no line; the step's own lines go through
-    ``beat.say(message)`` (to ``report``), each restarting that clock, so a step that reports often adds
-    nothing. Silent when it ends sooner. A daemon thread: it never holds up the process's exit."""
+    """``with heartbeat(report, what) as beat:`` a long step says ``"{what}: still running ({s} s)"`` (a
+    :class:`Status`) through ``report`` whenever ``every_s`` seconds of wall time pass with no line (default
+    HEARTBEAT_S, or LIVE_HEARTBEAT_S for a ``report`` whose ``live`` attribute is true: the command line's, which
+    shows it in place on a terminal and every 5 s in a log); the step's own lines go through ``beat.say(message)``
+    (to ``report``), each restarting that clock, so a step that reports often adds nothing. Silent when it ends
+    sooner. A daemon thread: it never holds up the process's exit."""
 
-    def __init__(self, report: Callable[[str], None], what: str, every_s: float = HEARTBEAT_S):
+    def __init__(self, report: Callable[[str], None], what: str, every_s: float | None = None):
+        if every_s is None:
+            every_s = LIVE_HEARTBEAT_S if getattr(report, "live", False) else HEARTBEAT_S
         self.report, self.what, self.every_s = report, what, every_s
 
     def say(self, message: str) -> None:
@@ -171,7 +181,8 @@ class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)
         def beat() -> None:
             while not self._stop.wait(max(0.0, self._last + self.every_s - time.monotonic())):
                 if time.monotonic() - self._last >= self.every_s:
-                    self.say(f"{self.what}: still running ({time.monotonic() - self._started:.0f} s)")
+                    self._last = time.monotonic()  # a status: the step's own lines are what restarts the clock
+                    self.report(Status(f"{self.what}: still running ({time.monotonic() - self._started:.0f} s)"))
 
         self._thread = threading.Thread(target=beat, name="ipir-heartbeat", daemon=True)
         self._thread.start()

@@ -371,7 +371,7 @@ def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: 
 
     ``sections`` (:class:`ipir_mujoco.report.sections.Section`) draw their parts
     from ``metrics["sections"]``, after the core and before the numerical evidence.
-    ``progress`` hears a line per group of figures, and one at least every 10 s of wall time
+    ``progress`` hears a line per group of figures, and one at least every 5 s of wall time
     (the animation takes several seconds).
     """
     figures_dir = folder / "figures"

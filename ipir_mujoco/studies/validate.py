@@ -363,7 +363,7 @@ def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Call
     for section in sections:
         started = time.perf_counter()
         progress(f"{section.title} ...")
-        with heartbeat(progress, section.title) as beat:  # a line at least every 10 s whatever the section does
+        with heartbeat(progress, section.title) as beat:  # a line at least every 5 s whatever the section does
             result = section.compute(params, quick, lambda m, s=section: beat.say(f"{s.title}: {m}"))
         metrics["sections"][section.key] = result
         if section.verdict is not None and (verdict := section.verdict(result)) is not None:
