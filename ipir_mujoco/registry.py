@@ -134,7 +134,8 @@ def variant(name: str | Variant) -> Variant:
         key = ALIASES.get(name, name)
         if key in VARIANTS:
             return VARIANTS[key]
-    raise ParameterError(f"engine {name!r} is unknown; allowed: {', '.join(NAMES)}")
+    raise ParameterError(f"variant {name!r} is unknown (a model in an engine, ENGINE-MODEL[-RULE]); allowed: "
+                         f"{', '.join(NAMES)}")
 
 
 def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str | None = "kinematic",
@@ -368,7 +369,7 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
     """The variant on many designs at once through ``mujoco.batch`` (:func:`batched` variants only): one
     outcome per design, as :func:`ipir_mujoco.engine.run.batch.run_ratchet_batch` gives them."""
     if not batched(name):
-        raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
+        raise ParameterError(f"variant {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
     if not isinstance(designs, (list, tuple)):
         raise ParameterTypeError(f"designs={designs!r} is not a list of RobotParams")
     for params in designs:

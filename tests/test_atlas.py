@@ -213,9 +213,20 @@ def test_command_prints_one_line_per_idealization_metric_and_threshold(tmp_path,
     out = tmp_path / "cli"
     assert main(["atlas", "--vary", "L=0.1:0.3", "--idealization", "first-order-kinematics", "--threshold", "0.01",
                  "--threshold", "0.02", "--samples", "2", "--budget", "0", "--workers", "1", "--out", str(out)]) == 0
-    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("first-order-kinematics")]
+    printed, said = capsys.readouterr()
+    lines = [ln for ln in printed.splitlines() if ln.startswith("first-order-kinematics")]
     assert len(lines) == 2 * 2  # metrics (revolutions, travel_m) x thresholds
     saved = json.loads((out / "atlas.json").read_text())["idealizations"]["first-order-kinematics"]
+    # one count of designs, its runs twice it (idealized and real), the same on stderr's start line, each line and
+    # the last; one worker, singular; every file with its folder
+    designs = saved["revolutions"]["runs"] // 2
+    assert all(f"; {designs} designs ({2 * designs} runs of the equations: each idealized and real)" in line
+               for line in lines)
+    assert f"  {designs} designs of the equations ({2 * designs} runs), 0 of MuJoCo (0 runs) in " in printed
+    assert printed.count("(1 worker)") == 1 and "workers)" not in printed
+    # Saltelli's 2 x (1 + 2) points in 1-D: A, B and AB (= B, one parameter), 4 distinct designs
+    assert "the sample's 4 designs (Saltelli's 6 points, some the same)" in said
+    assert f"  files: {out}/atlas.json, {out}/samples.csv, {out}/" in printed
     for line, (metric, k) in zip(lines, [(m, k) for m in ("revolutions", "travel_m") for k in (0, 1)]):
         item = saved[metric]["by_threshold"][k]
         assert metric in line and f"safe in {100 * item['safe_fraction']:.1f} %" in line

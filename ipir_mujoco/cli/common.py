@@ -50,7 +50,8 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
                         help="what turns the crank: torque = the constant M (the paper's case, default); "
                              "motor = a DC gearmotor, M_stall (1 - omega / omega_noload); servo = that motor under "
                              "a speed controller holding omega_target (--set omega_target=RAD_S; docs/control.md); "
-                             "wins over --set and the config file")
+                             "wins over --set and the config file; a parameter only another drive uses (M, M_stall, "
+                             "omega_noload, the controller's) is refused")
     parser.add_argument("--feedforward", choices=FEEDFORWARDS, default=None,
                         help="--drive servo only: the torque table the speed controller adds to its PI, from "
                              "inverse kinetostatics at omega_target: none (PI alone, default), paper (the paper's "
@@ -182,6 +183,14 @@ def study_progress(command: str) -> Callable[[str], None]:
         terminal.say(f"{command}: {message}", status=isinstance(message, Status))
     progress.live = True
     return progress
+
+
+def files_line(out, *names) -> str:
+    """'OUT/a.csv, OUT/b.json, ...': every file a command wrote with its folder (``names`` relative to ``out``;
+    a path already holding its folder, a figure's as the study returned it, as it is)."""
+    from pathlib import Path
+
+    return ", ".join(str(n) if Path(n).parent != Path(".") else str(Path(out) / n) for n in names)
 
 
 def write_study_files(out, files: tuple[str, str, str], study: dict, write_csv, write_figure, table: str,

@@ -12,7 +12,7 @@ from ipir_mujoco.core.params import check_real, read_text_file
 
 from ..labels import signed
 from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, check_input_file, model_params, wall_progress
+from .common import EXIT_OK, add_model_options, check_input_file, files_line, model_params, wall_progress
 
 
 def add_parser(commands) -> None:
@@ -31,7 +31,7 @@ def add_parser(commands) -> None:
                      help="kinematic (the paper's rule, default) or unilateral (one-way clutches)")
     add_model_options(kin)
     kin.add_argument("--out", metavar="DIR", default="kinetostatics",
-                     help="writes DIR/kinetostatics.csv and DIR/kinetostatics.png (default ./kinetostatics)")
+                     help="writes DIR/kinetostatics.csv, DIR/kinetostatics.png and DIR/summary.json (default ./kinetostatics)")
     kin.set_defaults(handler=run)
 
 
@@ -116,5 +116,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"  clutch reactions rear {signed(s['lambda1'].min(), 4)} .. {signed(s['lambda1'].max(), 4)} N, "
           f"front {signed(s['lambda2'].min(), 4)} .. {signed(s['lambda2'].max(), 4)} N")
     print(f"  rod force        {signed(s['rod_force'].min(), 4)} .. {signed(s['rod_force'].max(), 4)} N (tension > 0)")
-    print(f"  wrote {args.out}/kinetostatics.csv, kinetostatics.png, summary.json")
+    print(f"  wrote {files_line(args.out, 'kinetostatics.csv', 'kinetostatics.png', 'summary.json')}")
     return EXIT_OK

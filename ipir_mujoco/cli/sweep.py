@@ -16,7 +16,7 @@ from .design_runs import add_scheduler_option, scheduler_executor
 
 
 def add_parser(commands) -> None:
-    swp = commands.add_parser("sweep", help="geometry what-if studies over many designs",
+    swp = commands.add_parser("sweep", help="what-if studies: engines over a grid or a sample of designs",
                               description="Vary parameters over a grid, a list or a space-filling sample; run the "
                                           "chosen engines on every design; stream the results to DIR/results.csv "
                                           "and draw them. Ctrl-C keeps what is done; --resume completes it.")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_model_options, compile_first, model_params
+from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
 from .design_runs import add_design_run_options, design_t_end
 
 
@@ -16,7 +16,7 @@ def add_parser(commands) -> None:
                     "standard deviation and 5/50/95 % quantiles with 95 % confidence intervals, and each event's "
                     "probability with its interval. With MuJoCo samples the estimate is multi-fidelity (the "
                     "equations as a control variate of MuJoCo), shown beside MuJoCo's plain Monte Carlo with the "
-                    "variance reduction. Writes DIR/uncertainty.json, samples.csv, uncertainty.png "
+                    "variance reduction. Writes DIR/uncertainty.json, DIR/samples.csv, DIR/uncertainty.png "
                     "(docs/uncertainty.md).")
     unc.add_argument("--dist", action="append", default=[], metavar="NAME=KIND:...",
                      help="an uncertain parameter: NAME=normal:MEAN:SD, uniform:LO:HI, lognormal:MU:SIGMA (of "
@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
                              correlation=correlation, workers=args.workers)
     figure = write_files(args.out, result)
     print(format_result(result))
-    print(f"  files: {args.out}/uncertainty.json, samples.csv, {figure}")
+    print(f"  files: {files_line(args.out, 'uncertainty.json', 'samples.csv', figure)}")
     return EXIT_OK
 
 

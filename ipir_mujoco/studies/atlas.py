@@ -270,7 +270,9 @@ def _run(atlas: Atlas, out: Path, meta: Path, fingerprint: str, U: np.ndarray, s
         for name in atlas.idealizations:
             if IDEALIZATIONS[name].equations is None:
                 continue
-            progress(f"{name} (equations): {len(designs)} designs")
+            distinct = len({tuple(repr(float(d[n])) for n in atlas.names) for d in designs})
+            progress(f"{name} (equations): the sample's {distinct} designs (Saltelli's {len(designs)} points, some "
+                     "the same), each run idealized and real; then designs placed at the crossings")
             with heartbeat(progress, f"{name} (equations)"):  # the runs, the fits and the indices: tens of s
                 rows = store.evaluate(name, "equations", designs)
                 measured[(name, "equations")] = (U, rows)
