@@ -5,8 +5,8 @@ Run on demand (not part of the test suite), from the repository root:
     python bench/startup.py [--repeats 5] [--smoke]
 
 Each command runs as a whole process on this interpreter (the ``ipir-mujoco``
-script beside it, else ``python -m ipir_mujoco``), its output thrown away; the
-floor is ``python -c "import numpy"`` on the same interpreter. The runs are
+script beside it, else the package run as a module), its output thrown away;
+the floor is ``python -c "import numpy"`` on the same interpreter. The runs are
 interleaved (floor, then each command, repeated), each time is the best of the
 repeats, and the ratio is taken between the bests, so that a machine's load
 moves the floor and the commands alike: wall time, and CPU time (user +
