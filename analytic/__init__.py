@@ -15,12 +15,23 @@ from ipir_mujoco.core.older_paths import keep_older_paths
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, refuse_idle_parameters, require_params
 from ipir_mujoco.core.results import COLUMNS, MODE_NAMES, Mode, RunResult
 
-from .compliant_run import simulate_compliant
 from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
-from .unilateral_run import simulate_unilateral
 
 CLUTCH_RULES = ("kinematic", "unilateral")
+# the one-way and compliant clutches' run loops load where a run needs them (PEP 562): the paper's case, the
+# default `ipir-mujoco simulate`, starts without them
+_RUNS = {"simulate_unilateral": "unilateral_run", "simulate_compliant": "compliant_run"}
+
+
+def __getattr__(name: str):
+    if name in _RUNS:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_RUNS[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 # a model's modes or regimes are in *_model.py, the loop that runs it in *_run.py; their older names:
 keep_older_paths({f"{__name__}.{older}": f"{__name__}.{now}" for older, now in (
@@ -66,8 +77,12 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         if clutch != "unilateral":
             raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
                                  "paper's rule locks rigidly; allowed: clutch='unilateral' or clutch_stiffness=rigid")
+        from .compliant_run import simulate_compliant
+
         return simulate_compliant(params, geometry, t_end, **options)
     if clutch == "unilateral":
+        from .unilateral_run import simulate_unilateral
+
         return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
 
