@@ -11,7 +11,7 @@ inverse kinetostatics.
 """
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.older_paths import keep_older_paths
+from ipir_mujoco.core.older_paths import keep_older_paths, lazy_names
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, refuse_idle_parameters, require_params
 from ipir_mujoco.core.results import COLUMNS, MODE_NAMES, Mode, RunResult
 
@@ -21,17 +21,8 @@ from .kinematics import Geometry, Linkage
 CLUTCH_RULES = ("kinematic", "unilateral")
 # the one-way and compliant clutches' run loops load where a run needs them (PEP 562): the paper's case, the
 # default `ipir-mujoco simulate`, starts without them
-_RUNS = {"simulate_unilateral": "unilateral_run", "simulate_compliant": "compliant_run"}
-
-
-def __getattr__(name: str):
-    if name in _RUNS:
-        import importlib
-
-        value = getattr(importlib.import_module(f".{_RUNS[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__, __dir__ = lazy_names(__name__, {"simulate_unilateral": "unilateral_run",
+                                             "simulate_compliant": "compliant_run"})
 
 # a model's modes or regimes are in *_model.py, the loop that runs it in *_run.py; their older names:
 keep_older_paths({f"{__name__}.{older}": f"{__name__}.{now}" for older, now in (

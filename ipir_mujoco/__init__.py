@@ -45,15 +45,6 @@ _PUBLIC = {"ParameterError": "core.errors", "SimulationError": "core.errors", "R
 __all__ = ["VARIANTS", "ParameterError", "RobotParams", "RunResult", "SimulationError", "__version__", "run"]
 
 
-def __getattr__(name: str):
-    if name in _PUBLIC:
-        import importlib
+from .core.older_paths import lazy_names as _lazy_names  # noqa: E402 (after the analytic folder is findable)
 
-        value = getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_PUBLIC))
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC)

@@ -24,15 +24,6 @@ __all__ = ["COLUMNS", "MODE_NAMES", "Mode", "PARAMETER_NAMES", "ParameterError",
            "SimulationError", "load_params", "require_params"]
 
 
-def __getattr__(name: str):
-    if name in _NAMES:
-        import importlib
+from .older_paths import lazy_names as _lazy_names  # noqa: E402
 
-        value = getattr(importlib.import_module(f".{_NAMES[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_NAMES))
+__getattr__, __dir__ = _lazy_names(__name__, _NAMES)

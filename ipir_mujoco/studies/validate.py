@@ -70,7 +70,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import heartbeat, progress_text, throttled
+from ipir_mujoco.core.options import (HEARTBEAT_S, LIVE_HEARTBEAT_S, Status, heartbeat, progress_text,
+                                      throttled)
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
@@ -107,8 +108,10 @@ def run_ladder(params: RobotParams, t_end: float, dt_out: float, rtol: float, at
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name} ...")
         tolerances = ({"accuracy": rung.accuracy} if registry.variant(rung.variant).is_mujoco
                       else {"rtol": rtol, "atol": atol})
-        beat = throttled(lambda t, i=i, rung=rung: progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: "
-                                                            + progress_text(t, t_end)))
+        # the run's time as the command line's status line (every second, in place on a terminal), else every 5 s
+        beat = throttled(lambda t, i=i, rung=rung: progress(Status(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: "
+                                                                   + progress_text(t, t_end))),
+                         LIVE_HEARTBEAT_S if getattr(progress, "live", False) else HEARTBEAT_S)
         run = registry.run(rung.variant, rung.params(params), t_end, dt_out=dt_out, progress=beat, **tolerances)
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: {run.summary['revolutions']:.3f} rev "
                  f"({time.perf_counter() - started:.2f} s)")
