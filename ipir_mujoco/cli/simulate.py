@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from ipir_mujoco import registry
 from ipir_mujoco.core import energy
@@ -12,7 +11,7 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
                                       refuse_steady_without_motor)
 from ipir_mujoco.core.params import check_real, check_whole
-from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
+from ipir_mujoco.core.results import RunResult, json_text, write_json, write_mode_changes
 
 from ..labels import fixed, significant
 from ..output import check_output_dir, staged_output
@@ -305,7 +304,7 @@ def run(args: argparse.Namespace) -> int:
             write_json(staging / "summary.json", record)
             write_paper_figures([result], staging)
     if args.json:
-        print(json.dumps(record, allow_nan=False))
+        print(json_text(record))
     else:
         print(format_summary(result, args.until_steady))
         if args.out is not None:
