@@ -43,7 +43,7 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import MAX_T_END, check_run_options, refuse_steady_without_motor
+from ipir_mujoco.core.options import MAX_T_END, check_run_options, refuse_steady_without_motor, study_dt_out
 from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
                                      read_toml_file, require_params)
 
@@ -187,9 +187,10 @@ class Study:
 
     @property
     def dt_out(self) -> float:
-        """Output interval of the sweep's runs [s]: enough for the metrics, light on memory."""
+        """Output interval of the sweep's runs [s]: enough for the metrics, light on memory (at most STUDY_SAMPLES
+        samples a run: :func:`ipir_mujoco.core.options.study_dt_out`)."""
         t_end = as_real(self.t_end)
-        return DT_OUT if t_end is None or not t_end > 0 else min(DT_OUT, t_end)
+        return DT_OUT if t_end is None or not t_end > 0 else study_dt_out(t_end, min(DT_OUT, t_end))
 
     def designs(self) -> list[dict[str, float]]:
         """Every design as {varied name: value}, in a fixed order (its index is the design id)."""
