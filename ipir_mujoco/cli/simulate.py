@@ -158,6 +158,11 @@ def _estimate_text(run: RunResult) -> str:
             f"{100 * run.steady_target:.2g} %)")
 
 
+def _number(value) -> str:
+    """A figure as the text summary shows it: n/a where it has no value (a check that could not run)."""
+    return "n/a" if value is None else f"{value:.3g}"
+
+
 def format_summary(run: RunResult, until_steady: bool = False) -> str:
     """The human-readable summary ``simulate`` prints (``until_steady``: the run was asked to stop there)."""
     s = run.summary
@@ -206,15 +211,19 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         lines.append(f"  accuracy: energy residual {accuracy['residual_ratio']:.1e} of the energy, loop gap "
                      f"{accuracy['loop_gap_m']:.1e} m" + ("" if accuracy.get("ok", True) else
                                                           "   OUT OF TOLERANCE: " + "; ".join(
-                                                              f"{v['figure']} {v['value']:.3g} (tolerance {v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
+                                                              f"{v['figure']} {_number(v['value'])} (tolerance "
+                                                              f"{v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
                                                               for v in accuracy.get("violations", []))))
     if accuracy.get("skid_check") in ("verified", "failed"):  # the run kept is the skid check's finest
         last = (run.settings.get("skid_check") or [{}])[-1]
         error = accuracy.get("skid_difference")
         lines.append(f"  skid check {accuracy['skid_check']}: the run at timestep {run.settings['timestep']:.3g} s "
-                     f"({len(run.settings.get('skid_check') or [])} halvings); largest estimated error "
+                     f"({sum(bool(h.get('differences')) for h in run.settings.get('skid_check') or [])} halvings); "
+                     "largest estimated error "
                      f"{last.get('figure')} " + ("n/a" if error is None else f"{error:.2g}")
                      + f" of it, its accuracy {accuracy['tolerances']['skid_difference']:.2g}")
+        lines += [f"  skid check failed: {v['reason']}" for v in accuracy.get("violations", [])
+                  if v.get("figure") == "skid_difference" and v.get("reason")]
     return "\n".join(lines)
 
 

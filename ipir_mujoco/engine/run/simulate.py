@@ -189,7 +189,7 @@ def simulate_mujoco(
         finer = {**options, "dt_out": dt} if every_step else options
         return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
-    return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule])
+    return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule], run.wall_budget_s)
 
 
 class _Run:
