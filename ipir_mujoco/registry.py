@@ -37,7 +37,7 @@ from typing import Any, Callable, Sequence
 from . import interrupts
 from .core.control import FeedforwardTable
 from .core.errors import ParameterError, ParameterTypeError
-from .core.options import check_type
+from .core.options import MAX_T_END, check_type
 from .core.params import RobotParams, check_real, check_whole, require_params
 from .core.results import RunResult
 
@@ -330,6 +330,13 @@ def _table(params: RobotParams) -> FeedforwardTable:
     from .core.control import TABLE_POINTS, reference_motion
 
     omega, dip = params.omega_target, params.speed_dip
+    lasts = FEEDFORWARD_REVOLUTIONS * 2 * math.pi / omega  # s: the table's motion, at the mean speed omega
+    if lasts > MAX_T_END:  # named by what the user gave, not the table's derived run length
+        raise ParameterError(f"omega_target={omega:g} rad/s with feedforward={params.feedforward!r}: the feedforward "
+                             f"table follows the crank through {FEEDFORWARD_REVOLUTIONS} revolutions at that speed, "
+                             f"{lasts:.3g} s, past the {MAX_T_END:g} s a run may take; allowed: omega_target >= "
+                             f"{FEEDFORWARD_REVOLUTIONS * 2 * math.pi / MAX_T_END:.3g} rad/s with a feedforward, or "
+                             "feedforward=none")
     if dip == 0.0:
         motion = CrankMotion.constant_speed(omega, params.phi0, FEEDFORWARD_REVOLUTIONS)
     else:  # the profile through the dead centres: phi(t) sampled finely, a spline through it

@@ -74,9 +74,15 @@ def run(args: argparse.Namespace) -> int:
     t_end = args.t_end if args.t_end is not None else T_END_ROUTE if route is not None else T_END
     options = {} if route is None else {"route": route}  # the wheeled model's accuracy monitor warns by default
     until = " (or to the route's end)" if route is not None else ""
-    print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
-    result = registry.run(variant, params, t_end, progress=progress_printer(t_end), wall_budget_s=args.wall_budget,
-                          **options)
+    report, said = progress_printer(t_end), []
+
+    def progress(t: float) -> None:  # the line once the run steps: every check of its input passed by then
+        if not said:
+            said.append(t)
+            print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
+        if report is not None:
+            report(t)
+    result = registry.run(variant, params, t_end, progress=progress, wall_budget_s=args.wall_budget, **options)
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
             f"({variant.mechanism_words})"
     out.parent.mkdir(parents=True, exist_ok=True)
