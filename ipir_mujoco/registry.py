@@ -37,7 +37,7 @@ from typing import Any, Callable, Sequence
 from . import interrupts
 from .core.control import FeedforwardTable
 from .core.errors import ParameterError, ParameterTypeError
-from .core.options import MAX_T_END, check_type
+from .core.options import MAX_T_END, check_run_options, check_type
 from .core.params import RobotParams, check_real, check_whole, require_params
 from .core.results import RunResult
 
@@ -129,10 +129,12 @@ def variant(name: str | Variant) -> Variant:
     """The variant named ``name`` (canonical or an alias); ParameterError listing the names otherwise."""
     if isinstance(name, Variant):
         return name
-    if isinstance(name, str):
-        key = ALIASES.get(name, name)
-        if key in VARIANTS:
-            return VARIANTS[key]
+    if not isinstance(name, str):
+        raise ParameterTypeError(f"engine {name!r} ({type(name).__name__}) is not a variant's name; allowed: "
+                                 f"{', '.join(NAMES)}")
+    key = ALIASES.get(name, name)
+    if key in VARIANTS:
+        return VARIANTS[key]
     raise ParameterError(f"engine {name!r} is unknown; allowed: {', '.join(NAMES)}")
 
 
@@ -223,7 +225,8 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
     starts from; a run whose modules skid (finite grip on the slides, the wheels) is kept at this step halved as
     many times as its skid check records (``RunResult.settings['skid_check']``, one entry a halving; its
     ``settings['timestep']`` is the step kept); None for the analytic engines."""
-    v = variant(name)
+    v, params = variant(name), require_params(params)
+    t_end, dt_out = check_run_options(t_end, dt_out)
     if not v.is_mujoco:
         return None
     from .engine.modelkinds.kinds import kind_for
@@ -319,7 +322,7 @@ def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
     (:func:`ipir_mujoco.analytic.inverse.inverse_kinetostatics`) on the paper's first-order geometry
     ('paper', L >> r) or the exact slider-crank ('exact'); None for 'none'. Computed above the engines and
     handed to each as data (the MuJoCo engine never runs the equations); cached per parameter set."""
-    if params.drive != "servo" or params.feedforward == "none":
+    if require_params(params).drive != "servo" or params.feedforward == "none":
         return None
     return _table(params)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ipir_mujoco.core.params import refuse_idle_parameters
 from ipir_mujoco.core.results import write_json
 
 from ..output import check_output_dir, staged_output
@@ -29,6 +30,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_output_dir(args.out, files=("metrics.json", "index.html", "report.md"), folders=("figures",))
     params = model_params(args)
+    refuse_idle_parameters(params)  # every rung would refuse it: refused before the first
 
     def progress(message: str) -> None:
         print(f"validate: {message}", file=sys.stderr, flush=True)

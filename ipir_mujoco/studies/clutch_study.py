@@ -61,9 +61,10 @@ import numpy as np
 from ipir_mujoco import registry
 from ipir_mujoco.registry import ENGINES
 from ipir_mujoco.core.cycles import cycles, steady_window
-from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.checks import check_numbers, check_sequence
+from ipir_mujoco.core.errors import ParameterError, SimulationError, refuse_all_failed
 from ipir_mujoco.core.options import study_dt_out
-from ipir_mujoco.core.params import RobotParams, check_whole
+from ipir_mujoco.core.params import RobotParams, check_whole, refuse_idle_parameters, require_params
 
 from .pool import map_unordered
 
@@ -192,6 +193,10 @@ def plan(base: RobotParams, designs: Sequence[tuple[float, float]], points: Sequ
     for key in points:
         point = points_table[key]
         rigid = design(base, point, None, 0.0)
+        try:  # a parameter no run of the study can use (the servo's, where the study sets the drive)
+            refuse_idle_parameters(rigid)
+        except ParameterError as exc:
+            raise ParameterError(f"the {key} point runs drive={point.drive} (the study sets it): {exc}") from None
         rigid_steps[key] = {registry.timestep(VARIANTS["mujoco"], rigid, point.t_end, DT_OUT_MAX)}
         for k, b in designs:
             params = design(base, point, k, b)
@@ -362,13 +367,19 @@ def run_study(base: RobotParams, stiffness: Sequence[float] = STIFFNESS, backlas
     ``scaling``: :func:`scaling`; ``settings``, ``wall_s``.
     """
     started = time.perf_counter()
+    base = require_params(base)
     workers = check_whole("workers", (os.cpu_count() or 1) if workers is None else workers, low=1, high=1024)
+    if not check_sequence("points", points) or not all(isinstance(p, str) and p in points_table for p in points):
+        raise ParameterError(f"points={tuple(points)!r}; allowed: one or more of {', '.join(points_table)}")
     if designs is None:
-        designs = [(float(k), float(b)) for k in stiffness for b in backlash]
+        designs = [(k, b) for k in check_numbers("stiffness", stiffness) for b in check_numbers("backlash", backlash)]
+    if not all(len(check_numbers("designs' pair", d)) == 2 for d in check_sequence("designs", designs)):
+        raise ParameterError(f"designs={designs!r}; allowed: a list of (stiffness [N/m], backlash [m]) pairs")
     designs = list(dict.fromkeys((float(k), float(b)) for k, b in designs))
     tasks = plan(base, designs, points, points_table)
     progress(f"{len(tasks)} runs on {workers} process{'es' if workers > 1 else ''}")
     results = run_tasks(base, tasks, points_table, workers, progress)
+    refuse_all_failed([results[t].get("error") for t in tasks], "runs")
     rigid = {}
     for key in points:
         point = points_table[key]

@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from ipir_mujoco import registry
+from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.options import MAX_T_END, refuse_steady_without_motor, study_dt_out
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse_idle_parameters
@@ -91,7 +92,7 @@ def check_metric(key: str) -> str:
 
 def parse_event(text: str) -> Event:
     """``KEY>V``, ``KEY>=V``, ``KEY<V``, ``KEY<=V`` or a name of :data:`NAMED_EVENTS`."""
-    spec = text.strip()
+    spec = check_text("event", text, "'KEY>V', 'KEY>=V', 'KEY<V', 'KEY<=V' or " + ", ".join(NAMED_EVENTS)).strip()
     if spec in NAMED_EVENTS:
         return Event(spec, *NAMED_EVENTS[spec])
     for op in (">=", "<=", ">", "<"):
