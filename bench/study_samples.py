@@ -6,11 +6,12 @@ spring), and a 10 s cruise at every step kept 3.2e6 samples (a 1.9 GB study at `
 a run every n-th step. This bench runs each of ``clutch-study --quick``'s MuJoCo compliant runs at a finite grip
 (and at unlimited grip, where the cap does not bind) twice: sampled at every step and as the study samples it,
 and prints per run the samples kept, the peak clutch force both ways, their relative difference and the bound the
-study states for it, ``peak_sampling_bound`` = (omega_c n h)^2 / 4 with omega_c = sqrt(k / min(m1, m2)), with the
-wall time and peak memory (ru_maxrss of a child process per run) both ways.
+study states for it, ``peak_sampling_bound`` = (omega n h)^2 / 4 with omega the fastest mode the spring takes part in
+(with a finite grip MuJoCo's skidding carriage's, ~30 sqrt(k / min(m1, m2))), at most 1, with the wall time and peak
+memory (ru_maxrss of a child process per run) both ways.
 
-    python bench/study_samples.py            # mu_wall 0.5 and unlimited, both operating points (~3 min)
-    python bench/study_samples.py --smoke    # one run
+    python bench/study_samples.py [--smoke]   # mu_wall 0.5 and unlimited, both operating points (~5 min)
+    python bench/study_samples.py --smoke     # one run
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import multiprocessing
 import resource
 import sys
 import time
+from types import SimpleNamespace
 
 
 def one(args):
@@ -28,7 +30,7 @@ def one(args):
     mu, point_key, k, backlash, every_step = args
     from ipir_mujoco import registry
     from ipir_mujoco.core.params import RobotParams
-    from ipir_mujoco.studies.clutch_study import DT_OUT_MAX, POINTS, design, mujoco_dt_out, spring_rate
+    from ipir_mujoco.studies.clutch_study import DT_OUT_MAX, POINTS, _peak_bound, design, mujoco_dt_out
 
     point = POINTS[point_key]
     params = design(RobotParams(mu_wall=mu), point, k, backlash)
@@ -39,7 +41,7 @@ def one(args):
     wall = time.perf_counter() - started
     s = run.series
     peak = float(max(s["lambda1"].max(), s["lambda2"].max()))
-    bound = (spring_rate(params) * max(run.settings["timestep"], dt_out)) ** 2 / 4
+    bound = _peak_bound(params, SimpleNamespace(stiffness=k, engine="mujoco"), run, dt_out)  # the study's own
     return (s["t"].size, peak, wall, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3, dt_out / h, bound)
 
 
