@@ -1,8 +1,14 @@
-"""The Python API's cases of bench/fuzz_surface.py: every public entry point called with one argument of the wrong
+"""The Python API's part of bench/fuzz_surface.py: every public entry point called with one argument of the wrong
 type at a time (the others valid), each of which must raise a ParameterTypeError (a ValueError and a TypeError)
-with a one-line message naming the argument."""
+with a one-line message naming the argument; run alone it is ``fuzz_surface.py --only api``:
+
+    python bench/fuzz_api.py [--smoke] [-v]
+    python bench/fuzz_api.py --smoke     # a few cases
+"""
 
 from __future__ import annotations
+
+import sys
 
 from fuzz_surface import Case
 
@@ -130,3 +136,15 @@ def api_cases() -> list[Case]:
     }.items():
         cases.append(Case(name, call=call, wrong_type=True, timeout=60.0))
     return cases
+
+
+if __name__ == "__main__":
+    import argparse
+
+    from fuzz_surface import main
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--smoke", action="store_true", help="a few cases")
+    parser.add_argument("-v", "--verbose", action="store_true", help="also print every clean case")
+    args = parser.parse_args()
+    sys.exit(main(["--only", "api"] + ["--smoke"] * args.smoke + ["-v"] * args.verbose))

@@ -373,14 +373,14 @@ def judge_api(case: Case, code: int, stdout: str, stderr: str) -> tuple[str, str
     return "clean", outcome["message"][:160]
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--smoke", action="store_true", help="a few cases of each kind")
     parser.add_argument("--only", choices=("cli", "api"), default=None)
     parser.add_argument("--match", default=None, help="only the cases whose name contains this")
     parser.add_argument("--explicit", action="store_true", help="the command line's named cases only (the issues')")
     parser.add_argument("-v", "--verbose", action="store_true")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
     import matplotlib.pyplot  # noqa: F401 (imported before the forks, as the commands import it)
 

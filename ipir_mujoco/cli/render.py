@@ -76,13 +76,14 @@ def run(args: argparse.Namespace) -> int:
     until = " (or to the route's end)" if route is not None else ""
     report, said = progress_printer(t_end), []
 
-    def progress(t: float) -> None:  # the line once the run steps: every check of its input passed by then
-        if not said:
+    def progress(t: float | None = None) -> None:  # the line once the run steps (every check of its input passed
+        if not said:  # by then), or after a run too short to report any step
             said.append(t)
             print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
-        if report is not None:
+        if report is not None and t is not None:
             report(t)
     result = registry.run(variant, params, t_end, progress=progress, wall_budget_s=args.wall_budget, **options)
+    progress()
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
             f"({variant.mechanism_words})"
     out.parent.mkdir(parents=True, exist_ok=True)
