@@ -43,7 +43,7 @@ def _constants():
         ("MuJoCo steps", r"at most (1e\d+) MuJoCo steps per run", options.MAX_STEPS),
         ("wall budget", r"and (\d+) s of wall time per run unless", options.DEFAULT_WALL_BUDGET_S),
         ("wall budget default", r"naming the budget \(default (\d+) s", options.DEFAULT_WALL_BUDGET_S),
-        ("progress every", r"one about every (\d+) s of wall time", WALL_EVERY_S),
+        ("progress every", r"one at least every (\d+) s of wall time", WALL_EVERY_S),
         ("simulate cap", r"with `--until-steady`, the cap \(default (\d+)\)", simulate.T_END_STEADY),
         ("route cap", r"`--t-end` caps it \(default (\d+) s then\)", simulate.T_END_ROUTE),
         ("steady accuracy analytic", r"stated accuracy, ([\d.e-]+) analytic and",

@@ -358,7 +358,7 @@ WRONG_TYPES = [
     (lambda: _optimize().parse_constraint(3), "constraint=3 (int) is not a string"),
     (lambda: Study(3), "axes=3 is not a list of axes"),
     (lambda: registry.timestep("mujoco-ratchet", None, 1.0, 1e-3), "params=None is not a RobotParams"),
-    (lambda: registry.run(None, RobotParams(), 0.1), "engine None (NoneType) is not a variant's name"),
+    (lambda: registry.run(None, RobotParams(), 0.1), "variant None (NoneType) is not a variant's name"),
     (lambda: analytic.simulate(RobotParams(), None, "kinematic", 0.1), "geometry=None (NoneType) is not a string"),
     (lambda: load_params(None, "m1=2"), "overrides='m1=2' is not a list of NAME=VALUE strings"),
     (lambda: RobotParams(m1="1"), "m1='1' is not a number"),

@@ -458,6 +458,20 @@ def refuse_idle_parameters(params: RobotParams) -> None:
                                      f"{through}={idle}")
 
 
+def refuse_idle_under(params: RobotParams, drives: Iterable[str]) -> None:
+    """A drive's parameter given (not at its default) in ``params`` that none of ``drives`` acts through, refused
+    in one line naming the first of ``drives`` and the drives that use it: the check of a study that runs one
+    design under drives of its own choosing (each case's ``params.replace(drive=...)`` would otherwise return the
+    parameter to its default without a word)."""
+    drives = tuple(dict.fromkeys(drives))
+    used = {name for drive in drives for name in DRIVE_FIELDS[drive]}
+    defaults = RobotParams()
+    for name in _DRIVEN_BY:
+        value = getattr(params, name)
+        if name not in used and value != getattr(defaults, name):
+            raise ParameterError(_idle_message(f"{name}={'model' if value is None else value!r}", name, drives[0]))
+
+
 def refuse_idle_names(drive: str, names: Iterable[str], what: str = "varied") -> None:
     """A study that varies (``what``) parameters ``names`` of which one only another drive than ``drive`` uses
     (DRIVE_FIELDS: ``M_stall`` swept under the constant torque), refused in one line before any run, as every

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.options import study_dt_out
+from ipir_mujoco.core.limits import study_dt_out
 from ipir_mujoco.core.params import RobotParams
 
 if TYPE_CHECKING:  # the atlas command's parser reads this module's defaults without numpy

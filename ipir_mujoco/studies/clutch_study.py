@@ -67,7 +67,8 @@ from ipir_mujoco.core.cycles import cycles, steady_window
 from ipir_mujoco.core.checks import check_numbers, check_sequence
 from ipir_mujoco.core.errors import ParameterError, SimulationError, refuse_all_failed
 from ipir_mujoco.core.options import study_dt_out
-from ipir_mujoco.core.params import RobotParams, check_whole, refuse_idle_parameters, require_params
+from ipir_mujoco.core.params import (RobotParams, check_whole, refuse_idle_parameters, refuse_idle_under,
+                                     require_params)
 
 from ..engine.kinds.timestep import clutch_rate
 from .pool import map_unordered
@@ -194,13 +195,15 @@ def plan(base: RobotParams, designs: Sequence[tuple[float, float]], points: Sequ
     """Every run of the study for ``designs`` [(k [N/m], backlash [m])], checked before any runs: a bad
     value raises a one-line ParameterError (the shared input checks, and MuJoCo's timestep rule)."""
     tasks, rigid_steps = [], {}
+    try:  # a parameter no run of the study can use (the servo's, where the study sets each point's drive)
+        refuse_idle_under(base, (points_table[key].drive for key in points))
+    except ParameterError as exc:
+        first = points_table[points[0]]
+        raise ParameterError(f"the {points[0]} point runs drive={first.drive} (the study sets it): {exc}") from None
     for key in points:
         point = points_table[key]
         rigid = design(base, point, None, 0.0)
-        try:  # a parameter no run of the study can use (the servo's, where the study sets the drive)
-            refuse_idle_parameters(rigid)
-        except ParameterError as exc:
-            raise ParameterError(f"the {key} point runs drive={point.drive} (the study sets it): {exc}") from None
+        refuse_idle_parameters(rigid)  # (the clutch's own: damping and backlash with a spring)
         rigid_steps[key] = {registry.timestep(VARIANTS["mujoco"], rigid, point.t_end, DT_OUT_MAX)}
         for k, b in designs:
             params = design(base, point, k, b)
