@@ -9,12 +9,13 @@ interleaved so that a busy machine slows both alike:
 
 - the slide model (``mujoco-ratchet``) on the default design (the paper's constant torque, unlimited grip) and
   with the default motor, stepped in C (its default) and in Python (``IPIR_MUJOCO_STEPPER=python``);
-- the wheeled model (``mujoco-wheels``: the robot in a round pipe, 38 degrees of freedom, 12 sprung wheels on
-  hub ratchets, stepped in C as the slide model) on the same designs, and with the default motor on a finite grip
-  (mu_wall 0.5).
+- the wheeled model (``mujoco-wheels``: the robot in a round pipe, 51 degrees of freedom, 12 sprung wheels on
+  hub ratchets and steer hinges, stepped in C as the slide model) on the same designs, and with the default motor
+  on a finite grip (mu_wall 0.5); each also with rigid wheels (``cornering_coefficient=rigid``: no steer hinges,
+  39 degrees of freedom).
 
-Prints wall seconds per simulated second and each wheeled run's ratio to the slide model's C loop on the same
-design (the issue's target: at most 10 at the defaults).
+Prints wall seconds per simulated second, each wheeled run's ratio to the slide model's C loop on the same
+design (the issue's target: at most 10 at the defaults) and to the same run with rigid wheels.
 
 ``--profile`` prints instead where a wheeled step's time goes, with the default motor on unlimited grip: the
 compiled loop's cost per step against a bare ``mj_step`` on a copy of the same state (the loop's own share: the
@@ -92,23 +93,29 @@ def main(argv=None) -> int:
         profile(RobotParams(drive="motor"), nstep=200 if args.smoke else 2000)
         return 0
     t_end, repeat = (0.05, 1) if args.smoke else (args.t_end, args.repeat)
-    rows = [  # (label, variant, params, python loop, the slide row it is compared with)
-        ("slides, defaults, C loop", "mujoco-ratchet", RobotParams(), False, None),
-        ("slides, defaults, Python loop", "mujoco-ratchet", RobotParams(), True, None),
-        ("wheels, defaults", "mujoco-wheels", RobotParams(), False, 0),
-        ("slides, motor, C loop", "mujoco-ratchet", RobotParams(drive="motor"), False, None),
-        ("wheels, motor", "mujoco-wheels", RobotParams(drive="motor"), False, 3),
-        ("wheels, motor, mu_wall 0.5", "mujoco-wheels", RobotParams(drive="motor", mu_wall=0.5), False, 3),
+    rigid = dict(cornering_coefficient=None)  # the wheels fixed on their axles (the model before steer hinges)
+    rows = [  # (label, variant, params, python loop, the slide row it is compared with, the rigid-wheel row)
+        ("slides, defaults, C loop", "mujoco-ratchet", RobotParams(), False, None, None),
+        ("slides, defaults, Python loop", "mujoco-ratchet", RobotParams(), True, None, None),
+        ("wheels, defaults", "mujoco-wheels", RobotParams(), False, 0, 3),
+        ("wheels, defaults, rigid wheels", "mujoco-wheels", RobotParams(**rigid), False, 0, None),
+        ("slides, motor, C loop", "mujoco-ratchet", RobotParams(drive="motor"), False, None, None),
+        ("wheels, motor", "mujoco-wheels", RobotParams(drive="motor"), False, 4, 6),
+        ("wheels, motor, rigid wheels", "mujoco-wheels", RobotParams(drive="motor", **rigid), False, 4, None),
+        ("wheels, motor, mu_wall 0.5", "mujoco-wheels", RobotParams(drive="motor", mu_wall=0.5), False, 4, 8),
+        ("wheels, motor, mu_wall 0.5, rigid", "mujoco-wheels", RobotParams(drive="motor", mu_wall=0.5, **rigid), False,
+         4, None),
     ]
     best = [float("inf")] * len(rows)
     for k in range(repeat):
-        for i, (label, variant, params, python, _) in enumerate(rows):
+        for i, (label, variant, params, python, _, _) in enumerate(rows):
             print(f"[{k + 1}/{repeat}] {label}", file=sys.stderr, flush=True)
             best[i] = min(best[i], once(variant, params, t_end, python))
-    print(f"{'run':32s} {'wall s / sim s':>15s} {'/ slides C (same design)':>26s}")
-    for (label, _, _, _, base), value in zip(rows, best):
+    print(f"{'run':36s} {'wall s / sim s':>15s} {'/ slides C (same design)':>26s} {'/ rigid wheels':>15s}")
+    for (label, _, _, _, base, fixed), value in zip(rows, best):
         ratio = "" if base is None else f"{value / best[base]:.1f}"
-        print(f"{label:32s} {value:15.3f} {ratio:>26s}")
+        steer = "" if fixed is None else f"{value / best[fixed]:.2f}"
+        print(f"{label:36s} {value:15.3f} {ratio:>26s} {steer:>15s}")
     return 0
 
 

@@ -38,8 +38,8 @@ from ..builders.model import SolverSettings, build_model, qpos_address, set_clos
 from .route_watch import check_route, pipe_fit
 from ..controllers.slide_clutches import slide_controller
 from .timestep import choose_settings
-from ..controllers.wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
-                     wheels_settings)
+from ..controllers.wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, slide_columns,
+                                  wheel_loop_options, wheel_slip, wheels_settings)
 from ..builders.wheels_model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
 
 
@@ -280,7 +280,8 @@ class WheelsKind(ModelKind):
         (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J],
         the wheels' states wheels1/2; the legs' press press1/2 [N] and wheels_off (:func:`.wheels.press_columns`);
         the modules' pose across the pipe y1/2, z1/2 [m], roll1/2, pitch1/2, yaw1/2 [rad]
-        (:func:`.wheels.pose_columns`), which with x1, x2, phi pose the robot for a replay."""
+        (:func:`.wheels.pose_columns`), which with x1, x2, phi pose the robot for a replay; slid1/2 [m], how far
+        each module's wheels slid sideways on the wall (:func:`.wheels.slide_columns`)."""
         cols = {}
         for k in (1, 2):
             wheels = scalars[f"wheels{k}"]
@@ -292,6 +293,7 @@ class WheelsKind(ModelKind):
         cols["skid_work"] = scalars["skid_work"].copy()
         cols.update(press_columns(model, params, q))
         cols.update(pose_columns(model, q))
+        cols.update(slide_columns(model, params, q))
         return cols
 
 
