@@ -31,7 +31,7 @@ import sys
 import mujoco
 import numpy as np
 
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.params import RobotParams, parse_overrides
 from ipir_mujoco.core.route import route_from_tables
 from ipir_mujoco.engine.builders.model import MOTOR, SolverSettings, drive_control
 from ipir_mujoco.engine.builders.wheels_model import (build_wheels_model, leg_names, leg_preload, set_wheels_state,
@@ -149,11 +149,7 @@ def main(argv=None) -> int:
     parser.add_argument("--free-side", action="store_true")
     parser.add_argument("--smoke", action="store_true")
     args = parser.parse_args(argv)
-    values = {"drive": "motor", "mu_wall": 0.8}
-    for item in args.set:
-        name, _, value = item.partition("=")
-        values[name] = float(value)
-    params = RobotParams(**values)
+    params = RobotParams(**{"drive": "motor", "mu_wall": 0.8, **parse_overrides(args.set)})
     ratios = [float(r) for r in args.ratios.split(",")]
     t_end = args.t_end or (LEAD + args.arc + 0.1) / 0.3
     if args.smoke:
