@@ -2,7 +2,7 @@
 
 Run on demand from the repository root (instant):
 
-    python bench/cornering_coefficient.py [--set NAME=VALUE]...
+    python bench/cornering_coefficient.py [--set NAME=VALUE]... [--smoke]
 
 A solid elastomer wheel rolling on a rigid wall at a small slip angle alpha carries a side force F = G c^2 C22
 alpha (Kalker's linear theory of rolling contact: J. J. Kalker, "On the rolling contact of two elastic bodies in
@@ -49,6 +49,7 @@ def coefficient(E: float, radius: float, diameter: float, preload: float) -> tup
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    parser.add_argument("--smoke", action="store_true", help="the same (it runs nothing): the suite's flag")
     args = parser.parse_args(argv)
     p = RobotParams(**parse_overrides(args.set))
     P = p.F_n1 / (2 * p.wheel_legs)

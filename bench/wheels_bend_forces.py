@@ -15,7 +15,7 @@ times its normal force (1: the wheel slides sideways at the friction limit); its
 module's speed; and its slip angle, atan(sideways slip / rolling speed). The closed form of a rigid module
 tangent to the bend at its middle, rings b = ring_spacing / 2 either side: each ring's slip angle b / R. Beside
 them each module's yaw off the centreline's direction at its point, and how long some wheel pressed with less
-than a tenth of its preload (off its wall).
+than a tenth of its preload (off its wall) while either module's point was in the bend.
 
 ``--free-side`` is a test edit: each wheel gets a frictionless slide along its axle (+-20 mm, a centring spring of
 1 % of its preload per 5 mm), so that the wall's friction can hold it only along its rolling direction; the
@@ -93,7 +93,8 @@ def run_case(params: RobotParams, ratio: float, arc: float, t_end: float, timest
         mujoco.mj_step(model, data)
         if step % EVERY:
             continue
-        if any(data.qpos[a] > (1 - OFF) * free_len for module in arms for a in module):
+        in_bend = any(bend.s0 < route.along(data.xpos[modules[i]], s_prev[i]) < bend.s0 + bend.length for i in (0, 1))
+        if in_bend and any(data.qpos[a] > (1 - OFF) * free_len for module in arms for a in module):
             off_time += EVERY * dt
         jv = np.zeros(data.nefc)
         mujoco.mj_mulJacVec(model, data, jv, data.qvel)
@@ -161,7 +162,7 @@ def main(argv=None) -> int:
         route, stats, off, dt = run_case(params, ratio, args.arc, t_end, args.timestep, args.free_side)
         R = ratio * params.pipe_diameter
         print(f"R/D {ratio:g} (R {R:g} m, step {dt:g} s, {t_end:.2f} s): closed-form ring slip angle b/R = "
-              f"{math.degrees(b / R):.3f} deg; some wheel off its wall {off:.3f} s")
+              f"{math.degrees(b / R):.3f} deg; some wheel off its wall {off:.3f} s in the bend")
         for i in (0, 1):
             st = stats[i]
             if not st["use"]:

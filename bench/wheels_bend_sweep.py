@@ -4,6 +4,7 @@ Run on demand from the repository root (tens of minutes on 2 busy cores; ``--wor
 
     python bench/wheels_bend_sweep.py [--ratios 1.5,2,3,5,10,20,50] [--mu 0.3,0.5,0.8] [--arc 1.0]
                                       [--set NAME=VALUE]... [--workers N] [--json FILE] [--smoke]
+    python bench/wheels_bend_sweep.py --closed-form [--ratios ...] [--mu ...] [--set NAME=VALUE]...
 
 Each case is the bend study's route (:mod:`ipir_mujoco.studies.bend_study`: a 0.6 m lead-in, L / 2, the bend,
 L / 2, 0.05 m), the default motor, F_n 50 N and every other parameter at its default (``--set`` changes them),
@@ -21,6 +22,11 @@ how long some wheel was off its wall in the bend's run and in its twin's (``rout
 the closed-form lift-off check of the bend (``lift_predicted`` and the least-pressed leg, the route's fit) and the
 step the run kept. The lift check's record over the rows ends the output: predicted and happened (a wheel off in
 the bend's run longer than in its twin's), false alarms and misses.
+
+``--closed-form`` runs nothing: per mu_wall and R/D, the rings' slip angle asin(b / R), the module's cock and the
+side force its fore ring's legs carry (:func:`ipir_mujoco.core.pipe.scrub_force`, module 1, a horizontal bend),
+the rings' whole sideways friction beside it, and the bend's lift-off check (the route's fit: the least-pressed
+leg, ``lift_predicted``).
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ import time
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams, parse_overrides
+from ipir_mujoco.core.pipe import bend_cock, bend_slip_angle, ring_side_grip, scrub_force
 from ipir_mujoco.core.route import route_from_tables
 from ipir_mujoco.studies.bend_study import DT_OUT, EXIT, LEAD_IN, T_CAP_PER_M, _passage, straight_route
 from ipir_mujoco.studies.pool import map_unordered
@@ -77,6 +84,27 @@ def run_case(item: tuple, overrides: dict) -> dict:
     return out
 
 
+def closed_form(overrides: dict, ratios, mus, arc: float) -> int:
+    """The ``--closed-form`` table (module docstring)."""
+    from ipir_mujoco.engine.builders.route_walls import fit_prediction
+
+    print("| mu_wall | R/D | ring slip angle [rad] | cock [rad] | fore ring's side force [N] | rings' sideways "
+          "friction [N] | bend's least press [N] | lift predicted |")
+    print("|---|---|---|---|---|---|---|---|")
+    for mu in mus:
+        p = RobotParams(**{"drive": "motor", **overrides, "mu_wall": mu})
+        for r in sorted(ratios):
+            radius = r * p.pipe_diameter
+            a, side = bend_slip_angle(p, radius), scrub_force(p, 0, (1.0, 0.0), radius)
+            cock = bend_cock(p, 0, (1.0, 0.0), radius)
+            fit = fit_prediction(bend_route(p, r, bend_angle(r, p, arc)), p, 0.5 * p.ring_spacing,
+                                 p.suspension_travel)["bends"][0]
+            least = min(fit["least_press1_n"], fit["least_press2_n"])
+            print(f"| {mu:g} | {r:g} | {a:.4f} | {cock:.4f} | {side:.2f} | "
+                  f"{ring_side_grip(p, 0, (1.0, 0.0)):.2f} | {least:.2f} | {least < 0} |")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ratios", default=",".join(f"{r:g}" for r in RATIOS))
@@ -86,10 +114,13 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--json", default=None, help="write every run's record here")
     parser.add_argument("--smoke", action="store_true", help="R/D 50 at mu_wall 0.5, 0.6 m of arc: the script runs")
+    parser.add_argument("--closed-form", action="store_true", help="the closed forms only, no runs")
     args = parser.parse_args(argv)
     overrides = parse_overrides(args.set)
     ratios = [float(r) for r in args.ratios.split(",")]
     mus = [float(m) for m in args.mu.split(",")]
+    if args.closed_form:
+        return closed_form(overrides, ratios, mus, args.arc)
     if args.smoke:
         ratios, mus, args.arc = [50.0], [0.5], 0.2
     base = RobotParams(**{"drive": "motor", **overrides})

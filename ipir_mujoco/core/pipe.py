@@ -200,6 +200,13 @@ def ring_side_grip(params, module: int, toward: tuple[float, float]) -> float:
                         for e in (hub_tangent(leg_direction(k, n)) for k in range(n)))
 
 
+def rigid_wheels(params) -> bool:
+    """Whether the wheeled model's wheels are fixed on their axles: ``cornering_coefficient`` rigid, or unlimited
+    grip (a steer-compliant wheel held against any load along the pipe would turn off its axis: the wheeled
+    model then builds rigid ones, :func:`ipir_mujoco.engine.builders.wheels_model.steer_compliant`)."""
+    return params.cornering_coefficient is None or params.mu_wall is None
+
+
 def bend_slip_angle(params, radius: float) -> float:
     """Each ring's slip angle [rad] in a bend of centreline radius ``radius`` [m]: a module whose rings, b =
     ``ring_spacing`` / 2 either side of its middle, both ride on the centreline is a chord of it, and turning
@@ -223,7 +230,7 @@ def ring_side_force(params, module: int, toward: tuple[float, float], slip: floa
     mu_wall 1, as there)."""
     if slip == 0.0:
         return 0.0
-    if params.cornering_coefficient is None or params.mu_wall is None:
+    if rigid_wheels(params):
         return math.copysign(ring_side_grip(params, module, toward), slip)
     n = int(params.wheel_legs)
     P = (params.F_n1, params.F_n2)[module] / (2 * n)
@@ -256,11 +263,22 @@ def scrub_force(params, module: int, toward: tuple[float, float], radius: float)
     whatever the radius (rigid wheels: at any radius). 0 for a module at rest, as each is half of every
     revolution."""
     a = bend_slip_angle(params, radius)
-    if params.cornering_coefficient is None or params.mu_wall is None:
+    if rigid_wheels(params):
         return ring_side_force(params, module, toward, a)
+    return ring_side_force(params, module, toward, a + bend_cock(params, module, toward, radius))
+
+
+def bend_cock(params, module: int, toward: tuple[float, float], radius: float) -> float:
+    """How far [rad] module ``module`` (0 rear, 1 front) cocks, nose out, on its legs' springs while it rolls through
+    a bend of centreline radius ``radius`` [m] turning towards the unit (y, z) ``toward``: psi solving
+    2 k_r b psi = G(a + psi) + G(a - psi) (:func:`scrub_force`; G = :func:`ring_side_force`, a =
+    :func:`bend_slip_angle`); rigid wheels (and unlimited grip): the rings' whole sideways friction over k_r b."""
+    a = bend_slip_angle(params, radius)
     n = int(params.wheel_legs)
     P = (params.F_n1, params.F_n2)[module] / (2 * n)
     lever = 0.5 * params.ring_spacing * n * P / (2 * params.suspension_travel)  # k_r b [N/rad]
+    if rigid_wheels(params):
+        return ring_side_force(params, module, toward, a) / lever
     # 2 k_r b psi - (G(a + psi) + G(a - psi)) grows with psi (G is concave for a positive slip and odd), from
     # -2 G(a) at 0 to >= 0 where 2 k_r b psi reaches twice the rings' whole sideways friction: one root, bisected
     low, high = 0.0, ring_side_grip(params, module, toward) / lever
@@ -268,7 +286,7 @@ def scrub_force(params, module: int, toward: tuple[float, float], radius: float)
         psi = 0.5 * (low + high)
         couple = ring_side_force(params, module, toward, a + psi) + ring_side_force(params, module, toward, a - psi)
         low, high = (psi, high) if 2.0 * lever * psi < couple else (low, psi)
-    return ring_side_force(params, module, toward, a + 0.5 * (low + high))
+    return 0.5 * (low + high)
 
 
 def side_grip_check(params, side1, side2, torque, grip_use=(0.0, 0.0)) -> dict:

@@ -46,7 +46,7 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.pipe import ARM_SHARE, WHEEL_SHARE, check_fit, sprung_mass
+from ipir_mujoco.core.pipe import ARM_SHARE, WHEEL_SHARE, check_fit, rigid_wheels, sprung_mass
 from ipir_mujoco.core.pipe import leg_direction as core_leg_direction
 
 from ...resources import mjcf_dir
@@ -152,11 +152,11 @@ def wheel_mass(params: RobotParams, module: int) -> float:
 
 
 def steer_compliant(params: RobotParams) -> bool:
-    """Whether the wheels steer on their hinges (a finite ``cornering_coefficient`` and a finite ``mu_wall``):
-    unlimited grip asks a held wheel to take any load along the pipe, and a steer-compliant wheel pushed back
-    harder than its cornering stiffness C [N/rad] swings off its axis (its trail's lever beats its spring), so
-    with unlimited grip the wheels are rigid."""
-    return params.cornering_coefficient is not None and params.mu_wall is not None
+    """Whether the wheels steer on their hinges (a finite ``cornering_coefficient`` and a finite ``mu_wall``,
+    :func:`ipir_mujoco.core.pipe.rigid_wheels`): unlimited grip asks a held wheel to take any load along the pipe,
+    and a steer-compliant wheel pushed back harder than its cornering stiffness C [N/rad] swings off its axis (its
+    trail's lever beats its spring), so with unlimited grip the wheels are rigid."""
+    return not rigid_wheels(params)
 
 
 def trail(params: RobotParams) -> float:
