@@ -37,7 +37,7 @@ from .loop_rows import loop_options
 from ..builders.model import SolverSettings, build_model, qpos_address, set_closed_loop_state
 from .route_watch import check_route, pipe_fit
 from ..controllers.slide_clutches import slide_controller
-from .timestep import choose_settings
+from .timestep import choose_settings, first_settings
 from ..controllers.wheels import (WheelRatchet, pose_columns, press_columns, refuse_clutches, wheel_loop_options, wheel_slip,
                      wheels_settings)
 from ..builders.wheels_model import NOSLIP_ITERATIONS, ROW_TIMES, build_wheels_model, set_wheels_state
@@ -194,6 +194,15 @@ class GripSlidesKind(ModelKind):
         params = super().check(params, implementation, rule, route, until_steady)
         refuse_grip(params, implementation)
         return params
+
+    def settings(self, params, t_end, dt_out, servo=None, implementation="ratchet", route=None):
+        """The automatic step (:func:`.timestep.choose_settings`); with rigid clutches the grip rows' time
+        constant STEPS_PER_TIME_CONSTANT steps and the carriage's share set: the first run of the rigid limit's
+        family (:func:`.timestep.first_settings`)."""
+        chosen, why = super().settings(params, t_end, dt_out, servo, implementation)
+        if params.clutch_stiffness is None:
+            chosen = first_settings(chosen, params)
+        return chosen, why
 
     def between_steps(self, params, implementation, rule):
         return [*super().between_steps(params, implementation, rule),

@@ -63,6 +63,7 @@ from .block_checks import BlockChecks
 from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
                                  climb_energy, mujoco_failure, steps_per_output)
 from ..modelkinds.kinds import ModelKind, kind_for
+from .rigid_limit import given_settings, rigid_limit
 from .skid_check import SLIDES_RULE, verify_skids
 from .wheel_skids import WHEELS_RULE
 from ..builders.model import SolverSettings
@@ -73,7 +74,7 @@ from ..modelkinds.route_watch import route_watch
 from .run_setup import RunSetup
 from ..loop.servo_drive import TickedDrive, controller_for
 from ..loop.stepper import WARNED
-from ..modelkinds.timestep import DT_MIN
+from ..modelkinds.timestep import DT_MIN, halved
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _GAP = SCALARS.index("motor_torque"), DEFERRED.index("loop_gap")
@@ -160,10 +161,15 @@ def simulate_mujoco(
                    progress=passes, servo=servo, accuracy=accuracy, until_steady=run.until_steady,
                    steady_tol=run.steady_tol, steady_cycles=run.steady_cycles, wall_budget_s=run.wall_budget_s,
                    kind=kind, feedforward=feedforward, route=route)
+    rigid_grip = kind.skid_rule == "slides" and params.clutch_stiffness is None  # the rigid limit's family
     if settings is not None:
-        result = _Run(params, settings, **options).result({"timestep_source": "given"})
+        extra = {"timestep_source": "given"}
+        if rigid_grip:
+            settings, extra["grip_time_constant_rule"] = given_settings(
+                params, settings, lambda: kind.settings(params, t_end, dt_out, servo, implementation)[0])
+        result = _Run(params, settings, **options).result(extra)
         if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            result.accuracy["skid_check"] = "not verified: timestep given"
+            _not_checked(kind, result, "timestep given")
         return result
     verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
     started = time.perf_counter()
@@ -178,18 +184,38 @@ def simulate_mujoco(
             if attempt == REFINEMENTS or chosen.timestep / 2 < DT_MIN:
                 raise
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
-            chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
+            chosen = halved(chosen)  # still a whole fraction of dt_out
     if not verify:
         if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            result.accuracy["skid_check"] = "not verified: compliant clutches"
+            _not_checked(kind, result, "compliant clutches")
         return result
     every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
+    if rigid_grip:
+        def member(settings: SolverSettings, member_end: float) -> RunResult:
+            # a member samples at each of its steps where the run does, else at the whole multiple of its step
+            # nearest dt_out: only its figures are read
+            out = settings.timestep * (1 if every_step else max(1, round(dt_out / settings.timestep)))
+            member_options = {**options, "accuracy": "warn", "t_end": member_end, "until_steady": False,
+                              "dt_out": out}
+            return _Run(params, settings, started=started, **member_options).result(extra)
+
+        return rigid_limit(result, member, accuracy, t_end)
 
     def rerun(dt: float) -> RunResult:
         finer = {**options, "dt_out": dt} if every_step else options
         return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
     return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule])
+
+
+def _not_checked(kind: ModelKind, result: RunResult, why: str) -> None:
+    """Mark a skidding run the engine did not check: the slides' rigid limit not extrapolated, the wheels' skids
+    not verified (``why``: 'timestep given' | 'compliant clutches')."""
+    if kind.skid_rule == "slides":
+        result.accuracy["rigid_limit"] = f"not extrapolated: {why}"
+        result.figures = {"values": {}, "errors": {}}
+    else:
+        result.accuracy["skid_check"] = f"not verified: {why}"
 
 
 class _Run:
