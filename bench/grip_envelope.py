@@ -134,8 +134,8 @@ def _line(i: int, mode: str, verdict: dict) -> str:
         f"{key} {diff:+.2e}" + ("" if bar is None else f" +-{bar:.1e} {'acc' if accepted else 'n/a'} "
                                                       f"{'in' if covered else 'OUT'}")
         for key, diff, bar, accepted, covered in verdict["figures"])
-    cost = ("" if verdict["cost"] is None else f", cost {verdict['cost']:.2f} first runs ({verdict['cost_steps']:.2f} in "
-            "steps)")
+    cost = ("" if verdict["cost"] is None
+            else f", cost {verdict['cost']:.2f} first runs ({verdict['cost_steps']:.2f} in steps)")
     return (f"[{i:3d}] {mode:6s} {verdict['class']:16s} {figures}  ({verdict['detail']}; MuJoCo "
             f"{verdict['wall']:.1f} s{cost})")
 

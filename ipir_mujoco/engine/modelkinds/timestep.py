@@ -172,3 +172,21 @@ def halved(settings: SolverSettings) -> SolverSettings:
     of an automatic step the accuracy monitor stopped keeps STEPS_PER_TIME_CONSTANT steps per time constant."""
     tau = settings.grip_time_constant
     return replace(settings, timestep=settings.timestep / 2, grip_time_constant=None if tau is None else tau / 2)
+
+
+def given_settings(params: RobotParams, settings: SolverSettings, automatic) -> tuple[SolverSettings, str]:
+    """A given step's settings on the slide model with finite grip, and the time constant's rule in words: where
+    the grip rows' time constant is not given, the automatic run's (``automatic()``: its settings; in seconds,
+    so that halving the given step converges to one model), at least two given steps (MuJoCo's floor); the
+    carriage at its default share where not given."""
+    if settings.grip_time_constant is not None:
+        tau, rule = settings.grip_time_constant, "given"
+    else:
+        try:
+            tau, rule = automatic().grip_time_constant, "the automatic run's"
+        except ParameterError:  # the automatic step would be below the smallest allowed: the given step's own
+            tau, rule = STEPS_PER_TIME_CONSTANT * settings.timestep, "of the given step (no automatic step)"
+        if tau < 2 * settings.timestep:
+            tau, rule = 2 * settings.timestep, "two given steps (the automatic run's is shorter)"
+    share = settings.carriage_share if settings.carriage_share is not None else carriage_share(params)
+    return replace(settings, grip_time_constant=tau, carriage_share=share), rule

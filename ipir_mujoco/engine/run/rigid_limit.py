@@ -1,41 +1,43 @@
 """The rigid limit of the slide model on finite grip: a skidding run's figures extrapolated, with their errors.
 
-Why: MuJoCo's one-way limits and friction rows are soft. On the carriages' model (:mod:`.grip_model`) a skid's
-error grows with the rows' time constant tau (their damping 2 / tau answers each reversal of a skid), with the
-timestep dt and with the carriage's inertia (a share sigma of its module's mass, which a skidding module carries
-along): to first order, f(tau, dt, sigma) = f* + A tau + B dt + C sigma, each term as large as the stated accuracy
-or larger at the automatic step (mjcf/README.md, "Finite grip: the rigid limit"). Halving the step alone, with
-the time constant tied to it, converges erratically (the terms partly cancel), and a time constant held in
-seconds converges to its own soft model, not to the rigid one.
+Why: MuJoCo's one-way limits and friction rows are soft, and a skid's error grows with the rows' time constant
+tau (each reversal of a skid is answered within it), with the step dt and with the carriage's inertia, a share
+sigma of its module's mass that a skidding module carries along (:mod:`.grip_model`): to first order
+f = f* + A tau + B dt + C sigma, each term at or above the stated accuracy at the automatic step (mjcf/README.md,
+"Finite grip: the rigid limit", has the measurements). The three are scaled together: a run's *regularization*
+h is its step, its grip rows' time constant STEPS_PER_TIME_CONSTANT h (in seconds; :mod:`.timestep`) and its
+carriage's share sigma_1 h / h_1 (the loop's time constant, two steps, with them), so that f(h) = f* + a h + ...
 
-So the three are scaled together: the *regularization* h of a run is its step, its time constant is
-:data:`STEPS_PER_TIME_CONSTANT` h and its carriage's share sigma_1 h / h_1 (h_1 and sigma_1 the first run's), so
-that f(h) = f* + a h + O(h^2) with one coefficient a. An automatically stepped run whose modules skid (beyond
-:func:`.skid_check.skidded`'s floor) is the finest member of a family of three, h_1, 2 h_1, 4 h_1 (:data:`MEMBERS`;
-each coarser step a whole fraction of the first run's simulated time, so that all three end at the same instant);
-the coarser two cost 3/4 of the first. Each figure the user reads (fixed time: revolutions, x1_final, x2_final; to
-the steady state: steady_speed_m_s, energy_per_metre_j_m) is then
+An automatically stepped run whose modules skid (beyond :func:`.skid_check.skidded`'s floor) is the finest
+member of a family (:func:`_choose`): at fixed time h, 2h, 4h (figures read at the first run's end, every step a
+whole fraction of its duration), to the steady state h, 1.5h, 2h (figures read over the first run's steady
+window, :func:`ipir_mujoco.core.cycles.window_figures`: where each run's steady test stops does not scatter
+them). A coarser member that does not stay sane (:func:`clean_motion`) gives way to a closer one, or to a finer
+run (ratio :data:`FINE`). Each figure (fixed time: revolutions, x1_final, x2_final; to the steady state:
+steady_speed_m_s, energy_per_metre_j_m) then has (:func:`extrapolate`)
 
-- its order of convergence, measured from the three runs: p with (f3 - f2) / (f2 - f1) = (h3^p - h2^p) /
+- its order of convergence measured from the three runs, p with (f3 - f2) / (f2 - f1) = (h3^p - h2^p) /
   (h2^p - h1^p);
-- its rigid limit, the first-order extrapolation from the two finest runs, E12 = (h2 f1 - h1 f2) / (h2 - h1)
-  (the measured order confirms it; an extrapolation with the measured order itself amplifies the runs' scatter);
-- its error, |E12 - E23| (E23 the same from the two coarser runs: the second-order remainder, which E23 carries
-  four times as large as E12, plus the runs' scatter), with a statistical steady window's own uncertainty added.
+- its rigid limit, the first-order extrapolation from the two finest runs, E12 = (h2 f1 - h1 f2) / (h2 - h1) (the
+  measured order checks it; extrapolating with the measured order itself would amplify the runs' scatter);
+- its error |E12 - E23| (E23 the same from the two coarser runs: the remainder beyond first order, larger in
+  E23), plus :data:`SCATTER` of the correction |f1 - E12| (fixed time: scatter three runs may not show), the
+  solver's impedance leak (1e-4 of the figure, the same in every run) and a statistical steady window's own
+  uncertainty.
 
-A figure is *accepted* where its error is within the stated accuracy (:data:`ACCURACY`: 1e-3 at fixed time, the
-monitor's, 3e-4 for the steady figures, relative to the figure, travel to at least a tenth of a stroke).
-The extrapolation is *not trustworthy* where the measured order is off (outside :data:`ORDER_RANGE`) or the runs'
-differences disagree in sign, unless both differences are below :data:`NOISE` of the accuracy (nothing to
-extrapolate: the figure does not depend on the regularization); then the accuracy monitor's mode decides: 'stop'
-raises an :class:`.monitor.AccuracyError` naming the figure and the estimate it did reach, 'warn' records it
-and goes on. A figure extrapolated but not accepted is reported with its error and recorded, not refused.
+A figure is *accepted* where its error is within the stated accuracy (:data:`ACCURACY`: 1e-3 at fixed time,
+3e-4 steady; relative to the figure, travel to at least a tenth of a stroke) and three runs measured its order.
+Runs closer than the accuracy leave nothing to extrapolate (:data:`FLAT`); otherwise the extrapolation is *not
+trustworthy* where the measured order is below :data:`ORDER_RANGE` or the runs' differences disagree in sign,
+and the accuracy monitor's mode decides: 'stop' raises an :class:`.monitor.AccuracyError` naming the figure and
+the estimate it did reach, 'warn' records a violation and goes on. A higher order (the coarser runs' motion
+error) keeps the finest run's figure within the runs' spread.
 
-Reported: the summary's figures are the extrapolated ones (:attr:`RunResult.figures`) and ``figure_errors`` holds
-each one's estimated absolute error; ``settings['extrapolation']`` the runs (time constant, step, carriage share,
-each one's accuracy record) and the measured order of each figure; the accuracy record ``rigid_limit``
-('extrapolated', 'no skid', 'not extrapolated: timestep given' or 'not extrapolated: compliant clutches'),
-``figures_accepted`` and, where a figure could not be trusted, a violation. The series is the finest run's.
+Reported: the summary's figures are the extrapolated ones (:attr:`RunResult.figures`), ``figure_errors`` each
+one's estimated absolute error; ``settings['extrapolation']`` the runs (time constant, step, carriage share,
+steps, wall time, accuracy figures), the steps used and each figure's measured order; the accuracy record
+``rigid_limit`` ('extrapolated', 'no skid', 'failed', 'not extrapolated: timestep given' or 'not extrapolated:
+compliant clutches'), ``figure_relative_errors``, ``figures_accepted``. The series is the first run's.
 """
 
 from __future__ import annotations
@@ -45,17 +47,14 @@ import time
 from dataclasses import dataclass, replace
 
 from ipir_mujoco.core.cycles import cycles, window_figures
-from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.results import RunResult
 from ipir_mujoco.core.steady_test import LIMIT_ACCURACY, find_steady, steady_at_end
 
-from ..builders.grip_model import carriage_share
 from ..builders.model import SolverSettings
 from ..loop.monitor import RESIDUAL_TOL, AccuracyError
-from ..modelkinds.timestep import STEPS_PER_TIME_CONSTANT
 from .skid_check import TRAVEL_FLOOR, skidded
 
-MEMBERS = (1, 2, 4)  # the family's regularizations over the first run's: the first run is the finest
 FIGURES = {"fixed": ("revolutions", "x1_final", "x2_final"),
            "steady": ("steady_speed_m_s", "energy_per_metre_j_m")}
 UNCERTAINTY = {"steady_speed_m_s": "steady_speed_uncertainty_m_s",
@@ -70,24 +69,6 @@ BRACKET = 2.0  # the safety factor of a two-run bound (mjcf/README.md)
 # family keeps the extrapolation's remainder small (mjcf/README.md, "Finite grip: the rigid limit")
 COARSE = {"fixed": (2.0, 4.0), "steady": (1.5, 2.0)}
 FINE = 2.0 / 3.0  # the finer member's ratio, where it does not
-
-
-def given_settings(params, settings: SolverSettings, automatic) -> tuple[SolverSettings, str]:
-    """A given step's settings on the slide model with finite grip, and the time constant's rule in words: where
-    the grip rows' time constant is not given, the automatic run's (``automatic()``: its settings; in seconds,
-    so that halving the given step converges to one model), at least two given steps (MuJoCo's floor); the
-    carriage at its default share where not given."""
-    if settings.grip_time_constant is not None:
-        tau, rule = settings.grip_time_constant, "given"
-    else:
-        try:
-            tau, rule = automatic().grip_time_constant, "the automatic run's"
-        except ParameterError:  # the automatic step would be below the smallest allowed: the given step's own
-            tau, rule = STEPS_PER_TIME_CONSTANT * settings.timestep, "of the given step (no automatic step)"
-        if tau < 2 * settings.timestep:
-            tau, rule = 2 * settings.timestep, "two given steps (the automatic run's is shorter)"
-    share = settings.carriage_share if settings.carriage_share is not None else carriage_share(params)
-    return replace(settings, grip_time_constant=tau, carriage_share=share), rule
 
 
 @dataclass(frozen=True)
@@ -380,3 +361,23 @@ def _untrusted(family: Family, mode: str, why: str) -> RunResult:
     record.setdefault("violations", []).append({"figure": "rigid_limit", "t_s": float(base.t_end), "value": None,
                                                 "tolerance": None, "reason": message})
     return base
+
+
+def not_extrapolated(result: RunResult, why: str) -> None:
+    """Mark a skidding run whose figures were not extrapolated (``why``: 'timestep given' | 'compliant
+    clutches'): its figures are its own, ``figure_errors`` empty."""
+    result.accuracy["rigid_limit"] = f"not extrapolated: {why}"
+    result.figures = {"values": {}, "errors": {}}
+
+
+class _Slides:
+    """The slide model's floor for :mod:`.simulate`'s rules (its skids are extrapolated, not halved)."""
+
+    name = "slides"
+
+    @staticmethod
+    def skidded(result: RunResult) -> bool:
+        return skidded(result)
+
+
+SLIDES = _Slides()

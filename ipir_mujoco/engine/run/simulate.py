@@ -63,8 +63,8 @@ from .block_checks import BlockChecks
 from ..modelkinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
                                  climb_energy, mujoco_failure, steps_per_output)
 from ..modelkinds.kinds import ModelKind, kind_for
-from .rigid_limit import given_settings, rigid_limit
-from .skid_check import SLIDES_RULE, verify_skids
+from .rigid_limit import SLIDES, not_extrapolated, rigid_limit
+from .skid_check import verify_skids
 from .wheel_skids import WHEELS_RULE
 from ..builders.model import SolverSettings
 from ..loop.monitor import (AccuracyError, AccuracyMonitor, Tolerances, check_accuracy_mode, energy_audit, residual_ratio,
@@ -74,7 +74,7 @@ from ..modelkinds.route_watch import route_watch
 from .run_setup import RunSetup
 from ..loop.servo_drive import TickedDrive, controller_for
 from ..loop.stepper import WARNED
-from ..modelkinds.timestep import DT_MIN, halved
+from ..modelkinds.timestep import DT_MIN, given_settings, halved
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _GAP = SCALARS.index("motor_torque"), DEFERRED.index("loop_gap")
@@ -85,10 +85,9 @@ ENERGY_SLOTS = {column: (False, SCALARS.index(column)) if column in SCALARS
                 else (True, DEFERRED.index(_RECORDED_AS.get(column, column)))
                 for column in ENERGY_COLUMNS if column in SCALARS or _RECORDED_AS.get(column, column) in DEFERRED}
 
-SKID_RULES = {"slides": SLIDES_RULE, "wheels": WHEELS_RULE}  # a model kind's skid_rule: the rule it names
+SKID_RULES = {"slides": SLIDES, "wheels": WHEELS_RULE}  # a model kind's skid_rule: its floor, and the wheels' check
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
-
 
 
 def simulate_mujoco(
@@ -168,8 +167,7 @@ def simulate_mujoco(
             settings, extra["grip_time_constant_rule"] = given_settings(
                 params, settings, lambda: kind.settings(params, t_end, dt_out, servo, implementation)[0])
         result = _Run(params, settings, **options).result(extra)
-        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            _not_checked(kind, result, "timestep given")
+        _unchecked(kind, result, "timestep given")
         return result
     verify = kind.verifies_skids and params.clutch_stiffness is None  # compliant: skid_check's docstring
     started = time.perf_counter()
@@ -186,14 +184,11 @@ def simulate_mujoco(
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
             chosen = halved(chosen)  # still a whole fraction of dt_out
     if not verify:
-        if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
-            _not_checked(kind, result, "compliant clutches")
+        _unchecked(kind, result, "compliant clutches")
         return result
     every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
     if rigid_grip:
-        def member(settings: SolverSettings, member_end: float) -> RunResult:
-            # a member samples at each of its steps where the run does, else at the whole multiple of its step
-            # nearest dt_out: only its figures are read
+        def member(settings: SolverSettings, member_end: float) -> RunResult:  # sampled as the first, or nearly
             out = settings.timestep * (1 if every_step else max(1, round(dt_out / settings.timestep)))
             member_options = {**options, "accuracy": "warn", "t_end": member_end, "until_steady": False,
                               "dt_out": out}
@@ -208,14 +203,14 @@ def simulate_mujoco(
     return verify_skids(result, rerun, accuracy, DT_MIN, SKID_RULES[kind.skid_rule])
 
 
-def _not_checked(kind: ModelKind, result: RunResult, why: str) -> None:
-    """Mark a skidding run the engine did not check: the slides' rigid limit not extrapolated, the wheels' skids
-    not verified (``why``: 'timestep given' | 'compliant clutches')."""
-    if kind.skid_rule == "slides":
-        result.accuracy["rigid_limit"] = f"not extrapolated: {why}"
-        result.figures = {"values": {}, "errors": {}}
-    else:
-        result.accuracy["skid_check"] = f"not verified: {why}"
+def _unchecked(kind: ModelKind, result: RunResult, why: str) -> None:
+    """Mark a run that skidded beyond its kind's floor and that the engine did not check (``why``: 'timestep
+    given' | 'compliant clutches'): the slides' rigid limit not extrapolated, the wheels' skids not verified."""
+    if kind.verifies_skids and SKID_RULES[kind.skid_rule].skidded(result):
+        if kind.skid_rule == "slides":
+            not_extrapolated(result, why)
+        else:
+            result.accuracy["skid_check"] = f"not verified: {why}"
 
 
 class _Run:
