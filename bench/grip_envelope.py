@@ -113,9 +113,9 @@ def judge(params: RobotParams, t_end: float, until_steady: bool, budget: float) 
         diff = (sm_[key] - sa_[key]) / scale
         if key in errors:
             bar = errors[key] / scale
-            out["figures"].append((key, diff, bar, bool(accepted.get(key)), abs(diff) <= bar))
+            out["figures"].append((key, diff, bar, bool(accepted.get(key)), abs(diff) <= bar, kind))
         else:
-            out["figures"].append((key, diff, None, abs(diff) <= TOL[kind], None))
+            out["figures"].append((key, diff, None, abs(diff) <= TOL[kind], None, kind))
     extrapolation = m.settings.get("extrapolation")
     if extrapolation and extrapolation.get("runs"):
         runs = extrapolation["runs"]
@@ -133,7 +133,7 @@ def _line(i: int, mode: str, verdict: dict) -> str:
     figures = "  ".join(
         f"{key} {diff:+.2e}" + ("" if bar is None else f" +-{bar:.1e} {'acc' if accepted else 'n/a'} "
                                                       f"{'in' if covered else 'OUT'}")
-        for key, diff, bar, accepted, covered in verdict["figures"])
+        for key, diff, bar, accepted, covered, _ in verdict["figures"])
     cost = ("" if verdict["cost"] is None
             else f", cost {verdict['cost']:.2f} first runs ({verdict['cost_steps']:.2f} in steps)")
     return (f"[{i:3d}] {mode:6s} {verdict['class']:16s} {figures}  ({verdict['detail']}; MuJoCo "
@@ -196,18 +196,17 @@ def summarize(verdicts: list, args, wall: float) -> None:
     refused = [v for v in answered if v["class"] == "refused"]
     print(f"refused: {len(refused)} of the {len(answered)} runs the equations answer "
           f"({100 * len(refused) / max(len(answered), 1):.1f} %; at most 5 % asked)")
-    figures = [(mode, f) for mode, v in verdicts if v["class"] == "extrapolated" for f in v["figures"]
-               if f[2] is not None]
+    figures = [f for _, v in verdicts if v["class"] == "extrapolated" for f in v["figures"] if f[2] is not None]
     for label, chosen in (("accepted", True), ("not accepted", False)):
-        group = [(mode, f) for mode, f in figures if f[3] == chosen]
-        covered = sum(f[4] for _, f in group)
-        within = sum(abs(f[1]) <= TOL[mode] for mode, f in group)
-        worst = max((abs(f[1]) / TOL[mode] for mode, f in group), default=0.0)
+        group = [f for f in figures if f[3] == chosen]
+        covered = sum(f[4] for f in group)
+        within = sum(abs(f[1]) <= TOL[f[5]] for f in group)
+        worst = max((abs(f[1]) / TOL[f[5]] for f in group), default=0.0)
         print(f"{label} figures: {len(group)}; the equations inside the error bar in {covered} "
               f"({100 * covered / max(len(group), 1):.1f} %), within the stated accuracy in {within} (worst "
               f"{worst:.2f} of it)")
-    plain = [(mode, f) for mode, v in verdicts if v["class"] == "no skid" for f in v["figures"]]
-    within = sum(abs(f[1]) <= TOL[mode] for mode, f in plain)
+    plain = [f for _, v in verdicts if v["class"] == "no skid" for f in v["figures"]]
+    within = sum(abs(f[1]) <= TOL[f[5]] for f in plain)
     print(f"no-skid figures (one run): {len(plain)}, within the stated accuracy {within}")
     for label, key in (("wall time", "cost"), ("steps", "cost_steps")):
         costs = [v[key] for _, v in verdicts if v[key] is not None]

@@ -51,7 +51,7 @@ def test_a_first_order_figure_is_extrapolated_to_its_limit_within_its_error():
     h = (1e-4, 2e-4, 4e-4)
     f_star, a, b = 0.25, 30.0, 2e4  # a correction of 3e-3, a second-order remainder of 4e-4
     f = tuple(f_star + a * x + b * x * x for x in h)
-    e = extrapolate(h, f, accuracy=1e-3 * f_star, kind="fixed")
+    e = extrapolate(h, f, accuracy=1e-3 * f_star, figure="revolutions")
     assert e.trusted and e.order == pytest.approx(measured_order(h, f))
     assert e.value == pytest.approx(f_star - b * h[0] * h[1], rel=1e-12)
     assert abs(e.value - f_star) <= e.error
@@ -61,20 +61,20 @@ def test_a_first_order_figure_is_extrapolated_to_its_limit_within_its_error():
 def test_a_figure_that_does_not_depend_on_the_regularization_is_not_extrapolated_beyond_its_scatter():
     h = (1e-4, 2e-4, 4e-4)
     f = (1.0, 1.0 + 1e-5, 1.0 - 2e-5)  # scatter at 1/50 of the accuracy: no order to measure, nothing to refuse
-    e = extrapolate(h, f, accuracy=1e-3, kind="fixed")
+    e = extrapolate(h, f, accuracy=1e-3, figure="x1_final")
     assert e.trusted and abs(e.value - 1.0) <= e.error <= 1e-4
 
 
 def test_runs_that_disagree_in_sign_or_converge_too_slowly_are_not_trusted():
     h = (1e-4, 2e-4, 4e-4)
     accuracy = 1e-3
-    wobble = extrapolate(h, (1.0, 1.004, 0.998), accuracy, "fixed")
+    wobble = extrapolate(h, (1.0, 1.004, 0.998), accuracy, "x1_final")
     assert not wobble.trusted and "sign" in wobble.reason
-    slow = extrapolate(h, tuple(1.0 + 0.01 * (x / h[0]) ** 0.3 for x in h), accuracy, "fixed")
+    slow = extrapolate(h, tuple(1.0 + 0.01 * (x / h[0]) ** 0.3 for x in h), accuracy, "x1_final")
     assert not slow.trusted and "order" in slow.reason
     # a higher order dominating the coarser runs (their motion's error): the finest run, within the runs' spread
     f = tuple(1.0 + 1e-4 * (x / h[0]) + 1e-3 * (x / h[0]) ** 3 for x in h)
-    steep = extrapolate(h, f, accuracy, "fixed")
+    steep = extrapolate(h, f, accuracy, "x1_final")
     assert steep.trusted and steep.order > 2 and steep.value == f[0]
     assert abs(steep.value - 1.0) <= steep.error
 

@@ -21,7 +21,7 @@ steady_speed_m_s, energy_per_metre_j_m) then has (:func:`extrapolate`)
 - its rigid limit, the first-order extrapolation from the two finest runs, E12 = (h2 f1 - h1 f2) / (h2 - h1) (the
   measured order checks it; extrapolating with the measured order itself would amplify the runs' scatter);
 - its error |E12 - E23| (E23 the same from the two coarser runs: the remainder beyond first order, larger in
-  E23), plus :data:`SCATTER` of the correction |f1 - E12| (fixed time: scatter three runs may not show), the
+  E23), plus :data:`SCATTER` of the correction |f1 - E12| (scatter three runs may not show), the
   solver's impedance leak (1e-4 of the figure, the same in every run) and a statistical steady window's own
   uncertainty.
 
@@ -62,7 +62,11 @@ UNCERTAINTY = {"steady_speed_m_s": "steady_speed_uncertainty_m_s",
 ACCURACY = {"fixed": RESIDUAL_TOL, "steady": LIMIT_ACCURACY["mujoco"]}
 ORDER_RANGE = (0.5, 2.0)  # a measured order outside it: the runs are not in the first-order regime
 FLAT = 1.0  # of the accuracy: runs closer than it leave nothing to extrapolate (the order is not measured)
-SCATTER = {"fixed": 0.15, "steady": 0.0}  # of the correction: the scatter no three runs show (mjcf/README.md)
+# of the correction |f1 - E12|: the scatter three runs may not show (mjcf/README.md): fixed-time figures and a
+# window's energy per metre (the motor's work less the energy in transit, both large) scatter up to 10-15 % of it;
+# the steady speed, a periodic limit of the same revolutions in every run, is smooth in h
+SCATTER = {"revolutions": 0.15, "x1_final": 0.15, "x2_final": 0.15, "energy_per_metre_j_m": 0.15,
+           "steady_speed_m_s": 0.0}
 BRACKET = 2.0  # the safety factor of a two-run bound (mjcf/README.md)
 # the coarser members' ratios, where the motion allows them: fixed-time figures scatter with where the last skid's
 # steps fall, which a wider family averages; steady figures, read over one window, are smooth in h, and a closer
@@ -104,9 +108,9 @@ def measured_order(h: tuple[float, float, float], f: tuple[float, float, float])
 
 
 def extrapolate(h: tuple[float, float, float], f: tuple[float, float, float], accuracy: float,
-                kind: str) -> Estimate:
+                figure: str) -> Estimate:
     """The rigid limit of one figure from its values ``f`` at the regularizations ``h`` (three runs, finest first;
-    module docstring); ``accuracy``: the figure's stated accuracy, absolute; ``kind``: 'fixed' | 'steady'."""
+    module docstring); ``accuracy``: the figure's stated accuracy, absolute; ``figure``: its name (:data:`SCATTER`)."""
     d1, d2 = f[1] - f[0], f[2] - f[1]
     e12 = (h[1] * f[0] - h[0] * f[1]) / (h[1] - h[0])
     e23 = (h[2] * f[1] - h[1] * f[2]) / (h[2] - h[1])
@@ -115,7 +119,7 @@ def extrapolate(h: tuple[float, float, float], f: tuple[float, float, float], ac
     if max(abs(d1), abs(d2)) <= FLAT * accuracy:  # within its accuracy the figure does not depend on h
         return Estimate(e12, spread, order, True)
     if order is not None and ORDER_RANGE[0] <= order <= ORDER_RANGE[1]:  # first order: E12, its remainder, scatter
-        return Estimate(e12, abs(e12 - e23) + SCATTER[kind] * abs(f[0] - e12), order, True)
+        return Estimate(e12, abs(e12 - e23) + SCATTER[figure] * abs(f[0] - e12), order, True)
     if order is not None and order > ORDER_RANGE[1]:  # a higher order dominates the coarser runs: the finest, within
         return Estimate(f[0], spread, order, True)  # the spread of the runs and of both extrapolations
     reason = ("the runs' differences disagree in sign" if order is None
@@ -272,7 +276,7 @@ def _estimates(family: Family, ratios: list[float]) -> tuple[dict[str, Estimate]
             estimates[key], scales[key] = Estimate(math.nan, math.inf, None, False, f"a run has no {key}"), 1.0
             continue
         scales[key] = figure_scale(key, values, first.params)
-        estimate = (extrapolate(h, values, ACCURACY[kind] * scales[key], kind) if len(ratios) == 3
+        estimate = (extrapolate(h, values, ACCURACY[kind] * scales[key], key) if len(ratios) == 3
                     else bracket(h, values))
         # what no member's regularization changes: every row leaks 1 - d of the acceleration it resists, d the
         # solver's impedance (the same in every member); and a statistical steady window's own uncertainty
