@@ -16,7 +16,10 @@ of a stroke):
    3e-4 h / 1e-4 s, for K = 2, 4, 8 and h = 4e-4 .. 2.5e-5 s: each halving's ratio of successive differences
    (2 for first order) and the first-order extrapolation from each pair of neighbours. K = 2 (MuJoCo's floor,
    the time constant of two steps before the round) and K = 4 give ratios far from any order; K = 8 gives ratios
-   near 2 and extrapolations that agree with each other and with the equations.
+   near 2 and extrapolations that agree with each other and with the equations; beside them the extrapolation
+   with the order the three runs measure, which amplifies their scatter;
+3. the carriage's share of its module's mass at one time constant and step, and the family's extrapolation with
+   the share held against the share scaled with h (held, its bias stays).
 """
 
 from __future__ import annotations
@@ -72,7 +75,27 @@ def main() -> None:
                     r = [(g2 - g1) / (g1 - f) if g1 != f else math.nan
                          for f, g1, g2 in zip(values[h], values[steps[i - 1]], values[steps[i - 2]])]
                     line += "   ratio " + " ".join(f"{v:.2f}" for v in r)
+                    # extrapolated with the order the three runs measure (Aitken) instead of first order
+                    aitken = [f - (g1 - f) / (q - 1) if q > 1 else math.nan
+                              for f, g1, q in zip(values[h], values[steps[i - 1]], r)]
+                    line += "   measured-order extrapolation " + " ".join(f"{v:+.1e}" for v in aitken)
                 print(line, flush=True)
+        if not args.smoke:
+            share_effect(p, a, t_end)
+
+
+def share_effect(p: RobotParams, a: dict, t_end: float) -> None:
+    """3. The carriage's share at one time constant and step (4e-4 s, 5e-5 s), and the family extrapolated with
+    the share held at 3e-4 against the share scaled with h."""
+    print("  3. the carriage's share (time constant 4e-4 s, step 5e-5 s):")
+    for share in (1e-3, 3e-4, 1e-4, 3e-5):
+        d = relative(mujoco(p, t_end, 5e-5, 4e-4, share), a, p)
+        print(f"     share {share:.0e}: " + "  ".join(f"{k} {v:+.3e}" for k, v in zip(KEYS, d)))
+    for label, scaled in (("held at 3e-4", False), ("scaled with h", True)):
+        f1, f2 = (relative(mujoco(p, t_end, h, 8 * h, CARRIAGE_SHARE * (h / 1e-4 if scaled else 1.0)), a, p)
+                  for h in (1e-4, 2e-4))
+        print(f"     K = 8, h 1e-4 and 2e-4 s, share {label}: first-order extrapolation "
+              + " ".join(f"{k} {2 * x - y:+.1e}" for k, x, y in zip(KEYS, f1, f2)), flush=True)
 
 
 if __name__ == "__main__":

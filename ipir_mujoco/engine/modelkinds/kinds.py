@@ -59,9 +59,9 @@ class ModelKind:
     skid : bool
         Whether the energy audit books the grips' (or the contacts') work against skidding, ``skid_j``.
     skid_rule : str or None
-        Where an automatically stepped run whose modules skidded is checked at half its step
-        (:func:`ipir_mujoco.engine.run.skid_check.verify_skids`), the name of the rule it is checked by (its
-        floor, figures and acceptance; ``simulate.SKID_RULES``: 'slides', 'wheels'); None: not checked.
+        How an automatically stepped run whose modules skidded is checked (``simulate.SKID_RULES``): 'slides',
+        its figures extrapolated to the rigid limit (:mod:`ipir_mujoco.engine.run.rigid_limit`); 'wheels',
+        rerun at half its step (:func:`ipir_mujoco.engine.run.skid_check.verify_skids`); None: not checked.
     pipe_built : bool
         Whether its build puts the pipe's walls in the model (else a viewer draws the slide model in a pipe).
     """

@@ -73,6 +73,7 @@ BRACKET = 2.0  # the safety factor of a two-run bound (mjcf/README.md)
 # family keeps the extrapolation's remainder small (mjcf/README.md, "Finite grip: the rigid limit")
 COARSE = {"fixed": (2.0, 4.0), "steady": (1.5, 2.0)}
 FINE = 2.0 / 3.0  # the finer member's ratio, where it does not
+MEMBER_SLACK = 1.05  # a steady family's member runs to this times the first run's end, plus half a revolution
 
 
 @dataclass(frozen=True)
@@ -181,8 +182,8 @@ class Family:
     ``t_cap`` [s]: the run's own t_end (with until_steady, the cap). Fixed time: every member runs to the first
     run's end and its figures are its summary's. Steady: the figures are read over the first run's steady window
     (the same revolutions, :func:`ipir_mujoco.core.cycles.window_figures`), so that where the steady test
-    happens to stop does not scatter them; each member runs two of the window's revolutions past its end (at most
-    to the cap). A member that fails (a SimulationError: MuJoCo unstable, a budget), or lacks the window, is kept
+    happens to stop does not scatter them; each member runs MEMBER_SLACK times the first run's time and half a
+    revolution more (at most to the cap). A member that fails (a SimulationError: MuJoCo unstable, a budget), or lacks the window, is kept
     as the one-line reason.
     """
 
@@ -198,7 +199,8 @@ class Family:
             self.window = find_steady([c.mean_speed_m_s for c in found], tol, n, first.steady_target, steady_at_end)
             window = found[self.window.start:self.window.end + 1]
             period = sum(c.period_s for c in window) / len(window)
-            self.t_member = min(t_cap, first.t_end + 2 * period)
+            # a member's revolutions run ahead or behind the first's by its soft error, a few per cent of the time
+            self.t_member = min(t_cap, MEMBER_SLACK * first.t_end + 0.5 * period)
         else:
             self.t_member = first.t_end
         self.members: dict[float, RunResult | str] = {1.0: first}
@@ -272,8 +274,7 @@ def _estimates(family: Family, ratios: list[float]) -> tuple[dict[str, Estimate]
     estimates, scales = {}, {}
     for key in FIGURES[kind]:
         values = tuple(figures[key] for figures in read)
-        if any(v is None for v in values):
-            estimates[key], scales[key] = Estimate(math.nan, math.inf, None, False, f"a run has no {key}"), 1.0
+        if any(v is None for v in values):  # a run without the figure (a stall's energy per metre): not reported
             continue
         scales[key] = figure_scale(key, values, first.params)
         estimate = (extrapolate(h, values, ACCURACY[kind] * scales[key], key) if len(ratios) == 3
