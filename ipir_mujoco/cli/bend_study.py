@@ -37,8 +37,8 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..report.bend_figure import write_bend_figure
-    from ..studies import bend_study as bs
-    from ..studies.clutch_study import parse_values
+    from ..studies.mechanism import bend_study as bs
+    from ..studies.mechanism.clutch_study import parse_values
 
     params = bs.study_params(model_params(args))
     ratios = parse_values("--ratios", args.ratios, log=False) if args.ratios is not None else \

@@ -31,8 +31,8 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..output import check_output_dir
-    from ..studies.calibrate import calibrate, parse_fit, write_files
-    from ..studies.measured import read_measured
+    from ..studies.design.calibrate import calibrate, parse_fit, write_files
+    from ..studies.comparison.measured import read_measured
 
     check_output_dir(args.out, files=("calibration.json", "posterior.toml", "calibration.png"))
     check_input_file("--data", args.data)

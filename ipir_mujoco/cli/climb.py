@@ -49,7 +49,7 @@ def add_parser(commands) -> None:
 
 def parse_inclines(text: str) -> tuple[float, ...]:
     """``--inclines`` as sorted distinct floats in -90..90 deg, or a one-line ParameterError."""
-    from ..studies.clutch_study import parse_values
+    from ..studies.mechanism.clutch_study import parse_values
 
     values = parse_values("--inclines", text, log=False)
     for value in values:
@@ -61,7 +61,7 @@ def parse_inclines(text: str) -> tuple[float, ...]:
 
 def parse_engines(text: str | None) -> tuple[str, ...]:
     """The engines (variant names of :mod:`ipir_mujoco.registry`) of ``--engines``, or the study's default."""
-    from ..studies.climbing import CLIMB_VARIANTS
+    from ..studies.climb.climbing import CLIMB_VARIANTS
 
     if text is None:
         return CLIMB_VARIANTS
@@ -74,7 +74,7 @@ def parse_engines(text: str | None) -> tuple[str, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..studies import climbing
+    from ..studies.climb import climbing
 
     params = model_params(args)
     if params.incline != 0.0:

@@ -41,7 +41,7 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..report.clutch_section import write_study_figure
-    from ..studies import clutch_study as cs
+    from ..studies.mechanism import clutch_study as cs
 
     base = model_params(args)
     defaults = type(base)()
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _columns() -> list[str]:
-    from ..studies.clutch_study import METRICS
+    from ..studies.mechanism.clutch_study import METRICS
 
     extra = ["t_steady_s", "timestep_s", "peak_sampling_bound", "wall_s"]
     return (["point", "clutch", "clutch_stiffness_n_m", "clutch_backlash_m"]

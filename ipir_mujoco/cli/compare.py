@@ -27,8 +27,9 @@ def add_parser(commands) -> None:
 def run(args: argparse.Namespace) -> int:
     from ipir_mujoco.core.results import json_text
 
-    from ..studies.compare import compare_runs, format_comparison, load_run
-    from ..studies.measured import compare_measured, format_measured_comparison, is_measured_csv, read_measured
+    from ..studies.comparison.compare import compare_runs, format_comparison, load_run
+    from ..studies.comparison.measured import (compare_measured, format_measured_comparison, is_measured_csv,
+                                               read_measured)
 
     measured_a, measured_b = is_measured_csv(args.run_a), is_measured_csv(args.run_b)
     if measured_a and measured_b:

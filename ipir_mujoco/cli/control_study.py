@@ -60,7 +60,7 @@ def parse_list(option: str, text: str, low: float, high: float, low_open: bool, 
 
 def run(args: argparse.Namespace) -> int:
     from ..report.control_figure import write_study_figure
-    from ..studies import control_study as cs
+    from ..studies.mechanism import control_study as cs
 
     base = model_params(args)
     cs.check_base(base)

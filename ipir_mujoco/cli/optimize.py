@@ -35,15 +35,9 @@ def add_parser(commands) -> None:
 
 
 def problem_from_args(args: argparse.Namespace):
-    from ..studies.optimize import (
-        DEFAULT_BUDGET,
-        DEFAULT_ENGINE,
-        DEFAULT_VERIFY,
-        Problem,
-        parse_constraint,
-        parse_objective,
-    )
-    from ..studies.sweep_space import parse_vary
+    from ..studies.design.optimize import (DEFAULT_BUDGET, DEFAULT_ENGINE, DEFAULT_VERIFY, Problem, parse_constraint,
+                                           parse_objective)
+    from ..studies.sweeps.sweep_space import parse_vary
 
     if not args.vary:
         raise ParameterError("optimize needs at least one --vary NAME=LO:HI")
@@ -61,7 +55,7 @@ def problem_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..studies.optimize import run_optimize
+    from ..studies.design.optimize import run_optimize
 
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:

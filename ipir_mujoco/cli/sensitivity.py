@@ -28,9 +28,9 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..report.optimize_plots import plot_indices
-    from ..studies.design_eval import check_key
-    from ..studies.sensitivity import run_sensitivity
-    from ..studies.sweep_space import parse_vary
+    from ..studies.design.design_eval import check_key
+    from ..studies.design.sensitivity import run_sensitivity
+    from ..studies.sweeps.sweep_space import parse_vary
 
     if not args.vary:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")

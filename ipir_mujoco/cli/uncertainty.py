@@ -46,8 +46,8 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..output import check_output_dir
-    from ..studies.uncertainty import check_metric, parse_event, run_uncertainty, write_files
-    from ..studies.uq_dists import combine, parse_dist, read_dist_file
+    from ..studies.uq.uncertainty import check_metric, parse_event, run_uncertainty, write_files
+    from ..studies.uq.uq_dists import combine, parse_dist, read_dist_file
 
     check_output_dir(args.out, files=("uncertainty.json", "samples.csv", "uncertainty.png"))
     base = model_params(args)
@@ -74,7 +74,7 @@ def _interval(pair) -> str:
 def format_result(result: dict) -> str:
     """The study's estimates as text: per metric a line per statistic with its 95 % interval; per event its
     probability and interval; the failures."""
-    from ..studies.uq_stats import BCA_MAX
+    from ..studies.uq.uq_stats import BCA_MAX
 
     study = result["study"]
     lines = [f"{study['engine']} on {study['samples']} samples"

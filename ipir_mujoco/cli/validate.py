@@ -28,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..report.sections import SECTIONS
     from ..report.validation import write_report
-    from ..studies.validate import validate
+    from ..studies.validation.validate import validate
 
     progress = study_progress("validate")
     metrics, rungs = validate(params, quick=args.quick, progress=progress, sections=SECTIONS)

@@ -24,7 +24,8 @@ class _OlderPaths(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     def find_spec(self, fullname, path=None, target=None):
         if fullname not in OLDER_PATHS:
             return None
-        return importlib.util.spec_from_loader(fullname, self)
+        now = importlib.util.find_spec(OLDER_PATHS[fullname])  # its file, as ``python -m`` names it in sys.argv[0]
+        return importlib.util.spec_from_loader(fullname, self, origin=now.origin if now is not None else None)
 
     def create_module(self, spec):
         module = importlib.import_module(OLDER_PATHS[spec.name])
@@ -33,6 +34,12 @@ class _OlderPaths(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def exec_module(self, module):
         module.__spec__ = module.__spec__.loader_state  # the module's own spec again (reload, python -m)
+
+    def get_code(self, fullname):
+        """The code of the module at its name now: ``python -m`` runs an older name (``python -m
+        ipir_mujoco.studies.convergence``) as the module itself."""
+        now = OLDER_PATHS[fullname]
+        return importlib.util.find_spec(now).loader.get_code(now)
 
 
 def keep_older_paths(table: dict[str, str]) -> None:

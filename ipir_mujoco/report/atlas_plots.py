@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
-from ..studies.atlas_surrogate import CONFIDENT
+from ..studies.idealizations.atlas_surrogate import CONFIDENT
 
 COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange")
 
@@ -65,7 +65,7 @@ def idealization_words(name: str) -> str:
 
 def metric_words(metric: str) -> tuple[str, str]:
     """(words, unit) of an atlas metric."""
-    from ..studies.atlas_space import METRIC_WORDS
+    from ..studies.idealizations.atlas_space import METRIC_WORDS
 
     return SHORT_METRICS.get(metric) or METRIC_WORDS.get(metric, (metric.replace("_", " "), "-"))
 

@@ -15,8 +15,8 @@ from pathlib import Path
 
 from ipir_mujoco.core.params import RobotParams
 
-from ..studies.atlas import Atlas, run_atlas, top_drivers
-from ..studies.sweep_space import Axis
+from ..studies.idealizations.atlas import Atlas, run_atlas, top_drivers
+from ..studies.sweeps.sweep_space import Axis
 from .atlas_plots import idealization_words, metric_words, plot_safe
 from .document import Heading, Image, Paragraph, Table
 

@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..studies.measured import UNITS
+from ..studies.comparison.measured import UNITS
 
 
 def estimate_text(value: float, interval, unit: str) -> str:

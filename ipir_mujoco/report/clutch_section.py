@@ -222,7 +222,7 @@ GRID = {"stiffness": (1e4, 1e5, 1e6, 1e7), "backlash": (0.0, 1e-3)}  # the curve
 def compute(params: RobotParams, quick: bool, progress) -> dict:
     """The realistic clutches (and, unless ``quick``, a grid for the curves) at both operating points."""
     from .. import registry
-    from ..studies.clutch_study import run_study
+    from ..studies.mechanism.clutch_study import run_study
 
     designs = [(p["clutch_stiffness"], p["clutch_backlash"]) for p in REALISTIC]
     if not quick:

@@ -31,7 +31,7 @@ def compute(params: RobotParams, quick: bool, progress) -> dict:
     """The section's runs (module docstring), each as the control study reads it
     (:func:`ipir_mujoco.studies.control_study.run_task`: its figures over the steady window and the crank speed
     over its last revolution), or an error."""
-    from ..studies.control_study import Task, run_task
+    from ..studies.mechanism.control_study import Task, run_task
 
     speed = params.omega_target if params.drive == "servo" else min(SPEED, params.omega_noload / 3)
     defaults = RobotParams()

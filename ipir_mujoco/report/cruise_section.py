@@ -31,7 +31,7 @@ DEFAULT_MOTOR = RobotParams(drive="motor")
 
 
 def compute(params: RobotParams, quick: bool, progress) -> dict:
-    from ..studies.cruise import cruise_study
+    from ..studies.validation.cruise import cruise_study
 
     return cruise_study(params, quick=quick, progress=progress)
 

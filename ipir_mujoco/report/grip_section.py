@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ipir_mujoco.core.params import RobotParams
 
-from ..studies import climbing, traction
+from ..studies.climb import climbing, traction
 from .document import Heading, Image, Paragraph, Table, fmt
 
 MU = {False: (0.3, 0.5, 0.8), True: (0.5,)}  # wheel-wall friction coefficients tried, full / quick

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..studies.compare import cost
+from ..studies.comparison.compare import cost
 from . import control_section, cruise_section
 from .document import pct
 

@@ -17,8 +17,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..output import write_atomically
-from ..studies.design_eval import key_value
-from ..studies.sweep_metrics import DESCRIBED, LEGACY, described
+from ..studies.design.design_eval import key_value
+from ..studies.sweeps.sweep_metrics import DESCRIBED, LEGACY, described
 
 
 def axis_label(key: str) -> str:

@@ -21,7 +21,7 @@ from ipir_mujoco.core.params import RobotParams
 
 from ..labels import signed_percent
 from .. import registry
-from ..studies import climbing
+from ..studies.climb import climbing
 from .climb_figure import write_climb_figure
 from .document import Heading, Image, Paragraph, Table, fmt
 

@@ -23,8 +23,8 @@ import numpy as np
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import parameter_units
 
-from ..studies.sweep_files import DIVERGENCE
-from ..studies.sweep_metrics import LEGACY, METRICS, UNITS, described
+from ..studies.sweeps.sweep_files import DIVERGENCE
+from ..studies.sweeps.sweep_metrics import LEGACY, METRICS, UNITS, described
 from .plots import new_figure
 
 # metrics where larger is better; the rest (energy per metre, forces, jumps, time to settle) are better small

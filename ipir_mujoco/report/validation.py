@@ -29,8 +29,8 @@ from ..resources import shipped
 from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Link, Paragraph, Table, fmt, pct, to_html, to_markdown
 from .plots import new_figure, write_paper_figures
-from ..studies.paper_reference import describe_differences
-from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, LadderRun
+from ..studies.validation.paper_reference import describe_differences
+from ..studies.validation.validate import FIGURE_RUNGS, LADDER_FIGURES, LadderRun
 
 
 # The report's animation: the start (t_end [s] simulated) of the ladder's last rung, MuJoCo's robot on wheels in its
@@ -253,7 +253,7 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
         previous = rung
     blocks.append(Table(header, rows))
 
-    from ..studies.lr_study import FIGURES as LR_FIGURES, describe_threshold
+    from ..studies.validation.lr_study import FIGURES as LR_FIGURES, describe_threshold
 
     study = metrics["lr_study"]
     blocks.append(Heading("Where L >> r breaks down"))
@@ -359,7 +359,7 @@ def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | Non
     settings = ANIMATION_QUICK if quick else ANIMATION
     video = VideoSettings(**{k: v for k, v in settings.items() if k != "t_end"})
     from .. import registry
-    from ..studies.ladder import VALIDATION_LADDER
+    from ..studies.validation.ladder import VALIDATION_LADDER
 
     variant = registry.variant(next(r.variant for r in VALIDATION_LADDER if r.name == rung.name))
     model = variant.model

@@ -47,7 +47,7 @@ from ipir_mujoco.core.params import RobotParams, check_whole, require_params
 from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
 
-from .pool import map_unordered
+from ..pool import map_unordered
 
 RATIOS = (0.6, 1.0, 1.5, 2.0, 3.0, 5.0, 7.5, 10.0)  # R/D, the default
 RATIOS_QUICK = (2.0, 5.0)

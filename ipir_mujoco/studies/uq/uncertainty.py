@@ -41,10 +41,10 @@ from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse
 from ipir_mujoco.core.results import write_json
 
 from . import uq_stats
-from .sweep_files import Progress
-from ..labels import SUMMARY
-from .figure_errors import figure_error, unusable_counts, why_unusable
-from .sweep_metrics import METRICS, UNITS, run_metrics
+from ..sweeps.sweep_files import Progress
+from ...labels import SUMMARY
+from ..figure_errors import figure_error, unusable_counts, why_unusable
+from ..sweeps.sweep_metrics import METRICS, UNITS, run_metrics
 from .uq_dists import Dist, sample
 
 # a run's number beside its summary's and the sweep metrics: [unit] meaning
@@ -73,7 +73,7 @@ NAMED_WORDS = {"stall": "stalls", "no-steady-state": "no steady state", "slides-
 
 def key_words(key: str) -> tuple[str, str]:
     """(words, unit) of a metric key: ('energy per metre', 'J/m') for 'energy_per_metre_j_m'."""
-    from .sweep_metrics import DESCRIBED
+    from ..sweeps.sweep_metrics import DESCRIBED
 
     words = DESCRIBED.get(key, SUMMARY.get(key, (_WORDS.get(key, key.replace("_", " ")), "")))[0]
     return _WORDS.get(key, words), KEY_UNITS.get(key, "-")
@@ -204,7 +204,7 @@ class SampleTask:
 
 def evaluate(task: SampleTask, designs: list[dict], workers: int, progress: Progress | None) -> list[dict]:
     """``task`` on every design, on ``workers`` processes: results in the designs' order."""
-    from .pool import map_unordered
+    from ..pool import map_unordered
 
     results: list[dict | None] = [None] * len(designs)
 
@@ -377,8 +377,8 @@ def _rows(designs, cheap, cheap_rows, faithful, faithful_rows, keys) -> list[dic
 
 def write_files(out: str | Path, result: dict) -> Path:
     """uncertainty.json, samples.csv and uncertainty.png into ``out``, all or nothing; returns the figure's path."""
-    from ..output import staged_output
-    from ..report.uncertainty_figure import plot_uncertainty
+    from ...output import staged_output
+    from ...report.uncertainty_figure import plot_uncertainty
 
     with staged_output(out) as staging:
         rows = result["rows"]

@@ -49,10 +49,10 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import RunResult
 
-from ..engine.loop.monitor import EXCURSION_PER_R, RESIDUAL_TOL
-from .compare import STEADY_FIGURES, compare_runs, relative_change
+from ...engine.loop.monitor import EXCURSION_PER_R, RESIDUAL_TOL
+from ..comparison.compare import STEADY_FIGURES, compare_runs, relative_change
 from .ladder import CROSS_CHECKS, LADDER, Rung
-from .pool import map_unordered
+from ..pool import map_unordered
 
 T_CAP = 10.0  # s: cap of every run; several times the default motor's settling time
 DT_OUT = 1e-3  # s: the equations' output interval (each revolution's end is an exact sample whatever it is);

@@ -29,9 +29,9 @@ from ipir_mujoco.core.options import check_type
 from ipir_mujoco.core.params import RobotParams, check_whole
 from ipir_mujoco.core.results import write_json
 
-from ..output import check_output_dir, study_folder, write_atomically
+from ...output import check_output_dir, study_folder, write_atomically
 from .design_eval import Evaluator, check_key, key_value, usable
-from .sweep_space import Axis, Study
+from ..sweeps.sweep_space import Axis, Study
 
 COLUMNS = ("metric", "parameter", "S1", "S1_conf", "ST", "ST_conf")
 

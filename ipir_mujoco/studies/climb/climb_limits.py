@@ -45,8 +45,8 @@ from ipir_mujoco.core.options import study_dt_out
 from ipir_mujoco.core.params import RobotParams, check_real
 from ipir_mujoco.core.results import REST_SPEED, RunResult  # REST_SPEED: m/s, at rest below it
 
-from .sweep_metrics import mean_speed
-from .sweep_space import DT_OUT as SWEEP_DT_OUT, T_END_STEADY
+from ..sweeps.sweep_metrics import mean_speed
+from ..sweeps.sweep_space import DT_OUT as SWEEP_DT_OUT, T_END_STEADY
 
 # the variants a climb study runs by default: the exact models with one-way clutches, one per engine
 CLIMB_VARIANTS = ("analytic-unilateral", "mujoco-ratchet")
@@ -179,7 +179,7 @@ def locked_pull_share(run: RunResult) -> float | None:
     """Share of the run's time in which a clutch the paper's rule locks would have to pull (reaction < 0)."""
     if run.clutch != "kinematic":
         return None
-    from .validate import clutch_pull
+    from ..validation.validate import clutch_pull
 
     return clutch_pull(run)["fraction_of_time"]
 

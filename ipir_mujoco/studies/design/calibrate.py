@@ -40,9 +40,9 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, allowed_text
 from ipir_mujoco.core.results import write_json
 
-from .figure_errors import unusable_counts, why_unusable
-from .measured import Measured
-from .uq_dists import inside
+from ..figure_errors import unusable_counts, why_unusable
+from ..comparison.measured import Measured
+from ..uq.uq_dists import inside
 
 DIFF_STEP = 1e-5  # relative finite-difference step: its error ~ rtol / step = 1e-5 of a derivative at rtol 1e-10
 NOISE_FLOOR = 1e-9  # a column's noise is at least this share of its range (a noiseless synthetic run)
@@ -239,8 +239,8 @@ def posterior_toml(result: dict) -> str:
 
 def write_files(out: str | Path, result: dict, measured: Measured) -> Path:
     """calibration.json, posterior.toml and calibration.png into ``out``, all or nothing; returns the figure."""
-    from ..output import staged_output
-    from ..report.calibration_figure import plot_calibration
+    from ...output import staged_output
+    from ...report.calibration_figure import plot_calibration
 
     with staged_output(out) as staging:
         write_json(staging / "calibration.json",

@@ -24,10 +24,10 @@ from pathlib import Path
 from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, StudyInterrupted
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams
 
-from .pool import end_pool, worker_init
-from .sweep import run_design
-from .sweep_files import Progress, ResultsFile, _cell
-from .sweep_metrics import METRICS
+from ..pool import end_pool, worker_init
+from ..sweeps.sweep import run_design
+from ..sweeps.sweep_files import Progress, ResultsFile, _cell
+from ..sweeps.sweep_metrics import METRICS
 
 # the parameters whose value is a word (drive, feedforward), not a number an objective can rank
 WORDS = tuple(n for n in PARAMETER_NAMES if isinstance(getattr(RobotParams(), n), str))
@@ -217,7 +217,7 @@ def verify_rows(rows: list[dict], names: list[str], base: RobotParams, reference
                 executor: futures.Executor | None = None) -> list[dict]:
     """Each row re-run in ``engine``: columns ``ENGINE:KEY`` and ``divergence:KEY``, (engine - reference) /
     |reference|, for every metric of ``keys``; ``verify_error`` why a run gave nothing. Runs on the pool."""
-    from .pool import map_unordered
+    from ..pool import map_unordered
 
     results: dict[int, dict] = {}
     designs = [{n: row[n] for n in names} for row in rows]

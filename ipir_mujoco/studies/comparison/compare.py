@@ -243,7 +243,7 @@ def _figures_until(run: RunResult, t_end: float) -> dict:
 
 def format_comparison(result: dict) -> str:
     """A readable table of :func:`compare_runs`' result: names with units, aligned columns, the tolerance."""
-    from ..labels import SERIES, SUMMARY, significant
+    from ...labels import SERIES, SUMMARY, significant
 
     def unit_of(table, key):
         name, unit = table.get(key, (key, ""))

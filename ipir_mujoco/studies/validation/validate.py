@@ -78,8 +78,8 @@ from ipir_mujoco.core.options import (HEARTBEAT_S, LIVE_HEARTBEAT_S, Status, hea
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
-from .. import __version__
-from .compare import cost, relative_change
+from ... import __version__
+from ..comparison.compare import cost, relative_change
 from .convergence import convergence_evidence
 from .ladder import VALIDATION_LADDER
 from .lr_study import RATIOS_FULL, RATIOS_QUICK, describe_threshold, lr_study

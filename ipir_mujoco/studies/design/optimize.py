@@ -39,10 +39,10 @@ from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
-from .figure_errors import unusable_counts, why_unusable
-from ..output import check_output_dir, study_folder
+from ..figure_errors import unusable_counts, why_unusable
+from ...output import check_output_dir, study_folder
 from .design_eval import Evaluator, check_key, key_value, usable, verify_rows
-from .sweep_space import Axis, Study
+from ..sweeps.sweep_space import Axis, Study
 
 DEFAULT_ENGINE = "analytic-unilateral"
 DEFAULT_VERIFY = "mujoco-ratchet"
@@ -386,7 +386,7 @@ def _finite(data):
 
 def _summary(row: dict, problem: Problem, keys: list[str]) -> dict:
     """A design of the result: its parameters and metrics at the top level, its verification beside."""
-    from .sweep_metrics import DESCRIBED
+    from ..sweeps.sweep_metrics import DESCRIBED
 
     item = {n: row[n] for n in problem.names}
     item.update({m: row.get(m) for m in DESCRIBED})
@@ -400,7 +400,7 @@ def _summary(row: dict, problem: Problem, keys: list[str]) -> dict:
 def _write_front(path: Path, front: list[dict], problem: Problem, keys: list[str]) -> None:
     import csv
 
-    from .sweep_metrics import METRICS
+    from ..sweeps.sweep_metrics import METRICS
 
     header = ["eval_id", *problem.names, *METRICS]
     if problem.verify:

@@ -49,7 +49,7 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError, refuse_all_
 from ipir_mujoco.core.checks import check_numbers
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole, require_params
 
-from .pool import map_unordered
+from ..pool import map_unordered
 
 CONTROLLERS = ("open-loop", "pi", "pi+paper", "pi+exact")
 FEEDFORWARD = {"pi": "none", "pi+paper": "paper", "pi+exact": "exact"}

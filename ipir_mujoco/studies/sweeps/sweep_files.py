@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .. import terminal
+from ... import terminal
 
 from .sweep_metrics import METRICS
 from .sweep_space import Study

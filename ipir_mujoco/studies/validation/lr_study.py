@@ -33,7 +33,7 @@ import numpy as np
 from ipir_mujoco import registry
 from ipir_mujoco.core.params import RobotParams
 
-from .compare import compare_runs, relative_change
+from ..comparison.compare import compare_runs, relative_change
 
 FIGURES = ("revolutions", "x1_final", "x2_final", "v1_max", "v2_max", "first_contraction_end_s")
 ANGLE_FIGURES = ("S_at_angle", "S_dot_at_angle")
@@ -95,7 +95,7 @@ def refine_threshold(params: RobotParams, figure: str, level: float, between: Se
     """The crossing |divergence| = ``level`` inside the grid's bracket ``between`` [L/r], narrowed to ``tol`` by
     :func:`.atlas_adaptive.refine_crossings` (the atlas's k-section): {"crossing": L/r, "crossing_interval": [lo,
     hi], "crossing_L_m": L at the crossing}. ``params``: the massless rod's design."""
-    from .atlas_adaptive import refine_crossings
+    from ..idealizations.atlas_adaptive import refine_crossings
 
     lo, hi = map(float, between)
     ends = np.array([divergence(params, x, figure, t_end, dt_out) for x in (lo, hi)])

@@ -70,8 +70,8 @@ from ipir_mujoco.core.options import study_dt_out
 from ipir_mujoco.core.params import (RobotParams, check_whole, refuse_idle_parameters, refuse_idle_under,
                                      require_params)
 
-from ..engine.kinds.timestep import clutch_rate
-from .pool import map_unordered
+from ...engine.kinds.timestep import clutch_rate
+from ..pool import map_unordered
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,8 @@ from ipir_mujoco.core.errors import StudyInterrupted
 from ipir_mujoco.core.params import RobotParams
 
 from .atlas_space import IDEALIZATIONS, measure
-from .pool import end_pool, worker_init
-from .sweep_files import Progress, ResultsFile, _cell
+from ..pool import end_pool, worker_init
+from ..sweeps.sweep_files import Progress, ResultsFile, _cell
 
 CHUNK = 8  # analytic pairs per pool task: a pair costs tens of ms, a task's round trip about one
 

@@ -62,8 +62,8 @@ from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse
 
 from ipir_mujoco.core.results import write_json
 
-from ..output import check_output_dir, study_folder
-from .pool import end_pool, worker_init
+from ...output import check_output_dir, study_folder
+from ..pool import end_pool, worker_init
 from .sweep_files import Progress, ResultsFile, _cell, header_for, make_row
 from .sweep_metrics import batch_metrics, run_metrics
 from .sweep_space import Study

@@ -46,16 +46,16 @@ from ipir_mujoco.core.options import heartbeat
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
-from .figure_errors import unusable_counts, why_unusable
-from ..output import check_output_dir, study_folder
+from ..figure_errors import unusable_counts, why_unusable
+from ...output import check_output_dir, study_folder
 from .atlas_adaptive import explore, refine_crossings
 from .atlas_eval import Samples
 from .atlas_space import (DEFAULT_BUDGET, DEFAULT_METRICS, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, IDEALIZATIONS,
                           MOTOR_METRICS, NAMES, TORQUE_METRICS, allowed)
 from .atlas_surrogate import MAX_POINTS, CostSurrogate, regions, safe_fraction
-from .sweep import refuse_all_invalid
-from .sensitivity import SALIB_MISSING
-from .sweep_space import Axis, T_END_STEADY
+from ..sweeps.sweep import refuse_all_invalid
+from ..design.sensitivity import SALIB_MISSING
+from ..sweeps.sweep_space import Axis, T_END_STEADY
 
 CANDIDATES = 4096  # space-filling designs on which the surrogates are read (safe fractions, placement)
 

@@ -41,8 +41,8 @@ from ipir_mujoco.core.params import RobotParams
 if TYPE_CHECKING:  # the atlas command's parser reads this module's defaults without numpy
     from ipir_mujoco.core.results import RunResult
 
-from .figure_errors import figure_error
-from .ladder import VALIDATION_LADDER, Rung
+from ..figure_errors import figure_error
+from ..validation.ladder import VALIDATION_LADDER, Rung
 
 RUNGS = {rung.name: rung for rung in VALIDATION_LADDER}
 # the atlas's defaults, here rather than in atlas.py so that the command line's help reads them without loading
