@@ -28,14 +28,30 @@ try:
     from .. import __version__
     from ..resources import shipped
     from .. import terminal
-    from . import (bend_study, calibrate, climb, clutch_study, compare, control_study, kinetostatics, optimize,
-                   params, render, sensitivity, simulate, sweep, uncertainty, validate)
-    from . import atlas
+    from ..core.older_paths import keep_older_paths
+    from ..studies.mechanism import (bend_command as bend_study, clutch_command as clutch_study,
+                                     control_command as control_study)
+    from ..studies.design import (calibrate_command as calibrate, optimize_command as optimize,
+                                  sensitivity_command as sensitivity)
+    from ..studies.climb import climb_command as climb
+    from . import compare, kinetostatics, params, render, simulate, validate
+    from ..studies.sweeps import sweep_command as sweep
+    from ..studies.uq import uncertainty_command as uncertainty
+    from ..studies.idealizations import atlas_command as atlas
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
     interrupts.loaded()
 
 EXIT_INTERRUPTED = interrupts.EXIT_INTERRUPTED  # 128 + SIGINT, as shells report it
+
+# a study's command was a module here; it is its study's now (ipir_mujoco.studies), under its older path too
+keep_older_paths({f"{__name__}.{older}": f"ipir_mujoco.studies.{now}" for older, now in (
+    ("sweep", "sweeps.sweep_command"), ("optimize", "design.optimize_command"),
+    ("sensitivity", "design.sensitivity_command"), ("calibrate", "design.calibrate_command"),
+    ("uncertainty", "uq.uncertainty_command"), ("atlas", "idealizations.atlas_command"),
+    ("climb", "climb.climb_command"), ("clutch_study", "mechanism.clutch_command"),
+    ("control_study", "mechanism.control_command"), ("bend_study", "mechanism.bend_command"),
+    ("design_runs", "design_runs"))})
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "console", "main"]
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
-from .design_runs import add_design_run_options, design_t_end
+from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params
+from ..design_runs import add_design_run_options, design_t_end
 
 
 def add_parser(commands) -> None:
@@ -45,9 +45,9 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..output import check_output_dir
-    from ..studies.uq.uncertainty import check_metric, parse_event, run_uncertainty, write_files
-    from ..studies.uq.uq_dists import combine, parse_dist, read_dist_file
+    from ...output import check_output_dir
+    from .uncertainty import check_metric, parse_event, run_uncertainty, write_files
+    from .uq_dists import combine, parse_dist, read_dist_file
 
     check_output_dir(args.out, files=("uncertainty.json", "samples.csv", "uncertainty.png"))
     base = model_params(args)
@@ -74,7 +74,7 @@ def _interval(pair) -> str:
 def format_result(result: dict) -> str:
     """The study's estimates as text: per metric a line per statistic with its 95 % interval; per event its
     probability and interval; the failures."""
-    from ..studies.uq.uq_stats import BCA_MAX
+    from .uq_stats import BCA_MAX
 
     study = result["study"]
     lines = [f"{study['engine']} on {study['samples']} samples"

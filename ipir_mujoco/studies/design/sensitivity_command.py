@@ -6,8 +6,8 @@ import argparse
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
-from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
+from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params
+from ..design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
 def add_parser(commands) -> None:
@@ -27,10 +27,10 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.optimize_plots import plot_indices
-    from ..studies.design.design_eval import check_key
-    from ..studies.design.sensitivity import run_sensitivity
-    from ..studies.sweeps.sweep_space import parse_vary
+    from ...report.optimize_plots import plot_indices
+    from .design_eval import check_key
+    from .sensitivity import run_sensitivity
+    from ..sweeps.sweep_space import parse_vary
 
     if not args.vary:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")

@@ -7,12 +7,12 @@ from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 
-from .. import registry
-from ..labels import significant
-from ..studies.sweeps.sweep_metrics import METRICS, UNITS
-from ..studies.sweeps.sweep_space import DEFAULT_VARIANTS, T_END_STEADY
-from .common import EXIT_OK, add_model_options, check_input_file, compile_first, model_params
-from .design_runs import add_scheduler_option, scheduler_executor
+from ... import registry
+from ...labels import significant
+from .sweep_metrics import METRICS, UNITS
+from .sweep_space import DEFAULT_VARIANTS, T_END_STEADY
+from ...cli.common import EXIT_OK, add_model_options, check_input_file, compile_first, model_params
+from ..design_runs import add_scheduler_option, scheduler_executor
 
 
 def add_parser(commands) -> None:
@@ -55,7 +55,7 @@ def add_parser(commands) -> None:
 
 def study_from_args(args: argparse.Namespace):
     """The Study the options describe: defaults, the study file, then the command line (which wins)."""
-    from ..studies.sweeps.sweep_space import Study, parse_vary, read_study
+    from .sweep_space import Study, parse_vary, read_study
 
     base = model_params(args)
     options = read_study(args.study, base) if args.study else {"base": base}
@@ -79,9 +79,9 @@ def study_from_args(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     from ipir_mujoco.core.results import write_json
 
-    from ..report.sweep_plots import (LARGER_IS_BETTER, best_designs, check_plot_metric, plot_sweep, rankings,
-                                      read_results)
-    from ..studies.sweeps.sweep import check_sweep_options, run_sweep
+    from ...report.sweep_plots import (LARGER_IS_BETTER, best_designs, check_plot_metric, plot_sweep, rankings,
+                                       read_results)
+    from .sweep import check_sweep_options, run_sweep
 
     if args.study is not None:
         check_input_file("--study", args.study)

@@ -7,11 +7,11 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params, study_progress
+from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params, study_progress
 
 
 def add_parser(commands) -> None:
-    from ..studies.idealizations.atlas_space import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, NAMES
+    from .atlas_space import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, NAMES
 
     atl = commands.add_parser(
         "atlas", help="where each of the paper's idealizations costs less than a threshold, over design ranges",
@@ -51,8 +51,8 @@ def add_parser(commands) -> None:
 
 
 def atlas_from_args(args: argparse.Namespace):
-    from ..studies.idealizations.atlas import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, Atlas
-    from ..studies.sweeps.sweep_space import parse_vary
+    from .atlas import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, Atlas
+    from ..sweeps.sweep_space import parse_vary
 
     if not args.vary:
         raise ParameterError("atlas needs at least one --vary NAME=LO:HI[:log]")
@@ -71,8 +71,8 @@ def run(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
     compile_first()  # before the pool: compiled once, said at once
-    from ..report.atlas_plots import plot_atlas
-    from ..studies.idealizations.atlas import run_atlas
+    from ...report.atlas_plots import plot_atlas
+    from .atlas import run_atlas
 
     result = run_atlas(atlas, args.out, resume=args.resume, workers=args.workers, progress=study_progress("atlas"))
     figures = plot_atlas(result, atlas, args.out)
@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
 
 def summary_lines(result: dict, atlas) -> list[str]:
     """One line per idealization, metric and threshold: the safe fraction, its interval, crossings, runs."""
-    from ..studies.idealizations.atlas import top_drivers
+    from .atlas import top_drivers
 
     lines = []
     for name, per_metric in result["idealizations"].items():

@@ -7,8 +7,8 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
-from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
+from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params
+from ..design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
 def add_parser(commands) -> None:
@@ -35,9 +35,8 @@ def add_parser(commands) -> None:
 
 
 def problem_from_args(args: argparse.Namespace):
-    from ..studies.design.optimize import (DEFAULT_BUDGET, DEFAULT_ENGINE, DEFAULT_VERIFY, Problem, parse_constraint,
-                                           parse_objective)
-    from ..studies.sweeps.sweep_space import parse_vary
+    from .optimize import DEFAULT_BUDGET, DEFAULT_ENGINE, DEFAULT_VERIFY, Problem, parse_constraint, parse_objective
+    from ..sweeps.sweep_space import parse_vary
 
     if not args.vary:
         raise ParameterError("optimize needs at least one --vary NAME=LO:HI")
@@ -55,13 +54,13 @@ def problem_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..studies.design.optimize import run_optimize
+    from .optimize import run_optimize
 
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
     compile_first((problem.engine,))  # before the pool: compiled once, said at once
-    from ..report.optimize_plots import plot_pareto
+    from ...report.optimize_plots import plot_pareto
 
     drawn = []
     with scheduler_executor(args.scheduler) as executor:

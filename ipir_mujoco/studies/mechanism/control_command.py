@@ -11,9 +11,9 @@ from pathlib import Path
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import check_real, check_whole
 
-from ..labels import significant
-from ..output import check_output_dir
-from .common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
+from ...labels import significant
+from ...output import check_output_dir
+from ...cli.common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
 
 FILES = ("control_study.csv", "control_study.json", "control_study.png")
 METRICS = ("mean_omega_rad_s", "speed_ripple", "peak_clutch_force_n", "peak_module_accel_m_s2",
@@ -59,8 +59,8 @@ def parse_list(option: str, text: str, low: float, high: float, low_open: bool, 
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.control_figure import write_study_figure
-    from ..studies.mechanism import control_study as cs
+    from ...report.control_figure import write_study_figure
+    from . import control_study as cs
 
     base = model_params(args)
     cs.check_base(base)

@@ -10,9 +10,9 @@ from pathlib import Path
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import check_whole
 
-from ..labels import significant
-from ..output import check_output_dir
-from .common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
+from ...labels import significant
+from ...output import check_output_dir
+from ...cli.common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
 
 FILES = ("clutch_study.csv", "clutch_study.json", "clutch_study.png")
 
@@ -40,8 +40,8 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.clutch_section import write_study_figure
-    from ..studies.mechanism import clutch_study as cs
+    from ...report.clutch_section import write_study_figure
+    from . import clutch_study as cs
 
     base = model_params(args)
     defaults = type(base)()
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _columns() -> list[str]:
-    from ..studies.mechanism.clutch_study import METRICS
+    from .clutch_study import METRICS
 
     extra = ["t_steady_s", "timestep_s", "peak_sampling_bound", "wall_s"]
     return (["point", "clutch", "clutch_stiffness_n_m", "clutch_backlash_m"]

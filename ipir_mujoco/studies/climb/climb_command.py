@@ -12,9 +12,9 @@ from ipir_mujoco import registry
 from ipir_mujoco.core.limits import check_run_options
 from ipir_mujoco.core.params import check_real
 
-from ..labels import significant
-from ..output import check_output_dir
-from .common import EXIT_OK, add_model_options, compile_first, model_params, study_progress, write_study_files
+from ...labels import significant
+from ...output import check_output_dir
+from ...cli.common import EXIT_OK, add_model_options, compile_first, model_params, study_progress, write_study_files
 
 FILES = ("climb.csv", "climb.json", "climb.png")
 KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
@@ -49,7 +49,7 @@ def add_parser(commands) -> None:
 
 def parse_inclines(text: str) -> tuple[float, ...]:
     """``--inclines`` as sorted distinct floats in -90..90 deg, or a one-line ParameterError."""
-    from ..studies.mechanism.clutch_study import parse_values
+    from ..mechanism.clutch_study import parse_values
 
     values = parse_values("--inclines", text, log=False)
     for value in values:
@@ -61,7 +61,7 @@ def parse_inclines(text: str) -> tuple[float, ...]:
 
 def parse_engines(text: str | None) -> tuple[str, ...]:
     """The engines (variant names of :mod:`ipir_mujoco.registry`) of ``--engines``, or the study's default."""
-    from ..studies.climb.climbing import CLIMB_VARIANTS
+    from .climbing import CLIMB_VARIANTS
 
     if text is None:
         return CLIMB_VARIANTS
@@ -74,7 +74,7 @@ def parse_engines(text: str | None) -> tuple[str, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..studies.climb import climbing
+    from . import climbing
 
     params = model_params(args)
     if params.incline != 0.0:
@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
 def write_figure(study: dict, params, path: Path) -> None:
     """climb.png (:func:`ipir_mujoco.report.climb_figure.climb_figure`) with the traction's own marks
     (:meth:`_FiniteGripOutput.draw`)."""
-    from ..report.climb_figure import climb_figure
+    from ...report.climb_figure import climb_figure
 
     fig = climb_figure(study, params)
     _traction_output(study).draw(fig)

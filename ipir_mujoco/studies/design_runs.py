@@ -8,7 +8,7 @@ from contextlib import contextmanager
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ..studies.sweeps.sweep_space import T_END_STEADY
+from .sweeps.sweep_space import T_END_STEADY
 
 SCHEMES = ("tcp", "tls", "ws", "wss")  # Dask's network transports
 CONNECT_TIMEOUT_S = 5.0  # s: a scheduler on the network answers in milliseconds; a wrong address is not waited on

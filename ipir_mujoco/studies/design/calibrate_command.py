@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import (EXIT_OK, add_model_options, check_input_file, compile_first, files_line, model_params,
-                     study_progress)
+from ...cli.common import (EXIT_OK, add_model_options, check_input_file, compile_first, files_line, model_params,
+                           study_progress)
 
 
 def add_parser(commands) -> None:
@@ -30,9 +30,9 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..output import check_output_dir
-    from ..studies.design.calibrate import calibrate, parse_fit, write_files
-    from ..studies.comparison.measured import read_measured
+    from ...output import check_output_dir
+    from .calibrate import calibrate, parse_fit, write_files
+    from ..comparison.measured import read_measured
 
     check_output_dir(args.out, files=("calibration.json", "posterior.toml", "calibration.png"))
     check_input_file("--data", args.data)

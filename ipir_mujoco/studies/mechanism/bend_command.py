@@ -9,8 +9,8 @@ from pathlib import Path
 
 from ipir_mujoco.core.params import check_whole
 
-from ..output import check_output_dir
-from .common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
+from ...output import check_output_dir
+from ...cli.common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
 
 FILES = ("bend_study.csv", "bend_study.json", "bend_study.png")
 
@@ -36,9 +36,9 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.bend_figure import write_bend_figure
-    from ..studies.mechanism import bend_study as bs
-    from ..studies.mechanism.clutch_study import parse_values
+    from ...report.bend_figure import write_bend_figure
+    from . import bend_study as bs
+    from .clutch_study import parse_values
 
     params = bs.study_params(model_params(args))
     ratios = parse_values("--ratios", args.ratios, log=False) if args.ratios is not None else \
