@@ -189,7 +189,7 @@ sys.exit(code)
 
 
 @pytest.mark.parametrize("target", ["numpy", "matplotlib", "ipir_mujoco.analytic.unilateral_model",
-                                    "ipir_mujoco.report.plots",
+                                    "ipir_mujoco.core.figures",
                                     "after"])
 def test_ctrl_c_at_any_moment_is_at_most_one_line(tmp_path, target):
     """While the command line loads (numpy, scipy, matplotlib), inside the run (a module the run imports), and
@@ -214,7 +214,7 @@ signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
 os.kill(os.getpid(), signal.SIGINT)  # pending until let through
 class Hook:
     def find_spec(self, name, path=None, target=None):
-        if name == "ipir_mujoco.report.plots":  # imported by the run, the command's handler armed
+        if name == "ipir_mujoco.core.figures":  # imported by the run, the command's handler armed
             open("reached", "w").close()
             # let through inside code run from a string (as namedtuple, dataclasses, numba's generated code and
             # MuJoCo's bindings run it while the work goes on)

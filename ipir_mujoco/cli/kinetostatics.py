@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from ipir_mujoco.analytic.inverse import CrankMotion, inverse_kinetostatics
     from ipir_mujoco.core.results import write_json
 
-    from ..report.plots import figure_kinetostatics
+    from ..core.figures import figure_kinetostatics
 
     if args.omega is not None:
         if not (math.isfinite(args.omega) and 0 < abs(args.omega) <= MAX_OMEGA):

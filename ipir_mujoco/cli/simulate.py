@@ -366,7 +366,7 @@ def run(args: argparse.Namespace) -> int:
     result = run_simulation(args)
     record = result.to_json_dict()
     if args.out is not None:
-        from ..report.plots import write_paper_figures  # matplotlib: only where figures are written
+        from ..core.figures import write_paper_figures  # matplotlib: only where figures are written
 
         with staged_output(args.out) as staging:
             result.write_csv(staging / "timeseries.csv")

@@ -286,7 +286,7 @@ class RunResult:
 
         A thin call of :func:`ipir_mujoco.report.plots.plot_runs` (the drawing lives in the report layer, which
         imports nothing of this module: no import cycle)."""
-        from ipir_mujoco.report.plots import plot_runs  # matplotlib is loaded only when a run is drawn
+        from ipir_mujoco.core.figures import plot_runs  # matplotlib is loaded only when a run is drawn
 
         return plot_runs([self, *others], path)
 

@@ -16,7 +16,7 @@ from ipir_mujoco.core.params import RobotParams
 
 from ..labels import signed_percent, summary_label
 from .document import Heading, Image, Paragraph, Table, fmt, pct
-from .plots import new_figure
+from ..core.figures import new_figure
 
 FIGURE = "cruise_histories.png"
 PAPER, EXACT, ROD, ONE_WAY, RATCHET, LOCKS = ("paper model", "exact geometry", "with rod mass", "one-way clutches",

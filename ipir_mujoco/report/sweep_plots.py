@@ -25,7 +25,7 @@ from ipir_mujoco.core.params import parameter_units
 
 from ..studies.sweeps.sweep_files import DIVERGENCE
 from ..studies.sweeps.sweep_metrics import LEGACY, METRICS, UNITS, described
-from .plots import new_figure
+from ..core.figures import new_figure
 
 # metrics where larger is better; the rest (energy per metre, forces, jumps, time to settle) are better small
 LARGER_IS_BETTER = ("mean_speed_m_s", "steady_speed_m_s", "distance_per_rev_m", "efficiency")

@@ -28,7 +28,7 @@ from .overview import (accuracy_flag, ladder_change, monitor_verdict, overview_c
 from ..resources import shipped
 from .diagram import write_mechanism_diagram
 from .document import Heading, Image, Link, Paragraph, Table, fmt, pct, to_html, to_markdown
-from .plots import new_figure, write_paper_figures
+from ..core.figures import new_figure, write_paper_figures
 from ..studies.validation.paper_reference import describe_differences
 from ..studies.validation.validate import FIGURE_RUNGS, LADDER_FIGURES, LadderRun
 
