@@ -18,8 +18,8 @@ check that it changed nothing else, leave the new names out of the later fingerp
 
     python bench/fingerprint.py --leave-out slip1_m,slip2_m,peak_grip_use,mu_wall,F_n1,F_n2 > after.txt
 
-(every dictionary key and sweep column of those names is dropped before hashing; a name that does
-not occur changes nothing, so the earlier fingerprint compares as it is).
+(every dictionary key, series column and sweep column of those names is dropped before hashing; a name
+that does not occur changes nothing, so the earlier fingerprint compares as it is).
 
 ``--smoke`` fingerprints the first two runs of each kind only, in seconds (a check that the bench runs;
 compare smoke fingerprints only with smoke fingerprints).
@@ -118,6 +118,8 @@ def digest_json(value) -> str:
 def digest_run(run) -> str:
     h = hashlib.sha256()
     for name in sorted(run.series):
+        if name in LEFT_OUT:
+            continue
         h.update(name.encode())
         h.update(np.ascontiguousarray(run.series[name]).tobytes())
     h.update(digest_json({"energy": run.energy, "summary": run.summary, "accuracy": run.accuracy,

@@ -20,7 +20,7 @@ import sys
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.params import RobotParams, parse_overrides
 from ipir_mujoco.core.route import route_from_tables
 
 LEAD, EXIT = 0.45, 0.4  # m: the straights before and after the bend
@@ -49,11 +49,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.smoke:
         args.planes, args.t_end = "0", 0.05
-    values = {"drive": "motor", "mu_wall": 0.8}
-    for item in args.set:
-        name, _, value = item.partition("=")
-        values[name] = float(value)
-    params = RobotParams(**values)
+    params = RobotParams(**{"drive": "motor", "mu_wall": 0.8, **parse_overrides(args.set)})
     radius = args.ratio * params.pipe_diameter
     for plane in (float(p) for p in args.planes.split(",")):
         route = route_from_tables([dict(kind="straight", length=LEAD),

@@ -3,7 +3,8 @@
 Run on demand from the repository root (about 25 min on 2 busy cores, most of it the bend; ``--cases``: some of
 them; ``--smoke``: a few seconds):
 
-    python bench/wheels_convergence.py [--cases cruise,riser,...] [--down-to STEP] [--solver-iterations] [--smoke]
+    python bench/wheels_convergence.py [--cases cruise,riser,...] [--down-to STEP] [--set NAME=VALUE]...
+                                       [--solver-iterations] [--smoke]
 
 The model's contact, limit and loop rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
 properties of the model, so halving the step refines one model rather than stiffening it. Four cases: ``cruise``
@@ -41,7 +42,7 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.cycles import cycle_boundaries, travel
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.params import RobotParams, parse_overrides
 from ipir_mujoco.core.route import route_from_tables
 from ipir_mujoco.engine.run.wheel_skids import skid_floor, skid_resolution
 
@@ -181,7 +182,10 @@ def main(argv=None) -> int:
                         help="fixed steps down to this [s] too (default: down to half the automatic run's step)")
     parser.add_argument("--cases", default=",".join(CASES),
                         help=f"comma-separated cases to run (default all: {','.join(CASES)})")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="change every case's parameters (e.g. cornering_coefficient=rigid)")
     args = parser.parse_args(argv)
+    overrides = parse_overrides(args.set)
     if args.time_constants:
         time_constants(args.smoke)
         return 0
@@ -200,6 +204,7 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|")
     worst_ok = True
     for name, (params, t_end, tables) in cases.items():
+        params = params.replace(**overrides)
         route = route_from_tables(tables, "bend.toml") if tables else None
         print(f"{name}: the automatic run", file=sys.stderr, flush=True)
         auto = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, route=route)  # the step it chooses

@@ -2,9 +2,10 @@
 
 Run on demand from the repository root (a few minutes; ``--smoke``: seconds):
 
-    python bench/wheels_steady.py [--smoke]
+    python bench/wheels_steady.py [--fn 10,50] [--set NAME=VALUE]... [--smoke]
 
-The default motor, mu_wall 0.5, F_n1 = F_n2 = 10 N and 50 N, to the periodic steady state (``--until-steady``,
+The default motor, mu_wall 0.5, F_n1 = F_n2 = 10 N and 50 N (``--fn``; ``--set`` changes other parameters, e.g.
+``cornering_coefficient=rigid``), to the periodic steady state (``--until-steady``,
 capped at 20 s): ``analytic-unilateral`` against ``mujoco-wheels`` at its automatic settings. Beside the speeds:
 the wheeled run's mean press per module, how long a wheel was off its wall, and the closed-form lift-off check
 (the least-pressed leg's press; below 0, a wheel lifts: the constant press of the analytic model does not hold
@@ -20,20 +21,23 @@ import argparse
 import sys
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.params import RobotParams, parse_overrides
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="0.2 s runs at a given 1e-4 s step (no skid check's "
                         "reruns), no steady state: the script runs")
+    parser.add_argument("--fn", default="10,50", help="the presses F_n1 = F_n2 [N], comma-separated")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     args = parser.parse_args(argv)
+    overrides = parse_overrides(args.set)
     cap = 0.2 if args.smoke else 20.0
     print("| F_n [N] | analytic [m/s] | MuJoCo wheels [m/s] | difference | press 1 / 2 [N] | wheel off [s] | "
           "least press 1 / 2, closed form [N] |")
     print("|---|---|---|---|---|---|---|")
-    for F_n in (10.0, 50.0):
-        params = RobotParams(drive="motor", mu_wall=0.5, F_n1=F_n, F_n2=F_n)
+    for F_n in (float(f) for f in args.fn.split(",")):
+        params = RobotParams(**{"drive": "motor", "mu_wall": 0.5, **overrides, "F_n1": F_n, "F_n2": F_n})
         print(f"F_n {F_n:g} N", file=sys.stderr, flush=True)
         a = registry.run("analytic-unilateral", params, cap, dt_out=1e-3, until_steady=not args.smoke)
         w = registry.run("mujoco-wheels", params, cap, dt_out=1e-3, until_steady=not args.smoke,

@@ -17,7 +17,7 @@ from ipir_mujoco.core.params import PARAMETER_NAMES, describe_parameters, parse_
 
 CONTRACT_NAMES = ("m1 m2 r L J_A F_r1 F_r2 M rod_mass rod_inertia phi0 omega0 drive M_stall omega_noload "
                   "clutch_stiffness clutch_damping clutch_backlash incline g mu_wall F_n1 F_n2 pipe_diameter wheel_radius "
-                  "wheel_legs suspension_travel ring_spacing omega_target speed_dip feedforward control_rate speed_kp speed_ki").split()
+                  "wheel_legs suspension_travel ring_spacing cornering_coefficient omega_target speed_dip feedforward control_rate speed_kp speed_ki").split()
 
 
 def test_contract_names_and_the_papers_defaults():

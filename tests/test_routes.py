@@ -66,10 +66,10 @@ def test_the_bend_lift_check_against_hand_cases():
     mu = sqrt(3) / 2."""
     from ipir_mujoco.core.pipe import bend_lift_check, scrub_force
 
-    p = RobotParams(mu_wall=0.6, F_n1=60.0, F_n2=30.0, wheel_legs=3)
+    p = RobotParams(mu_wall=0.6, F_n1=60.0, F_n2=30.0, wheel_legs=3, cornering_coefficient=None)  # rigid wheels
     P1, P2 = 60.0 / 6, 30.0 / 6
-    assert scrub_force(p, 0, (1.0, 0.0)) == pytest.approx(2 * 0.6 * P1, rel=1e-12)
-    assert scrub_force(p, 1, (0.0, 1.0)) == pytest.approx(math.sqrt(3) * 0.6 * P2, rel=1e-12)
+    assert scrub_force(p, 0, (1.0, 0.0), 1.0) == pytest.approx(2 * 0.6 * P1, rel=1e-12)
+    assert scrub_force(p, 1, (0.0, 1.0), 1e6) == pytest.approx(math.sqrt(3) * 0.6 * P2, rel=1e-12)  # any radius
     quiet = p.replace(drive="torque", M=0.0, F_r1=0.0, F_r2=0.0, m1=1e-9, m2=1e-9)
     check = bend_lift_check(quiet, 1e6, (0.0, 1.0), [(0.0, 0.0)])
     for i, P in ((1, P1), (2, P2)):
@@ -77,6 +77,34 @@ def test_the_bend_lift_check_against_hand_cases():
     assert check["lift_predicted"] is False
     for mu, lifts in ((0.85, False), (0.88, True)):  # either side of sqrt(3) / 2 = 0.866
         assert bend_lift_check(quiet.replace(mu_wall=mu), 1e6, (0.0, 1.0), [(0.0, 0.0)])["lift_predicted"] is lifts
+
+
+def test_the_wheels_side_force_in_a_bend_against_hand_cases():
+    """Steer-compliant wheels (docs/model.md, "The wheels' side force"): wheel k slips at a (e_k . d), a = asin(b /
+    R) a ring's slip angle, and pushes min(C |alpha_k|, mu_wall P) along e_k, C = cornering_coefficient P. While
+    none slides a ring carries C a n / 2 along d (3 legs: sum (e_k . d)^2 = 1 + 1/4 + 1/4 = 3/2 across a
+    horizontal bend), and the module cocks by psi = C_r a / (k_r b) (C_r = 3 C / 2, k_r = 3 P / (2 travel)), so its
+    fore ring carries C_r (a + psi). Where every wheel slides, the ring's whole sideways friction (2 mu P across a
+    horizontal bend), as rigid wheels at any radius."""
+    from ipir_mujoco.core.pipe import bend_lift_check, ring_side_force, scrub_force
+
+    p = RobotParams(mu_wall=0.6, F_n1=60.0, F_n2=30.0, wheel_legs=3, cornering_coefficient=10.0,
+                    suspension_travel=0.004, ring_spacing=0.1)
+    P1 = 60.0 / 6
+    assert ring_side_force(p, 0, (1.0, 0.0), 0.01) == pytest.approx(10.0 * P1 * 0.01 * 1.5, rel=1e-12)
+    assert ring_side_force(p, 0, (1.0, 0.0), -0.01) == pytest.approx(-10.0 * P1 * 0.01 * 1.5, rel=1e-12)
+    # the bottom wheel (e . d = 1) slides from C alpha = mu P, alpha = 0.06; the upper two (e . d = 1/2) from 0.12
+    assert ring_side_force(p, 0, (1.0, 0.0), 0.09) == pytest.approx(0.6 * P1 + 2 * 10.0 * P1 * 0.045 * 0.5, rel=1e-12)
+    assert ring_side_force(p, 0, (1.0, 0.0), 0.5) == pytest.approx(2 * 0.6 * P1, rel=1e-12)
+    R = 5.0
+    a = math.asin(0.05 / R)
+    C_r, k_r = 1.5 * 10.0 * P1, 1.5 * P1 / 0.004
+    assert scrub_force(p, 0, (1.0, 0.0), R) == pytest.approx(C_r * (a + C_r * a / (k_r * 0.05)), rel=1e-12)
+    assert scrub_force(p, 0, (1.0, 0.0), 0.1) == pytest.approx(2 * 0.6 * P1, rel=1e-12)
+    # the side force falls as 1 / R, so a gentle bend's lift check tends to the straight pipe's
+    quiet = p.replace(drive="torque", M=0.0, F_r1=0.0, F_r2=0.0, m1=1e-9, m2=1e-9)
+    far = bend_lift_check(quiet, 1e3, (0.0, 1.0), [(0.0, 0.0)])
+    assert far["least_press1_n"] == pytest.approx(P1, rel=1e-3) and far["lift_predicted"] is False
 
 
 def test_the_closed_form_fits_against_hand_cases():

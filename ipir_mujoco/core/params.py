@@ -120,6 +120,13 @@ class RobotParams:
     ring_spacing: float = _number("m", "distance along the pipe between a module's two rings of wheel legs (the "
                                   "wheeled MuJoCo model; it carries the module's pitch and yaw moments)", 0.1,
                                   0.0, 1.0, low_open=True)
+    cornering_coefficient: float | None = _number(
+        "1/rad", "each wheel's cornering stiffness over its leg's preload (the wheeled MuJoCo model): a rolling "
+        "wheel's side force grows from zero with its slip angle, cornering_coefficient x preload x slip angle, up "
+        "to mu_wall times its press, where it slides; 8 /rad: Kalker's rolling-contact theory for a 15 mm "
+        "polyurethane wheel at its 8.3 N preload, within car tyres' 6-11 /rad (mjcf/README.md)", 8.0, 0.0, 100.0,
+        low_open=True, none_word="rigid",
+        none_text="wheels fixed on their axles: sideways, Coulomb friction at any slip angle")
 
     omega_target: float = _number("rad/s", "crank speed the speed controller holds (drive = servo; below "
                                   "omega_noload)", 10.0, 0.0, 1e5, low_open=True)

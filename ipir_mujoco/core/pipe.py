@@ -200,15 +200,93 @@ def ring_side_grip(params, module: int, toward: tuple[float, float]) -> float:
                         for e in (hub_tangent(leg_direction(k, n)) for k in range(n)))
 
 
-def scrub_force(params, module: int, toward: tuple[float, float]) -> float:
-    """The sideways friction [N] on each ring of module ``module`` (0 rear, 1 front) while it rolls through a bend
-    turning across the pipe towards the unit (y, z) ``toward``: its wheels roll only along the module's axis, so as
-    the module turns at v / R its two rings' wheels slide across the pipe (the fore ring's towards the bend's inside,
-    the aft ring's out) and each wheel's friction mu_wall P acts along its circumferential direction e_k (its
-    spring takes the radial part of the slide), so a ring feels :func:`ring_side_grip` across the pipe, the
-    two rings opposite ways: a couple the legs' springs carry as a ring load that size (the couple's lever is the
-    ring spacing either way). Quasi-static, Coulomb; 0 for a module at rest, as each is half of every revolution."""
-    return ring_side_grip(params, module, toward)
+def rigid_wheels(params) -> bool:
+    """Whether the wheeled model's wheels are fixed on their axles: ``cornering_coefficient`` rigid, or unlimited
+    grip (a steer-compliant wheel held against any load along the pipe would turn off its axis: the wheeled
+    model then builds rigid ones, :func:`ipir_mujoco.engine.builders.wheels_model.steer_compliant`)."""
+    return params.cornering_coefficient is None or params.mu_wall is None
+
+
+def bend_slip_angle(params, radius: float) -> float:
+    """Each ring's slip angle [rad] in a bend of centreline radius ``radius`` [m]: a module whose rings, b =
+    ``ring_spacing`` / 2 either side of its middle, both ride on the centreline is a chord of it, and turning
+    through the bend each ring moves along the centreline's tangent there, asin(b / R) off the module's axis (the
+    fore ring's towards the bend's inside, the aft ring's out)."""
+    return math.asin(min(1.0, 0.5 * params.ring_spacing / radius))
+
+
+def ring_side_force(params, module: int, toward: tuple[float, float], slip: float) -> float:
+    """The side force [N] along the unit (y, z) ``toward`` across the pipe that a ring of module ``module`` (0 rear,
+    1 front) carries when it rolls at the slip angle ``slip`` [rad] towards ``toward`` (its velocity that far off
+    the module's axis). Wheel k, its sideways direction e_k (:func:`hub_tangent`), slips at alpha_k = slip
+    (e_k . toward) and pushes along e_k with
+
+        F_k = min(C |alpha_k|, mu_wall P),   C = cornering_coefficient P   (P the leg's preload)
+
+    (docs/model.md, "The wheels' side force"), so the ring carries sum_k F_k |e_k . toward|: C slip n / 2 while no
+    wheel slides (n = wheel_legs evenly spaced: sum_k (e_k . toward)^2 = n / 2), :func:`ring_side_grip` when
+    all do. Rigid wheels (``cornering_coefficient`` rigid, fixed on their axles; the wheeled model's wheels with
+    unlimited grip too) carry :func:`ring_side_grip` at any slip angle but zero (unlimited grip counted as
+    mu_wall 1, as there)."""
+    if slip == 0.0:
+        return 0.0
+    if rigid_wheels(params):
+        return math.copysign(ring_side_grip(params, module, toward), slip)
+    n = int(params.wheel_legs)
+    P = (params.F_n1, params.F_n2)[module] / (2 * n)
+    mu = params.mu_wall
+    C = params.cornering_coefficient * P
+    total = 0.0
+    for e in (hub_tangent(leg_direction(k, n)) for k in range(n)):
+        share = abs(e[0] * toward[0] + e[1] * toward[1])
+        total += min(C * abs(slip) * share, mu * P) * share
+    return math.copysign(total, slip)
+
+
+COCK_HALVINGS = 60  # bisections of the bend's cock (:func:`scrub_force`): its bracket halves each time, to 1e-18
+
+
+def scrub_force(params, module: int, toward: tuple[float, float], radius: float) -> float:
+    """The side force [N] on module ``module``'s (0 rear, 1 front) fore ring, the more loaded, while it rolls through
+    a bend of centreline radius ``radius`` [m] turning across the pipe towards the unit (y, z) ``toward``, steady
+    and quasi-static (docs/model.md, "The wheels' side force"). Its wheels roll only along the module's axis, so
+    its rings slip at +-a, a = :func:`bend_slip_angle` (the fore ring's velocity turned towards the bend's
+    inside, the aft ring's out); their side forces :func:`ring_side_force` push the fore ring out and the aft
+    ring in, a couple that the legs' springs carry as the module cocks (its nose out) by psi, which adds psi to
+    both rings' slip: the fore ring slips at a + psi and the aft at a - psi, their net push out, G(a + psi) -
+    G(a - psi), is carried by both rings' springs moving out, and the couple, b (G(a + psi) + G(a - psi)), by
+    the springs across the rings' spacing: psi = (G(a + psi) + G(a - psi)) / (2 k_r b), k_r = n k / 2 a ring's
+    springs' stiffness across the pipe (k = P / suspension_travel), b = ring_spacing / 2. The fore ring's
+    springs then carry G(a + psi). While no wheel slides G(x) = C x n / 2 and psi = C_r a / (k_r b) (C_r = C n / 2,
+    C_r / k_r = cornering_coefficient suspension_travel), so the fore ring carries C_r a (1 + C_r / (k_r b)),
+    falling as 1 / R; where every wheel slides, the ring's whole sideways friction :func:`ring_side_grip`
+    whatever the radius (rigid wheels: at any radius). 0 for a module at rest, as each is half of every
+    revolution."""
+    a = bend_slip_angle(params, radius)
+    if rigid_wheels(params):
+        return ring_side_force(params, module, toward, a)
+    return ring_side_force(params, module, toward, a + bend_cock(params, module, toward, radius))
+
+
+def bend_cock(params, module: int, toward: tuple[float, float], radius: float) -> float:
+    """How far [rad] module ``module`` (0 rear, 1 front) cocks, nose out, on its legs' springs while it rolls through
+    a bend of centreline radius ``radius`` [m] turning towards the unit (y, z) ``toward``: psi solving
+    2 k_r b psi = G(a + psi) + G(a - psi) (:func:`scrub_force`; G = :func:`ring_side_force`, a =
+    :func:`bend_slip_angle`); rigid wheels (and unlimited grip): the rings' whole sideways friction over k_r b."""
+    a = bend_slip_angle(params, radius)
+    n = int(params.wheel_legs)
+    P = (params.F_n1, params.F_n2)[module] / (2 * n)
+    lever = 0.5 * params.ring_spacing * n * P / (2 * params.suspension_travel)  # k_r b [N/rad]
+    if rigid_wheels(params):
+        return ring_side_force(params, module, toward, a) / lever
+    # 2 k_r b psi - (G(a + psi) + G(a - psi)) grows with psi (G is concave for a positive slip and odd), from
+    # -2 G(a) at 0 to >= 0 where 2 k_r b psi reaches twice the rings' whole sideways friction: one root, bisected
+    low, high = 0.0, ring_side_grip(params, module, toward) / lever
+    for _ in range(COCK_HALVINGS):
+        psi = 0.5 * (low + high)
+        couple = ring_side_force(params, module, toward, a + psi) + ring_side_force(params, module, toward, a - psi)
+        low, high = (psi, high) if 2.0 * lever * psi < couple else (low, psi)
+    return 0.5 * (low + high)
 
 
 def side_grip_check(params, side1, side2, torque, grip_use=(0.0, 0.0)) -> dict:
@@ -251,9 +329,10 @@ def bend_lift_check(params, radius: float, toward: tuple[float, float], across) 
     along the bend. On top of the straight pipe's loads (half the sprung weight across, here as given; the rod's
     side force, the motor's couple on module 1) each ring carries
 
-    - the wheels' scrub (:func:`scrub_force`) along +-toward: the bend's own load, mu_wall times a share of the
-      press whatever the radius (at the defaults' 3 legs 2 mu_wall P across a horizontal bend, 1.73 mu_wall P
-      across one turning up);
+    - the wheels' side force (:func:`scrub_force`, the fore ring's) along +-toward: the bend's own load, growing
+      with the rings' slip angle b / R while the wheels roll on it, capped at the rings' sideways friction where
+      they slide (rigid wheels: the cap at any radius; at the defaults' 3 legs 2 mu_wall P across a horizontal
+      bend, 1.73 mu_wall P across one turning up);
     - the rod's push or pull at its angle to the module: the rod is a chord of the bend of length at most r + L,
       (r + L) / (2 R) off the module's axis, carrying the moving module's rolling resistance and weight (at most
       max(F_ri + m_i g)) while neither module skids;
@@ -275,7 +354,7 @@ def bend_lift_check(params, radius: float, toward: tuple[float, float], across) 
     for i, Fn in enumerate((params.F_n1, params.F_n2), start=1):
         m = sprung_mass(params, i - 1)  # across the pipe the springs carry the module less its legs
         P = Fn / (2 * n)
-        scrub = scrub_force(params, i - 1, toward)
+        scrub = scrub_force(params, i - 1, toward, radius)
         scrubs.append(scrub)
         couple = torque / params.ring_spacing if i == 1 else 0.0
         least = math.inf
@@ -316,10 +395,14 @@ SCRUB_FLOOR = 1e-3  # m
 
 
 def across_paths(series: dict, params) -> tuple[float, float]:
-    """How far [m] each module's rings moved across the pipe over a wheeled run, from its pose columns (``y``,
-    ``z``, ``roll``, ``pitch``, ``yaw`` and 1 or 2; small turns): the longer of its two rings' paths in (y, z)
-    (ring centres ``ring_spacing`` / 2 fore and aft of the module's point) plus its wheels' path round the pipe
-    from its roll (D / 2 |d roll|), sample to sample. (module 1's, module 2's)."""
+    """How far [m] each module's wheels slid across the pipe over a wheeled run: its most-slid wheel's sideways
+    slide, the series' ``slid1``, ``slid2`` where the run has them (the engine's, from MuJoCo's kinematics: a
+    steer-compliant wheel rolls its ring across the pipe without sliding); else from its pose columns (``y``,
+    ``z``, ``roll``, ``pitch``, ``yaw`` and 1 or 2; small turns), as rigid wheels slide: the longer of its two
+    rings' paths in (y, z) (ring centres ``ring_spacing`` / 2 fore and aft of the module's point) plus its
+    wheels' path round the pipe from its roll (D / 2 |d roll|), sample to sample. (module 1's, module 2's)."""
+    if "slid1" in series and "slid2" in series:
+        return float(series["slid1"][-1]), float(series["slid2"][-1])
     a, out = 0.5 * params.ring_spacing, []
     for k in (1, 2):
         y, z, roll, pitch, yaw = (np.asarray(series[f"{c}{k}"], dtype=float) for c in ("y", "z", "roll", "pitch", "yaw"))
@@ -338,7 +421,7 @@ def side_summary(params, series: dict) -> dict:
       across it. Above 1 the rings slide across the pipe; a module that skids along the pipe holds nothing across
       it whatever this says (its wheels' friction is all along the pipe), nor does a lifted wheel.
     - ``scrub_predicted``: either above 1.
-    - ``across1_m``, ``across2_m`` [m]: how far MuJoCo's rings moved across the pipe (:func:`across_paths`); a
+    - ``across1_m``, ``across2_m`` [m]: how far MuJoCo's wheels slid across the pipe (:func:`across_paths`); a
       slide from SCRUB_FLOOR on.
     - ``scrubbed``: either at least SCRUB_FLOOR: the wheels slid across the pipe, a loss the equations' rails lack.
     """

@@ -103,10 +103,11 @@ class WheelsKind(ModelKind):
         (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J],
         the wheels' states wheels1/2; the legs' press press1/2 [N] and wheels_off (:func:`.ratchet.press_columns`);
         the modules' pose across the pipe y1/2, z1/2 [m], roll1/2, pitch1/2, yaw1/2 [rad]
-        (:func:`.ratchet.pose_columns`), which with x1, x2, phi pose the robot for a replay."""
+        (:func:`.ratchet.pose_columns`), which with x1, x2, phi pose the robot for a replay; slid1/2 [m], how far
+        each module's wheels slid sideways on the wall (:func:`.ratchet.slide_columns`)."""
         from ipir_mujoco.core.results import grip_use
 
-        from .ratchet import pose_columns, press_columns, wheel_slip
+        from .ratchet import pose_columns, press_columns, slide_columns, wheel_slip
 
         cols = {}
         for k in (1, 2):
@@ -119,6 +120,7 @@ class WheelsKind(ModelKind):
         cols["skid_work"] = scalars["skid_work"].copy()
         cols.update(press_columns(model, params, q))
         cols.update(pose_columns(model, q))
+        cols.update(slide_columns(model, params, q))
         return cols
 
     def skid_rule(self, params):

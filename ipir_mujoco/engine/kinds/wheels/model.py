@@ -46,7 +46,7 @@ import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.pipe import ARM_SHARE, WHEEL_SHARE, check_fit, sprung_mass
+from ipir_mujoco.core.pipe import ARM_SHARE, WHEEL_SHARE, check_fit, rigid_wheels, sprung_mass
 from ipir_mujoco.core.pipe import leg_direction as core_leg_direction
 
 from ....resources import mjcf_dir
@@ -69,6 +69,8 @@ STOP_COMPRESSION = 4.0  # the arm's inner stop, in suspension travels of compres
 # crank, is 30 times a 5 N press); mu 10 let such a module skid
 MU_UNLIMITED = 100.0
 NOSLIP_ITERATIONS = 0  # MuJoCo's no-slip pass: off (a held robot creeps ~3e-6 m/s without it; it doubles the cost)
+TRAIL_SHARE = 0.25  # the steer-compliant wheel's trail over its radius (mjcf/README.md, "The wheels' side force")
+STEER_STOP = 1.0  # rad: the steer hinge's stops either way, beyond any slip angle the side-force law is used at
 IMPEDANCE = (0.9999, 0.9999, 0.001, 0.5, 2.0)  # every row's solimp: MuJoCo's largest impedance, as the slides'
 
 
@@ -149,6 +151,38 @@ def wheel_mass(params: RobotParams, module: int) -> float:
     return WHEEL_SHARE * (params.m1, params.m2)[module]
 
 
+def steer_compliant(params: RobotParams) -> bool:
+    """Whether the wheels steer on their hinges (a finite ``cornering_coefficient`` and a finite ``mu_wall``,
+    :func:`ipir_mujoco.core.pipe.rigid_wheels`): unlimited grip asks a held wheel to take any load along the pipe,
+    and a steer-compliant wheel pushed back harder than its cornering stiffness C [N/rad] swings off its axis (its
+    trail's lever beats its spring), so with unlimited grip the wheels are rigid."""
+    return not rigid_wheels(params)
+
+
+def trail(params: RobotParams) -> float:
+    """The steer-compliant wheel's trail e [m]: how far its centre (and contact) follows its steer axis along the
+    module, TRAIL_SHARE of ``wheel_radius``."""
+    return TRAIL_SHARE * params.wheel_radius
+
+
+def cornering_stiffness(params: RobotParams, module: int) -> float:
+    """One wheel's cornering stiffness C [N/rad]: ``cornering_coefficient`` times its leg's preload."""
+    return params.cornering_coefficient * leg_preload(params, module)
+
+
+def steer_stiffness(params: RobotParams, module: int) -> float:
+    """The steer hinge's spring [N m/rad], C e: a rolling wheel steered by its slip angle alpha to its path holds
+    it with the contact's side force C alpha at the trail e."""
+    return cornering_stiffness(params, module) * trail(params)
+
+
+def wheel_inertias(params: RobotParams, module: int) -> tuple[float, float]:
+    """A wheel's inertias [kg m^2] about its hub's axis, a disc's m R^2 / 2, and across it, a disc's about a
+    diameter with the drawn tyre's half-width."""
+    m, R = wheel_mass(params, module), params.wheel_radius
+    return 0.5 * m * R * R, 0.25 * m * R * R + m * HALF_WIDTH ** 2 / 3
+
+
 def housing_radius(params: RobotParams) -> float:
     """The housing's radius [m]: inside the wheels' ring, D/2 - 2 R."""
     return 0.5 * params.pipe_diameter - 2.0 * params.wheel_radius
@@ -201,55 +235,70 @@ def build_wheels_spec(params: RobotParams, settings: SolverSettings | None = Non
     return spec
 
 
+def add_leg(body, prefix: str, u: np.ndarray, x: float, params: RobotParams, module: int,
+            times: RowTimes = ROW_TIMES) -> None:
+    """One wheel leg of module ``module`` (0 rear, 1 front) on ``body`` (an MjSpec body), pointing along the unit
+    ``u`` (3,) across the pipe, ``x`` [m] along the body's axis from its origin, its names ``prefix`` + '_arm',
+    '_steer', '_hub', '_wheel', '_strut', '_tyre' (module docstring): the arm on its sprung slide, the wheel on
+    its steer hinge (steer-compliant wheels, ``cornering_coefficient`` finite: about u through the point the
+    trail e ahead of the wheel's centre, its spring C e and critical damping) and its hub hinge, the sphere
+    touching the wall."""
+    R, travel, n = params.wheel_radius, params.suspension_travel, leg_count(params)
+    reach = 0.5 * params.pipe_diameter - R  # the wheel's centre from the axis, the arm at 0
+    limit = [times.limit, 1.0]
+    arm = body.add_body(name=prefix + "_arm", pos=[x, 0.0, 0.0])
+    arm.mass, arm.ipos, arm.inertia = ARM_SHARE * (params.m1, params.m2)[module], [0, 0, 0], [1e-8, 1e-8, 1e-8]
+    arm.explicitinertial = True
+    slide = arm.add_joint(name=prefix + "_arm", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=u.tolist())
+    slide.stiffness = [leg_stiffness(params, module), 0.0, 0.0]
+    slide.springref = travel
+    slide.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+    slide.range = [-(STOP_COMPRESSION - 1.0) * travel, travel]
+    slide.solref_limit, slide.solimp_limit = limit, list(IMPEDANCE)
+    arm.add_geom(name=prefix + "_strut", type=mujoco.mjtGeom.mjGEOM_CAPSULE, contype=0, conaffinity=0,
+                 group=1, size=[0.003, 0, 0], fromto=[0, 0, 0, *(0.9 * reach * u)], rgba=[0.4, 0.4, 0.45, 1])
+    wheel = arm.add_body(name=prefix + "_wheel", pos=(reach * u).tolist())
+    J, across = wheel_inertias(params, module)
+    a = hub_axis(u)
+    wheel.mass, wheel.ipos = wheel_mass(params, module), [0, 0, 0]
+    wheel.fullinertia = (J * np.outer(a, a) + across * (np.eye(3) - np.outer(a, a)))[[0, 1, 2, 0, 0, 1],
+                                                                                      [0, 1, 2, 1, 2, 2]]
+    wheel.explicitinertial = True
+    if steer_compliant(params):  # the steer hinge first: it turns the hub's axis
+        # its axis meets the wall the trail ahead of the contact: a leg tilted off the wall's normal (a cocked
+        # module) then leaves the trail as it is (an axis through the wheel's centre would move it by R tilt)
+        steer = wheel.add_joint(name=prefix + "_steer", type=mujoco.mjtJoint.mjJNT_HINGE, axis=u.tolist(),
+                                pos=(trail(params) * np.array([1.0, 0.0, 0.0]) + R * u).tolist())
+        steer.stiffness = [steer_stiffness(params, module), 0.0, 0.0]  # undamped (mjcf/README.md)
+        steer.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        steer.range = [-STEER_STOP, STEER_STOP]
+        steer.solref_limit, steer.solimp_limit = limit, list(IMPEDANCE)
+    hub = wheel.add_joint(name=prefix + "_hub", type=mujoco.mjtJoint.mjJNT_HINGE, axis=a.tolist())
+    hub.frictionloss = (params.F_r1, params.F_r2)[module] * R / (2 * n)
+    hub.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+    hub.range = [-1e9, 1e9]  # the engine sets the lower bound before the first step
+    hub.margin = 1e-9
+    hub.solref_limit, hub.solimp_limit = limit, list(IMPEDANCE)
+    hub.solref_friction, hub.solimp_friction = limit, list(IMPEDANCE)
+    wheel.add_geom(name=prefix + "_wheel", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[R, 0, 0], contype=1,
+                   conaffinity=0, condim=3, friction=[contact_friction(params), 0.0, 0.0], group=3,
+                   rgba=[0.25, 0.25, 0.25, 1], solref=[times.contact, 1.0], solimp=list(IMPEDANCE))
+    wheel.add_geom(name=prefix + "_tyre", type=mujoco.mjtGeom.mjGEOM_CYLINDER, contype=0, conaffinity=0,
+                   group=1, size=[R, 0, 0], fromto=[*(-HALF_WIDTH * a), *(HALF_WIDTH * a)],
+                   rgba=[0.2, 0.2, 0.2, 1])
+
+
 def _write_legs(spec: mujoco.MjSpec, params: RobotParams, times: RowTimes, hint: str) -> None:
     """The modules' masses and inertias, their rings of legs (module docstring)."""
-    n, R, travel = leg_count(params), params.wheel_radius, params.suspension_travel
-    reach = 0.5 * params.pipe_diameter - R  # the wheel's centre from the axis, the arm at 0
-    mu = contact_friction(params)
-    masses, resistances = (params.m1, params.m2), (params.F_r1, params.F_r2)
-    contact = dict(solref=[times.contact, 1.0], solimp=list(IMPEDANCE))
-    limit = [times.limit, 1.0]
+    n = leg_count(params)
+    masses = (params.m1, params.m2)
     rho, s = housing_radius(params), params.ring_spacing
     for i, module in enumerate(MODULES):
         body = _element(spec.body, f"{module}_module", hint)
         m_arm, m_wheel = ARM_SHARE * masses[i], wheel_mass(params, i)
-        J = 0.5 * m_wheel * R * R
-        k = leg_stiffness(params, i)
         for prefix in leg_names(params)[i]:
             ring, leg = prefix.split("_")[1], int(prefix.split("_leg")[1])
-            u = leg_direction(leg, n)
-            x = (-0.5 if ring == "aft" else 0.5) * s
-            arm = body.add_body(name=prefix + "_arm", pos=[x, 0.0, 0.0])
-            arm.mass, arm.ipos, arm.inertia = m_arm, [0, 0, 0], [1e-8, 1e-8, 1e-8]
-            arm.explicitinertial = True
-            slide = arm.add_joint(name=prefix + "_arm", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=u.tolist())
-            slide.stiffness = [k, 0.0, 0.0]
-            slide.springref = travel
-            slide.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-            slide.range = [-(STOP_COMPRESSION - 1.0) * travel, travel]
-            slide.solref_limit, slide.solimp_limit = limit, list(IMPEDANCE)
-            arm.add_geom(name=prefix + "_strut", type=mujoco.mjtGeom.mjGEOM_CAPSULE, contype=0, conaffinity=0,
-                         group=1, size=[0.003, 0, 0], fromto=[0, 0, 0, *(0.9 * reach * u)], rgba=[0.4, 0.4, 0.45, 1])
-            wheel = arm.add_body(name=prefix + "_wheel", pos=(reach * u).tolist())
-            across = J / 2 + m_wheel * HALF_WIDTH ** 2 / 3
-            a = hub_axis(u)
-            wheel.mass, wheel.ipos = m_wheel, [0, 0, 0]
-            wheel.fullinertia = (J * np.outer(a, a) + across * (np.eye(3) - np.outer(a, a)))[[0, 1, 2, 0, 0, 1],
-                                                                                              [0, 1, 2, 1, 2, 2]]
-            wheel.explicitinertial = True
-            hub = wheel.add_joint(name=prefix + "_hub", type=mujoco.mjtJoint.mjJNT_HINGE, axis=a.tolist())
-            hub.frictionloss = resistances[i] * R / (2 * n)
-            hub.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-            hub.range = [-1e9, 1e9]  # the engine sets the lower bound before the first step
-            hub.margin = 1e-9
-            hub.solref_limit, hub.solimp_limit = limit, list(IMPEDANCE)
-            hub.solref_friction, hub.solimp_friction = limit, list(IMPEDANCE)
-            wheel.add_geom(name=prefix + "_wheel", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[R, 0, 0], contype=1,
-                           conaffinity=0, condim=3, friction=[mu, 0.0, 0.0], group=3, rgba=[0.25, 0.25, 0.25, 1],
-                           **contact)
-            wheel.add_geom(name=prefix + "_tyre", type=mujoco.mjtGeom.mjGEOM_CYLINDER, contype=0, conaffinity=0,
-                           group=1, size=[R, 0, 0], fromto=[*(-HALF_WIDTH * a), *(HALF_WIDTH * a)],
-                           rgba=[0.2, 0.2, 0.2, 1])
+            add_leg(body, prefix, leg_direction(leg, n), (-0.5 if ring == "aft" else 0.5) * s, params, i, times)
         carried = 2 * n * (m_arm + m_wheel)
         own = body.mass - carried  # the module's mass m_i includes its legs
         body.mass = own

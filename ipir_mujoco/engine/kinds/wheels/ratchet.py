@@ -238,6 +238,34 @@ def pose_columns(model: mujoco.MjModel, q: np.ndarray) -> dict[str, np.ndarray]:
     return cols
 
 
+def slide_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> dict[str, np.ndarray]:
+    """slid1/2 [m]: how far each module's wheels have slid sideways on the wall so far, from the samples' ``q``
+    (n, nq): per wheel the sum over the samples of its centre's step along its hub's axis (the mean of the axis at
+    the step's two ends, as MuJoCo's kinematics place them), the module's most-slid wheel's sum at each sample.
+    A wheel rolling on its wall moves along its rolling direction, across its hub's axis: a rigid wheel while its
+    ring holds its place across the pipe, a steer-compliant one also while it steers its ring across the pipe
+    (``cornering_coefficient``), so what moves a centre along its hub's axis is sliding (and the contact's
+    softness, and a wheel off its wall). Rigid wheels: the ring's own path across the pipe, as its three wheels'
+    circumferential directions span the ring's plane."""
+    from ..builders.wheels_model import leg_names
+
+    data = mujoco.MjData(model)
+    legs = leg_names(params)
+    bodies = np.array([[model.body(n + "_wheel").id for n in module] for module in legs])
+    hubs = np.array([[model.joint(n + "_hub").id for n in module] for module in legs])
+    count = q.shape[0]
+    centres, axes = np.empty((count,) + bodies.shape + (3,)), np.empty((count,) + hubs.shape + (3,))
+    for i in range(count):
+        data.qpos[:] = q[i]
+        mujoco.mj_kinematics(model, data)
+        centres[i], axes[i] = data.xpos[bodies], data.xaxis[hubs]
+    mid = axes[:-1] + axes[1:]
+    mid /= np.linalg.norm(mid, axis=-1, keepdims=True)
+    slid = np.abs(np.einsum("nmkj,nmkj->nmk", np.diff(centres, axis=0), mid))
+    total = np.concatenate([np.zeros((1,) + bodies.shape), np.cumsum(slid, axis=0)]).max(axis=-1)
+    return {"slid1": total[:, 0], "slid2": total[:, 1]}
+
+
 def press_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> dict[str, np.ndarray]:
     """press1/2 [N]: each module's legs' total press on the wall (:func:`leg_press`); wheels_off [-]: how many
     legs of both modules are off their wall (pressing with less than LIFT_SHARE of their preload)."""

@@ -79,8 +79,8 @@ def fit_prediction(route: Route, params: RobotParams, half_base: float, spring_t
         b = min(lifting, key=lambda b: min(b["least_press1_n"], b["least_press2_n"]))
         i = 1 if b["least_press1_n"] <= b["least_press2_n"] else 2
         predicted = (f"a wheel may leave the wall in bend {b['bend']} (R/D {b['R_over_D']:.3g}): module {i}'s "
-                     f"least-pressed leg {b[f'least_press{i}_n']:.3g} N with its wheels' sideways scrub "
-                     f"({b['scrub_n'][i - 1]:.3g} N per ring) on the straight pipe's loads")
+                     f"least-pressed leg {b[f'least_press{i}_n']:.3g} N with its wheels' side force in the bend "
+                     f"({b['scrub_n'][i - 1]:.3g} N on its fore ring) on the straight pipe's loads")
     else:
         predicted = (f"passes: in bend {worst['bend']} (R/D {worst['R_over_D']:.3g}) the wheels press with "
                      f"{100 * worst['wall_press_share']:.0f} % of their preload and no leg lifts")

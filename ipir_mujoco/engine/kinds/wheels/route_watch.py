@@ -175,9 +175,9 @@ class RouteWatch:
                 if self.lost is not None:
                     why += f"; {self.lost}"
                 if self.unlimited_grip and self.in_bend(s, front):
-                    why += ("; unlimited grip: in a bend the wheels, which roll only along their module's axis, "
-                            "must also slide across the pipe, and mu_wall=unlimited holds them (give a finite "
-                            "mu_wall)")
+                    why += ("; unlimited grip: the wheels are rigid then, and in a bend, rolling only along their "
+                            "module's axis, they must also slide across the pipe, which mu_wall=unlimited holds them "
+                            "from (give a finite mu_wall: the wheels then steer on their cornering compliance)")
                 self.stop = (f"stalled: less than {PROGRESS_M * 1e3:g} mm of progress in {PROGRESS_S:g} s "
                              f"({why}), at {self.route.where(self.s_max)}, t = {ti:.4f} s")
                 return i

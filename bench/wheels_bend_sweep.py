@@ -1,0 +1,189 @@
+"""The bend penalty of the wheeled MuJoCo model against R/D: time through a bend over its straightened twin's.
+
+Run on demand from the repository root (tens of minutes on 2 busy cores; ``--workers 2`` halves it):
+
+    python bench/wheels_bend_sweep.py [--ratios 1.5,2,3,5,10,20,50] [--mu 0.3,0.5,0.8] [--arc 1.0]
+                                      [--set NAME=VALUE]... [--workers N] [--json FILE] [--smoke]
+    python bench/wheels_bend_sweep.py --closed-form [--ratios ...] [--mu ...] [--set NAME=VALUE]...
+
+Each case is the bend study's route (:mod:`ipir_mujoco.studies.bend_study`: a 0.6 m lead-in, L / 2, the bend,
+L / 2, 0.05 m), the default motor, F_n 50 N and every other parameter at its default (``--set`` changes them),
+with a horizontal bend of R/D from ``--ratios`` whose angle is 90 degrees or less, so that its arc is at most
+``--arc`` metres (at R/D 50 a 90 degree bend of this pipe is 12.6 m long; 1 m keeps each run a few simulated
+seconds). Its straightened twin is the same route with the bend replaced by a straight of the bend's arc, the
+same marks. Both run as ``mujoco-wheels`` runs with the route do (the automatic step, 5e-5 s with a bend, and the
+skid check), and the passage is the bend study's window: the robot's centre from L / 2 before the bend to L / 2
+after it, a centreline length L + arc. The penalty is the bend's passage time over its twin's, less one: it
+should fall as the bend gentles, to nothing in a straight pipe.
+
+Per row: the bend's angle and arc, both passage times and the penalty, both energies [J] (the motor's work less
+the kinetic energy gained over the window), how the bend's run ended where it did not pass (its ``route_stop``),
+how long some wheel was off its wall in the bend's run and in its twin's (``route_wheel_off_s``, the whole run),
+the closed-form lift-off check of the bend (``lift_predicted`` and the least-pressed leg, the route's fit) and the
+step the run kept. The lift check's record over the rows ends the output: predicted and happened (a wheel off in
+the bend's run longer than in its twin's), false alarms and misses.
+
+``--closed-form`` runs nothing: per mu_wall and R/D, the rings' slip angle asin(b / R), the module's cock and the
+side force its fore ring's legs carry (:func:`ipir_mujoco.core.pipe.scrub_force`, module 1, a horizontal bend),
+the rings' whole sideways friction beside it, and the bend's lift-off check (the route's fit: the least-pressed
+leg, ``lift_predicted``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import math
+import sys
+import time
+
+from ipir_mujoco import registry
+from ipir_mujoco.core.errors import SimulationError
+from ipir_mujoco.core.params import RobotParams, parse_overrides
+from ipir_mujoco.core.pipe import bend_cock, bend_slip_angle, ring_side_grip, scrub_force
+from ipir_mujoco.core.route import route_from_tables
+from ipir_mujoco.studies.bend_study import DT_OUT, EXIT, LEAD_IN, T_CAP_PER_M, _passage, straight_route
+from ipir_mujoco.studies.pool import map_unordered
+
+RATIOS = (1.5, 2.0, 3.0, 5.0, 10.0, 20.0, 50.0)
+MUS = (0.3, 0.5, 0.8)
+ARC = 1.0  # m: the longest bend's arc
+LIFT_SLACK_S = 0.01  # s: a wheel off its wall this much longer in the bend's run than in its twin's lifted there
+
+
+def bend_angle(ratio: float, params: RobotParams, arc: float) -> float:
+    """The bend's angle [deg]: 90, or less so that its arc is at most ``arc`` [m]."""
+    return min(90.0, math.degrees(arc / (ratio * params.pipe_diameter)))
+
+
+def bend_route(params: RobotParams, ratio: float, angle: float):
+    half = dict(kind="straight", length=params.L / 2)
+    return route_from_tables([dict(kind="straight", length=LEAD_IN), half,
+                              dict(kind="bend", radius=ratio * params.pipe_diameter, angle=angle, plane=0.0), half,
+                              dict(kind="straight", length=EXIT)], "bend sweep")
+
+
+def run_case(item: tuple, overrides: dict) -> dict:
+    """One run in a worker: item = (mu_wall, 'bend' | 'straight', R/D or the arc [m], angle [deg])."""
+    mu, kind, ratio, angle = item
+    params = RobotParams(**{"drive": "motor", **overrides, "mu_wall": mu})
+    arc = math.radians(angle) * ratio * params.pipe_diameter if kind == "bend" else ratio
+    route = bend_route(params, ratio, angle) if kind == "bend" else straight_route(params, arc)
+    started = time.perf_counter()
+    try:
+        run = registry.run("mujoco-wheels", params, T_CAP_PER_M * route.length, dt_out=DT_OUT, route=route,
+                           accuracy="warn")
+    except SimulationError as exc:
+        return {"error": str(exc), "passed": False, "time_s": None, "wall_s": time.perf_counter() - started}
+    out = _passage(run, route, 1, 4)
+    fit = run.summary["route_fit"]["bends"]
+    out.update(wall_s=time.perf_counter() - started, lift_predicted=run.summary["lift_predicted"],
+               least_press_n=min(run.summary["least_press1_n"], run.summary["least_press2_n"]),
+               bend_least_press_n=(min(min(b["least_press1_n"], b["least_press2_n"]) for b in fit) if fit else None))
+    return out
+
+
+def closed_form(overrides: dict, ratios, mus, arc: float) -> int:
+    """The ``--closed-form`` table (module docstring)."""
+    from ipir_mujoco.engine.builders.route_walls import fit_prediction
+
+    print("| mu_wall | R/D | ring slip angle [rad] | cock [rad] | fore ring's side force [N] | rings' sideways "
+          "friction [N] | bend's least press [N] | lift predicted |")
+    print("|---|---|---|---|---|---|---|---|")
+    for mu in mus:
+        p = RobotParams(**{"drive": "motor", **overrides, "mu_wall": mu})
+        for r in sorted(ratios):
+            radius = r * p.pipe_diameter
+            a, side = bend_slip_angle(p, radius), scrub_force(p, 0, (1.0, 0.0), radius)
+            cock = bend_cock(p, 0, (1.0, 0.0), radius)
+            fit = fit_prediction(bend_route(p, r, bend_angle(r, p, arc)), p, 0.5 * p.ring_spacing,
+                                 p.suspension_travel)["bends"][0]
+            least = min(fit["least_press1_n"], fit["least_press2_n"])
+            print(f"| {mu:g} | {r:g} | {a:.4f} | {cock:.4f} | {side:.2f} | "
+                  f"{ring_side_grip(p, 0, (1.0, 0.0)):.2f} | {least:.2f} | {least < 0} |")
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--ratios", default=",".join(f"{r:g}" for r in RATIOS))
+    parser.add_argument("--mu", default=",".join(f"{m:g}" for m in MUS))
+    parser.add_argument("--arc", type=float, default=ARC, help="the longest bend's arc [m]")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--json", default=None, help="write every run's record here")
+    parser.add_argument("--smoke", action="store_true", help="R/D 50 at mu_wall 0.5, 0.6 m of arc: the script runs")
+    parser.add_argument("--closed-form", action="store_true", help="the closed forms only, no runs")
+    args = parser.parse_args(argv)
+    overrides = parse_overrides(args.set)
+    ratios = [float(r) for r in args.ratios.split(",")]
+    mus = [float(m) for m in args.mu.split(",")]
+    if args.closed_form:
+        return closed_form(overrides, ratios, mus, args.arc)
+    if args.smoke:
+        ratios, mus, args.arc = [50.0], [0.5], 0.2
+    base = RobotParams(**{"drive": "motor", **overrides})
+    items = []
+    for mu in mus:
+        arcs = set()
+        for r in sorted(ratios, reverse=True):
+            angle = bend_angle(r, base, args.arc)
+            items.append((mu, "bend", r, angle))
+            arcs.add(round(math.radians(angle) * r * base.pipe_diameter, 12))
+        items += [(mu, "straight", arc, 0.0) for arc in sorted(arcs, reverse=True)]
+    results = {}
+    started = time.perf_counter()
+
+    def done(item, result):
+        results[item] = result
+        print(f"[{len(results)}/{len(items)}] mu_wall {item[0]:g} {item[1]} {item[2]:g}: "
+              f"{'passage %.4f s' % result['time_s'] if result.get('time_s') else result.get('route_stop', result.get('error'))}"
+              f" ({result['wall_s']:.0f} s wall)", file=sys.stderr, flush=True)
+
+    map_unordered(functools.partial(run_case, overrides=overrides), items, args.workers, done)
+    print(f"wheeled MuJoCo model, the motor, F_n {base.F_n1:g}/{base.F_n2:g} N, cornering_coefficient "
+          f"{'rigid' if base.cornering_coefficient is None else f'{base.cornering_coefficient:g} /rad'}"
+          f"{' (' + ', '.join(args.set) + ')' if args.set else ''}; bends horizontal, at most 90 deg and "
+          f"{args.arc:g} m of arc; {time.perf_counter() - started:.0f} s wall")
+    print("| mu_wall | R/D | angle [deg] | arc [m] | bend [s] | straight [s] | penalty | energy bend / straight [J] "
+          "| outcome | wheel off bend / straight [s] | lift predicted (least press [N]) | step [s] |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    record = {"predicted and lifted": 0, "predicted, no lift (false alarm)": 0, "lifted, not predicted (miss)": 0,
+              "neither": 0}
+    rows = []
+    for mu in mus:
+        for r in sorted(ratios):
+            angle = bend_angle(r, base, args.arc)
+            arc = math.radians(angle) * r * base.pipe_diameter
+            bend = results[(mu, "bend", r, angle)]
+            twin = results[(mu, "straight", round(arc, 12), 0.0)]
+            tb, ts = bend.get("time_s"), twin.get("time_s")
+            penalty = f"{100 * (tb / ts - 1):+.2f} %" if tb and ts else "-"
+            eb, es = bend.get("energy_j"), twin.get("energy_j")
+            energy = f"{eb:.3f} / {es:.3f}" if eb is not None and es is not None else "-"
+            outcome = "passed" if bend.get("passed") else bend.get("route_stop", bend.get("error"))
+            off_b, off_s = bend.get("route_wheel_off_s"), twin.get("route_wheel_off_s")
+            off = f"{off_b:.3f} / {off_s:.3f}" if off_b is not None and off_s is not None else "-"
+            predicted = bend.get("lift_predicted")
+            lifted = off_b is not None and off_s is not None and off_b > off_s + LIFT_SLACK_S
+            if predicted is not None:
+                key = ("predicted and lifted" if predicted and lifted else "predicted, no lift (false alarm)"
+                       if predicted else "lifted, not predicted (miss)" if lifted else "neither")
+                record[key] += 1
+            press = bend.get("bend_least_press_n")
+            lift = f"{predicted} ({press:.2f})" if press is not None else "-"
+            print(f"| {mu:g} | {r:g} | {angle:.1f} | {arc:.3f} | {tb if tb is None else f'{tb:.4f}'} | "
+                  f"{ts if ts is None else f'{ts:.4f}'} | {penalty} | {energy} | {outcome} | {off} | {lift} | "
+                  f"{bend.get('timestep_s', '-')} |")
+            rows.append({"mu_wall": mu, "R_over_D": r, "angle_deg": angle, "arc_m": arc, "bend": bend,
+                         "straight": twin})
+    print("lift check over the rows: " + ", ".join(f"{k} {v}" for k, v in record.items()))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"rows": rows, "lift_record": record, "overrides": overrides}, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
