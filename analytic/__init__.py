@@ -11,16 +11,18 @@ inverse kinetostatics.
 """
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.older_paths import keep_older_paths
-from ipir_mujoco.core.options import CLUTCH_RULES
+from ipir_mujoco.core.older_paths import keep_older_paths, lazy_names
+from ipir_mujoco.core.limits import CLUTCH_RULES
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, load_params, refuse_idle_parameters, require_params
 from ipir_mujoco.core.results import COLUMNS, MODE_NAMES, Mode, RunResult
 
-from .compliant_run import simulate_compliant
 from .kinematic_clutch import simulate_kinematic
 from .kinematics import Geometry, Linkage
-from .unilateral_run import simulate_unilateral
 
+# the one-way and compliant clutches' run loops load where a run needs them (PEP 562): the paper's case, the
+# default `ipir-mujoco simulate`, starts without them
+__getattr__, __dir__ = lazy_names(__name__, {"simulate_unilateral": "unilateral_run",
+                                             "simulate_compliant": "compliant_run"})
 
 # a model's modes or regimes are in *_model.py, the loop that runs it in *_run.py; their older names:
 keep_older_paths({f"{__name__}.{older}": f"{__name__}.{now}" for older, now in (
@@ -74,10 +76,34 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
         if clutch != "unilateral":
             raise ParameterError(f"clutch_stiffness={params.clutch_stiffness!r} N/m with clutch={clutch!r}: the "
                                  "paper's rule locks rigidly; allowed: clutch='unilateral' or clutch_stiffness=rigid")
+        from .compliant_run import simulate_compliant
+
         return simulate_compliant(params, geometry, t_end, **options)
     if clutch == "unilateral":
+        from .unilateral_run import simulate_unilateral
+
         return simulate_unilateral(params, geometry, t_end, **options)
     return simulate_kinematic(params, geometry, t_end, **options)
+
+
+def compile_kernels() -> bool:
+    """Compile the analytic kernels now (numba, where it may: :mod:`.accel`, which says so on logger
+    'ipir_mujoco' when it compiles rather than loads them) and call every model once briefly, as numba compiles
+    each kernel at its first call: for a command about to run many designs, before its pool starts, so that
+    the kernels are compiled once and its workers load them from numba's cache. True if they run compiled."""
+    from . import accel
+
+    if not accel.accelerate():
+        return False
+    for geometry, clutch, params in (("approx", "kinematic", RobotParams()), ("exact", "kinematic", RobotParams()),
+                                     ("exact", "unilateral", RobotParams()),
+                                     ("exact", "unilateral", RobotParams(clutch_stiffness=1e5))):
+        simulate(params, geometry, clutch, 0.02, dt_out=1e-3)
+    from ipir_mujoco.core.route import route_from_tables  # and along a route (its kernels' first calls)
+
+    bend = route_from_tables([dict(kind="straight", length=0.4), dict(kind="bend", radius=0.5, angle=30.0)])
+    simulate(RobotParams(drive="motor"), "exact", "unilateral", 0.02, route=bend, dt_out=1e-3)
+    return True
 
 
 def _check_servo(params: RobotParams, options: dict) -> None:

@@ -29,7 +29,8 @@ import threading
 import time
 from pathlib import Path
 
-from ipir_mujoco.core.options import HEARTBEAT_S  # s between two "still compiling" lines
+# s between two "still compiling" notes (a terminal's status line; a log shows one every HEARTBEAT_S)
+from ipir_mujoco.core.options import LIVE_HEARTBEAT_S as HEARTBEAT_S
 
 MODES = ("auto", "1", "0")
 MODE = os.environ.get("IPIR_MUJOCO_JIT", "auto").strip().lower() or "auto"
@@ -99,7 +100,8 @@ def accelerate() -> bool:
     return True
 
 
-HEARTBEAT_MAX = 30  # lines at most (5 min): where the cache cannot be written, compiling never shows as done
+HEARTBEAT_MAX = 300  # notes at most (5 min): where the cache cannot be written, compiling never shows as done
+QUIET_S = 5.0  # s with no kernel compiling (and the stepper's cache written) after which compiling is done
 
 
 class _Compiles:
@@ -136,10 +138,11 @@ class _Compiles:
 
 def _heartbeat() -> None:
     """While the kernels compile (numba compiles each at its first call, inside the runs that follow), say
-    every HEARTBEAT_S that it is still compiling, on logger 'ipir_mujoco', until the compiled stepper's cache
-    index has appeared (:func:`compilation_pending` turns False) and no kernel has been compiling for a whole
-    HEARTBEAT_S; then say how long it took (up to the last compile's end). A daemon thread: it never holds up
-    the process's exit."""
+    every HEARTBEAT_S that it is still compiling, on logger 'ipir_mujoco' as a status (the record's ``status``
+    true: the command line shows it as its status line, :mod:`ipir_mujoco.terminal`), until the compiled
+    stepper's cache index has appeared (:func:`compilation_pending` turns False) and no kernel has been
+    compiling for QUIET_S; then say how long it took (up to the last compile's end). A daemon thread: it never
+    holds up the process's exit."""
     from numba.core import event
 
     started = time.monotonic()
@@ -151,10 +154,11 @@ def _heartbeat() -> None:
         try:
             for _ in range(HEARTBEAT_MAX):
                 time.sleep(HEARTBEAT_S)
-                if not compilation_pending() and not compiles.busy_within(HEARTBEAT_S):
+                if not compilation_pending() and not compiles.busy_within(QUIET_S):
                     log.info(f"kernels compiled ({max(compiles.last, started) - started:.0f} s)")
                     return
-                log.info(f"still compiling the kernels ({time.monotonic() - started:.0f} s so far)")
+                log.info(f"still compiling the kernels ({time.monotonic() - started:.0f} s so far)",
+                         extra={"status": True})
         finally:
             event.unregister("numba:compile", listener)
 

@@ -16,7 +16,10 @@ Targets (ratios measured in this one run; absolute times printed too):
   ``mj_step`` over the same steps of the same compiled model (in a C loop);
 - a 20 x 20 sweep of L and m2 (MuJoCo ratchet + analytic one-way, 1 s each,
   the sweep's defaults): at most 1.5x the MuJoCo floor, the designs' steps x a
-  plain ``mj_step`` / the cores.
+  plain ``mj_step`` / the cores;
+- the command's start-up (``bench/startup.py``, best of at least 5): ``--help``
+  and ``params`` at most 1.5x, ``simulate`` at most 2.5x the interpreter
+  loading numpy, in CPU time.
 
 The first target compares with an old revision of the package: where its
 git history is missing (an installed package) or ``--before none``, the bench
@@ -43,6 +46,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import analytic_speed  # noqa: E402  (bench/ siblings)
 import ratchet_step  # noqa: E402
+import startup  # noqa: E402
 
 from ipir_mujoco.engine.modelkinds.timestep import choose_settings  # noqa: E402
 from ipir_mujoco.studies.sweep import run_sweep  # noqa: E402
@@ -144,6 +148,10 @@ def main() -> None:
                     - ratchet_step.call_overhead(case, timestep, *costs[1])
                     for _ in range(1 if args.smoke else max(args.repeats, 3)))
         rows.append(sweep_row(plain, args.repeats, 2 if args.smoke else 20, t_run))
+    floor, started = startup.measure(max(args.repeats, 5) if not args.smoke else 1)
+    for name, (wall, cpu), wanted in started:
+        rows.append((f"start-up: {name}", f"{wall * 1e3:.0f} ms wall, {cpu * 1e3:.0f} ms CPU; python -c 'import numpy' "
+                     f"{floor[0] * 1e3:.0f} / {floor[1] * 1e3:.0f} ms", cpu / floor[1], f"<= {wanted:g} x the floor (CPU)"))
     print("\n| target | measured | ratio | wanted |\n|---|---|---|---|")
     for name, measured, ratio, wanted in rows:
         print(f"| {name} | {measured} | {ratio:.3g} | {wanted} |")

@@ -25,16 +25,6 @@ returns a :class:`RunResult`; bad input is a :class:`ParameterError` (a ValueErr
 """
 
 import os as _os
-import sys as _sys
-
-# The command line (`ipir-mujoco`, `python -m ipir_mujoco`) starts here: its Ctrl-C guard goes in before the
-# imports below (numpy and the registry), so that a Ctrl-C while they load is one line, not a traceback
-# (ipir_mujoco.interrupts; a Python program importing the package gets no handler from here).
-_starting_command = bool(_sys.argv) and _os.path.basename(_sys.argv[0]) in ("ipir-mujoco", "-m")
-if _starting_command:
-    from . import interrupts as _interrupts
-
-    _starting_command = _interrupts.guard_loading()
 
 __version__ = "0.2.0"
 
@@ -46,13 +36,15 @@ if (not _os.path.isdir(_os.path.join(_here, "analytic"))
         and _os.path.isfile(_os.path.join(_here, "..", "analytic", "__init__.py"))):
     __path__.append(_os.path.dirname(_here))  # noqa: F821 (a package's own __path__)
 
-try:
-    from .core.errors import ParameterError, SimulationError  # noqa: E402  (after the analytic folder is findable)
-    from .core.params import RobotParams  # noqa: E402
-    from .core.results import RunResult  # noqa: E402
-    from .registry import VARIANTS, run  # noqa: E402
-finally:
-    if _starting_command:
-        _interrupts.loaded()
+# The public names load on first use (PEP 562), so that importing the package imports neither numpy nor the
+# registry: ``ipir-mujoco --help`` and ``params`` need none of them (the command line's Ctrl-C guard,
+# ipir_mujoco.cli, goes in before anything heavy loads).
+_PUBLIC = {"ParameterError": "core.errors", "SimulationError": "core.errors", "RobotParams": "core.params",
+           "RunResult": "core.results", "VARIANTS": "registry", "run": "registry"}
 
 __all__ = ["VARIANTS", "ParameterError", "RobotParams", "RunResult", "SimulationError", "__version__", "run"]
+
+
+from .core.older_paths import lazy_names as _lazy_names  # noqa: E402 (after the analytic folder is findable)
+
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC)

@@ -7,9 +7,8 @@ summary.json and metrics.json.
 
 from __future__ import annotations
 
+import functools
 import numbers
-
-from ipir_mujoco.core.results import SERIES_UNITS
 
 # summary key -> (name, unit)
 SUMMARY: dict[str, tuple[str, str]] = {
@@ -31,12 +30,24 @@ SUMMARY: dict[str, tuple[str, str]] = {
     "speed_ripple": ("crank speed ripple, peak-to-peak / mean", "-"),
 }
 
-# time-series column -> (name, unit); the units are the result container's (core.results.SERIES_UNITS)
-SERIES: dict[str, tuple[str, str]] = {column: (name, SERIES_UNITS[column]) for column, name in {
-    "t": "time", "phi": "crank angle", "omega": "crank speed", "x1": "module 1 position",
-    "x2": "module 2 position", "v1": "module 1 velocity", "v2": "module 2 velocity", "S": "gap S",
-    "S_dot": "gap rate S_dot",
-}.items()}
+# time-series column -> name; its unit is the result container's (core.results.SERIES_UNITS). ``SERIES``
+# (column -> (name, unit)) is built at its first use: core.results loads numpy, which a command's --help does not
+SERIES_NAMES = {"t": "time", "phi": "crank angle", "omega": "crank speed", "x1": "module 1 position",
+                "x2": "module 2 position", "v1": "module 1 velocity", "v2": "module 2 velocity", "S": "gap S",
+                "S_dot": "gap rate S_dot"}
+
+
+@functools.cache
+def _series() -> dict[str, tuple[str, str]]:
+    from ipir_mujoco.core.results import SERIES_UNITS
+
+    return {column: (name, SERIES_UNITS[column]) for column, name in SERIES_NAMES.items()}
+
+
+def __getattr__(name: str):
+    if name == "SERIES":
+        return _series()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def summary_label(key: str) -> str:
@@ -47,7 +58,7 @@ def summary_label(key: str) -> str:
 
 def series_label(key: str) -> str:
     """'gap S [m]' for 'S'; the key itself if it has no entry."""
-    name, unit = SERIES.get(key, (key, ""))
+    name, unit = _series().get(key, (key, ""))
     return f"{name} [{unit}]" if unit else name
 
 

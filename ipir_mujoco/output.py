@@ -15,8 +15,6 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import shutil
-import tempfile
 import time
 from pathlib import Path
 from typing import Iterable, Iterator
@@ -44,6 +42,8 @@ def check_output_dir(out: str | Path, option: str = "--out", files: Iterable[str
         existing = existing.parent
     if not existing.is_dir():
         raise ParameterError(f"{option} {str(out)!r}: {str(existing)!r} is a file, not a folder")
+    import tempfile  # here, with shutil below: the command line's parsers load this module (--help)
+
     try:
         handle, probe = tempfile.mkstemp(prefix=".ipir-write-test-", dir=existing)
         os.close(handle)
@@ -87,6 +87,8 @@ def _alive(pid: int) -> bool:
 def remove_stale_staging(out: Path) -> list[Path]:
     """Remove the ``.OUT-partial-*`` staging folders beside ``out`` whose process is gone (killed while it
     wrote); return what was removed."""
+    import shutil
+
     removed = []
     for candidate in out.parent.glob(f".{out.name}-partial-*"):
         match = _PARTIAL.search(candidate.name[len(out.name) + 1:])
@@ -111,6 +113,9 @@ def staged_output(out: str | Path) -> Iterator[Path]:
     and ``out`` is left as it was. Staging folders of killed runs are removed
     first (:func:`remove_stale_staging`).
     """
+    import shutil
+    import tempfile
+
     out = check_output_dir(out).resolve()
     out.parent.mkdir(parents=True, exist_ok=True)
     remove_stale_staging(out)

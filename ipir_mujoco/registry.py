@@ -32,17 +32,18 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from . import interrupts
-from .core.control import FeedforwardTable
 from .core.errors import ParameterError, ParameterTypeError
-from .core.options import CLUTCH_RULES as RULES  # the clutch rules (--clutch)
-from .core.options import check_type
+from .core.limits import CLUTCH_RULES as RULES  # the clutch rules (--clutch)
 from .core.params import RobotParams, check_real, check_whole, require_params
-from .core.results import RunResult
 from .engine.kinds import KINDS  # the model kinds' declarations (no MuJoCo: engine/kinds/__init__.py)
 from .engine.kinds.base import MUJOCO_CLUTCHES  # the MuJoCo clutches a variant names (--mujoco-clutch)
+
+if TYPE_CHECKING:  # annotations only: the names, flags and checks above load without numpy (``--help``)
+    from .core.control import FeedforwardTable
+    from .core.results import RunResult
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
 # beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
@@ -148,7 +149,8 @@ def variant(name: str | Variant) -> Variant:
         key = ALIASES.get(name, name)
         if key in VARIANTS:
             return VARIANTS[key]
-    raise ParameterError(f"engine {name!r} is unknown; allowed: {', '.join(NAMES)}")
+    raise ParameterError(f"variant {name!r} is unknown (a model in an engine, ENGINE-MODEL[-RULE]); allowed: "
+                         f"{', '.join(NAMES)}")
 
 
 def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str | None = "kinematic",
@@ -346,7 +348,7 @@ def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
 @functools.lru_cache(maxsize=64)
 def _table(params: RobotParams) -> FeedforwardTable:
     from .analytic.inverse import CrankMotion, inverse_kinetostatics
-    from .core.control import TABLE_POINTS, reference_motion
+    from .core.control import TABLE_POINTS, FeedforwardTable, reference_motion
 
     omega, dip = params.omega_target, params.speed_dip
     if dip == 0.0:
@@ -386,14 +388,16 @@ def run_batch(name: str | Variant, designs: Sequence[RobotParams], t_end: float,
     """The variant on many designs at once through ``mujoco.batch`` (:func:`batched` variants only): one
     outcome per design, as :func:`ipir_mujoco.engine.kinds.slides.batch.run_ratchet_batch` gives them."""
     if not batched(name):
-        raise ParameterError(f"engine {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
+        raise ParameterError(f"variant {variant(name).name!r} has no batched runs; allowed: mujoco-ratchet")
     if not isinstance(designs, (list, tuple)):
         raise ParameterTypeError(f"designs={designs!r} is not a list of RobotParams")
     for params in designs:
         require_params(params)
     check_whole("nthread", nthread, low=1, high=1024)
-    check_type("until_steady", until_steady, bool, "True or False")
+    from .core.options import check_type
     from .engine.kinds.slides import batch
+
+    check_type("until_steady", until_steady, bool, "True or False")
 
     steady = {"until_steady": True} if until_steady else {}
     with interrupts.as_keyboard_interrupt():  # as run(): Ctrl-C is KeyboardInterrupt, never a failed design

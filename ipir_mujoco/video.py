@@ -43,6 +43,7 @@ OVERLAY_MIN_WIDTH = 320  # px: narrower frames show the robot without the text
 ROUTE_VIEW_DISTANCE = 0.9  # m: the camera above the plane along a route (fovy 45 deg: 0.75 m of it in a frame's
 # height, 0.41 m between the texts: the robot, 0.4 m long, and its pipe, 0.16 m wide by default, fit there)
 SIDE_VIEW = (90.0, -50.0)  # deg: the camera's azimuth and elevation without a route
+DRAWN_EXTENT = 1.0  # m: the drawing model's extent, MuJoCo's scale for its clipping planes (checker_floor)
 LIBRARIES = {"egl": ("EGL", "EGL (Debian: apt-get install libegl1)"),
              "osmesa": ("OSMesa", "OSMesa (Debian: apt-get install libosmesa6)")}
 
@@ -150,6 +151,12 @@ def checker_floor(spec) -> None:
     floor.size = [max(100.0, floor.size[0]), max(1.0, floor.size[1]), 0.01]
     spec.visual.headlight.ambient = [0.45, 0.45, 0.45]
     spec.visual.headlight.diffuse = [0.6, 0.6, 0.6]
+    # the drawing's scale: MuJoCo clips what is nearer the camera than 0.01 extent and farther than 50 extent,
+    # the extent it would compute from every geom. The wheeled model's straight wall (a contact cylinder 2 km
+    # long, drawn nowhere) made it 2000 m, so the near plane stood 20 m out and every frame was black (the slide
+    # model's 100 m floor made it 20 m: 0.2 m). At DRAWN_EXTENT the near plane is 1 cm from the camera and the far
+    # 50 m: the robot, its pipe and a route's bends in view, and the viewer's zoom in steps of the robot's size
+    spec.stat.extent = DRAWN_EXTENT
 
 
 def state_text(t: float, phi: float, phi0: float, omega: float, v1: float, v2: float,
@@ -245,21 +252,26 @@ def render_frames(run: RunResult, settings: VideoSettings = VideoSettings(), t_e
             if settings.width < OVERLAY_MIN_WIDTH:  # the text would cover the robot
                 yield _read_frame(settings, viewport, renderer)
                 continue
-            # the text on dark panels: white text alone is hard to read over the light floor
-            for y, height, width in ((0.80, 0.20, 0.80), (0.0, 0.25, 0.75)):  # fractions of the frame
-                mujoco.mjr_rectangle(mujoco.MjrRect(0, int(settings.height * y), int(settings.width * width),
-                                                    int(settings.height * height)), 0.1, 0.1, 0.12, 0.55)
-            mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport,
-                               f"{title}\nt = {when:.3f} s{along}", f"\n{settings.speed:g}x real time", renderer)
+            _overlay(mujoco.mjtGridPos.mjGRID_TOPLEFT, viewport, f"{title}\nt = {when:.3f} s{along}",
+                     f"\n{settings.speed:g}x real time", renderer)
             labels, values = state_text(when, phi, float(s["phi"][0]), float(np.interp(when, t, s["omega"])),
                                         float(np.interp(when, t, s["v1"])), float(np.interp(when, t, s["v2"])), held,
                                         drawn_kind(drawn).free)
-            mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels,
-                               values, renderer)
+            _overlay(mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport, labels, values, renderer)
             yield _read_frame(settings, viewport, renderer)
     finally:
         renderer.free()
         context.free()
+
+
+def _overlay(corner, viewport, left: str, right: str, renderer) -> None:
+    """Text in a corner of the frame (MuJoCo's two columns), on the box MuJoCo draws behind it, as small as the
+    text: drawn twice, so that the box is dark enough (half black, then three quarters) for the grey labels to
+    read over the light floor, and covers no more of the robot than the text itself."""
+    import mujoco
+
+    for _ in range(2):
+        mujoco.mjr_overlay(mujoco.mjtFont.mjFONT_NORMAL, corner, viewport, left, right, renderer)
 
 
 def _counted(frames, total: int, progress: Callable[[int, int], None]):

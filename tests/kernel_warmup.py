@@ -24,21 +24,12 @@ WAIT_S = 900.0  # the most a worker waits for the compile (a bound on a stuck on
 def warm_up() -> None:
     """Compile the kernels in this process (or load the cache) with the heartbeat asleep, and call each analytic
     engine once briefly: numba compiles each kernel at its first call."""
-    from ipir_mujoco.analytic import RobotParams, accel, simulate
+    from ipir_mujoco.analytic import accel, compile_kernels
 
     period = accel.HEARTBEAT_S
     accel.HEARTBEAT_S = 1e9  # read once as the thread goes to sleep: a thread started now never wakes to log
     try:
-        accel.accelerate()  # compile now (or load the cache) whatever the runs below spend
-        for geometry, clutch, params in (("approx", "kinematic", RobotParams()),
-                                         ("exact", "kinematic", RobotParams()),
-                                         ("exact", "unilateral", RobotParams()),
-                                         ("exact", "unilateral", RobotParams(clutch_stiffness=1e5))):
-            simulate(params, geometry, clutch, 0.02, dt_out=1e-3)
-        from ipir_mujoco.core.route import route_from_tables  # and along a route (its kernels' first calls)
-
-        bend = route_from_tables([dict(kind="straight", length=0.4), dict(kind="bend", radius=0.5, angle=30.0)])
-        simulate(RobotParams(drive="motor"), "exact", "unilateral", 0.02, route=bend, dt_out=1e-3)
+        compile_kernels()  # compile now (or load the cache), each engine called once, along a route too
     finally:
         accel.HEARTBEAT_S = period
 

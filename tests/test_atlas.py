@@ -170,11 +170,28 @@ def test_report_section_where_the_paper_model_holds(tmp_path):
     assert any(isinstance(b, Image) and b.path == "figures/atlas_safe.png" for b in blocks)
     table = next(b for b in blocks if isinstance(b, Table))
     assert len(table.rows) == 3 * 2  # idealizations x metrics
+    # SALib comes with the package: the indices are computed, and the locks' cost is driven by named parameters
+    assert table.header[-1] == "driven by" and all(" (ST " in row[-1] for row in table.rows[-2:]), table.rows
     verdict = atlas_section.verdict(metrics)
     assert verdict["short"] == "least safe: locking clutches" and "crank revolutions" in verdict["answer"]
     assert "Where the paper's model holds" in to_markdown(blocks)
     # no '|cost|' in the table's header: its bars split the Markdown table's cells
     assert "|cost|" not in to_markdown(blocks) and table.header[2] == "safe share, cost within +-1 %"
+
+
+def test_indices_not_computed_say_why_and_what_adds_them_in_place():
+    """Where the Sobol indices were skipped (SALib removed after the install, designs without a value), the
+    "driven by" answer says so and why, with the command that adds what is missing: never a bare '-'."""
+    from ipir_mujoco.studies.atlas import top_drivers
+    from ipir_mujoco.studies.sensitivity import SALIB_MISSING
+
+    said = top_drivers({"sensitivity": {"skipped": SALIB_MISSING}})
+    assert said.startswith("not computed: needs SALib") and "pip install 'SALib>=1.6,<1.7'" in said
+    assert top_drivers({"sensitivity": {"of": "equations", "skipped": "3 designs gave no value"}}) == \
+        "not computed: 3 designs gave no value"
+    ranked = {"of": "equations", "L": {"S1": 0.5, "S1_conf": 0.1, "ST": 0.9, "ST_conf": 0.1},
+              "m2": {"S1": 0.0, "S1_conf": 0.1, "ST": 0.05, "ST_conf": 0.1}}  # m2's interval includes 0
+    assert top_drivers({"sensitivity": ranked}) == "L (ST 0.90 +- 0.10)"
 
 
 def test_a_folder_another_run_is_writing_is_refused(tmp_path):
@@ -198,9 +215,20 @@ def test_command_prints_one_line_per_idealization_metric_and_threshold(tmp_path,
     out = tmp_path / "cli"
     assert main(["atlas", "--vary", "L=0.1:0.3", "--idealization", "first-order-kinematics", "--threshold", "0.01",
                  "--threshold", "0.02", "--samples", "2", "--budget", "0", "--workers", "1", "--out", str(out)]) == 0
-    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("first-order-kinematics")]
+    printed, said = capsys.readouterr()
+    lines = [ln for ln in printed.splitlines() if ln.startswith("first-order-kinematics")]
     assert len(lines) == 2 * 2  # metrics (revolutions, travel_m) x thresholds
     saved = json.loads((out / "atlas.json").read_text())["idealizations"]["first-order-kinematics"]
+    # one count of designs, its runs twice it (idealized and real), the same on stderr's start line, each line and
+    # the last; one worker, singular; every file with its folder
+    designs = saved["revolutions"]["runs"] // 2
+    assert all(f"; {designs} designs ({2 * designs} runs of the equations: each idealized and real)" in line
+               for line in lines)
+    assert f"  {designs} designs of the equations ({2 * designs} runs), 0 of MuJoCo (0 runs) in " in printed
+    assert printed.count("(1 worker)") == 1 and "workers)" not in printed
+    # Saltelli's 2 x (1 + 2) points in 1-D: A, B and AB (= B, one parameter), 4 distinct designs
+    assert "the sample's 4 designs (Saltelli's 6 points, some the same)" in said
+    assert f"  files: {out}/atlas.json, {out}/samples.csv, {out}/" in printed
     for line, (metric, k) in zip(lines, [(m, k) for m in ("revolutions", "travel_m") for k in (0, 1)]):
         item = saved[metric]["by_threshold"][k]
         assert metric in line and f"safe in {100 * item['safe_fraction']:.1f} %" in line

@@ -120,6 +120,23 @@ def test_every_subcommand_has_help(capsys):
     assert "NAME=VALUE" in capsys.readouterr().out
 
 
+def test_help_and_params_start_without_the_numerics(tmp_path):
+    """`--help` (the command list, every subcommand's parser built), `params` and a subcommand's --help load
+    neither numpy nor the engines: the start-up a user waits for most often is the interpreter and the parsers
+    (bench/startup.py times it against `python -c "import numpy"`). Each in a fresh interpreter. Of the MuJoCo
+    engine only the model kinds' declarations may load (``engine/kinds``' package modules: their names and
+    variants, which the registry lists); nothing that builds, steps or runs a model."""
+    heavy = ("numpy", "scipy", "matplotlib", "mujoco", "numba", "ipir_mujoco.analytic", "ipir_mujoco.engine.run",
+             "ipir_mujoco.engine.loop", "ipir_mujoco.engine.builders", "ipir_mujoco.engine.kinds.common",
+             "ipir_mujoco.engine.kinds.timestep")
+    for argv in (["--help"], ["params"], ["params", "--json"], ["sweep", "--help"], ["atlas", "--help"]):
+        code = ("import sys; from ipir_mujoco.cli import main\n"
+                f"try:\n    main({argv!r})\nexcept SystemExit:\n    pass\n"
+                f"print(sorted(m for m in {heavy!r} if m in sys.modules), file=sys.stderr)")
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+        assert done.returncode == 0 and done.stdout and done.stderr.strip() == "[]", (argv, done.stderr)
+
+
 def test_params_lists_every_parameter_with_unit_default_and_range(capsys):
     from ipir_mujoco.core.params import PARAMETER_NAMES
 
@@ -207,3 +224,46 @@ def test_the_text_summary_prints_no_negative_zero_and_no_round_off_terms():
     text = format_summary(RunResult("mujoco", "exact", "unilateral", RobotParams(), 1.0, series, energy))
     assert "-0.0" not in text and "module 2 (front) moved   0.0000 m   peak speed 0.000 m/s" in text
     assert "clutch dampers" not in text and "clutch springs 0.25" in text
+
+
+def test_the_accuracy_line_tells_one_story():
+    """A run past a tolerance with 'warn' (a route's wheels): each figure's largest value over the run with its
+    tolerance, and for the one past it when it first crossed and its value there. The two numbers once stood side
+    by side with nothing saying which was which ('energy residual 8.9e-02 of the energy' beside 'OUT OF
+    TOLERANCE: residual_ratio 0.00199')."""
+    from ipir_mujoco.cli.simulate import accuracy_line
+
+    record = {"residual_ratio": 0.089, "loop_gap_m": 2e-6, "worst_at_s": {"residual_ratio": 3.1, "loop_gap_m": 0.4},
+              "tolerances": {"residual_ratio": 1e-3, "loop_gap_m": 5e-5, "excursion_m": 1e-5}, "ok": False,
+              "violations": [{"figure": "residual_ratio", "value": 0.00199, "tolerance": 1e-3, "t_s": 0.52}]}
+    line = accuracy_line(record)
+    assert line == ("  accuracy: energy residual at most 0.089 of the energy put through (at t=3.1 s), tolerance 0.001; "
+                    "loop gap at most 2e-06 m (at t=0.4 s), tolerance 5e-05\n"
+                    "  OUT OF TOLERANCE: energy residual first past its 0.001 at t=0.52 s (0.00199 there)")
+    assert "OUT OF" not in accuracy_line({**record, "ok": True, "violations": []})
+
+
+def test_every_file_a_command_names_carries_its_folder(tmp_path, capsys):
+    """'files: fit/calibration.json, posterior.toml' named posterior.toml without the folder it is in."""
+    from ipir_mujoco.cli.common import files_line
+
+    assert files_line("fit", "calibration.json", "posterior.toml", "fit/calibration.png") == \
+        "fit/calibration.json, fit/posterior.toml, fit/calibration.png"
+    code, out, _ = run_cli(capsys, "simulate", "--t-end", "0.05", "--out", tmp_path / "run")
+    named = out.splitlines()[-1].split("wrote ", 1)[1].split(", ")
+    assert code == 0 and len(named) == 6 and all((tmp_path / "run" / Path(n).name).is_file() and
+                                                  Path(n).parent == tmp_path / "run" for n in named)
+
+
+def test_help_texts_say_what_the_models_are(capsys):
+    """simulate's --help calls the wheeled model what it is (a 3-D robot in its round pipe, not 'free in the
+    plane'); no help prints a doubled percent sign (argparse does not %-format descriptions)."""
+    for command in ("simulate", "sensitivity", "uncertainty", "calibrate"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        assert "%%" not in text and "free in the plane" not in text
+        if command == "simulate":
+            assert "wheels = the robot in 3-D in its round pipe" in text
+        if command in ("uncertainty", "calibrate"):
+            assert "DIR/samples.csv" in text or "DIR/posterior.toml" in text

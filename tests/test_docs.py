@@ -68,3 +68,13 @@ def test_every_model_variant_and_alias_is_documented():
     section = CLI.split("## Model variants: one name per model")[1].split("\n## ")[0]
     for name in (*registry.NAMES, *registry.ALIASES):
         assert f"`{name}`" in section, name
+
+
+def test_the_docs_import_robotparams_one_way():
+    """README and docs/ import the parameter set as the package's public name, one way (not from
+    ipir_mujoco.analytic here and ipir_mujoco.core.params there)."""
+    root = Path(__file__).resolve().parent.parent
+    imports = [line.strip() for page in [root / "README.md", *sorted((root / "docs").glob("*.md"))]
+               for line in page.read_text().splitlines()
+               if "import" in line and "RobotParams" in line and line.strip().startswith(("from ", "import "))]
+    assert imports and all(line.startswith("from ipir_mujoco import ") for line in imports), imports

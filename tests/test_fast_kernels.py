@@ -240,6 +240,7 @@ def test_compiling_is_announced_once_in_one_line_where_it_compiles(tmp_path, mon
     monkeypatch.setattr(accel.log, "level", logging.INFO)
     monkeypatch.setattr(accel, "HEARTBEAT_S", 0.01)  # the heartbeat's period, shortened
     monkeypatch.setattr(accel, "HEARTBEAT_MAX", 10**9)  # and no cap on its lines, whatever the load
+    monkeypatch.setattr(accel, "QUIET_S", 0.01)  # and the quiet that says compiling has ended
 
     def logged(text: str) -> bool:  # wait (up to 60 s, the heartbeat thread's turn) for a line holding text
         for _ in range(6000):

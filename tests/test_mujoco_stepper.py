@@ -473,3 +473,28 @@ def test_friction_off_the_slides_is_refused(tmp_path):
                                     '<joint name="crank_hinge" class="linkage" frictionloss="0.01"/>'))
     with pytest.raises(ParameterError, match=r"^frictionloss on 'crank_hinge' in the MJCF model: .* allowed: "):
         simulate_mujoco(RobotParams(), "unilateral", "ratchet", 0.01, mjcf=path)
+
+
+@pytest.mark.parametrize("name", ["ratchet", "locks, paper's rule", "stall", "grip, stall",
+                                  "compliant grip, damped, play"])
+def test_a_run_stepped_in_parts_of_a_block_is_the_same_run(monkeypatch, name):
+    """A block whose steps take long is stepped in parts, its progress reported between them (so that a slow run's
+    status line moves every second): the parts change nothing. Every part one sample (the finest split; how it is
+    split depends on the machine's speed) gives the block-at-once run's numbers bit for bit, its stall included,
+    and calls the progress between the parts (PROGRESS_WALL_S at 0: at every sample) but never past t_end."""
+    from ipir_mujoco.engine.run import block_checks
+    from ipir_mujoco.engine.run import simulate as run_module
+
+    params, rule, implementation, t_end, options = DESIGNS[name]
+    options = {"dt_out": 1e-3, **options}
+    whole = simulate_mujoco(params, rule, implementation, t_end, **options)
+    monkeypatch.setattr(run_module, "chunk_after", lambda chunk, block, recorded, wall: 1)
+    monkeypatch.setattr(block_checks, "PROGRESS_WALL_S", 0.0)
+    said = []
+    parts = simulate_mujoco(params, rule, implementation, t_end, progress=said.append, **options)
+    for column, values in whole.series.items():
+        np.testing.assert_array_equal(parts.series[column], values, err_msg=column)
+    assert parts.energy == whole.energy and parts.accuracy == whole.accuracy and parts.stall == whole.stall
+    # a report per sample of the run after its first block (stepped whole: no rate measured yet; 50 samples at
+    # dt_out 1 ms), in order
+    assert len(said) >= len(whole.series["t"]) - 51 and said == sorted(said) and said[-1] <= whole.t_end

@@ -150,6 +150,9 @@ def test_package_metadata():
     # the Dask scheduler is its own extra; the test extra pulls it in only for the Dask test of sweep
     assert any(r.startswith("dask[distributed]") for r in extras["dask"])
     assert "ipir-mujoco[dask]" in extras["test"] and not any(r.startswith("dask") for r in extras["test"])
+    # what the validation report and the atlas use is installed by the README's plain `pip install .`: SALib
+    # (their Sobol indices, the report's "driven by" column), unconditionally
+    assert any(r.startswith("SALib>=") and ";" not in r for r in project["dependencies"])
 
 
 def _printed_text(path: Path) -> list[str]:

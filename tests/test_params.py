@@ -156,3 +156,55 @@ def test_config_file_that_is_not_utf8_or_is_a_folder_is_refused_in_one_line(tmp_
         load_params(path)
     with pytest.raises(ParameterError, match="is a folder"):
         load_params(tmp_path)
+
+
+# (parameter, a value other than its default, a drive that does not use it, the drives the message names)
+IDLE = [("M_stall", 0.3, "torque", ("motor", "servo")), ("omega_noload", 40.0, "torque", ("motor", "servo")),
+        ("M", 0.3, "motor", ("torque",)), ("M", 0.3, "servo", ("torque",)),
+        ("omega_target", 5.0, "motor", ("servo",)), ("speed_kp", 0.1, "torque", ("servo",))]
+
+
+@pytest.mark.parametrize("name, value, drive, users", IDLE)
+def test_a_parameter_the_drive_does_not_use_is_refused_by_every_interface(tmp_path, capsys, name, value, drive,
+                                                                            users):
+    """`--set M_stall=0.3` under the paper's constant torque once ran the constant torque and said nothing: every
+    interface (the command line's --set, a TOML file, the Python run, a sweep varying it) refuses it in one line
+    naming the drives that use it, before any work; with such a drive it runs."""
+    from cli_run import run_cli
+
+    from ipir_mujoco import run
+    from ipir_mujoco.studies.sweep_space import Study, parse_vary
+
+    def said(text: str) -> bool:
+        return (f"{name}" in text and " or ".join(f"drive={d}" for d in users) + " uses" in text
+                and f"the drive here is '{drive}'" in text and f"--drive {users[0]}" in text)
+
+    config = tmp_path / "p.toml"
+    config.write_text(f'drive = "{drive}"\n{name} = {value}\n')
+    for argv in (["--drive", drive, "--set", f"{name}={value}"], ["--config", str(config)]):
+        code, out, err = run_cli(capsys, "simulate", "--t-end", "0.01", *argv)
+        assert code == 2 and out == "" and err.count("\n") == 1 and said(err), err
+    for variant in ("analytic-approx", "mujoco-ratchet"):
+        with pytest.raises(ParameterError) as refused:
+            run(variant, RobotParams(drive=drive, **{name: value}), 0.01)
+        assert said(str(refused.value))
+    with pytest.raises(ParameterError) as refused:
+        Study((parse_vary(f"{name}={value},{2 * value}"),), RobotParams(drive=drive))
+    assert said(str(refused.value)) and f"{name} (varied)" in str(refused.value)
+    code, _, err = run_cli(capsys, "simulate", "--t-end", "0.01", "--drive", users[0], "--set", f"{name}={value}")
+    assert code == 0, err
+
+
+def test_naming_the_drive_returns_what_it_does_not_use_to_the_defaults():
+    """replace(drive=...) (the studies' motor and torque cases of one design) drops every drive's parameter the
+    named drive does not act through: a run would refuse it. What it uses, or what is given, stays."""
+    defaults = RobotParams()
+    same = RobotParams(M=0.3, M_stall=0.8).replace(drive="torque")  # the torque case of a design given both
+    assert (same.M, same.M_stall) == (0.3, defaults.M_stall)
+    motor = RobotParams(M=0.3).replace(drive="motor")
+    assert (motor.drive, motor.M) == ("motor", defaults.M)
+    torque = RobotParams(drive="servo", M_stall=0.9, omega_target=5.0).replace(drive="torque")
+    assert (torque.M_stall, torque.omega_target) == (defaults.M_stall, defaults.omega_target)
+    kept = RobotParams(drive="servo", M_stall=0.9, omega_target=5.0).replace(drive="motor")
+    assert (kept.M_stall, kept.omega_target) == (0.9, defaults.omega_target)
+    assert RobotParams(M=0.3).replace(drive="motor", M=0.4).M == 0.4  # given: kept, and refused by a run

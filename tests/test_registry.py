@@ -42,7 +42,8 @@ def test_aliases_name_the_same_variants_and_unknown_names_are_one_line():
     assert registry.variant("mujoco-lock-kinematic").name == "mujoco-lock"
     for alias, name in registry.ALIASES.items():
         assert registry.variant(alias) is registry.VARIANTS[name]
-    with pytest.raises(ParameterError, match="^engine 'mujoco-slides' is unknown; allowed: analytic-approx, "):
+    with pytest.raises(ParameterError, match=r"^variant 'mujoco-slides' is unknown \(a model in an engine, "
+                                             r"ENGINE-MODEL\[-RULE\]\); allowed: analytic-approx, "):
         registry.variant("mujoco-slides")
 
 

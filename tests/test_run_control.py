@@ -90,7 +90,7 @@ def test_a_long_step_says_it_is_still_running_until_it_ends():
 
 
 @pytest.mark.parametrize("t_end", [60.0, 1.0])  # a route's cap (tenths and wall lines), a short run (wall only)
-def test_a_long_run_in_a_log_says_where_it_is_after_2_s_then_every_10_s(t_end, monkeypatch, capsys):
+def test_a_long_run_in_a_log_says_where_it_is_after_2_s_then_every_5_s(t_end, monkeypatch, capsys):
     """cli.common.progress_printer in a log file (stderr not a terminal), on a made-up clock: nothing while the
     run is younger than FIRST_WALL_S, a line at it, then one each WALL_EVERY_S (a run finished sooner is silent)."""
     import time
@@ -101,11 +101,11 @@ def test_a_long_run_in_a_log_says_where_it_is_after_2_s_then_every_10_s(t_end, m
     monkeypatch.setattr(time, "monotonic", lambda: clock[0])
     report = common.progress_printer(t_end)
     printed = []
-    for wall, simulated in [(1.9, 0.01), (2.0, 0.02), (11.9, 0.03), (12.0, 0.04), (15.0, 0.05)]:
+    for wall, simulated in [(1.9, 0.01), (2.0, 0.02), (6.9, 0.03), (7.0, 0.04), (10.0, 0.05)]:
         clock[0] = 100.0 + wall
         report(simulated)
         printed += capsys.readouterr().err.splitlines()
-    assert common.FIRST_WALL_S == 2.0 and common.WALL_EVERY_S == 10.0  # the times above are these
+    assert common.FIRST_WALL_S == 2.0 and common.WALL_EVERY_S == 5.0  # the times above are these
     assert printed == [f"simulated 0.02 / {t_end:g} s", f"simulated 0.04 / {t_end:g} s"]
 
 
@@ -128,7 +128,7 @@ def test_a_run_repeated_at_a_finer_step_goes_on_saying_where_it_is(monkeypatch, 
         clock[0] = 100.0 + wall
         passes(simulated)
     passes.begin(2.5e-5)  # the skid check's repeat from t = 0
-    for wall, simulated in [(12.0, 0.4), (17.0, 0.9), (22.0, 1.5), (60.0, 3.0), (71.0, 3.2)]:
+    for wall, simulated in [(9.0, 0.4), (11.5, 0.9), (14.0, 1.5), (33.0, 3.0), (38.5, 3.2)]:
         clock[0] = 100.0 + wall
         passes(simulated)
     printed = capsys.readouterr().err.splitlines()
@@ -136,7 +136,7 @@ def test_a_run_repeated_at_a_finer_step_goes_on_saying_where_it_is(monkeypatch, 
     again = [line for line in printed if "again" in line]
     assert printed[:2] == ["simulated 2.50 / 5 s", "simulated 3.07 / 5 s"]
     # the first attempt's tenths printed at 3 and 6 s of wall time; then wall lines only (the time reported stays
-    # in its sixth tenth): at 17 s (11 s after the last line; 12 s was 6 s after), 60 and 71 s, none at 22 s
+    # in its sixth tenth): at 11.5 s (5.5 s after the last line; 9 s was 3 s after), 33 and 38.5 s, none at 14 s
     assert again == ["simulated 0.90 / 5 s again, at a 2.5e-05 s step (attempt 2: the accuracy check)",
                      "simulated 3.00 / 5 s again, at a 2.5e-05 s step (attempt 2: the accuracy check)",
                      "simulated 3.20 / 5 s again, at a 2.5e-05 s step (attempt 2: the accuracy check)"]

@@ -401,3 +401,94 @@ def test_the_camera_along_a_route_looks_square_to_its_plane():
     up = route_from_tables([BEND[0], dict(BEND[1], plane=90.0), dict(kind="straight", length=0.3)])
     azimuth, elevation = route_view(up)  # from -y, looking along +y: +x to the right, +z up
     assert abs(azimuth - 90.0) < 1e-6 and abs(elevation) < 1e-6
+
+
+def test_every_drawing_clips_nothing_near_the_camera():
+    """Without OpenGL: MuJoCo clips what is nearer the camera than znear x extent and farther than zfar x extent.
+    In every drawing model (render's and the viewer's, the slides and the wheels, without and along a route) the
+    near plane stands within 2 cm of the camera, far inside the robot's 0.5 m and a route's 0.9 m view distance,
+    and the far plane beyond 10 m. (The wheeled model's 2 km straight wall once made the extent 2000 m: its near
+    plane stood 20 m out, and every frame without a route was black.)"""
+    from ipir_mujoco.core.route import route_from_tables
+    from ipir_mujoco.video import _render_model
+    from ipir_mujoco.view import ViewedRobot
+
+    route = route_from_tables(BEND, "bend.toml")
+    models = [_render_model(RobotParams(), VideoSettings(width=96, height=64), model, route)
+              for model, route in (("slides", None), ("wheels", None), ("wheels", route))]
+    models += [ViewedRobot(RobotParams(), model=model).model for model in ("slides", "wheels")]
+    for model in models:
+        near, far = (float(model.vis.map.znear * model.stat.extent), float(model.vis.map.zfar * model.stat.extent))
+        assert near <= 0.02 and far >= 10.0, (near, far)
+
+
+@pytest.fixture(scope="module")
+def wheels_run():
+    from ipir_mujoco import registry
+
+    # 0.04 s from rest of the wheeled model in its straight pipe, no route (the case once drawn black)
+    return registry.run("mujoco-wheels", RobotParams(), 0.04, dt_out=1e-3)
+
+
+def _pixel_of(point, lookat, distance: float, azimuth: float, elevation: float, fovy: float, size) -> tuple:
+    """(row, column) of the pixel where a MuJoCo free camera (looking at ``lookat`` from ``distance`` [m] at
+    ``azimuth``, ``elevation`` [deg], vertical field of view ``fovy`` [deg]) draws the world point ``point``, in a
+    frame of ``size`` (height, width) px, top row first: a pinhole projection, z up."""
+    from ipir_mujoco.video import view_direction
+
+    forward = view_direction(azimuth, elevation)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    d = np.asarray(point) - (np.asarray(lookat) - distance * forward)
+    scale = 0.5 * size[0] / math.tan(math.radians(fovy) / 2)
+    return (round(0.5 * size[0] - scale * (d @ up) / (d @ forward)),
+            round(0.5 * size[1] + scale * (d @ right) / (d @ forward)))
+
+
+@pytest.mark.slow
+def test_a_wheeled_run_without_a_route_is_drawn_in_its_pipe(wheels_run):
+    """The first frame of the wheeled robot in its straight pipe is a picture, not a black frame: nine tenths of
+    its pixels are lit (the floor, the pipe, the robot; the frame once was all black but its text), and at each
+    module's housing, where the camera's projection puts it, the pixel is the housing's colour (green where its
+    clutch holds, grey-blue where not): the robot is where it is. 256 x 144 px: no text drawn over it."""
+    _require_gl()
+    import mujoco
+
+    from ipir_mujoco.replay import replay_for
+    from ipir_mujoco.video import HOUSINGS, SIDE_VIEW, _held, _render_model, render_frames
+
+    settings = VideoSettings(width=256, height=144, fps=10.0, speed=0.1)
+    frame = next(iter(render_frames(wheels_run, settings, t_end=0.0))).astype(int)
+    lit = frame.sum(axis=2) > 3 * 40  # brighter than a dark grey in every channel on average
+    assert lit.mean() > 0.9, lit.mean()
+    model = _render_model(wheels_run.params, settings, "wheels")
+    data = mujoco.MjData(model)
+    replay = replay_for(model, wheels_run)
+    replay.pose(data, 0.0)
+    lookat = replay.lookat(data)
+    for name, held in zip(HOUSINGS, _held(int(wheels_run.series["mode"][0]))):
+        row, column = _pixel_of(data.geom_xpos[model.geom(name).id], lookat, 0.5, *SIDE_VIEW,
+                                float(model.vis.global_.fovy), frame.shape[:2])
+        r, g, b = frame[row, column]
+        assert (g > r + 40 and g > b + 20) if held else (b > r + 20 and b > g), (name, held, (r, g, b))
+
+
+@pytest.mark.slow
+def test_the_reports_animation_shows_the_wheeled_robot_at_a_readable_size(wheels_run, tmp_path):
+    """The validation report animates the ladder's last rung, the robot on wheels in its pipe, at 640 px or more
+    (--quick; 768 px in full), and says so in its caption."""
+    _require_gl()
+    from PIL import Image
+
+    from ipir_mujoco.report.validation import ANIMATION, _mechanism_section, write_animation
+    from ipir_mujoco.studies.validate import LadderRun
+
+    note, settings = write_animation(LadderRun("wheels in contact", "", wheels_run), tmp_path / "robot.gif", True)
+    assert note is None and settings["model"] == "wheels" and ANIMATION["width"] >= 768
+    with Image.open(tmp_path / "robot.gif") as gif:
+        assert gif.size[0] >= 640
+        gif.seek(gif.n_frames - 1)
+        assert (np.asarray(gif.convert("RGB"), dtype=int).sum(axis=2) > 120).mean() > 0.9
+    caption = _mechanism_section({"mechanism.png": "m.png", "robot.gif": "r.gif"}, None, settings)[-1].caption
+    assert "on wheels in its pipe" in caption and "--mujoco-model wheels" in caption

@@ -27,6 +27,7 @@ try:
 
     from .. import __version__
     from ..resources import shipped
+    from .. import terminal
     from . import (bend_study, calibrate, climb, clutch_study, compare, control_study, kinetostatics, optimize,
                    params, render, sensitivity, simulate, sweep, uncertainty, validate)
     from . import atlas
@@ -88,7 +89,8 @@ def _command(argv: Sequence[str] | None) -> int:
         prefix = f"ipir-mujoco {args.command}"
         notes = _show_notes(prefix)
         try:
-            return args.handler(args)
+            with terminal.command():
+                return args.handler(args)
         except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
             if args.debug or isinstance(exc, SystemExit):
                 raise
@@ -122,12 +124,23 @@ def _show_notes(prefix: str) -> logging.Handler:
     """What the package says while it works (logger 'ipir_mujoco' at INFO, e.g. that the analytic kernels
     compile once, the first time a machine runs them long enough) goes to stderr as one line each, with the
     command's name; returns the handler, to remove when the command ends."""
-    handler = logging.StreamHandler(sys.stderr)
+    handler = _Notes()
     handler.setFormatter(logging.Formatter(f"{prefix}: %(message)s"))
     logger = logging.getLogger("ipir_mujoco")
     logger.addHandler(handler)
     logger.setLevel(logging.INFO)
     return handler
+
+
+class _Notes(logging.Handler):
+    """The package's notes on stderr, a record marked ``status`` (the compile's "still compiling") as the status
+    line (:mod:`ipir_mujoco.terminal`: in place on a terminal, every 5 s in a log)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            terminal.say(self.format(record), status=bool(getattr(record, "status", False)))
+        except Exception:  # noqa: BLE001 (logging's rule: a note that cannot be written is dropped)
+            self.handleError(record)
 
 
 def _describe_failure(exc: BaseException) -> tuple[int, str]:

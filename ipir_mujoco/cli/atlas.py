@@ -7,7 +7,7 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params, study_progress
+from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params, study_progress
 
 
 def add_parser(commands) -> None:
@@ -67,19 +67,22 @@ def atlas_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report.atlas_plots import plot_atlas
-    from ..studies.atlas import run_atlas
-
     atlas = atlas_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    compile_first()  # before the pool: compiled once, said at once
+    from ..report.atlas_plots import plot_atlas
+    from ..studies.atlas import run_atlas
+
     result = run_atlas(atlas, args.out, resume=args.resume, workers=args.workers, progress=study_progress("atlas"))
     figures = plot_atlas(result, atlas, args.out)
     for line in summary_lines(result, atlas):
         print(line)
-    print(f"  {result['runs']['equations']} equation runs, {result['runs']['mujoco']} MuJoCo runs in "
-          f"{result['wall_s']:.1f} s ({result['workers']} workers)")
-    print(f"  files: {args.out}/atlas.json, {args.out}/samples.csv, " + ", ".join(str(f) for f in figures))
+    runs = result["runs"]
+    print(f"  {runs['equations'] // 2} designs of the equations ({runs['equations']} runs), {runs['mujoco'] // 2} of "
+          f"MuJoCo ({runs['mujoco']} runs) in {result['wall_s']:.1f} s ({result['workers']} worker"
+          f"{'s' if result['workers'] != 1 else ''})")
+    print(f"  files: {files_line(args.out, 'atlas.json', 'samples.csv', *figures)}")
     sys.stdout.flush()
     return EXIT_OK
 
@@ -100,9 +103,10 @@ def summary_lines(result: dict, atlas) -> list[str]:
                     cross = "; crossings " + (", ".join(f"{param}={v:.5g} [{lo:.5g}, {hi:.5g}]" for v, lo, hi in values)
                                               or "none")
                 regions = item.get("runs_by_region")
-                spent = (f"; {entry['runs']} {entry['measured_by']} runs"
-                         + (f" (safe {regions['safe']}, unsafe {regions['unsafe']}, boundary {regions['boundary']})"
-                            if regions else ""))
+                by = "MuJoCo" if entry["measured_by"] == "mujoco" else "the equations"
+                spent = (f"; {entry['runs'] // 2} designs ({entry['runs']} runs of {by}: each idealized and real)"
+                         + (f" (safe {regions['safe'] // 2}, unsafe {regions['unsafe'] // 2}, boundary "
+                            f"{regions['boundary'] // 2})" if regions else ""))
                 if entry.get("missing"):
                     spent += f"; {entry['missing']} designs gave no value (samples.csv: notes, error)"
                 equations = entry.get("equations")

@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
 
     progress = study_progress("bend-study")
     progress(f"{len(ratios) * len(planes)} bends and {len(ratios)} straight twins on {workers} processes (a line "
-             "per finished run, and every 10 s of a running one)")
+             "per finished run, and every 5 s of a running one)")
     study = bs.run_study(params, ratios, workers=workers, progress=progress, planes=planes)
     write_study_files(args.out, FILES, study, write_csv, lambda path: write_bend_figure(study, path),
                       format_table(study), f"{len(study['rows'])} bends")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_OK, add_model_options, check_input_file, model_params, study_progress
+from .common import (EXIT_OK, add_model_options, check_input_file, compile_first, files_line, model_params,
+                     study_progress)
 
 
 def add_parser(commands) -> None:
@@ -14,7 +15,7 @@ def add_parser(commands) -> None:
         description="Fit the --fit parameters within their ranges so that the model's run matches the measured "
                     "columns (least squares, each column weighed by its noise), with 95 % confidence intervals, "
                     "their correlation, and a warning for a parameter the data cannot identify. Writes "
-                    "DIR/calibration.json, posterior.toml (for 'uncertainty --dist-file'), calibration.png "
+                    "DIR/calibration.json, DIR/posterior.toml (for 'uncertainty --dist-file'), DIR/calibration.png "
                     "(docs/uncertainty.md).")
     cal.add_argument("--data", required=True, metavar="FILE.csv",
                      help="the measured run: a header row with t [s] and any of x1 x2 [m], phi [rad], omega [rad/s], "
@@ -38,10 +39,11 @@ def run(args: argparse.Namespace) -> int:
     fits = [parse_fit(f) for f in args.fit]
     base = model_params(args)
     measured = read_measured(args.data)
+    compile_first((args.engine,))
     result = calibrate(measured, fits, base=base, engine=args.engine, progress=study_progress("calibrate"))
     figure = write_files(args.out, result, measured)
     print(format_result(result))
-    print(f"  files: {args.out}/calibration.json, posterior.toml, {figure}")
+    print(f"  files: {files_line(args.out, 'calibration.json', 'posterior.toml', figure)}")
     for name in result["not_identifiable"]:
         print(f"ipir-mujoco calibrate: warning: {name} is not identifiable from these data (its interval spans its "
               "fit range, or a direction of the parameters leaves the fit unchanged); its value is not a measurement",

@@ -9,12 +9,12 @@ from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import check_run_options
+from ipir_mujoco.core.limits import check_run_options
 from ipir_mujoco.core.params import check_real
 
 from ..labels import significant
 from ..output import check_output_dir
-from .common import EXIT_OK, add_model_options, model_params, study_progress, write_study_files
+from .common import EXIT_OK, add_model_options, compile_first, model_params, study_progress, write_study_files
 
 FILES = ("climb.csv", "climb.json", "climb.png")
 KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
@@ -86,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
     t_end = climbing.default_t_end(params) if args.t_end is None else args.t_end
     check_run_options(t_end, climbing.DT_OUT)
     check_output_dir(args.out, files=FILES)
+    compile_first(engines)
 
     study = climbing.climb_study(params, inclines, engines, tolerance, t_end, study_progress("climb"))
     write_study_files(args.out, FILES, study, write_csv, lambda path: write_figure(study, params, path),

@@ -12,7 +12,7 @@ from ipir_mujoco.core.params import check_whole
 
 from ..labels import significant
 from ..output import check_output_dir
-from .common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
+from .common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
 
 FILES = ("clutch_study.csv", "clutch_study.json", "clutch_study.png")
 
@@ -59,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
     designs = [(k, b) for k in stiffness for b in backlash]
     cs.plan(base, designs, points)  # every value checked before anything is written or run
     check_output_dir(args.out, files=FILES)
+    compile_first()  # before the pool: compiled once, said at once
 
     study = cs.run_study(base, designs=designs, points=points, workers=args.workers,
                          progress=study_progress("clutch-study"))

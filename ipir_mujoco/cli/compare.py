@@ -12,7 +12,7 @@ from .common import EXIT_OK
 
 
 def add_parser(commands) -> None:
-    cmp_ = commands.add_parser("compare", help="compare two runs written by 'simulate --out'",
+    cmp_ = commands.add_parser("compare", help="compare two runs written by 'simulate --out', or a measured run (CSV) against one",
                                description="Compare run B against run A: summary figures, RMS and largest "
                                            "differences at matching time and at matching crank angle, mode "
                                            "switches matched one by one, and when a tolerance is first exceeded.")

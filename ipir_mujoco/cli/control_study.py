@@ -13,7 +13,7 @@ from ipir_mujoco.core.params import check_real, check_whole
 
 from ..labels import significant
 from ..output import check_output_dir
-from .common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
+from .common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
 
 FILES = ("control_study.csv", "control_study.json", "control_study.png")
 METRICS = ("mean_omega_rad_s", "speed_ripple", "peak_clutch_force_n", "peak_module_accel_m_s2",
@@ -74,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
         check_whole("workers", args.workers, low=1, high=1024)
     cs.check_speeds(base, speeds, dips, profile_speed)  # every value checked before anything is written or run
     check_output_dir(args.out, files=FILES)
+    compile_first()  # before the pool: compiled once, said at once
 
     study = cs.run_study(base, speeds, dips, profile_speed, workers=args.workers,
                          progress=study_progress("control-study"))

@@ -7,13 +7,12 @@ import math
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import MAX_T_END, check_run_options
+from ipir_mujoco.core.limits import MAX_T_END, check_run_options
 from ipir_mujoco.core.params import check_real, read_text_file
-from ipir_mujoco.core.results import write_json
 
 from ..labels import signed
 from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, check_input_file, model_params, wall_progress
+from .common import EXIT_OK, add_model_options, check_input_file, files_line, model_params, wall_progress
 
 
 def add_parser(commands) -> None:
@@ -32,7 +31,7 @@ def add_parser(commands) -> None:
                      help="kinematic (the paper's rule, default) or unilateral (one-way clutches)")
     add_model_options(kin)
     kin.add_argument("--out", metavar="DIR", default="kinetostatics",
-                     help="writes DIR/kinetostatics.csv and DIR/kinetostatics.png (default ./kinetostatics)")
+                     help="writes DIR/kinetostatics.csv, DIR/kinetostatics.png and DIR/summary.json (default ./kinetostatics)")
     kin.set_defaults(handler=run)
 
 
@@ -77,6 +76,7 @@ MIN_SAMPLES = 4  # rows of --samples: the cubic spline through them needs 4
 
 def run(args: argparse.Namespace) -> int:
     from ipir_mujoco.analytic.inverse import CrankMotion, inverse_kinetostatics
+    from ipir_mujoco.core.results import write_json
 
     from ..report.plots import figure_kinetostatics
 
@@ -116,5 +116,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"  clutch reactions rear {signed(s['lambda1'].min(), 4)} .. {signed(s['lambda1'].max(), 4)} N, "
           f"front {signed(s['lambda2'].min(), 4)} .. {signed(s['lambda2'].max(), 4)} N")
     print(f"  rod force        {signed(s['rod_force'].min(), 4)} .. {signed(s['rod_force'].max(), 4)} N (tension > 0)")
-    print(f"  wrote {args.out}/kinetostatics.csv, kinetostatics.png, summary.json")
+    print(f"  wrote {files_line(args.out, 'kinetostatics.csv', 'kinetostatics.png', 'summary.json')}")
     return EXIT_OK

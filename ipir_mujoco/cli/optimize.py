@@ -7,7 +7,7 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
 from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
@@ -62,6 +62,7 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
+    compile_first((problem.engine,))  # before the pool: compiled once, said at once
     from ..report.optimize_plots import plot_pareto
 
     drawn = []
@@ -85,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
             divs = {k[len("divergence:"):]: v for k, v in item["verify"].items() if k.startswith("divergence:")}
             div = "; divergence " + ", ".join(f"{k} {_fmt(v)}" for k, v in divs.items())
         print(f"  {'best' if 'best' in record else 'front'}: {where}{': ' + objs if objs else ''}{div}")
-    print(f"  files: {args.out}/evaluations.csv, pareto.csv, optimize.json, {figure}")
+    print(f"  files: {files_line(args.out, 'evaluations.csv', 'pareto.csv', 'optimize.json', figure)}")
     for key in record["flat_objectives"]:
         print(f"ipir-mujoco optimize: note: {key} is the same in every feasible design, so the search could not "
               f"tell them apart (a run too short for a whole crank revolution? --t-end is {problem.t_end:g} s)",

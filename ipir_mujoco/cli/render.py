@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ipir_mujoco import registry
+from ipir_mujoco import registry, terminal
 from ipir_mujoco.core.errors import ParameterError
 
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer, tenths_printer
@@ -68,7 +68,10 @@ def run(args: argparse.Namespace) -> int:
     options = {} if route is None else {"route": route}  # the wheeled model's accuracy monitor warns by default
     until = " (or to the route's end)" if route is not None else ""
     print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
-    result = registry.run(variant, params, t_end, progress=progress_printer(t_end), **options)
+    try:
+        result = registry.run(variant, params, t_end, progress=progress_printer(t_end), **options)
+    finally:
+        terminal.end_status()  # a run that ended before its t_end (a route's end) leaves it standing
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \
             f"({variant.mechanism_words})"
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -6,7 +6,7 @@ import argparse
 
 from ipir_mujoco.core.errors import ParameterError
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
 from .design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
@@ -14,7 +14,7 @@ def add_parser(commands) -> None:
     sen = commands.add_parser("sensitivity", help="Sobol sensitivity indices of metrics over parameter ranges",
                               description="Saltelli-sample the box of --vary ranges (SALib), run every design in one "
                                           "engine on all cores, and give each metric's first-order (S1) and total "
-                                          "(ST) Sobol indices with 95 %% confidence intervals.")
+                                          "(ST) Sobol indices with 95 % confidence intervals.")
     sen.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI", help="a parameter range")
     sen.add_argument("--metric", action="append", default=[], metavar="KEY", help="a sweep metric (several allowed)")
     sen.add_argument("--samples", type=int, default=None, metavar="N",
@@ -36,6 +36,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")
     axes = tuple(parse_vary(v) for v in args.vary)
     metrics = tuple(check_key(m, f"--metric {m!r}") for m in args.metric)
+    compile_first((args.engine or "analytic-unilateral",))  # before the pool: compiled once, said at once
     drawn = []
     with scheduler_executor(args.scheduler) as executor:
         indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
@@ -49,5 +50,5 @@ def run(args: argparse.Namespace) -> int:
     for i in indices:
         print(f"  {i['metric']:22s} {i['parameter']:12s} S1 {i['S1']:+.3f} +- {i['S1_conf']:.3f}   "
               f"ST {i['ST']:+.3f} +- {i['ST_conf']:.3f}")
-    print(f"  files: {args.out}/indices.csv, sensitivity.json, evaluations.csv, {figure}")
+    print(f"  files: {files_line(args.out, 'indices.csv', 'sensitivity.json', 'evaluations.csv', figure)}")
     return EXIT_OK

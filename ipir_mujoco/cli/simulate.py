@@ -4,19 +4,22 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
 from ipir_mujoco import registry
 from ipir_mujoco.core import energy
 from ipir_mujoco.core.energy import INPUT, RESIDUAL_KEY
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.options import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
-                                      refuse_steady_without_motor)
+from ipir_mujoco.core.limits import (DEFAULT_WALL_BUDGET_S, check_run_options, check_step_count,
+                                     refuse_steady_without_motor)
 from ipir_mujoco.core.params import check_real, check_whole
-from ipir_mujoco.core.results import RunResult, write_json, write_mode_changes
 
+from .. import terminal
 from ..labels import fixed, significant
-from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer
+from .common import EXIT_OK, add_model_options, check_input_file, files_line, model_params, progress_printer
+
+if TYPE_CHECKING:  # the parser loads without numpy (``ipir-mujoco --help``); a run loads the results with it
+    from ipir_mujoco.core.results import RunResult
 
 
 def add_parser(commands) -> None:
@@ -37,8 +40,9 @@ def add_parser(commands) -> None:
                           "or velocity-triggered lock (default with --clutch kinematic)")
     sim.add_argument("--mujoco-model", choices=registry.MUJOCO_MODELS, default="slides",
                      help="MuJoCo's model of the robot: slides = the modules on slide joints, their resistance joint "
-                          "friction (default); wheels = the modules free in the plane on wheels pressed on the pipe's "
-                          "walls by springs, a ratchet in every hub, friction mu_wall at the contacts (mjcf/README.md)")
+                          "friction (default); wheels = the robot in 3-D in its round pipe (pipe_diameter), each "
+                          "module free to move across it and tilt, on rings of wheel legs pressed on the wall by "
+                          "springs, a ratchet in every hub, friction mu_wall at the contacts (mjcf/README.md)")
     sim.add_argument("--route", metavar="FILE.toml", default=None,
                      help="a pipeline of [[segment]] tables (straights and bends, docs/cli.md), for the exact "
                           "equations (--geometry exact, its default with --route) or --mujoco-model wheels; the run "
@@ -79,6 +83,7 @@ def add_parser(commands) -> None:
 
 
 DT_OUT = 1e-4  # s: the default output interval
+FIGURES = ("fig2_crank.png", "fig3_modules.png", "fig4_gap.png")  # --out's figures (report.plots.write_paper_figures)
 
 
 def output_interval(args: argparse.Namespace) -> float:
@@ -148,6 +153,8 @@ def run_simulation(args: argparse.Namespace) -> RunResult:
         if "budget" in str(exc) and "wall" in str(exc):  # say which option raises it
             raise SimulationError(f"{exc} (--wall-budget {args.wall_budget:g} s; raise it, or 'inf')") from None
         raise
+    finally:
+        terminal.end_status()  # a run that ended before its t_end (steady, a route's end) leaves it standing
 
 
 def _estimate_text(run: RunResult) -> str:
@@ -171,6 +178,7 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
     lines = [
         f"{run.engine} engine, {run.geometry} geometry, {run.clutch} clutches, {run.t_end:g} s "
         f"({run.wall_time_s:.2f} s wall)",
+        f"  drive                    {drive_text(run.params)}",
         f"  crank revolutions        {s['revolutions']:.4f}",
         f"  module 1 (rear) moved    {fixed(s['x1_final'], 4)} m{along}   peak speed {fixed(s['v1_max'], 3)} m/s",
         f"  module 2 (front) moved   {fixed(s['x2_final'], 4)} m{along}   peak speed {fixed(s['v2_max'], 3)} m/s",
@@ -206,11 +214,7 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         lines += route_lines(s)
     accuracy = s.get("accuracy") or {}
     if "loop_gap_m" in accuracy:
-        lines.append(f"  accuracy: energy residual {accuracy['residual_ratio']:.1e} of the energy, loop gap "
-                     f"{accuracy['loop_gap_m']:.1e} m" + ("" if accuracy.get("ok", True) else
-                                                          "   OUT OF TOLERANCE: " + "; ".join(
-                                                              f"{v['figure']} {v['value']:.3g} (tolerance {v['tolerance']:.3g}) at t={v['t_s']:.4g} s"
-                                                              for v in accuracy.get("violations", []))))
+        lines.append(accuracy_line(accuracy))
     if accuracy.get("skid_check") in ("verified", "failed"):  # the run kept is the skid check's finest
         last = (run.settings.get("skid_check") or [{}])[-1]
         error = accuracy.get("skid_difference")
@@ -219,6 +223,41 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
                      f"{last.get('figure')} " + ("n/a" if error is None else f"{error:.2g}")
                      + f" of it, its accuracy {accuracy['tolerances']['skid_difference']:.2g}")
     return "\n".join(lines)
+
+
+# the accuracy monitor's figures in words (engine/loop/monitor.py), for the summary's accuracy line
+FIGURE_WORDS = {"residual_ratio": ("energy residual", "of the energy put through"),
+                "loop_gap_m": ("loop gap", "m"), "excursion_m": ("ratchet excursion", "m")}
+
+
+def accuracy_line(accuracy: dict) -> str:
+    """The MuJoCo monitor's record in one story: each figure's largest value over the run and when (its
+    tolerance beside it), and for a figure past its tolerance when it first crossed it (with 'warn' the run went
+    on, and the largest is what it reached)."""
+    tolerances, at = accuracy.get("tolerances", {}), accuracy.get("worst_at_s", {})
+    parts = []
+    for key in ("residual_ratio", "loop_gap_m"):
+        name, unit = FIGURE_WORDS[key]
+        tol = tolerances.get(key)
+        part = f"{name} at most {abs(accuracy[key]):.2g} {unit}" + (f" (at t={at[key]:.4g} s)" if key in at else "")
+        parts.append(part + (f", tolerance {tol:.2g}" if tol is not None else ""))
+    line = "  accuracy: " + "; ".join(parts)
+    crossed = accuracy.get("violations") or []
+    if not accuracy.get("ok", True) and crossed:
+        line += "\n  OUT OF TOLERANCE: " + "; ".join(
+            f"{FIGURE_WORDS.get(v['figure'], (v['figure'],))[0]} first past its {v['tolerance']:.2g} at "
+            f"t={v['t_s']:.4g} s ({abs(v['value']):.3g} there)" for v in crossed)
+    return line
+
+
+def drive_text(params) -> str:
+    """What turns the crank, in words with the parameters it acts through (core.params.DRIVE_FIELDS)."""
+    motor = f"M_stall {params.M_stall:g} N m, no-load {params.omega_noload:g} rad/s"
+    if params.drive == "torque":
+        return f"constant torque M {params.M:g} N m (the paper's)"
+    if params.drive == "motor":
+        return f"DC gearmotor at full voltage, {motor}"
+    return f"speed controller holding {params.omega_target:g} rad/s, gearmotor {motor}"
 
 
 def wall_lines(s: dict, unlimited_grip: bool = False) -> list[str]:
@@ -289,12 +328,15 @@ def save_run_mjcf(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.core.results import write_json, write_mode_changes
+
+    from ..output import check_output_dir, staged_output
+
     check_options(args)
     # bad parameters are reported before the output folder is looked at
     refuse_steady_without_motor(model_params(args).drive, args.until_steady)
     if args.out is not None:
-        check_output_dir(args.out, files=("timeseries.csv", "mode_changes.csv", "summary.json", "fig2_crank.png",
-                                          "fig3_modules.png", "fig4_gap.png"))
+        check_output_dir(args.out, files=("timeseries.csv", "mode_changes.csv", "summary.json", *FIGURES))
     if args.save_mjcf is not None:
         save_run_mjcf(args)
     result = run_simulation(args)
@@ -312,5 +354,5 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(format_summary(result, args.until_steady))
         if args.out is not None:
-            print(f"  wrote {args.out}/timeseries.csv, mode_changes.csv, summary.json and fig2-4 PNG")
+            print(f"  wrote {files_line(args.out, 'timeseries.csv', 'mode_changes.csv', 'summary.json', *FIGURES)}")
     return EXIT_OK

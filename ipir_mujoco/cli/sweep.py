@@ -6,18 +6,17 @@ import argparse
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.results import write_json
 
 from .. import registry
 from ..labels import significant
 from ..studies.sweep_metrics import METRICS, UNITS
 from ..studies.sweep_space import DEFAULT_VARIANTS, T_END_STEADY
-from .common import EXIT_OK, add_model_options, check_input_file, model_params
+from .common import EXIT_OK, add_model_options, check_input_file, compile_first, model_params
 from .design_runs import add_scheduler_option, scheduler_executor
 
 
 def add_parser(commands) -> None:
-    swp = commands.add_parser("sweep", help="geometry what-if studies over many designs",
+    swp = commands.add_parser("sweep", help="what-if studies: engines over a grid or a sample of designs",
                               description="Vary parameters over a grid, a list or a space-filling sample; run the "
                                           "chosen engines on every design; stream the results to DIR/results.csv "
                                           "and draw them. Ctrl-C keeps what is done; --resume completes it.")
@@ -78,6 +77,8 @@ def study_from_args(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.core.results import write_json
+
     from ..report.sweep_plots import (LARGER_IS_BETTER, best_designs, check_plot_metric, plot_sweep, rankings,
                                       read_results)
     from ..studies.sweep import check_sweep_options, run_sweep
@@ -90,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
     if args.no_batch and args.batch_size is not None:
         raise ParameterError(f"--batch-size {args.batch_size} with --no-batch: the batch size is for mujoco.batch; "
                              "allowed: one of the two")
+    compile_first(study.engines)  # before the pool: compiled once, said at once
     with scheduler_executor(args.scheduler) as executor:
         results = run_sweep(study, args.out, executor=executor, batch_mujoco=False if args.no_batch else None,
                             resume=args.resume, workers=args.workers, timeout_per_design=args.timeout_per_design,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, files_line, model_params
 from .design_runs import add_design_run_options, design_t_end
 
 
@@ -16,7 +16,7 @@ def add_parser(commands) -> None:
                     "standard deviation and 5/50/95 % quantiles with 95 % confidence intervals, and each event's "
                     "probability with its interval. With MuJoCo samples the estimate is multi-fidelity (the "
                     "equations as a control variate of MuJoCo), shown beside MuJoCo's plain Monte Carlo with the "
-                    "variance reduction. Writes DIR/uncertainty.json, samples.csv, uncertainty.png "
+                    "variance reduction. Writes DIR/uncertainty.json, DIR/samples.csv, DIR/uncertainty.png "
                     "(docs/uncertainty.md).")
     unc.add_argument("--dist", action="append", default=[], metavar="NAME=KIND:...",
                      help="an uncertain parameter: NAME=normal:MEAN:SD, uniform:LO:HI, lognormal:MU:SIGMA (of "
@@ -55,13 +55,14 @@ def run(args: argparse.Namespace) -> int:
     dists = combine([parse_dist(d) for d in args.dist], from_file)
     metrics = tuple(dict.fromkeys(check_metric(m) for m in args.metric))
     events = tuple(parse_event(e) for e in args.event)
+    compile_first()  # before the pool: compiled once, said at once (the equations run every sample)
     result = run_uncertainty(dists, metrics, events, base=base, engine=args.engine, samples=args.samples,
                              mujoco_samples=args.mujoco_samples, t_end=design_t_end(args),
                              until_steady=bool(args.until_steady), seed=0 if args.seed is None else args.seed,
                              correlation=correlation, workers=args.workers)
     figure = write_files(args.out, result)
     print(format_result(result))
-    print(f"  files: {args.out}/uncertainty.json, samples.csv, {figure}")
+    print(f"  files: {files_line(args.out, 'uncertainty.json', 'samples.csv', figure)}")
     return EXIT_OK
 
 

@@ -3,12 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
-
-from ipir_mujoco.core.results import write_json
 
 from ..output import check_output_dir, staged_output
-from .common import EXIT_OK, add_model_options, model_params
+from .common import EXIT_OK, add_model_options, compile_first, model_params, study_progress
 
 
 def add_parser(commands) -> None:
@@ -23,16 +20,17 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output_dir(args.out, files=("metrics.json", "index.html", "report.md"), folders=("figures",))
+    params = model_params(args)
+    compile_first()  # before the report's imports (matplotlib): a cold cache is said within a second or two
+
+    from ipir_mujoco.core.results import write_json
+
     from ..report.sections import SECTIONS
     from ..report.validation import write_report
     from ..studies.validate import validate
 
-    check_output_dir(args.out, files=("metrics.json", "index.html", "report.md"), folders=("figures",))
-    params = model_params(args)
-
-    def progress(message: str) -> None:
-        print(f"validate: {message}", file=sys.stderr, flush=True)
-
+    progress = study_progress("validate")
     metrics, rungs = validate(params, quick=args.quick, progress=progress, sections=SECTIONS)
     with staged_output(args.out) as staging:
         write_json(staging / "metrics.json", metrics)

@@ -14,9 +14,16 @@ and the judge between them (:mod:`ipir_mujoco.studies`) import it; it imports ne
 (numpy only), so that sharing it shares no physics.
 """
 
-from .errors import ParameterError, SimulationError
-from .params import PARAMETER_NAMES, RobotParams, load_params, require_params
-from .results import COLUMNS, MODE_NAMES, Mode, RunResult
+# The names below load on first use (PEP 562): importing one light module of the package (core.errors,
+# core.params) does not load numpy with core.results.
+_NAMES = {"ParameterError": "errors", "SimulationError": "errors", "PARAMETER_NAMES": "params",
+          "RobotParams": "params", "load_params": "params", "require_params": "params", "COLUMNS": "results",
+          "MODE_NAMES": "results", "Mode": "results", "RunResult": "results"}
 
 __all__ = ["COLUMNS", "MODE_NAMES", "Mode", "PARAMETER_NAMES", "ParameterError", "RobotParams", "RunResult",
            "SimulationError", "load_params", "require_params"]
+
+
+from .older_paths import lazy_names as _lazy_names  # noqa: E402
+
+__getattr__, __dir__ = _lazy_names(__name__, _NAMES)

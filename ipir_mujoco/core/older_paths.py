@@ -1,4 +1,5 @@
-"""Older import paths: a module that moved or was renamed keeps its older dotted name, as the very same module.
+"""Older import paths: a module that moved or was renamed keeps its older dotted name, as the very same module;
+and a package's names loaded on first use (:func:`lazy_names`).
 
 Users' scripts import modules by the paths they had (``ipir_mujoco.engine.simulate`` from when the engine was one
 folder, ``ipir_mujoco.analytic.unilateral_clutch`` before the analytic model's run loops were named ``*_run``).
@@ -41,3 +42,19 @@ def keep_older_paths(table: dict[str, str]) -> None:
         # first: an older package path (``engine.modelkinds``) is a package now under another name, whose folder
         # the path finder would search for the older path's modules and load a second copy of each
         sys.meta_path.insert(0, _OlderPaths())
+
+
+def lazy_names(package: str, table: dict[str, str]):
+    """A package's ``__getattr__`` and ``__dir__`` (PEP 562) for the names of ``table`` ({name: its submodule,
+    relative to ``package``}): each imported on first use and kept, so that importing the package loads none of
+    them (the command line's parsers and ``--help`` load no numpy through ``ipir_mujoco`` and its ``core``)."""
+    def __getattr__(name: str):
+        if name in table:
+            value = getattr(importlib.import_module(f"{package}.{table[name]}"), name)
+            setattr(sys.modules[package], name, value)
+            return value
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    def __dir__() -> list[str]:
+        return sorted(set(vars(sys.modules[package])) | set(table))
+    return __getattr__, __dir__

@@ -6,7 +6,7 @@ what is allowed. Both models' entry points (:func:`ipir_mujoco.analytic.simulate
 :func:`ipir_mujoco.engine.simulate_mujoco`) build one from their keywords; the registry
 (:mod:`ipir_mujoco.registry`), the command line and the study files reach it through them. What only one
 engine has (the analytic solver's tolerances, MuJoCo's solver settings and clutch choice) is that engine's
-own check.
+own check. The bounds it checks against (:mod:`.limits`, numpy-free) are re-exported here.
 """
 
 from __future__ import annotations
@@ -20,55 +20,9 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL
 from .steady_watch import check_steady_test
 from .errors import ParameterError, ParameterTypeError
-from .params import as_real, check_real, check_whole
-
-MAX_T_END = 3600.0  # s: an hour of simulated motion; a motor reaches its steady state in seconds, and a
-# MuJoCo run at its 1e-4 s step already takes 3.6e7 steps for an hour
-MAX_SAMPLES = 10_000_000  # samples kept per run: ~20 float64 columns -> 1.6 GB in memory, ~4 GB as CSV
-SAMPLE_BYTES = 20 * 8  # bytes per kept sample (about 20 float64 columns)
-MAX_STEPS = 100_000_000  # MuJoCo steps per run: ~7 min at ~4 us a step (bench/ratchet_step.py); the longest
-# run the engine chooses by itself, 3600 s at its 1e-4 s step, is 3.6e7 steps, so only a tiny given timestep
-# with a long t_end reaches it
-DEFAULT_WALL_BUDGET_S = 1800.0  # s of wall time a run may take unless told otherwise: the longest default-step
-# run (3600 s of MuJoCo, ~2.5 min) fits ~10 times over, and no run left alone goes on for hours
-
-
-def check_step_count(t_end: float, timestep: float, t_end_name: str = "t_end",
-                     timestep_name: str = "timestep") -> int:
-    """The MuJoCo step count t_end / timestep (both [s]), or a one-line ParameterError naming both and the
-    allowed maximum MAX_STEPS: bounded up front, so that a run of 1e12 steps is refused, not started."""
-    steps = t_end / timestep
-    if steps > MAX_STEPS:
-        raise ParameterError(
-            f"{t_end_name}={t_end:g} s with {timestep_name}={timestep:g} s would take {steps:.3g} MuJoCo steps "
-            f"(~{steps * 4e-6 / 3600:.3g} h at ~4 us a step); allowed: at most {MAX_STEPS:.0e} steps "
-            f"({timestep_name} >= {t_end / MAX_STEPS:.3g} s for this {t_end_name})")
-    return int(math.ceil(steps))
-
-
-def check_run_options(t_end: Any, dt_out: Any) -> tuple[float, float]:
-    """(t_end [s], dt_out [s]) as floats: 0 < t_end <= MAX_T_END, 0 < dt_out <= t_end, and at most
-    MAX_SAMPLES samples kept (t_end / dt_out + 1), with the size it would need named in the message."""
-    t_end = check_real("t_end", t_end, high=MAX_T_END, unit="s")
-    dt_out = check_real("dt_out", dt_out, unit="s")
-    if dt_out > t_end:
-        raise ParameterError(f"dt_out={dt_out:g} s is out of range; allowed: dt_out <= t_end ({t_end:g} s)")
-    samples = t_end / dt_out + 1
-    if samples > MAX_SAMPLES:
-        raise ParameterError(
-            f"t_end={t_end:g} s with dt_out={dt_out:g} s would keep {samples:.3g} samples "
-            f"(~{samples * SAMPLE_BYTES / 1e9:.3g} GB); allowed: at most {MAX_SAMPLES:.0e} samples "
-            f"(dt_out >= {t_end / (MAX_SAMPLES - 1):.3g} s for this t_end)")
-    return t_end, dt_out
-
-
-def refuse_steady_without_motor(drive: str, until_steady: bool) -> None:
-    """A run asked to stop at its periodic steady state under the constant torque, which has none (the crank
-    speeds up for ever or comes to rest): refused in one line, with what has a steady state."""
-    if until_steady and drive == "torque":
-        raise ParameterError("until_steady with drive=torque: a constant torque has no periodic steady state (the "
-                             "crank speeds up for ever, or comes to rest); allowed: drive=motor or servo (--drive "
-                             "motor), or a run of fixed length without until_steady")
+from .limits import (CLUTCH_RULES, DEFAULT_WALL_BUDGET_S, MAX_SAMPLES, MAX_STEPS, MAX_T_END, SAMPLE_BYTES,  # noqa: F401
+                     check_run_options, check_step_count, refuse_steady_without_motor)  # (re-exported)
+from .params import as_real, check_whole
 
 
 @dataclass(frozen=True)
@@ -189,20 +143,26 @@ def throttled(report: Callable[[float], None], every_s: float = 5.0) -> Callable
     return progress
 
 
-# the clutch rules every engine takes: the paper's (its locks switch by the sign of the gap's rate S_dot) and
-# one-way clutches (they only push)
-CLUTCH_RULES = ("kinematic", "unilateral")
-# s of wall time between two "still running" lines of one long step (and of the compiling analytic kernels')
-HEARTBEAT_S = 10.0
+HEARTBEAT_S = 5.0  # s of wall time between two "still running" lines of one long step (a log's: at least so often)
+LIVE_HEARTBEAT_S = 1.0  # s: the same for a printer that shows them as a terminal's status line (``report.live``)
+
+
+class Status(str):
+    """A progress message that a printer may show as its status line, in place of the last one (a terminal's
+    single line rewritten: "still running (12 s)"), rather than as a line of its own (:mod:`ipir_mujoco.terminal`)."""
 
 
 class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)
-    """``with heartbeat(report, what) as beat:`` a long step says ``"{what}: still running ({s} s)"`` through
-    ``report`` whenever ``every_s`` seconds of wall time pass with no line; the step's own lines go through
-    ``beat.say(message)`` (to ``report``), each restarting that clock, so a step that reports often adds
-    nothing. Silent when it ends sooner. A daemon thread: it never holds up the process's exit."""
+    """``with heartbeat(report, what) as beat:`` a long step says ``"{what}: still running ({s} s)"`` (a
+    :class:`Status`) through ``report`` whenever ``every_s`` seconds of wall time pass with no line (default
+    HEARTBEAT_S, or LIVE_HEARTBEAT_S for a ``report`` whose ``live`` attribute is true: the command line's, which
+    shows it in place on a terminal and every 5 s in a log); the step's own lines go through ``beat.say(message)``
+    (to ``report``), each restarting that clock, so a step that reports often adds nothing. Silent when it ends
+    sooner. A daemon thread: it never holds up the process's exit."""
 
-    def __init__(self, report: Callable[[str], None], what: str, every_s: float = HEARTBEAT_S):
+    def __init__(self, report: Callable[[str], None], what: str, every_s: float | None = None):
+        if every_s is None:
+            every_s = LIVE_HEARTBEAT_S if getattr(report, "live", False) else HEARTBEAT_S
         self.report, self.what, self.every_s = report, what, every_s
 
     def say(self, message: str) -> None:
@@ -221,7 +181,8 @@ class heartbeat:  # noqa: N801 (used as a context manager, like contextlib's)
         def beat() -> None:
             while not self._stop.wait(max(0.0, self._last + self.every_s - time.monotonic())):
                 if time.monotonic() - self._last >= self.every_s:
-                    self.say(f"{self.what}: still running ({time.monotonic() - self._started:.0f} s)")
+                    self._last = time.monotonic()  # a status: the step's own lines are what restarts the clock
+                    self.report(Status(f"{self.what}: still running ({time.monotonic() - self._started:.0f} s)"))
 
         self._thread = threading.Thread(target=beat, name="ipir-heartbeat", daemon=True)
         self._thread.start()

@@ -35,6 +35,11 @@ DRIVES = ("torque", "motor", "servo")
 FEEDFORWARDS = ("none", "paper", "exact")  # drive = servo: the feedforward table's model (core/control.py)
 # the speed controller's parameters: they act only with drive=servo
 SERVO_FIELDS = ("omega_target", "speed_dip", "feedforward", "control_rate", "speed_kp", "speed_ki")
+MOTOR_FIELDS = ("M_stall", "omega_noload")  # the DC gearmotor's: drive=motor, and the servo's motor
+# the parameters each drive acts through; one that no chosen drive uses is refused (refuse_idle_parameters)
+DRIVE_FIELDS = {"torque": ("M",), "motor": MOTOR_FIELDS, "servo": (*MOTOR_FIELDS, *SERVO_FIELDS)}
+_DRIVEN_BY = {"M": "the constant torque", **{n: "the DC gearmotor" for n in MOTOR_FIELDS},
+              **{n: "the speed controller" for n in SERVO_FIELDS}}
 
 
 def _number(units: str, text: str, default: float, low: float, high: float, *, low_open: bool = False,
@@ -220,12 +225,17 @@ class RobotParams:
         return values
 
     def replace(self, **changes: Any) -> "RobotParams":
-        """A copy with some values changed (validated like a new set). A change of ``drive`` away from 'servo'
-        also returns the speed controller's parameters (SERVO_FIELDS) not given in ``changes`` to their
-        defaults: they belong to the servo, and another drive refuses them (:func:`refuse_idle_parameters`)."""
-        if self.drive == "servo" and changes.get("drive", "servo") != "servo":
-            for name in SERVO_FIELDS:
-                changes.setdefault(name, _FIELDS[name].default)
+        """A copy with some values changed (validated like a new set). ``drive`` given (the same or another)
+        also returns every drive's parameter that drive does not act through (DRIVE_FIELDS: M for the constant
+        torque, M_stall and omega_noload for the motor and the servo, the speed controller's SERVO_FIELDS), if not
+        given in ``changes``, to its default: a run would refuse it (:func:`refuse_idle_parameters`). So a study
+        that runs one design under several drives names the drive of each case, and each case keeps what its
+        drive uses."""
+        drive = changes.get("drive")
+        if drive in DRIVE_FIELDS:
+            for name in _DRIVEN_BY:
+                if name not in DRIVE_FIELDS[drive]:
+                    changes.setdefault(name, _FIELDS[name].default)
         return dataclasses.replace(self, **changes)
 
 
@@ -414,17 +424,16 @@ _ACTS_THROUGH = (
 
 def refuse_idle_parameters(params: RobotParams) -> None:
     """Parameters that act only through another one, given without it, refused in one line (never silently
-    ignored), for every engine: the speed controller's (SERVO_FIELDS) need drive=servo; clutch damping and
-    backlash need a clutch with a spring (a finite ``clutch_stiffness``). (The wheels' normal forces F_n1, F_n2
-    are not refused with unlimited grip: they are the wheeled MuJoCo model's leg preload whatever mu_wall is.)"""
+    ignored), for every engine: each drive's own (DRIVE_FIELDS: M for drive=torque, M_stall and omega_noload for
+    drive=motor or servo, the speed controller's for drive=servo) with another drive, the message naming the
+    drives that use it; clutch damping and backlash need a clutch with a spring (a finite ``clutch_stiffness``).
+    (The wheels' normal forces F_n1, F_n2 are not refused with unlimited grip: they are the wheeled MuJoCo
+    model's leg preload whatever mu_wall is.)"""
     defaults = RobotParams()
-    if params.drive != "servo":
-        for name in SERVO_FIELDS:
-            value, default = getattr(params, name), getattr(defaults, name)
-            if value != default:
-                shown = "model" if value is None else value
-                raise ParameterError(f"{name}={shown!r} sets the speed controller, which only drive=servo has; "
-                                     f"allowed: drive=servo, or leave {name} out (drive={params.drive!r})")
+    for name in _DRIVEN_BY:
+        value, default = getattr(params, name), getattr(defaults, name)
+        if name not in DRIVE_FIELDS[params.drive] and value != default:
+            raise ParameterError(_idle_message(f"{name}={'model' if value is None else value!r}", name, params.drive))
     for through, names, needs, idle, unit in _ACTS_THROUGH:
         if getattr(params, through) is not None:
             continue
@@ -433,6 +442,22 @@ def refuse_idle_parameters(params: RobotParams) -> None:
             if value != default:
                 raise ParameterError(f"{name}={value!r}{unit} needs {needs}; allowed: {default!r} with "
                                      f"{through}={idle}")
+
+
+def refuse_idle_names(drive: str, names: Iterable[str], what: str = "varied") -> None:
+    """A study that varies (``what``) parameters ``names`` of which one only another drive than ``drive`` uses
+    (DRIVE_FIELDS: ``M_stall`` swept under the constant torque), refused in one line before any run, as every
+    run would refuse it (:func:`refuse_idle_parameters`)."""
+    for name in names:
+        if name in _DRIVEN_BY and name not in DRIVE_FIELDS[drive]:
+            raise ParameterError(_idle_message(f"{name} ({what})", name, drive))
+
+
+def _idle_message(given: str, name: str, drive: str) -> str:
+    users = [d for d in DRIVES if name in DRIVE_FIELDS[d]]
+    return (f"{given} sets {_DRIVEN_BY[name]}, which only {' or '.join(f'drive={d}' for d in users)} uses, and the "
+            f"drive here is {drive!r}; allowed: {' or '.join(f'--drive {d}' for d in users)} (drive = ... in a "
+            f"file), or leave {name} out")
 
 
 def require_params(params: Any) -> RobotParams:

@@ -36,6 +36,7 @@ def neighbourhood(params: RobotParams) -> tuple[Axis, ...]:
 
 
 def compute(params: RobotParams, quick: bool, progress) -> dict:
+    params = params.replace(drive=params.drive)  # without another drive's parameters (the sections' motor's)
     axes = neighbourhood(params)
     atlas = Atlas(axes, params, budget=0, samples=SAMPLES[quick], thresholds=THRESHOLDS)
     with tempfile.TemporaryDirectory(prefix="ipir-atlas-") as folder:
@@ -55,7 +56,8 @@ def render(metrics: dict, figures_dir: Path) -> list:
           "/ |real|, in the equations over a quasi-random sample of "
         + f"{metrics['samples'] * (len(axes) + 2)} designs ({metrics['runs']} runs). The safe share is the "
           "sample's share of designs where the cost stays within +- the threshold (Wilson's 95 % interval); what drives "
-          "the cost: its largest total Sobol indices (ST, 95 % interval). MuJoCo's side and other ranges: "
+          "the cost: its largest total Sobol indices (ST, 95 % interval; '-' where no index's interval excludes 0: "
+          "too few designs to tell, or a cost that hardly varies). MuJoCo's side and other ranges: "
           "ipir-mujoco atlas (docs/cli.md).")]
     rows = []
     for name, per in metrics["idealizations"].items():

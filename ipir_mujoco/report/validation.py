@@ -33,11 +33,13 @@ from ..studies.paper_reference import describe_differences
 from ..studies.validate import FIGURE_RUNGS, LADDER_FIGURES, LadderRun
 
 
-# The report's animation: the start of the MuJoCo ratchet run (t_end [s] simulated), ten times slower than
-# real time; --quick draws fewer, smaller frames
-ANIMATION = {"t_end": 0.5, "width": 480, "height": 270, "fps": 12.5, "speed": 0.1}  # 80 ms a frame
-ANIMATION_QUICK = {"t_end": 0.2, "width": 320, "height": 180, "fps": 10.0, "speed": 0.1}
-ANIMATION_RUNG = "MuJoCo ratchet"
+# The report's animation: the start (t_end [s] simulated) of the ladder's last rung, MuJoCo's robot on wheels in its
+# pipe (the robot the mechanism diagram draws), ten times slower than real time, at a size whose text and wheels
+# read in a page (768 px wide: the text, MuJoCo's larger font, in two corners off the robot); the MuJoCo ratchet's
+# run where a ladder has no wheeled rung. --quick draws fewer, smaller frames
+ANIMATION = {"t_end": 0.5, "width": 768, "height": 432, "fps": 12.5, "speed": 0.1}  # 80 ms a frame
+ANIMATION_QUICK = {"t_end": 0.2, "width": 640, "height": 360, "fps": 10.0, "speed": 0.1}
+ANIMATION_RUNGS = ("wheels in contact", "MuJoCo ratchet")  # the first of them the ladder ran
 
 
 def figure_clutch_reactions(rung: LadderRun, path: Path) -> None:
@@ -160,10 +162,13 @@ def _mechanism_section(figures: dict[str, str], animation_note: str | None, sett
         "The symbols are those of docs/model.md.")]
     blocks.append(Image(figures["mechanism.png"], "The robot, to scale for these parameters."))
     if animation_note is None:
+        wheels = settings.get("model", "wheels") == "wheels"
+        robot = ("MuJoCo's robot on wheels in its pipe (the ladder's last rung, a one-way ratchet in every wheel's "
+                 "hub)" if wheels else "MuJoCo with one-way clutches (the ratchet)")
         blocks.append(Image(figures["robot.gif"], (
-            f"MuJoCo with one-way clutches (the ratchet), the first {settings['t_end']:g} s from rest at "
-            f"{settings['speed']:g}x real time, rendered by MuJoCo offscreen. A module turns green while its clutch "
-            "holds it. The same video for any design: ipir-mujoco render --out robot.gif")))
+            f"{robot}, the first {settings['t_end']:g} s from rest at {settings['speed']:g}x real time, rendered by "
+            "MuJoCo offscreen. A module turns green while its clutch holds it. The same video for any design: "
+            f"ipir-mujoco render{' --mujoco-model wheels' if wheels else ''} --out robot.gif")))
     else:
         blocks.append(Paragraph(f"(No animation: {animation_note}. The rest of the report does not need it; "
                                 "'ipir-mujoco render' writes one where headless OpenGL exists.)"))
@@ -347,16 +352,23 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
 
 
 def write_animation(rung: LadderRun, path: Path, quick: bool) -> tuple[str | None, dict]:
-    """The report's animation of ``rung``'s run; (None, settings) if written, else (why not, settings)."""
+    """The report's animation of ``rung``'s run (a MuJoCo run); (None, settings) if written, else (why not,
+    settings); the settings say which MuJoCo model it draws (``model``: 'slides' or 'wheels')."""
     from ..video import RenderUnavailable, VideoSettings, write_video
 
     settings = ANIMATION_QUICK if quick else ANIMATION
     video = VideoSettings(**{k: v for k, v in settings.items() if k != "t_end"})
+    from .. import registry
+    from ..studies.ladder import VALIDATION_LADDER
+
+    variant = registry.variant(next(r.variant for r in VALIDATION_LADDER if r.name == rung.name))
+    model = variant.model
     try:
-        write_video(rung.run, path, video, t_end=settings["t_end"], title="MuJoCo, one-way clutches (ratchet)")
+        write_video(rung.run, path, video, t_end=settings["t_end"],
+                    title=f"MuJoCo, one-way clutches ({variant.mechanism_words})")
     except RenderUnavailable as exc:
-        return str(exc), settings
-    return None, settings
+        return str(exc), {**settings, "model": model}
+    return None, {**settings, "model": model}
 
 
 def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: Sequence = (),
@@ -365,7 +377,7 @@ def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: 
 
     ``sections`` (:class:`ipir_mujoco.report.sections.Section`) draw their parts
     from ``metrics["sections"]``, after the core and before the numerical evidence.
-    ``progress`` hears a line per group of figures, and one at least every 10 s of wall time
+    ``progress`` hears a line per group of figures, and one at least every 5 s of wall time
     (the animation takes several seconds).
     """
     figures_dir = folder / "figures"
@@ -380,7 +392,7 @@ def write_report(folder: Path, metrics: dict, rungs: list[LadderRun], sections: 
         figure_pull_per_stroke(metrics["clutch_pull"]["per_stroke"], figures_dir / "pull_per_stroke.png")
         overview_figure(metrics).savefig(figures_dir / OVERVIEW, dpi=110)
         beat.say("writing report: the animation")
-        physics = next(r for r in rungs if r.name == ANIMATION_RUNG)
+        physics = next(r for name in ANIMATION_RUNGS for r in rungs if r.name == name)
         note, animation = write_animation(physics, figures_dir / "robot.gif", metrics["settings"]["quick"])
         extra = []
         for section in sections:

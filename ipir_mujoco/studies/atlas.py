@@ -53,6 +53,7 @@ from .atlas_space import (DEFAULT_BUDGET, DEFAULT_METRICS, DEFAULT_SAMPLES, DEFA
                           MOTOR_METRICS, NAMES, TORQUE_METRICS, allowed)
 from .atlas_surrogate import MAX_POINTS, CostSurrogate, regions, safe_fraction
 from .sweep import refuse_all_invalid
+from .sensitivity import SALIB_MISSING
 from .sweep_space import Axis, T_END_STEADY
 
 CANDIDATES = 4096  # space-filling designs on which the surrogates are read (safe fractions, placement)
@@ -195,7 +196,11 @@ def wilson(safe: int, n: int) -> list[float]:
 
 def top_drivers(entry: dict, count: int = 2) -> str:
     """'L (ST 0.95 +- 0.10), m2 (...)': the parameters of largest total Sobol index whose 95 % interval
-    excludes 0 ('-' if none: too few samples to tell, or a cost that does not vary)."""
+    excludes 0 ('-' if none: too few samples to tell, or a cost that does not vary); where the indices were not
+    computed, 'not computed: ' and why (SALib missing: the command that adds it)."""
+    skipped = entry.get("sensitivity", {}).get("skipped")
+    if skipped:
+        return f"not computed: {skipped}"
     ranked = sorted(((p, v) for p, v in entry.get("sensitivity", {}).items() if isinstance(v, dict)
                      and v.get("ST") is not None and v.get("ST_conf") is not None and v["ST"] - v["ST_conf"] > 0),
                     key=lambda pv: -pv[1]["ST"])
@@ -265,7 +270,9 @@ def _run(atlas: Atlas, out: Path, meta: Path, fingerprint: str, U: np.ndarray, s
         for name in atlas.idealizations:
             if IDEALIZATIONS[name].equations is None:
                 continue
-            progress(f"{name} (equations): {len(designs)} designs")
+            distinct = len({tuple(repr(float(d[n])) for n in atlas.names) for d in designs})
+            progress(f"{name} (equations): the sample's {distinct} designs (Saltelli's {len(designs)} points, some "
+                     "the same), each run idealized and real; then designs placed at the crossings")
             with heartbeat(progress, f"{name} (equations)"):  # the runs, the fits and the indices: tens of s
                 rows = store.evaluate(name, "equations", designs)
                 measured[(name, "equations")] = (U, rows)
@@ -343,7 +350,7 @@ def _equations_entry(atlas: Atlas, name: str, metric: str, U: np.ndarray, rows: 
     elif saltelli:
         entry["sensitivity"] = {"of": "equations", "skipped": f"{int((~ok).sum())} designs gave no value"}
     else:
-        entry["sensitivity"] = {"skipped": "needs SALib: pip install 'ipir-mujoco[optimize]'"}
+        entry["sensitivity"] = {"skipped": SALIB_MISSING}
     return _by_threshold(atlas, entry)
 
 
@@ -378,5 +385,5 @@ def _mujoco_entry(atlas: Atlas, st: dict, metric: str, candidates: np.ndarray) -
             points = salib[0].sample(problem, 512, calc_second_order=False, seed=atlas.seed)
         entry["sensitivity"] = {"of": "surrogate", **sobol_indices(atlas.names, s.cost(points)[0], atlas.seed)}
     else:
-        entry["sensitivity"] = {"skipped": "needs SALib: pip install 'ipir-mujoco[optimize]'"}
+        entry["sensitivity"] = {"skipped": SALIB_MISSING}
     return _by_threshold(atlas, entry)

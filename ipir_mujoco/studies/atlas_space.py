@@ -31,12 +31,14 @@ motor or the servo, a run to its periodic steady state (:data:`MOTOR_METRICS`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.cycles import travel
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.results import RunResult
+
+if TYPE_CHECKING:  # the atlas command's parser reads this module's defaults without numpy
+    from ipir_mujoco.core.results import RunResult
 
 from .ladder import VALIDATION_LADDER, Rung
 
@@ -146,6 +148,8 @@ def allowed(base: RobotParams, varied: set[str], budget: int) -> dict[str, str]:
 
 def metric_value(metric: str, run: RunResult) -> float | None:
     if metric == "travel_m":
+        from ipir_mujoco.core.cycles import travel
+
         x = travel(run.series)
         return float(x[-1] - x[0])
     value = run.summary.get(metric)

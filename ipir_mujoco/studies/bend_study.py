@@ -55,7 +55,7 @@ EXIT = 0.05  # m: straight after the bend
 DT_OUT = 1e-3  # s: the samples the progress is read from (the passage's times are good to this)
 T_CAP_PER_M = 20.0  # s per metre of route: the run's cap (the default motor cruises at ~0.53 m/s: 1.9 s/m)
 MU_WALL = 0.8  # the study's wall friction unless --set gives one: the straight-pipe acceptance case
-PROGRESS_EVERY_S = 10.0  # s of wall time between a running case's progress lines
+PROGRESS_EVERY_S = 5.0  # s of wall time between a running case's progress lines (a log's interval, terminal.py)
 PLANES = (0.0,)  # deg: the bends' planes, the default (0: horizontal, across gravity)
 TWIN_SLACK = 0.005  # a bend faster than its twin by more than this share of the twin's time gets a note: the
 # centre's crossing times carry ~0.05 s of a stroke's ripple (module docstring), ~2-7 % of a passage of 0.7-2.7 s

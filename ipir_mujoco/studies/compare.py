@@ -260,8 +260,8 @@ def format_comparison(result: dict) -> str:
                      "n/a" if v["relative"] is None else f"{100 * v['relative']:+.3f} %"))
     lines += _aligned(rows)
     tolerance = result["tolerance"]
-    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a| (at least a turn, the "
-              "stroke 2r or r x the largest crank speed);",
+    lines += ["", "largest |b - a| over the run, in the quantity's unit; scale = largest |a| (at least a turn for phi, "
+              "the stroke 2r for x1 x2 S, r x the largest crank speed for v1 v2 S_dot);",
               f"first over = first time |b - a| > tolerance x scale (tolerance {tolerance:g} = {100 * tolerance:g} %)"]
     rows = [("quantity", "unit", "at same time", "at same crank angle", "scale", "first over [s]")]
     for q in QUANTITIES:

@@ -145,7 +145,8 @@ def format_measured_comparison(result: dict) -> str:
         if k == 0:
             lines.append("  " + "  ".join("-" * w for w in widths))
     tol = result["tolerance"]
-    lines += ["", f"scale = largest |measured| (at least the stroke 2r, a turn, r x or the largest crank speed); "
+    lines += ["", "scale = largest |measured| (at least the stroke 2r for positions, a turn for the crank angle, r x "
+              "the largest crank speed for speeds, the largest crank speed for omega);",
               f"first over = first time |b - a| > {tol:g} x scale"]
     if result["ignored_columns"]:
         lines.append(f"note: measured columns not compared (not model columns): {' '.join(result['ignored_columns'])}")

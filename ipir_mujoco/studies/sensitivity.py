@@ -36,12 +36,16 @@ from .sweep_space import Axis, Study
 COLUMNS = ("metric", "parameter", "S1", "S1_conf", "ST", "ST_conf")
 
 
+# SALib is a dependency of the package: missing, only from an environment changed after the install
+SALIB_MISSING = "needs SALib, a dependency of ipir-mujoco missing from this environment: pip install 'SALib>=1.6,<1.7'"
+
+
 def _salib():
     try:
         from SALib.analyze import sobol as analyze
         from SALib.sample import sobol as sample
     except ImportError:
-        raise ParameterError("sensitivity needs SALib: pip install 'ipir-mujoco[optimize]'") from None
+        raise ParameterError(f"sensitivity {SALIB_MISSING}") from None
     return sample, analyze
 
 

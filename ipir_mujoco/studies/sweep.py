@@ -58,7 +58,7 @@ from typing import Callable
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError, StudyInterrupted
 from ipir_mujoco.core.options import check_type
-from ipir_mujoco.core.params import RobotParams, check_real, check_whole
+from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse_idle_parameters
 
 from ipir_mujoco.core.results import write_json
 
@@ -232,12 +232,13 @@ def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_desi
 
 def refuse_all_invalid(base: RobotParams, designs: list[dict]) -> None:
     """A study none of whose designs is a valid parameter set (``L=0.01,0.02`` with r = 0.05: L <= r) is
-    refused before anything is written, naming the first design's fault; one valid design is enough to run
-    (the invalid ones are then recorded as failed rows)."""
+    refused before anything is written, naming the first design's fault (a parameter its drive does not use,
+    ``M_stall`` varied under the constant torque, included: every engine would refuse it); one valid design is
+    enough to run (the invalid ones are then recorded as failed rows)."""
     first = None
     for values in designs:
         try:
-            base.replace(**values)
+            refuse_idle_parameters(base.replace(**values))
             return
         except ValueError as exc:
             first = first or (values, exc)

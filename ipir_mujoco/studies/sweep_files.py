@@ -16,11 +16,12 @@ from __future__ import annotations
 import csv
 import math
 import os
-import sys
 import time
 from pathlib import Path
 
 from ipir_mujoco.core.errors import ParameterError
+
+from .. import terminal
 
 from .sweep_metrics import METRICS
 from .sweep_space import Study
@@ -176,25 +177,37 @@ class ResultsFile:
 
 
 class Progress:
-    """Designs done, rate and time left, on stderr (a line per tenth when not a terminal)."""
+    """Designs done, rate and time left, on stderr: on a terminal the status line, rewritten as each design
+    ends and every second while one runs; in a log a line per tenth of the designs and, while designs run, at
+    least every 5 s (:mod:`ipir_mujoco.terminal`; the ticker speaks only within a command of the command line)."""
 
     def __init__(self, total: int, already: int, enabled: bool = True, what: str = "sweep"):
         self.total, self.done, self.start, self.enabled = total, already, time.perf_counter(), enabled
         self.what = what  # the study's name, heading each line
         self.first = already
-        self.tty = sys.stderr.isatty()
         self.next_line = already + max(1, total // 10)
+        if enabled:
+            terminal.ticker(self, Progress.text)
+
+    @property
+    def finished(self) -> bool:
+        return self.done >= self.total
+
+    def text(self) -> str:
+        elapsed = time.perf_counter() - self.start
+        rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
+        left = f"{(self.total - self.done) / rate:.0f} s left" if rate > 0 else f"{elapsed:.0f} s so far"
+        return f"{self.what} {self.done}/{self.total} designs, {rate:.2f} designs/s, {left}"
 
     def advance(self, count: int = 1) -> None:
         self.done += count
         if not self.enabled:
             return
-        elapsed = time.perf_counter() - self.start
-        rate = (self.done - self.first) / elapsed if elapsed > 0 else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else float("inf")
-        text = f"{self.what} {self.done}/{self.total} designs, {rate:.2f} designs/s, {left:.0f} s left"
-        if self.tty:
-            print("\r" + text, end="\n" if self.done >= self.total else "", file=sys.stderr, flush=True)
-        elif self.done >= self.next_line or self.done >= self.total:
-            print(text, file=sys.stderr, flush=True)
+        text = self.text()
+        if self.done >= self.total:
+            terminal.say(text)
+        elif self.done >= self.next_line and not terminal.on_terminal():  # a log: a line per tenth
             self.next_line = self.done + max(1, self.total // 10)
+            terminal.say(text)
+        else:
+            terminal.say(text, status=True)

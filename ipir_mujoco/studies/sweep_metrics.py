@@ -66,12 +66,12 @@ in both engines.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from ipir_mujoco.core.cycles import cycle_summary, travel
 from ipir_mujoco.labels import SUMMARY
+
+if TYPE_CHECKING:  # numpy and the cycles load where a metric is computed: the sweep's parser reads METRICS only
+    import numpy as np
 
 LEGACY = {"mean_speed_mps": "mean_speed_m_s", "accel_jump_mps2": "accel_jump_m_s2"}  # old spelling -> new
 # metric: (in words, unit): the summary's figures as ipir_mujoco.labels names them, and the sweep's own
@@ -100,6 +100,8 @@ LAST_CYCLES = 3
 def accel_jump(series: dict[str, np.ndarray]) -> float:
     """Largest jump [m/s^2] of either module's acceleration at an event instant the series holds twice
     (before and after; module docstring); 0 if none."""
+    import numpy as np
+
     t = np.asarray(series["t"], dtype=float)
     twins = np.flatnonzero(t[1:] == t[:-1])
     if twins.size == 0:
@@ -117,6 +119,10 @@ def mean_speed(series: dict[str, np.ndarray]) -> float:
     then average over the same strokes. Counted from the start, a run just past a whole turn and one just
     short of it average over different strokes of an accelerating crank, and their mean speeds can differ
     by far more than their revolutions do."""
+    import numpy as np
+
+    from ipir_mujoco.core.cycles import travel
+
     t, phi = np.asarray(series["t"], dtype=float), np.asarray(series["phi"], dtype=float)
     reach = np.maximum.accumulate(phi) - phi[0]  # the running maximum, as the revolution count
     turns = min(LAST_CYCLES, int(math.floor(reach[-1] / (2 * math.pi) + 1e-9)))
@@ -165,7 +171,7 @@ def design_metrics(series: dict[str, np.ndarray], summary: dict[str, Any], energ
         "energy_per_metre_j_m": _number(summary.get("energy_per_metre_j_m")),
         "efficiency": _number(efficiency),
         "peak_clutch_force_n": _number(summary.get("peak_clutch_force_n")),
-        "peak_rod_force_n": float(np.abs(series["rod_force"]).max()) if "rod_force" in series else math.nan,
+        "peak_rod_force_n": float(abs(series["rod_force"]).max()) if "rod_force" in series else math.nan,
         "accel_jump_m_s2": accel_jump(series) if len(t) > 1 else 0.0,
         "stalled": float(stalled),
         "residual_ratio": _number(accuracy.get("residual_ratio")),
@@ -206,6 +212,8 @@ def run_metrics(run) -> dict[str, float]:
 def batch_metrics(outcome: dict, steady_tol: float | None = None, steady_cycles: int | None = None) -> dict[str, float]:
     """Metrics of one design of :func:`ipir_mujoco.engine.kinds.slides.batch.run_ratchet_batch` (its ``series``,
     ``motor_work_j``, ``friction_work_j`` and, where the batch gives them, ``accuracy`` and ``stall``)."""
+    from ipir_mujoco.core.cycles import cycle_summary
+
     series = outcome["series"]
     options = {k: v for k, v in (("tol", steady_tol), ("n", steady_cycles)) if v is not None}
     summary = cycle_summary(series, **options)

@@ -39,13 +39,11 @@ import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import MAX_T_END, check_run_options, refuse_steady_without_motor
+from ipir_mujoco.core.limits import MAX_T_END, check_run_options, refuse_steady_without_motor
 from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
-                                     read_toml_file, require_params)
+                                     read_toml_file, refuse_idle_names, require_params)
 
 # the variants a sweep runs by default (any of registry.NAMES, or their aliases, may be given)
 DEFAULT_VARIANTS = ("mujoco-ratchet", "analytic-unilateral")
@@ -119,6 +117,8 @@ def parse_vary(text: str) -> Axis:
         if count > MAX_DESIGNS:
             raise ParameterError(f"--vary {text!r}: N={count:g} points would need {count * 8:.3g} bytes for the "
                                  f"axis alone; allowed: N <= {MAX_DESIGNS} (designs per sweep)")
+        import numpy as np  # here only: the command line's parsers read this module's defaults without numpy
+
         spaced = np.geomspace if log else np.linspace
         return Axis(name, tuple(float(v) for v in spaced(numbers[0], numbers[1], int(count))), log=log)
     raise ParameterError(f"--vary {text!r} is malformed; expected NAME=START:STOP:N[:log], NAME=A,B,C or "
@@ -154,6 +154,7 @@ class Study:
         if len(set(names)) != len(names):
             raise ParameterError(f"--vary names a parameter twice: {names}")
         set_("base", require_params(self.base))
+        refuse_idle_names(self.base.drive, names)  # M_stall varied under the constant torque: every run refuses it
         if isinstance(self.engines, str):
             raise ParameterError(f"engines={self.engines!r} is a single string; allowed: a list of engine names, "
                                  f"e.g. [{self.engines!r}], from: {', '.join(registry.NAMES)}")

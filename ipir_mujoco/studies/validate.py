@@ -73,7 +73,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.options import heartbeat, progress_text, throttled
+from ipir_mujoco.core.options import (HEARTBEAT_S, LIVE_HEARTBEAT_S, Status, heartbeat, progress_text,
+                                      throttled)
 from ipir_mujoco.core.params import RobotParams
 from ipir_mujoco.core.results import MODE_NAMES, Mode, RunResult
 
@@ -110,8 +111,10 @@ def run_ladder(params: RobotParams, t_end: float, dt_out: float, rtol: float, at
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name} ...")
         tolerances = ({"accuracy": rung.accuracy} if registry.variant(rung.variant).is_mujoco
                       else {"rtol": rtol, "atol": atol})
-        beat = throttled(lambda t, i=i, rung=rung: progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: "
-                                                            + progress_text(t, t_end)))
+        # the run's time as the command line's status line (every second, in place on a terminal), else every 5 s
+        beat = throttled(lambda t, i=i, rung=rung: progress(Status(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: "
+                                                                   + progress_text(t, t_end))),
+                         LIVE_HEARTBEAT_S if getattr(progress, "live", False) else HEARTBEAT_S)
         run = registry.run(rung.variant, rung.params(params), t_end, dt_out=dt_out, progress=beat, **tolerances)
         progress(f"[{i}/{len(VALIDATION_LADDER)}] {rung.name}: {run.summary['revolutions']:.3f} rev "
                  f"({time.perf_counter() - started:.2f} s)")
@@ -351,13 +354,16 @@ def validate(params: RobotParams, quick: bool = False, progress: Callable[[str],
     """
     settings = {"t_end_s": 1.0, "quick": quick, "dt_out_s": 1e-3 if quick else 1e-4, "rtol": 1e-10, "atol": 1e-12,
                 "mujoco": registry.mujoco_defaults()}
-    rungs = run_ladder(params, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
+    # the ladder's runs under the design's drive, without another drive's parameters (the motor's, given for the
+    # sections that run the motor: each names its drive): a run refuses what its drive does not use
+    own = params.replace(drive=params.drive)
+    rungs = run_ladder(own, settings["t_end_s"], settings["dt_out_s"], settings["rtol"], settings["atol"], progress)
     # MuJoCo's settings are chosen per run from the motion: record what each MuJoCo rung used
     settings["mujoco_runs"] = {r.name: {k: r.run.settings[k] for k in ("timestep", "integrator",
                                                                          "constraint_time_constant", "solimp")}
                                for r in rungs if r.run.engine == "mujoco"}
-    study = lr_study(params, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
-    convergence = convergence_evidence(params, quick, lambda m: progress(f"convergence: {m}"))
+    study = lr_study(own, RATIOS_QUICK if quick else RATIOS_FULL, settings["t_end_s"], 1e-3, progress)
+    convergence = convergence_evidence(own, quick, lambda m: progress(f"convergence: {m}"))
     metrics = build_metrics(params, rungs, settings, study, convergence)
     run_sections(metrics, params, quick, progress, sections)
     return metrics, rungs
@@ -373,7 +379,7 @@ def run_sections(metrics: dict, params: RobotParams, quick: bool, progress: Call
     for section in sections:
         started = time.perf_counter()
         progress(f"{section.title} ...")
-        with heartbeat(progress, section.title) as beat:  # a line at least every 10 s whatever the section does
+        with heartbeat(progress, section.title) as beat:  # a line at least every 5 s whatever the section does
             result = section.compute(params, quick, lambda m, s=section: beat.say(f"{s.title}: {m}"))
         metrics["sections"][section.key] = result
         if section.verdict is not None and (verdict := section.verdict(result)) is not None:

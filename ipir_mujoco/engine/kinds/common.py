@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.options import CLUTCH_RULES as RULES  # the clutch rules
+from ipir_mujoco.core.limits import CLUTCH_RULES as RULES  # the clutch rules
 from ipir_mujoco.core.options import RepeatProgress
 from ipir_mujoco.core.params import RobotParams, refuse_idle_parameters
 from ipir_mujoco.core.results import REST_SPEED, REST_TIME  # at rest: slower [m/s], this long [s] is a stall

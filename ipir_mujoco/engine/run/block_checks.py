@@ -17,10 +17,20 @@ from ..builders.model import CRANK_HINGE, FRONT_SLIDE, REAR_SLIDE
 
 
 # s of wall time: a run whose 0.1 s of simulated time takes longer (a wheeled run at a finer step: 3-4 s at
-# 1.25e-5 s beside another job) reports at the first check past it too, so that a printer that wants a line every
-# 10 s of wall time (ipir_mujoco.cli.common.WALL_EVERY_S) is called often enough to print within 10 s plus one
-# check's wall time (the README's bend90 route at 1.25e-5 s, idle: 1.45 s; its longest gap 11.8 s)
-PROGRESS_WALL_S = 1.0
+# 1.25e-5 s beside another job) reports once this much wall time has passed too, so that a terminal's status line
+# moves at least every second (ipir_mujoco.terminal) and a log gets its line every 5 s
+PROGRESS_WALL_S = 0.5
+# s of wall time: the most one call of the stepper takes, about (a block of BLOCK_TIME that takes longer is
+# stepped in parts, the progress reported between them; the checks stay at the blocks' ends: the same results)
+CHUNK_WALL_S = 0.25
+
+
+def chunk_after(chunk: int, block: int, recorded: int, wall: float) -> int:
+    """The samples the stepper's next call records: as many as the last call's rate (``recorded`` samples in
+    ``wall`` seconds) steps in CHUNK_WALL_S, at least 1 and at most a ``block``."""
+    if wall <= 0:
+        return block
+    return max(1, min(block, int(CHUNK_WALL_S * recorded / wall)))
 
 
 class BlockChecks:
@@ -41,6 +51,15 @@ class BlockChecks:
         # a stall is final only under constant loads: not with a crank servo's time-varying torque; the speed
         # controller's only while it asks for full voltage (:meth:`_stall`)
         self.stall_watch = run.servo is None
+
+    def progress_only(self, newest: int) -> None:
+        """Between a slow block's parts: the progress, if PROGRESS_WALL_S of wall time has passed (nothing else:
+        the checks keep their simulated times)."""
+        run = self.run
+        now = time.perf_counter()
+        if run.progress is not None and now - self.reported_at >= PROGRESS_WALL_S:
+            run.progress(float(run.recorder.t[newest]))
+            self.reported_at = now
 
     def check(self, newest: int, messages: list[str]) -> int | None:
         """Returns the row to end the run at (steady state or stall), or None to go on."""

@@ -59,7 +59,7 @@ from ipir_mujoco.core.options import RunOptions, check_step_count, check_type
 from ipir_mujoco.core.params import RobotParams, require_params
 from ipir_mujoco.core.results import RunResult
 
-from .block_checks import BlockChecks
+from .block_checks import BlockChecks, chunk_after
 from ..kinds.common import (BLOCK_TIME, IMPLEMENTATIONS, REFINEMENTS, CrankServo, PassProgress, captured_warnings,
                                  climb_energy, mujoco_failure, steps_per_output)
 from ..kinds import ModelKind, kind_for
@@ -278,9 +278,11 @@ class _Run:
         block = max(1, round(BLOCK_TIME / self.dt_out))
         checks = BlockChecks(self)
         pending, last = -1, None  # the first interval has no sample before it to fill in
+        chunk = block  # samples per call of the stepper: a block, fewer where a block takes long (CHUNK_WALL_S)
         while done < n_steps:
-            first = rec.count
-            status, taken = steps.record(rec, block - samples % block, sps, n_steps - done, pending, messages)
+            first, called = rec.count, time.perf_counter()
+            status, taken = steps.record(rec, min(chunk, block - samples % block), sps, n_steps - done, pending,
+                                         messages)
             done += taken
             samples += rec.count - first
             pending = rec.count - 1 if rec.count > first else pending
@@ -292,6 +294,10 @@ class _Run:
                 last = checks.check(pending, messages)
                 if last is not None:
                     break
+            elif pending >= 0:  # inside a slow block: its progress only (the checks stay at the blocks' ends)
+                checks.progress_only(pending)
+            if rec.count > first:
+                chunk = chunk_after(chunk, block, rec.count - first, time.perf_counter() - called)
         ctl.finish()  # (the compliant clutches: the anchors and dampers for the final state)
         mujoco.mj_forward(m, d)  # energies, gap and momentum at the final state
         if pending >= 1:
