@@ -43,8 +43,10 @@ from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.params import RobotParams, parse_overrides
 from ipir_mujoco.core.pipe import bend_cock, bend_slip_angle, ring_side_grip, scrub_force
 from ipir_mujoco.core.route import route_from_tables
-from ipir_mujoco.studies.bend_study import DT_OUT, EXIT, LEAD_IN, T_CAP_PER_M, _passage, straight_route
+from ipir_mujoco.studies.bend_study import (DT_OUT, EXIT, LEAD_IN, T_CAP_PER_M, _passage, equations_case,
+                                            straight_route)
 from ipir_mujoco.studies.pool import map_unordered
+from ipir_mujoco.studies.route_compare import percent
 
 RATIOS = (1.5, 2.0, 3.0, 5.0, 10.0, 20.0, 50.0)
 MUS = (0.3, 0.5, 0.8)
@@ -65,23 +67,32 @@ def bend_route(params: RobotParams, ratio: float, angle: float):
 
 
 def run_case(item: tuple, overrides: dict) -> dict:
-    """One run in a worker: item = (mu_wall, 'bend' | 'straight', R/D or the arc [m], angle [deg])."""
+    """One case in a worker: item = (mu_wall, 'bend' | 'straight', R/D or the arc [m], angle [deg]); MuJoCo's run
+    and, under ``equations``, the equations' along the same route
+    (:func:`ipir_mujoco.studies.bend_study.equations_case`)."""
     mu, kind, ratio, angle = item
     params = RobotParams(**{"drive": "motor", **overrides, "mu_wall": mu})
     arc = math.radians(angle) * ratio * params.pipe_diameter if kind == "bend" else ratio
     route = bend_route(params, ratio, angle) if kind == "bend" else straight_route(params, arc)
+    equations = equations_case(params, route)
     started = time.perf_counter()
     try:
         run = registry.run("mujoco-wheels", params, T_CAP_PER_M * route.length, dt_out=DT_OUT, route=route,
                            accuracy="warn")
     except SimulationError as exc:
-        return {"error": str(exc), "passed": False, "time_s": None, "wall_s": time.perf_counter() - started}
+        return {"error": str(exc), "passed": False, "time_s": None, "wall_s": time.perf_counter() - started,
+                "equations": equations}
     out = _passage(run, route, 1, 4)
     fit = run.summary["route_fit"]["bends"]
     out.update(wall_s=time.perf_counter() - started, lift_predicted=run.summary["lift_predicted"],
                least_press_n=min(run.summary["least_press1_n"], run.summary["least_press2_n"]),
-               bend_least_press_n=(min(min(b["least_press1_n"], b["least_press2_n"]) for b in fit) if fit else None))
+               bend_least_press_n=(min(min(b["least_press1_n"], b["least_press2_n"]) for b in fit) if fit else None),
+               equations=equations, slid_m=max(float(run.series["slid1"][-1]), float(run.series["slid2"][-1])))
     return out
+
+
+def mm(metres: float | None) -> float | None:
+    return None if metres is None else 1e3 * metres
 
 
 def closed_form(overrides: dict, ratios, mus, arc: float) -> int:
@@ -146,9 +157,11 @@ def main(argv=None) -> int:
           f"{'rigid' if base.cornering_coefficient is None else f'{base.cornering_coefficient:g} /rad'}"
           f"{' (' + ', '.join(args.set) + ')' if args.set else ''}; bends horizontal, at most 90 deg and "
           f"{args.arc:g} m of arc; {time.perf_counter() - started:.0f} s wall")
-    print("| mu_wall | R/D | angle [deg] | arc [m] | bend [s] | straight [s] | penalty | energy bend / straight [J] "
-          "| outcome | wheel off bend / straight [s] | lift predicted (least press [N]) | step [s] |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| mu_wall | R/D | angle [deg] | arc [m] | MuJoCo bend / straight [s] | MuJoCo penalty | equations bend / "
+          "straight [s] | equations penalty | MuJoCo - equations in the bend: time / energy | energy bend / straight "
+          "[J]: MuJoCo; equations | scrub [J]: equations / MuJoCo's skid, bend less straight | outcome | wheel off "
+          "bend / straight [s] | slid bend / straight [mm] | lift predicted (least press [N]) | step [s] |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     record = {"predicted and lifted": 0, "predicted, no lift (false alarm)": 0, "lifted, not predicted (miss)": 0,
               "neither": 0}
     rows = []
@@ -158,10 +171,14 @@ def main(argv=None) -> int:
             arc = math.radians(angle) * r * base.pipe_diameter
             bend = results[(mu, "bend", r, angle)]
             twin = results[(mu, "straight", round(arc, 12), 0.0)]
-            tb, ts = bend.get("time_s"), twin.get("time_s")
-            penalty = f"{100 * (tb / ts - 1):+.2f} %" if tb and ts else "-"
-            eb, es = bend.get("energy_j"), twin.get("energy_j")
-            energy = f"{eb:.3f} / {es:.3f}" if eb is not None and es is not None else "-"
+            eb, es = bend["equations"], twin["equations"]
+
+            def pair(a, b, digits=4):
+                return " / ".join("-" if x is None else f"{x:.{digits}f}" for x in (a, b))
+
+            def penalty(a, b):
+                return percent(a / b - 1) if a and b else "-"
+
             outcome = "passed" if bend.get("passed") else bend.get("route_stop", bend.get("error"))
             off_b, off_s = bend.get("route_wheel_off_s"), twin.get("route_wheel_off_s")
             off = f"{off_b:.3f} / {off_s:.3f}" if off_b is not None and off_s is not None else "-"
@@ -173,9 +190,15 @@ def main(argv=None) -> int:
                 record[key] += 1
             press = bend.get("bend_least_press_n")
             lift = f"{predicted} ({press:.2f})" if press is not None else "-"
-            print(f"| {mu:g} | {r:g} | {angle:.1f} | {arc:.3f} | {tb if tb is None else f'{tb:.4f}'} | "
-                  f"{ts if ts is None else f'{ts:.4f}'} | {penalty} | {energy} | {outcome} | {off} | {lift} | "
-                  f"{bend.get('timestep_s', '-')} |")
+            skid = (bend["scrub_j"] - twin["scrub_j"] if bend.get("scrub_j") is not None and
+                    twin.get("scrub_j") is not None else None)
+            print(f"| {mu:g} | {r:g} | {angle:.1f} | {arc:.3f} | {pair(bend.get('time_s'), twin.get('time_s'))} | "
+                  f"{penalty(bend.get('time_s'), twin.get('time_s'))} | {pair(eb['time_s'], es['time_s'])} | "
+                  f"{penalty(eb['time_s'], es['time_s'])} | {penalty(bend.get('time_s'), eb['time_s'])} / "
+                  f"{penalty(bend.get('energy_j'), eb['energy_j'])} | "
+                  f"{pair(bend.get('energy_j'), twin.get('energy_j'), 3)}; {pair(eb['energy_j'], es['energy_j'], 3)} | "
+                  f"{pair(eb['scrub_j'], skid, 3)} | {outcome} | {off} | "
+                  f"{pair(mm(bend.get('slid_m')), mm(twin.get('slid_m')), 1)} | {lift} | {bend.get('timestep_s', '-')} |")
             rows.append({"mu_wall": mu, "R_over_D": r, "angle_deg": angle, "arc_m": arc, "bend": bend,
                          "straight": twin})
     print("lift check over the rows: " + ", ".join(f"{k} {v}" for k, v in record.items()))
