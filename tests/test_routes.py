@@ -282,7 +282,7 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
              "straight": passage(ts, es, True), "analytic": {"time_s": ta, "energy_j": ea},
              "equations": {"time_s": qt, "energy_j": qe, "scrub_j": 0.1, "route_stop": "reached the route's end"},
              "equations_straight": {"time_s": ta, "energy_j": ea},
-             "mujoco_vs_equations": {"time_s": tb / qt - 1, "energy_j": eb / qe - 1}}
+             "mujoco_vs_equations": {"time_s": tb / qt - 1, "energy_j": eb / qe - 1, "outcome": "miss"}}
             for r, w, tb, eb, ts, es, ta, ea, qt, qe in ((2.0, 0.7, 1.2, 0.9, 1.3, 1.4, 1.32, 1.41, 1.25, 1.0),
                                                          (5.0, 1.46, 2.74, 2.91, 2.73, 2.91, 2.735, 2.913, 2.75, 2.9))]
     study = {"rows": rows, "reference": {"steady_speed_m_s": 0.53, "energy_per_metre_j_m": 2.0},
@@ -294,7 +294,8 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
     assert float(read[1]["equations_time_s"]) == 2.75
     assert float(read[0]["mujoco_vs_equations_time"]) == pytest.approx(1.2 / 1.25 - 1, rel=1e-12)
     table = format_table(study)
-    assert "2.74 / 2.73 / 2.735" in table and "2.75 / 2.735, 2.9 / 2.913" in table and "-4.00 %, -10.00 %" in table
+    assert "2.74 / 2.73 / 2.735" in table and "2.75 / 2.735, 2.9 / 2.913" in table
+    assert "-4.00 %, -10.00 %: miss" in table and read[0]["mujoco_vs_equations"] == "miss"
     fig = bend_figure(study)
     assert isinstance(fig, Figure)
     bend = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "bend:time"][0]

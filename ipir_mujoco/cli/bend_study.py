@@ -64,7 +64,7 @@ COLUMNS = ("plane_deg", "R_over_D", "radius_m", "window_m", "analytic_time_s", "
            "bend_wheel_off_s", "bend_module_off_s", "bend_arm_reach", "bend_residual_ratio", "bend_skid_j",
            "predicted", "bend_potential_j", "note", "equations_time_s", "equations_energy_j", "equations_scrub_j",
            "equations_route_stop", "equations_straight_time_s", "equations_straight_energy_j",
-           "mujoco_vs_equations_time", "mujoco_vs_equations_energy")
+           "mujoco_vs_equations_time", "mujoco_vs_equations_energy", "mujoco_vs_equations")
 
 
 def _flat(row: dict) -> dict:
@@ -74,6 +74,7 @@ def _flat(row: dict) -> dict:
             "equations_scrub_j": e.get("scrub_j"), "equations_route_stop": e.get("error", e.get("route_stop")),
             "equations_straight_time_s": es.get("time_s"), "equations_straight_energy_j": es.get("energy_j"),
             "mujoco_vs_equations_time": versus.get("time_s"), "mujoco_vs_equations_energy": versus.get("energy_j"),
+            "mujoco_vs_equations": versus.get("outcome"),
             "plane_deg": row.get("plane_deg", 0.0), "note": row.get("note"), "bend_potential_j": b.get("potential_j"),
             "R_over_D": row["R_over_D"], "radius_m": row["radius_m"], "window_m": row["window_m"],
             "analytic_time_s": a["time_s"], "analytic_energy_j": a["energy_j"], "straight_time_s": s.get("time_s"),
@@ -116,7 +117,7 @@ def format_table(study: dict) -> str:
 
     header = ["plane [deg]", "R/D", "window [m]", "time [s] bend / straight / analytic",
               "energy [J] bend / straight / analytic", "equations: time [s], energy [J] bend / straight",
-              "MuJoCo - equations: time, energy", "wheels off [s]", "closed form", "outcome"]
+              "MuJoCo - equations: time, energy: class", "wheels off [s]", "closed form", "outcome"]
     rows = []
     for row in study["rows"]:
         f = _flat(row)
@@ -125,7 +126,8 @@ def format_table(study: dict) -> str:
                      f"{num(f['bend_energy_j'])} / {num(f['straight_energy_j'])} / {num(f['analytic_energy_j'])}",
                      f"{num(f['equations_time_s'])} / {num(f['equations_straight_time_s'])}, "
                      f"{num(f['equations_energy_j'])} / {num(f['equations_straight_energy_j'])}",
-                     f"{pct(f['mujoco_vs_equations_time'])}, {pct(f['mujoco_vs_equations_energy'])}",
+                     f"{pct(f['mujoco_vs_equations_time'])}, {pct(f['mujoco_vs_equations_energy'])}: "
+                     f"{f['mujoco_vs_equations'] or 'n/a'}",
                      num(f["bend_wheel_off_s"], 3),
                      _short(f["predicted"] or ""),
                      "passed" if f["bend_passed"] else f"stopped: {f['bend_route_stop']}"])

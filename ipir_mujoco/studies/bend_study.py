@@ -20,9 +20,11 @@ The equations along the same route: each case's route (the bend, and its straigh
 analytic route model (``analytic-unilateral`` with the route: the linkage spanning the bend's chord, gravity at
 each module, the wheels' scrub in its closed form; docs/model.md, "The equations along a route"), over the same
 window (:func:`ipir_mujoco.studies.route_compare.window`): its passage time, energy and scrub work (``equations``
-in each case's record), and MuJoCo's difference from it in the bend (``mujoco_vs_equations``: time and energy,
-MuJoCo's over the equations' less one), so that a bend's cost in MuJoCo is judged against an independent model of
-the same bend, not only against MuJoCo's own straight pipe.
+in each case's record), and MuJoCo's difference from it in the bend (``mujoco_vs_equations``: time, and energy
+over what the robot dissipated, MuJoCo's less the equations'; and the class
+:func:`ipir_mujoco.studies.route_compare.judge` gives it: both within 2 %, or a lift or a scrub the closed-form
+checks predicted and MuJoCo showed, or a stop, or a miss), so that a bend's cost in MuJoCo is judged against an
+independent model of the same bend, not only against MuJoCo's own straight pipe.
 
 ``planes`` [deg]: the bend's plane turned about the pipe's axis (:mod:`ipir_mujoco.core.route`): 0 turns it in the
 horizontal plane, across gravity (the default); 90 turns it up, in the plane of gravity, so that the route leaves
@@ -54,7 +56,7 @@ from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
 
 from .pool import map_unordered
-from .route_compare import relative
+from .route_compare import judge
 from .route_compare import window as route_window
 
 RATIOS = (0.6, 1.0, 1.5, 2.0, 3.0, 5.0, 7.5, 10.0)  # R/D, the default
@@ -133,7 +135,8 @@ def _passage(run, route, first: int, last: int) -> dict:
            "route_arm_reach": s["route_arm_reach"], "predicted": s["route_fit"]["predicted"],
            "wheels_keep_wall": all(b["wheels_keep_wall"] for b in s["route_fit"]["bends"]),
            "timestep_s": run.settings["timestep"], "residual_ratio": s["accuracy"].get("residual_ratio"),
-           "skid_j": run.energy.get("skid_j")}
+           "skid_j": run.energy.get("skid_j"), "lift_predicted": s.get("lift_predicted"),
+           "slid_m": max(float(run.series[c][-1]) for c in ("slid1", "slid2")) if "slid1" in run.series else None}
     passage = route_window(run, first, last)
     out.update(passage, passed=passage["time_s"] is not None)
     return out
@@ -247,11 +250,13 @@ def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: i
             window = params.L + math.pi / 2 * r * params.pipe_diameter
             analytic = {"time_s": window / ref["steady_speed_m_s"], "energy_j": window * ref["energy_per_metre_j_m"]}
             equations = bend.get("equations") or {}
+            versus = judge(equations, bend, work="energy_j", done="passed")
             rows.append({"plane_deg": p, "R_over_D": r, "radius_m": r * params.pipe_diameter, "window_m": window,
                          "bend": bend, "straight": straight, "analytic": analytic, "note": twin_note(bend, straight),
                          "equations": equations, "equations_straight": straight.get("equations") or {},
-                         "mujoco_vs_equations": {key: relative(bend.get(key), equations.get(key))
-                                                 for key in ("time_s", "energy_j")}})
+                         "mujoco_vs_equations": {"time_s": versus["time_diff"], "energy_j": versus["work_diff"],
+                                                 "outcome": versus["outcome"], "lift": versus["lift"],
+                                                 "scrub": versus["scrub"]}})
     return {"rows": rows, "reference": ref,
             "settings": {"lead_in_m": LEAD_IN, "exit_m": EXIT, "dt_out_s": DT_OUT, "angle_deg": 90.0,
                          "planes_deg": list(planes),

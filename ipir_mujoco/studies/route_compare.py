@@ -118,35 +118,38 @@ def relative(a: float | None, b: float | None) -> float | None:
     return None if a is None or b is None or b == 0 else a / b - 1.0
 
 
-def work_difference(equations: dict, mujoco: dict) -> float | None:
+def work_difference(equations: dict, mujoco: dict, work: str = "net_work_j") -> float | None:
     """MuJoCo's motor work less the equations' (each net of the kinetic energy the robot has at the route's end:
     ``net_work_j``) over the energy put through the robot: the equations' net motor work, or the work their
     resistances dissipated where that is more (a route downhill, where gravity does part of the work and the
     motor's share is small or negative: a difference in what the robot dissipates is judged against what it
-    dissipates, not against the small difference of two large terms); None where either is missing."""
-    w_eq, w_mj, lost = equations.get("net_work_j"), mujoco.get("net_work_j"), equations.get("dissipated_j")
+    dissipates, not against the small difference of two large terms); None where either is missing. ``work``: the
+    records' key to compare (a bend's window: ``energy_j``, what the robot dissipated there)."""
+    w_eq, w_mj, lost = equations.get(work), mujoco.get(work), equations.get("dissipated_j")
     if w_eq is None or w_mj is None:
         return None
     scale = max(abs(w_eq), lost or 0.0)
     return None if scale == 0 else (w_mj - w_eq) / scale
 
 
-def judge(equations: dict, mujoco: dict) -> dict:
-    """The comparison of two engine records (:func:`compare_route`'s record from them)."""
+def judge(equations: dict, mujoco: dict, work: str = "net_work_j", done: str = "route_done") -> dict:
+    """The comparison of two engine records (:func:`compare_route`'s record from them); ``work``: the key of the
+    work compared (:func:`work_difference`), ``done``: of whether a run got through (a bend's window: ``energy_j``
+    and ``passed``)."""
     lift = {"predicted": bool(mujoco.get("lift_predicted")), "happened": (mujoco.get("route_wheel_off_s") or 0.0) > 0}
     scrub = {"predicted": (equations.get("scrub_j") or 0.0) > 0 or bool(mujoco.get("scrub_predicted")),
              "happened": (mujoco.get("slid_m") or 0.0) >= SCRUB_FLOOR}
     record = {"equations": equations, "mujoco": mujoco, "lift": lift, "scrub": scrub,
               "time_diff": relative(mujoco.get("time_s"), equations.get("time_s")),
-              "work_diff": work_difference(equations, mujoco)}
-    record["outcome"] = classify(record)
+              "work_diff": work_difference(equations, mujoco, work)}
+    record["outcome"] = classify(record, done)
     return record
 
 
-def classify(record: dict) -> str:
+def classify(record: dict, done: str = "route_done") -> str:
     """The record's class (module docstring): 'agree', 'lift', 'scrub', 'stopped (both|MuJoCo|equations)' or
-    'miss'."""
-    done = (bool(record["equations"].get("route_done")), bool(record["mujoco"].get("route_done")))
+    'miss'; ``done``: the engine records' key of whether a run got through."""
+    done = (bool(record["equations"].get(done)), bool(record["mujoco"].get(done)))
     if not all(done):
         return "stopped (" + ("both" if not any(done) else "MuJoCo" if done[0] else "equations") + ")"
     diffs = (record["time_diff"], record["work_diff"])
