@@ -10,6 +10,7 @@ slider-crank kinematics, the paper's hybrid model, the one-way-clutch model
 inverse kinetostatics.
 """
 
+from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.older_paths import keep_older_paths, lazy_names
 from ipir_mujoco.core.limits import CLUTCH_RULES
@@ -48,6 +49,8 @@ def simulate(params: RobotParams, geometry: str = "approx", clutch: str = "kinem
     rigid clutches with unlimited grip).
     """
     params = require_params(params)
+    check_text("geometry", geometry, "approx, exact")
+    check_text("clutch", clutch, ", ".join(CLUTCH_RULES))
     try:
         geometry = Geometry(geometry).value
     except ValueError:

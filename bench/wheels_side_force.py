@@ -5,7 +5,7 @@ Run on demand from the repository root (about a minute on 2 busy cores):
     python bench/wheels_side_force.py [--slips 0.01,0.02,0.05,0.1,0.3] [--steps 1e-4,5e-5,2.5e-5]
                                       [--set NAME=VALUE]... [--smoke]
 
-The rig (:func:`ipir_mujoco.engine.builders.pipe_rig.cornering_rig`): a ring of the default robot's legs (module
+The rig (:func:`ipir_mujoco.engine.kinds.wheels.rig.cornering_rig`): a ring of the default robot's legs (module
 1's: their springs, steer hinges, hubs and wheels as :func:`ipir_mujoco.engine.builders.wheels_model.add_leg`
 builds them) on a carriage driven at 0.3 m/s along a straight pipe, its axis turned off the pipe's by the slip
 angle, gravity off, mu_wall 0.5 unless --set gives one; steady after 0.3 s, means over the next 0.1 s. Per slip
@@ -23,7 +23,7 @@ import argparse
 import sys
 
 from ipir_mujoco.core.params import RobotParams, parse_overrides
-from ipir_mujoco.engine.builders.pipe_rig import corner, cornering_law, cornering_rig
+from ipir_mujoco.engine.kinds.wheels.rig import corner, cornering_law, cornering_rig
 from ipir_mujoco.engine.builders.wheels_model import leg_count
 
 SPEED = 0.3  # m/s

@@ -32,6 +32,8 @@ def check_output_dir(out: str | Path, option: str = "--out", files: Iterable[str
     and each of the ``files`` and ``folders`` the command will write there is free or of that kind
     (:func:`check_names`). Nothing is created.
     """
+    if not str(out).strip():  # Path('') is '.': an empty --out "$DIR" would write into the current folder
+        raise ParameterError(f"{option} {str(out)!r} names no folder; give a folder path")
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ParameterError(f"{option} {str(out)!r} exists and is not a folder; give a folder path")

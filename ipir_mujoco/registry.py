@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 from . import interrupts
 from .core.errors import ParameterError, ParameterTypeError
 from .core.limits import CLUTCH_RULES as RULES  # the clutch rules (--clutch)
+from .core.limits import MAX_T_END, check_run_options
 from .core.params import RobotParams, check_real, check_whole, require_params
 from .engine.kinds import KINDS  # the model kinds' declarations (no MuJoCo: engine/kinds/__init__.py)
 from .engine.kinds.base import MUJOCO_CLUTCHES  # the MuJoCo clutches a variant names (--mujoco-clutch)
@@ -145,10 +146,12 @@ def variant(name: str | Variant) -> Variant:
     """The variant named ``name`` (canonical or an alias); ParameterError listing the names otherwise."""
     if isinstance(name, Variant):
         return name
-    if isinstance(name, str):
-        key = ALIASES.get(name, name)
-        if key in VARIANTS:
-            return VARIANTS[key]
+    if not isinstance(name, str):
+        raise ParameterTypeError(f"variant {name!r} ({type(name).__name__}) is not a variant's name; allowed: "
+                                 f"{', '.join(NAMES)}")
+    key = ALIASES.get(name, name)
+    if key in VARIANTS:
+        return VARIANTS[key]
     raise ParameterError(f"variant {name!r} is unknown (a model in an engine, ENGINE-MODEL[-RULE]); allowed: "
                          f"{', '.join(NAMES)}")
 
@@ -240,7 +243,8 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
     starts from; a run whose modules skid (finite grip on the slides, the wheels) is kept at this step halved as
     many times as its skid check records (``RunResult.settings['skid_check']``, one entry a halving; its
     ``settings['timestep']`` is the step kept); None for the analytic engines."""
-    v = variant(name)
+    v, params = variant(name), require_params(params)
+    t_end, dt_out = check_run_options(t_end, dt_out)
     if not v.is_mujoco:
         return None
     from .engine.kinds import kind_for
@@ -340,7 +344,7 @@ def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
     (:func:`ipir_mujoco.analytic.inverse.inverse_kinetostatics`) on the paper's first-order geometry
     ('paper', L >> r) or the exact slider-crank ('exact'); None for 'none'. Computed above the engines and
     handed to each as data (the MuJoCo engine never runs the equations); cached per parameter set."""
-    if params.drive != "servo" or params.feedforward == "none":
+    if require_params(params).drive != "servo" or params.feedforward == "none":
         return None
     return _table(params)
 
@@ -351,6 +355,13 @@ def _table(params: RobotParams) -> FeedforwardTable:
     from .core.control import TABLE_POINTS, FeedforwardTable, reference_motion
 
     omega, dip = params.omega_target, params.speed_dip
+    lasts = FEEDFORWARD_REVOLUTIONS * 2 * math.pi / omega  # s: the table's motion, at the mean speed omega
+    if lasts > MAX_T_END:  # named by what the user gave, not the table's derived run length
+        raise ParameterError(f"omega_target={omega:g} rad/s with feedforward={params.feedforward!r}: the feedforward "
+                             f"table follows the crank through {FEEDFORWARD_REVOLUTIONS} revolutions at that speed, "
+                             f"{lasts:.3g} s, past the {MAX_T_END:g} s a run may take; allowed: omega_target >= "
+                             f"{FEEDFORWARD_REVOLUTIONS * 2 * math.pi / MAX_T_END:.3g} rad/s with a feedforward, or "
+                             "feedforward=none")
     if dip == 0.0:
         motion = CrankMotion.constant_speed(omega, params.phi0, FEEDFORWARD_REVOLUTIONS)
     else:  # the profile through the dead centres: phi(t) sampled finely, a spline through it

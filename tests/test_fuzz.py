@@ -218,6 +218,27 @@ CASES = [
      "'feedforward' is not a number"),
     (["sweep", "--vary", "L=0.1,0.2", "--resume", "--out", "{f}/swp_garbage/results.csv"], 2, "is not a folder"),
     (["render", "--t-end", "0.1", "--out", "/sys/ipir-mujoco-test/x.gif"], 2, "cannot write in"),
+    # round 4 (issue 53): every option and range checked before the first run, the value the user gave named
+    (["optimize", "--vary", "drive=0:1", "--objective", "max:revolutions", "--out", "{f}/o"], 2,
+     "--vary 'drive=0:1': drive is not a number"),
+    (["optimize", "--vary", "L=0.01:0.04", "--objective", "max:revolutions", "--out", "{f}/o"], 2,
+     "no design of the study can have L=0.01"),
+    (["optimize", "--vary", "m1=-1:1", "--objective", "max:revolutions", "--out", "{f}/o"], 2,
+     "m1=-1.0 is out of range"),
+    (["optimize", "--vary", "L=0.1:0.3", "--objective", "max:revolutions", "--verify", "", "--out", "{f}/o"], 2,
+     "--verify '' names no model"),
+    (["sensitivity", "--vary", "L=0.1:0.3", "--metric", "revolutions", "--engine", "", "--out", "{f}/o"], 2,
+     "engine '' is unknown"),
+    (["sweep", "--vary", "L=0.1,0.2", "--set", "omega_target=5", "--out", "{f}/s"], 2, "only drive=servo"),
+    (["clutch-study", "--points", "startup", "--set", "omega_target=5", "--out", "{f}/c"], 2,
+     "the startup point runs drive=torque (the study sets it): omega_target=5.0"),
+    (["climb", "--inclines", "0", "--set", "omega_target=5", "--out", "{f}/c"], 2, "only drive=servo"),
+    (["simulate", "--drive", "servo", "--feedforward", "exact", "--set", "omega_target=1e-9"], 2,
+     "omega_target=1e-09 rad/s with feedforward='exact'"),
+    (["render", "--t-end", "1e9", "--out", "{f}/x.gif"], 2, "t_end=1e+09 is out of range"),  # no "simulating" line
+    (["simulate", "--t-end", "0.01", "--out", ""], 2, "--out '' names no folder"),
+    (["sweep", "--vary", "L=0.1,0.2", "--study", "", "--out", "{f}/s"], 2, "--study '' names no file"),
+    (["simulate", "--engine", "mujoco", "--mujoco-model", "wheels", "--route", ""], 2, "--route '' names no file"),
 ]
 
 
@@ -324,6 +345,31 @@ def test_numbers_of_every_numeric_type_are_numbers(value):
     assert check_run_options(value, Fraction(1, 1000)) == (2.0, 0.001)
 
 
+# round 4 (issue 53): a wrong type anywhere in the public API is a ParameterTypeError (a ValueError and a
+# TypeError) naming it, not an AttributeError or TypeError from inside pathlib or re
+WRONG_TYPES = [
+    (lambda: _route().read_route(None), "path=None (NoneType) is not a path"),
+    (lambda: _route().read_route(3), "path=3 (int) is not a path"),
+    (lambda: _route().read_route(b"route.toml"), "path=b'route.toml' (bytes) is not a path"),
+    (lambda: _route().route_from_tables([{"kind": ["straight"], "length": 0.4}]),
+     "kind=['straight'] is not a string"),
+    (lambda: _route().route_from_tables("straight"), "is not a list of [[segment]] tables"),
+    (lambda: _optimize().parse_objective(None), "objective=None (NoneType) is not a string"),
+    (lambda: _optimize().parse_constraint(3), "constraint=3 (int) is not a string"),
+    (lambda: Study(3), "axes=3 is not a list of axes"),
+    (lambda: registry.timestep("mujoco-ratchet", None, 1.0, 1e-3), "params=None is not a RobotParams"),
+    (lambda: registry.run(None, RobotParams(), 0.1), "variant None (NoneType) is not a variant's name"),
+    (lambda: analytic.simulate(RobotParams(), None, "kinematic", 0.1), "geometry=None (NoneType) is not a string"),
+    (lambda: load_params(None, "m1=2"), "overrides='m1=2' is not a list of NAME=VALUE strings"),
+    (lambda: RobotParams(m1="1"), "m1='1' is not a number"),
+    (lambda: RobotParams(drive=1), "drive=1 is not a string"),
+    (lambda: _study("clutch_study").run_study(RobotParams(), (1e4,), (0.0,), "startup"), "points='startup'"),
+    (lambda: _study("bend_study").run_study(RobotParams(), "2"), "ratios='2' (str) is not a list"),
+    (lambda: _study("compare").compare_runs(None, None), "a=None is not a RunResult"),
+    (lambda: _study("frames").read_sweep(None), "folder=None (NoneType) is not a path"),
+]
+
+
 @pytest.mark.parametrize("call,fragment", [
     (lambda: RobotParams(mass=1), "unknown parameter 'mass'"),
     (lambda: RobotParams(m1="1"), "m1='1' is not a number"),
@@ -379,6 +425,7 @@ def test_numbers_of_every_numeric_type_are_numbers(value):
     (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", resume="no"), "resume='no'"),
     (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", workers=0), "workers=0"),
     (lambda: run_sweep(Study((parse_vary("L=0.1,0.2"),)), "s", on_row=3), "on_row=3 is not callable"),
+    *WRONG_TYPES,  # round 4: a wrong type anywhere in the public API
 ])
 def test_python_api_bad_input_is_a_parameter_error_naming_the_value(call, fragment, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # a call that wrongly went ahead would write here, and be seen below
@@ -406,6 +453,18 @@ def _bend_study():
     return bend_study
 
 
+def _route():
+    from ipir_mujoco.core import route
+
+    return route
+
+
+def _study(name):
+    import importlib
+
+    return importlib.import_module(f"ipir_mujoco.studies.{name}")
+
+
 def _problem():
     o = _optimize()
     return o.Problem((parse_vary("L=0.1:0.3"),), (o.Objective("max", "revolutions"),), budget=2, verify=None)
@@ -416,6 +475,7 @@ def _problem():
     lambda: registry.run("mujoco-ratchet", RobotParams(), 0.01, foo=1),
     lambda: _optimize().Problem("L=0.1:0.3", (_optimize().Objective("max", "revolutions"),)),
     lambda: run_sweep("x", "sweep"),
+    *[call for call, _ in WRONG_TYPES],
 ])
 def test_a_wrong_type_is_both_a_parameter_error_and_a_type_error(call):
     """docs/cli.md, 'From Python': one except ValueError catches every bad input; a wrong type is a TypeError

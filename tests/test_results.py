@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -84,9 +85,12 @@ def test_container_refuses_missing_or_ragged_columns():
         RunResult("test", "exact", "kinematic", RobotParams(), 2.0, series, {})
 
 
-def test_json_refuses_nan(tmp_path):
-    with pytest.raises(ValueError):
-        write_json(tmp_path / "x.json", {"a": float("nan")})
+def test_json_writes_a_number_that_is_not_finite_as_null(tmp_path):
+    """JSON has no NaN or infinity: the writer puts null (docs/cli.md says what it means per key), so that a
+    valid run never ends in an internal error at its last step and strict readers take every file."""
+    write_json(tmp_path / "x.json", {"a": float("nan"), "b": [float("inf"), 1.5]})
+    text = (tmp_path / "x.json").read_text()
+    assert json.loads(text, parse_constant=lambda name: pytest.fail(name)) == {"a": None, "b": [None, 1.5]}
 
 
 def test_the_residual_ratio_is_against_the_energy_put_through_the_robot():

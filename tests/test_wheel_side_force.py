@@ -1,6 +1,7 @@
 """The wheels' side-force law (docs/model.md, "The wheels' side force") as MuJoCo builds it: one ring of the
-wheeled model's legs (module 1's, built by ``wheels_model.add_leg``) on a carriage driven along a straight pipe
-with its axis turned off the pipe's by a slip angle (``pipe_rig.cornering_rig``), gravity off.
+wheeled model's legs (module 1's, built by ``kinds.wheels.model.add_leg``) on a carriage driven along a straight
+pipe with its axis turned off the pipe's by a slip angle (``ipir_mujoco.engine.kinds.wheels.rig.cornering_rig``),
+gravity off.
 
 Wheel k slips at alpha_k = atan(tan(slip) e_k . y) and is pushed across its rolling direction with
 min(C |alpha_k|, mu_wall N_k), C = cornering_coefficient x its leg's preload; below the limit it steers by alpha_k
@@ -25,7 +26,7 @@ import math
 import pytest
 
 from ipir_mujoco.analytic import RobotParams
-from ipir_mujoco.engine.builders.pipe_rig import corner, cornering_law, cornering_rig
+from ipir_mujoco.engine.kinds.wheels.rig import corner, cornering_law, cornering_rig
 from ipir_mujoco.engine.builders.wheels_model import cornering_stiffness, trail
 
 DT, SPEED, DURATION, WINDOW = 5e-5, 0.3, 0.2, 0.05

@@ -88,6 +88,8 @@ def check_input_file(option: str, path: str) -> None:
     """A file the user names exists and is a file (not a folder), or a one-line ParameterError."""
     from pathlib import Path
 
+    if not str(path).strip():  # Path('') is '.', the current folder
+        raise ParameterError(f"{option} {path!r} names no file; give a file")
     target = Path(path)
     if target.is_dir():
         raise ParameterError(f"{option} {path!r} is a folder; give a file")

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from ipir_mujoco.core.errors import ParameterError
 
@@ -26,6 +25,8 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.core.results import json_text
+
     from ..studies.compare import compare_runs, format_comparison, load_run
     from ..studies.measured import compare_measured, format_measured_comparison, is_measured_csv, read_measured
 
@@ -37,8 +38,8 @@ def run(args: argparse.Namespace) -> int:
         measured = read_measured(args.run_a if measured_a else args.run_b)
         result = compare_measured(measured, load_run(args.run_b if measured_a else args.run_a),
                                   tolerance=args.tolerance, measured_is_a=measured_a)
-        print(json.dumps(result, allow_nan=False) if args.json else format_measured_comparison(result))
+        print(json_text(result) if args.json else format_measured_comparison(result))
         return EXIT_OK
     result = compare_runs(load_run(args.run_a), load_run(args.run_b), tolerance=args.tolerance)
-    print(json.dumps(result, allow_nan=False) if args.json else format_comparison(result))
+    print(json_text(result) if args.json else format_comparison(result))
     return EXIT_OK

@@ -50,8 +50,12 @@ def problem_from_args(args: argparse.Namespace):
     axes = tuple(parse_vary(v) for v in args.vary)
     objectives = tuple(parse_objective(o) for o in args.objective)
     constraints = tuple(parse_constraint(c) for c in args.constraint)
+    if args.verify is not None and not args.verify.strip():
+        raise ParameterError(f"--verify {args.verify!r} names no model; allowed: a model variant (default "
+                             f"{DEFAULT_VERIFY}), or none to skip the verification")
     verify = DEFAULT_VERIFY if args.verify is None else (None if args.verify.strip() == "none" else args.verify)
-    return Problem(axes, objectives, constraints, model_params(args), args.engine or DEFAULT_ENGINE, verify,
+    engine = DEFAULT_ENGINE if args.engine is None else args.engine  # '' is refused by name, not read as the default
+    return Problem(axes, objectives, constraints, model_params(args), engine, verify,
                    design_t_end(args), bool(args.until_steady), DEFAULT_BUDGET if args.budget is None else args.budget,
                    0 if args.seed is None else args.seed)
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ipir_mujoco import registry, terminal
 from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.limits import DEFAULT_WALL_BUDGET_S
 
 from .common import EXIT_OK, add_model_options, check_input_file, model_params, progress_printer, tenths_printer
 from .simulate import T_END, T_END_ROUTE
@@ -38,6 +39,9 @@ def add_parser(commands) -> None:
     ren.add_argument("--fps", type=float, default=25.0, help="frames per second of the video (default 25)")
     ren.add_argument("--width", type=int, default=640, help="frame width in pixels, even (default 640)")
     ren.add_argument("--height", type=int, default=360, help="frame height in pixels, even (default 360)")
+    ren.add_argument("--wall-budget", type=float, default=DEFAULT_WALL_BUDGET_S, metavar="SECONDS",
+                     help=f"stop the run with an error after SECONDS of wall time, its accuracy checks' repeats "
+                          f"included (default {DEFAULT_WALL_BUDGET_S:g} s; 'inf' for no limit), as simulate's")
     add_model_options(ren)
     ren.set_defaults(handler=run)
 
@@ -62,14 +66,25 @@ def run(args: argparse.Namespace) -> int:
     if out.is_dir():
         raise ParameterError(f"--out {str(out)!r} is a folder; give a video file name (.gif or .mp4)")
     check_output_dir(out.parent)  # a folder that cannot be written is refused now, not after every frame
+    if not args.wall_budget > 0:  # nan and <= 0; inf is no limit
+        raise ParameterError(f"--wall-budget {args.wall_budget:g} is out of range; allowed: a number of seconds "
+                             "> 0, or inf (no limit)")
     params = model_params(args)
     variant = registry.from_flags("mujoco", None, args.clutch, args.mujoco_clutch, args.mujoco_model)
     t_end = args.t_end if args.t_end is not None else T_END_ROUTE if route is not None else T_END
     options = {} if route is None else {"route": route}  # the wheeled model's accuracy monitor warns by default
     until = " (or to the route's end)" if route is not None else ""
-    print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
+    report, said = progress_printer(t_end), []
+
+    def progress(t: float | None = None) -> None:  # the line once the run steps (every check of its input passed
+        if not said:  # by then), or after a run too short to report any step
+            said.append(t)
+            print(f"simulating {t_end:g} s in MuJoCo{until} ...", file=sys.stderr, flush=True)
+        if report is not None and t is not None:
+            report(t)
     try:
-        result = registry.run(variant, params, t_end, progress=progress_printer(t_end), **options)
+        result = registry.run(variant, params, t_end, progress=progress, wall_budget_s=args.wall_budget, **options)
+        progress()
     finally:
         terminal.end_status()  # a run that ended before its t_end (a route's end) leaves it standing
     title = f"MuJoCo, {'one-way clutches' if variant.rule == 'unilateral' else 'the paper' + chr(39) + 's rule'} " \

@@ -40,7 +40,8 @@ def run(args: argparse.Namespace) -> int:
     drawn = []
     with scheduler_executor(args.scheduler) as executor:
         indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
-                                  engine=args.engine or "analytic-unilateral", t_end=design_t_end(args),
+                                  engine="analytic-unilateral" if args.engine is None else args.engine,
+                                  t_end=design_t_end(args),
                                   until_steady=bool(args.until_steady),
                                   samples=64 if args.samples is None else args.samples,
                                   seed=0 if args.seed is None else args.seed, resume=args.resume,

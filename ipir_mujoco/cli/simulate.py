@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from typing import TYPE_CHECKING
 
 from ipir_mujoco import registry
@@ -168,6 +167,11 @@ def _estimate_text(run: RunResult) -> str:
             f"{100 * run.steady_target:.2g} %)")
 
 
+def _number(value) -> str:
+    """A figure as the text summary shows it: n/a where it has no value (a check that could not run)."""
+    return "n/a" if value is None else f"{value:.3g}"
+
+
 def format_summary(run: RunResult, until_steady: bool = False) -> str:
     """The human-readable summary ``simulate`` prints (``until_steady``: the run was asked to stop there)."""
     s = run.summary
@@ -219,9 +223,12 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
         last = (run.settings.get("skid_check") or [{}])[-1]
         error = accuracy.get("skid_difference")
         lines.append(f"  skid check {accuracy['skid_check']}: the run at timestep {run.settings['timestep']:.3g} s "
-                     f"({len(run.settings.get('skid_check') or [])} halvings); largest estimated error "
+                     f"({sum(bool(h.get('differences')) for h in run.settings.get('skid_check') or [])} halvings); "
+                     "largest estimated error "
                      f"{last.get('figure')} " + ("n/a" if error is None else f"{error:.2g}")
                      + f" of it, its accuracy {accuracy['tolerances']['skid_difference']:.2g}")
+        lines += [f"  skid check failed: {v['reason']}" for v in accuracy.get("violations", [])
+                  if v.get("figure") == "skid_difference" and v.get("reason")]
     return "\n".join(lines)
 
 
@@ -328,7 +335,7 @@ def save_run_mjcf(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ipir_mujoco.core.results import write_json, write_mode_changes
+    from ipir_mujoco.core.results import json_text, write_json, write_mode_changes
 
     from ..output import check_output_dir, staged_output
 
@@ -350,7 +357,7 @@ def run(args: argparse.Namespace) -> int:
             write_json(staging / "summary.json", record)
             write_paper_figures([result], staging)
     if args.json:
-        print(json.dumps(record, allow_nan=False))
+        print(json_text(record))
     else:
         print(format_summary(result, args.until_steady))
         if args.out is not None:

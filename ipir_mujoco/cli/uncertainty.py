@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_output_dir(args.out, files=("uncertainty.json", "samples.csv", "uncertainty.png"))
     base = model_params(args)
-    from_file, correlation = read_dist_file(args.dist_file) if args.dist_file else ([], None)
+    from_file, correlation = read_dist_file(args.dist_file) if args.dist_file is not None else ([], None)
     dists = combine([parse_dist(d) for d in args.dist], from_file)
     metrics = tuple(dict.fromkeys(check_metric(m) for m in args.metric))
     events = tuple(parse_event(e) for e in args.event)

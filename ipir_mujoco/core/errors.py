@@ -38,3 +38,15 @@ class SimulationError(RuntimeError):
     message : str
         The one line.
     """
+
+
+def refuse_all_failed(errors, what: str = "runs", where: str = "") -> None:
+    """A study every one of whose runs failed has failed itself (the command line: exit status 1, not a table of
+    errors with exit status 0): a SimulationError naming how many and the first failure. ``errors``: one per
+    run, its one-line error or None / '' where it gave a result; ``where``: where the rows are kept, if
+    anywhere."""
+    errors = list(errors)
+    if errors and all(errors):
+        kept = f" (the rows are in {where})" if where else ""
+        raise SimulationError(f"every one of the {len(errors)} {what} failed; the first: "
+                              f"{' '.join(str(errors[0]).split())}{kept}")

@@ -3,11 +3,12 @@ cannot be read, never a traceback."""
 
 from __future__ import annotations
 
+import os
 import tomllib
 from pathlib import Path
 from typing import Any
 
-from .errors import ParameterError
+from .errors import ParameterError, ParameterTypeError
 
 MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far past any real one, and a bound
 # on what /dev/zero or a mistyped multi-GB file would make the command read into memory
@@ -16,7 +17,13 @@ MAX_TEXT_BYTES = 100_000_000  # bytes of a config, study or samples file: far pa
 def read_text_file(path: str | Path, what: str, max_bytes: int = MAX_TEXT_BYTES) -> str:
     """A text file's contents as UTF-8, or a ParameterError saying in one line why it cannot be read (also
     for a device or pipe, /dev/zero, and a file past ``max_bytes``, MAX_TEXT_BYTES unless a kind of file has a
-    smaller bound; only max_bytes + 1 bytes are ever read)."""
+    smaller bound; only max_bytes + 1 bytes are ever read). A ``path`` that is not a str or path object (None,
+    bytes, a number) is a ParameterTypeError; an empty one names no file."""
+    if not isinstance(path, (str, os.PathLike)) or isinstance(os.fspath(path), bytes):
+        raise ParameterTypeError(f"{what} path={path!r} ({type(path).__name__}) is not a path; allowed: a str or "
+                                 "pathlib.Path naming a file")
+    if not str(path).strip():  # Path('') is '.', the current folder
+        raise ParameterError(f"{what} {str(path)!r} names no file; give a file")
     path = Path(path)
     try:
         if path.exists() and not path.is_dir() and not path.is_file():

@@ -19,8 +19,24 @@ SAMPLE_BYTES = 20 * 8  # bytes per kept sample (about 20 float64 columns)
 MAX_STEPS = 100_000_000  # MuJoCo steps per run: ~7 min at ~4 us a step (bench/ratchet_step.py); the longest
 # run the engine chooses by itself, 3600 s at its 1e-4 s step, is 3.6e7 steps, so only a tiny given timestep
 # with a long t_end reaches it
+# samples a study keeps per run at most (docs/cli.md, "Entry point and exit status"): a study runs many runs, each
+# worker holds one at a time, and a run's figures are read with a few copies of its ~35 float64 columns: ~56 MB
+# a run, ~250 MB of a worker's memory with the copies. A run that would keep more is sampled more coarsely
+# (:func:`study_dt_out`); its steps stay the ones its accuracy needs
+STUDY_SAMPLES = 200_000
 DEFAULT_WALL_BUDGET_S = 1800.0  # s of wall time a run may take unless told otherwise: the longest default-step
 # run (3600 s of MuJoCo, ~2.5 min) fits ~10 times over, and no run left alone goes on for hours
+
+
+def study_dt_out(t_end: float, dt_out: float, step: float | None = None) -> float:
+    """The output interval [s] of a study's run of ``t_end`` [s] wanted every ``dt_out`` [s]: ``dt_out``, or where
+    that would keep more than STUDY_SAMPLES samples the interval that keeps that many, a whole number of MuJoCo's
+    ``step`` [s] where given (its samples fall on steps). Bounds what every study holds in memory whatever the
+    step its runs need (a finite grip's skids, a stiff clutch's spring)."""
+    if t_end / dt_out + 1 <= STUDY_SAMPLES:
+        return dt_out
+    wanted = t_end / (STUDY_SAMPLES - 1)
+    return wanted if step is None else step * math.ceil(wanted / step * (1 - 1e-12))
 
 
 def check_step_count(t_end: float, timestep: float, t_end_name: str = "t_end",

@@ -21,7 +21,8 @@ from .cycles import STEADY_CYCLES, STEADY_TOL
 from .steady_watch import check_steady_test
 from .errors import ParameterError, ParameterTypeError
 from .limits import (CLUTCH_RULES, DEFAULT_WALL_BUDGET_S, MAX_SAMPLES, MAX_STEPS, MAX_T_END, SAMPLE_BYTES,  # noqa: F401
-                     check_run_options, check_step_count, refuse_steady_without_motor)  # (re-exported)
+                     STUDY_SAMPLES, check_run_options, check_step_count, refuse_steady_without_motor,
+                     study_dt_out)  # (re-exported)
 from .params import as_real, check_whole
 
 
@@ -53,26 +54,30 @@ class RunOptions:
         set_(self, "t_end", t_end)
         set_(self, "dt_out", dt_out)
         if not isinstance(self.until_steady, (bool, np.bool_)):
-            raise ParameterError(f"until_steady={self.until_steady!r} is not a bool; allowed: True or False")
+            raise ParameterTypeError(f"until_steady={self.until_steady!r} is not a bool; allowed: True or False")
         set_(self, "until_steady", bool(self.until_steady))
         tol, cycles = check_steady_test(self.steady_tol, self.steady_cycles)
         set_(self, "steady_tol", tol)
         set_(self, "steady_cycles", cycles)
         if self.progress is not None and not callable(self.progress):
-            raise ParameterError(f"progress={self.progress!r} is not callable; allowed: a function of the "
+            raise ParameterTypeError(f"progress={self.progress!r} is not callable; allowed: a function of the "
                                  "simulated time [s], or None")
         if self.wall_budget_s is None:
             set_(self, "wall_budget_s", DEFAULT_WALL_BUDGET_S)
         else:
             budget = None if isinstance(self.wall_budget_s, bool) else as_real(self.wall_budget_s)
-            if budget is None or math.isnan(budget) or not budget > 0:
+            if budget is None:
+                raise ParameterTypeError(f"wall_budget_s={self.wall_budget_s!r} is not a number; allowed: a number "
+                                         f"of seconds > 0, inf (no limit), or None (the default, "
+                                         f"{DEFAULT_WALL_BUDGET_S:g} s)")
+            if math.isnan(budget) or not budget > 0:
                 raise ParameterError(f"wall_budget_s={self.wall_budget_s!r} is out of range; allowed: a number "
                                      f"of seconds > 0, inf (no limit), or None (the default, "
                                      f"{DEFAULT_WALL_BUDGET_S:g} s)")
             set_(self, "wall_budget_s", None if math.isinf(budget) else budget)
         if self.max_switches is not None:
             if isinstance(self.max_switches, bool) or not isinstance(self.max_switches, (int, np.integer)):
-                raise ParameterError(f"max_switches={self.max_switches!r} is out of range; allowed: a whole "
+                raise ParameterTypeError(f"max_switches={self.max_switches!r} is out of range; allowed: a whole "
                                      "number >= 1")
             set_(self, "max_switches", check_whole("max_switches", self.max_switches, low=1))
 

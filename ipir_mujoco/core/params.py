@@ -156,14 +156,17 @@ class RobotParams:
             meta = f.metadata
             value = getattr(self, f.name)
             if meta["kind"] == "choice":
-                if not isinstance(value, str) or value not in meta["choices"]:
+                if not isinstance(value, str):
+                    raise ParameterTypeError(f"{f.name}={value!r} is not a string; allowed: "
+                                             f"{', '.join(meta['choices'])}")
+                if value not in meta["choices"]:
                     raise ParameterError(f"{f.name}={value!r} is unknown; allowed: {', '.join(meta['choices'])}")
                 continue
             if value is None and meta["none_word"] is not None:
                 continue
             number = as_real(value)
-            if number is None:
-                raise ParameterError(f"{f.name}={value!r} is not a number; allowed: {allowed_text(f.name)}")
+            if number is None:  # a wrong type: a ParameterTypeError (a TypeError too)
+                raise ParameterTypeError(f"{f.name}={value!r} is not a number; allowed: {allowed_text(f.name)}")
             if not math.isfinite(number):
                 raise ParameterError(f"{f.name}={number} is not finite; allowed: {allowed_text(f.name)}")
             if not _inside(number, meta):
@@ -288,6 +291,21 @@ def allowed_text(name: str) -> str:
     return text
 
 
+def check_own_range(name: str, value: Any) -> float:
+    """``value`` as a float if it lies in parameter ``name``'s own allowed range (its row of the table alone, not
+    the rules that tie it to other parameters, as L > r), else a one-line ParameterError naming it: the check of
+    a range of designs (a study's ``--vary``) before any design is made. A parameter that is not a number
+    (``drive``, ``feedforward``) is refused here too."""
+    meta = _FIELDS[name].metadata
+    if meta["kind"] != "number":
+        raise ParameterError(f"{name} is not a number (allowed: {allowed_text(name)}); a study varies numeric "
+                             "parameters only (give it with --set or --drive)")
+    number = as_real(value)
+    if number is None or not math.isfinite(number) or not _inside(number, meta):
+        raise ParameterError(f"{name}={value!r} is out of range; allowed: {allowed_text(name)}")
+    return number
+
+
 def describe_parameters() -> list[dict[str, Any]]:
     """Every parameter: name, meaning, unit, default and allowed range (for listings and reports)."""
     rows = []
@@ -355,11 +373,14 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     Raises :class:`ParameterError` for a malformed item, an unknown name or a
     value that is not a number. Range checks happen when the set is built.
     """
-    if isinstance(items, str):
-        raise ParameterError(f"overrides={items!r} is a single string; allowed: a list of NAME=VALUE strings")
+    if isinstance(items, (str, bytes)) or not isinstance(items, Iterable):
+        raise ParameterTypeError(f"overrides={items!r} is not a list of NAME=VALUE strings; allowed: e.g. "
+                                 "['L=0.3', 'm2=2']")
     values: dict[str, Any] = {}
     for item in items:
-        name, sep, text = str(item).partition("=")
+        if not isinstance(item, str):
+            raise ParameterTypeError(f"overrides holds {item!r}, not a NAME=VALUE string; allowed: e.g. ['L=0.3']")
+        name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
             raise ParameterError(f"--set {item!r} is malformed; expected NAME=VALUE, e.g. L=0.3")
@@ -399,7 +420,7 @@ def load_params(
     values: dict[str, Any] = {}
     if config is not None:
         if not isinstance(config, (str, os.PathLike)):
-            raise ParameterError(f"config={config!r} is not a path; allowed: the path of a TOML file, or None")
+            raise ParameterTypeError(f"config={config!r} is not a path; allowed: the path of a TOML file, or None")
         values.update(read_toml(config))
     if isinstance(overrides, Mapping):
         unknown = [n for n in overrides if n not in PARAMETER_NAMES]
@@ -442,6 +463,20 @@ def refuse_idle_parameters(params: RobotParams) -> None:
             if value != default:
                 raise ParameterError(f"{name}={value!r}{unit} needs {needs}; allowed: {default!r} with "
                                      f"{through}={idle}")
+
+
+def refuse_idle_under(params: RobotParams, drives: Iterable[str]) -> None:
+    """A drive's parameter given (not at its default) in ``params`` that none of ``drives`` acts through, refused
+    in one line naming the first of ``drives`` and the drives that use it: the check of a study that runs one
+    design under drives of its own choosing (each case's ``params.replace(drive=...)`` would otherwise return the
+    parameter to its default without a word)."""
+    drives = tuple(dict.fromkeys(drives))
+    used = {name for drive in drives for name in DRIVE_FIELDS[drive]}
+    defaults = RobotParams()
+    for name in _DRIVEN_BY:
+        value = getattr(params, name)
+        if name not in used and value != getattr(defaults, name):
+            raise ParameterError(_idle_message(f"{name}={'model' if value is None else value!r}", name, drives[0]))
 
 
 def refuse_idle_names(drive: str, names: Iterable[str], what: str = "varied") -> None:

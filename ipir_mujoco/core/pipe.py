@@ -203,7 +203,7 @@ def ring_side_grip(params, module: int, toward: tuple[float, float]) -> float:
 def rigid_wheels(params) -> bool:
     """Whether the wheeled model's wheels are fixed on their axles: ``cornering_coefficient`` rigid, or unlimited
     grip (a steer-compliant wheel held against any load along the pipe would turn off its axis: the wheeled
-    model then builds rigid ones, :func:`ipir_mujoco.engine.builders.wheels_model.steer_compliant`)."""
+    model then builds rigid ones, :func:`ipir_mujoco.engine.kinds.wheels.model.steer_compliant`)."""
     return params.cornering_coefficient is None or params.mu_wall is None
 
 

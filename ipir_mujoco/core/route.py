@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, ParameterTypeError
 
 MAX_SEGMENTS = 100
 MAX_LENGTH = 100.0  # m: a straight's length and a bend's radius at most
@@ -332,7 +332,10 @@ def _value(source: str, k: int, table: dict, key: str, low: float, high: float, 
 
 def route_from_tables(tables: list, source: str = "route") -> Route:
     """A Route from a list of segment tables (dicts as TOML gives them); ParameterError on bad input."""
-    if not isinstance(tables, list) or not 1 <= len(tables) <= MAX_SEGMENTS:
+    if not isinstance(tables, (list, tuple)):
+        raise ParameterTypeError(f"{source}: tables={tables!r} is not a list of [[segment]] tables; allowed: a list "
+                                 "of dicts, e.g. [{'kind': 'straight', 'length': 0.4}]")
+    if not 1 <= len(tables) <= MAX_SEGMENTS:
         raise ParameterError(f"{source}: needs [[segment]] tables; allowed: 1..{MAX_SEGMENTS} segments")
     pieces: list[Piece] = []
     s = 0.0
@@ -343,13 +346,16 @@ def route_from_tables(tables: list, source: str = "route") -> Route:
     up = np.array([0.0, 0.0, 1.0])
     for k, table in enumerate(tables):
         if not isinstance(table, dict):
-            raise ParameterError(f"{source}: segment {k + 1} is not a table; allowed: [[segment]] tables")
+            raise ParameterTypeError(f"{source}: segment {k + 1} is not a table; allowed: [[segment]] tables")
         kind = table.get("kind")
         allowed = {"straight": {"kind", "length", "incline"}, "bend": {"kind", "radius", "angle", "plane"}}
+        if not isinstance(kind, str):
+            raise ParameterTypeError(f"{source}: segment {k + 1}: kind={kind!r} is not a string; allowed: kind = "
+                                     "\"straight\" or \"bend\"")
         if kind not in allowed:
             raise ParameterError(f"{source}: segment {k + 1}: kind={kind!r} is unknown; allowed: kind = "
                                  "\"straight\" or \"bend\"")
-        extra = sorted(set(table) - allowed[kind])
+        extra = sorted(str(key) for key in set(table) - allowed[kind])
         if extra:
             raise ParameterError(f"{source}: segment {k + 1} ({kind}): {extra[0]!r} is unknown; allowed: "
                                  f"{', '.join(sorted(allowed[kind] - {'kind'}))}")

@@ -41,7 +41,7 @@ from typing import Callable
 
 import numpy as np
 
-from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError
 from ipir_mujoco.core.options import heartbeat
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
@@ -76,6 +76,9 @@ class Atlas:
 
     def __post_init__(self) -> None:
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        if not isinstance(self.axes, (tuple, list)) or not all(isinstance(a, Axis) for a in self.axes):
+            raise ParameterTypeError(f"axes={self.axes!r} is not a tuple of Axis; allowed: e.g. "
+                                     "(parse_vary('L=0.1:0.3'),)")
         if not self.axes:
             raise ParameterError("atlas needs at least one --vary NAME=LO:HI[:log]")
         for axis in self.axes:

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import ParameterError, SimulationError
+from ipir_mujoco.core.limits import study_dt_out
 from ipir_mujoco.core.params import RobotParams
 
 if TYPE_CHECKING:  # the atlas command's parser reads this module's defaults without numpy
@@ -167,8 +168,8 @@ def run_side(side: Side, params: RobotParams, t_end: float, until_steady: bool) 
     rung: Rung = RUNGS[side.rung]
     mujoco = registry.variant(rung.variant).is_mujoco
     options = {"accuracy": rung.accuracy} if mujoco else {"wall_budget_s": ANALYTIC_WALL_BUDGET_S}
-    return registry.run(rung.variant, side.params(params), t_end, dt_out=min(1e-3, t_end), until_steady=until_steady,
-                        **options)
+    return registry.run(rung.variant, side.params(params), t_end, dt_out=study_dt_out(t_end, min(1e-3, t_end)),
+                        until_steady=until_steady, **options)
 
 
 def measure(pair: Pair, params: RobotParams, metrics: tuple[str, ...], t_end: float, until_steady: bool) -> dict:

@@ -49,7 +49,8 @@ from typing import Callable, Sequence
 
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError
+from ipir_mujoco.core.checks import check_numbers
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, SimulationError, refuse_all_failed
 from ipir_mujoco.core.options import progress_text
 from ipir_mujoco.core.params import RobotParams, check_whole, require_params
 from ipir_mujoco.core.pipe import check_fit
@@ -114,6 +115,7 @@ def straight_route(params: RobotParams, length: float):
 
 def check_ratios(ratios: Sequence[float], params: RobotParams) -> None:
     """ParameterError (one line) for an R/D the pipe cannot have: above 1/2 (the inner wall), at most 100."""
+    ratios = check_numbers("ratios", ratios, "a list of R/D values, 0.5 < R/D <= 100")
     if not ratios:
         raise ParameterError("--ratios is empty; allowed: one or more R/D values, 0.5 < R/D <= 100")
     for r in ratios:
@@ -243,6 +245,7 @@ def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: i
         progress(f"[{len(results)}/{len(items)}] R/D {r:g} {what}: {status} ({result['wall_s']:.1f} s wall)")
 
     map_unordered(functools.partial(run_case, params), items, workers, done)
+    refuse_all_failed([results[item].get("error") for item in items], "runs")
     rows = []
     for p in planes:
         for r in sorted(ratios):

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ipir_mujoco import registry
+from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, allowed_text
 from ipir_mujoco.core.results import write_json
@@ -57,7 +58,7 @@ class FitRange:
 
 def parse_fit(text: str) -> FitRange:
     """``NAME=LO:HI`` inside the parameter's allowed range, or a one-line ParameterError."""
-    name, sep, spec = str(text).partition("=")
+    name, sep, spec = check_text("fit", text, "NAME=LO:HI").partition("=")
     name = name.strip()
     if not sep:
         raise ParameterError(f"--fit {text!r} is malformed; expected NAME=LO:HI")

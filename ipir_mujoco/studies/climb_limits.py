@@ -41,6 +41,7 @@ from ipir_mujoco.core.cycles import steady_window as settled_cycles  # its own s
 from ipir_mujoco.analytic.dynamics import OneDofDynamics
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.analytic.forces import drive_torque
+from ipir_mujoco.core.options import study_dt_out
 from ipir_mujoco.core.params import RobotParams, check_real
 from ipir_mujoco.core.results import REST_SPEED, RunResult  # REST_SPEED: m/s, at rest below it
 
@@ -155,9 +156,15 @@ def run_engine(engine: str, params: RobotParams, t_end: float, dt_out: float = D
     """One run of ``engine`` (a variant name of :mod:`ipir_mujoco.registry`): to the steady state under the
     motor (``t_end`` [s] the cap), else for ``t_end``. ``every_step``: MuJoCo sampled at each of its steps
     (the timestep it chooses for ``dt_out``), so that a mean over a window is its impulse: a sample holds its
-    step's force, and read every 1 ms a rigid clutch's one-step engagement peaks alias it."""
+    step's force, and read every 1 ms a rigid clutch's one-step engagement peaks alias it) while the run keeps at
+    most STUDY_SAMPLES samples (:func:`ipir_mujoco.core.options.study_dt_out`), else every n-th step."""
+    every_step = every_step and registry.variant(engine).is_mujoco
+    if every_step:
+        step = registry.timestep(engine, params, t_end, dt_out)
+        if study_dt_out(t_end, step, step) != step:  # a long run: every n-th step, within the cap
+            dt_out, every_step = study_dt_out(t_end, step, step), False
     return registry.run(engine, params, t_end, dt_out=dt_out, until_steady=params.drive == "motor",
-                        every_step=every_step and registry.variant(engine).is_mujoco)
+                        every_step=every_step)
 
 
 def steady_window(run: RunResult) -> tuple[float, float, bool]:

@@ -10,8 +10,9 @@ from __future__ import annotations
 import time
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.params import RobotParams, check_real
+from ipir_mujoco.core.errors import ParameterError, refuse_all_failed
+from ipir_mujoco.core.checks import check_numbers
+from ipir_mujoco.core.params import RobotParams, check_real, refuse_idle_parameters, require_params
 
 from . import climb_limits
 from .climb_limits import (CLIMB_VARIANTS, DT_OUT, GRID, T_END, T_END_TORQUE, TOLERANCE_DEG, Progress, bisect_incline,
@@ -36,6 +37,9 @@ def climb_study(params: RobotParams, inclines, engines=CLIMB_VARIANTS, tolerance
     (motor only; empty for a constant torque), "traction": :func:`.traction.traction_study` (finite grip:
     the wheels' limits; unlimited: a note), "rows": :func:`incline_curve`, "engines", "wall_s"}.
     """
+    params = require_params(params)
+    inclines = check_numbers("inclines", inclines, "a list of inclines [deg], -90..90")
+    refuse_idle_parameters(params)  # a parameter no run of the study can use: refused here, not in every run
     if params.drive == "servo":  # its torque at rest depends on the controller's history: no restart limit
         raise ParameterError("drive='servo' in climb: the study's restart limit and steady climb are the constant "
                              "torque's and the motor's (a fixed torque at rest); allowed: --drive torque or motor "
@@ -58,6 +62,7 @@ def climb_study(params: RobotParams, inclines, engines=CLIMB_VARIANTS, tolerance
             limits[engine] = steady_climb_limit(params, engine, low, high, tolerance, t_end, progress, memo)
     traction = traction_study(params, engines, limits, tolerance, t_end, progress, memo)
     rows = incline_curve(params, inclines, engines, t_end, progress)
+    refuse_all_failed([m.get("error") for row in rows for m in row["engines"].values()], "runs of the inclines")
     return {"drive": params.drive, "torque_at_rest_n_m": restart["torque_at_rest_n_m"], "restart": restart,
             "restart_paper_model": paper, "energy_bound": bound,
             "vertical": torque_needed(params.replace(incline=90.0)), "steady_climb": limits, "traction": traction,

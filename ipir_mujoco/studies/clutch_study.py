@@ -23,7 +23,13 @@ Per run (:func:`run_metrics`; cruise: over the steady window, the last
   holds). MuJoCo is sampled at every step
   h <= 0.1 / omega_c: its peak lies within (omega_c h)^2 / 4 <= 2.5e-3 of the
   converged one (entering the spring between two steps, and the turning point
-  between samples, each up to (omega_c h)^2 / 8; mjcf/README.md).
+  between samples, each up to (omega_c h)^2 / 8; mjcf/README.md); every n-th
+  step where that would keep more than STUDY_SAMPLES samples: with a finite
+  grip MuJoCo's skidding carriage (1e-3 of its module's mass) rings on the
+  spring ~30 times faster than omega_c, its step is that much finer, and the
+  bound (carriage rate x n h)^2 / 4 (at most 1) no longer resolves the peak;
+  ``python bench/study_samples.py`` measures the difference every n-th step
+  makes to each peak.
 * ``peak_acceleration_m_s2`` [m/s^2]: the largest |a1|, |a2| (the linkage's
   own accelerations included: at start-up they set it unless an impact is
   harder).
@@ -58,8 +64,11 @@ import numpy as np
 from ipir_mujoco import registry
 from ipir_mujoco.registry import ENGINES
 from ipir_mujoco.core.cycles import cycles, steady_window
-from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.params import RobotParams, check_whole
+from ipir_mujoco.core.checks import check_numbers, check_sequence
+from ipir_mujoco.core.errors import ParameterError, SimulationError, refuse_all_failed
+from ipir_mujoco.core.options import study_dt_out
+from ipir_mujoco.core.params import (RobotParams, check_whole, refuse_idle_parameters, refuse_idle_under,
+                                     require_params)
 
 from ..engine.kinds.timestep import clutch_rate
 from .pool import map_unordered
@@ -159,10 +168,26 @@ def design(base: RobotParams, point: OperatingPoint, stiffness: float | None, ba
     return base.replace(drive=point.drive, clutch_stiffness=stiffness, clutch_backlash=backlash)
 
 
-def analytic_dt_out(params: RobotParams) -> float:
-    """Output interval [s]: at most 1/500 of the fastest clutch period, at most 1e-4 s."""
-    rate = clutch_rate(params)
-    return DT_OUT_MAX if rate == 0 else min(DT_OUT_MAX, 2 * math.pi / rate / OUTPUT_PERIODS)
+def spring_rate(params: RobotParams) -> float:
+    """sqrt(k / min(m1, m2)) [rad/s]: the clutch spring's fastest oscillation on a module (0: rigid). The analytic
+    model's clutch anchor has no mass (a finite grip's skid slides it at the grip), so this is its clutch's rate
+    whatever the grip; MuJoCo's skidding carriage adds a faster mode of its own (:func:`.timestep.clutch_rate`)."""
+    return 0.0 if params.clutch_stiffness is None else math.sqrt(params.clutch_stiffness / min(params.m1, params.m2))
+
+
+def analytic_dt_out(params: RobotParams, t_end: float | None = None) -> float:
+    """Output interval [s]: at most 1/500 of the clutch spring's period (:func:`spring_rate`), at most 1e-4 s, and
+    with ``t_end`` [s] coarse enough to keep at most STUDY_SAMPLES samples (:func:`.options.study_dt_out`: the
+    peak force is sampled whatever the grid, the module docstring)."""
+    rate = spring_rate(params)
+    wanted = DT_OUT_MAX if rate == 0 else min(DT_OUT_MAX, 2 * math.pi / rate / OUTPUT_PERIODS)
+    return wanted if t_end is None else study_dt_out(t_end, wanted)
+
+
+def mujoco_dt_out(t_end: float, timestep: float) -> float:
+    """MuJoCo's output interval [s] for a run of ``t_end`` [s] at ``timestep`` [s]: every step, or every n-th where
+    that would keep more than STUDY_SAMPLES samples (:func:`.options.study_dt_out`)."""
+    return study_dt_out(t_end, timestep, timestep)
 
 
 def plan(base: RobotParams, designs: Sequence[tuple[float, float]], points: Sequence[str],
@@ -170,9 +195,15 @@ def plan(base: RobotParams, designs: Sequence[tuple[float, float]], points: Sequ
     """Every run of the study for ``designs`` [(k [N/m], backlash [m])], checked before any runs: a bad
     value raises a one-line ParameterError (the shared input checks, and MuJoCo's timestep rule)."""
     tasks, rigid_steps = [], {}
+    try:  # a parameter no run of the study can use (the servo's, where the study sets each point's drive)
+        refuse_idle_under(base, (points_table[key].drive for key in points))
+    except ParameterError as exc:
+        first = points_table[points[0]]
+        raise ParameterError(f"the {points[0]} point runs drive={first.drive} (the study sets it): {exc}") from None
     for key in points:
         point = points_table[key]
         rigid = design(base, point, None, 0.0)
+        refuse_idle_parameters(rigid)  # (the clutch's own: damping and backlash with a spring)
         rigid_steps[key] = {registry.timestep(VARIANTS["mujoco"], rigid, point.t_end, DT_OUT_MAX)}
         for k, b in designs:
             params = design(base, point, k, b)
@@ -197,10 +228,12 @@ def run_task(base: RobotParams, point: OperatingPoint, task: Task) -> dict:
     started = time.perf_counter()
     try:
         if task.engine == "analytic":
-            dt_out = analytic_dt_out(params)
+            dt_out = analytic_dt_out(params, point.t_end)
             run = registry.run(VARIANTS["analytic"], params, point.t_end, dt_out=dt_out, **steady)
         else:
-            dt_out = task.timestep  # sampled at every step: an impact peaks between coarser samples
+            # sampled at every step (an impact peaks between coarser samples), or every n-th step where the run
+            # would keep more than STUDY_SAMPLES samples (peak_sampling_bound says what that costs)
+            dt_out = mujoco_dt_out(point.t_end, task.timestep)
             # compliant: the engine's own step rule (it halves the step if its accuracy monitor fails);
             # rigid: the step of the compliant runs it is compared with
             step = None if task.stiffness is not None else task.timestep
@@ -209,20 +242,22 @@ def run_task(base: RobotParams, point: OperatingPoint, task: Task) -> dict:
         return {"error": " ".join(str(exc).split())}
     metrics = run_metrics(run, point)
     metrics.update(wall_s=time.perf_counter() - started, dt_out_s=dt_out,
-                   timestep_s=run.settings.get("timestep"), peak_sampling_bound=_peak_bound(params, task, run))
+                   timestep_s=run.settings.get("timestep"), peak_sampling_bound=_peak_bound(params, task, run, dt_out))
     if run.accuracy is not None:
         metrics["residual_ratio"] = run.accuracy.get("residual_ratio")
     return metrics
 
 
-def _peak_bound(params: RobotParams, task: Task, run) -> float | None:
-    """Relative error bound of the peak force as sampled (see the module docstring); None for rigid runs."""
+def _peak_bound(params: RobotParams, task: Task, run, dt_out: float) -> float | None:
+    """Relative error bound of the peak force as sampled (see the module docstring); None for rigid runs. MuJoCo's
+    at its sampling interval ``dt_out`` [s] (its step, or n of them), with the fastest mode its spring takes part
+    in (with a finite grip the skidding carriage's: :func:`.timestep.clutch_rate`), at most 1: past
+    omega dt_out ~ 2 sampling resolves no peak."""
     if task.stiffness is None:
         return None
-    rate = clutch_rate(params)
     if task.engine == "analytic":  # a maximum located on the dense output to the search's time tolerance
-        return 0.0 if params.clutch_damping == 0 else (rate * PEAK_TIME_TOL * run.t_end) ** 2
-    return (rate * run.settings["timestep"]) ** 2 / 4
+        return 0.0 if params.clutch_damping == 0 else (spring_rate(params) * PEAK_TIME_TOL * run.t_end) ** 2
+    return min(1.0, (clutch_rate(params) * max(run.settings["timestep"], dt_out)) ** 2 / 4)
 
 
 def run_metrics(run, point: OperatingPoint) -> dict:
@@ -340,13 +375,19 @@ def run_study(base: RobotParams, stiffness: Sequence[float] = STIFFNESS, backlas
     ``scaling``: :func:`scaling`; ``settings``, ``wall_s``.
     """
     started = time.perf_counter()
+    base = require_params(base)
     workers = check_whole("workers", (os.cpu_count() or 1) if workers is None else workers, low=1, high=1024)
+    if not check_sequence("points", points) or not all(isinstance(p, str) and p in points_table for p in points):
+        raise ParameterError(f"points={tuple(points)!r}; allowed: one or more of {', '.join(points_table)}")
     if designs is None:
-        designs = [(float(k), float(b)) for k in stiffness for b in backlash]
+        designs = [(k, b) for k in check_numbers("stiffness", stiffness) for b in check_numbers("backlash", backlash)]
+    if not all(len(check_numbers("designs' pair", d)) == 2 for d in check_sequence("designs", designs)):
+        raise ParameterError(f"designs={designs!r}; allowed: a list of (stiffness [N/m], backlash [m]) pairs")
     designs = list(dict.fromkeys((float(k), float(b)) for k, b in designs))
     tasks = plan(base, designs, points, points_table)
     progress(f"{len(tasks)} runs on {workers} process{'es' if workers > 1 else ''}")
     results = run_tasks(base, tasks, points_table, workers, progress)
+    refuse_all_failed([results[t].get("error") for t in tasks], "runs")
     rigid = {}
     for key in points:
         point = points_table[key]

@@ -36,7 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.core.errors import ParameterError
+from ipir_mujoco.core.checks import check_path, check_real
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError
 from ipir_mujoco.core.params import RobotParams, read_text_file
 from ipir_mujoco.core.results import COLUMNS, RunResult, mode_changes
 
@@ -70,7 +71,7 @@ def load_run(folder: str | Path) -> RunResult:
     wrong: a missing or unreadable file, a time series with fewer than two samples, a row torn or
     ragged, a value that is not a finite number, a summary that is not the one simulate writes.
     """
-    folder = Path(folder)
+    folder = Path(check_path("folder", folder, "the path of a run folder 'simulate --out' wrote"))
     if not folder.is_dir():
         raise ParameterError(f"{str(folder)!r} is not a run folder (it does not exist or is a file); "
                              "write one with 'ipir-mujoco simulate --out DIR'")
@@ -162,8 +163,11 @@ def match_switches(a: RunResult, b: RunResult) -> dict:
 
 def compare_runs(a: RunResult, b: RunResult, tolerance: float = 0.01, n_grid: int = 2000) -> dict:
     """Compare run ``b`` against run ``a`` (see the module docstring)."""
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ParameterError(f"tolerance={tolerance} is out of range; allowed: > 0")
+    for name, run in (("a", a), ("b", b)):
+        if not isinstance(run, RunResult):
+            raise ParameterTypeError(f"{name}={run!r} is not a RunResult; allowed: a run (registry.run, or "
+                                     "load_run of a 'simulate --out' folder)")
+    tolerance = check_real("tolerance", tolerance)  # > 0
     t_end = min(a.series["t"][-1], b.series["t"][-1])
     grid = np.linspace(0.0, t_end, n_grid)
     on_time = {}

@@ -45,8 +45,9 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.cycles import STEADY_CYCLES, cycles, speed_figures, steady_window, travel
-from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.params import RobotParams, check_real, check_whole
+from ipir_mujoco.core.errors import ParameterError, SimulationError, refuse_all_failed
+from ipir_mujoco.core.checks import check_numbers
+from ipir_mujoco.core.params import RobotParams, check_real, check_whole, require_params
 
 from .pool import map_unordered
 
@@ -80,6 +81,7 @@ class Task:
 
 def check_base(base: RobotParams) -> None:
     """The study sets the drive and the controller's parameters itself: given ones are refused (one line)."""
+    require_params(base)
     defaults = RobotParams()
     for name in ("drive", "omega_target", "speed_dip", "feedforward"):
         if getattr(base, name) != getattr(defaults, name):
@@ -100,6 +102,7 @@ def design(base: RobotParams, task: Task) -> RobotParams:
 
 def check_speeds(base: RobotParams, speeds: Sequence[float], dips: Sequence[float], profile_speed: float) -> None:
     """Every speed and dip checked before any run: as the parameter set checks omega_target and speed_dip."""
+    speeds, dips = check_numbers("speeds", speeds), check_numbers("dips", dips)
     if not speeds and not dips:
         raise ParameterError("--speeds and --dips are both empty; allowed: at least one value")
     for w in speeds:
@@ -236,6 +239,7 @@ def run_study(base: RobotParams, speeds: Sequence[float] = SPEEDS, dips: Sequenc
 
     analytic_first = sorted(tasks, key=lambda t: (t.variant.startswith("mujoco"), -t.dip))  # the slow ones first
     map_unordered(functools.partial(_run_item, base), analytic_first, workers, done)
+    refuse_all_failed([results[t].get("error") for t in tasks], "runs")
 
     def row(task: Task) -> dict:
         return {"variant": task.variant, "controller": task.controller, "speed_rad_s": task.speed,

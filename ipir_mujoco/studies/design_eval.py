@@ -21,7 +21,7 @@ import os
 from concurrent import futures
 from pathlib import Path
 
-from ipir_mujoco.core.errors import ParameterError, StudyInterrupted
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, StudyInterrupted
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams
 
 from .pool import end_pool, worker_init
@@ -37,7 +37,7 @@ KEYS = (*METRICS, *(n for n in PARAMETER_NAMES if n not in WORDS))
 def check_key(key: str, option: str) -> str:
     """A metric or numeric parameter name, or a one-line ParameterError naming what is allowed."""
     if not isinstance(key, str):
-        raise ParameterError(f"{option}: key {key!r} is not a string; allowed: a metric or a parameter name")
+        raise ParameterTypeError(f"{option}: key {key!r} is not a string; allowed: a metric or a parameter name")
     key = key.strip()
     if key in WORDS:
         raise ParameterError(f"{option}: {key!r} is not a number (it names a choice, e.g. "

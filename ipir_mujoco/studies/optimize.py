@@ -33,8 +33,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ipir_mujoco.core.errors import ParameterError, ParameterTypeError
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError, refuse_all_failed
 from ipir_mujoco.core.options import check_type
+from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
@@ -54,6 +55,7 @@ class Objective:
     key: str
 
     def __post_init__(self) -> None:
+        check_text("Objective sense", self.sense, "'min' or 'max'")
         if self.sense not in ("min", "max"):
             raise ParameterError(f"Objective sense={self.sense!r} is not allowed; allowed: 'min' or 'max'")
         object.__setattr__(self, "key", check_key(self.key, f"Objective key={self.key!r}"))
@@ -67,6 +69,7 @@ class Constraint:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "key", check_key(self.key, f"Constraint key={self.key!r}"))
+        check_text("Constraint op", self.op, "'<=' or '>='")
         if self.op not in ("<=", ">="):
             raise ParameterError(f"Constraint op={self.op!r} is not allowed; allowed: '<=' or '>=' (a design is "
                                  "feasible where KEY <= VALUE, or KEY >= VALUE)")
@@ -80,13 +83,16 @@ class Constraint:
 
 
 def parse_objective(text: str) -> Objective:
-    sense, sep, key = text.partition(":")
+    """``min:KEY`` or ``max:KEY`` (``--objective``) as an Objective; one-line ParameterError otherwise."""
+    sense, sep, key = check_text("objective", text, "'min:KEY' or 'max:KEY'").partition(":")
     if not sep or sense.strip() not in ("min", "max"):
         raise ParameterError(f"--objective {text!r} is malformed; expected min:KEY or max:KEY")
     return Objective(sense.strip(), check_key(key, f"--objective {text!r}"))
 
 
 def parse_constraint(text: str) -> Constraint:
+    """``KEY<=VALUE`` or ``KEY>=VALUE`` (``--constraint``) as a Constraint; one-line ParameterError otherwise."""
+    check_text("constraint", text, "'KEY<=VALUE' or 'KEY>=VALUE'")
     match = re.fullmatch(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=)\s*(\S+)\s*", text)
     try:
         value = float(match.group(3)) if match else math.nan
@@ -127,7 +133,9 @@ class Problem:
             if not axis.is_range:
                 raise ParameterError(f"--vary {axis.name}: give a range NAME=LO:HI[:log]")
         object.__setattr__(self, "budget", check_whole("budget", self.budget, low=1, high=100_000))
-        engines = (self.engine,) + ((self.verify,) if self.verify and self.verify != self.engine else ())
+        check_type("engine", self.engine, str, "a model variant's name, e.g. 'analytic-unilateral'")
+        check_type("verify", self.verify, (str, type(None)), "a model variant's name, or None (no verification)")
+        engines = (self.engine,) + ((self.verify,) if self.verify is not None and self.verify != self.engine else ())
         # the sweep's checks of axes, base, engines, t_end, seed and until_steady, in one place
         object.__setattr__(self, "study", Study(self.axes, self.base, engines, self.t_end, sample=self.budget, seed=self.seed,
                            until_steady=self.until_steady))
@@ -324,6 +332,7 @@ def _run_locked(problem: Problem, out: Path, resume: bool, workers, progress: bo
         rows = list(ev.cache.values())
         reused = ev.reused
     rows.sort(key=lambda r: r["eval_id"])
+    refuse_all_failed([r.get("error") for r in rows], "designs", str(out / "evaluations.csv"))
     feasible = [r for r in rows if problem.feasible(r)]
     if feasible:
         points = np.array([problem.objective_values(r) for r in feasible])

@@ -75,7 +75,7 @@ def _read_complete_lines(path: Path) -> list[str]:
     except UnicodeDecodeError as exc:
         line = data[:exc.start].count(b"\n") + 1
         raise ParameterError(f"{str(path)!r} line {line} is not UTF-8 text (a corrupted file?); resume needs the "
-                             "results.csv a sweep wrote: remove the line, or run the sweep again in another --out")
+                             f"{path.name} this study wrote: remove the line, or run again in another --out")
     return [ln for ln in text.splitlines(keepends=True) if ln.endswith("\n")]
 
 
@@ -87,7 +87,8 @@ def _parse_rows(path: Path, lines: list[str]) -> list[list[str]]:
             rows.extend(csv.reader([line]))
         except csv.Error as exc:
             raise ParameterError(f"{str(path)!r} line {number} is not a CSV row ({exc}); resume needs the "
-                                 "results.csv a sweep wrote: remove the line, or run again in another --out") from None
+                                 f"{path.name} this study wrote: remove the line, or run again in another "
+                                 "--out") from None
     return rows
 
 
@@ -143,9 +144,13 @@ class ResultsFile:
                 raise ParameterError(f"{str(path)!r} exists; use --resume to complete it, or another --out")
             complete = _read_complete_lines(path)
             rows = _parse_rows(path, complete)
-            if not rows or rows[0] != header:
-                raise ParameterError(f"{str(path)!r} was written for other engines, metrics or parameters; "
-                                     "resume needs the same study and version")
+            if not rows:
+                raise ParameterError(f"{str(path)!r} is empty, not even its header (a damaged file?); resume needs "
+                                     f"the {path.name} this study wrote: remove it, or run again in another --out")
+            if rows[0] != header:
+                raise ParameterError(f"{str(path)!r}'s header is not this study's (written for other engines, "
+                                     f"metrics or parameters, or damaged); resume needs the {path.name} this study "
+                                     "wrote, of the same version: run again in another --out")
             self.done = _done_designs(path, rows, len(header))
             check_cells(path, rows, set(numeric))
             self.rows = {int(r[0]): dict(zip(header, r)) for r in rows[1:] if r}

@@ -40,10 +40,10 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ipir_mujoco import registry
-from ipir_mujoco.core.errors import ParameterError
-from ipir_mujoco.core.limits import MAX_T_END, check_run_options, refuse_steady_without_motor
-from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_real, check_whole,
-                                     read_toml_file, refuse_idle_names, require_params)
+from ipir_mujoco.core.errors import ParameterError, ParameterTypeError
+from ipir_mujoco.core.limits import MAX_T_END, check_run_options, refuse_steady_without_motor, study_dt_out
+from ipir_mujoco.core.params import (PARAMETER_NAMES, RobotParams, as_real, check_own_range, check_real, check_whole,
+                                     read_toml_file, refuse_idle_names, refuse_idle_parameters, require_params)
 
 # the variants a sweep runs by default (any of registry.NAMES, or their aliases, may be given)
 DEFAULT_VARIANTS = ("mujoco-ratchet", "analytic-unilateral")
@@ -73,7 +73,8 @@ class Axis:
 def parse_vary(text: str) -> Axis:
     """Parse one ``--vary`` specification (see the module docstring)."""
     if not isinstance(text, str):
-        raise ParameterError(f"vary={text!r} is not a string; allowed: NAME=START:STOP:N, NAME=A,B,C or NAME=LO:HI")
+        raise ParameterTypeError(f"vary={text!r} is not a string; allowed: NAME=START:STOP:N, NAME=A,B,C or "
+                                 "NAME=LO:HI")
     name, sep, spec = text.partition("=")
     name = name.strip()
     if not sep or not spec:
@@ -125,6 +126,92 @@ def parse_vary(text: str) -> Axis:
                          "NAME=LO:HI[:log]")
 
 
+CORNERS = 4096  # combinations of the other axes' ends a range's end is tried with (2^12: twelve other axes)
+
+
+def axis_text(axis: Axis) -> str:
+    """An axis as --vary spells it (a long list shortened), for messages."""
+    if axis.is_range:
+        return f"{axis.name}={axis.low:g}:{axis.high:g}" + (":log" if axis.log else "")
+    shown = ",".join(f"{v:g}" for v in axis.values[:4]) + (",..." if len(axis.values) > 4 else "")
+    return f"{axis.name}={shown}"
+
+
+def _usable(base: RobotParams, values: dict) -> ParameterError | None:
+    """None if ``values`` on ``base`` make a design a run can take, else why not (its one-line error)."""
+    try:
+        refuse_idle_parameters(base.replace(**values))
+    except ParameterError as exc:
+        return exc
+    return None
+
+
+def _idle(base: RobotParams, name: str, value: float) -> ParameterError | None:
+    """Why a run would refuse ``name`` = ``value`` on ``base`` whatever the design (a parameter that acts only
+    through another one the base leaves out: the speed controller's without the servo), or None (also where the
+    value is refused only with the base's other parameters: that design's own error)."""
+    try:
+        params = base.replace(**{name: value})
+    except ParameterError:
+        return None
+    try:
+        refuse_idle_parameters(params)
+    except ParameterError as exc:
+        return exc
+    return None
+
+
+def _refuse_idle_base(base: RobotParams, varied: list[str]) -> None:
+    """A parameter of ``base`` no run takes whatever the grid of ``varied`` gives (a speed-controller parameter
+    with another drive), refused in one line."""
+    try:
+        refuse_idle_parameters(base)
+    except ParameterError as exc:
+        if "clutch_stiffness" not in varied:  # a varied stiffness gives the damping and the play their spring
+            raise ParameterError(f"{exc} (in --set or --config)") from None
+
+
+def check_axes(axes: tuple[Axis, ...], base: RobotParams) -> None:
+    """Refuse, before the first design, a ``--vary`` no design of the study could use, in one line naming it: a
+    parameter that is not a number (``drive``); a value, or a range's end, outside the parameter's own allowed
+    range (``m1=-1:1``); a range over the whole number ``wheel_legs`` (a list varies it); a range one of whose ends
+    makes no design a run takes with the base and any end of the other axes (``L=0.01:0.04`` below r = 0.05 m,
+    ``omega_target`` with a drive other than servo); a list none of whose values a run takes for a reason of its
+    own (a speed-controller parameter without the servo), and a base parameter no run takes (the same, set with
+    --set or --config). A list's values refused only with the others' (L below
+    r in a grid of L) stay designs of their own: a sweep records each one's error (:func:`.sweep.refuse_all_invalid`
+    refuses a sweep none of whose designs is valid)."""
+    _refuse_idle_base(base, [a.name for a in axes])
+    for axis in axes:
+        where = f"--vary {axis_text(axis)!r}"
+        try:
+            for value in ((axis.low, axis.high) if axis.is_range else axis.values):
+                check_own_range(axis.name, value)
+        except ParameterError as exc:
+            raise ParameterError(f"{where}: {exc}") from None
+        if axis.is_range and axis.name == "wheel_legs":
+            raise ParameterError(f"{where}: wheel_legs is a whole number, and a range gives fractions; allowed: a "
+                                 f"list of whole numbers, e.g. wheel_legs={int(math.ceil(axis.low))},"
+                                 f"{int(math.floor(axis.high))}")
+        others = [a for a in axes if a is not axis]
+        names = [a.name for a in others]
+        ends = [(a.low, a.high) if a.is_range else (min(a.values), max(a.values)) for a in others]
+        for value in ((axis.low, axis.high) if axis.is_range else ()):
+            first = None
+            for combo in itertools.islice(itertools.product(*ends), CORNERS):
+                why = _usable(base, {**dict(zip(names, combo)), axis.name: value})
+                if why is None:
+                    break
+                first = first or why
+            else:
+                raise ParameterError(f"{where}: no design of the study can have {axis.name}={value:g}: "
+                                     f"{' '.join(str(first).split())}")
+        if not axis.is_range:
+            idle = [_idle(base, axis.name, v) for v in axis.values[:CORNERS]]
+            if all(idle):
+                raise ParameterError(f"{where}: {' '.join(str(idle[0]).split())}")
+
+
 @dataclass(frozen=True)
 class Study:
     """What a sweep runs: base parameters, axes, sampling, engines, simulated time [s].
@@ -145,8 +232,9 @@ class Study:
 
     def __post_init__(self) -> None:
         set_ = functools.partial(object.__setattr__, self)
-        if isinstance(self.axes, (str, Axis)) or not all(isinstance(a, Axis) for a in self.axes):
-            raise ParameterError(f"axes={self.axes!r} is not a list of axes; build them with parse_vary('NAME=SPEC')")
+        if not isinstance(self.axes, (list, tuple)) or not all(isinstance(a, Axis) for a in self.axes):
+            raise ParameterTypeError(f"axes={self.axes!r} is not a list of axes; build them with "
+                                     "parse_vary('NAME=SPEC')")
         set_("axes", tuple(self.axes))
         if not self.axes:
             raise ParameterError("a sweep needs at least one --vary")
@@ -175,6 +263,7 @@ class Study:
         if not isinstance(self.until_steady, bool):
             raise ParameterError(f"until_steady={self.until_steady!r} is not true or false")
         refuse_steady_without_motor(self.base.drive, self.until_steady)
+        check_axes(self.axes, self.base)
         ranges = [a for a in self.axes if a.is_range]
         if self.sample is None and ranges:
             raise ParameterError(f"--vary {ranges[0].name}=LO:HI is a range: give --sample N, or N points (LO:HI:N)")
@@ -188,9 +277,10 @@ class Study:
 
     @property
     def dt_out(self) -> float:
-        """Output interval of the sweep's runs [s]: enough for the metrics, light on memory."""
+        """Output interval of the sweep's runs [s]: enough for the metrics, light on memory (at most STUDY_SAMPLES
+        samples a run: :func:`ipir_mujoco.core.options.study_dt_out`)."""
         t_end = as_real(self.t_end)
-        return DT_OUT if t_end is None or not t_end > 0 else min(DT_OUT, t_end)
+        return DT_OUT if t_end is None or not t_end > 0 else study_dt_out(t_end, min(DT_OUT, t_end))
 
     def designs(self) -> list[dict[str, float]]:
         """Every design as {varied name: value}, in a fixed order (its index is the design id)."""

@@ -34,8 +34,9 @@ from pathlib import Path
 import numpy as np
 
 from ipir_mujoco import registry
+from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.errors import ParameterError, SimulationError
-from ipir_mujoco.core.options import MAX_T_END, refuse_steady_without_motor
+from ipir_mujoco.core.options import MAX_T_END, refuse_steady_without_motor, study_dt_out
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole, refuse_idle_parameters
 from ipir_mujoco.core.results import write_json
 
@@ -120,7 +121,7 @@ def check_metric(key: str) -> str:
 
 def parse_event(text: str) -> Event:
     """``KEY>V``, ``KEY>=V``, ``KEY<V``, ``KEY<=V`` or a name of :data:`NAMED_EVENTS`."""
-    spec = text.strip()
+    spec = check_text("event", text, "'KEY>V', 'KEY>=V', 'KEY<V', 'KEY<=V' or " + ", ".join(NAMED_EVENTS)).strip()
     if spec in NAMED_EVENTS:
         return Event(spec, *NAMED_EVENTS[spec])
     for op in (">=", "<=", ">", "<"):
@@ -239,7 +240,7 @@ def run_uncertainty(dists: list[Dist], metrics: tuple[str, ...], events: tuple[E
     # would refuse it; refused here, once
     refuse_idle_parameters(base.replace(**first))
     keys = tuple(dict.fromkeys((*metrics, *(e.key for e in events))))
-    dt_out = min(1e-3, t_end)
+    dt_out = study_dt_out(t_end, min(1e-3, t_end))  # at most STUDY_SAMPLES a run
     started = time.perf_counter()
     cheap_rows = evaluate(SampleTask(base, cheap, t_end, dt_out, until_steady, keys), designs, workers,
                           Progress(samples, 0, progress, what=f"uncertainty {cheap}") if progress else None)

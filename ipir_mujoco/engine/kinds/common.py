@@ -18,6 +18,7 @@ from typing import Callable, Iterator
 import mujoco
 import numpy as np
 
+from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.limits import CLUTCH_RULES as RULES  # the clutch rules
 from ipir_mujoco.core.options import RepeatProgress
@@ -69,6 +70,8 @@ def check_clutch_options(params: RobotParams, clutch: str = "unilateral", implem
     """What every MuJoCo entry point (serial and batched runs, the viewer) refuses in the parameters and the
     clutch choice (ParameterError, one line): ``clutch`` a rule of RULES, ``implementation`` one of
     IMPLEMENTATIONS."""
+    check_text("implementation", implementation, ", ".join(IMPLEMENTATIONS))
+    check_text("clutch", clutch, ", ".join(RULES))
     if implementation not in IMPLEMENTATIONS:
         raise ParameterError(f"mujoco clutch {implementation!r} is unknown; allowed: {', '.join(IMPLEMENTATIONS)}")
     if clutch not in RULES:

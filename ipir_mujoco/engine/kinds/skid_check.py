@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 
+from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.results import RunResult
 from ipir_mujoco.core.steady_test import LIMIT_ACCURACY
 
@@ -113,10 +114,11 @@ class SkidRule:
             result.accuracy["skid_check"] = "not verified: timestep given"
         return result
 
-    def verify(self, result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+    def verify(self, result: RunResult, rerun, mode: str, dt_min: float,
+               wall_budget_s: float | None = None) -> RunResult:
         """``result`` (an automatically stepped run) or a finer run of the same design, verified by this rule
-        (:func:`verify_skids`)."""
-        return verify_skids(result, rerun, mode, dt_min, self)
+        (:func:`verify_skids`) within the run's wall-time budget ``wall_budget_s`` [s]."""
+        return verify_skids(result, rerun, mode, dt_min, self, wall_budget_s)
 
 
 class NoSkids(SkidRule):
@@ -127,7 +129,8 @@ class NoSkids(SkidRule):
     def skidded(self, result: RunResult) -> bool:
         return False
 
-    def verify(self, result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+    def verify(self, result: RunResult, rerun, mode: str, dt_min: float,
+               wall_budget_s: float | None = None) -> RunResult:
         return result
 
 
@@ -142,7 +145,8 @@ class Unverified(SkidRule):
     def skidded(self, result: RunResult) -> bool:
         return self.rule.skidded(result)
 
-    def verify(self, result: RunResult, rerun, mode: str, dt_min: float) -> RunResult:
+    def verify(self, result: RunResult, rerun, mode: str, dt_min: float,
+               wall_budget_s: float | None = None) -> RunResult:
         if self.skidded(result):
             result.accuracy["skid_check"] = f"not verified: {self.why}"
         return result
@@ -187,21 +191,32 @@ class SlideSkids(SkidRule):
 SLIDES_RULE = SlideSkids()
 
 
-def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES_RULE) -> RunResult:
+def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES_RULE,
+                 wall_budget_s: float | None = None) -> RunResult:
     """``result`` (an automatically stepped run that may skid) or a finer run of the same design, verified as
     the module docstring says. ``rerun(timestep)`` runs the design again at that step [s] and returns its
     RunResult; ``mode``: the accuracy monitor's ('stop' | 'warn'); ``dt_min`` [s]: the smallest step a run may
     take (halving stops before it); ``rule``: the model's floor, figures and acceptance (:data:`SLIDES_RULE`,
-    :data:`ipir_mujoco.engine.kinds.wheels.skids.WHEELS_RULE`)."""
+    :data:`ipir_mujoco.engine.kinds.wheels.skids.WHEELS_RULE`); ``wall_budget_s`` [s]: the run's wall-time budget,
+    which its repeats share (each RunResult's ``wall_time_s`` counts from the run's start): a repeat predicted
+    past it (:func:`_past_budget`) is not started, and the run says which steps the check needed."""
     if not rule.skidded(result):
         result.accuracy["skid_check"] = "no skid"
         return result
     coarse, history = result, []
-    fine = result
+    fine, spent_before = result, 0.0
     for _ in range(HALVINGS):
         dt = coarse.settings["timestep"] / 2
         if dt < dt_min:
             break
+        late = _past_budget(coarse, spent_before, dt, len(history), wall_budget_s)
+        if late is not None:
+            if mode == "stop":
+                raise SimulationError(late)
+            history = history or [{"timestep": coarse.settings["timestep"], "half": dt, "kind": "fixed",
+                                   "figure": "none", "difference": math.inf, "differences": {}}]
+            return _verified(coarse, history, ACCEPT * SKID_TOL[history[-1]["kind"]], late)
+        spent_before = coarse.wall_time_s
         fine = rerun(dt)
         kind, diff = rule.differences(coarse, fine)
         history.append({"timestep": coarse.settings["timestep"], "half": dt, "kind": kind, "differences": diff})
@@ -225,6 +240,25 @@ def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES
     if mode == "stop":
         raise AccuracyError(message)
     return _verified(fine, history, tolerance, message)
+
+
+def _past_budget(coarse: RunResult, spent_before: float, dt: float, done: int,
+                 wall_budget_s: float | None) -> str | None:
+    """Why the next repeat, at ``dt`` [s], is not started (one line), or None: the check still needs at least
+    max(2 - ``done``, 1) halvings, each about twice the last run's wall time (half the step, twice the steps;
+    the last run took ``coarse.wall_time_s`` - ``spent_before`` [s], counted from the run's start), and the run
+    has spent ``coarse.wall_time_s`` of its ``wall_budget_s`` [s]."""
+    if wall_budget_s is None:
+        return None
+    spent, last = coarse.wall_time_s, max(coarse.wall_time_s - spent_before, 0.0)
+    steps = [dt / 2 ** k for k in range(max(2 - done, 1))]
+    needed = sum(last * 2 ** (k + 1) for k in range(len(steps)))
+    if spent + needed <= wall_budget_s:
+        return None
+    return (f"the run exceeded its wall-time budget of {wall_budget_s:g} s in its skid check (the modules skid, and "
+            f"the check runs the design again at a finer step): it would need runs at "
+            f"{' and '.join(f'{h:.3g} s' for h in steps)} (about {needed:.3g} s of wall time more, after "
+            f"{spent:.3g} s); raise the budget, or give the timestep yourself (a given step is not checked)")
 
 
 def _verified(run: RunResult, history: list, tolerance: float, failed: str | None) -> RunResult:

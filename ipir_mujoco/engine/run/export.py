@@ -12,11 +12,11 @@ FILE.xml``) the robot does not crawl, its modules rock in place.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import mujoco
 
+from ipir_mujoco.core.checks import check_path
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams, require_params
 
@@ -93,7 +93,8 @@ def save_mjcf(path, params: RobotParams, clutch: str = "unilateral", implementat
               **options) -> Path:
     """Write :func:`compiled_mjcf` to ``path`` (a .xml file); return the path. Nothing is written if the
     arguments are refused."""
-    if not isinstance(path, (str, os.PathLike)) or not str(path).endswith(".xml"):
+    check_path("path", path, "a path ending in .xml")
+    if not str(path).endswith(".xml"):
         raise ParameterError(f"path={path!r} is not an .xml file name; allowed: a path ending in .xml")
     text = compiled_mjcf(params, clutch, implementation, **options)
     target = Path(path)

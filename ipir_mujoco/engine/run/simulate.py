@@ -178,7 +178,7 @@ def simulate_mujoco(
         finer = {**options, "dt_out": dt} if every_step else options
         return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
-    return rule.verify(result, rerun, accuracy, DT_MIN)
+    return rule.verify(result, rerun, accuracy, DT_MIN, run.wall_budget_s)
 
 
 class _Run:

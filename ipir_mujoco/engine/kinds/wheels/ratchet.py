@@ -247,6 +247,8 @@ def slide_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> 
     (``cornering_coefficient``), so what moves a centre along its hub's axis is sliding (and the contact's
     softness, and a wheel off its wall). Rigid wheels: the ring's own path across the pipe, as its three wheels'
     circumferential directions span the ring's plane."""
+    from .model import leg_names
+
     data = mujoco.MjData(model)
     legs = leg_names(params)
     bodies = np.array([[model.body(n + "_wheel").id for n in module] for module in legs])

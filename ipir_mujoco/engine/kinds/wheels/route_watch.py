@@ -286,12 +286,13 @@ def check_route(route, model: str, params, until_steady: bool, reach: float | No
     from the route's, or whose first straight is shorter than the robot (it starts in it: ``reach`` [m], how far
     the robot reaches ahead of its rear module's point A; the round-pipe model's by default). The round pipe's walls
     (:mod:`.pipe_walls`) take any route: at most MAX_SEGMENTS + 2 pieces."""
-    from ipir_mujoco.core.errors import ParameterError
+    from ipir_mujoco.core.errors import ParameterError, ParameterTypeError
 
     if route is None:
         return params
     if not isinstance(route, Route):
-        raise ParameterError(f"route={route!r}; allowed: a Route (ipir_mujoco.core.route.read_route), or None")
+        raise ParameterTypeError(f"route={route!r} is not a Route; allowed: a Route "
+                                 "(ipir_mujoco.core.route.read_route), or None")
     if model != "wheels":
         raise ParameterError("--route applies only to the wheeled model; allowed: --mujoco-model wheels")
     if until_steady:
