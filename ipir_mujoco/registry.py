@@ -240,9 +240,10 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
     """The timestep [s] MuJoCo chooses by itself for a run of ``t_end`` [s] sampled every ``dt_out`` [s] (along
     ``route``, a :class:`ipir_mujoco.core.route.Route`, for the wheeled model): the
     variant's model kind's (:meth:`ipir_mujoco.engine.kinds.base.ModelKind.settings`), the step every such run
-    starts from; a run whose modules skid (finite grip on the slides, the wheels) is kept at this step halved as
-    many times as its skid check records (``RunResult.settings['skid_check']``, one entry a halving; its
-    ``settings['timestep']`` is the step kept); None for the analytic engines."""
+    starts from; a run whose wheels skid is kept at this step halved as many times as its skid check records
+    (``RunResult.settings['skid_check']``, one entry a halving; its ``settings['timestep']`` is the step kept), and
+    a slide run on finite grip whose modules skid is this run, its figures extrapolated from coarser ones
+    (``settings['extrapolation']``); None for the analytic engines."""
     v, params = variant(name), require_params(params)
     t_end, dt_out = check_run_options(t_end, dt_out)
     if not v.is_mujoco:

@@ -234,3 +234,16 @@ def test_command_prints_one_line_per_idealization_metric_and_threshold(tmp_path,
         assert metric in line and f"safe in {100 * item['safe_fraction']:.1f} %" in line
         assert all(f"L={v:.5g}" in line for v in item["crossings"]["L"])
     assert (out / "atlas_1d.png").is_file() and (out / "atlas_safe.png").is_file()
+
+
+def test_a_costs_error_bar_follows_from_its_runs_figures_error_bars():
+    """cost = (i - r) / |r|: at first order its error is (e_i + |i / r| e_r) / |r|; none where no run states a
+    bar (the equations), the figure's own bar carried where only one does."""
+    from ipir_mujoco.studies.atlas_space import cost_error, signed_cost
+
+    i, r, e_i, e_r = 1.2, 0.8, 1e-4, 2e-4
+    assert cost_error(i, r, e_i, e_r) == pytest.approx((e_i + 1.5 * e_r) / 0.8, rel=1e-12)
+    # the bound holds the cost of any pair within the bars (its extremes at the bars' corners)
+    worst = max(abs(signed_cost(i + a * e_i, r + b * e_r) - signed_cost(i, r)) for a in (-1, 1) for b in (-1, 1))
+    assert worst <= cost_error(i, r, e_i, e_r) * (1 + 1e-3)
+    assert cost_error(i, r, None, None) is None and cost_error(i, r, None, e_r) == pytest.approx(1.5 * e_r / 0.8)

@@ -210,16 +210,23 @@ def test_engines_agree_on_the_travel_sliding_back_down_a_riser():
 
 def test_a_riser_without_drive_slides_at_the_hand_calculated_acceleration():
     """Drive off, 6 N of grip per module: both skid, a = (G1 + G2 - (m1 + m2 + m_rod) g) / (m1 + m2 + m_rod +
-    m_c1 + m_c2) (the carriages' inertia, which has no weight, included: -3.8381 m/s^2). MuJoCo's
-    semi-implicit step gives x_n = a dt^2 n (n + 1) / 2, t/dt = n: a relative error dt / t = 1e-4 at 1 s."""
+    m_c1 + m_c2). The first run carries the carriages' inertia (its share of the modules', which has no weight:
+    -3.8381 m/s^2), and MuJoCo's semi-implicit step gives x_n = a dt^2 n (n + 1) / 2, t/dt = n: a relative error
+    dt / t = 1e-4 at 1 s. The summary's rigid limit has neither: a = -3.8398 m/s^2, the equations' law, within
+    its own error bar."""
     p = RobotParams(M=0.0, incline=90.0, mu_wall=0.3, F_n1=20.0, F_n2=20.0)
     run = mujoco_run(p, 1.0)
     mass = p.m1 + p.m2 + p.rod_mass
-    a = (sum(p.grip) - mass * p.g) / (mass + CARRIAGE_SHARE * (p.m1 + p.m2))
     t = run.series["t"][-1]
+    share = run.settings["carriage_share"]
+    a_first = (sum(p.grip) - mass * p.g) / (mass + share * (p.m1 + p.m2))
+    for k in (1, 2):
+        assert run.series[f"x{k}"][-1] == pytest.approx(0.5 * a_first * t * t, rel=2e-4)
+    assert run.summary["slip1_m"] == pytest.approx(-0.5 * a_first * t * t, rel=2e-4)
+    a_rigid = (sum(p.grip) - mass * p.g) / mass
     for key in ("x1_final", "x2_final"):
-        assert run.summary[key] == pytest.approx(0.5 * a * t * t, rel=2e-4)
-    assert run.summary["slip1_m"] == pytest.approx(-0.5 * a * t * t, rel=2e-4)
+        assert abs(run.summary[key] - 0.5 * a_rigid * t * t) <= run.summary["figure_errors"][key]
+        assert run.accuracy["figures_accepted"][key]
 
 
 def test_a_riser_at_rest_stands_on_just_enough_grip_and_skids_on_a_little_less():
@@ -242,12 +249,14 @@ def test_a_riser_at_rest_stands_on_just_enough_grip_and_skids_on_a_little_less()
 
 def test_the_energy_audit_closes_with_the_skid_work(cruise):
     """skid_j is the carriages' friction rows' work; it is G_i times the carriages' travel up to what the
-    rows do below G_i (the creep, < 1e-8 m per revolution: 1e-6 J over these 10 revolutions of two 5 N grips;
-    measured 1.5e-8 J); with it the residual is within the monitor's tolerance, and without it the audit would
-    miss 6 % of the motor's work."""
+    rows do below G_i: their creep, and the engagement and release of each skid within the rows' time constant
+    (8 steps, a soft term the rigid limit extrapolates away; measured 8e-5 of skid_j). The audit books it, so it
+    must lie within the monitor's tolerance of it; with skid_j the residual is within the tolerance, and without
+    it the audit would miss 6 % of the motor's work."""
     _, run = cruise
     e, s = run.energy, run.series
-    assert e["skid_j"] == pytest.approx(sum(G * s[f"slip{k}"][-1] for k, G in enumerate(CRUISE.grip, 1)), abs=1e-6)
+    assert e["skid_j"] == pytest.approx(sum(G * s[f"slip{k}"][-1] for k, G in enumerate(CRUISE.grip, 1)),
+                                        rel=RESIDUAL_TOL)
     assert abs(e["residual_j"]) < RESIDUAL_TOL * e["motor_work_j"]
     assert abs(e["residual_j"] + e["skid_j"]) > 50 * RESIDUAL_TOL * e["motor_work_j"]
     assert e["motor_work_j"] == pytest.approx(e["kinetic_j"] + e["potential_j"] + e["friction_j"] + e["skid_j"]
@@ -264,19 +273,18 @@ def test_the_excursion_figure_measures_the_clutchs_give_not_a_skid():
 
 def test_a_grip_below_the_rolling_resistance_still_never_drags_a_module_forward():
     """G = 0.5 N < F_r = 1 N: a module rolling forward pulls its carriage forward with F_r, more than the grip;
-    the wall's one-way limit holds the carriage (slip never decreases) and the run agrees with the equations
-    within 0.5 % in travel (the monitor's 0.1 % target on a 1 s run that skids 0.6 m per module). The skid check
-    need not bring this run within 1e-3 (skids longer than the travel, of which the carriage's share alone takes
-    3e-4 each): in 'warn' it is recorded, verified or failed, with the monitor's own figures within theirs."""
+    the wall's one-way limit holds the carriage (slip never decreases). The run's step is set by the motion (its
+    automatic step is halved once by the monitor), so the rigid limit comes from a finer run: its skids within
+    0.5 % of the equations' (1 s, 0.6 m per module), each figure within its error bar."""
     p = RobotParams(mu_wall=0.05, F_n1=10.0, F_n2=10.0)
-    run = mujoco_run(p, 1.0, accuracy="warn")
+    run = mujoco_run(p, 1.0)
     reference = registry.run("analytic-unilateral", p, 1.0, dt_out=1e-3)
     for k in (1, 2):
         assert np.all(np.diff(run.series[f"slip{k}"]) >= 0.0)
         assert run.summary[f"slip{k}_m"] == pytest.approx(reference.summary[f"slip{k}_m"], rel=5e-3)
-    assert run.summary["revolutions"] == pytest.approx(reference.summary["revolutions"], rel=1e-3)
-    assert [v["figure"] for v in run.accuracy["violations"]] in ([], ["skid_difference"])
-    assert (run.accuracy["skid_check"] == "failed") == (not run.accuracy["ok"])
+    assert run.accuracy["rigid_limit"] == "extrapolated" and run.accuracy["ok"]
+    for key, error in run.summary["figure_errors"].items():
+        assert abs(run.summary[key] - reference.summary[key]) <= error, key
 
 
 # --- compliant clutches on finite grip ----------------------------------------------------------------------------

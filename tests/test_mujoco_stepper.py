@@ -112,6 +112,16 @@ def both_paths(monkeypatch, *args, **options):
     return python, compiled
 
 
+def timeless(value):
+    """``value`` without its wall times (keys starting 'wall', as bench/fingerprint.py leaves them out): the rigid
+    limit's runs record each one's, which no two runs share."""
+    if isinstance(value, dict):
+        return {k: timeless(v) for k, v in value.items() if not k.startswith("wall")}
+    if isinstance(value, list):
+        return [timeless(v) for v in value]
+    return value
+
+
 @needs_compiled
 @pytest.mark.parametrize("name", DESIGNS)
 def test_the_compiled_loop_equals_the_python_loop_bit_for_bit(monkeypatch, name):
@@ -122,7 +132,7 @@ def test_the_compiled_loop_equals_the_python_loop_bit_for_bit(monkeypatch, name)
     for column, values in python.series.items():
         np.testing.assert_array_equal(compiled.series[column], values, err_msg=column)
     assert compiled.energy == python.energy and compiled.accuracy == python.accuracy
-    assert compiled.stall == python.stall and compiled.settings == python.settings
+    assert compiled.stall == python.stall and timeless(compiled.settings) == timeless(python.settings)
     assert compiled.t_end == python.t_end and len(python.series["t"]) > 100
     if name in ("stall", "grip, stall"):
         assert compiled.stall is not None and compiled.t_end < 1.0

@@ -262,3 +262,38 @@ def test_a_metric_mujoco_leaves_empty_falls_back_to_the_equations_with_a_note():
     assert rev["estimator"] == "multi-fidelity" and rev["correlation"] == pytest.approx(1.0, abs=1e-9)
     # f = 1.0001 g exactly: the control variate recovers 1.0001 x the mean of all 50 equations' samples
     assert rev["mean"] == pytest.approx(1.0001 * g.mean(), rel=1e-12)
+
+
+def test_mujocos_figures_come_with_their_error_bars_and_its_unused_runs_with_why():
+    """A MuJoCo run on finite grip gives each figure with its error bar (its rigid limit's): the study uses it,
+    widens the means' intervals by the bars' mean (each MuJoCo value may be off by its bar, so their mean, which
+    the estimators take with weight 1, by at most the bars' mean), and counts the runs it could not use by why."""
+    from ipir_mujoco.studies.uncertainty import estimate
+
+    rng = np.random.default_rng(1)
+    g = rng.normal(1.0, 0.1, 50)
+    cheap = [{"revolutions": v} for v in g]
+    bars = [1e-3, 3e-3, 2e-3, 2e-3]
+    faithful = [{"revolutions": v, "revolutions_error": e} for v, e in zip(g[:4], bars)]
+    faithful.append({"error": "MuJoCo accuracy check failed at t=1 s: the modules skid, and the rigid limit of "
+                              "x1_final is not trustworthy: the runs' differences disagree in sign"})
+    without = [{"revolutions": v} for v in g[:4]] + [faithful[-1]]  # the same runs, no error bars
+    plain = estimate(cheap, without, ("revolutions",), ())["metrics"]["revolutions"]
+    out = estimate(cheap, faithful, ("revolutions",), ())
+    rev = out["metrics"]["revolutions"]
+    assert rev["mujoco_error_bar"] == pytest.approx(np.mean(bars), rel=1e-12)
+    assert rev["mean_interval"] == pytest.approx([plain["mean_interval"][0] - np.mean(bars),
+                                                  plain["mean_interval"][1] + np.mean(bars)], rel=1e-12)
+    assert out["failures"]["mujoco_used"] == 4
+    assert out["failures"]["mujoco_reasons"] == {"rigid limit not trustworthy (finite grip)": 1}
+
+
+def test_a_study_reads_a_figures_error_bar_and_a_mean_of_figures_gets_their_mean():
+    from ipir_mujoco.studies.figure_errors import figure_error, why_unusable
+
+    summary = {"x1_final": 0.2, "x2_final": 0.3, "figure_errors": {"x1_final": 1e-4, "x2_final": 3e-4}}
+    assert figure_error(summary, "x1_final") == 1e-4
+    assert figure_error(summary, "travel_m") == pytest.approx(2e-4)
+    assert figure_error(summary, "revolutions") is None and figure_error({"x1_final": 0.2}, "x1_final") is None
+    assert why_unusable("MuJoCo accuracy check failed at t=0.5 s: the energy residual ...") == "accuracy monitor"
+    assert why_unusable("mu_wall=-1 is out of range", bad_input=True) == "refused its parameters"

@@ -109,6 +109,10 @@ def summary_lines(result: dict, atlas) -> list[str]:
                             f"{regions['boundary'] // 2})" if regions else ""))
                 if entry.get("missing"):
                     spent += f"; {entry['missing']} designs gave no value (samples.csv: notes, error)"
+                if entry.get("unusable"):  # MuJoCo's pairs it could not use, by why
+                    spent += "; not used: " + ", ".join(f"{why} {n}" for why, n in entry["unusable"].items())
+                if entry.get("cost_error_max") is not None:
+                    spent += f"; costs within error bars up to {entry['cost_error_max']:.2g} (MuJoCo's rigid limit)"
                 equations = entry.get("equations")
                 if equations:  # MuJoCo measured it: the equations' answer beside it
                     eq = next(i for i in equations["by_threshold"] if i["threshold"] == item["threshold"])

@@ -74,7 +74,9 @@ def run(args: argparse.Namespace) -> int:
         record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor,
                               figure=lambda out: drawn.append(plot_pareto(out, problem)))
     figure = drawn[0]
-    print(f"{record['evaluations']} evaluations ({record['reused_on_resume']} re-used), {record['feasible']} feasible")
+    print(f"{record['evaluations']} evaluations ({record['reused_on_resume']} re-used), {record['feasible']} feasible"
+          + ("" if not record.get("unusable") else
+             "; not used: " + ", ".join(f"{why} {n}" for why, n in record["unusable"].items())))
     items = [record["best"]] if "best" in record else record["front"]
     if "best" in record and record["best"] is None:
         print("  no feasible design found")

@@ -219,6 +219,8 @@ def format_summary(run: RunResult, until_steady: bool = False) -> str:
     accuracy = s.get("accuracy") or {}
     if "loop_gap_m" in accuracy:
         lines.append(accuracy_line(accuracy))
+    if accuracy.get("rigid_limit") == "extrapolated":  # the slides on finite grip: each figure's rigid limit
+        lines += rigid_limit_lines(run)
     if accuracy.get("skid_check") in ("verified", "failed"):  # the run kept is the skid check's finest
         last = (run.settings.get("skid_check") or [{}])[-1]
         error = accuracy.get("skid_difference")
@@ -265,6 +267,21 @@ def drive_text(params) -> str:
     if params.drive == "motor":
         return f"DC gearmotor at full voltage, {motor}"
     return f"speed controller holding {params.omega_target:g} rad/s, gearmotor {motor}"
+
+
+def rigid_limit_lines(run) -> list[str]:
+    """The rigid limit in words: each figure with its error, accepted (within the stated accuracy) or not, the
+    measured order, and the runs it was extrapolated from."""
+    s, record, extrapolation = run.summary, run.accuracy, run.settings["extrapolation"]
+    used = [r for r in extrapolation["runs"] if "failed" not in r and r["timestep_s"] in extrapolation["used"]]
+    runs = ", ".join(f"{r['time_constant_s']:.3g} s at {r['timestep_s']:.3g} s" for r in used)
+    lines = [f"  rigid limit ({extrapolation['plan']}), from runs with the grip rows' time constant and step {runs}:"]
+    for key, error in s["figure_errors"].items():
+        order = extrapolation["order"].get(key)
+        verdict = "accepted" if record["figures_accepted"][key] else "NOT within the stated accuracy"
+        lines.append(f"    {key} {significant(s[key], 7)} +- {error:.2g} ({record['figure_relative_errors'][key]:.2g} "
+                     f"of it, {verdict}; measured order " + ("n/a" if order is None else f"{order:.2f}") + ")")
+    return lines
 
 
 def wall_lines(s: dict, unlimited_grip: bool = False) -> list[str]:

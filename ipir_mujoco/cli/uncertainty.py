@@ -93,6 +93,9 @@ def format_result(result: dict) -> str:
             mc = e["mujoco_mc"]
             lines.append(f"    MuJoCo alone ({mc['samples']} runs): mean {mc['mean']:.6g} "
                          f"{_interval(mc['mean_interval'])}, std {mc['std']:.4g} {_interval(mc['std_interval'])}")
+            if e.get("mujoco_error_bar") is not None:
+                lines.append(f"    MuJoCo's figures carry error bars (the rigid limit on finite grip), "
+                             f"{e['mujoco_error_bar']:.3g} on average: the means' intervals are widened by it")
             worth = e["variance_reduction"] * mc["samples"]
             lines.append(f"    correlation {e['correlation']:.5f}, coefficient {e['coefficient']:.4g}: variance "
                          f"reduction {e['variance_reduction']:.3g}x, worth {worth:.0f} plain MuJoCo runs")
@@ -112,6 +115,10 @@ def format_result(result: dict) -> str:
         if not e.get("resolved", True):
             lines.append(f"    {e['note']}")
     failures = result["failures"]
+    if study["mujoco_samples"]:
+        reasons = "; ".join(f"{reason}: {n}" for reason, n in failures["mujoco_reasons"].items())
+        lines.append(f"  MuJoCo runs used: {failures['mujoco_used']} of {study['mujoco_samples']}"
+                     + (f" (not used: {reasons})" if reasons else ""))
     if failures["equations"] or failures["mujoco"]:
         lines.append(f"  failed runs left out: {failures['equations']} equations, {failures['mujoco']} MuJoCo; the "
                      f"first: {failures['first_error']}")

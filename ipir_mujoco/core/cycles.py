@@ -326,16 +326,8 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     residuals = [abs(c.residual_j) for c in found if c.residual_j is not None]
     out["cycle_energy_residual_j"] = max(residuals) if residuals else None
     if window is not None:
-        k = steady.end
         out["t_steady_s"] = window[-1].t_end
-        if steady.test == "exact":
-            out["steady_speed_m_s"], out["distance_per_rev_m"] = limit_motion(found[max(k - 2, 0):k + 1], tol)
-        else:  # no approach left to extrapolate: the window's totals
-            time = sum(c.period_s for c in window)
-            out["distance_per_rev_m"] = sum(c.distance_m for c in window) / len(window)
-            out["steady_speed_m_s"] = sum(c.distance_m for c in window) / time
-        energy = transit_free_energy(window)
-        out["energy_per_metre_j_m"], out["efficiency"] = energy["energy_per_metre"], energy["efficiency"]
+        out.update(window_figures(found, steady, tol))
         if target is not None:
             out.update(steady_test=steady.test, steady_revolutions=len(window),
                        **steady_uncertainties(window, steady, out["steady_speed_m_s"], out["energy_per_metre_j_m"]))
@@ -352,6 +344,26 @@ def cycle_summary(series: dict[str, np.ndarray], tol: float = STEADY_TOL, n: int
     out["peak_clutch_force_n"] = float(max(v.max() for v in lambdas)) if lambdas else None
     out.update(speed_figures(series, float(t[0]), float(t[-1])))
     return out
+
+
+def window_figures(found: list[Cycle], steady: Steady, tol: float = STEADY_TOL) -> dict:
+    """The steady figures of the window ``steady`` (revolutions ``steady.start`` .. ``steady.end`` of ``found``,
+    :func:`cycles`' list) as :func:`cycle_summary` reports them: ``steady_speed_m_s`` [m/s] and
+    ``distance_per_rev_m`` [m] (by the exact test the periodic limit from its last three revolutions,
+    :func:`limit_motion`; by the statistical one the window's totals: no approach left to extrapolate),
+    ``energy_per_metre_j_m`` [J/m] and ``efficiency`` [-] (:func:`transit_free_energy`). Also what reads one
+    run's steady figures over another run's window (the rigid-limit extrapolation of MuJoCo's finite grip)."""
+    window = found[steady.start:steady.end + 1]
+    k = steady.end
+    if steady.test == "exact":
+        speed, distance = limit_motion(found[max(k - 2, 0):k + 1], tol)
+    else:
+        time = sum(c.period_s for c in window)
+        distance = sum(c.distance_m for c in window) / len(window)
+        speed = sum(c.distance_m for c in window) / time
+    energy = transit_free_energy(window)
+    return {"steady_speed_m_s": speed, "distance_per_rev_m": distance,
+            "energy_per_metre_j_m": energy["energy_per_metre"], "efficiency": energy["efficiency"]}
 
 
 def steady_uncertainties(window: list[Cycle], steady: Steady, speed: float, energy: float | None) -> dict:

@@ -144,6 +144,12 @@ class RunResult:
     ``residual_ratio`` and ``loop_gap_m``), or None. ``route`` is None, or a
     run along a route's summary keys (``route_done``, ``route_time_s``,
     ``route_stop``, ...: ``ipir_mujoco.engine.kinds.wheels.route_watch``).
+    ``figures`` is None, or figures that stand in the summary in place of the
+    series' own, with their estimated absolute errors: ``{"values": {FIGURE:
+    value}, "errors": {FIGURE: error}}`` (MuJoCo's finite grip: the rigid limit
+    extrapolated from runs at several constraint time constants,
+    ``ipir_mujoco.engine.kinds.slides_grip.rigid_limit``); the summary then has
+    ``figure_errors`` = its ``errors``.
 
     Parameters
     ----------
@@ -166,7 +172,7 @@ class RunResult:
         Wall time of the run [s].
     settings : dict
         Solver settings and what chose them.
-    stall, accuracy, route
+    stall, accuracy, route, figures
         As above.
 
     Attributes
@@ -187,6 +193,7 @@ class RunResult:
     stall: str | None = None
     accuracy: dict[str, Any] | None = None
     route: dict[str, Any] | None = None
+    figures: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         missing = [c for c in COLUMNS if c not in self.series]
@@ -241,6 +248,9 @@ class RunResult:
         summary["accuracy"] = accuracy
         if self.route is not None:  # a run along a route: route_done, route_time_s, route_stop, ...
             summary.update(self.route)
+        if self.figures is not None:  # figures extrapolated beyond the series (the rigid limit), with their errors
+            summary.update(self.figures["values"])
+            summary["figure_errors"] = dict(self.figures["errors"])
         return summary
 
     def to_json_dict(self) -> dict[str, Any]:

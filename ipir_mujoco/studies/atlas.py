@@ -46,6 +46,7 @@ from ipir_mujoco.core.options import heartbeat
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
+from .figure_errors import unusable_counts, why_unusable
 from ..output import check_output_dir, study_folder
 from .atlas_adaptive import explore, refine_crossings
 from .atlas_eval import Samples
@@ -361,6 +362,10 @@ def _mujoco_entry(atlas: Atlas, st: dict, metric: str, candidates: np.ndarray) -
     rows = st["rows"]
     entry: dict = {"measured_by": "mujoco", "designs": len(rows), "runs": 2 * len(rows), "stopped": st["stopped"],
                    "missing": int(np.sum(~np.isfinite(_costs(rows, metric)))), "by_threshold": []}
+    # the pairs it could not use and why; the largest error bar of a cost it did use (MuJoCo's rigid limit)
+    entry["unusable"] = unusable_counts(why_unusable(r["error"]) for r in rows if r["error"])
+    bars = [r["cost_error"].get(metric) for r in rows if r.get("cost_error", {}).get(metric) is not None]
+    entry["cost_error_max"] = max(bars) if bars else None
     s = st["surrogates"].get(metric)
     if s is None:
         entry["by_threshold"] = [{"threshold": t, "safe_fraction": None, "safe_fraction_interval": None}

@@ -2,8 +2,8 @@
 
 ``samples.csv`` columns: ``sample_id``, ``idealization``, ``fidelity`` (``equations`` or ``mujoco``), the
 varied parameters (full precision), then for every metric ``idealized:METRIC``, ``real:METRIC`` (the two
-runs' values) and ``cost:METRIC`` ((idealized - real) / |real|), then ``notes`` (stalls) and ``error`` (why
-a pair gave nothing). One flushed row per evaluated pair (:class:`~.sweep_files.ResultsFile`, the sweep's
+runs' values) and ``cost:METRIC`` ((idealized - real) / |real|) and ``cost_error:METRIC`` (its error bar, where a run's figure has
+one: MuJoCo's rigid limit on finite grip), then ``notes`` (stalls) and ``error`` (why a pair gave nothing). One flushed row per evaluated pair (:class:`~.sweep_files.ResultsFile`, the sweep's
 streaming), so Ctrl-C or a crash keeps every finished pair; resumed, the study asks for the same designs in
 the same order (its samples are seeded, its adaptive choices are made on the values as the file holds them)
 and finds them in the file instead of running them again. Sorted by sample_id at the end.
@@ -29,7 +29,7 @@ CHUNK = 8  # analytic pairs per pool task: a pair costs tens of ms, a task's rou
 def header(names: list[str], metrics: tuple[str, ...]) -> list[str]:
     columns = ["sample_id", "idealization", "fidelity", *names]
     for m in metrics:
-        columns += [f"idealized:{m}", f"real:{m}", f"cost:{m}"]
+        columns += [f"idealized:{m}", f"real:{m}", f"cost:{m}", f"cost_error:{m}"]
     return columns + ["notes", "error"]
 
 
@@ -44,7 +44,8 @@ def _measure_many(base: RobotParams, name: str, fidelity: str, designs: list[dic
         try:
             params = base.replace(**design)
         except ValueError as exc:
-            out.append({"idealized": {}, "real": {}, "cost": {}, "note": "", "error": f"invalid design: {exc}"})
+            out.append({"idealized": {}, "real": {}, "cost": {}, "cost_error": {}, "note": "",
+                        "error": f"invalid design: {exc}"})
             continue
         out.append(measure(pair, params, metrics, t_end, until_steady))
     return out
@@ -98,6 +99,7 @@ class Samples:
 
     def _parse(self, raw: dict) -> dict:
         return {"sample_id": int(raw["sample_id"]), "cost": {m: _number(raw[f"cost:{m}"]) for m in self.metrics},
+                "cost_error": {m: _number(raw[f"cost_error:{m}"]) for m in self.metrics},
                 "note": raw["notes"], "error": raw["error"]}
 
     def evaluate(self, name: str, fidelity: str, designs: list[dict], label: str = "") -> list[dict]:
@@ -153,6 +155,7 @@ class Samples:
                 row[f"idealized:{m}"] = result["idealized"].get(m)
                 row[f"real:{m}"] = result["real"].get(m)
                 row[f"cost:{m}"] = result["cost"].get(m)
+                row[f"cost_error:{m}"] = result["cost_error"].get(m)
             cells = {c: _cell(row.get(c)) for c in self.header}
             cells.update(zip(self.names, key[2:]))  # full precision: a resumed study finds its designs exactly
             self.file.writer.writerow([cells[c] for c in self.header])

@@ -41,6 +41,7 @@ from ipir_mujoco.core.params import RobotParams
 if TYPE_CHECKING:  # the atlas command's parser reads this module's defaults without numpy
     from ipir_mujoco.core.results import RunResult
 
+from .figure_errors import figure_error
 from .ladder import VALIDATION_LADDER, Rung
 
 RUNGS = {rung.name: rung for rung in VALIDATION_LADDER}
@@ -175,8 +176,8 @@ def run_side(side: Side, params: RobotParams, t_end: float, until_steady: bool) 
 def measure(pair: Pair, params: RobotParams, metrics: tuple[str, ...], t_end: float, until_steady: bool) -> dict:
     """Both runs of ``pair`` on ``params``: {"idealized": {metric: value}, "real": {...}, "cost": {...},
     "note": stall reasons, "error": why a run gave nothing ("" if none)}."""
-    out: dict = {"idealized": {}, "real": {}, "cost": {}, "note": "", "error": ""}
-    notes = []
+    out: dict = {"idealized": {}, "real": {}, "cost": {}, "cost_error": {}, "note": "", "error": ""}
+    notes, bars = [], {}
     for key, side in (("idealized", pair.idealized), ("real", pair.real)):
         try:
             run = run_side(side, params, t_end, until_steady)
@@ -191,7 +192,18 @@ def measure(pair: Pair, params: RobotParams, metrics: tuple[str, ...], t_end: fl
         elif until_steady and not run.summary.get("steady"):  # its steady figures are empty: say why
             notes.append(f"{side.variant}: not steady by {t_end:g} s")
         out[key] = {m: metric_value(m, run) for m in metrics}
+        bars[key] = {m: figure_error(run.summary, m) for m in metrics}  # MuJoCo's figures on finite grip: their bars
     out["note"] = " | ".join(notes)
     if not out["error"]:
         out["cost"] = {m: signed_cost(out["idealized"][m], out["real"][m]) for m in metrics}
+        out["cost_error"] = {m: cost_error(out["idealized"][m], out["real"][m], bars["idealized"][m], bars["real"][m])
+                             for m in metrics}
     return out
+
+
+def cost_error(idealized, real, idealized_error, real_error) -> float | None:
+    """The error bar of :func:`signed_cost` from its runs' figures' error bars (first order: (e_i + |i / r| e_r) /
+    |r|); None where neither run states one or the cost is missing."""
+    if (idealized_error is None and real_error is None) or idealized is None or real is None or real == 0:
+        return None
+    return ((idealized_error or 0.0) + abs(idealized / real) * (real_error or 0.0)) / abs(real)

@@ -40,6 +40,7 @@ from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import PARAMETER_NAMES, RobotParams, allowed_text
 from ipir_mujoco.core.results import write_json
 
+from .figure_errors import unusable_counts, why_unusable
 from .measured import Measured
 from .uq_dists import inside
 
@@ -89,6 +90,11 @@ class _Model:
         self.scale = {c: max(float(np.ptp(v)), float(np.max(np.abs(v))), 1e-12) for c, v in measured.columns.items()}
         self.noise = dict(self.scale)
         self.runs = 0
+        # MuJoCo answers every run ('warn'): a run whose accuracy check failed (its rigid limit on finite grip not
+        # trustworthy, a monitor figure) is used with that recorded, not dropped; counted by why
+        self.mujoco = registry.variant(engine).is_mujoco
+        self.flagged: list[str] = []
+        self.figure_errors: dict = {}
 
     def params(self, x) -> RobotParams:
         return self.base.replace(**{f.name: float(v) for f, v in zip(self.fits, x)})
@@ -98,10 +104,15 @@ class _Model:
         if self.progress is not None and self.runs % 10 == 0:
             self.progress(f"{self.runs} runs of the model")
         try:
-            run = registry.run(self.engine, self.params(x), self.t_end, dt_out=self.dt_out)
+            run = registry.run(self.engine, self.params(x), self.t_end, dt_out=self.dt_out,
+                               **({"accuracy": "warn"} if self.mujoco else {}))
         except (ParameterError, ValueError) as exc:
             raise ParameterError(f"calibrate: the model refuses {self._where(x)}: {' '.join(str(exc).split())}"
                                  ) from None
+        if self.mujoco:
+            self.flagged += [why_unusable(v.get("reason") or "accuracy check failed")
+                             for v in (run.accuracy or {}).get("violations", [])[:1]]
+            self.figure_errors = dict(run.summary.get("figure_errors") or {})
         s = run.series
         t = np.asarray(s["t"], dtype=float)
         keep = np.concatenate([[True], np.diff(t) > 0])  # an event instant is written twice: keep one
@@ -197,6 +208,8 @@ def calibrate(measured: Measured, fits: list[FitRange], *, base: RobotParams | N
         "residual_rms": {c: float(np.sqrt(np.mean((fitted[c] - v) ** 2))) for c, v in measured.columns.items()},
         "noise": model.noise, "singular_values_relative": relative.tolist(),
         "cost": float(fit.cost), "reduced_chi2": s2, "runs": model.runs, "status": fit.message,
+        # MuJoCo's runs used with their accuracy flagged, by why; the fitted run's figures' error bars (finite grip)
+        "runs_flagged": unusable_counts(model.flagged), "model_figure_errors": model.figure_errors,
         "wall_s": time.perf_counter() - started, "base": base.as_dict(),
         "model": fitted, "residuals": residuals,
     }

@@ -39,6 +39,7 @@ from ipir_mujoco.core.checks import check_text
 from ipir_mujoco.core.params import RobotParams, check_real, check_whole
 from ipir_mujoco.core.results import write_json
 
+from .figure_errors import unusable_counts, why_unusable
 from ..output import check_output_dir, study_folder
 from .design_eval import Evaluator, check_key, key_value, usable, verify_rows
 from .sweep_space import Axis, Study
@@ -350,7 +351,9 @@ def _run_locked(problem: Problem, out: Path, resume: bool, workers, progress: bo
     _write_front(out / "pareto.csv", front, problem, keys)
     record = {"fingerprint": problem.fingerprint(), "settings": settings, "status": "done",
               "evaluations": len(rows), "feasible": len(feasible), "reused_on_resume": reused,
-              "flat_objectives": flat_objectives(problem, feasible)}
+              "flat_objectives": flat_objectives(problem, feasible),
+              # the runs that gave nothing, by why (a MuJoCo figure with its error bar is used, its bar in notes)
+              "unusable": unusable_counts(why_unusable(r["error"]) for r in rows if r.get("error"))}
     summary = [_summary(r, problem, keys) for r in front]
     if len(problem.objectives) == 1:
         record["best"] = summary[0] if summary else None

@@ -43,6 +43,7 @@ from ipir_mujoco.core.results import write_json
 from . import uq_stats
 from .sweep_files import Progress
 from ..labels import SUMMARY
+from .figure_errors import figure_error, unusable_counts, why_unusable
 from .sweep_metrics import METRICS, UNITS, run_metrics
 from .uq_dists import Dist, sample
 
@@ -92,6 +93,7 @@ NAMED_EVENTS = {"stall": ("stalled", ">", 0.5), "no-steady-state": ("steady", "<
 OPERATORS = {">=": operator.ge, "<=": operator.le, ">": operator.gt, "<": operator.lt}
 MAX_SAMPLES = 100_000
 MIN_MUJOCO = 3  # pairs the multi-fidelity estimate needs (a correlation and a coefficient from them)
+ERROR = "_error"  # a sample's figure's error bar, beside it (MuJoCo on finite grip: figure_errors)
 # the equation's variant paired with each MuJoCo variant: the same clutch rule, the exact geometry
 _ANALYTIC_OF = {"unilateral": "analytic-unilateral", "kinematic": "analytic-exact"}
 _MUJOCO_OF = {"unilateral": "mujoco-ratchet", "kinematic": "mujoco-lock"}
@@ -193,7 +195,11 @@ class SampleTask:
         except SimulationError as exc:
             return index, {"error": " ".join(str(exc).split())}
         values = sample_values(run)
-        return index, {k: values[k] for k in self.keys}
+        out = {k: values[k] for k in self.keys}
+        summary = run.summary
+        # a MuJoCo figure on finite grip comes with its error bar (the rigid limit's): kept beside it
+        out.update({f"{k}{ERROR}": e for k in self.keys if (e := figure_error(summary, k)) is not None})
+        return index, out
 
 
 def evaluate(task: SampleTask, designs: list[dict], workers: int, progress: Progress | None) -> list[dict]:
@@ -281,7 +287,10 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
     ok_cheap = np.array(["error" not in r for r in cheap_rows])
     ok_pair = np.array(["error" not in r for r in faithful_rows], dtype=bool) & ok_cheap[:m] if m else np.array([])
     failures = {"equations": int((~ok_cheap).sum()), "mujoco": int(m - ok_pair.sum()) if m else 0,
-                "first_error": next((r["error"] for r in [*cheap_rows, *faithful_rows] if "error" in r), None)}
+                "first_error": next((r["error"] for r in [*cheap_rows, *faithful_rows] if "error" in r), None),
+                "mujoco_reasons": unusable_counts(why_unusable(r["error"], bool(r.get("bad_input")))
+                                                  for r in faithful_rows if "error" in r),
+                "mujoco_used": int(ok_pair.sum()) if m else 0}
     if not ok_cheap.any():
         if all(r.get("bad_input") for r in cheap_rows):
             raise ParameterError(f"every sample was refused by the equations; the first: {failures['first_error']}")
@@ -299,6 +308,12 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
             entry = uq_stats.multi_fidelity(f[pair], g[:m][pair], g[rest], seed)
             entry["estimator"] = "multi-fidelity"
             entry["mujoco_mc"] = uq_stats.mc_statistics(f[pair], seed)
+            bar = _error_bar(faithful_rows, key, pair)
+            if bar is not None:  # MuJoCo's figures carry their error bars: their mean widens the means' intervals
+                entry["mujoco_error_bar"] = bar
+                for stats in (entry, entry["mujoco_mc"]):
+                    lo, hi = stats["mean_interval"]
+                    stats["mean_interval"] = [lo - bar, hi + bar]
             entry["equations_mc"] = uq_stats.mc_statistics(g[usable_g], seed)
             entry["missing"] = int((~usable_g).sum() + (~np.isfinite(f)).sum())
         else:
@@ -326,6 +341,15 @@ def estimate(cheap_rows: list[dict], faithful_rows: list[dict], metrics, events,
     return out
 
 
+def _error_bar(rows: list[dict], key: str, used: np.ndarray) -> float | None:
+    """The mean error bar of ``key`` over the MuJoCo runs ``used`` (boolean, shape (len(rows),)) that state one
+    (:func:`.figure_errors.figure_error`), or None where none does: every such run's figure may be off by its
+    bar, so their mean by at most the bars' mean, which the estimators' means (their MuJoCo values with weight
+    1) inherit."""
+    bars = [r[f"{key}{ERROR}"] for r, u in zip(rows, used) if u and f"{key}{ERROR}" in r]
+    return float(np.mean(bars)) if bars else None
+
+
 def _finite(value):
     """JSON has no NaN or infinity: None in their place (an interval the samples cannot bound on one side)."""
     if isinstance(value, dict):
@@ -345,6 +369,7 @@ def _rows(designs, cheap, cheap_rows, faithful, faithful_rows, keys) -> list[dic
             if i < len(results):
                 r = results[i]
                 row.update({f"{engine}:{k}": r.get(k) for k in keys})
+                row.update({f"{engine}:{k}{ERROR}": r[f"{k}{ERROR}"] for k in keys if f"{k}{ERROR}" in r})
                 row[f"{engine}:error"] = r.get("error", "")
         rows.append(row)
     return rows

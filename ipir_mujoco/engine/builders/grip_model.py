@@ -70,14 +70,16 @@ def carriage_share(params: RobotParams) -> float:
 
 
 def write_grip(spec: mujoco.MjSpec, params: RobotParams, solref: list, solimp: list, slides: tuple[str, str],
-               clutch_actuators: tuple[str, str]) -> None:
+               clutch_actuators: tuple[str, str], share: float | None = None) -> None:
     """Add the carriages, their slides and the tendons for ``params.grip`` (finite); see the module docstring.
 
-    ``solref``, ``solimp``: every constraint's soft parameters (as the slides'); ``slides``: the modules'
-    slide joints, rear first; ``clutch_actuators``: the compliant clutches' actuators, moved onto the tendons
-    when ``params.clutch_stiffness`` is finite.
+    ``solref``, ``solimp``: the soft parameters of the carriages' and the rolls' rows (their one-way limits and
+    friction); ``slides``: the modules' slide joints, rear first; ``clutch_actuators``: the compliant clutches'
+    actuators, moved onto the tendons when ``params.clutch_stiffness`` is finite; ``share``: the carriage's
+    inertia over its module's mass (None: :func:`carriage_share`).
     """
     grips = params.grip
+    share = carriage_share(params) if share is None else share
     masses = (params.m1, params.m2)
     compliant = params.clutch_stiffness is not None
     resistances = (params.F_r1, params.F_r2)
@@ -87,7 +89,7 @@ def write_grip(spec: mujoco.MjSpec, params: RobotParams, solref: list, solimp: l
         body.explicitinertial = True
         body.mass, body.ipos, body.inertia = BODY_MASS, [0, 0, 0], [BODY_MASS] * 3
         skid = body.add_joint(name=SKIDS[i], type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
-        skid.armature = carriage_share(params) * masses[i]
+        skid.armature = share * masses[i]
         skid.frictionloss = grips[i]
         skid.limited = mujoco.mjtLimited.mjLIMITED_TRUE
         skid.range = [-RANGE_FAR, RANGE_FAR]  # the engine sets the upper bound before the first step

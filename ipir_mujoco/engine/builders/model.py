@@ -71,12 +71,22 @@ class SolverSettings:
     'implicit' or 'euler' (:data:`INTEGRATORS`); MuJoCo's 'rk4' is refused, as
     the engines' energy and work bookkeeping reads a step's values after it,
     which under RK4 are its last stage's.
+
+    The slide model with finite grip only (:mod:`.grip_model`; other models ignore them):
+    ``grip_time_constant`` [s] is the solref time constant of its one-way limits and friction rows (the
+    carriages' slides and the wheels' rolls; default: the constraint time constant), and ``carriage_share``
+    [-] each carriage's inertia over its module's mass (default: :func:`.grip_model.carriage_share`). Both
+    are the regularization the rigid limit is extrapolated from (:mod:`ipir_mujoco.engine.kinds.slides_grip.rigid_limit`).
+    Every time constant must be at least two steps: MuJoCo would use two steps in its place (unless its
+    ``refsafe`` flag is disabled), so a shorter one is refused rather than silently changed.
     """
 
     timestep: float = 1e-4
     integrator: str = "implicitfast"
     constraint_time_constant: float | None = None
     solimp: tuple[float, float, float] = (0.9999, 0.9999, 0.001)
+    grip_time_constant: float | None = None
+    carriage_share: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.timestep) and 0 < self.timestep <= 1e-2):
@@ -87,10 +97,13 @@ class SolverSettings:
                                  + ", ".join(INTEGRATORS))
         if self.integrator not in INTEGRATORS:
             raise ParameterError(f"integrator={self.integrator!r} is unknown; allowed: {', '.join(INTEGRATORS)}")
-        tc = self.time_constant
-        if not (math.isfinite(tc) and tc >= 2 * self.timestep * (1 - 1e-12)):
-            raise ParameterError(f"constraint_time_constant={tc} s is out of range; allowed: >= 2 timesteps "
-                                 f"({2 * self.timestep} s), MuJoCo's stability limit")
+        for name, tc in (("constraint_time_constant", self.time_constant), ("grip_time_constant", self.grip_rows)):
+            if not (isinstance(tc, (int, float)) and math.isfinite(tc) and tc >= 2 * self.timestep * (1 - 1e-12)):
+                raise ParameterError(f"{name}={tc} s is out of range; allowed: >= 2 timesteps "
+                                     f"({2 * self.timestep} s), MuJoCo's stability limit")
+        share = self.carriage_share
+        if share is not None and not (isinstance(share, (int, float)) and math.isfinite(share) and 0 < share <= 0.1):
+            raise ParameterError(f"carriage_share={share} is out of range; allowed: 0 < carriage_share <= 0.1")
         d0, d1, width = self.solimp
         if not (0 < d0 <= d1 < 1 and width > 0):
             raise ParameterError(f"solimp={self.solimp} is out of range; allowed: 0 < d0 <= d1 < 1, width > 0")
@@ -99,8 +112,19 @@ class SolverSettings:
     def time_constant(self) -> float:
         return 2 * self.timestep if self.constraint_time_constant is None else self.constraint_time_constant
 
+    @property
+    def grip_rows(self) -> float:
+        """The finite-grip rows' time constant [s]: ``grip_time_constant``, or the constraint time constant."""
+        return self.time_constant if self.grip_time_constant is None else self.grip_time_constant
+
     def as_dict(self) -> dict:
-        return {**asdict(self), "constraint_time_constant": self.time_constant}
+        """The settings as a run records them; the finite-grip fields only where set (a run without finite grip
+        records what it always did)."""
+        out = {**asdict(self), "constraint_time_constant": self.time_constant}
+        for key in ("grip_time_constant", "carriage_share"):
+            if out[key] is None:
+                del out[key]
+        return out
 
 
 def check_params(params: RobotParams) -> None:
@@ -159,8 +183,8 @@ def build_spec(params: RobotParams, settings: SolverSettings = SolverSettings(),
         write(spec, params, hint)
     _write_solver(spec, settings, hint, ratchet and params.clutch_stiffness is None)
     if params.grip is not None:  # the wheels' finite grip: carriages and tendons (grip_model), rigid or compliant
-        write_grip(spec, params, [settings.time_constant, 1.0], [*settings.solimp, 0.5, 2.0], SLIDES,
-                   (REAR_CLUTCH, FRONT_CLUTCH))
+        write_grip(spec, params, [settings.grip_rows, 1.0], [*settings.solimp, 0.5, 2.0], SLIDES,
+                   (REAR_CLUTCH, FRONT_CLUTCH), settings.carriage_share)
     return spec
 
 

@@ -1,31 +1,20 @@
-"""Skids verified by the step: a run on finite grip whose modules skidded is run again at half its step until
-two runs agree to the stated accuracy, or the run says it cannot. :func:`verify_skids` is the loop; a model's
-rule (:data:`SLIDES_RULE` here, the wheels' in :mod:`.wheel_skids`) says when a run skidded, which figures it
-compares and when they agree.
+"""Skids verified by the step: a run whose modules skidded is run again at half its step until two runs agree to
+the stated accuracy, or the run says it cannot. :func:`verify_skids` is the loop; a model's rule (the wheels', in
+:mod:`.wheels.skids`) says when a run skidded, which figures it compares and when they agree. Also the floor below
+which a skid does not count (:func:`skidded`), which the slide model's rigid limit (:mod:`.slides_grip.rigid_limit`) shares.
 
-Why: a skid ends and starts where the steps fall, and MuJoCo's one-way limits (the clutch on the wheels'
-roll, the wall's on the carriage) answer a reversal through their soft rows' damping, within a constraint time
-constant (two steps): the skid a module makes per stroke is off by an amount that shrinks with the step
-(first order or a little faster) and that no figure of the accuracy monitor shows (the energy audit closes,
-the limits give ~1e-10 m). Measured on a riser that climbs 0.15 m in 2 s while skidding 0.29 m (M_stall 2 N m,
-mu_wall 0.5, F_n 45 N) at 5e-5 s: module 2's travel off the equations by 1.3e-3 with the limits' time constant
-at 2 steps, 5.3e-3 at 4 and 1.3e-2 at 8, and unchanged (1.3e-3) with the friction rows' or the loop's at 8.
-How far the skids' error moves the travel depends on the skid against the net travel, which no bound known
-before the run gives. So the run measures it: the same run at half the step, the difference of the figures
-the user reads (fixed time: revolutions and each module's travel; to the steady state: the steady speed and
-the energy per metre) estimates the finer run's error for a scheme that converges at first order or faster
-(Richardson's estimate, |f(dt) - f(dt/2)| >= |f(dt/2) - f(0)|).
+Why: a skid ends and starts where the steps fall, and soft constraints answer a reversal within their time
+constant: the skid a module makes per stroke is off by an amount that shrinks with the step and that no figure
+of the accuracy monitor shows. The slide model on finite grip was checked this way until its rows' time
+constants were set in seconds and its figures extrapolated to the rigid limit instead (:mod:`.slides_grip.rigid_limit`:
+with the time constant tied to the step, a 60 deg design's travel was off by 1.90e-3, 1.91e-3, 1.36e-3, 5.0e-4,
+3.9e-4 over four halvings, so that agreeing halvings could not tell a converged run from a stalled one).
 
-The finest run is kept once the differences of its last two halvings are within half (:data:`ACCEPT`) the
-accuracy stated for the figures (1e-3 at fixed time, the monitor's; 3e-4 for the steady figures,
-:data:`ipir_mujoco.core.steady_test.LIMIT_ACCURACY`), each
-relative to its value, a module's travel to at least a tenth of a stroke (:data:`TRAVEL_FLOOR`: a robot that
-holds its place has no relative travel error). At most :data:`HALVINGS` halvings; where they do not reach it,
-the accuracy monitor's mode decides, as for its own figures: 'stop' raises an :class:`.monitor.AccuracyError`
-naming the figure, 'warn' returns the finest run with the figure in its accuracy record. Runs whose timestep
-was given, and compliant clutches (whose spring's rate already sets a step of a few microseconds, and whose
-skid is the anchor's slide on that spring, not a limit's reversal), are not rerun: their accuracy record says
-the skids were not verified.
+The finest run is kept once the differences of its last two halvings are within the rule's share (:data:`ACCEPT`
+by default) of the accuracy stated for the figures, at most :data:`HALVINGS` halvings; where they do not reach
+it, the accuracy monitor's mode decides, as for its own figures: 'stop' raises an :class:`.monitor.AccuracyError`
+naming the figure, 'warn' returns the finest run with the figure in its accuracy record. Runs whose timestep was
+given, and compliant clutches, are not rerun: their accuracy record says the skids were not verified.
 """
 
 from __future__ import annotations
@@ -36,7 +25,6 @@ from ipir_mujoco.core.errors import SimulationError
 from ipir_mujoco.core.results import RunResult
 from ipir_mujoco.core.steady_test import LIMIT_ACCURACY
 
-from ..builders.grip_model import carriage_share
 from ..loop.monitor import RESIDUAL_TOL, AccuracyError
 
 HALVINGS = 3  # the most halvings of the step a skid check makes (1e-4 s down to 1.25e-5 s)
@@ -74,50 +62,34 @@ def steady_difference(a: dict, b: dict, key: str, spread: str) -> float | None:
     return math.copysign((abs(a[key] - b[key]) + own) / scale, a[key] - b[key])
 
 
-def differences(coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, float]]:
-    """('steady' | 'fixed', {figure: relative difference}) of two runs of one design at two steps: their steady
-    speed and energy per metre where both reached the steady state (inf where only one did; where the finer run
-    was found steady by the statistical test, its figure's own uncertainty U is added: what is left to trust
-    is the difference and U together), else revolutions and x1_final, x2_final (travel relative to at least
-    TRAVEL_FLOOR strokes). To each travel and steady figure the bias no halving shows is added: the carriage's
-    inertia shortens a skid by about its share of the module's mass (:func:`.grip_model.carriage_share`), so a
-    module's travel by that share of its slip (the steady figures: of both slips over both travels)."""
-    a, b = coarse.summary, fine.summary
-    share = carriage_share(fine.params)  # the carriages' inertia: a skid short by about this share of itself
-    if a["steady"] or b["steady"]:
-        if not (a["steady"] and b["steady"]):
-            return "steady", {"steady": math.inf}
-        out = {}
-        moved = abs(b["x1_final"]) + abs(b["x2_final"])
-        bias = share * (b["slip1_m"] + b["slip2_m"]) / moved if moved > 0 else math.inf
-        for key, spread in STEADY_FIGURES:
-            if (d := steady_difference(a, b, key, spread)) is not None:
-                out[key] = abs(d) + bias
-        return "steady", out
-    floor = TRAVEL_FLOOR * 2 * fine.params.r
-    out = {"revolutions": abs(a["revolutions"] - b["revolutions"]) / max(abs(a["revolutions"]), abs(b["revolutions"]),
-                                                                        TRAVEL_FLOOR)}
-    for k, key in ((1, "x1_final"), (2, "x2_final")):
-        out[key] = (abs(a[key] - b[key]) + share * b[f"slip{k}_m"]) / max(abs(a[key]), abs(b[key]), floor)
-    return "fixed", out
-
-
 class SkidRule:
-    """What a run does with a skid rule (a subclass gives its floor ``skidded(result)``, its figures
-    ``differences(coarse, fine)``, its acceptance ``judge(history)`` and ``failure(history)``): a model kind gives
-    its own (:meth:`ipir_mujoco.engine.kinds.base.ModelKind.skid_rule`)."""
+    """What a run does with a skid rule (a subclass gives its floor ``skidded(result)``, and, for
+    :func:`verify_skids`, its figures ``differences(coarse, fine)``, its acceptance ``judge(history)`` and
+    ``failure(history)``): a model kind gives its own (:meth:`ipir_mujoco.engine.kinds.base.ModelKind.skid_rule`).
+    A rule that checks otherwise (the slides' rigid limit,
+    :class:`ipir_mujoco.engine.kinds.slides_grip.rigid_limit.RigidLimit`) overrides :meth:`verify`,
+    :meth:`unverified` and :meth:`given_settings`."""
+
+    def given_settings(self, params, settings, automatic) -> tuple:
+        """(the settings a run whose timestep was given runs with, what the run records of them): ``settings`` as
+        given; ``automatic()`` gives the settings the engine would have chosen."""
+        return settings, {}
+
+    def unverified(self, result: RunResult, why: str) -> RunResult:
+        """``result``, not checked (``why``), its accuracy record saying so where it skidded."""
+        if self.skidded(result):
+            result.accuracy["skid_check"] = f"not verified: {why}"
+        return result
 
     def given(self, result: RunResult) -> RunResult:
-        """``result``, of a run whose timestep was given: not rerun; its accuracy record says so where it
-        skidded."""
-        if self.skidded(result):
-            result.accuracy["skid_check"] = "not verified: timestep given"
-        return result
+        """``result``, of a run whose timestep was given: not rerun."""
+        return self.unverified(result, "timestep given")
 
     def verify(self, result: RunResult, rerun, mode: str, dt_min: float,
                wall_budget_s: float | None = None) -> RunResult:
         """``result`` (an automatically stepped run) or a finer run of the same design, verified by this rule
-        (:func:`verify_skids`) within the run's wall-time budget ``wall_budget_s`` [s]."""
+        (:func:`verify_skids`) within the run's wall-time budget ``wall_budget_s`` [s]; ``rerun`` as
+        :func:`verify_skids` takes it."""
         return verify_skids(result, rerun, mode, dt_min, self, wall_budget_s)
 
 
@@ -135,9 +107,9 @@ class NoSkids(SkidRule):
 
 
 class Unverified(SkidRule):
-    """A rule whose runs are not rerun (``why``: compliant clutches, whose skid is the anchor's slide on the
+    """A rule whose runs are not checked (``why``: compliant clutches, whose skid is the anchor's slide on the
     spring, not a limit's reversal, and whose spring already sets a step of a few microseconds): a run that
-    skidded (by ``rule``'s floor) says so in its accuracy record."""
+    skidded (by ``rule``'s floor) says so in its accuracy record, in ``rule``'s words."""
 
     def __init__(self, rule: SkidRule, why: str):
         self.rule, self.why, self.name = rule, why, rule.name
@@ -145,59 +117,24 @@ class Unverified(SkidRule):
     def skidded(self, result: RunResult) -> bool:
         return self.rule.skidded(result)
 
+    def unverified(self, result: RunResult, why: str) -> RunResult:
+        return self.rule.unverified(result, why)
+
     def verify(self, result: RunResult, rerun, mode: str, dt_min: float,
                wall_budget_s: float | None = None) -> RunResult:
-        if self.skidded(result):
-            result.accuracy["skid_check"] = f"not verified: {self.why}"
-        return result
+        return self.rule.unverified(result, self.why)
 
 
 NO_SKIDS = NoSkids()
 
 
-class SlideSkids(SkidRule):
-    """The slide model's rule (module docstring): its floor (:func:`skidded`), its figures' differences
-    (:func:`differences`) and its acceptance (the last two halvings each within ACCEPT of the tolerance)."""
-
-    name = "slides"
-
-    def skidded(self, result: RunResult) -> bool:
-        return skidded(result)
-
-    def differences(self, coarse: RunResult, fine: RunResult) -> tuple[str, dict[str, float]]:
-        return differences(coarse, fine)
-
-    def judge(self, history: list) -> tuple[bool, str, float, float]:
-        """(passed, the figure that decides, its difference, the share of the tolerance it is held to) after the
-        halvings of ``history`` (each ``{"kind", "differences"}``, the latest last); records each halving's worst
-        figure and difference in it."""
-        last = history[-1]
-        last["figure"] = max(last["differences"], key=last["differences"].get)
-        last["difference"] = last["differences"][last["figure"]]
-        tolerance = ACCEPT * SKID_TOL[last["kind"]]
-        step = max(history[-2:], key=lambda h: h["difference"])  # the halving that keeps the check from passing
-        # two halvings at least, each within ACCEPT of the tolerance: one pair of runs can agree by chance
-        return len(history) >= 2 and step["difference"] <= tolerance, step["figure"], step["difference"], tolerance
-
-    def failure(self, history: list) -> str:
-        """Why the check did not pass, after its last halving (the middle of its one-line message)."""
-        step = max(history[-2:], key=lambda h: h["difference"])
-        tolerance = SKID_TOL[history[-1]["kind"]]
-        return (f"halving the timestep from {step['timestep']:.3g} s to {step['half']:.3g} s moved {step['figure']} "
-                f"by {step['difference']:.2e} of it, more than {ACCEPT:g} of the tolerance {tolerance:.3g} (each of "
-                "the last two halvings must stay within it; the skids' error under the step)")
-
-
-SLIDES_RULE = SlideSkids()
-
-
-def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule=SLIDES_RULE,
+def verify_skids(result: RunResult, rerun, mode: str, dt_min: float, rule,
                  wall_budget_s: float | None = None) -> RunResult:
     """``result`` (an automatically stepped run that may skid) or a finer run of the same design, verified as
     the module docstring says. ``rerun(timestep)`` runs the design again at that step [s] and returns its
     RunResult; ``mode``: the accuracy monitor's ('stop' | 'warn'); ``dt_min`` [s]: the smallest step a run may
-    take (halving stops before it); ``rule``: the model's floor, figures and acceptance (:data:`SLIDES_RULE`,
-    :data:`ipir_mujoco.engine.kinds.wheels.skids.WHEELS_RULE`); ``wall_budget_s`` [s]: the run's wall-time budget,
+    take (halving stops before it); ``rule``: the model's floor, figures and acceptance
+    (:data:`ipir_mujoco.engine.kinds.wheels.skids.WHEELS_RULE`); ``wall_budget_s`` [s]: the run's wall-time budget,
     which its repeats share (each RunResult's ``wall_time_s`` counts from the run's start): a repeat predicted
     past it (:func:`_past_budget`) is not started, and the run says which steps the check needed."""
     if not rule.skidded(result):

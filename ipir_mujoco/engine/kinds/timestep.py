@@ -53,11 +53,12 @@ accuracy monitor catches what they miss and the engine then halves the step.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
-from ..builders.grip_model import COMPLIANT_CARRIAGE_SHARE
+from ..builders.grip_model import COMPLIANT_CARRIAGE_SHARE, carriage_share
 from ..builders.model import SolverSettings
 from ..loop.monitor import RESIDUAL_TOL
 
@@ -72,6 +73,9 @@ RESIDUAL_CONSTANT = {"ratchet": 0.36, "lock": 2.4, "none": 0.36}  # C of the law
 LEAK_RATIO = 3e4  # module-to-rod mass ratio from which a light rod shortens the step
 SERVO_SHARE = 0.2  # of 1 / (servo rate)
 CLUTCH_SHARE = 0.1  # of 1 / omega_c, the fastest clutch spring's angular frequency (see the module docstring)
+# the slide model on finite grip (rigid clutches): its grip rows' time constant over its step, in the runs of the rigid
+# limit's family (ipir_mujoco.engine.kinds.slides_grip.rigid_limit; mjcf/README.md, "Finite grip: the rigid limit", says why 8)
+STEPS_PER_TIME_CONSTANT = 8
 
 
 def clutch_rate(params: RobotParams) -> float:
@@ -153,3 +157,36 @@ def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None
     steps = math.ceil(dt_out / needed * (1 - 1e-12))
     why = {"omega_bound_rad_s": omega_b, "revolutions_bound": revolutions, **limits}
     return SolverSettings(timestep=dt_out / steps), why
+
+
+def first_settings(settings: SolverSettings, params: RobotParams) -> SolverSettings:
+    """``settings`` (an automatic step h) as the first run of the rigid limit's family on finite grip
+    (:mod:`ipir_mujoco.engine.kinds.slides_grip.rigid_limit`): the grip rows' time constant STEPS_PER_TIME_CONSTANT h [s], the
+    carriage at its share for ``params``' clutches (:func:`.grip_model.carriage_share`)."""
+    return replace(settings, grip_time_constant=STEPS_PER_TIME_CONSTANT * settings.timestep,
+                   carriage_share=carriage_share(params))
+
+
+def halved(settings: SolverSettings) -> SolverSettings:
+    """``settings`` at half its step, the grip rows' time constant (where set) with it: the engine's refinement
+    of an automatic step the accuracy monitor stopped keeps STEPS_PER_TIME_CONSTANT steps per time constant."""
+    tau = settings.grip_time_constant
+    return replace(settings, timestep=settings.timestep / 2, grip_time_constant=None if tau is None else tau / 2)
+
+
+def given_settings(params: RobotParams, settings: SolverSettings, automatic) -> tuple[SolverSettings, str]:
+    """A given step's settings on the slide model with finite grip, and the time constant's rule in words: where
+    the grip rows' time constant is not given, the automatic run's (``automatic()``: its settings; in seconds,
+    so that halving the given step converges to one model), at least two given steps (MuJoCo's floor); the
+    carriage at its default share where not given."""
+    if settings.grip_time_constant is not None:
+        tau, rule = settings.grip_time_constant, "given"
+    else:
+        try:
+            tau, rule = automatic().grip_time_constant, "the automatic run's"
+        except ParameterError:  # the automatic step would be below the smallest allowed: the given step's own
+            tau, rule = STEPS_PER_TIME_CONSTANT * settings.timestep, "of the given step (no automatic step)"
+        if tau < 2 * settings.timestep:
+            tau, rule = 2 * settings.timestep, "two given steps (the automatic run's is shorter)"
+    share = settings.carriage_share if settings.carriage_share is not None else carriage_share(params)
+    return replace(settings, grip_time_constant=tau, carriage_share=share), rule

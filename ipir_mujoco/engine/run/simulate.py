@@ -70,7 +70,7 @@ from ..loop.recorder import DEFERRED, EXTRA_COLUMNS, SCALARS, Recorder
 from .run_setup import RunSetup
 from ..loop.servo_drive import TickedDrive, controller_for
 from ..loop.stepper import WARNED
-from ..kinds.timestep import DT_MIN
+from ..kinds.timestep import DT_MIN, halved
 
 # columns of the recorder's arrays the monitor reads
 _TORQUE, _GAP = SCALARS.index("motor_torque"), DEFERRED.index("loop_gap")
@@ -83,7 +83,6 @@ ENERGY_SLOTS = {column: (False, SCALARS.index(column)) if column in SCALARS
 
 
 __all__ = ["EXTRA_COLUMNS", "IMPLEMENTATIONS", "CrankServo", "captured_warnings", "simulate_mujoco"]
-
 
 
 def simulate_mujoco(
@@ -158,7 +157,9 @@ def simulate_mujoco(
                    kind=kind, feedforward=feedforward, route=route)
     rule = kind.skid_rule(params)  # the kind's skid check (kinds/skid_check.py)
     if settings is not None:
-        return rule.given(_Run(params, settings, **options).result({"timestep_source": "given"}))
+        settings, given = rule.given_settings(
+            params, settings, lambda: kind.settings(params, t_end, dt_out, servo, implementation, route=route)[0])
+        return rule.given(_Run(params, settings, **options).result({"timestep_source": "given", **given}))
     started = time.perf_counter()
     chosen, why = kind.settings(params, t_end, dt_out, servo, implementation, route=route)
     failures = []
@@ -171,14 +172,34 @@ def simulate_mujoco(
             if attempt == REFINEMENTS or chosen.timestep / 2 < DT_MIN:
                 raise
             failures.append({"timestep": chosen.timestep, "reason": str(exc)})
-            chosen = replace(chosen, timestep=chosen.timestep / 2)  # still a whole fraction of dt_out
-    every_step = math.isclose(dt_out, chosen.timestep, rel_tol=1e-12)  # sampled at each step: so at the finer one
+            chosen = halved(chosen)  # still a whole fraction of dt_out
+    return rule.verify(result, _Reruns(params, chosen, options, extra, started), accuracy, DT_MIN,
+                       run.wall_budget_s)
 
-    def rerun(dt: float) -> RunResult:
-        finer = {**options, "dt_out": dt} if every_step else options
-        return _Run(params, replace(chosen, timestep=dt), started=started, **finer).result(extra)
 
-    return rule.verify(result, rerun, accuracy, DT_MIN, run.wall_budget_s)
+class _Reruns:
+    """What a skid rule may run again of one automatically stepped run (``chosen`` its settings, ``options`` and
+    ``extra`` its _Run's, ``started`` its start on the wall clock): the design at a finer step (called with the
+    step [s]: :func:`ipir_mujoco.engine.kinds.skid_check.verify_skids`), or with other settings for ``t_end`` [s],
+    recording and never stopping on its accuracy monitor nor at its steady state (:meth:`member`: the rigid
+    limit's family, :mod:`ipir_mujoco.engine.kinds.slides_grip.rigid_limit`). A run sampled at each step is
+    sampled at each of the finer ones' steps."""
+
+    def __init__(self, params, chosen: SolverSettings, options: dict, extra: dict, started: float):
+        self.params, self.chosen, self.options, self.extra, self.started = params, chosen, options, extra, started
+        self.t_cap = options["t_end"]  # s: the run's t_end (with until_steady the cap)
+        self.every_step = math.isclose(options["dt_out"], chosen.timestep, rel_tol=1e-12)
+
+    def __call__(self, dt: float) -> RunResult:
+        finer = {**self.options, "dt_out": dt} if self.every_step else self.options
+        return _Run(self.params, replace(self.chosen, timestep=dt), started=self.started, **finer).result(self.extra)
+
+    def member(self, settings: SolverSettings, member_end: float) -> RunResult:
+        dt_out = self.options["dt_out"]
+        out = settings.timestep * (1 if self.every_step else max(1, round(dt_out / settings.timestep)))
+        member_options = {**self.options, "accuracy": "warn", "t_end": member_end, "until_steady": False,
+                          "dt_out": out}
+        return _Run(self.params, settings, started=self.started, **member_options).result(self.extra)
 
 
 class _Run:

@@ -4,7 +4,7 @@ friction G_i, carries the clutch.
 Its builder is the slide model's, which adds the carriages where the parameters give a finite grip
 (:mod:`ipir_mujoco.engine.builders.grip_model`); its clutches: the rigid ratchets of :mod:`.ratchet` or the
 compliant clutches of :mod:`.compliant`, their compiled forms in :mod:`.compiled` and ``_clutch_grip.c``; its skid
-rule: :data:`ipir_mujoco.engine.kinds.skid_check.SLIDES_RULE`.
+rule: a skidding run's figures extrapolated to the rigid limit (:mod:`.rigid_limit`).
 """
 
 from __future__ import annotations
@@ -41,6 +41,17 @@ class GripSlidesKind(SlidesKind):
         params = super().check(params, implementation, rule, route, until_steady)
         refuse_grip(params, implementation)
         return params
+
+    def settings(self, params, t_end, dt_out, servo=None, implementation="ratchet", route=None):
+        """The automatic step (:func:`ipir_mujoco.engine.kinds.timestep.choose_settings`); with rigid clutches
+        the grip rows' time constant STEPS_PER_TIME_CONSTANT steps and the carriage's share set: the first run of
+        the rigid limit's family (:func:`ipir_mujoco.engine.kinds.timestep.first_settings`)."""
+        from ..timestep import first_settings
+
+        chosen, why = super().settings(params, t_end, dt_out, servo, implementation, route)
+        if params.clutch_stiffness is None:
+            chosen = first_settings(chosen, params)
+        return chosen, why
 
     def between_steps(self, params, implementation, rule):
         return [*super().between_steps(params, implementation, rule),
@@ -81,14 +92,15 @@ class GripSlidesKind(SlidesKind):
         return cols
 
     def skid_rule(self, params):
-        """The slide model's rule (:data:`ipir_mujoco.engine.kinds.skid_check.SLIDES_RULE`); with compliant
-        clutches the skids are not verified (their skid is the anchor's slide on the spring, whose rate already
-        sets a step of a few microseconds: :mod:`ipir_mujoco.engine.kinds.skid_check`)."""
-        from ..skid_check import SLIDES_RULE, Unverified
+        """The rigid limit (:data:`.rigid_limit.RIGID_LIMIT`); with compliant clutches the figures are not
+        extrapolated (their skid is the anchor's slide on the spring, whose rate already sets a step of a few
+        microseconds: :mod:`ipir_mujoco.engine.kinds.skid_check`)."""
+        from ..skid_check import Unverified
+        from .rigid_limit import RIGID_LIMIT
 
         if params.clutch_stiffness is not None:
-            return Unverified(SLIDES_RULE, "compliant clutches")
-        return SLIDES_RULE
+            return Unverified(RIGID_LIMIT, "compliant clutches")
+        return RIGID_LIMIT
 
 
 KIND = GripSlidesKind()
