@@ -4,7 +4,7 @@ and the lift and scrub checks' record against what MuJoCo did.
 Run on demand from the repository root (about a minute of wall time per route and worker on 2 busy cores):
 
     python bench/route_agreement.py [--routes N] [--seed S] [--first K] [--workers N] [--log FILE.jsonl]
-                                    [--set NAME=VALUE]... [--smoke]
+                                    [--set NAME=VALUE]... [--wall-budget SECONDS] [--smoke]
 
 Route k of seed S (its own random stream, so any route can be rerun alone: ``--first k --routes 1``): a 0.3 m
 first straight rising at an incline drawn from -90..90 deg, or exactly 90, -90 or 0 (a quarter each), then 1-3
@@ -23,7 +23,8 @@ has then, MuJoCo's differences in % (the work's over the energy put through the 
 forms' predictions (lift: ``lift_predicted``; scrub: the equations' wheels beyond their friction in a bend) beside
 what MuJoCo did (a wheel off its wall for how long; how far its wheels slid sideways), and the class (``agree``:
 both within 2 %; ``lift``, ``scrub``: predicted and happened; ``stopped``: an engine did not get through, with its
-reason; ``miss``: none of these). Then the counts per class, the checks' confusion matrices (false alarms and
+reason; ``over budget``: a run took more than ``--wall-budget`` of wall time; ``miss``: none of these). Then the
+counts per class, the checks' confusion matrices (false alarms and
 misses), the largest differences among the routes that agree, and the wall time per route.
 
 ``--log FILE.jsonl`` appends each finished route's record (its spec, both engines' records) and, on a later run
@@ -34,6 +35,7 @@ with the same file, skips the routes it holds (printing their lines first): a lo
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import sys
@@ -50,6 +52,8 @@ from ipir_mujoco.studies.route_compare import AGREE, compare_route, confusion, p
 D = RobotParams().pipe_diameter  # m: the default pipe, to name the bends' R / D
 ARC = 0.6  # m: a bend's longest arc
 T_CAP = (10.0, 10.0)  # s, s/m: each run's cap, a constant and per metre of route
+WALL_BUDGET_S = 1200.0  # s: each run's wall time at most (a MuJoCo run whose wheels skid in tight bends reruns at
+# halved steps down to 6e-6 s: up to 15 times its first run's cost; its skid check keeps the step it reached)
 
 
 def spec(seed: int, k: int, overrides: dict) -> dict:
@@ -71,12 +75,12 @@ def spec(seed: int, k: int, overrides: dict) -> dict:
     return {"k": k, "segments": tables, "params": params}
 
 
-def run_route(item: dict) -> dict:
+def run_route(item: dict, wall_budget_s: float) -> dict:
     """One route in a worker: its spec and :func:`compare_route`'s record, and the wall time [s]."""
     started = time.perf_counter()
     route = route_from_tables(item["segments"], f"route {item['k']}")
     params = load_params(None, item["params"])
-    record = compare_route(params, route, T_CAP[0] + T_CAP[1] * route.length)
+    record = compare_route(params, route, T_CAP[0] + T_CAP[1] * route.length, wall_budget_s=wall_budget_s)
     record.update(spec=item, wall_s=time.perf_counter() - started, length_m=route.length,
                   bends=[(round(p.radius / D, 2), round(math.degrees(p.angle), 1), round(math.degrees(p.plane)))
                          for p in route.bends])
@@ -102,7 +106,7 @@ def line(r: dict) -> str:
             f"{fig(m.get('net_work_j'), 'J')} ({percent(r['work_diff'])}), scrub {fig(e.get('scrub_j'), 'J')}; "
             f"predicted {said}; MuJoCo {seen}; {r['mujoco'].get('wall_s', 0):.0f}+{r['equations'].get('wall_s', 0):.0f}"
             " s wall")
-    if r["outcome"].startswith("stopped") or r["outcome"] == "miss":
+    if r["outcome"].startswith(("stopped", "over")) or r["outcome"] == "miss":
         for name, rec in (("equations", e), ("MuJoCo", m)):
             if not rec.get("route_done"):
                 text += f"\n       {name}: {rec.get('route_stop')}"
@@ -139,6 +143,8 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--log", default=None, metavar="FILE.jsonl", help="append records here; skip those it holds")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    parser.add_argument("--wall-budget", type=float, default=WALL_BUDGET_S, metavar="SECONDS",
+                        help="each run's wall-time budget (default %(default)g s)")
     parser.add_argument("--smoke", action="store_true", help="one short route (a check that the script runs)")
     args = parser.parse_args(argv)
     overrides = parse_overrides(args.set)
@@ -172,7 +178,7 @@ def main(argv=None) -> int:
             with open(args.log, "a") as handle:
                 handle.write(json.dumps(record) + "\n")
 
-    map_unordered(run_route, todo, args.workers, done)
+    map_unordered(functools.partial(run_route, wall_budget_s=args.wall_budget), todo, args.workers, done)
     report(records)
     return 0
 

@@ -23,6 +23,7 @@ acceptance's classes (mjcf/README.md, "MuJoCo against the equations in bends"):
   straight pipe's sideways-grip check predicted a slide (``scrub_predicted``, where the summary has it);
 - ``stopped``: an engine did not reach the route's end, each engine's ``route_stop`` line says why (``both``
   where both stopped, else which);
+- ``over budget``: a run exceeded its wall-time budget (no verdict on its physics);
 - ``miss``: beyond AGREE with no such prediction that came true.
 """
 
@@ -89,27 +90,31 @@ def engine_record(run) -> dict:
     return out
 
 
-def run_engine(variant: str, params, route, t_cap: float, dt_out: float = DT_OUT) -> tuple[object | None, dict]:
+def run_engine(variant: str, params, route, t_cap: float, dt_out: float = DT_OUT,
+               wall_budget_s: float | None = None) -> tuple[object | None, dict]:
     """(the run or None, its record :func:`engine_record` or {'error': line}) of ``variant`` along ``route`` for at
-    most ``t_cap`` [s]; ``wall_s`` [s] in the record."""
+    most ``t_cap`` [s] of simulated time and ``wall_budget_s`` [s] of wall time (None: the package's default; a
+    MuJoCo run's skid check keeps the step it reached within it); ``wall_s`` [s] in the record."""
     started = time.perf_counter()
     options = {"accuracy": "warn"} if variant == MUJOCO else {}
     try:
-        run = registry.run(variant, params, t_cap, route=route, dt_out=dt_out, **options)
+        run = registry.run(variant, params, t_cap, route=route, dt_out=dt_out, wall_budget_s=wall_budget_s,
+                           **options)
     except SimulationError as exc:
         return None, {"error": str(exc), "route_done": False, "route_stop": f"failed: {exc}",
-                      "wall_s": time.perf_counter() - started}
+                      "over_budget": "wall-time budget" in str(exc), "wall_s": time.perf_counter() - started}
     record = engine_record(run)
     record["wall_s"] = time.perf_counter() - started
     return run, record
 
 
-def compare_route(params, route, t_cap: float, dt_out: float = DT_OUT) -> dict:
-    """Both engines along ``route`` (module docstring) with ``params``, each for at most ``t_cap`` [s]: {'equations':
-    record, 'mujoco': record, 'time_diff', 'work_diff' (MuJoCo's over the equations' less 1, None where either did
-    not reach the end), 'lift', 'scrub' ({'predicted', 'happened'}), 'outcome' (:func:`classify`)}."""
-    _, equations = run_engine(EQUATIONS, params, route, t_cap, dt_out)
-    _, mujoco = run_engine(MUJOCO, params, route, t_cap, dt_out)
+def compare_route(params, route, t_cap: float, dt_out: float = DT_OUT, wall_budget_s: float | None = None) -> dict:
+    """Both engines along ``route`` (module docstring) with ``params``, each for at most ``t_cap`` [s] and
+    ``wall_budget_s`` [s] of wall time: {'equations': record, 'mujoco': record, 'time_diff', 'work_diff' (MuJoCo's
+    over the equations' less 1, None where either did not reach the end), 'lift', 'scrub' ({'predicted',
+    'happened'}), 'outcome' (:func:`classify`)}."""
+    _, equations = run_engine(EQUATIONS, params, route, t_cap, dt_out, wall_budget_s)
+    _, mujoco = run_engine(MUJOCO, params, route, t_cap, dt_out, wall_budget_s)
     return judge(equations, mujoco)
 
 
@@ -149,6 +154,8 @@ def judge(equations: dict, mujoco: dict, work: str = "net_work_j", done: str = "
 def classify(record: dict, done: str = "route_done") -> str:
     """The record's class (module docstring): 'agree', 'lift', 'scrub', 'stopped (both|MuJoCo|equations)' or
     'miss'; ``done``: the engine records' key of whether a run got through."""
+    if record["equations"].get("over_budget") or record["mujoco"].get("over_budget"):
+        return "over budget"
     done = (bool(record["equations"].get(done)), bool(record["mujoco"].get(done)))
     if not all(done):
         return "stopped (" + ("both" if not any(done) else "MuJoCo" if done[0] else "equations") + ")"
