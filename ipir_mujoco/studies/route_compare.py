@@ -20,7 +20,8 @@ acceptance's classes (mjcf/README.md, "MuJoCo against the equations in bends"):
   lift-off check predicted it (``lift_predicted``: the straight pipe's and every bend's, :mod:`.core.pipe`), or the
   wheels slid sideways on the wall (MuJoCo's ``slid1``, ``slid2``, from ``core.pipe.SCRUB_FLOOR`` on) where the
   equations' closed form has a wheel beyond its friction limit in a bend (their ``scrub_j`` > 0) or the
-  straight pipe's sideways-grip check predicted a slide (``scrub_predicted``, where the summary has it);
+  straight pipe's sideways-grip check predicted a slide under the drive's loads (``scrub_predicted``: the
+  summary's, or along a route :func:`ipir_mujoco.core.pipe.side_summary`'s);
 - ``stopped``: an engine did not reach the route's end, each engine's ``route_stop`` line says why (``both``
   where both stopped, else which);
 - ``over budget``: a run exceeded its wall-time budget (no verdict on its physics);
@@ -36,7 +37,7 @@ import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.errors import SimulationError
-from ipir_mujoco.core.pipe import SCRUB_FLOOR
+from ipir_mujoco.core.pipe import SCRUB_FLOOR, side_summary
 
 AGREE = 0.02  # the acceptance's bound on the two engines' time and motor work along a route
 # the series' columns of work dissipated (the rolling resistance, skids, the scrub in bends; MuJoCo's contacts'
@@ -87,6 +88,9 @@ def engine_record(run) -> dict:
                                                                                       s.get("slip2_m")))
     if "slid1" in run.series:
         out["slid_m"] = max(float(run.series["slid1"][-1]), float(run.series["slid2"][-1]))
+        if out["scrub_predicted"] is None:  # along a route the summary has none: the straight pipe's check on the
+            # drive's loads (the rod's side force and the motor's couple against the rings' sideways grip)
+            out["scrub_predicted"] = bool(side_summary(run.params, run.series)["scrub_predicted"])
     return out
 
 
