@@ -265,8 +265,17 @@ def _contact_sentence(rungs: list[LadderRun]) -> str:
     return (" On wheels pressed on the pipe's walls (MuJoCo's contacts, a ratchet in every hub) the robot changes "
             f"crank revolutions by {_percent(relative_change(wheels['revolutions'], ratchet['revolutions']))} and "
             f"module 1's travel by {_percent(relative_change(wheels['x1_final'], ratchet['x1_final']))} against the "
-            "ratchet on slides (the rocking modules' wheels briefly leave the wall; MuJoCo's energy residual "
-            f"{_residual(named['wheels in contact'])}).")
+            f"ratchet on slides ({_press(wheels)}; MuJoCo's energy residual {_residual(named['wheels in contact'])}).")
+
+
+def _press(summary: dict) -> str:
+    """The wheels' press and grip as MuJoCo has them, beside the slides' constant press (the constant-press
+    idealization's measure): mean press per module, wheels off their wall, grip mu_wall x press where finite."""
+    text = (f"the wheels pressed {summary['press1_n']:.4g} / {summary['press2_n']:.4g} N on the mean, a wheel off its "
+            f"wall {summary['wheel_off_s']:.3g} s")
+    if summary.get("grip1_n") is not None:
+        text += f", a grip of {summary['grip1_n']:.4g} / {summary['grip2_n']:.4g} N (mu_wall x press)"
+    return text
 
 
 def _residual(summary: dict) -> str:
