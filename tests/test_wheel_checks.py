@@ -121,3 +121,43 @@ def test_the_predicted_slide_is_the_path_the_springs_place_the_ring_on():
     assert result["slid1_m"] == pytest.approx(2 * 2 * F * 2 / (3 * k), rel=1e-12)
     assert result["scrub_predicted"] is (result["slid1_m"] >= SCRUB_FLOOR)
     assert result["slid2_m"] == 0.0
+
+
+def test_the_rings_motion_in_closed_form_is_the_step_by_step_recurrence():
+    """ring_response sums each sliding stretch in closed form; stepped sample by sample (each interval turns
+    (place - load, velocity / omega) by -omega dt; at rest where the wheels hold) it is the same to round-off,
+    over random loads and holds."""
+    def stepped(spring, grip, step):
+        c, s = math.cos(step), math.sin(step)
+        out, x, v = np.empty_like(spring), [0.0, 0.0], [0.0, 0.0]
+        for j, (load, hold) in enumerate(zip(spring.tolist(), grip.tolist())):
+            out[j] = x
+            if hold:
+                v = [0.0, 0.0]
+                continue
+            for a in (0, 1):
+                y = x[a] - load[a]
+                x[a], v[a] = load[a] + y * c + v[a] * s, v[a] * c - y * s
+        return out
+
+    rng = np.random.default_rng(7)
+    for share in (0.0, 0.2, 0.6, 1.0):
+        spring = rng.normal(size=(2000, 2))
+        grip = rng.random(2000) < share
+        assert np.abs(W.ring_response(spring, grip, 0.05) - stepped(spring, grip, 0.05)).max() < 1e-12
+
+
+def test_the_constant_press_measures_say_the_wheels_grip_as_mujoco_has_it():
+    """The atlas's constant-press pair notes the wheeled run's grip (mu_wall x measured press) against the
+    slides' mu_wall F_n; the validation report's sentence on the wheeled rung says the press and grip too."""
+    from ipir_mujoco.studies.atlas_space import IDEALIZATIONS, measure
+    from ipir_mujoco.studies.validate import _press
+
+    params = RobotParams(mu_wall=0.5, F_n1=30.0, F_n2=40.0)
+    out = measure(IDEALIZATIONS["constant-press"].mujoco, params, ("revolutions",), 0.05, False)
+    assert out["error"] == "" and "mujoco-wheels: grip " in out["note"]
+    assert "against mu_wall F_n 15 / 20 N" in out["note"]
+    summary = {"press1_n": 30.2, "press2_n": 40.1, "wheel_off_s": 0.0, "grip1_n": 15.1, "grip2_n": 20.05}
+    assert _press(summary) == ("the wheels pressed 30.2 / 40.1 N on the mean, a wheel off its wall 0 s, a grip of "
+                               "15.1 / 20.05 N (mu_wall x press)")
+    assert "grip" not in _press({**summary, "grip1_n": None})

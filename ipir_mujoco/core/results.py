@@ -217,9 +217,14 @@ class RunResult:
         """The summary figures of the command-line contract (docs/cli.md)."""
         summary = summarize(self.series, self.energy, self.params.grip)
         if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form checks beside its outcome (a
-            # route's bends have theirs in route_fit)
-            summary.update(run_summary(self.params, self.series, (self.route or {}).get("route_fit"),
-                                       straight=not self.route))
+            # route's bends have theirs in route_fit); computed once per series (a long run's take a second)
+            key = (id(self.series), len(self.series["t"]), id(self.route))
+            cached = self.__dict__.get("_wall_summary")
+            if cached is None or cached[0] != key:
+                cached = (key, run_summary(self.params, self.series, (self.route or {}).get("route_fit"),
+                                           straight=not self.route))
+                self.__dict__["_wall_summary"] = cached
+            summary.update(cached[1])
         summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall

@@ -125,7 +125,7 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
     holds less across it, Coulomb's cone, and nothing while it skids: :func:`held`).
     ``lift_predicted``: a least press below 0. ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
     outcome, ``scrubbed``, is the run's path from the same floor)."""
-    from .pipe import SCRUB_FLOOR, scrub_force
+    from .pipe import SCRUB_FLOOR
 
     n = int(params.wheel_legs)
     u, _ = leg_frames(n)
@@ -147,10 +147,7 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             spring = np.where(grip[:, None], 0.0, load)
             moving = ~grip & np.broadcast_to(np.asarray(rolling[module], dtype=bool), (samples,))
             if params.mu_wall is not None and moving.any():
-                size = np.hypot(spring[:, 0], spring[:, 1])
-                for j in np.flatnonzero(moving & (size > 0)):
-                    toward = (float(spring[j, 0] / size[j]), float(spring[j, 1] / size[j]))
-                    spring[j] += scrub_force(params, module, toward) * np.array(toward)
+                spring = spring + _steering_scrub(params, module, spring, moving)
             place = spring if dt is None else ring_response(spring, grip, frequency * dt)
             least = min(least, float(np.min(leg_presses(params, module, place + weight))))
             shifts = np.diff(place, axis=0) * (2.0 / (n * stiffness))
@@ -164,6 +161,30 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
         out[f"side_use{i}"] = ratio
     out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
     out["scrub_predicted"] = max(out["slid1_m"], out["slid2_m"]) >= SCRUB_FLOOR
+    return out
+
+
+SCRUB_BINS = 720  # directions across the pipe the steering scrub is taken at (0.5 deg apart: to cos 0.25 deg)
+
+
+def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray) -> np.ndarray:
+    """The wheels' sideways scrub [N] along each sample's spring load (shape (n, 2)) where ``moving`` (the module
+    rolls and the ring slides), :func:`.pipe.scrub_force` at the load's direction rounded to one of SCRUB_BINS
+    (the law is called once per direction, not per sample); zero elsewhere."""
+    from .pipe import scrub_force
+
+    size = np.hypot(spring[:, 0], spring[:, 1])
+    where = moving & (size > 0)
+    out = np.zeros_like(spring)
+    if not where.any():
+        return out
+    angle = np.arctan2(spring[where, 1], spring[where, 0])
+    bins = np.round(angle / (2 * math.pi) * SCRUB_BINS).astype(int) % SCRUB_BINS
+    force = np.empty(where.sum())
+    for b in np.unique(bins):
+        a = 2 * math.pi * b / SCRUB_BINS
+        force[bins == b] = scrub_force(params, module, (math.cos(a), math.sin(a)))
+    out[where] = force[:, None] * spring[where] / size[where, None]
     return out
 
 
@@ -185,22 +206,32 @@ def ring_response(spring: np.ndarray, grip: np.ndarray, step: float) -> np.ndarr
     """Where a ring sits [N: the springs' load that holds it there] at each sample, shape (n, 2): a mass on its
     springs, undamped, pushed by ``spring`` (shape (n, 2)) held over each interval, ``step`` = omega dt its
     natural frequency times the interval; at rest, where it is, while its wheels hold (``grip``, shape (n,)).
-    Exact for a load constant over each interval: with y = place - load, y' = velocity / omega,
-    (y, y') turns by ``step`` each interval."""
-    c, s = math.cos(step), math.sin(step)
-    out = np.empty_like(spring)
-    rows = spring.tolist()
-    held_at = grip.tolist()
-    x = [0.0, 0.0]
-    v = [0.0, 0.0]
-    for j, (load, hold) in enumerate(zip(rows, held_at)):
-        out[j] = x
-        if hold:
-            v = [0.0, 0.0]
-            continue
-        for a in (0, 1):
-            y = x[a] - load[a]
-            x[a], v[a] = load[a] + y * c + v[a] * s, v[a] * c - y * s
+    Exact for a load constant over each interval: with w = place + i velocity / omega, each interval turns
+    w - load by -``step``: w' = a w + (1 - a) load, a = exp(-i step), summed in closed form over each stretch
+    of samples where the wheels slide (from rest where they held)."""
+    spring = np.asarray(spring, dtype=float).reshape(-1, 2)
+    grip = np.asarray(grip, dtype=bool).reshape(-1)
+    out = np.zeros_like(spring)
+    free = np.flatnonzero(~grip)
+    if not free.size:
+        return out
+    breaks = np.flatnonzero(np.diff(free) > 1)
+    starts = np.concatenate([[free[0]], free[breaks + 1]])
+    ends = np.concatenate([free[breaks] + 1, [free[-1] + 1]])
+    a = complex(math.cos(step), -math.sin(step))
+    place = np.zeros(2)
+    last = 0
+    for j0, j1 in zip(starts, ends):
+        out[last:j0] = place  # held since the last stretch: where the ring stopped, at rest
+        k = np.arange(j1 - j0 + 1)
+        turn = np.exp(-1j * step * k)  # a^k
+        back = np.exp(1j * step * (k[:-1] + 1))  # a^-(m + 1)
+        for c in (0, 1):
+            w = turn * (place[c] + (1 - a) * np.concatenate([[0.0], np.cumsum(back * spring[j0:j1, c])]))
+            out[j0:j1, c] = w.real[:-1]  # the place at each sample's start; after the last, the place it stops at
+            place[c] = w.real[-1]
+        last = j1
+    out[last:] = place
     return out
 
 
