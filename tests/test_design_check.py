@@ -83,3 +83,25 @@ def test_the_tightest_bend_grows_with_the_ring_spacing_as_its_square():
         assert bend_wheel_spread(s / 2, p.wheel_radius, R, p.pipe_diameter) == pytest.approx(
             2 * p.suspension_travel, rel=1e-6)
     assert radii[1] / radii[0] == pytest.approx(2.0, rel=0.05)
+
+
+def test_a_route_puts_its_bends_into_the_bend_rules(capsys):
+    """With mjcf/bend90.toml (one bend of R/D 5): tightest_bend is judged against R/D 5, and bend_scrub is the
+    bend's own lift check (core.pipe.bend_lift_check), which the wheels' scrub at mu_wall 0.8 fails and at 0.3
+    does not (mjcf/README.md, "Routes": the robot stalls in a tight bend at 0.8 and passes at 0.3)."""
+    from ipir_mujoco.core.pipe import bend_lift_check
+    from ipir_mujoco.core.route import read_route
+    from ipir_mujoco.engine.builders.route_walls import bend_loads
+    from ipir_mujoco.resources import mjcf_dir
+
+    path = mjcf_dir() / "bend90.toml"
+    route = read_route(path)
+    for mu, holds in ((0.3, True), (0.8, False)):
+        p = RobotParams(mu_wall=mu)
+        r = rules(p, route)
+        assert r["tightest_bend"]["limit"] == pytest.approx(route.bends[0].radius / p.pipe_diameter)
+        check = bend_lift_check(p, route.bends[0].radius, *bend_loads(route, route.bends[0], p.g))
+        assert r["bend_scrub"]["value"] == pytest.approx(min(check["least_press1_n"], check["least_press2_n"]))
+        assert r["bend_scrub"]["holds"] is holds
+    code, out, _ = run_cli(capsys, "design-check", "--route", str(path), "--set", "mu_wall=0.3")
+    assert code == 0 and out.strip().endswith("every rule holds")
