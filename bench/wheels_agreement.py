@@ -28,7 +28,8 @@ its drive torque, its modules' grip use and rolling: a prediction made without M
 and the MuJoCo run's own (its summary's ``lift_predicted``, ``scrub_predicted``: the loop's pin force, its torque
 and its wheels' states). The end prints the counts per class and each check's confusion matrix (predicted or not
 against happened or not), with its false alarms (predicted, did not happen) as a share of the designs where
-nothing happened and of the predictions, and its misses.
+nothing happened and of the predictions, and its misses; and, for comparison, the lift check the summary gave
+before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_check`).
 
 ``--log FILE.jsonl`` appends each design's record as it finishes; a rerun with the same log skips the designs it
 holds (reprinting their lines), so a stopped benchmark resumes. The tables in mjcf/README.md ("The round pipe")
@@ -53,12 +54,13 @@ from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.kinetostatics import pin_forces
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.pipe import lift_check
 from ipir_mujoco.core.wheel_checks import check, ring_loads
 
 TRAVEL_REL, TRAVEL_FLOOR = 0.01, 1e-3  # the acceptance: travel within 1 % (or 1 mm)
 SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
 CLASSES = ("agree", "lifted", "scrubbed", "stopped", "outside")
-CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"))
+CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"), ("lift", "quasi-static"))
 
 
 def log_uniform(rng, lo: float, hi: float) -> float:
@@ -175,15 +177,25 @@ def line(row: dict) -> str:
             f"{row['wall_s']:.0f} s" + (f" | {row['why']}" if "why" in row else ""))
 
 
+def predicted(row: dict, name: str, source: str) -> bool:
+    """Whether the check ``name`` ('lift', 'scrub') on ``source``'s loads predicted it for the design: 'equations',
+    'run' (the record's), or 'quasi-static' (the lift check before Dec 7, on springs alone and the drive's largest
+    torque: :func:`ipir_mujoco.core.pipe.lift_check`, from the design's parameters)."""
+    if source == "quasi-static":
+        return bool(lift_check(RobotParams(**row["params"]))["lift_predicted"])
+    return bool(row["checks"][source][f"{name}_predicted"])
+
+
 def confusion(rows: list[dict], name: str, source: str) -> str:
     """The check's confusion matrix over the designs that ran: predicted or not against happened or not."""
     cells = {(p, h): [] for p in (True, False) for h in (True, False)}
     for row in rows:
         if "checks" in row:
-            cells[(bool(row["checks"][source][f"{name}_predicted"]), bool(row["happened"][name]))].append(row["design"])
+            cells[(predicted(row, name, source), bool(row["happened"][name]))].append(row["design"])
     tp, fa, miss, tn = (len(cells[k]) for k in ((True, True), (True, False), (False, True), (False, False)))
     share = (lambda a, b: f"{a}/{b} = {100 * a / b:.0f} %" if b else f"{a}/0")
-    whose = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads"}[source]
+    whose = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads",
+             "quasi-static": "springs alone, quasi-static (the check before Dec 7)"}[source]
     return (f"{name} check on {whose}: predicted and happened {tp}, predicted but not (false alarms) "
             f"{fa}, happened but not predicted (misses) {miss}, neither {tn}; false alarms {share(fa, fa + tn)} of the "
             f"designs where it did not happen, {share(fa, fa + tp)} of the predictions; misses "
