@@ -28,8 +28,8 @@ try:
     from .. import __version__
     from ..resources import shipped
     from .. import terminal
-    from . import (bend_study, calibrate, climb, clutch_study, compare, control_study, kinetostatics, optimize,
-                   params, render, sensitivity, simulate, sweep, uncertainty, validate)
+    from . import (bend_study, calibrate, climb, clutch_study, compare, control_study, design_check, kinetostatics,
+                   optimize, params, render, sensitivity, simulate, sweep, uncertainty, validate)
     from . import atlas
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
@@ -40,7 +40,7 @@ EXIT_INTERRUPTED = interrupts.EXIT_INTERRUPTED  # 128 + SIGINT, as shells report
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "console", "main"]
 
 COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
-            climb, control_study, bend_study, atlas, uncertainty, calibrate)
+            climb, control_study, bend_study, atlas, uncertainty, calibrate, design_check)
 
 
 def build_parser() -> Parser:
