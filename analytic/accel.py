@@ -40,7 +40,8 @@ LOAD_COST_S = 0.5  # s of Python-mode integration after which a process compiles
 
 ACCELERATED = False  # True once the kernels run compiled in this process (read it as accel.ACCELERATED)
 # the modules whose functions are compiled and call each other
-_COMPILED_MODULES = ("kernel_base", "route_geometry", "route_kernels", "kernels", "dense", "dop853")
+_COMPILED_MODULES = ("kernel_base", "route_geometry", "route_scrub", "route_kernels", "kernels", "dense",
+                     "dop853")
 _FUNCTIONS: list = []  # every @jit function, in definition order
 _spent = 0.0  # s of analytic integration run in Python so far (auto mode)
 _refused = False  # numba is missing, disabled, or failed to compile: never try again

@@ -41,6 +41,7 @@ from .accel import jit
 from .kernel_base import (P_FR1, P_FR2, P_JA, P_L, P_M1, P_M2, P_R, P_ROD_I, P_ROD_M, TINY,
                           drive_torque)
 from .route_geometry import add, combine, cross, dot, module_pose, scale, sub
+from .route_scrub import module_scrub
 
 ROUTE = 4  # the kernels' model number
 CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # results.Mode; 0 (both held) is statics
@@ -49,7 +50,11 @@ CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # results.Mode; 0 (both held) is 
 # [kg m^2]; gravity's acceleration vector g_vec [m/s^2] in route coordinates; the route's length [m], how many
 # packed pieces follow (its exit straight included)
 (Q_G1, Q_G2, Q_DIR1, Q_DIR2, Q_RULE, Q_H, Q_IT1, Q_IT2, Q_GX, Q_GY, Q_GZ, Q_END, Q_COUNT) = range(17, 30)
-Q_PIECES = 30
+# the wheels (:mod:`.route_scrub`): mu_wall (0 with unlimited grip: the rails, no scrub), cornering_coefficient
+# [1/rad] (inf: rigid), legs per ring, each module's legs' preload F_ni / (2 n) [N], the legs' deflection at preload
+# [m], the hubs' distance from the axis pipe_diameter / 2 - wheel_radius [m]
+(Q_MU, Q_CORNER, Q_LEGS, Q_P1, Q_P2, Q_TRAVEL, Q_RHO) = range(30, 37)
+Q_PIECES = 37
 RULE_ONE_WAY, RULE_PAPER = 0.0, 1.0
 N_EVENTS = 3  # module 1, module 2 (a moving module's speed, a held one's margin), the route's end
 NEWTON_STEPS = 30  # a bound: from the integrated value (within the solver's tolerance) it takes 1-2
@@ -62,14 +67,16 @@ LOOP_TOL = 1e-14
 
 @jit
 def scrub_force(p, module, s, v):
-    """The hook for the wheels' scrub in a bend: the force [N] along the path, backward, on module ``module`` (0 rear,
-    1 front) rolling forward at station s [m] and speed v >= 0 [m/s], beside its rolling resistance F_ri; it
-    dissipates scrub_force * v [W], booked as the audit's ``scrub_j``, and at v = 0 it is part of what a module
-    at rest must overcome to roll off (its hold's margin, :func:`route_guards`, and the mode choice,
+    """The wheels' scrub in a bend: the force [N] along the path, backward, on module ``module`` (0 rear, 1 front)
+    rolling forward at station s [m] and speed v >= 0 [m/s], beside its rolling resistance F_ri; it dissipates
+    scrub_force * v [W], booked as the audit's ``scrub_j``, and at v = 0 it is part of what a module at rest must
+    overcome to roll off (its hold's margin, :func:`route_guards`, and the mode choice,
     :meth:`.route_model.RouteModel.choose`). A module skidding back on locked wheels meets its grip G_i, all of its
-    wheels' friction. ``p``: the constants (the robot and the route: the curvature at s is
-    :func:`.route_geometry.centreline`'s). Zero until the wheels' side-force model is stated."""
-    return 0.0
+    wheels' friction. ``p``: the constants (the robot, its wheels and the route). The closed form
+    (:func:`.route_scrub.module_scrub`) depends on the module's place alone: its wheels' slip angles are the
+    geometry's, so their dissipated power is proportional to v."""
+    return module_scrub(p, Q_PIECES, int(p[Q_COUNT]), s, p[Q_H], p[Q_MU], p[Q_CORNER], int(p[Q_LEGS]),
+                        p[Q_P1 + module], p[Q_TRAVEL], p[Q_RHO])[0]
 
 
 @jit

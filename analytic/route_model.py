@@ -26,8 +26,8 @@ from .dynamics import OneDofDynamics
 from .grip_model import GripMode, GripModel
 from .kinematics import Linkage
 from .route_geometry import PIECE, pack_route
-from .route_kernels import (EXPANSION, N_EVENTS, Q_COUNT, Q_DIR1, Q_END, Q_G1, Q_GX, Q_H, Q_IT1, Q_RULE,
-                            ROUTE, RULE_ONE_WAY, RULE_PAPER)
+from .route_kernels import (EXPANSION, N_EVENTS, Q_COUNT, Q_DIR1, Q_END, Q_G1, Q_GX, Q_H, Q_IT1, Q_MU, Q_PIECES,
+                            Q_RULE, ROUTE, RULE_ONE_WAY, RULE_PAPER)
 from .unilateral_model import _MODE_REST_FLOOR, _TOL_V
 
 # route_state's outputs, by name
@@ -46,6 +46,17 @@ def transverse_inertia(params: RobotParams, mass: float) -> float:
     return mass * (3.0 * rho * rho + params.ring_spacing ** 2) / 12.0
 
 
+def wheel_constants(params: RobotParams) -> tuple[float, ...]:
+    """The wheels' constants of the scrub's closed form (:data:`.route_kernels.Q_MU` .. ``Q_RHO``): mu_wall (0 with
+    unlimited grip: the equations' rails, which carry any force across the pipe, and no scrub), the cornering
+    coefficient [1/rad] (inf for rigid wheels), the legs per ring n, each module's legs' preload F_ni / (2 n) [N],
+    the legs' deflection at their preload [m] and the hubs' distance from the pipe's axis [m]."""
+    n = int(params.wheel_legs)
+    corner = math.inf if params.cornering_coefficient is None else params.cornering_coefficient
+    return (params.mu_wall or 0.0, corner, float(n), params.F_n1 / (2 * n), params.F_n2 / (2 * n),
+            params.suspension_travel, 0.5 * params.pipe_diameter - params.wheel_radius)
+
+
 class RouteModel(GripModel):
     """The robot with ``clutch`` 'unilateral' (one-way clutches, finite grip where ``params.mu_wall`` is) or
     'kinematic' (the paper's locks) along ``route``; the interface :mod:`.route_run` drives."""
@@ -58,13 +69,14 @@ class RouteModel(GripModel):
         self.F = (params.F_r1, params.F_r2)
         pieces = pack_route(route)
         up = route.up
-        head = np.zeros(Q_COUNT + 1 - 17)
+        head = np.zeros(Q_PIECES - 17)
         head[Q_G1 - 17:Q_G1 - 15] = self.grip
         head[Q_RULE - 17] = RULE_PAPER if clutch == "kinematic" else RULE_ONE_WAY
         head[Q_H - 17] = 0.5 * params.ring_spacing
         head[Q_IT1 - 17:Q_IT1 - 15] = transverse_inertia(params, params.m1), transverse_inertia(params, params.m2)
         head[Q_GX - 17:Q_GX - 14] = -params.g * up
         head[Q_END - 17], head[Q_COUNT - 17] = route.length, pieces.size // PIECE
+        head[Q_MU - 17:Q_PIECES - 17] = wheel_constants(params)
         base = np.concatenate([kernels.pack(OneDofDynamics(params, "exact")), head, pieces])
         # module 2's station at the start: the straight pipe's gap, then the loop closed along the route
         self.joints = [piece.s0 for piece in route.pieces[1:]] + [route.length]  # [m] where the curvature jumps

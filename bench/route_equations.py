@@ -13,8 +13,8 @@ reaching the route's end), the time the robot's centre (midway between A and C a
 first bend's start to the last one's end, and the motor's work [J] to the route's end, of both, their differences in
 % of the twin's, and the route time's and the work's differences split in
 
-- chord: the route less its twin with g = 0 (nothing but the linkage spanning the bend's chord, the modules'
-  points inside the centreline, and the inertia terms);
+- chord: the route less its twin with g = 0 (the linkage spanning the bend's chord, the modules' points inside
+  the centreline, the inertia terms, and the wheels' scrub in the bends, whose work the scrub column gives);
 - gravity: the rest, the per-module gravity of the route's grades;
 - yaw: the route with the modules' transverse inertias set to 0 (their yaw through a bend then stores nothing),
   against the full model: what the modules' yaw kinetic energy changes, with its closed-form share of a module's
@@ -23,7 +23,8 @@ first bend's start to the last one's end, and the motor's work [J] to the route'
 With ``--random N`` it runs N random routes instead (``--seed S``; 1-3 bends of R/D 1.5-50 in planes -180..180 deg,
 turning -180..180 deg, straights between them or not, a first incline of -90..90 deg, mu_wall 0.2-0.8, F_n 20-100 N,
 M_stall 0.5-2 N m, to the route's end or 30 s) and prints each route's outcome and its energy audit's residual
-against the energy put through, then the outcomes' counts and the largest residual.
+against the energy put through, then the outcomes' counts and the largest residual. The scrub column: the wheels'
+scrub work along the route [J] (analytic/route_scrub.py; zero with unlimited grip, the paper's rule's default).
 
 docs/model.md, "The equations along a route", quotes this script's tables.
 """
@@ -131,7 +132,7 @@ def main(argv: list[str]) -> int:
           "the straightened twin")
     print(f"{'route':44s} {'time':>8s} {'twin':>8s} {'d time':>7s} {'bends':>7s} {'twin':>7s} {'d bends':>7s} "
           f"{'work':>8s} {'twin':>8s} {'d work':>7s} {'chord t/W':>13s} {'gravity t/W':>15s} {'yaw t/W':>15s} "
-          f"{'yaw KE':>7s} {'residual':>9s}")
+          f"{'yaw KE':>7s} {'scrub':>7s} {'residual':>9s}")
     for name, build in list(ROUTES.items())[:2 if args.smoke else None]:
         route = build()
         bends = route.bends
@@ -162,7 +163,7 @@ def main(argv: list[str]) -> int:
               f"{pct(bend, bend0):+7.2f} "
               f"{work:8.4f} {work0:8.4f} {total[1]:+7.2f} {chord[0]:+6.2f}/{chord[1]:+6.2f} "
               f"{gravity[0]:+7.2f}/{gravity[1]:+7.2f} {yaw[0]:+7.3f}/{yaw[1]:+7.3f} {100 * share:6.2f}% "
-              f"{residual:9.1e}")
+              f"{s['energy']['scrub_j']:7.4f} {residual:9.1e}")
     return 0
 
 

@@ -47,6 +47,7 @@ import numpy as np
 from ipir_mujoco.analytic import RobotParams
 from ipir_mujoco.engine.loop import stepper
 from ipir_mujoco.engine.clutches import Ratchet
+from ipir_mujoco.engine.kinds.slides.loop_rows import loop_options
 from ipir_mujoco.engine.builders.model import (CRANK_HINGE, FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE,
                                       SolverSettings, build_model, dof_address, drive_control, qpos_address,
                                       set_closed_loop_state)
@@ -177,11 +178,7 @@ def run_callback(library, params, timestep, steps, chunk):
 def run_compiled(params, timestep, steps, chunk):
     model, data = fresh(params, timestep)
     ratchet = Ratchet(model, data)
-    friction = [int(i) for i in np.flatnonzero(model.dof_frictionloss > 0)]
-    motor = model.actuator(MOTOR).id
-    loop = stepper.CompiledSteps(model, data, ratchet, np.zeros((1, model.nv)), motor=motor,
-                                 crank_q=qpos_address(model, CRANK_HINGE), crank_v=dof_address(model, CRANK_HINGE),
-                                 slope=0.0, friction_dofs=friction, torque=float(data.actuator_force[motor]))
+    loop = stepper.CompiledSteps(model, data, ratchet, np.zeros((1, model.nv)), **loop_options(model, data))
     tracker = Tracker(model, data)
     started = time.perf_counter()
     for _ in range(steps // chunk):

@@ -1,41 +1,50 @@
 """The wheeled MuJoCo model (a robot in a round pipe) against the analytic finite-grip model, random designs.
 
-Run on demand from the repository root (about 30-60 min on 2 busy cores; ``--smoke``: 4 designs of 0.3 s at a given 1e-4 s step, seconds):
+Run on demand from the repository root (an hour or more for 100 designs on 2 busy cores; ``--smoke``: 4 designs
+of 0.3 s at a given 1e-4 s step, seconds):
 
-    python bench/wheels_agreement.py [--designs 100] [--seed 1] [--workers 2] [--wall-budget S] [--skip N]
-                                     [--only N,M,...] [--timestep S] [--smoke]
+    python bench/wheels_agreement.py [--designs 200] [--seed 1] [--workers 2] [--log FILE.jsonl]
+                                     [--wall-budget S] [--skip N] [--only N,M,...] [--timestep S] [--smoke]
 
 Each design is drawn over the envelope (log-uniform where a range spans decades): m1, m2 0.2-5 kg; r 0.02-0.07 m
 (the crank fits the 0.16 m pipe); L / r 1.5-6; J_A 1e-4-1e-2 kg m^2; F_r1, F_r2 0.2-5 N; the drive a constant
 torque M 0.05-1 N m or the motor (M_stall 0.1-2 N m, omega_noload 10-60 rad/s); incline -90..90 deg; mu_wall
-0.1-1; F_n1, F_n2 5-200 N; phi0 anywhere; 1-2 s. ``analytic-unilateral`` (the one-way equations with finite grip)
-and ``mujoco-wheels`` (its automatic settings) run it, and the design lands in one class:
+0.1-1; F_n1, F_n2 5-200 N; phi0 anywhere; 1-2 s. The wheeled geometry is the parameters' defaults.
+``analytic-unilateral`` (the one-way equations with finite grip) and ``mujoco-wheels`` (its automatic settings,
+the skid check's halvings included) run it. Per design, whatever its class: each module's travel error (MuJoCo
+- equations, and relative) and skid error, the lift-off and scrub checks beside MuJoCo's outcome, and the class:
 
-- ``agree``: each module's travel within 1 % of the analytic model's (at least 1 cm) and its skid within 5 % +
-  2 mm;
-- ``lifted``: a wheel left its wall (``wheel_off_s`` > 0) and the closed-form lift-off check predicted it
-  (``lift_predicted``): the constant-press idealization does not hold there, and the run says so;
-- ``stopped``: refused (bad input for a model), stopped (a stall) or flagged by MuJoCo's accuracy monitor (its
-  figure beyond tolerance, in the run's summary), with its reason;
-- ``scrubbed``: a module's rings slid across the pipe (their path across it, from the run's pose columns, at
-  least SCRUB_FLOOR: the run summary's ``across1_m``, ``across2_m``, :func:`ipir_mujoco.core.pipe.across_paths`)
-  and the closed-form sideways-grip check predicted it
-  (:func:`ipir_mujoco.core.pipe.side_grip_check` on the analytic run's linkage forces: a ring's load across the
-  pipe beyond its wheels' sideways friction). The analytic model's rails carry those loads without moving; the
-  wheels scrub instead (energy lost, and grip along the pipe lost while they slide), which it does not know;
-- ``outside``: none of these (each printed with its figures).
+- ``agree``: each module's travel within 1 % of the equations' (or 1 mm) and its skid within 5 % + 2 mm;
+- ``lifted``: a wheel left its wall (``wheel_off_s`` > 0) and the lift-off check predicted it;
+- ``scrubbed``: a module's rings slid across the pipe (``scrubbed``: their path across it at least
+  :data:`ipir_mujoco.core.pipe.SCRUB_FLOOR`) and the scrub check predicted it;
+- ``stopped``: refused (bad input for a model), stopped (a stall) or flagged by MuJoCo's accuracy monitor, with
+  its reason;
+- ``outside``: none of these.
 
-Prints one line per design and the counts per class. The table in mjcf/README.md ("The round pipe") is this
-script's output.
+The checks (:func:`ipir_mujoco.core.wheel_checks.check`) are closed forms of the rings under the linkage's loads.
+Two sets of loads feed them: the equations' (the analytic run's pin forces, :func:`.kinetostatics.pin_forces`,
+its drive torque, its modules' grip use and rolling: a prediction made without MuJoCo, which decides the class)
+and the MuJoCo run's own (its summary's ``lift_predicted``, ``scrub_predicted``: the loop's pin force, its torque
+and its wheels' states). The end prints the counts per class and each check's confusion matrix (predicted or not
+against happened or not), with its false alarms (predicted, did not happen) as a share of the designs where
+nothing happened and of the predictions, and its misses; and, for comparison, the lift check the summary gave
+before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_check`).
+
+``--log FILE.jsonl`` appends each design's record as it finishes; a rerun with the same log skips the designs it
+holds (reprinting their lines), so a stopped benchmark resumes. The tables in mjcf/README.md ("The round pipe")
+are this script's output.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
 
 import numpy as np
 
@@ -45,10 +54,13 @@ from ipir_mujoco.analytic.forces import drive_torque
 from ipir_mujoco.analytic.kinetostatics import pin_forces
 from ipir_mujoco.core.errors import ParameterError, SimulationError
 from ipir_mujoco.core.params import RobotParams
-from ipir_mujoco.core.pipe import SCRUB_FLOOR, side_grip_check
+from ipir_mujoco.core.pipe import lift_check
+from ipir_mujoco.core.wheel_checks import check, ring_loads
 
-TRAVEL_REL, TRAVEL_FLOOR = 0.01, 0.01  # the acceptance: travel within 1 % (at least 1 cm)
+TRAVEL_REL, TRAVEL_FLOOR = 0.01, 1e-3  # the acceptance: travel within 1 % (or 1 mm)
 SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
+CLASSES = ("agree", "lifted", "scrubbed", "stopped", "outside")
+CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"), ("lift", "quasi-static"))
 
 
 def log_uniform(rng, lo: float, hi: float) -> float:
@@ -69,77 +81,125 @@ def design(rng) -> tuple[RobotParams, float]:
     return RobotParams(**values), float(rng.uniform(1.0, 2.0))
 
 
-def within(a: float, b: float, rel: float, floor: float) -> bool:
-    return abs(b - a) <= max(rel * abs(a), floor) if floor == TRAVEL_FLOOR else abs(b - a) <= rel * abs(a) + floor
+def travel_within(a: float, b: float) -> bool:
+    return abs(b - a) <= max(TRAVEL_REL * abs(a), TRAVEL_FLOOR)
 
 
-def side_check(analytic, params: RobotParams) -> dict:
-    """The closed-form sideways-grip check (:func:`ipir_mujoco.core.pipe.side_grip_check`) on the analytic run's
-    linkage forces across the pipe (module 1's at A, module 2's at C: :func:`.kinetostatics.pin_forces`), its
-    drive's torque and its modules' grip use."""
-    series = analytic.series
-    _, on_rod_y, _, pin_y = pin_forces(series, OneDofDynamics(params, analytic.geometry))
-    return side_grip_check(params, pin_y, on_rod_y, drive_torque(params, series["omega"]),
-                           (series["grip_use1"], series["grip_use2"]))
+def skid_within(a: float, b: float) -> bool:
+    return abs(b - a) <= SKID_REL * abs(a) + SKID_FLOOR
+
+
+def equations_checks(analytic, params: RobotParams) -> dict:
+    """The lift-off and scrub checks (:func:`ipir_mujoco.core.wheel_checks.check`) on the analytic run's loads:
+    the linkage's forces across the pipe (module 1's at A, module 2's at C: :func:`.kinetostatics.pin_forces`),
+    its drive's torque, its modules' grip use and rolling, its samples' interval."""
+    s = analytic.series
+    _, on_rod_y, _, pin_y = pin_forces(s, OneDofDynamics(params, analytic.geometry))
+    loads = ring_loads(params, -pin_y, -on_rod_y, drive_torque(params, s["omega"]))
+    return check(params, loads, (s["grip_use1"], s["grip_use2"]), (s["wheels1"] == 1, s["wheels2"] == 1),
+                 float(s["t"][1] - s["t"][0]))
 
 
 def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None,
           timestep: float | None = None) -> dict:
     """Run one design in both engines and classify it (module docstring); ``budget`` [s]: the MuJoCo run's
     wall-time budget (a run past it stops with that reason); ``timestep`` [s]: the MuJoCo run's step (default its
-    automatic one)."""
-    row = {"design": index, "params": params, "t_end": t_end}
+    automatic one). A JSON-ready record."""
+    row = {"design": index, "params": params.as_dict(), "t_end": t_end}
+    started = time.perf_counter()
     try:
         analytic = registry.run("analytic-unilateral", params, t_end, dt_out=1e-3)
-        started = time.perf_counter()
         options = {} if budget is None else {"wall_budget_s": budget}
         if timestep is not None:
             options["timestep"] = timestep
         wheels = registry.run("mujoco-wheels", params, t_end, dt_out=1e-3, **options)
-        row["wall_s"] = time.perf_counter() - started
     except (ParameterError, SimulationError) as exc:
-        return {**row, "class": "stopped", "why": " ".join(str(exc).split())}
+        return {**row, "class": "stopped", "why": " ".join(str(exc).split()), "wall_s": time.perf_counter() - started}
+    row["wall_s"] = time.perf_counter() - started
     a, w = analytic.summary, wheels.summary
-    row.update({k: (a[k], w[k]) for k in ("x1_final", "x2_final", "slip1_m", "slip2_m", "revolutions")})
+    for k in ("x1_final", "x2_final", "slip1_m", "slip2_m", "revolutions"):
+        row[k] = (a[k], w[k])
     row.update({k: (a["energy"].get(k, 0.0), w["energy"].get(k, 0.0)) for k in ("motor_work_j", "skid_j")})
-    row.update(wheel_off_s=w["wheel_off_s"], lift_predicted=w["lift_predicted"], press=(w["press1_n"], w["press2_n"]))
-    side = side_check(analytic, params)
-    row.update(side_use=(side["side_use1"], side["side_use2"]), scrub_predicted=side["scrub_predicted"],
-               across=(w["across1_m"], w["across2_m"]))
+    eq = equations_checks(analytic, params)
+    row["checks"] = {"equations": {k: eq[k] for k in ("least_press1_n", "least_press2_n", "lift_predicted",
+                                                      "slid1_m", "slid2_m", "scrub_predicted")},
+                     "run": {k: w[k] for k in ("least_press1_n", "least_press2_n", "lift_predicted",
+                                               "side_use1", "side_use2", "scrub_predicted")}}
+    row["happened"] = {"lift": w["wheel_off_s"] > 0, "scrub": bool(w["scrubbed"])}
+    row.update(wheel_off_s=w["wheel_off_s"], across=(w["across1_m"], w["across2_m"]), press=(w["press1_n"], w["press2_n"]),
+               grip=(w["grip1_n"], w["grip2_n"]), unpredicted=w["unpredicted"], timestep=wheels.settings["timestep"])
+    violations = wheels.accuracy.get("violations") or []
     stops = [s for s in (analytic.stall, wheels.stall) if s]
-    agree = all(within(a[f"x{k}_final"], w[f"x{k}_final"], TRAVEL_REL, TRAVEL_FLOOR)
-                and abs(w[f"slip{k}_m"] - a[f"slip{k}_m"]) <= SKID_REL * a[f"slip{k}_m"] + SKID_FLOOR for k in (1, 2))
-    if agree:
+    if all(travel_within(a[f"x{k}_final"], w[f"x{k}_final"]) and skid_within(a[f"slip{k}_m"], w[f"slip{k}_m"])
+           for k in (1, 2)):
         return {**row, "class": "agree"}
-    if w["wheel_off_s"] > 0 and w["lift_predicted"]:
-        return {**row, "class": "lifted"}
+    for name, kind in (("lift", "lifted"), ("scrub", "scrubbed")):
+        if row["happened"][name] and eq[f"{name}_predicted"]:
+            return {**row, "class": kind}
     if stops:
         return {**row, "class": "stopped", "why": stops[0]}
-    violations = wheels.accuracy.get("violations") or []
     if violations:  # the run warned: the accuracy monitor's figure beyond its tolerance, said in the summary
         v = violations[0]
         return {**row, "class": "stopped", "why": f"flagged by the accuracy monitor: {v['figure']} {v['value']:.3g} "
                                                   f"(tolerance {v['tolerance']:.3g}) at t = {v['t_s']:.3g} s"}
-    if row["scrub_predicted"] and max(row["across"]) >= SCRUB_FLOOR:
-        return {**row, "class": "scrubbed"}
     return {**row, "class": "outside"}
+
+
+def error_text(a: float, w: float) -> str:
+    """MuJoCo - equations [mm] and relative to the equations' [%]."""
+    rel = "" if a == 0 else f" {100 * (w - a) / abs(a):+.2f} %"
+    return f"{1e3 * (w - a):+.2f} mm{rel}"
 
 
 def line(row: dict) -> str:
     p = row["params"]
-    drive = f"M {p.M:.3g}" if p.drive == "torque" else f"motor {p.M_stall:.3g} N m/{p.omega_noload:.3g} rad/s"
-    head = (f"#{row['design']:3d} {row['class']:8s} m {p.m1:.2f}/{p.m2:.2f} r {p.r:.3f} L/r {p.L / p.r:.2f} "
-            f"inc {p.incline:+6.1f} mu {p.mu_wall:.2f} F_n {p.F_n1:.0f}/{p.F_n2:.0f} {drive} {row['t_end']:.2f} s")
-    if row["class"] == "stopped" and "x1_final" not in row:
-        return head + f" | {row['why']}"
-    figures = " ".join(f"{k} {a:+.4f}/{w:+.4f}" for k, (a, w) in
-                       ((k, row[k]) for k in ("revolutions", "x1_final", "x2_final", "slip1_m", "slip2_m")))
-    figures += " | drive work {:.3f}/{:.3f} J skid work {:.3f}/{:.3f} J".format(*row["motor_work_j"], *row["skid_j"])
-    return head + (f" | {figures} | off {row['wheel_off_s']:.3f} s lift predicted {row['lift_predicted']} "
-                   f"press {row['press'][0]:.1f}/{row['press'][1]:.1f} N | side grip use {row['side_use'][0]:.2f}/"
-                   f"{row['side_use'][1]:.2f} across {1e3 * row['across'][0]:.2f}/{1e3 * row['across'][1]:.2f} mm | "
-                   f"{row['wall_s']:.0f} s"
-                   + (f" | {row['why']}" if "why" in row else ""))
+    drive = f"M {p['M']:.3g}" if p["drive"] == "torque" else f"motor {p['M_stall']:.3g} N m/{p['omega_noload']:.3g} rad/s"
+    head = (f"#{row['design']:3d} {row['class']:8s} m {p['m1']:.2f}/{p['m2']:.2f} r {p['r']:.3f} L/r "
+            f"{p['L'] / p['r']:.2f} inc {p['incline']:+6.1f} mu {p['mu_wall']:.2f} F_n {p['F_n1']:.0f}/{p['F_n2']:.0f} "
+            f"{drive} {row['t_end']:.2f} s")
+    if "x1_final" not in row:
+        return head + f" | {row['why']} | {row['wall_s']:.0f} s"
+    errors = " ".join(f"x{k} {row[f'x{k}_final'][0]:+.4f}/{row[f'x{k}_final'][1]:+.4f} m ({error_text(*row[f'x{k}_final'])})"
+                      for k in (1, 2))
+    skids = " ".join(f"skid{k} {1e3 * row[f'slip{k}_m'][0]:.1f}/{1e3 * row[f'slip{k}_m'][1]:.1f} mm"
+                     for k in (1, 2))
+    eq, run = row["checks"]["equations"], row["checks"]["run"]
+    checks = (f"lift: eq {eq['least_press1_n']:+.2f}/{eq['least_press2_n']:+.2f} N run "
+              f"{run['least_press1_n']:+.2f}/{run['least_press2_n']:+.2f} N off {row['wheel_off_s']:.3f} s; "
+              f"scrub: eq slid {1e3 * eq['slid1_m']:.2f}/{1e3 * eq['slid2_m']:.2f} mm run "
+              f"{'yes' if run['scrub_predicted'] else 'no'} across {1e3 * row['across'][0]:.2f}/"
+              f"{1e3 * row['across'][1]:.2f} mm")
+    grip = "" if row["grip"][0] is None else (f" | grip {row['grip'][0]:.1f}/{row['grip'][1]:.1f} N against "
+                                              f"{p['mu_wall'] * p['F_n1']:.1f}/{p['mu_wall'] * p['F_n2']:.1f} N")
+    return (head + f" | {errors} | {skids} | rev {row['revolutions'][0]:.4f}/{row['revolutions'][1]:.4f} | "
+            f"drive work {row['motor_work_j'][0]:.3f}/{row['motor_work_j'][1]:.3f} J skid work "
+            f"{row['skid_j'][0]:.3f}/{row['skid_j'][1]:.3f} J | {checks}{grip} | step {row['timestep']:.3g} s "
+            f"{row['wall_s']:.0f} s" + (f" | {row['why']}" if "why" in row else ""))
+
+
+def predicted(row: dict, name: str, source: str) -> bool:
+    """Whether the check ``name`` ('lift', 'scrub') on ``source``'s loads predicted it for the design: 'equations',
+    'run' (the record's), or 'quasi-static' (the lift check before Dec 7, on springs alone and the drive's largest
+    torque: :func:`ipir_mujoco.core.pipe.lift_check`, from the design's parameters)."""
+    if source == "quasi-static":
+        return bool(lift_check(RobotParams(**row["params"]))["lift_predicted"])
+    return bool(row["checks"][source][f"{name}_predicted"])
+
+
+def confusion(rows: list[dict], name: str, source: str) -> str:
+    """The check's confusion matrix over the designs that ran: predicted or not against happened or not."""
+    cells = {(p, h): [] for p in (True, False) for h in (True, False)}
+    for row in rows:
+        if "checks" in row:
+            cells[(predicted(row, name, source), bool(row["happened"][name]))].append(row["design"])
+    tp, fa, miss, tn = (len(cells[k]) for k in ((True, True), (True, False), (False, True), (False, False)))
+    share = (lambda a, b: f"{a}/{b} = {100 * a / b:.0f} %" if b else f"{a}/0")
+    whose = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads",
+             "quasi-static": "springs alone, quasi-static (the check before Dec 7)"}[source]
+    return (f"{name} check on {whose}: predicted and happened {tp}, predicted but not (false alarms) "
+            f"{fa}, happened but not predicted (misses) {miss}, neither {tn}; false alarms {share(fa, fa + tn)} of the "
+            f"designs where it did not happen, {share(fa, fa + tp)} of the predictions; misses "
+            f"{cells[(False, True)]}; false alarms {cells[(True, False)]}")
 
 
 def main(argv=None) -> int:
@@ -147,7 +207,9 @@ def main(argv=None) -> int:
     parser.add_argument("--designs", type=int, default=100)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--skip", type=int, default=0, help="draw and skip the first N designs (resume a run)")
+    parser.add_argument("--log", default=None, metavar="FILE.jsonl",
+                        help="append each design's record; designs already in it are not run again (resume)")
+    parser.add_argument("--skip", type=int, default=0, help="draw and skip the first N designs")
     parser.add_argument("--wall-budget", type=float, default=None,
                         help="each MuJoCo run's wall-time budget [s]: a run past it is stopped with that reason")
     parser.add_argument("--only", default=None, metavar="N,M,...",
@@ -161,20 +223,37 @@ def main(argv=None) -> int:
     count = 4 if args.smoke else args.designs
     if args.smoke and args.timestep is None:  # a given step is not checked (the skid check reruns up to 15x)
         args.timestep = 1e-4
-    jobs = []
+    done: dict[int, dict] = {}
+    if args.log and Path(args.log).exists():
+        for text in Path(args.log).read_text(encoding="utf-8").splitlines():
+            if text.strip():
+                record = json.loads(text)
+                done[record["design"]] = record
+    jobs, rows = [], []
     for k in range(count):
         params, t_end = design(rng)
         if (k >= args.skip and only is None) or (only is not None and (k in only or (args.skip and k >= args.skip))):
-            jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep))
-    counts = {"agree": 0, "lifted": 0, "stopped": 0, "scrubbed": 0, "outside": 0}
+            if k in done:
+                rows.append(done[k])
+                print(line(done[k]), flush=True)
+            else:
+                jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep))
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = [pool.submit(judge, *job) for job in jobs]
-        for done, future in enumerate(futures, start=1):
+        for finished, future in enumerate(as_completed(futures), start=1):
             row = future.result()
-            counts[row["class"]] += 1
+            rows.append(row)
             print(line(row), flush=True)
-            print(f"[{done}/{len(jobs)}] {counts}", file=sys.stderr, flush=True)
-    print(" ".join(f"{k}: {v}" for k, v in counts.items()))
+            if args.log:
+                with open(args.log, "a", encoding="utf-8") as handle:
+                    handle.write(json.dumps(row) + "\n")
+            print(f"[{finished}/{len(jobs)}]", file=sys.stderr, flush=True)
+    rows.sort(key=lambda r: r["design"])
+    print(" ".join(f"{c}: {sum(r['class'] == c for r in rows)}" for c in CLASSES))
+    for name, source in CHECKS:
+        print(confusion(rows, name, source))
+    unsaid = [r["design"] for r in rows if r.get("unpredicted")]
+    print(f"runs whose summary says 'unpredicted': {unsaid}")
     return 0
 
 

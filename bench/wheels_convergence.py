@@ -6,8 +6,9 @@ them; ``--smoke``: a few seconds):
     python bench/wheels_convergence.py [--cases cruise,riser,...] [--down-to STEP] [--set NAME=VALUE]...
                                        [--solver-iterations] [--smoke]
 
-The model's contact, limit and loop rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
-properties of the model, so halving the step refines one model rather than stiffening it. Four cases: ``cruise``
+The model's contact and limit rows have time constants in seconds (``wheels_model.ROW_TIMES``, 2e-4 s),
+properties of the model, so halving the step refines one model rather than stiffening it (the loop's pin, a rigid
+joint, follows the step: 2 steps). Four cases: ``cruise``
 (the default motor, mu_wall 0.5, F_n 50 N, 1 s); ``riser`` (the default motor up a vertical pipe with mu_wall 0.18,
 a grip of 9 N per module against a weight of 9.81 N, 0.5 s: both skid down); ``incline 30`` (mu_wall 0.15 at 30
 deg, 0.5 s: both skid back); ``bend`` (a 0.4 m straight, a 30 deg bend of radius 0.8 m (R/D 5) and a straight,
@@ -124,7 +125,7 @@ def time_constants(smoke: bool) -> None:
     print("| row time constant [s] | step [s] | slide of module 1 [m] | analytic [m] | difference |")
     print("|---|---|---|---|---|")
     for tau in ((2e-4,) if smoke else (1e-3, 4e-4, 2e-4, 1e-4)):
-        model = build_wheels_model(params, SolverSettings(timestep=tau / 4), RowTimes(tau, tau, tau))
+        model = build_wheels_model(params, SolverSettings(timestep=tau / 4), RowTimes(tau, tau))
         data = mujoco.MjData(model)
         set_wheels_state(model, data, params)
         data.ctrl[model.actuator(MOTOR).id] = drive_control(params)

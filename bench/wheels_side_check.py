@@ -7,14 +7,14 @@ Run on demand from the repository root (about a minute for 30 designs on 2 cores
 Random designs over the agreement benchmark's envelope (``bench/wheels_agreement.py``'s ``design``: masses,
 crank, rod, inertia, resistances, drive, incline -90..90 deg, mu_wall 0.1-1, F_n 5-200 N), each run on the wheeled
 model for ``--t-end`` s at a given 1e-4 s step (no skid check: the outcome looked at is the rings' slide across the
-pipe, not the skid's length). Per design: the closed-form check (:func:`ipir_mujoco.core.pipe.side_summary`: the
-drive's loads, quasi-static, no skid), how far MuJoCo's rings moved across the pipe (``across1_m``, ``across2_m``),
+pipe, not the skid's length). Per design: the summary's closed-form check (:func:`ipir_mujoco.core.wheel_checks.check`
+on the run's own loads: the largest ring load over what its wheels hold across the pipe while they grip along it),
+how far MuJoCo's rings moved across the pipe (``across1_m``, ``across2_m``),
 the larger skid along the pipe and how long a wheel was off its wall. The designs fall in:
 
 - ``held``: no skid (< 0.1 mm), no wheel off, check below 1 in both modules: the check says the wheels hold across
   the pipe; the rings must move less than SCRUB_FLOOR (1 mm);
-- ``predicted``: no skid, no wheel off, a check above 1: a slide predicted (the check takes the torque at stall, so
-  it errs that way);
+- ``predicted``: no skid, no wheel off, a check above 1: the loads go beyond the wheels' sideways grip;
 - ``skid or lift``: a module skidded along the pipe or a wheel was off its wall: its wheels hold nothing across the
   pipe then, whatever the check says.
 

@@ -244,9 +244,10 @@ finite = dict(allow_nan=False, allow_infinity=False)
 @pytest.mark.slow
 def test_properties_over_a_wide_range_of_designs(m1, m2, ratio, F_r1, F_r2, M, phi0, omega0, log_k, damping, backlash,
                                                  drive, incline, geometry):
-    params = RobotParams(m1=m1, m2=m2, L=0.05 * ratio, F_r1=F_r1, F_r2=F_r2, M=M, phi0=phi0, omega0=omega0,
+    torque = dict(M=M) if drive == "torque" else {}  # M is the constant torque's (refused with the motor)
+    params = RobotParams(m1=m1, m2=m2, L=0.05 * ratio, F_r1=F_r1, F_r2=F_r2, phi0=phi0, omega0=omega0,
                          clutch_stiffness=10**log_k, clutch_damping=damping, clutch_backlash=backlash, drive=drive,
-                         incline=incline)
+                         incline=incline, **torque)
     run = analytic.simulate(params, geometry, "unilateral", 0.2, dt_out=1e-3)
     s, e = run.series, run.energy
     assert s["lambda1"].min() >= 0 and s["lambda2"].min() >= 0

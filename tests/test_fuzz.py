@@ -228,7 +228,7 @@ CASES = [
     (["optimize", "--vary", "L=0.1:0.3", "--objective", "max:revolutions", "--verify", "", "--out", "{f}/o"], 2,
      "--verify '' names no model"),
     (["sensitivity", "--vary", "L=0.1:0.3", "--metric", "revolutions", "--engine", "", "--out", "{f}/o"], 2,
-     "engine '' is unknown"),
+     "variant '' is unknown"),
     (["sweep", "--vary", "L=0.1,0.2", "--set", "omega_target=5", "--out", "{f}/s"], 2, "only drive=servo"),
     (["clutch-study", "--points", "startup", "--set", "omega_target=5", "--out", "{f}/c"], 2,
      "the startup point runs drive=torque (the study sets it): omega_target=5.0"),

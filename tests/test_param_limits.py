@@ -120,7 +120,11 @@ def test_every_limit_gives_a_row_or_a_recorded_failure_in_the_studies(tmp_path):
         except ParameterError as exc:  # a value no design can use with the defaults (a speed-controller parameter
             # without the servo, a clutch's damping or play without its spring): refused before the first run, as
             # each engine refuses it in its row
-            assert all(str(exc).split(": ", 1)[1] in metrics["error"] for metrics in results.values()), (exc, results)
+            # (at the field's default the run is the default design's, which no engine refuses; the study still
+            # refuses an axis of a field its designs do not use, whatever its values)
+            default = getattr(RobotParams(), name) == design[name]
+            assert all(default or str(exc).split(": ", 1)[1] in metrics["error"] for metrics in results.values()), \
+                (exc, results)
             continue
         file = ResultsFile(tmp_path / f"{k}.csv", header_for(study), resume=False)
         file.write(make_row(0, design, results, engines))

@@ -22,6 +22,7 @@ import sympy as sp
 
 from ipir_mujoco.analytic.grip_model import GripMode
 from ipir_mujoco.analytic.route_geometry import centreline, module_pose, piece_at
+from ipir_mujoco.analytic import route_kernels
 from ipir_mujoco.analytic.route_kernels import LOOP_TOL, Q_COUNT, Q_PIECES
 from ipir_mujoco.analytic.route_model import RouteModel, transverse_inertia
 from ipir_mujoco.core.params import RobotParams
@@ -251,8 +252,10 @@ def closed(model: RouteModel, station: float, phi: float) -> float:
     return s2v
 
 
-def symbolic(mode: GripMode, station1: float, s2v: float, phi: float, omega: float, v1: float):
-    """(v1, v2, alpha, a1, a2, R1, R2) from the symbolic equations in ``mode`` at s1 = station1, s2 = s2v."""
+def symbolic(mode: GripMode, station1: float, s2v: float, phi: float, omega: float, v1: float, scrub=(0.0, 0.0)):
+    """(v1, v2, alpha, a1, a2, R1, R2) from the symbolic equations in ``mode`` at s1 = station1, s2 = s2v; ``scrub``
+    [N]: each module's scrub force, added to its rolling resistance while it rolls (its closed form is
+    tests/test_route_scrub.py's)."""
     p = PARAMS
     mass_f, terms_f = lagrange()
     row_f, hessian_f = loop_terms()
@@ -269,7 +272,7 @@ def symbolic(mode: GripMode, station1: float, s2v: float, phi: float, omega: flo
     state = (station1, s2v, phi, v[0], v[1], omega, *g)
     M = np.asarray(mass_f(*state), dtype=float)
     h = np.asarray(terms_f(*state), dtype=float).ravel()
-    rolling = (p.F_r1, p.F_r2)
+    rolling = (p.F_r1 + scrub[0], p.F_r2 + scrub[1])
     forces = np.array([-rolling[i] if held[i] == 1 else 0.0 for i in (0, 1)] + [p.M])
     rows = [row] + [np.eye(3)[i] for i in (0, 1) if held[i] == 0]
     A = np.array(rows)
@@ -359,7 +362,8 @@ def test_the_route_kernels_match_lagrange_at_random_states(model, station, mode)
     for _ in range(2):
         phi, omega, v1 = rng.uniform(0, 2 * math.pi), rng.uniform(-20, 20), rng.uniform(0.0, 1.0)
         s2v = closed(model, station, phi)
-        want = symbolic(mode, station, s2v, phi, omega, v1)
+        scrub = [route_kernels.scrub_force(model.constants[mode], i, s, 0.0) for i, s in enumerate((station, s2v))]
+        want = symbolic(mode, station, s2v, phi, omega, v1, scrub)
         y = np.array([phi, omega, station, s2v, v1, 0.0, 0.0])
         got = model.state(y, mode)
         # scales: accelerations r omega^2 + g, forces (m1 + m2) times that

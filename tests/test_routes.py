@@ -279,20 +279,29 @@ def test_the_bend_study_writes_its_table_and_figure_and_refuses_bad_ratios(capsy
                 "skid_j": 0.0, "predicted": "passes" if keeps else "a wheel leaves the wall", "wheels_keep_wall": keeps}
 
     rows = [{"R_over_D": r, "radius_m": 0.16 * r, "window_m": w, "bend": passage(tb, eb, r > 2),
-             "straight": passage(ts, es, True), "analytic": {"time_s": ta, "energy_j": ea}}
-            for r, w, tb, eb, ts, es, ta, ea in ((2.0, 0.7, 1.2, 0.9, 1.3, 1.4, 1.32, 1.41),
-                                                 (5.0, 1.46, 2.74, 2.91, 2.73, 2.91, 2.735, 2.913))]
+             "straight": passage(ts, es, True), "analytic": {"time_s": ta, "energy_j": ea},
+             "equations": {"time_s": qt, "energy_j": qe, "scrub_j": 0.1, "route_stop": "reached the route's end"},
+             "equations_straight": {"time_s": ta, "energy_j": ea},
+             "mujoco_vs_equations": {"time_s": tb / qt - 1, "energy_j": eb / qe - 1, "outcome": "miss"}}
+            for r, w, tb, eb, ts, es, ta, ea, qt, qe in ((2.0, 0.7, 1.2, 0.9, 1.3, 1.4, 1.32, 1.41, 1.25, 1.0),
+                                                         (5.0, 1.46, 2.74, 2.91, 2.73, 2.91, 2.735, 2.913, 2.75, 2.9))]
     study = {"rows": rows, "reference": {"steady_speed_m_s": 0.53, "energy_per_metre_j_m": 2.0},
              "settings": {"params": RobotParams(mu_wall=0.8).as_dict()}}
     write_csv(tmp_path / "s.csv", study)
     with open(tmp_path / "s.csv") as f:
         read = list(csv.DictReader(f))
     assert tuple(read[0]) == COLUMNS and float(read[1]["bend_time_s"]) == 2.74
-    assert "2.74 / 2.73 / 2.735" in format_table(study)
+    assert float(read[1]["equations_time_s"]) == 2.75
+    assert float(read[0]["mujoco_vs_equations_time"]) == pytest.approx(1.2 / 1.25 - 1, rel=1e-12)
+    table = format_table(study)
+    assert "2.74 / 2.73 / 2.735" in table and "2.75 / 2.735, 2.9 / 2.913" in table
+    assert "-4.00 %, -10.00 %: miss" in table and read[0]["mujoco_vs_equations"] == "miss"
     fig = bend_figure(study)
     assert isinstance(fig, Figure)
     bend = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "bend:time"][0]
     assert list(bend.get_ydata()) == pytest.approx([1.2 / 1.32, 2.74 / 2.735], rel=1e-12)
+    equations = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "equations:energy"][0]
+    assert list(equations.get_ydata()) == pytest.approx([1.0 / 1.41, 2.9 / 2.913], rel=1e-12)
     for argv, word in ((("--ratios", "0.4"), "--ratios"), (("--ratios", "1,abc"), "--ratios"),
                        (("--planes", "200"), "--planes"),
                        (("--set", "pipe_diameter=0.05"), "pipe_diameter")):  # refused before any run or progress

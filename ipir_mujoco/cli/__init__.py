@@ -31,8 +31,8 @@ try:
     from ..core.older_paths import keep_older_paths
     from ..studies.mechanism import (bend_command as bend_study, clutch_command as clutch_study,
                                      control_command as control_study)
-    from ..studies.design import (calibrate_command as calibrate, optimize_command as optimize,
-                                  sensitivity_command as sensitivity)
+    from ..studies.design import (calibrate_command as calibrate, design_check_command as design_check,
+                                  optimize_command as optimize, sensitivity_command as sensitivity)
     from ..studies.climb import climb_command as climb
     from . import compare, kinetostatics, params, render, simulate, validate
     from ..studies.sweeps import sweep_command as sweep
@@ -51,12 +51,12 @@ keep_older_paths({f"{__name__}.{older}": f"ipir_mujoco.studies.{now}" for older,
     ("uncertainty", "uq.uncertainty_command"), ("atlas", "idealizations.atlas_command"),
     ("climb", "climb.climb_command"), ("clutch_study", "mechanism.clutch_command"),
     ("control_study", "mechanism.control_command"), ("bend_study", "mechanism.bend_command"),
-    ("design_runs", "design_runs"))})
+    ("design_check", "design.design_check_command"), ("design_runs", "design_runs"))})
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "console", "main"]
 
 COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
-            climb, control_study, bend_study, atlas, uncertainty, calibrate)
+            climb, control_study, bend_study, atlas, uncertainty, calibrate, design_check)
 
 
 def build_parser() -> Parser:

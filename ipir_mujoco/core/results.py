@@ -78,7 +78,7 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .errors import ParameterError
 from .params import RobotParams
-from .pipe import lift_summary, side_summary
+from .wheel_checks import run_summary
 from .steady_test import steady_target
 
 # [m/s] a module, the crank pin or the gap slower than this is at rest: far below any motion a run resolves,
@@ -105,6 +105,7 @@ SERIES_UNITS: dict[str, str] = {
     "crank_pin_force": "N", "resistance1": "N", "resistance2": "N", "clutch_overlap1": "m", "clutch_overlap2": "m",
     "slip1": "m", "slip2": "m", "grip_use1": "-", "grip_use2": "-", "wheels1": "-", "wheels2": "-",
     "loop_gap": "m", "momentum": "kg m/s", "drive_u": "-", "y1": "m", "y2": "m", "yaw1": "rad", "yaw2": "rad",
+    "link_y1": "N", "link_y2": "N", "link_z1": "N", "link_z2": "N",
 }
 
 
@@ -222,11 +223,15 @@ class RunResult:
     def summary(self) -> dict[str, Any]:
         """The summary figures of the command-line contract (docs/cli.md)."""
         summary = summarize(self.series, self.energy, self.params.grip)
-        if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form lift-off check beside its outcome
-            summary.update(lift_summary(self.params, (self.route or {}).get("route_fit")))
-            if not self.route and "yaw2" in self.series:  # and the sideways-grip check, where the run has its
-                # pose columns (a route's bends have theirs in route_fit)
-                summary.update(side_summary(self.params, self.series))
+        if "press1" in self.series:  # the wheeled MuJoCo model: the closed-form checks beside its outcome (a
+            # route's bends have theirs in route_fit); computed once per series (a long run's take a second)
+            key = (id(self.series), len(self.series["t"]), id(self.route))
+            cached = self.__dict__.get("_wall_summary")
+            if cached is None or cached[0] != key:
+                cached = (key, run_summary(self.params, self.series, (self.route or {}).get("route_fit"),
+                                           straight=not self.route))
+                self.__dict__["_wall_summary"] = cached
+            summary.update(cached[1])
         summary.update(cycle_summary(self.series, *self.steady_test, target=self.steady_target))
         summary["stalled"] = self.stall is not None
         summary["stall_reason"] = self.stall

@@ -5,9 +5,10 @@ to the rear module leaving it) over the analytic finite-grip model's straight-pi
 (the line at 1: length / steady speed): the wheeled MuJoCo model in the bend (markers joined, one line per bend
 plane; a red cross at 1 where it did not pass) and in the same length of straight pipe (open squares). Bottom panel:
 the energy the robot used over the same window (the motor's work less the kinetic and potential energy gained) over
-the analytic prediction (energy per metre x length), the same. A shaded band marks the R/D where the closed form says the wheels need more spread
+the analytic prediction (energy per metre x length), the same. Crosses: the equations along the same route (the
+analytic route model through the same bend, its wheels' scrub in closed form), in the bend plane's colour. A shaded band marks the R/D where the closed form says the wheels need more spread
 than their springs reach. Log R/D axis. Lines and markers carry gids (``bend:time``, ``straight:time``,
-``analytic:time``, ``failed:time``, ``wall-lost:time`` and the same ``:energy``): the data a test can read.
+``analytic:time``, ``equations:time``, ``failed:time``, ``wall-lost:time`` and the same ``:energy``): the data a test can read.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from matplotlib.figure import Figure
 
 
 def _values(rows: list[dict], which: str, key: str) -> np.ndarray:
-    return np.array([np.nan if (v := r[which].get(key)) is None else float(v) for r in rows])
+    return np.array([np.nan if (v := (r.get(which) or {}).get(key)) is None else float(v) for r in rows])
 
 
 PLANE_STYLES = (("o-", "tab:blue"), ("D--", "tab:green"), ("^:", "tab:purple"), ("v-.", "tab:brown"))
@@ -56,6 +57,9 @@ def bend_figure(study: dict) -> Figure:
             ax.plot([r["R_over_D"] for r in mine], _values(mine, "bend", key) / _values(mine, "analytic", key), style,
                     color=colour, ms=6, gid=f"bend:{gid}" if k == 0 else f"bend@{plane:g}:{gid}",
                     label=f"MuJoCo wheels, 90-degree bend, plane {plane:g} deg" + (f" ({across})" if across else ""))
+            ax.plot([r["R_over_D"] for r in mine], _values(mine, "equations", key) / _values(mine, "analytic", key),
+                    "x", color=colour, ms=8, mew=1.6, gid=f"equations:{gid}" if k == 0 else f"equations@{plane:g}:{gid}",
+                    label=f"equations along the same route, plane {plane:g} deg")
         failed = [r["R_over_D"] for r in every if not r["bend"].get("passed")]
         if failed:
             ax.plot(failed, [1.0] * len(failed), "x", color="tab:red", ms=10, mew=2, gid=f"failed:{gid}",

@@ -12,9 +12,9 @@ from ipir_mujoco.core.older_paths import keep_older_paths
 # each module's group folder (below studies/), where its older path ``ipir_mujoco.studies.<module>`` points
 GROUPS = {
     "validation": ("validate", "ladder", "paper_reference", "cruise", "lr_study", "convergence"),
-    "comparison": ("compare", "agreement", "measured"),
+    "comparison": ("compare", "agreement", "measured", "route_compare"),
     "sweeps": ("sweep", "sweep_space", "sweep_files", "sweep_metrics", "frames"),
-    "design": ("design_eval", "optimize", "sensitivity", "calibrate"),
+    "design": ("design_eval", "optimize", "sensitivity", "calibrate", "design_rules"),
     "uq": ("uncertainty", "uq_dists", "uq_stats"),
     "idealizations": ("atlas", "atlas_space", "atlas_eval", "atlas_adaptive", "atlas_surrogate", "gp"),
     "climb": ("climbing", "climb_limits", "traction"),

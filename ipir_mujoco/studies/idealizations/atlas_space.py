@@ -189,6 +189,11 @@ def measure(pair: Pair, params: RobotParams, metrics: tuple[str, ...], t_end: fl
             break
         if run.stall:
             notes.append(f"{side.variant}: stalled: {run.stall}")
+        grip = run.summary.get("grip1_n")
+        if grip is not None:  # the round pipe's grip as MuJoCo has it, beside the constant press's mu_wall F_n
+            p = run.params
+            notes.append(f"{side.variant}: grip {grip:.4g} / {run.summary['grip2_n']:.4g} N (mu_wall x measured "
+                         f"press) against mu_wall F_n {p.mu_wall * p.F_n1:.4g} / {p.mu_wall * p.F_n2:.4g} N")
         elif until_steady and not run.summary.get("steady"):  # its steady figures are empty: say why
             notes.append(f"{side.variant}: not steady by {t_end:g} s")
         out[key] = {m: metric_value(m, run) for m in metrics}

@@ -21,8 +21,9 @@ def add_parser(commands) -> None:
         description="Run the wheeled MuJoCo model (--mujoco-model wheels) along a route with a 90-degree bend for "
                     "each R/D, and the same length of straight pipe; time and motor work from the front module "
                     "entering the bend to the rear module leaving it, beside the analytic finite-grip model's "
-                    "straight-pipe prediction over that length. Writes DIR/bend_study.csv, DIR/bend_study.json and "
-                    "the figure DIR/bend_study.png; prints the table.")
+                    "straight-pipe prediction over that length and the equations along the same route (the bend "
+                    "and its straight twin) with MuJoCo's difference from them. Writes DIR/bend_study.csv, "
+                    "DIR/bend_study.json and the figure DIR/bend_study.png; prints the table.")
     cmd.add_argument("--ratios", metavar="LIST", default=None,
                      help="bend radius over pipe diameter, R/D: a comma-separated list (default 0.6,1,1.5,2,3,5,7.5,10)")
     cmd.add_argument("--quick", action="store_true", help="R/D 2 and 5 only, for a first look")
@@ -61,12 +62,20 @@ def run(args: argparse.Namespace) -> int:
 COLUMNS = ("plane_deg", "R_over_D", "radius_m", "window_m", "analytic_time_s", "analytic_energy_j", "straight_time_s",
            "straight_energy_j", "bend_time_s", "bend_energy_j", "bend_passed", "bend_route_stop",
            "bend_wheel_off_s", "bend_module_off_s", "bend_arm_reach", "bend_residual_ratio", "bend_skid_j",
-           "predicted", "bend_potential_j", "note")
+           "predicted", "bend_potential_j", "note", "equations_time_s", "equations_energy_j", "equations_scrub_j",
+           "equations_route_stop", "equations_straight_time_s", "equations_straight_energy_j",
+           "mujoco_vs_equations_time", "mujoco_vs_equations_energy", "mujoco_vs_equations")
 
 
 def _flat(row: dict) -> dict:
     b, s, a = row["bend"], row["straight"], row["analytic"]
-    return {"plane_deg": row.get("plane_deg", 0.0), "note": row.get("note"), "bend_potential_j": b.get("potential_j"),
+    e, es, versus = row.get("equations") or {}, row.get("equations_straight") or {}, row.get("mujoco_vs_equations") or {}
+    return {"equations_time_s": e.get("time_s"), "equations_energy_j": e.get("energy_j"),
+            "equations_scrub_j": e.get("scrub_j"), "equations_route_stop": e.get("error", e.get("route_stop")),
+            "equations_straight_time_s": es.get("time_s"), "equations_straight_energy_j": es.get("energy_j"),
+            "mujoco_vs_equations_time": versus.get("time_s"), "mujoco_vs_equations_energy": versus.get("energy_j"),
+            "mujoco_vs_equations": versus.get("outcome"),
+            "plane_deg": row.get("plane_deg", 0.0), "note": row.get("note"), "bend_potential_j": b.get("potential_j"),
             "R_over_D": row["R_over_D"], "radius_m": row["radius_m"], "window_m": row["window_m"],
             "analytic_time_s": a["time_s"], "analytic_energy_j": a["energy_j"], "straight_time_s": s.get("time_s"),
             "straight_energy_j": s.get("energy_j"), "bend_time_s": b.get("time_s"), "bend_energy_j": b.get("energy_j"),
@@ -98,19 +107,27 @@ def _short(predicted: str) -> str:
 
 def format_table(study: dict) -> str:
     """The study as text: per R/D the passage's time and energy, MuJoCo in the bend / in a straight / the analytic
-    model's straight prediction, and how the run ended."""
+    model's straight prediction, the equations along the same route (the bend / its straight twin) and MuJoCo's
+    difference from them in the bend, and how the run ended."""
     def num(v, digits=4):
         return "n/a" if v is None else f"{v:.{digits}g}"
 
+    def pct(v):
+        return "n/a" if v is None else f"{100 * v:+.2f} %"
+
     header = ["plane [deg]", "R/D", "window [m]", "time [s] bend / straight / analytic",
-              "energy [J] bend / straight / analytic",
-              "wheels off [s]", "closed form", "outcome"]
+              "energy [J] bend / straight / analytic", "equations: time [s], energy [J] bend / straight",
+              "MuJoCo - equations: time, energy: class", "wheels off [s]", "closed form", "outcome"]
     rows = []
     for row in study["rows"]:
         f = _flat(row)
         rows.append([f"{f['plane_deg']:g}", f"{f['R_over_D']:g}", f"{f['window_m']:.3f}",
                      f"{num(f['bend_time_s'])} / {num(f['straight_time_s'])} / {num(f['analytic_time_s'])}",
                      f"{num(f['bend_energy_j'])} / {num(f['straight_energy_j'])} / {num(f['analytic_energy_j'])}",
+                     f"{num(f['equations_time_s'])} / {num(f['equations_straight_time_s'])}, "
+                     f"{num(f['equations_energy_j'])} / {num(f['equations_straight_energy_j'])}",
+                     f"{pct(f['mujoco_vs_equations_time'])}, {pct(f['mujoco_vs_equations_energy'])}: "
+                     f"{f['mujoco_vs_equations'] or 'n/a'}",
                      num(f["bend_wheel_off_s"], 3),
                      _short(f["predicted"] or ""),
                      "passed" if f["bend_passed"] else f"stopped: {f['bend_route_stop']}"])
@@ -124,6 +141,8 @@ def format_table(study: dict) -> str:
                          f"{f['bend_potential_j']:.3g} J over the window, taken out of the bend's energy")
         if f["note"]:
             lines.append(f"{where}: the bend passed {f['note']}")
+        if f["equations_time_s"] is None:
+            lines.append(f"{where}: the equations did not pass: {f['equations_route_stop']}")
     ref = study["reference"]
     lines.append(f"analytic straight pipe: {ref['steady_speed_m_s']:.5g} m/s, {ref['energy_per_metre_j_m']:.5g} J/m")
     return "\n".join(lines)

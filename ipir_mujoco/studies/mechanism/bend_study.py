@@ -16,6 +16,16 @@ steady state in a straight pipe, speed v and energy per metre e: time length / v
 wheeled model's own straight pipe (the same route with the bend straightened: its marks at the same
 distances), so that what the bend costs is told apart from what the wheels cost in any pipe.
 
+The equations along the same route: each case's route (the bend, and its straightened twin) also runs in the
+analytic route model (``analytic-unilateral`` with the route: the linkage spanning the bend's chord, gravity at
+each module, the wheels' scrub in its closed form; docs/model.md, "The equations along a route"), over the same
+window (:func:`ipir_mujoco.studies.comparison.route_compare.window`): its passage time, energy and scrub work (``equations``
+in each case's record), and MuJoCo's difference from it in the bend (``mujoco_vs_equations``: time, and energy
+over what the robot dissipated, MuJoCo's less the equations'; and the class
+:func:`ipir_mujoco.studies.comparison.route_compare.judge` gives it: both within 2 %, or a lift or a scrub the closed-form
+checks predicted and MuJoCo showed, or a stop, or a miss), so that a bend's cost in MuJoCo is judged against an
+independent model of the same bend, not only against MuJoCo's own straight pipe.
+
 ``planes`` [deg]: the bend's plane turned about the pipe's axis (:mod:`ipir_mujoco.core.route`): 0 turns it in the
 horizontal plane, across gravity (the default); 90 turns it up, in the plane of gravity, so that the route leaves
 the bend as a riser. The energy over the window is the motor's work less the kinetic *and potential* energy gained
@@ -37,7 +47,6 @@ import sys
 import time
 from typing import Callable, Sequence
 
-import numpy as np
 
 from ipir_mujoco import registry
 from ipir_mujoco.core.checks import check_numbers
@@ -47,6 +56,8 @@ from ipir_mujoco.core.params import RobotParams, check_whole, require_params
 from ipir_mujoco.core.pipe import check_fit
 from ipir_mujoco.core.route import route_from_tables
 
+from ..comparison.route_compare import judge
+from ..comparison.route_compare import window as route_window
 from ..pool import map_unordered
 
 RATIOS = (0.6, 1.0, 1.5, 2.0, 3.0, 5.0, 7.5, 10.0)  # R/D, the default
@@ -116,27 +127,20 @@ def check_ratios(ratios: Sequence[float], params: RobotParams) -> None:
 
 def _passage(run, route, first: int, last: int) -> dict:
     """The window from the robot's centre at mark ``first`` to mark ``last`` (route pieces' starts): time [s]
-    and the energy the robot used [J] (the motor's work less the kinetic energy gained: the window's ends fall
-    at any phase of a revolution, whose kinetic energy swings by tenths of a joule), or None where the run did
-    not get there."""
+    and the energy the robot used [J] (the motor's work less the kinetic and potential energy gained: the window's
+    ends fall at any phase of a revolution, whose kinetic energy swings by tenths of a joule;
+    :func:`..comparison.route_compare.window`), or None where the run did not get there; with MuJoCo's route keys."""
     s = run.summary
-    times = s["route_piece_times_s"]
-    t_a, t_b = times[first], times[last]
     out = {"route_done": s["route_done"], "route_stop": s["route_stop"], "route_s_m": s["route_s_m"],
            "route_length_m": s["route_length_m"], "route_wall_loss": s["route_wall_loss"],
            "route_wheel_off_s": s["route_wheel_off_s"], "route_module_off_s": s["route_module_off_s"],
            "route_arm_reach": s["route_arm_reach"], "predicted": s["route_fit"]["predicted"],
            "wheels_keep_wall": all(b["wheels_keep_wall"] for b in s["route_fit"]["bends"]),
            "timestep_s": run.settings["timestep"], "residual_ratio": s["accuracy"].get("residual_ratio"),
-           "skid_j": run.energy.get("skid_j"), "passed": t_b is not None, "time_s": None, "energy_j": None,
-           "potential_j": None}
-    if t_a is not None and t_b is not None:
-        t = run.series["t"]
-        work, kinetic, potential = (np.interp([t_a, t_b], t, run.series[c]) for c in ("motor_work", "kinetic",
-                                                                                      "potential"))
-        gained = float(potential[1] - potential[0])
-        out.update(time_s=t_b - t_a, potential_j=gained,
-                   energy_j=float(work[1] - work[0] - (kinetic[1] - kinetic[0])) - gained)
+           "skid_j": run.energy.get("skid_j"), "lift_predicted": s.get("lift_predicted"),
+           "slid_m": max(float(run.series[c][-1]) for c in ("slid1", "slid2")) if "slid1" in run.series else None}
+    passage = route_window(run, first, last)
+    out.update(passage, passed=passage["time_s"] is not None)
     return out
 
 
@@ -153,10 +157,25 @@ def run_case(params: RobotParams, item: tuple[str, float, float]) -> dict:
                            progress=_quiet_printer(what, started, t_cap))
     except SimulationError as exc:
         return {"kind": kind, "R_over_D": ratio, "error": str(exc), "passed": False,
-                "wall_s": time.perf_counter() - started}
+                "wall_s": time.perf_counter() - started, "equations": equations_case(params, route)}
     out = _passage(run, route, 1, 4)
     out.update(kind=kind, R_over_D=ratio, plane_deg=plane, radius_m=ratio * params.pipe_diameter,
-               window_m=params.L + arc, wall_s=time.perf_counter() - started)
+               window_m=params.L + arc, wall_s=time.perf_counter() - started, equations=equations_case(params, route))
+    return out
+
+
+def equations_case(params: RobotParams, route) -> dict:
+    """The equations (``analytic-unilateral``) along ``route``: its passage's ``time_s``, ``energy_j`` and
+    ``scrub_j`` (:func:`..comparison.route_compare.window`), ``passed``, its ``route_stop``, ``residual_ratio`` and ``wall_s``
+    [s]; a failure's line as ``error``."""
+    started = time.perf_counter()
+    try:
+        run = registry.run("analytic-unilateral", params, T_CAP_PER_M * route.length, dt_out=DT_OUT, route=route)
+    except SimulationError as exc:
+        return {"error": str(exc), "passed": False, "time_s": None, "energy_j": None, "scrub_j": None}
+    out = route_window(run, 1, 4)
+    out.update(passed=out["time_s"] is not None, route_stop=run.summary["route_stop"],
+               residual_ratio=run.summary["accuracy"]["residual_ratio"], wall_s=time.perf_counter() - started)
     return out
 
 
@@ -201,7 +220,8 @@ def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: i
               progress: Callable[[str], None] = lambda _m: None, planes: Sequence[float] = PLANES) -> dict:
     """The study (module docstring) as a JSON-ready dict: ``rows`` (one per plane and R/D: the bend's passage,
     its straightened twin's, the analytic reference over the same length, ``note`` where the bend was faster
-    than its twin), ``reference``, ``settings``, ``wall_s``."""
+    than its twin; the equations' passage of the bend and of the twin, ``equations`` and
+    ``equations_straight``, and ``mujoco_vs_equations``), ``reference``, ``settings``, ``wall_s``."""
     require_params(base)
     check_whole("workers", workers, low=1, high=1024)
     if not callable(progress):
@@ -232,8 +252,14 @@ def run_study(base: RobotParams, ratios: Sequence[float] = RATIOS, *, workers: i
             bend, straight = results[("bend", r, p)], results[("straight", r, 0.0)]
             window = params.L + math.pi / 2 * r * params.pipe_diameter
             analytic = {"time_s": window / ref["steady_speed_m_s"], "energy_j": window * ref["energy_per_metre_j_m"]}
+            equations = bend.get("equations") or {}
+            versus = judge(equations, bend, work="energy_j", done="passed")
             rows.append({"plane_deg": p, "R_over_D": r, "radius_m": r * params.pipe_diameter, "window_m": window,
-                         "bend": bend, "straight": straight, "analytic": analytic, "note": twin_note(bend, straight)})
+                         "bend": bend, "straight": straight, "analytic": analytic, "note": twin_note(bend, straight),
+                         "equations": equations, "equations_straight": straight.get("equations") or {},
+                         "mujoco_vs_equations": {"time_s": versus["time_diff"], "energy_j": versus["work_diff"],
+                                                 "outcome": versus["outcome"], "lift": versus["lift"],
+                                                 "scrub": versus["scrub"]}})
     return {"rows": rows, "reference": ref,
             "settings": {"lead_in_m": LEAD_IN, "exit_m": EXIT, "dt_out_s": DT_OUT, "angle_deg": 90.0,
                          "planes_deg": list(planes),

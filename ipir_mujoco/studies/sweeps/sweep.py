@@ -107,7 +107,6 @@ def engine_metrics(engine: str, params: RobotParams, t_end: float, dt_out: float
     if bars:  # MuJoCo's figures on finite grip: their rigid limit's error bars (figure_errors), said in the notes
         said = "rigid limit: " + ", ".join(f"{k} +-{e:.3g}" for k, e in bars.items())
         metrics["note"] = f"{metrics['note']}; {said}" if metrics.get("note") else said
-        metrics["figure_errors"] = dict(bars)
     return metrics
 
 

@@ -279,9 +279,18 @@ def _contact_sentence(rungs: list[LadderRun]) -> str:
     wheels, ratchet = named["wheels in contact"], named["MuJoCo ratchet"]
     return (" The slides (against wheels pressed on the pipe's walls: MuJoCo's contacts, a ratchet in every hub) "
             f"cost {_percent(cost(ratchet['revolutions'], wheels['revolutions']))} in crank revolutions and "
-            f"{_percent(cost(ratchet['x1_final'], wheels['x1_final']))} in module 1's travel (the rocking "
-            "modules' wheels briefly leave the wall; MuJoCo's energy residual "
-            f"{_residual(named['wheels in contact'])}).")
+            f"{_percent(cost(ratchet['x1_final'], wheels['x1_final']))} in module 1's travel ({_press(wheels)}; "
+            f"MuJoCo's energy residual {_residual(named['wheels in contact'])}).")
+
+
+def _press(summary: dict) -> str:
+    """The wheels' press and grip as MuJoCo has them, beside the slides' constant press (the constant-press
+    idealization's measure): mean press per module, wheels off their wall, grip mu_wall x press where finite."""
+    text = (f"the wheels pressed {summary['press1_n']:.4g} / {summary['press2_n']:.4g} N on the mean, a wheel off its "
+            f"wall {summary['wheel_off_s']:.3g} s")
+    if summary.get("grip1_n") is not None:
+        text += f", a grip of {summary['grip1_n']:.4g} / {summary['grip2_n']:.4g} N (mu_wall x press)"
+    return text
 
 
 def _residual(summary: dict) -> str:

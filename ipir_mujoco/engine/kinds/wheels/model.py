@@ -32,7 +32,8 @@ which says why), inside m_i; the module's inertia is a solid cylinder of its mas
 the radius inside its wheels. The pipe's wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat
 walls along each leg's track let a skidding module roll off them: a rolled wheel's normal on a plane has a moment
 about the axis that rolls it on).
-Every row's time constant is a property of the model in seconds (:class:`RowTimes`), not a multiple of the step.
+Every contact's and limit's time constant is a property of the model in seconds (:class:`RowTimes`), not a multiple
+of the step; the loop's pin, a rigid joint, follows the step (2 steps, as the slide model's constraints).
 """
 
 from __future__ import annotations
@@ -78,15 +79,16 @@ IMPEDANCE = (0.9999, 0.9999, 0.001, 0.5, 2.0)  # every row's solimp: MuJoCo's la
 class RowTimes:
     """The time constants [s] of the model's soft rows (MuJoCo's solref, damping ratio 1), properties of the
     model and not of the step (mjcf/README.md, "The round pipe: convergence"): ``contact`` (wheel and housing
-    against the wall), ``limit`` (the hubs' ratchets and friction, the arms' stops), ``loop`` (the rod's pin on
-    module 2). MuJoCo needs each >= 2 steps; :func:`wheels_timestep` picks the step from them."""
+    against the wall), ``limit`` (the hubs' ratchets and friction, the arms' stops). MuJoCo needs each >= 2 steps;
+    :func:`wheels_timestep` picks the step from them. The loop's pin (the rod on module 2) is no such row: it is
+    a rigid joint, its softness numerical only, so it follows the step as the slide model's constraints do
+    (:attr:`.model.SolverSettings.time_constant`, 2 steps: :func:`build_wheels_spec`)."""
 
     contact: float = 2e-4
     limit: float = 2e-4
-    loop: float = 2e-4
 
     def shortest(self) -> float:
-        return min(self.contact, self.limit, self.loop)
+        return min(self.contact, self.limit)
 
 
 ROW_TIMES = RowTimes()
@@ -227,7 +229,11 @@ def build_wheels_spec(params: RobotParams, settings: SolverSettings | None = Non
     spec.option.impratio = 1.0
     spec.option.noslip_iterations = NOSLIP_ITERATIONS
     eq = _element(spec.equality, LOOP, hint)
-    eq.solref, eq.solimp = [times.loop, 1.0], list(IMPEDANCE)
+    # the loop's pin is rigid: its soft row at 2 steps (the slide model's), stiffer as the step shrinks. Held at the
+    # contacts' 2e-4 s it gained energy where the step is finer and the crank fast (the constant-torque runaway of
+    # 5 s at the defaults, at its automatic 1.1e-5 s: a residual of -2.5 % of the drive's work, -6.6 J, halving
+    # with the step; at 2 steps -4.4e-4: mjcf/README.md, "The round pipe: energy")
+    eq.solref, eq.solimp = [settings.time_constant, 1.0], list(IMPEDANCE)
     for name in HOUSINGS:
         g = _element(spec.geom, name, hint)
         g.solref, g.solimp = [times.contact, 1.0], list(IMPEDANCE)
@@ -339,27 +345,34 @@ def sag(params: RobotParams, module: int) -> float:
 
 
 def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
-    """The loop closed at ``phi0`` with module 1 at 0, both modules sagged by their weight on their springs (the
-    mean of the two sags, so that the loop closes, and at most to the lower legs' stops; the springs settle the
-    rest), every wheel on its wall, at rest
-    or with the crank at ``omega0`` (the slide model's rule, :func:`.model.start_closed_loop`)."""
-    freed = start_closed_loop(model, data, params)
-    # no further than the lower legs' stops (a module heavier than its press rests on them; a larger drop would
-    # start its housing inside the wall)
-    drop = min(0.5 * (sag(params, 0) + sag(params, 1)), (STOP_COMPRESSION - 1.0) * params.suspension_travel)
+    """The loop closed at ``phi0`` with module 1 at 0, each module sagged by its own weight on its springs
+    (:func:`sag`, at most to its lower legs' stops: a module heavier than its press rests on them, and a larger
+    drop would start its housing inside the wall), every wheel on its wall, at rest or with the crank at
+    ``omega0`` (the slide model's rule, :func:`.model.start_closed_loop`). Where the two sags differ the rod
+    leaves the crank's plane on its cross pin (``rod_tilt``) by asin((delta2 - delta1) / L) and the loop closes
+    in the plane on the rod's projection, L cos of that: started at a common height, the module with the
+    larger sag dropped from it at the first step and bounced on its springs by the difference (up to a few
+    millimetres, a lift of its upper wheels where its weight leaves its press little margin)."""
+    cap = (STOP_COMPRESSION - 1.0) * params.suspension_travel
+    drops = [min(sag(params, i), cap) for i in (0, 1)]
+    tilt = math.asin(max(-1.0, min(1.0, (drops[1] - drops[0]) / params.L)))
+    projected = params.L * math.cos(tilt)
+    planar = params if projected == params.L else params.replace(L=projected)
+    freed = start_closed_loop(model, data, planar)
+    # module 2's slide is measured from the model's reference pose at x = r + L (the rod's own length)
+    data.qpos[qpos_address(model, FRONT_SLIDE)] += projected - params.L
+    data.qpos[qpos_address(model, ROD_TILT)] = tilt
     n = leg_count(params)
     for i in (0, 1):
-        data.qpos[qpos_address(model, VERTICALS[i])] = -drop
+        data.qpos[qpos_address(model, VERTICALS[i])] = -drops[i]
         for prefix in leg_names(params)[i]:
             u = leg_direction(int(prefix.split("_leg")[1]), n)
             # the arm reaches what the module left, and SEAT into the wall: a contact at a distance of exactly 0
             # is left out of MuJoCo's first step, and the module would drop until its wheels meet the wall
             lo, hi = model.jnt_range[model.joint(prefix + "_arm").id]
-            data.qpos[qpos_address(model, prefix + "_arm")] = min(max(drop * u[2] + SEAT, lo), hi)
+            data.qpos[qpos_address(model, prefix + "_arm")] = min(max(drops[i] * u[2] + SEAT, lo), hi)
     if freed is not None:  # the wheels of the moving module roll with it
         target, speed = freed
         for prefix in leg_names(params)[0 if target == REAR_SLIDE else 1]:
             data.qvel[dof_address(model, prefix + "_hub")] = speed / params.wheel_radius
     mujoco.mj_forward(model, data)
-
-

@@ -274,6 +274,19 @@ def press_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> 
     return {"press1": press[:, 0].sum(axis=1), "press2": press[:, 1].sum(axis=1), "wheels_off": off}
 
 
+def link_columns(params: RobotParams, scalars: dict, out: dict, pose: dict) -> dict[str, np.ndarray]:
+    """The linkage's forces on each module [N] from the samples of a straight-pipe run: link_y1/2 across the pipe
+    in the crank's plane, link_z1/2 along z. Module 2 feels the loop's pin force at C (the recorder's
+    ``loop_fx``, ``loop_fy``: MuJoCo's connect rows act on the rod, module 2 takes their opposite); module 1
+    the opposite through the crank's bearing at A (the rod's and the crank's own inertia left out: they weigh
+    1 % of a module). Along z: the rod's force ``rod_force`` (tension > 0) along its slope out of the plane,
+    (z2 - z1) / L, from the modules' heights (``pose``: :func:`pose_columns`): where the two modules sag
+    differently on their springs the rod pulls one down and the other up."""
+    across = -scalars["loop_fy"]
+    vertical = -out["rod_force"] * (pose["z2"] - pose["z1"]) / params.L
+    return {"link_y1": -across, "link_y2": across.copy(), "link_z1": -vertical, "link_z2": vertical}
+
+
 def wheel_loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:
     """:func:`.stepper.make_steps`' keyword arguments for the wheeled model after ``mj_forward`` on its initial
     state: as :func:`.loop_rows.loop_options` gives them for the slide model, with ``power`` (:class:`WheelPower`)

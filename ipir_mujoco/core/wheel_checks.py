@@ -1,0 +1,289 @@
+"""The round-pipe robot's rings under the linkage's loads: the closed-form lift-off and scrub checks.
+
+Each module of the wheeled MuJoCo model rides on two rings ``ring_spacing`` = s apart, each of n =
+``wheel_legs`` legs evenly spaced about the pipe's axis, leg k pressed outward along u_k by a linear spring with
+preload P = F_ni / (2 n) and stiffness k = P / ``suspension_travel``; each leg's wheel rolls only along the pipe,
+so across it the wheel holds by friction along its circumferential direction e_k (x cross u_k), up to mu_wall
+times its press. A ring loaded across the pipe by F (y across in the crank's plane, z up in a horizontal pipe):
+
+- **while its wheels grip** the ring does not move: e_1 .. e_n span the plane, so the wheels' friction carries F
+  as long as it lies inside the zonotope sum_k [-1, 1] mu N_k e_k (N_k each leg's press). Its facets are normal to
+  the generators' perpendiculars, the legs' own directions u_j, so the wheels hold F exactly when, for every leg j,
+  |F . u_j| <= sum_k mu N_k |e_k . u_j| (:func:`held`). A module that skids along the pipe has its wheels'
+  friction all along it (Coulomb's cone: with the share u of its grip used along the pipe, sqrt(1 - u^2) is left
+  across), so it holds nothing across while it skids;
+- **beyond that grip** the ring slides across the pipe until its springs take the load: it moves by 2 F / (n k)
+  (sum_k u_k u_k^T = n / 2 I), which changes leg j's press by (2 / n) F . u_j; leg j lifts where
+  F . u_j < -F_ni / 4, whatever n and k. The check gives the springs the whole load there (the sliding wheels'
+  friction, which still holds some of it, left out), so it errs towards a lift.
+
+The weight is on the springs from the start (the robot starts at rest sagged on them; its wheels' friction
+carries only what is added later): half the sprung weight across the pipe per ring (:func:`~.pipe.sprung_mass`).
+The linkage's loads per ring: module 1 feels the crank's bearing force across the pipe at A, split half to each
+ring (A is the rings' middle), and the drive's reaction couple -T about z as -+T / s on its aft and fore rings;
+module 2 the rod's force at C, half to each ring; each module the rod's force along the pipe's normal where the
+rod leaves the crank's plane (``vertical``). :func:`ring_loads` builds them from any run's forces (the analytic
+run's pin forces, MuJoCo's loop force); :func:`check` applies the two rules to every sample.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .pipe import leg_direction, sprung_mass
+
+RINGS = ("aft", "fore")
+
+
+def leg_frames(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(u, e): each leg's outward direction and its wheel's circumferential direction, (y, z), shapes (n, 2)."""
+    u = np.array([leg_direction(k, n)[1:] for k in range(n)])
+    return u, np.stack([-u[:, 1], u[:, 0]], axis=1)
+
+
+def weight_load(params, module: int) -> np.ndarray:
+    """The load [N] of its weight on each ring of ``module`` (0 rear, 1 front) across a straight pipe, (y, z):
+    half its sprung mass's weight across the pipe, down."""
+    return np.array([0.0, -0.5 * sprung_mass(params, module) * params.g * math.cos(math.radians(params.incline))])
+
+
+def leg_presses(params, module: int, spring_load) -> np.ndarray:
+    """Each leg's press [N] with its ring's springs carrying ``spring_load`` [N] ((..., 2): y, z), shape (..., n):
+    P + (2 / n) F . u_k (negative: the leg would pull, its wheel is off the wall)."""
+    n = int(params.wheel_legs)
+    u, _ = leg_frames(n)
+    preload = (params.F_n1, params.F_n2)[module] / (2 * n)
+    return preload + (2.0 / n) * np.asarray(spring_load, dtype=float) @ u.T
+
+
+def side_holds(params, module: int) -> np.ndarray:
+    """What each ring of ``module``'s wheels hold across the pipe by friction along each leg's direction u_j [N],
+    shape (n,): sum_k mu_wall N_k |e_k . u_j|, N_k each leg's press under the weight (module docstring); inf with
+    unlimited grip (a finite model's friction still ends somewhere: MuJoCo's is 100 times the press)."""
+    n = int(params.wheel_legs)
+    if params.mu_wall is None:
+        return np.full(n, math.inf)
+    u, e = leg_frames(n)
+    press = np.maximum(leg_presses(params, module, weight_load(params, module)), 0.0)
+    return params.mu_wall * (np.abs(e @ u.T) * press[:, None]).sum(axis=0)
+
+
+def held(params, module: int, load, grip_use=0.0) -> np.ndarray:
+    """Whether ``module``'s ring holds the linkage's ``load`` [N] ((..., 2): y, z) by its wheels' friction, shape
+    (...): |F . u_j| <= sqrt(1 - u^2) sum_k mu N_k |e_k . u_j| for every leg j, u = ``grip_use`` the share of
+    the module's grip used along the pipe (1 while it skids)."""
+    n = int(params.wheel_legs)
+    u, _ = leg_frames(n)
+    left = np.sqrt(1.0 - np.clip(np.asarray(grip_use, dtype=float), 0.0, 1.0) ** 2)[..., None]
+    across = np.abs(np.asarray(load, dtype=float) @ u.T)
+    with np.errstate(invalid="ignore"):  # inf * 0 where an unlimited grip skids (it does not)
+        hold = np.nan_to_num(side_holds(params, module) * left, nan=math.inf)
+    return np.all(across <= hold, axis=-1)
+
+
+def ring_loads(params, side1, side2, torque, vertical1=0.0, vertical2=0.0) -> dict[str, np.ndarray]:
+    """The linkage's loads [N] on each ring across the pipe, shape (..., 2) (y, z), keyed '1aft', '1fore',
+    '2aft', '2fore': ``side1`` the force across the pipe on module 1 at A (through the crank's bearing), ``side2``
+    on module 2 at C (the rod's pin), ``torque`` [N m] the drive's torque on the crank (its reaction, -T about
+    z, on module 1's rings as -+T / s), ``vertical1``, ``vertical2`` the forces along z on each module (the rod
+    out of the crank's plane). Arrays of one shape (samples) or scalars."""
+    s = params.ring_spacing
+    side1, side2, torque = (np.asarray(v, dtype=float) for v in (side1, side2, torque))
+    shape = np.broadcast(side1, side2, torque, np.asarray(vertical1), np.asarray(vertical2)).shape
+    z1 = np.broadcast_to(0.5 * np.asarray(vertical1, dtype=float), shape)
+    z2 = np.broadcast_to(0.5 * np.asarray(vertical2, dtype=float), shape)
+    couple = torque / s
+
+    def pair(y, z):
+        return np.stack(np.broadcast_arrays(y, z), axis=-1)
+
+    return {"1aft": pair(0.5 * side1 + couple, z1), "1fore": pair(0.5 * side1 - couple, z1),
+            "2aft": pair(0.5 * side2, z2), "2fore": pair(0.5 * side2, z2)}
+
+
+def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(False, False),
+          dt: float | None = None) -> dict:
+    """The lift-off and scrub checks on the rings' linkage ``loads`` (:func:`ring_loads`, samples along the first
+    axis) with each module's ``grip_use`` share along the pipe and whether it ``rolling`` (arrays of the samples'
+    shape, or scalars); ``dt`` [s] the samples' interval (None: each sample static).
+
+    Per ring and sample: where its wheels hold the load by their sideways friction (:func:`held`) the ring stays
+    where it is; where they do not, its springs carry the load, and a module that rolls meanwhile also carries
+    its wheels' sideways scrub along it (:func:`.pipe.scrub_force`, the bend's law: a module turned on its springs
+    steers its rolling wheels across the pipe, and their friction drags its rings on until they slide). The ring
+    follows the springs' load as a mass on springs, the module's sprung mass m on n k of them (translation across
+    the pipe, undamped: the legs have no damper, and a load faster than its period sqrt(m / (n k)) moves it less
+    than the same load held, a load held as long as it more, up to twice), solved exactly from sample to sample
+    with the load held over each (:func:`ring_response`); with ``dt`` None, statically.
+
+    Returns per module i: ``least_press{i}_n`` [N], its least-pressed leg's press over the samples (the weight on
+    the springs and the ring's place; < 0 a lift); ``slid{i}_m`` [m], the path its rings move across the pipe (the
+    longer ring's); ``side_use{i}``, its largest load over what its wheels hold across the pipe while they grip along
+    it (over the samples and legs, > 1 where they slide; 0 with unlimited grip; a module that skids along the pipe
+    holds less across it, Coulomb's cone, and nothing while it skids: :func:`held`).
+    ``lift_predicted``: a least press below 0. ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
+    outcome, ``scrubbed``, is the run's path from the same floor)."""
+    from .pipe import SCRUB_FLOOR
+
+    n = int(params.wheel_legs)
+    u, _ = leg_frames(n)
+    out: dict = {}
+    for i in (1, 2):
+        module = i - 1
+        stiffness = (params.F_n1, params.F_n2)[module] / (2 * n) / params.suspension_travel
+        frequency = math.sqrt(n * stiffness / sprung_mass(params, module))
+        weight = weight_load(params, module)
+        use = np.clip(np.asarray(grip_use[module], dtype=float), 0.0, 1.0)
+        holds = side_holds(params, module)
+        least, path, ratio = math.inf, 0.0, 0.0
+        for ring, sign in zip(RINGS, (1.0, -1.0)):
+            load = np.asarray(loads[f"{i}{ring}"], dtype=float).reshape(-1, 2)
+            samples = load.shape[0]
+            ring_use = np.broadcast_to(use, (samples,)) if use.ndim else np.full(samples, float(use))
+            load = load + sign * pitch_couple(params, module)[None, :] * ring_use[:, None]
+            grip = held(params, module, load, ring_use)
+            spring = np.where(grip[:, None], 0.0, load)
+            moving = ~grip & np.broadcast_to(np.asarray(rolling[module], dtype=bool), (samples,))
+            if params.mu_wall is not None and moving.any():
+                spring = spring + _steering_scrub(params, module, spring, moving)
+            place = spring if dt is None else ring_response(spring, grip, frequency * dt)
+            least = min(least, float(np.min(leg_presses(params, module, place + weight))))
+            shifts = np.diff(place, axis=0) * (2.0 / (n * stiffness))
+            path = max(path, float(np.sum(np.hypot(shifts[:, 0], shifts[:, 1]))))
+            if params.mu_wall is not None:  # against the whole grip: a skidding module's share is in held()
+                across = np.abs(load @ u.T)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    ratio = max(ratio, float(np.max(np.where(holds[None, :] > 0, across / holds[None, :], 0.0))))
+        out[f"least_press{i}_n"] = least
+        out[f"slid{i}_m"] = path
+        out[f"side_use{i}"] = ratio
+    out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
+    out["scrub_predicted"] = max(out["slid1_m"], out["slid2_m"]) >= SCRUB_FLOOR
+    return out
+
+
+SCRUB_BINS = 720  # directions across the pipe the steering scrub is taken at (0.5 deg apart: to cos 0.25 deg)
+
+
+def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray) -> np.ndarray:
+    """The wheels' sideways scrub [N] along each sample's spring load (shape (n, 2)) where ``moving`` (the module
+    rolls and the ring slides), :func:`.pipe.scrub_force` at the load's direction rounded to one of SCRUB_BINS
+    (the law is called once per direction, not per sample); zero elsewhere."""
+    from .pipe import scrub_force
+
+    size = np.hypot(spring[:, 0], spring[:, 1])
+    where = moving & (size > 0)
+    out = np.zeros_like(spring)
+    if not where.any():
+        return out
+    angle = np.arctan2(spring[where, 1], spring[where, 0])
+    bins = np.round(angle / (2 * math.pi) * SCRUB_BINS).astype(int) % SCRUB_BINS
+    force = np.empty(where.sum())
+    for b in np.unique(bins):
+        a = 2 * math.pi * b / SCRUB_BINS
+        force[bins == b] = scrub_force(params, module, (math.cos(a), math.sin(a)))
+    out[where] = force[:, None] * spring[where] / size[where, None]
+    return out
+
+
+def pitch_couple(params, module: int) -> np.ndarray:
+    """The load [N] on each ring of ``module`` (0 rear, 1 front), (y, z), +- on its aft and fore rings, of the
+    couple its wheels' friction along the pipe makes at the wall while it uses all its grip: each wheel's friction
+    mu N_k acts at the wall, D / 2 from the axis along its leg, and the weight across the pipe presses the lower
+    legs harder (sum_k N_k u_k = the ring's weight across, W / 2), so the friction's resultant lies off the axis
+    by D / 2 times W / F_n of it: a couple mu (D / 2) W about the axis across the pipe and the weight, which the
+    two rings carry as +- mu (D / 2) W / s along the weight. Scaled by the share of the grip in use (with the
+    friction shared as the presses are: Coulomb's law while it skids, and towards it as the least-pressed wheels
+    reach their limit first); zero with unlimited grip (its skid does not happen)."""
+    if params.mu_wall is None:
+        return np.zeros(2)
+    return params.mu_wall * 0.5 * params.pipe_diameter * 2.0 * weight_load(params, module) / params.ring_spacing
+
+
+def ring_response(spring: np.ndarray, grip: np.ndarray, step: float) -> np.ndarray:
+    """Where a ring sits [N: the springs' load that holds it there] at each sample, shape (n, 2): a mass on its
+    springs, undamped, pushed by ``spring`` (shape (n, 2)) held over each interval, ``step`` = omega dt its
+    natural frequency times the interval; at rest, where it is, while its wheels hold (``grip``, shape (n,)).
+    Exact for a load constant over each interval: with w = place + i velocity / omega, each interval turns
+    w - load by -``step``: w' = a w + (1 - a) load, a = exp(-i step), summed in closed form over each stretch
+    of samples where the wheels slide (from rest where they held)."""
+    spring = np.asarray(spring, dtype=float).reshape(-1, 2)
+    grip = np.asarray(grip, dtype=bool).reshape(-1)
+    out = np.zeros_like(spring)
+    free = np.flatnonzero(~grip)
+    if not free.size:
+        return out
+    breaks = np.flatnonzero(np.diff(free) > 1)
+    starts = np.concatenate([[free[0]], free[breaks + 1]])
+    ends = np.concatenate([free[breaks] + 1, [free[-1] + 1]])
+    a = complex(math.cos(step), -math.sin(step))
+    place = np.zeros(2)
+    last = 0
+    for j0, j1 in zip(starts, ends):
+        out[last:j0] = place  # held since the last stretch: where the ring stopped, at rest
+        k = np.arange(j1 - j0 + 1)
+        turn = np.exp(-1j * step * k)  # a^k
+        back = np.exp(1j * step * (k[:-1] + 1))  # a^-(m + 1)
+        for c in (0, 1):
+            w = turn * (place[c] + (1 - a) * np.concatenate([[0.0], np.cumsum(back * spring[j0:j1, c])]))
+            out[j0:j1, c] = w.real[:-1]  # the place at each sample's start; after the last, the place it stops at
+            place[c] = w.real[-1]
+        last = j1
+    out[last:] = place
+    return out
+
+
+def run_summary(params, series: dict, route_fit: dict | None = None, straight: bool = True) -> dict:
+    """The wall's keys of a wheeled run's summary: the closed-form checks beside MuJoCo's outcome.
+
+    In a straight pipe (``straight``, a run with the linkage's force columns ``link_y1`` .. ``link_z2``): the
+    checks of :func:`check` on the run's own loads (the loop's pin force, the drive's torque, each module's grip
+    use and rolling, the samples' interval): ``least_press1_n``, ``least_press2_n``, ``lift_predicted``,
+    ``side_use1``, ``side_use2``, ``scrub_predicted``; beside them MuJoCo's outcome, ``across1_m``,
+    ``across2_m`` and ``scrubbed`` (:func:`.pipe.side_summary`'s). Otherwise (along a route, or a series
+    without those columns): the quasi-static checks of :func:`.pipe.lift_summary` (with the route's bends) and,
+    in a straight pipe with the pose columns, :func:`.pipe.side_summary`. Always: ``grip1_n``, ``grip2_n`` [N],
+    each module's grip limit as MuJoCo has it, mu_wall times its measured mean press (None with unlimited grip:
+    beside mu_wall F_ni, the equations'), and ``unpredicted``: a lift (``wheel_off_s`` > 0) or a slide across
+    the pipe (``scrubbed``) the checks did not predict, in words, else None."""
+    from .pipe import across_paths, lift_summary, side_summary, SCRUB_FLOOR
+
+    out: dict = {}
+    if straight and "link_y1" in series:
+        t = np.asarray(series["t"], dtype=float)
+        loads = ring_loads(params, series["link_y1"], series["link_y2"], series["motor_torque"], series["link_z1"],
+                           series["link_z2"])
+        grip = tuple(series.get(f"grip_use{k}", 0.0) for k in (1, 2))
+        rolling = tuple(np.asarray(series[f"wheels{k}"]) == 1.0 for k in (1, 2))
+        result = check(params, loads, grip, rolling, float(np.median(np.diff(t))) if len(t) > 1 else None)
+        across = across_paths(series, params)
+        out.update({key: result[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted", "side_use1",
+                                                 "side_use2", "scrub_predicted")})
+        out.update(across1_m=across[0], across2_m=across[1], scrubbed=max(across) >= SCRUB_FLOOR)
+    else:
+        out.update(lift_summary(params, route_fit))
+        if straight and "yaw2" in series:
+            out.update(side_summary(params, series))
+    presses = (float(np.mean(series["press1"])), float(np.mean(series["press2"])))
+    out.update({f"grip{k}_n": None if params.mu_wall is None else params.mu_wall * presses[k - 1] for k in (1, 2)})
+    out["unpredicted"] = unpredicted(out, series)
+    return out
+
+
+def unpredicted(keys: dict, series: dict) -> str | None:
+    """A lift or a slide across the pipe that happened with no prediction, in words (None if none): a wheel off
+    its wall (the summary's ``wheel_off_s``, from the samples' ``wheels_off``) where ``lift_predicted`` is
+    false; rings that slid (``scrubbed``) where ``scrub_predicted`` is false."""
+    t, off = np.asarray(series["t"], dtype=float), np.asarray(series["wheels_off"], dtype=float)
+    off_s = float(np.sum(np.diff(t)[off[:-1] > 0]))
+    said = []
+    if off_s > 0 and not keys.get("lift_predicted"):
+        first = float(t[np.flatnonzero(off > 0)[0]])
+        said.append(f"a wheel was off its wall {off_s:.3g} s from t = {first:.3g} s with no lift predicted (least "
+                    f"press {keys['least_press1_n']:.3g} N / {keys['least_press2_n']:.3g} N)")
+    if keys.get("scrubbed") and not keys.get("scrub_predicted"):
+        said.append(f"the rings slid {1e3 * keys['across1_m']:.3g} mm / {1e3 * keys['across2_m']:.3g} mm across the "
+                    "pipe with no slide predicted")
+    return "; ".join(said) or None

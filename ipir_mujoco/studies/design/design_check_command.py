@@ -1,0 +1,59 @@
+"""``ipir-mujoco design-check``: the round-pipe robot's closed-form design rules for one design, no simulation."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ...cli.common import EXIT_OK, add_model_options, check_input_file, model_params
+
+
+def add_parser(commands) -> None:
+    cmd = commands.add_parser(
+        "design-check", help="the round-pipe robot's design rules (closed form, no simulation), each with its margin",
+        description="For one design of the wheeled robot in its round pipe: each closed-form rule with its value, "
+                    "limit, margin and whether it holds: the stall push against each module's grip, the restart "
+                    "torque, the weight against the press, a wheel's lift at stall (and at speed, for the motor), "
+                    "the rings' sideways grip, the tightest bend the geometry passes and the wheels' scrub in a bend "
+                    "(docs/model.md, 'The round pipe: design rules'). Exit status 0 whatever the verdicts.")
+    add_model_options(cmd)
+    cmd.add_argument("--route", metavar="FILE.toml", default=None,
+                     help="a route (as simulate --route): the bend rules take its bends")
+    cmd.add_argument("--json", action="store_true", help="print {\"rules\": [...], \"holds\": ...} as JSON")
+    cmd.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ipir_mujoco.engine.builders.wheels_model import check_wheels_params
+
+    from .design_rules import design_rules
+
+    params = model_params(args)
+    check_wheels_params(params)  # the wheeled model's own refusals: a robot that does not fit its pipe
+    route = None
+    if args.route is not None:
+        from ipir_mujoco.core.route import read_route
+
+        check_input_file("--route", args.route)
+        route = read_route(args.route)
+        route.check_pipe(params.pipe_diameter)
+    result = design_rules(params, route)
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+    else:
+        print(format_rules(result))
+    return EXIT_OK
+
+
+def format_rules(result: dict) -> str:
+    """One line per rule: name, value, limit, margin and unit, whether it holds, why; the verdict last."""
+    def number(value) -> str:
+        return "-" if value is None else f"{value:.4g}"
+
+    lines = [f"{'rule':20s} {'value':>10s} {'limit':>10s} {'margin':>10s} {'unit':5s} holds"]
+    for r in result["rules"]:
+        lines.append(f"{r['name']:20s} {number(r['value']):>10s} {number(r['limit']):>10s} "
+                     f"{number(r['margin']):>10s} {r['unit']:5s} {'yes' if r['holds'] else 'NO '}   {r['why']}")
+    failing = [r["name"] for r in result["rules"] if not r["holds"]]
+    lines.append("every rule holds" if result["holds"] else f"rules that do not hold: {', '.join(failing)}")
+    return "\n".join(lines)

@@ -1,0 +1,163 @@
+"""The round-pipe robot's rings under the linkage's loads (core.wheel_checks): closed forms, no simulation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ipir_mujoco.core import wheel_checks as W
+from ipir_mujoco.core.params import RobotParams
+from ipir_mujoco.core.pipe import SCRUB_FLOOR, leg_direction, sprung_mass
+
+GRIP = RobotParams(mu_wall=0.5, F_n1=30.0, F_n2=40.0, g=0.0)  # weightless: the wheels' friction alone
+
+
+def test_a_ring_holds_a_load_inside_its_wheels_friction_zonotope_and_nothing_while_it_skids():
+    """With 3 legs at 120 deg each facet of the zonotope is normal to a leg: along leg j the wheels hold
+    mu P sum_k |e_k . u_j| = mu P (0 + 2 sin 120 deg) = sqrt(3) mu P; a load a hair inside it holds, a hair
+    outside does not, whatever its direction (the legs' directions and the directions between them)."""
+    P = GRIP.F_n1 / 6
+    edge = math.sqrt(3) * GRIP.mu_wall * P
+    assert W.side_holds(GRIP, 0) == pytest.approx(np.full(3, edge), rel=1e-12)
+    u, _ = W.leg_frames(3)
+    for j in range(3):
+        along = edge * u[j]
+        assert W.held(GRIP, 0, along * (1 - 1e-9)) and not W.held(GRIP, 0, along * (1 + 1e-9))
+    # the facets' normals are +-u_j, 60 deg apart; half-way between two of them (across the crank's plane, +y, between
+    # leg 1 at +30 deg and the opposite of leg 2 at -30 deg) the zonotope reaches edge / cos 30 deg
+    corner = edge / math.cos(math.radians(30)) * np.array([1.0, 0.0])
+    assert W.held(GRIP, 0, corner * (1 - 1e-9)) and not W.held(GRIP, 0, corner * (1 + 1e-9))
+    # Coulomb's cone: with the share g of the grip used along the pipe, sqrt(1 - g^2) of it is left across
+    assert W.held(GRIP, 0, 0.599 * edge * u[0], grip_use=0.8) and not W.held(GRIP, 0, 0.601 * edge * u[0], grip_use=0.8)
+    assert not W.held(GRIP, 0, 1e-9 * u[0], grip_use=1.0)  # skidding: nothing across
+    assert W.held(GRIP.replace(mu_wall=None), 0, 1e6 * u[0], grip_use=1.0)  # unlimited grip never skids
+
+
+def test_ring_loads_carry_the_linkage_force_and_the_motors_couple():
+    """Module 1's rings take its force across the pipe half each and the motor's reaction -T about z as a couple
+    (moment about A of the two rings' loads = -T); module 2's rings half of its force each."""
+    p = RobotParams(ring_spacing=0.12)
+    side1, side2, T = np.array([-3.0, 1.0]), np.array([2.5, -4.0]), np.array([0.7, -0.2])
+    loads = W.ring_loads(p, side1, side2, T, vertical1=np.array([0.4, 0.0]), vertical2=-1.0)
+    aft, fore = loads["1aft"], loads["1fore"]
+    assert aft[:, 0] + fore[:, 0] == pytest.approx(side1, rel=1e-12)
+    assert 0.5 * p.ring_spacing * (fore[:, 0] - aft[:, 0]) == pytest.approx(-T, rel=1e-12)
+    assert aft[:, 1] + fore[:, 1] == pytest.approx([0.4, 0.0], abs=1e-15)
+    assert loads["2aft"] == pytest.approx(loads["2fore"]) and loads["2aft"][:, 0] == pytest.approx(side2 / 2)
+    assert loads["2aft"][:, 1] == pytest.approx([-0.5, -0.5])
+
+
+def test_a_leg_lifts_where_the_springs_load_along_it_reaches_a_quarter_of_the_press():
+    """Beyond the wheels' friction the springs carry the load: leg j's press is P + (2 / n) F . u_j, 0 where
+    F . u_j = -F_n / 4, whatever n (3 and 5 legs), with the module skidding (no friction across)."""
+    for n in (3, 5):
+        p = GRIP.replace(wheel_legs=float(n))
+        u = np.array(leg_direction(0, n)[1:])
+        for scale, lifts in ((1 - 1e-9, False), (1 + 1e-9, True)):
+            load = -scale * p.F_n1 / 4 * u
+            loads = {"1aft": load[None, :], "1fore": np.zeros((1, 2)), "2aft": np.zeros((1, 2)),
+                     "2fore": np.zeros((1, 2))}
+            result = W.check(p, loads, grip_use=(1.0, 1.0))
+            assert result["least_press1_n"] == pytest.approx(p.F_n1 / (2 * n) * (1 - scale), abs=1e-9)
+            assert result["lift_predicted"] is lifts
+    # the same load within the wheels' grip (the module rolls): the ring does not move, no leg lifts
+    load = -0.9 * GRIP.F_n1 / 4 * np.array(leg_direction(0, 3)[1:])
+    assert np.abs(load @ W.leg_frames(3)[0].T).max() > W.side_holds(GRIP, 0).max()  # beyond the grip: it slides
+    held = GRIP.replace(mu_wall=2.0)
+    loads = {"1aft": load[None, :], "1fore": np.zeros((1, 2)), "2aft": np.zeros((1, 2)), "2fore": np.zeros((1, 2))}
+    assert W.check(held, loads)["least_press1_n"] == pytest.approx(held.F_n1 / 6, rel=1e-12)
+
+
+def test_the_weight_stays_on_the_springs_and_lifts_the_upper_legs_at_F_n():
+    """With leg 0 down the upper legs (30 deg above the horizontal) lift where the sprung weight reaches F_n
+    (3 legs), friction or none: the robot starts at rest sagged on its springs."""
+    p = RobotParams(mu_wall=1.0, F_n1=20.0, F_n2=20.0)
+    zero = {key: np.zeros((1, 2)) for key in ("1aft", "1fore", "2aft", "2fore")}
+    W_sprung = sprung_mass(p, 0) * p.g
+    least = W.check(p, zero)["least_press1_n"]
+    assert least == pytest.approx(p.F_n1 / 6 - W_sprung / 6, rel=1e-12)
+    heavy = p.replace(m1=1.01 * p.F_n1 / (p.g * sprung_mass(p, 0) / p.m1))
+    assert W.check(heavy, zero)["lift_predicted"] is True
+
+
+def test_a_ring_on_its_springs_follows_a_load_as_a_mass_on_springs():
+    """Undamped: a load held from rest moves the ring to twice its static place at half a period and back; a load
+    held for a tenth of a period moves it by about (omega t)^2 / 2 of its static place, far less; while the wheels
+    hold the ring stays where it is."""
+    steps = 2000
+    step = 2 * math.pi / 1000  # a period per 1000 samples
+    load = np.zeros((steps, 2))
+    load[:, 0] = 1.0
+    place = W.ring_response(load, np.zeros(steps, dtype=bool), step)
+    assert place[:, 0].max() == pytest.approx(2.0, rel=1e-6) and place[500, 0] == pytest.approx(2.0, rel=1e-6)
+    assert place[1000, 0] == pytest.approx(0.0, abs=1e-9)
+    short = np.zeros((steps, 2))
+    short[:100, 0] = 1.0  # a tenth of a period
+    peak = W.ring_response(short, np.zeros(steps, dtype=bool), step)[:, 0].max()
+    assert peak == pytest.approx(2 * math.sin(math.pi * 0.1), rel=1e-6)  # 0.618 of the static 1, not 2
+    hold = np.zeros(steps, dtype=bool)
+    hold[:250] = True
+    assert np.all(W.ring_response(load, hold, step)[:251, 0] == 0.0)
+
+
+def test_the_wheels_friction_at_the_wall_pitches_a_module_with_its_weight_across():
+    """mu (D / 2) W / s on each ring, along the weight, at the whole grip; none with unlimited grip."""
+    p = RobotParams(mu_wall=0.6, ring_spacing=0.08, m1=2.0)
+    W_sprung = sprung_mass(p, 0) * p.g
+    assert W.pitch_couple(p, 0) == pytest.approx([0.0, -0.6 * 0.08 * W_sprung / 0.08], rel=1e-12)
+    assert not W.pitch_couple(p.replace(mu_wall=None), 0).any()
+
+
+def test_the_predicted_slide_is_the_path_the_springs_place_the_ring_on():
+    """A skidding module whose ring load swings from +F to -F across the pipe and back slides 2 x 2 x 2F / (n k)."""
+    p = RobotParams(mu_wall=0.5, g=0.0)
+    k = p.F_n1 / 6 / p.suspension_travel
+    F = 0.5 * p.F_n1 / 6
+    swing = np.array([[F, 0.0], [-F, 0.0], [F, 0.0]])
+    loads = {"1aft": swing, "1fore": np.zeros((3, 2)), "2aft": np.zeros((3, 2)), "2fore": np.zeros((3, 2))}
+    result = W.check(p, loads, grip_use=(np.ones(3), np.zeros(3)))
+    assert result["slid1_m"] == pytest.approx(2 * 2 * F * 2 / (3 * k), rel=1e-12)
+    assert result["scrub_predicted"] is (result["slid1_m"] >= SCRUB_FLOOR)
+    assert result["slid2_m"] == 0.0
+
+
+def test_the_rings_motion_in_closed_form_is_the_step_by_step_recurrence():
+    """ring_response sums each sliding stretch in closed form; stepped sample by sample (each interval turns
+    (place - load, velocity / omega) by -omega dt; at rest where the wheels hold) it is the same to round-off,
+    over random loads and holds."""
+    def stepped(spring, grip, step):
+        c, s = math.cos(step), math.sin(step)
+        out, x, v = np.empty_like(spring), [0.0, 0.0], [0.0, 0.0]
+        for j, (load, hold) in enumerate(zip(spring.tolist(), grip.tolist())):
+            out[j] = x
+            if hold:
+                v = [0.0, 0.0]
+                continue
+            for a in (0, 1):
+                y = x[a] - load[a]
+                x[a], v[a] = load[a] + y * c + v[a] * s, v[a] * c - y * s
+        return out
+
+    rng = np.random.default_rng(7)
+    for share in (0.0, 0.2, 0.6, 1.0):
+        spring = rng.normal(size=(2000, 2))
+        grip = rng.random(2000) < share
+        assert np.abs(W.ring_response(spring, grip, 0.05) - stepped(spring, grip, 0.05)).max() < 1e-12
+
+
+def test_the_constant_press_measures_say_the_wheels_grip_as_mujoco_has_it():
+    """The atlas's constant-press pair notes the wheeled run's grip (mu_wall x measured press) against the
+    slides' mu_wall F_n; the validation report's sentence on the wheeled rung says the press and grip too."""
+    from ipir_mujoco.studies.atlas_space import IDEALIZATIONS, measure
+    from ipir_mujoco.studies.validate import _press
+
+    params = RobotParams(mu_wall=0.5, F_n1=30.0, F_n2=40.0)
+    out = measure(IDEALIZATIONS["constant-press"].mujoco, params, ("revolutions",), 0.05, False)
+    assert out["error"] == "" and "mujoco-wheels: grip " in out["note"]
+    assert "against mu_wall F_n 15 / 20 N" in out["note"]
+    summary = {"press1_n": 30.2, "press2_n": 40.1, "wheel_off_s": 0.0, "grip1_n": 15.1, "grip2_n": 20.05}
+    assert _press(summary) == ("the wheels pressed 30.2 / 40.1 N on the mean, a wheel off its wall 0 s, a grip of "
+                               "15.1 / 20.05 N (mu_wall x press)")
+    assert "grip" not in _press({**summary, "grip1_n": None})
