@@ -169,9 +169,9 @@ SCRUB_BINS = 720  # directions across the pipe the steering scrub is taken at (0
 
 def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray) -> np.ndarray:
     """The wheels' sideways scrub [N] along each sample's spring load (shape (n, 2)) where ``moving`` (the module
-    rolls and the ring slides), :func:`.pipe.scrub_force` at the load's direction rounded to one of SCRUB_BINS
+    rolls and the ring slides), :func:`.pipe.ring_side_grip` at the load's direction rounded to one of SCRUB_BINS
     (the law is called once per direction, not per sample); zero elsewhere."""
-    from .pipe import scrub_force
+    from .pipe import ring_side_grip
 
     size = np.hypot(spring[:, 0], spring[:, 1])
     where = moving & (size > 0)
@@ -183,7 +183,7 @@ def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray)
     force = np.empty(where.sum())
     for b in np.unique(bins):
         a = 2 * math.pi * b / SCRUB_BINS
-        force[bins == b] = scrub_force(params, module, (math.cos(a), math.sin(a)))
+        force[bins == b] = ring_side_grip(params, module, (math.cos(a), math.sin(a)))
     out[where] = force[:, None] * spring[where] / size[where, None]
     return out
 
