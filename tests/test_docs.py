@@ -8,8 +8,9 @@ from pathlib import Path
 
 from ipir_mujoco.analytic import RobotParams, simulate
 from ipir_mujoco.core.params import describe_parameters
-from ipir_mujoco.cli import COMMANDS, build_parser
+from ipir_mujoco.cli import TOOLS, build_parser
 from ipir_mujoco.cli.params import format_table
+from ipir_mujoco.studies import declared
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 CLI = (DOCS / "cli.md").read_text()
@@ -25,9 +26,9 @@ def test_every_subcommand_and_option_is_documented():
     parser = build_parser()
     subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     sections = _sections()
-    # one module per subcommand: cli/clutch_study.py is `clutch-study`
+    # one module per tool (cli/kinetostatics.py is `kinetostatics`) and one declaration per study with a command
     assert set(subparsers.choices) == set(sections) == {c.__name__.rsplit(".", 1)[-1].replace("_", "-")
-                                                         for c in COMMANDS}
+                                                         for c in TOOLS} | {s.name for s in declared() if s.command}
     shared = CLI.split("## Options every model command shares")[1].split("\n## ")[0]
     for name, sub in subparsers.choices.items():
         for action in sub._actions:

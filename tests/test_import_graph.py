@@ -113,8 +113,9 @@ def test_the_finder_sees_every_kind_of_import():
     assert len(edges) > 100
     assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.engine.run.simulate"]  # relative, top level
     assert "ipir_mujoco.engine.kinds" in edges["ipir_mujoco.registry"]  # inside registry.timestep
-    assert "ipir_mujoco.report.plots" in edges["ipir_mujoco.core.results"]  # inside RunResult.plot
-    assert "ipir_mujoco.core.results" not in edges["ipir_mujoco.report.plots"]  # TYPE_CHECKING only
+    assert "ipir_mujoco.core.figures" in edges["ipir_mujoco.core.results"]  # inside RunResult.plot
+    assert "ipir_mujoco.core.results" not in edges["ipir_mujoco.core.figures"]  # TYPE_CHECKING only
+    assert "ipir_mujoco.studies.design.calibrate" in edges["ipir_mujoco.studies.design.calibrate_command"]  # in run
     assert "ipir_mujoco.analytic.kinematic_clutch" in edges["ipir_mujoco.analytic"]  # the analytic/ folder
 
 
@@ -140,6 +141,43 @@ def test_the_architecture_document_places_every_module_of_the_engine_core_and_an
     assert [f"engine/{folder}/" for folder in ENGINE_FOLDERS if f"engine/{folder}/" not in text] == []
     kinds = sorted(p.parent.name for p in (engine / "kinds").glob("*/__init__.py"))
     assert [f"engine/kinds/{kind}/" for kind in kinds if f"engine/kinds/{kind}/" not in text] == []
+
+
+# the package's layers from the bottom up (docs/architecture.md, "The layers"): a module imports from its own layer
+# and the layers below only. The package's __init__ imports only core at its top (its public names load on first
+# use), so it stands with core; labels, output, resources, interrupts and terminal are the tools every layer uses.
+LAYERS = (
+    ("ipir_mujoco", "ipir_mujoco.core", "ipir_mujoco.labels", "ipir_mujoco.output", "ipir_mujoco.resources",
+     "ipir_mujoco.interrupts", "ipir_mujoco.terminal"),
+    ("ipir_mujoco.analytic", "ipir_mujoco.engine"),
+    ("ipir_mujoco.registry", "ipir_mujoco.replay", "ipir_mujoco.video"),
+    ("ipir_mujoco.studies",),
+    ("ipir_mujoco.report",),
+    ("ipir_mujoco.cli", "ipir_mujoco.view", "ipir_mujoco.__main__"),
+)
+
+
+def package_layer(module: str) -> int:
+    """The index in LAYERS of ``module``'s layer: the layer of the longest prefix that names it."""
+    found = [(len(prefix), i) for i, layer in enumerate(LAYERS) for prefix in layer
+             if module == prefix or module.startswith(prefix + ".")]
+    assert found, f"{module} is in no layer of LAYERS"
+    return max(found)[1]
+
+
+def test_no_module_imports_a_layer_above_it():
+    """No module of the package imports one of a layer above its own, the imports inside functions included (a
+    study that drew its figure by importing the report inside its run function was such an edge: it is given its
+    report module by the command line now, ipir_mujoco.studies.contract)."""
+    edges = graph()
+    upward = sorted((name, target) for name, targets in edges.items() for target in targets
+                    if package_layer(target) > package_layer(name))
+    assert upward == []
+    # the edges looked at include function-level ones across layers (validate's command imports the report
+    # inside its run), and an edge the other way would count as upward
+    assert "ipir_mujoco.report.sections" in edges["ipir_mujoco.cli.validate"]
+    assert package_layer("ipir_mujoco.cli.validate") > package_layer("ipir_mujoco.report.sections") \
+        > package_layer("ipir_mujoco.studies.validation.validate")
 
 
 # the engine's folders from the bottom up: a module imports from its own folder and the folders below only

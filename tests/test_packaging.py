@@ -68,9 +68,7 @@ def test_the_shared_core_imports_neither_model():
 
     for file, name in _layer_imports(Path(ipir_mujoco.core.__file__).parent, "ipir_mujoco.core"):
         assert name.split(".")[0] not in ("mujoco", "scipy"), f"{file} imports {name}"
-        # RunResult.plot is a thin call of the report's plot_runs (matplotlib, no dynamics), imported lazily
-        drawing = file == "results.py" and name in ("ipir_mujoco.report.plots", "ipir_mujoco.report.plots.plot_runs")
-        if name.startswith("ipir_mujoco.") and not drawing:
+        if name.startswith("ipir_mujoco."):
             assert name.startswith("ipir_mujoco.core"), f"{file} imports {name}"
 
 

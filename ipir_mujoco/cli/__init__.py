@@ -3,8 +3,11 @@
 Exit status: 0 success, 2 bad input (one line on stderr naming the value and
 what is allowed), 1 a failure of the simulation itself (with the reason), 130
 interrupted (Ctrl-C). Every failure is one line on stderr; ``--debug`` (before
-or after the subcommand) re-raises it with its traceback instead. Each
-subcommand lives in its own module with ``add_parser(commands)`` and
+or after the subcommand) re-raises it with its traceback instead. A study's
+subcommand is its declaration's (``ipir_mujoco.studies.contract``: its name,
+options, run function and report module), found by
+``ipir_mujoco.studies.declared``; every other subcommand (the tools of
+:data:`TOOLS`) lives in its own module here with ``add_parser(commands)`` and
 ``run(args) -> int``.
 """
 
@@ -29,15 +32,8 @@ try:
     from ..resources import shipped
     from .. import terminal
     from ..core.older_paths import keep_older_paths
-    from ..studies.mechanism import (bend_command as bend_study, clutch_command as clutch_study,
-                                     control_command as control_study)
-    from ..studies.design import (calibrate_command as calibrate, design_check_command as design_check,
-                                  optimize_command as optimize, sensitivity_command as sensitivity)
-    from ..studies.climb import climb_command as climb
+    from ..studies import declared
     from . import compare, kinetostatics, params, render, simulate, validate
-    from ..studies.sweeps import sweep_command as sweep
-    from ..studies.uq import uncertainty_command as uncertainty
-    from ..studies.idealizations import atlas_command as atlas
     from .common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, Parser, add_global_options
 finally:
     interrupts.loaded()
@@ -55,8 +51,9 @@ keep_older_paths({f"{__name__}.{older}": f"ipir_mujoco.studies.{now}" for older,
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "build_parser", "console", "main"]
 
-COMMANDS = (simulate, validate, compare, sweep, optimize, sensitivity, kinetostatics, params, render, clutch_study,
-            climb, control_study, bend_study, atlas, uncertainty, calibrate, design_check)
+# the commands that are not studies: one module each, with add_parser(commands) and run(args) -> int; every
+# study with a command of its own adds its own (its declaration: ipir_mujoco.studies.contract)
+TOOLS = (simulate, validate, compare, kinetostatics, params, render)
 
 
 def build_parser() -> Parser:
@@ -69,11 +66,39 @@ def build_parser() -> Parser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     add_global_options(parser, top=True)
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for command in COMMANDS:
-        command.add_parser(commands)
+    for tool in TOOLS:
+        tool.add_parser(commands)
+    for study in declared():
+        if study.command:
+            add_study(commands, study)
     for subparser in set(commands.choices.values()):
         add_global_options(subparser)
     return parser
+
+
+def add_study(commands, study) -> None:
+    """The subcommand of a study's declaration (:class:`ipir_mujoco.studies.contract.Declaration`): its parser, its
+    options, and a handler that runs it with its report module (each name imported when first read)."""
+    parser = commands.add_parser(study.name, help=study.summary, description=study.description)
+    study.options(parser)
+
+    def handler(args) -> int:
+        study.run(args, _Figures(study.figures) if study.figures is not None else None)
+        return EXIT_OK
+    parser.set_defaults(handler=handler)
+
+
+class _Figures:
+    """A study's report module (``ipir_mujoco.report.<name>``), imported when a name of it is first read: after
+    the study's checks and its kernels' compile, so that matplotlib's import delays neither."""
+
+    def __init__(self, name: str):
+        self._name = f"ipir_mujoco.report.{name}"
+
+    def __getattr__(self, attribute: str):
+        import importlib
+
+        return getattr(importlib.import_module(self._name), attribute)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

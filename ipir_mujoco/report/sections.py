@@ -7,19 +7,21 @@ figures into the report's figures folder and returns its blocks
 (:mod:`ipir_mujoco.report.document`); ``verdict``, if given, adds a
 {question, answer, evidence, short, key} to the report's opening verdicts (``short``: the verdict in a few
 words, ``key``: its key figure with its unit, '' if none; the summary table shows both).
-:data:`SECTIONS` lists them in report order; ``ipir-mujoco validate`` runs
-them all.
+:data:`SECTIONS` lists them in report order, read from the studies' declarations
+(:func:`ipir_mujoco.studies.declared`: each study names its sections and their report modules here, which
+define ``compute``, ``render`` and ``verdict``); ``ipir-mujoco validate`` runs them all.
 """
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 from ipir_mujoco.core.params import RobotParams
 
-from . import atlas_section, clutch_section, control_section, cruise_section, grip_section, riser_section
+from ..studies import declared
 
 Progress = Callable[[str], None]
 
@@ -33,14 +35,15 @@ class Section:
     verdict: Callable[[dict], dict | None] | None = None
 
 
-SECTIONS: tuple[Section, ...] = (
-    Section("clutch_engagement", "Real clutches: engagement loads", clutch_section.compute, clutch_section.render,
-            clutch_section.verdict),
-    Section("cruise", "Under a real motor", cruise_section.compute, cruise_section.render, cruise_section.verdict),
-    Section("vertical_riser", "Vertical riser", riser_section.compute, riser_section.render, riser_section.verdict),
-    Section("finite_grip", "Finite grip", grip_section.compute, grip_section.render, grip_section.verdict),
-    Section("speed_control", "Speed control", control_section.compute, control_section.render,
-            control_section.verdict),
-    Section("model_holds", "Where the paper's model holds", atlas_section.compute, atlas_section.render,
-            atlas_section.verdict),
-)
+def _sections() -> tuple[Section, ...]:
+    """Every study's sections (:class:`ipir_mujoco.studies.contract.Section`), by their place, with their report
+    module's functions."""
+    declared_sections = sorted((s for study in declared() for s in study.sections), key=lambda s: s.place)
+    found = []
+    for s in declared_sections:
+        module = importlib.import_module(f"{__package__}.{s.module}")
+        found.append(Section(s.key, s.title, module.compute, module.render, getattr(module, "verdict", None)))
+    return tuple(found)
+
+
+SECTIONS: tuple[Section, ...] = _sections()

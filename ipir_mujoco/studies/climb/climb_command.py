@@ -1,4 +1,6 @@
-"""``ipir-mujoco climb``: the steepest pipe a design climbs with its drive, and its speed against the incline."""
+"""The climb study (``ipir-mujoco climb``): the steepest pipe a design climbs with its drive, and its speed against
+the incline. Its runs: :mod:`.climbing`; its figure ``report/climb_figure.py``; its report sections
+``report/riser_section.py`` and ``report/grip_section.py``."""
 
 from __future__ import annotations
 
@@ -14,7 +16,8 @@ from ipir_mujoco.core.params import check_real
 
 from ...labels import significant
 from ...output import check_output_dir
-from ...cli.common import EXIT_OK, add_model_options, compile_first, model_params, study_progress, write_study_files
+from ..command import add_model_options, compile_first, model_params, study_progress, write_study_files
+from ..contract import Declaration, Section
 
 FILES = ("climb.csv", "climb.json", "climb.png")
 KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m", "peak_clutch_force_n",
@@ -22,14 +25,7 @@ KEYS = ("steady", "steady_speed_m_s", "mean_speed_m_s", "revolutions", "travel_m
 GRIP_KEYS = ("slip_m", "peak_grip_use")  # columns added with a finite grip (mu_wall)
 
 
-def add_parser(commands) -> None:
-    cmd = commands.add_parser(
-        "climb", help="climbing ability: the steepest incline a design climbs, speed and clutch loads against it",
-        description="For the design and its drive: the steepest incline at which the drive restarts the robot from "
-                    "rest at every crank angle (quasi-static), for the motor the steepest it climbs to a steady "
-                    "state from rest (bisection on runs), the energy bound; and at each incline of --inclines each "
-                    "engine's steady speed (motor) or mean speed (constant torque), clutch reactions and climbing "
-                    "efficiency. Writes DIR/climb.csv, DIR/climb.json and the figure DIR/climb.png.")
+def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--inclines", metavar="LIST|START:STOP:N", default="0:90:10",
                      help="pipe inclines above the horizontal [deg], -90..90: a comma-separated list or N evenly "
                           "spaced values from START to STOP (default 0:90:10)")
@@ -44,7 +40,6 @@ def add_parser(commands) -> None:
                           "(constant torque; default 1 s)")
     add_model_options(cmd)
     cmd.add_argument("--out", metavar="DIR", default="climb", help="results folder (default ./climb)")
-    cmd.set_defaults(handler=run)
 
 
 def parse_inclines(text: str) -> tuple[float, ...]:
@@ -73,7 +68,7 @@ def parse_engines(text: str | None) -> tuple[str, ...]:
     return names
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, figures) -> None:
     from . import climbing
 
     params = model_params(args)
@@ -89,16 +84,26 @@ def run(args: argparse.Namespace) -> int:
     compile_first(engines)
 
     study = climbing.climb_study(params, inclines, engines, tolerance, t_end, study_progress("climb"))
-    write_study_files(args.out, FILES, study, write_csv, lambda path: write_figure(study, params, path),
+    write_study_files(args.out, FILES, study, write_csv,
+                      lambda path: write_figure(study, params, path, figures.climb_figure),
                       format_study(study, params), f"{len(inclines)} inclines x {len(engines)} engines")
-    return EXIT_OK
 
 
-def write_figure(study: dict, params, path: Path) -> None:
-    """climb.png (:func:`ipir_mujoco.report.climb_figure.climb_figure`) with the traction's own marks
-    (:meth:`_FiniteGripOutput.draw`)."""
-    from ...report.climb_figure import climb_figure
+STUDY = Declaration(
+    "climb", "climbing ability: the steepest incline a design climbs, speed and clutch loads against it",
+    "For the design and its drive: the steepest incline at which the drive restarts the robot from rest at every "
+    "crank angle (quasi-static), for the motor the steepest it climbs to a steady state from rest (bisection on "
+    "runs), the energy bound; and at each incline of --inclines each engine's steady speed (motor) or mean speed "
+    "(constant torque), clutch reactions and climbing efficiency. Writes DIR/climb.csv, DIR/climb.json and the "
+    "figure DIR/climb.png.",
+    options=add_options, run=run, files=FILES, figures="climb_figure",
+    sections=(Section("vertical_riser", "Vertical riser", "riser_section", 30),
+              Section("finite_grip", "Finite grip", "grip_section", 40)))
 
+
+def write_figure(study: dict, params, path: Path, climb_figure) -> None:
+    """climb.png: ``climb_figure(study, params)`` (the report's, :func:`ipir_mujoco.report.climb_figure.climb_figure`)
+    with the traction's own marks (:meth:`_FiniteGripOutput.draw`)."""
     fig = climb_figure(study, params)
     _traction_output(study).draw(fig)
     fig.savefig(path, dpi=110)
@@ -185,7 +190,6 @@ def format_study(study: dict, params) -> str:
     if any(engine.startswith("mujoco") for row in study["rows"] for engine in row["engines"]):
         lines.append(MUJOCO_NOTE)
     return "\n".join(lines)
-
 
 
 class _UnlimitedGripOutput:

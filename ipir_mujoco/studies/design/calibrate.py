@@ -31,6 +31,7 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -237,14 +238,15 @@ def posterior_toml(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_files(out: str | Path, result: dict, measured: Measured) -> Path:
-    """calibration.json, posterior.toml and calibration.png into ``out``, all or nothing; returns the figure."""
+def write_files(out: str | Path, result: dict, measured: Measured, *, figure: Callable) -> Path:
+    """calibration.json, posterior.toml and calibration.png into ``out``, all or nothing; returns the figure's path.
+    ``figure(path, result, measured)`` draws it (the report's
+    :func:`ipir_mujoco.report.calibration_figure.plot_calibration`: the report stands above the studies)."""
     from ...output import staged_output
-    from ...report.calibration_figure import plot_calibration
 
     with staged_output(out) as staging:
         write_json(staging / "calibration.json",
                    {k: v for k, v in result.items() if k not in ("model", "residuals")})
         (staging / "posterior.toml").write_text(posterior_toml(result), encoding="utf-8")
-        plot_calibration(staging / "calibration.png", result, measured)
+        figure(staging / "calibration.png", result, measured)
     return Path(out) / "calibration.png"

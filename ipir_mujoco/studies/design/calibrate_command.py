@@ -1,35 +1,28 @@
-"""``ipir-mujoco calibrate``: fit parameters to a measured run (least squares, intervals, identifiability)."""
+"""The calibration (``ipir-mujoco calibrate``): fit parameters to a measured run (least squares, intervals,
+identifiability). Its fit: :mod:`.calibrate`; its figure: ``report/calibration_figure.py``."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from ...cli.common import (EXIT_OK, add_model_options, check_input_file, compile_first, files_line, model_params,
-                           study_progress)
+from ..command import add_model_options, check_input_file, compile_first, files_line, model_params, study_progress
+from ..contract import Declaration
 
 
-def add_parser(commands) -> None:
-    cal = commands.add_parser(
-        "calibrate", help="fit parameters to a measured run (CSV of t and any of x1 x2 phi omega v1 v2)",
-        description="Fit the --fit parameters within their ranges so that the model's run matches the measured "
-                    "columns (least squares, each column weighed by its noise), with 95 % confidence intervals, "
-                    "their correlation, and a warning for a parameter the data cannot identify. Writes "
-                    "DIR/calibration.json, DIR/posterior.toml (for 'uncertainty --dist-file'), DIR/calibration.png "
-                    "(docs/uncertainty.md).")
-    cal.add_argument("--data", required=True, metavar="FILE.csv",
+def add_options(cmd: argparse.ArgumentParser) -> None:
+    cmd.add_argument("--data", required=True, metavar="FILE.csv",
                      help="the measured run: a header row with t [s] and any of x1 x2 [m], phi [rad], omega [rad/s], "
                           "v1 v2 [m/s]; irregular times and noise are fine")
-    cal.add_argument("--fit", action="append", default=[], metavar="NAME=LO:HI",
+    cmd.add_argument("--fit", action="append", default=[], metavar="NAME=LO:HI",
                      help="a parameter to fit and its range (inside its allowed range; several allowed)")
-    cal.add_argument("--engine", default="analytic-unilateral",
+    cmd.add_argument("--engine", default="analytic-unilateral",
                      help="the model fitted (default analytic-unilateral; a MuJoCo variant works, slowly)")
-    add_model_options(cal)
-    cal.add_argument("--out", metavar="DIR", default="calibration", help="results folder (default ./calibration)")
-    cal.set_defaults(handler=run)
+    add_model_options(cmd)
+    cmd.add_argument("--out", metavar="DIR", default="calibration", help="results folder (default ./calibration)")
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, figures) -> None:
     from ...output import check_output_dir
     from .calibrate import calibrate, parse_fit, write_files
     from ..comparison.measured import read_measured
@@ -41,14 +34,23 @@ def run(args: argparse.Namespace) -> int:
     measured = read_measured(args.data)
     compile_first((args.engine,))
     result = calibrate(measured, fits, base=base, engine=args.engine, progress=study_progress("calibrate"))
-    figure = write_files(args.out, result, measured)
+    figure = write_files(args.out, result, measured, figure=figures.plot_calibration)
     print(format_result(result))
     print(f"  files: {files_line(args.out, 'calibration.json', 'posterior.toml', figure)}")
     for name in result["not_identifiable"]:
         print(f"ipir-mujoco calibrate: warning: {name} is not identifiable from these data (its interval spans its "
               "fit range, or a direction of the parameters leaves the fit unchanged); its value is not a measurement",
               file=sys.stderr)
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "calibrate", "fit parameters to a measured run (CSV of t and any of x1 x2 phi omega v1 v2)",
+    "Fit the --fit parameters within their ranges so that the model's run matches the measured columns (least "
+    "squares, each column weighed by its noise), with 95 % confidence intervals, their correlation, and a warning "
+    "for a parameter the data cannot identify. Writes DIR/calibration.json, DIR/posterior.toml (for 'uncertainty "
+    "--dist-file'), DIR/calibration.png (docs/uncertainty.md).",
+    options=add_options, run=run, files=("calibration.json", "posterior.toml", "calibration.png"),
+    figures="calibration_figure")
 
 
 def format_result(result: dict) -> str:

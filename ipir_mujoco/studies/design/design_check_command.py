@@ -1,29 +1,23 @@
-"""``ipir-mujoco design-check``: the round-pipe robot's closed-form design rules for one design, no simulation."""
+"""The design check (``ipir-mujoco design-check``): the round-pipe robot's closed-form design rules for one design,
+no simulation. Its rules: :mod:`.design_rules`."""
 
 from __future__ import annotations
 
 import argparse
 import json
 
-from ...cli.common import EXIT_OK, add_model_options, check_input_file, model_params
+from ..command import add_model_options, check_input_file, model_params
+from ..contract import Declaration
 
 
-def add_parser(commands) -> None:
-    cmd = commands.add_parser(
-        "design-check", help="the round-pipe robot's design rules (closed form, no simulation), each with its margin",
-        description="For one design of the wheeled robot in its round pipe: each closed-form rule with its value, "
-                    "limit, margin and whether it holds: the stall push against each module's grip, the restart "
-                    "torque, the weight against the press, a wheel's lift at stall (and at speed, for the motor), "
-                    "the rings' sideways grip, the tightest bend the geometry passes and the wheels' scrub in a bend "
-                    "(docs/model.md, 'The round pipe: design rules'). Exit status 0 whatever the verdicts.")
+def add_options(cmd: argparse.ArgumentParser) -> None:
     add_model_options(cmd)
     cmd.add_argument("--route", metavar="FILE.toml", default=None,
                      help="a route (as simulate --route): the bend rules take its bends")
     cmd.add_argument("--json", action="store_true", help="print {\"rules\": [...], \"holds\": ...} as JSON")
-    cmd.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, figures) -> None:
     from ipir_mujoco.engine.builders.wheels_model import check_wheels_params
 
     from .design_rules import design_rules
@@ -42,7 +36,16 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(result, allow_nan=False))
     else:
         print(format_rules(result))
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "design-check", "the round-pipe robot's design rules (closed form, no simulation), each with its margin",
+    "For one design of the wheeled robot in its round pipe: each closed-form rule with its value, limit, margin and "
+    "whether it holds: the stall push against each module's grip, the restart torque, the weight against the press, "
+    "a wheel's lift at stall (and at speed, for the motor), the rings' sideways grip, the tightest bend the "
+    "geometry passes and the wheels' scrub in a bend (docs/model.md, 'The round pipe: design rules'). Exit status "
+    "0 whatever the verdicts.",
+    options=add_options, run=run)
 
 
 def format_rules(result: dict) -> str:

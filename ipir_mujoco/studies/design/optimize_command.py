@@ -1,4 +1,5 @@
-"""``ipir-mujoco optimize``: the best design, or the Pareto front, within bounds and constraints."""
+"""The optimization study (``ipir-mujoco optimize``): the best design, or the Pareto front, within bounds and
+constraints. Its search: :mod:`.optimize`; its figure: ``report/optimize_plots.py``."""
 
 from __future__ import annotations
 
@@ -7,31 +8,25 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params
+from ..command import add_model_options, compile_first, files_line, model_params
+from ..contract import Declaration
 from ..design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
 
-def add_parser(commands) -> None:
-    opt = commands.add_parser("optimize", help="optimize designs: one objective or a Pareto front",
-                              description="Search the box of --vary ranges for the design that minimises or "
-                                          "maximises one objective (Sobol start + COBYQA), or for the Pareto front "
-                                          "of several (NSGA-II, pymoo), under constraints, in the fast engine; "
-                                          "verify the optimum or front in MuJoCo. Ctrl-C keeps what is done; "
-                                          "--resume completes it without re-running any design.")
-    opt.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI[:log]", help="a bounded parameter")
-    opt.add_argument("--objective", action="append", default=[], metavar="min:KEY|max:KEY",
+def add_options(cmd: argparse.ArgumentParser) -> None:
+    cmd.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI[:log]", help="a bounded parameter")
+    cmd.add_argument("--objective", action="append", default=[], metavar="min:KEY|max:KEY",
                      help="KEY: a sweep metric (e.g. steady_speed_m_s) or a parameter name; give several for a "
                           "Pareto front")
-    opt.add_argument("--constraint", action="append", default=[], metavar="KEY<=V|KEY>=V",
+    cmd.add_argument("--constraint", action="append", default=[], metavar="KEY<=V|KEY>=V",
                      help="a constraint on a metric or parameter; a stalled or failed design is infeasible")
-    opt.add_argument("--budget", type=int, default=None, help="designs to evaluate, >= 1 (default 100)")
-    opt.add_argument("--engine", default=None, help="engine of the search (default analytic-unilateral)")
-    opt.add_argument("--verify", default=None, metavar="ENGINE|none",
+    cmd.add_argument("--budget", type=int, default=None, help="designs to evaluate, >= 1 (default 100)")
+    cmd.add_argument("--engine", default=None, help="engine of the search (default analytic-unilateral)")
+    cmd.add_argument("--verify", default=None, metavar="ENGINE|none",
                      help="engine re-running the optimum / front (default mujoco-ratchet; none: skip)")
-    add_design_run_options(opt)
-    add_model_options(opt)
-    add_output_options(opt, "optimize", "optimization")
-    opt.set_defaults(handler=run)
+    add_design_run_options(cmd)
+    add_model_options(cmd)
+    add_output_options(cmd, "optimize", "optimization")
 
 
 def problem_from_args(args: argparse.Namespace):
@@ -53,19 +48,17 @@ def problem_from_args(args: argparse.Namespace):
                    0 if args.seed is None else args.seed)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, figures) -> None:
     from .optimize import run_optimize
 
     problem = problem_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
     compile_first((problem.engine,))  # before the pool: compiled once, said at once
-    from ...report.optimize_plots import plot_pareto
-
     drawn = []
     with scheduler_executor(args.scheduler) as executor:
         record = run_optimize(problem, args.out, resume=args.resume, workers=args.workers, executor=executor,
-                              figure=lambda out: drawn.append(plot_pareto(out, problem)))
+                              figure=lambda out: drawn.append(figures.plot_pareto(out, problem)))
     figure = drawn[0]
     print(f"{record['evaluations']} evaluations ({record['reused_on_resume']} re-used), {record['feasible']} feasible"
           + ("" if not record.get("unusable") else
@@ -90,7 +83,16 @@ def run(args: argparse.Namespace) -> int:
         print(f"ipir-mujoco optimize: note: {key} is the same in every feasible design, so the search could not "
               f"tell them apart (a run too short for a whole crank revolution? --t-end is {problem.t_end:g} s)",
               file=sys.stderr)
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "optimize", "optimize designs: one objective or a Pareto front",
+    "Search the box of --vary ranges for the design that minimises or maximises one objective (Sobol start + "
+    "COBYQA), or for the Pareto front of several (NSGA-II, pymoo), under constraints, in the fast engine; verify "
+    "the optimum or front in MuJoCo. Ctrl-C keeps what is done; --resume completes it without re-running any "
+    "design.",
+    options=add_options, run=run, files=("evaluations.csv", "pareto.csv", "optimize.json", "pareto.png"),
+    figures="optimize_plots")
 
 
 def _fmt(v) -> str:

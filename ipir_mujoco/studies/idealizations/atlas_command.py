@@ -1,4 +1,6 @@
-"""``ipir-mujoco atlas``: where each of the paper's idealizations can be trusted, over a box of designs."""
+"""The idealization atlas (``ipir-mujoco atlas``): where each of the paper's idealizations can be trusted, over a
+box of designs. Its runs: :mod:`.atlas`; its figures ``report/atlas_plots.py``, its report section
+``report/atlas_section.py``."""
 
 from __future__ import annotations
 
@@ -7,47 +9,39 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params, study_progress
+from ..command import add_model_options, compile_first, files_line, model_params, study_progress
+from ..contract import Declaration, Section
 
 
-def add_parser(commands) -> None:
+def add_options(cmd: argparse.ArgumentParser) -> None:
     from .atlas_space import DEFAULT_BUDGET, DEFAULT_SAMPLES, DEFAULT_TOLERANCE, NAMES
 
-    atl = commands.add_parser(
-        "atlas", help="where each of the paper's idealizations costs less than a threshold, over design ranges",
-        description="For each idealization of the paper's model (removed one at a time, as the validation "
-                    "report's ladder does), the relative cost (idealized - real) / |real| of each metric over "
-                    "the box of --vary ranges, and the region where it stays below each --threshold: the "
-                    "equations sampled densely (quasi-random), MuJoCo within --budget runs placed near the "
-                    "boundary by a Gaussian-process surrogate, Sobol indices of each cost. Writes DIR/atlas.json, "
-                    "DIR/samples.csv (streamed; Ctrl-C keeps what is done, --resume completes it) and figures.")
-    atl.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI[:log]", help="a parameter range")
-    atl.add_argument("--idealization", action="append", default=[], metavar="NAME",
+    cmd.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI[:log]", help="a parameter range")
+    cmd.add_argument("--idealization", action="append", default=[], metavar="NAME",
                      help=f"one of: {', '.join(NAMES)} (several allowed; default: every one the options allow)")
-    atl.add_argument("--metric", action="append", default=[], metavar="KEY",
+    cmd.add_argument("--metric", action="append", default=[], metavar="KEY",
                      help="revolutions, travel_m, x1_final, x2_final, v1_max, v2_max under constant torque "
                           "(default revolutions, travel_m); steady_speed_m_s, energy_per_metre_j_m, "
                           "distance_per_rev_m, efficiency, t_steady_s under --drive motor or servo (default the "
                           "first two)")
-    atl.add_argument("--threshold", action="append", type=float, default=[], metavar="REL",
+    cmd.add_argument("--threshold", action="append", type=float, default=[], metavar="REL",
                      help="relative cost below which an idealization is safe, > 0 (several allowed; default 0.01)")
-    atl.add_argument("--budget", type=int, default=None, metavar="N",
+    cmd.add_argument("--budget", type=int, default=None, metavar="N",
                      help=f"MuJoCo runs for the whole atlas, 2 per design (default {DEFAULT_BUDGET}; 0: the "
                           "equations only)")
-    atl.add_argument("--samples", type=int, default=None, metavar="N",
+    cmd.add_argument("--samples", type=int, default=None, metavar="N",
                      help=f"the equations' designs: N x (parameters + 2) (Saltelli; default {DEFAULT_SAMPLES})")
-    atl.add_argument("--boundary-tol", type=float, default=None, metavar="FRACTION",
+    cmd.add_argument("--boundary-tol", type=float, default=None, metavar="FRACTION",
                      help="MuJoCo stops once the designs whose side of a threshold is not known at 95 %% are less "
                           f"than this share of the box (default {DEFAULT_TOLERANCE:g})")
-    atl.add_argument("--seed", type=int, default=None, help="seed, >= 0 (default 0)")
-    atl.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
+    cmd.add_argument("--seed", type=int, default=None, help="seed, >= 0 (default 0)")
+    cmd.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
                      help="simulated time per run (default 1 s; under the motor the cap of a run to its steady "
                           "state, default 10 s)")
-    add_model_options(atl)
-    atl.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
-    atl.add_argument("--out", metavar="DIR", default="atlas", help="results folder (default ./atlas)")
-    atl.add_argument("--resume", action="store_true", help="complete an interrupted atlas in DIR")
-    atl.set_defaults(handler=run)
+    add_model_options(cmd)
+    cmd.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    cmd.add_argument("--out", metavar="DIR", default="atlas", help="results folder (default ./atlas)")
+    cmd.add_argument("--resume", action="store_true", help="complete an interrupted atlas in DIR")
 
 
 def atlas_from_args(args: argparse.Namespace):
@@ -66,25 +60,33 @@ def atlas_from_args(args: argparse.Namespace):
                  args.t_end, DEFAULT_TOLERANCE if args.boundary_tol is None else args.boundary_tol)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, figures) -> None:
     atlas = atlas_from_args(args)
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers {args.workers}: allowed: a whole number >= 1")
     compile_first()  # before the pool: compiled once, said at once
-    from ...report.atlas_plots import plot_atlas
     from .atlas import run_atlas
 
     result = run_atlas(atlas, args.out, resume=args.resume, workers=args.workers, progress=study_progress("atlas"))
-    figures = plot_atlas(result, atlas, args.out)
+    drawn = figures.plot_atlas(result, atlas, args.out)
     for line in summary_lines(result, atlas):
         print(line)
     runs = result["runs"]
     print(f"  {runs['equations'] // 2} designs of the equations ({runs['equations']} runs), {runs['mujoco'] // 2} of "
           f"MuJoCo ({runs['mujoco']} runs) in {result['wall_s']:.1f} s ({result['workers']} worker"
           f"{'s' if result['workers'] != 1 else ''})")
-    print(f"  files: {files_line(args.out, 'atlas.json', 'samples.csv', *figures)}")
+    print(f"  files: {files_line(args.out, 'atlas.json', 'samples.csv', *drawn)}")
     sys.stdout.flush()
-    return EXIT_OK
+
+STUDY = Declaration(
+    "atlas", "where each of the paper's idealizations costs less than a threshold, over design ranges",
+    "For each idealization of the paper's model (removed one at a time, as the validation report's ladder does), "
+    "the relative cost (idealized - real) / |real| of each metric over the box of --vary ranges, and the region "
+    "where it stays below each --threshold: the equations sampled densely (quasi-random), MuJoCo within --budget "
+    "runs placed near the boundary by a Gaussian-process surrogate, Sobol indices of each cost. Writes "
+    "DIR/atlas.json, DIR/samples.csv (streamed; Ctrl-C keeps what is done, --resume completes it) and figures.",
+    options=add_options, run=run, files=("atlas.json", "samples.csv"), figures="atlas_plots",
+    sections=(Section("model_holds", "Where the paper's model holds", "atlas_section", 60),))
 
 
 def summary_lines(result: dict, atlas) -> list[str]:

@@ -1,4 +1,5 @@
-"""``ipir-mujoco bend-study``: time and energy for the wheeled robot to pass a 90-degree bend, against R/D."""
+"""The bend study (``ipir-mujoco bend-study``): time and energy for the wheeled robot to pass a 90-degree bend,
+against R/D. Its runs: :mod:`.bend_study`; its figure: ``report/bend_figure.py``."""
 
 from __future__ import annotations
 
@@ -10,20 +11,13 @@ from pathlib import Path
 from ipir_mujoco.core.params import check_whole
 
 from ...output import check_output_dir
-from ...cli.common import EXIT_OK, add_study_options, model_params, study_progress, write_study_files
+from ..command import add_study_options, model_params, study_progress, write_study_files
+from ..contract import Declaration
 
 FILES = ("bend_study.csv", "bend_study.json", "bend_study.png")
 
 
-def add_parser(commands) -> None:
-    cmd = commands.add_parser(
-        "bend-study", help="the wheeled MuJoCo robot through a 90-degree bend: time and energy against R/D",
-        description="Run the wheeled MuJoCo model (--mujoco-model wheels) along a route with a 90-degree bend for "
-                    "each R/D, and the same length of straight pipe; time and motor work from the front module "
-                    "entering the bend to the rear module leaving it, beside the analytic finite-grip model's "
-                    "straight-pipe prediction over that length and the equations along the same route (the bend "
-                    "and its straight twin) with MuJoCo's difference from them. Writes DIR/bend_study.csv, "
-                    "DIR/bend_study.json and the figure DIR/bend_study.png; prints the table.")
+def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--ratios", metavar="LIST", default=None,
                      help="bend radius over pipe diameter, R/D: a comma-separated list (default 0.6,1,1.5,2,3,5,7.5,10)")
     cmd.add_argument("--quick", action="store_true", help="R/D 2 and 5 only, for a first look")
@@ -33,11 +27,9 @@ def add_parser(commands) -> None:
                           "bends out of the mechanism's plane)")
     add_study_options(cmd, "bend-study", "e.g. pipe_diameter=0.2; "
                                        "the study runs the default motor and, unless given, mu_wall 0.8")
-    cmd.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ...report.bend_figure import write_bend_figure
+def run(args: argparse.Namespace, figures) -> None:
     from . import bend_study as bs
     from .clutch_study import parse_values
 
@@ -54,9 +46,18 @@ def run(args: argparse.Namespace) -> int:
     progress(f"{len(ratios) * len(planes)} bends and {len(ratios)} straight twins on {workers} processes (a line "
              "per finished run, and every 5 s of a running one)")
     study = bs.run_study(params, ratios, workers=workers, progress=progress, planes=planes)
-    write_study_files(args.out, FILES, study, write_csv, lambda path: write_bend_figure(study, path),
+    write_study_files(args.out, FILES, study, write_csv, lambda path: figures.write_bend_figure(study, path),
                       format_table(study), f"{len(study['rows'])} bends")
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "bend-study", "the wheeled MuJoCo robot through a 90-degree bend: time and energy against R/D",
+    "Run the wheeled MuJoCo model (--mujoco-model wheels) along a route with a 90-degree bend for each R/D, and the "
+    "same length of straight pipe; time and motor work from the front module entering the bend to the rear module "
+    "leaving it, beside the analytic finite-grip model's straight-pipe prediction over that length and the "
+    "equations along the same route (the bend and its straight twin) with MuJoCo's difference from them. Writes "
+    "DIR/bend_study.csv, DIR/bend_study.json and the figure DIR/bend_study.png; prints the table.",
+    options=add_options, run=run, files=FILES, figures="bend_figure")
 
 
 COLUMNS = ("plane_deg", "R_over_D", "radius_m", "window_m", "analytic_time_s", "analytic_energy_j", "straight_time_s",

@@ -1,4 +1,5 @@
-"""``ipir-mujoco clutch-study``: engagement loads of real (compliant, backlashed) one-way clutches."""
+"""The clutch study (``ipir-mujoco clutch-study``): engagement loads of real (compliant, backlashed) one-way
+clutches. Its runs: :mod:`.clutch_study`; its figure and report section: ``report/clutch_section.py``."""
 
 from __future__ import annotations
 
@@ -12,17 +13,13 @@ from ipir_mujoco.core.params import check_whole
 
 from ...labels import significant
 from ...output import check_output_dir
-from ...cli.common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
+from ..command import add_study_options, compile_first, model_params, study_progress, write_study_files
+from ..contract import Declaration, Section
 
 FILES = ("clutch_study.csv", "clutch_study.json", "clutch_study.png")
 
 
-def add_parser(commands) -> None:
-    cmd = commands.add_parser(
-        "clutch-study", help="engagement loads of real one-way clutches: stiffness and backlash, both engines",
-        description="Run the analytic compliant clutch and MuJoCo's compliant ratchet over clutch stiffness and "
-                    "backlash at the default motor's cruise and at the paper's start-up; write DIR/clutch_study.csv, "
-                    "DIR/clutch_study.json and the figure DIR/clutch_study.png; print the table.")
+def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--stiffness", metavar="LIST|START:STOP:N", default=None,
                      help="clutch stiffness seen at the module [N/m]: a comma-separated list, or N log-spaced values "
                           "from START to STOP (default 1e3:1e7:9)")
@@ -36,11 +33,9 @@ def add_parser(commands) -> None:
                                        "the study sets drive, clutch_stiffness and clutch_backlash itself")
     cmd.add_argument("--quick", action="store_true",
                      help="a small grid (1e4,1e5,1e6 N/m x 0,1e-3 m) for a first look; --stiffness/--backlash win")
-    cmd.set_defaults(handler=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ...report.clutch_section import write_study_figure
+def run(args: argparse.Namespace, figures) -> None:
     from . import clutch_study as cs
 
     base = model_params(args)
@@ -63,9 +58,17 @@ def run(args: argparse.Namespace) -> int:
 
     study = cs.run_study(base, designs=designs, points=points, workers=args.workers,
                          progress=study_progress("clutch-study"))
-    write_study_files(args.out, FILES, study, write_csv, lambda path: write_study_figure(study, path),
+    write_study_files(args.out, FILES, study, write_csv, lambda path: figures.write_study_figure(study, path),
                       format_table(study), f"{len(study['rows'])} designs x 2 engines")
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "clutch-study", "engagement loads of real one-way clutches: stiffness and backlash, both engines",
+    "Run the analytic compliant clutch and MuJoCo's compliant ratchet over clutch stiffness and backlash at the "
+    "default motor's cruise and at the paper's start-up; write DIR/clutch_study.csv, DIR/clutch_study.json and the "
+    "figure DIR/clutch_study.png; print the table.",
+    options=add_options, run=run, files=FILES, figures="clutch_section",
+    sections=(Section("clutch_engagement", "Real clutches: engagement loads", "clutch_section", 10),))
 
 
 def _columns() -> list[str]:

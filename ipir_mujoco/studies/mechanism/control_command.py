@@ -1,5 +1,6 @@
-"""``ipir-mujoco control-study``: speed control of the crank, open loop against PI with and without feedforward,
-and a crank-speed profile that slows through the dead centres, in both engines."""
+"""The control study (``ipir-mujoco control-study``): speed control of the crank, open loop against PI with and
+without feedforward, and a crank-speed profile that slows through the dead centres, in both engines. Its runs:
+:mod:`.control_study`; its figure ``report/control_figure.py``, its report section ``report/control_section.py``."""
 
 from __future__ import annotations
 
@@ -13,7 +14,8 @@ from ipir_mujoco.core.params import check_real, check_whole
 
 from ...labels import significant
 from ...output import check_output_dir
-from ...cli.common import EXIT_OK, add_study_options, compile_first, model_params, study_progress, write_study_files
+from ..command import add_study_options, compile_first, model_params, study_progress, write_study_files
+from ..contract import Declaration, Section
 
 FILES = ("control_study.csv", "control_study.json", "control_study.png")
 METRICS = ("mean_omega_rad_s", "speed_ripple", "peak_clutch_force_n", "peak_module_accel_m_s2",
@@ -21,15 +23,7 @@ METRICS = ("mean_omega_rad_s", "speed_ripple", "peak_clutch_force_n", "peak_modu
            "peak_motor_torque_n_m", "steady", "t_steady_s", "wall_s")
 
 
-def add_parser(commands) -> None:
-    cmd = commands.add_parser(
-        "control-study", help="speed control of the crank: open loop, PI, PI + feedforward, a dead-centre profile",
-        description="At matching mean crank speeds, run the open-loop motor (a constant voltage that cruises at "
-                    "the speed), the PI speed controller, and PI with the paper's and the exact feedforward, each to "
-                    "its steady state in the paper's geometry, the exact equations and MuJoCo; and a speed target "
-                    "that dips through the dead centres against constant speed at the same mean. Writes "
-                    "DIR/control_study.csv, DIR/control_study.json and the figure DIR/control_study.png; prints the "
-                    "table (docs/control.md).")
+def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--speeds", metavar="LIST", default=None,
                      help="mean crank speeds [rad/s] of the controller comparison, comma-separated (default 5,10; "
                           "each below omega_noload)")
@@ -40,7 +34,6 @@ def add_parser(commands) -> None:
     cmd.add_argument("--quick", action="store_true", help="10 rad/s and dips 0, 0.2 only; --speeds/--dips win")
     add_study_options(cmd, "control-study", "e.g. control_rate=500; "
                                        "the study sets drive, omega_target, speed_dip and feedforward itself")
-    cmd.set_defaults(handler=run)
 
 
 def parse_list(option: str, text: str, low: float, high: float, low_open: bool, unit: str = "") -> tuple[float, ...]:
@@ -58,8 +51,7 @@ def parse_list(option: str, text: str, low: float, high: float, low_open: bool, 
     return tuple(sorted(set(values)))
 
 
-def run(args: argparse.Namespace) -> int:
-    from ...report.control_figure import write_study_figure
+def run(args: argparse.Namespace, figures) -> None:
     from . import control_study as cs
 
     base = model_params(args)
@@ -78,9 +70,19 @@ def run(args: argparse.Namespace) -> int:
 
     study = cs.run_study(base, speeds, dips, profile_speed, workers=args.workers,
                          progress=study_progress("control-study"))
-    write_study_files(args.out, FILES, study, write_csv, lambda path: write_study_figure(study, path),
+    write_study_files(args.out, FILES, study, write_csv, lambda path: figures.write_study_figure(study, path),
                       format_table(study), f"{len(study['rows']) + len(study['profile']['rows'])} runs")
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "control-study", "speed control of the crank: open loop, PI, PI + feedforward, a dead-centre profile",
+    "At matching mean crank speeds, run the open-loop motor (a constant voltage that cruises at the speed), the PI "
+    "speed controller, and PI with the paper's and the exact feedforward, each to its steady state in the paper's "
+    "geometry, the exact equations and MuJoCo; and a speed target that dips through the dead centres against "
+    "constant speed at the same mean. Writes DIR/control_study.csv, DIR/control_study.json and the figure "
+    "DIR/control_study.png; prints the table (docs/control.md).",
+    options=add_options, run=run, files=FILES, figures="control_figure",
+    sections=(Section("speed_control", "Speed control", "control_section", 50),))
 
 
 def write_csv(path: Path, study: dict) -> None:

@@ -30,6 +30,7 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -375,10 +376,11 @@ def _rows(designs, cheap, cheap_rows, faithful, faithful_rows, keys) -> list[dic
     return rows
 
 
-def write_files(out: str | Path, result: dict) -> Path:
-    """uncertainty.json, samples.csv and uncertainty.png into ``out``, all or nothing; returns the figure's path."""
+def write_files(out: str | Path, result: dict, *, figure: Callable) -> Path:
+    """uncertainty.json, samples.csv and uncertainty.png into ``out``, all or nothing; returns the figure's path.
+    ``figure(path, result, words)`` draws it (the report's :func:`ipir_mujoco.report.uncertainty_figure.plot_uncertainty`:
+    the report stands above the studies)."""
     from ...output import staged_output
-    from ...report.uncertainty_figure import plot_uncertainty
 
     with staged_output(out) as staging:
         rows = result["rows"]
@@ -392,7 +394,7 @@ def write_files(out: str | Path, result: dict) -> Path:
                  "events": {e: event_words(e) for e in result["events"]},
                  "engines": {e: registry.variant(e).label for e in (result["study"]["engine"],
                                                                      result["study"]["mujoco_engine"]) if e}}
-        plot_uncertainty(staging / "uncertainty.png", result, words)
+        figure(staging / "uncertainty.png", result, words)
     return Path(out) / "uncertainty.png"
 
 

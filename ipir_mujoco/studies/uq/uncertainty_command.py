@@ -1,50 +1,42 @@
-"""``ipir-mujoco uncertainty``: metrics and event probabilities under uncertain parameters, two fidelities."""
+"""The uncertainty study (``ipir-mujoco uncertainty``): metrics and event probabilities under uncertain parameters,
+two fidelities. Its runs and statistics: :mod:`.uncertainty`; its figure: ``report/uncertainty_figure.py``."""
 
 from __future__ import annotations
 
 import argparse
 
-from ...cli.common import EXIT_OK, add_model_options, compile_first, files_line, model_params
+from ..command import add_model_options, compile_first, files_line, model_params
+from ..contract import Declaration
 from ..design_runs import add_design_run_options, design_t_end
 
 
-def add_parser(commands) -> None:
-    unc = commands.add_parser(
-        "uncertainty", help="metrics and event probabilities under uncertain parameters (equations + MuJoCo)",
-        description="Draw --samples parameter sets from the --dist distributions, run the equations on all of "
-                    "them and MuJoCo on the first --mujoco-samples (the same draws), and give each metric's mean, "
-                    "standard deviation and 5/50/95 % quantiles with 95 % confidence intervals, and each event's "
-                    "probability with its interval. With MuJoCo samples the estimate is multi-fidelity (the "
-                    "equations as a control variate of MuJoCo), shown beside MuJoCo's plain Monte Carlo with the "
-                    "variance reduction. Writes DIR/uncertainty.json, DIR/samples.csv, DIR/uncertainty.png "
-                    "(docs/uncertainty.md).")
-    unc.add_argument("--dist", action="append", default=[], metavar="NAME=KIND:...",
+def add_options(cmd: argparse.ArgumentParser) -> None:
+    cmd.add_argument("--dist", action="append", default=[], metavar="NAME=KIND:...",
                      help="an uncertain parameter: NAME=normal:MEAN:SD, uniform:LO:HI, lognormal:MU:SIGMA (of "
                           "log NAME) or truncnormal:MEAN:SD:LO:HI, in the parameter's unit; inside its allowed range")
-    unc.add_argument("--dist-file", metavar="FILE.toml",
+    cmd.add_argument("--dist-file", metavar="FILE.toml",
                      help="distributions as a [dist] table (NAME = \"KIND:...\") and optionally a [correlation]; "
                           "what 'calibrate' writes as posterior.toml; --dist wins for a parameter both name")
-    unc.add_argument("--metric", action="append", default=[], metavar="KEY",
+    cmd.add_argument("--metric", action="append", default=[], metavar="KEY",
                      help="a run's summary key or sweep metric (several allowed), e.g. steady_speed_m_s")
-    unc.add_argument("--event", action="append", default=[], metavar="'KEY>V'",
+    cmd.add_argument("--event", action="append", default=[], metavar="'KEY>V'",
                      help="an event whose probability to give: KEY>V, KEY>=V, KEY<V, KEY<=V, or stall, "
                           "no-steady-state, slides-back (e.g. 'skid_m>0.01', 'peak_clutch_force_n>15')")
-    unc.add_argument("--samples", type=int, default=1000, metavar="N",
+    cmd.add_argument("--samples", type=int, default=1000, metavar="N",
                      help="parameter draws run in the equations (default 1000)")
-    unc.add_argument("--mujoco-samples", type=int, default=0, metavar="M",
+    cmd.add_argument("--mujoco-samples", type=int, default=0, metavar="M",
                      help="of them, how many also run in MuJoCo (default 0; 3 or more for the multi-fidelity "
                           "estimate, e.g. 20)")
-    unc.add_argument("--engine", default=None,
+    cmd.add_argument("--engine", default=None,
                      help="either engine of the pair (the other matches its clutch rule): analytic-unilateral with "
                           "mujoco-ratchet (default), or analytic-exact with mujoco-lock")
-    add_design_run_options(unc)
-    add_model_options(unc)
-    unc.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
-    unc.add_argument("--out", metavar="DIR", default="uncertainty", help="results folder (default ./uncertainty)")
-    unc.set_defaults(handler=run)
+    add_design_run_options(cmd)
+    add_model_options(cmd)
+    cmd.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    cmd.add_argument("--out", metavar="DIR", default="uncertainty", help="results folder (default ./uncertainty)")
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, figures) -> None:
     from ...output import check_output_dir
     from .uncertainty import check_metric, parse_event, run_uncertainty, write_files
     from .uq_dists import combine, parse_dist, read_dist_file
@@ -60,10 +52,21 @@ def run(args: argparse.Namespace) -> int:
                              mujoco_samples=args.mujoco_samples, t_end=design_t_end(args),
                              until_steady=bool(args.until_steady), seed=0 if args.seed is None else args.seed,
                              correlation=correlation, workers=args.workers)
-    figure = write_files(args.out, result)
+    figure = write_files(args.out, result, figure=figures.plot_uncertainty)
     print(format_result(result))
     print(f"  files: {files_line(args.out, 'uncertainty.json', 'samples.csv', figure)}")
-    return EXIT_OK
+
+
+STUDY = Declaration(
+    "uncertainty", "metrics and event probabilities under uncertain parameters (equations + MuJoCo)",
+    "Draw --samples parameter sets from the --dist distributions, run the equations on all of them and MuJoCo on "
+    "the first --mujoco-samples (the same draws), and give each metric's mean, standard deviation and 5/50/95 % "
+    "quantiles with 95 % confidence intervals, and each event's probability with its interval. With MuJoCo "
+    "samples the estimate is multi-fidelity (the equations as a control variate of MuJoCo), shown beside MuJoCo's "
+    "plain Monte Carlo with the variance reduction. Writes DIR/uncertainty.json, DIR/samples.csv, "
+    "DIR/uncertainty.png (docs/uncertainty.md).",
+    options=add_options, run=run, files=("uncertainty.json", "samples.csv", "uncertainty.png"),
+    figures="uncertainty_figure")
 
 
 def _interval(pair) -> str:
