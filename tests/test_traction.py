@@ -1,4 +1,5 @@
-"""Traction limits (studies/traction.py), their place in ``climb``, and the validation report's Finite grip section.
+"""Traction limits (studies/climb/traction.py), their place in ``climb``, and the validation report's Finite grip
+section.
 
 Hand checks (docs/model.md, "Finite grip"; docs/cli.md, the climb worked example). A standing robot's
 holds are statics: with the drive off each module holds its own weight share, module 2 with the rod's

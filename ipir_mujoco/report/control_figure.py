@@ -99,7 +99,7 @@ def study_figure(study: dict) -> Figure:
             bottom = ax.get_ylim()[0]
             ax.set_ylim(bottom, tallest * (12.0 if log else 1.45))
         ax.legend(fontsize=8, title="bars: hatch = model", title_fontsize=8, loc="upper center", ncols=len(shown))
-        if missing:  # MuJoCo's rigid ratchet: its peaks measure its timestep (studies/control_study.py)
+        if missing:  # MuJoCo's rigid ratchet: its peaks measure its timestep (studies/mechanism/control_study.py)
             ax.set_xlabel(f"controller and mean crank speed\n({', '.join(missing)}: n/a, a rigid ratchet's sampled "
                           "peak measures its timestep)")
 

@@ -344,7 +344,8 @@ def build_blocks(metrics: dict, figures: dict[str, str], animation_note: str | N
                             + (" (quick run)." if settings["quick"] else ".")
                             + " MuJoCo: " + _mujoco_settings_text(settings) + " (evidence: the package's mjcf/README.md)."))
     blocks.append(Table(["software", "version"], [[k, v] for k, v in metrics["versions"].items()]))
-    blocks.append(Paragraph("All numbers above are in metrics.json (schema in ipir_mujoco/studies/validate.py); "
+    blocks.append(Paragraph("All numbers above are in metrics.json (schema in "
+                            "ipir_mujoco/studies/validation/validate.py); "
                             "the model and its conventions are in docs/model.md. The documents this report names "
                             f"are installed with the package: docs/model.md as {shipped('docs/model.md')}, "
                             f"mjcf/README.md as {shipped('mjcf/README.md')}."))
