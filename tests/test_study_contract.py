@@ -1,0 +1,66 @@
+"""The study contract (ipir_mujoco/studies/contract.py): what a study declares, and that the command line and the
+validation report read exactly the declared list."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pytest
+
+from ipir_mujoco.cli import TOOLS, build_parser
+from ipir_mujoco.studies import declared
+from ipir_mujoco.studies.contract import Declaration, Section
+
+REPORT = Path(__file__).resolve().parent.parent / "ipir_mujoco" / "report"
+
+
+def _subcommands() -> dict[str, argparse.ArgumentParser]:
+    parser = build_parser()
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+
+
+def test_the_command_line_has_one_subcommand_per_declared_study_and_per_tool():
+    studies = [s.name for s in declared() if s.command]
+    tools = [t.__name__.rsplit(".", 1)[-1] for t in TOOLS]
+    assert len(set(studies)) == len(studies) and not set(studies) & set(tools)
+    assert list(_subcommands()) == tools + studies  # the tools first, then the studies in declared() order
+    assert {"sweep", "climb", "atlas", "uncertainty", "design-check"} <= set(studies)
+
+
+def test_the_report_reads_the_declared_sections_in_their_place_order():
+    from ipir_mujoco.report.sections import SECTIONS
+
+    declared_sections = sorted((s for study in declared() for s in study.sections), key=lambda s: s.place)
+    assert [s.key for s in SECTIONS] == [s.key for s in declared_sections]
+    assert len({s.key for s in declared_sections}) == len(declared_sections)
+    assert len({s.place for s in declared_sections}) == len(declared_sections)  # no tie left to file order
+    for section, read in zip(declared_sections, SECTIONS):
+        assert read.title == section.title and read.compute.__module__ == f"ipir_mujoco.report.{section.module}"
+
+
+def test_every_declared_report_module_is_a_file_of_the_report():
+    named = {s.figures for s in declared() if s.figures} | {x.module for s in declared() for x in s.sections}
+    assert named and sorted(m for m in named if not (REPORT / f"{m}.py").is_file()) == []
+
+
+def test_every_study_with_a_command_names_its_files_or_writes_none():
+    """A study's files are written into its --out folder: a study that names files has --out."""
+    commands = _subcommands()
+    for study in declared():
+        if study.files:
+            dests = {a.dest for a in commands[study.name]._actions}
+            assert "out" in dests, study.name
+
+
+@pytest.mark.parametrize("fields, word", [
+    ({"name": "Bad_Name", "summary": "s"}, "lower-case words"),
+    ({"name": "ok", "summary": "s", "options": lambda parser: None}, "together"),
+    ({"name": "ok", "summary": "s", "run": lambda args, figures: None}, "together"),
+    ({"name": "ok", "summary": "s", "figures": "report.x"}, "module's name"),
+])
+def test_a_bad_declaration_is_refused_where_it_is_made(fields, word):
+    with pytest.raises(ValueError, match=word):
+        Declaration(**fields)
+    with pytest.raises(ValueError, match="module's name"):
+        Section("k", "title", "../x", 1)
