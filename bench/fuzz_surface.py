@@ -67,7 +67,7 @@ BASE = {
     "simulate": ["simulate", "--t-end", "0.02"],
     "validate": ["validate", "--quick"],
     "compare": ["compare", "{f}/run", "{f}/run2"],
-    "sweep": ["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.02", "--workers", "1"],
+    "sweep": ["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.02", "--workers", "1"],
     "optimize": ["optimize", "--vary", "L=0.1:0.3", "--objective", "max:revolutions", "--budget", "2", "--verify",
                  "none", "--t-end", "0.02", "--workers", "1"],
     "sensitivity": ["sensitivity", "--vary", "L=0.1:0.3", "--metric", "revolutions", "--samples", "2", "--t-end",
@@ -77,7 +77,7 @@ BASE = {
     "render": ["render", "--t-end", "0.02", "--fps", "5"],
     "clutch-study": ["clutch-study", "--stiffness", "1e4", "--backlash", "0", "--points", "startup", "--workers",
                      "1"],
-    "climb": ["climb", "--inclines", "0", "--engines", "analytic-unilateral", "--t-end", "0.05"],
+    "climb": ["climb", "--inclines", "0", "--variants", "analytic-unilateral", "--t-end", "0.05"],
     "control-study": ["control-study", "--quick", "--workers", "1"],
     "bend-study": ["bend-study", "--quick", "--workers", "1"],
     "atlas": ["atlas", "--vary", "L=0.1:0.3", "--idealization", "first-order-kinematics", "--metric", "revolutions",
@@ -187,9 +187,9 @@ def explicit_cli_cases() -> list[Case]:
                                                  "--verify", ""], BAD),
         Case("sensitivity --vary drive=0:1", sen + ["--vary", "drive=0:1"], BAD),
         Case("sensitivity --vary m1=-1:1", sen + ["--vary", "m1=-1:1"], BAD),
-        Case("sweep --vary m1=-1,1", ["sweep", "--vary", "m1=-1,1", "--engines", "analytic-approx", "--t-end", "0.02",
+        Case("sweep --vary m1=-1,1", ["sweep", "--vary", "m1=-1,1", "--variants", "analytic-approx", "--t-end", "0.02",
                                       "--workers", "1"], BAD),
-        Case("sweep --vary drive=1,2", ["sweep", "--vary", "drive=1,2", "--engines", "analytic-approx", "--t-end",
+        Case("sweep --vary drive=1,2", ["sweep", "--vary", "drive=1,2", "--variants", "analytic-approx", "--t-end",
                                         "0.02", "--workers", "1"], BAD),
         Case("clutch-study --set omega_target=5", BASE["clutch-study"] + ["--set", "omega_target=5"], BAD),
         Case("clutch-study --set speed_dip=0.1", BASE["clutch-study"] + ["--set", "speed_dip=0.1"], BAD),
@@ -202,7 +202,7 @@ def explicit_cli_cases() -> list[Case]:
         Case("route first straight 0.31", wheels[:-2] + ["--route", "{f}/short.toml", "--set", "mu_wall=0.5"], BAD),
         Case("optimize --resume binary evaluations", opt + ["--vary", "L=0.1:0.3", "--resume", "--out",
                                                             "{f}/opt_binary"], BAD),
-        Case("sweep all designs fail", ["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end",
+        Case("sweep all designs fail", ["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end",
                                         "0.5", "--timeout-per-design", "1e-6", "--workers", "1"], frozenset({1})),
         Case("simulate --out ''", ["simulate", "--t-end", "0.02", "--out", ""], BAD),
         Case("simulate --wall-budget 1e-6 wheels", wheels + ["--set", "mu_wall=0.5", "--wall-budget", "1e-6"],
@@ -227,7 +227,7 @@ def make_fixtures(root: Path) -> None:
         assert main(["simulate", "--t-end", "0.05", "--dt-out", "1e-3", "--out", str(root / "run")]) == 0
         assert main(["simulate", "--geometry", "exact", "--t-end", "0.05", "--dt-out", "1e-3", "--out",
                      str(root / "run2")]) == 0
-        assert main(["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.02", "--workers",
+        assert main(["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.02", "--workers",
                      "1", "--out", str(root / "swp")]) == 0
         assert main(["optimize", "--vary", "L=0.1:0.3", "--objective", "max:revolutions", "--budget", "2",
                      "--verify", "none", "--t-end", "0.02", "--workers", "1", "--out", str(root / "opt_binary")]) == 0

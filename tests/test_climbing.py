@@ -274,7 +274,7 @@ def test_a_downhill_runaway_is_simulated_to_its_end(engine):
     (["simulate", "--engine", "mujoco", "--set", "incline=-90.5"], "incline=-90.5"),
     (["climb", "--inclines", "0,95"], "incline=95.0"), (["climb", "--inclines", "nan"], "incline=nan"),
     (["climb", "--inclines=-100:0:3"], "incline=-100.0"), (["climb", "--set", "incline=10"], "--inclines"),
-    (["climb", "--engines", "mujoco"], "mujoco"), (["climb", "--tolerance", "0"], "--tolerance"),
+    (["climb", "--variants", "mujoco"], "mujoco"), (["climb", "--tolerance", "0"], "--tolerance"),
 ])
 def test_an_incline_outside_plus_minus_90_deg_or_nan_exits_2_in_one_line(argv, fragment, capsys, tmp_path):
     assert main(argv + (["--out", str(tmp_path / "x")] if argv[0] == "climb" else [])) == 2

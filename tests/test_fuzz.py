@@ -82,7 +82,7 @@ def files(tmp_path_factory):
     (f / "clash").mkdir()
     (f / "clash" / "summary.json").mkdir()  # a folder where simulate writes a file
     sweep = f / "swp"
-    assert main(["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05",
+    assert main(["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.05",
                  "--out", str(sweep)]) == 0
     for name, tail in {"garbage": b"hello world\n", "binary": b"\xff\xfe\x00\x01\n", "nul": b"5,\x00\n",
                        "extra": (sweep / "results.csv").read_bytes().splitlines()[1] + b",1,2\n"}.items():
@@ -137,7 +137,7 @@ CASES = [
      "engines='analytic-approx' is not a list"),
     (["sweep", "--study", "{f}/sweep_not_table.toml", "--out", "{f}/s"], 2, "must be a table"),
     (["sweep", "--study", "{f}/params_bad.toml", "--out", "{f}/s"], 2, "m1='heavy' is not a number"),
-    (["sweep", "--vary", "L=0.1,0.2", "--engines", ",", "--out", "{f}/s"], 2, "--engines ',' names no engine"),
+    (["sweep", "--vary", "L=0.1,0.2", "--variants", ",", "--out", "{f}/s"], 2, "--variants ',' names no variant"),
     (["sweep", "--vary", "L=0.08:0.3:1e12", "--out", "{f}/s"], 2, "allowed: N <= 100000"),
     (["sweep", "--vary", "L=0.08:0.3:400", "--vary", "m2=0.1:1:400", "--out", "{f}/s"], 2, "400 x 400"),
     (["sweep", "--vary", "L=0.1,nan", "--out", "{f}/s"], 2, "every value must be a finite number"),
@@ -159,15 +159,15 @@ CASES = [
     (["simulate", "--wall-budget", "-5"], 2, "--wall-budget -5 is out of range"),
     (["simulate", "--t-end", "0.5", "--wall-budget", "1e-6"], 1, "--wall-budget 1e-06 s; raise it"),
     # sweeps
-    (["sweep", "--vary", "L=0.01,0.02", "--engines", "analytic-approx", "--t-end", "0.1", "--out", "{f}/s"], 2,
+    (["sweep", "--vary", "L=0.01,0.02", "--variants", "analytic-approx", "--t-end", "0.1", "--out", "{f}/s"], 2,
      "every one of the 2 designs is invalid; the first (L=0.01)"),
-    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+    (["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.05", "--resume",
       "--out", "{f}/swp_garbage"], 2, "results.csv' line 4 has 1 cells"),
-    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+    (["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.05", "--resume",
       "--out", "{f}/swp_extra"], 2, "results.csv' line 4 has"),
-    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+    (["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.05", "--resume",
       "--out", "{f}/swp_binary"], 2, "results.csv' line 4 is not UTF-8"),
-    (["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end", "0.05", "--resume",
+    (["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end", "0.05", "--resume",
       "--out", "{f}/swp_nul"], 2, "results.csv' line 4"),
     # configuration files
     (["simulate", "--config", "{f}/big_int.toml"], 2, "an integer of more than 4300 digits"),
@@ -227,7 +227,7 @@ CASES = [
      "m1=-1.0 is out of range"),
     (["optimize", "--vary", "L=0.1:0.3", "--objective", "max:revolutions", "--verify", "", "--out", "{f}/o"], 2,
      "--verify '' names no model"),
-    (["sensitivity", "--vary", "L=0.1:0.3", "--metric", "revolutions", "--engine", "", "--out", "{f}/o"], 2,
+    (["sensitivity", "--vary", "L=0.1:0.3", "--metric", "revolutions", "--variant", "", "--out", "{f}/o"], 2,
      "variant '' is unknown"),
     (["sweep", "--vary", "L=0.1,0.2", "--set", "omega_target=5", "--out", "{f}/s"], 2, "only drive=servo"),
     (["clutch-study", "--points", "startup", "--set", "omega_target=5", "--out", "{f}/c"], 2,
@@ -254,7 +254,7 @@ def test_bad_input_is_one_line_with_the_right_exit_status_and_creates_nothing(ca
 
 
 def test_a_sweep_whose_every_design_fails_exits_1_naming_the_first_failure(capsys, tmp_path):
-    code, _, err, _ = run_cli(capsys, ["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--t-end",
+    code, _, err, _ = run_cli(capsys, ["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--t-end",
                                        "0.5", "--timeout-per-design", "1e-6", "--out", tmp_path / "s"])
     assert code == 1 and err.strip().count("\n") == 0 or err.splitlines()[-1].startswith("ipir-mujoco sweep"), err
     last = err.splitlines()[-1]  # after the progress lines
@@ -270,7 +270,7 @@ def test_a_sweep_on_a_full_disk_exits_1_in_one_line(capsys, tmp_path, monkeypatc
         raise OSError(errno.ENOSPC, "No space left on device", str(path))
 
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", full)
-    code, _, err, _ = run_cli(capsys, ["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx",
+    code, _, err, _ = run_cli(capsys, ["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx",
                                        "--t-end", "0.05", "--out", tmp_path / "s"])
     assert code == 1 and "No space left on device" in err.splitlines()[-1], err
     assert sum("ipir-mujoco sweep:" in line for line in err.splitlines()) == 1

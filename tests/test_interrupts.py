@@ -112,9 +112,9 @@ SWEEP = ["sweep", "--vary", "L=0.1:0.3:10", "--t-end", "0.3"]
 
 @pytest.mark.slow
 @pytest.mark.parametrize("extra,env", [
-    (["--engines", "analytic-unilateral", "--workers", "2"], {}),
-    (["--engines", "mujoco-ratchet", "--no-batch", "--workers", "1"], {}),
-    (["--engines", "mujoco-ratchet", "--no-batch", "--workers", "1"], {"IPIR_MUJOCO_STEPPER": "python"}),
+    (["--variants", "analytic-unilateral", "--workers", "2"], {}),
+    (["--variants", "mujoco-ratchet", "--no-batch", "--workers", "1"], {}),
+    (["--variants", "mujoco-ratchet", "--no-batch", "--workers", "1"], {"IPIR_MUJOCO_STEPPER": "python"}),
 ], ids=["analytic pool", "mujoco compiled loop", "mujoco python loop"])
 def test_sweep_interrupted_then_resumed_gives_the_uninterrupted_rows(tmp_path, extra, env, capsys, monkeypatch):
     out, reference = tmp_path / "sweep", tmp_path / "reference"

@@ -183,7 +183,7 @@ def test_an_objective_that_cannot_tell_designs_apart_is_said(tmp_path, capsys):
     in every design, so the 'best' is arbitrary; the command says so on stderr (and optimize.json lists it),
     and a run long enough to tell the designs apart says nothing."""
     argv = ("optimize", "--vary", "m2=0.5:2", "--objective", "max:mean_speed_m_s", "--budget", "4",
-            "--engine", "analytic-unilateral", "--verify", "none", "--workers", "1")
+            "--variant", "analytic-unilateral", "--verify", "none", "--workers", "1")
     code, _, err = run_cli(capsys, *argv, "--t-end", "0.05", "--out", tmp_path / "short")
     assert code == 0 and "note: mean_speed_m_s is the same in every feasible design" in err
     assert json.loads((tmp_path / "short" / "optimize.json").read_text())["flat_objectives"] == ["mean_speed_m_s"]

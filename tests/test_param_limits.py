@@ -137,7 +137,7 @@ def test_every_limit_gives_a_row_or_a_recorded_failure_in_the_studies(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("argv", [
-    ["sweep", "--vary", "incline=-90,90", "--vary", "F_r1=0,1e6", "--engines", "analytic-unilateral,mujoco-ratchet"],
+    ["sweep", "--vary", "incline=-90,90", "--vary", "F_r1=0,1e6", "--variants", "analytic-unilateral,mujoco-ratchet"],
     ["optimize", "--vary", "g=0:100", "--objective", "max:revolutions", "--budget", "3", "--verify",
      "mujoco-ratchet"],
     ["sensitivity", "--vary", "incline=-90:90", "--vary", "F_r2=0:1e6", "--metric", "revolutions", "--samples", "2"],

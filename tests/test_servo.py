@@ -211,7 +211,7 @@ def test_a_sweep_row_carries_the_runs_crank_speed_figures(tmp_path, capsys):
     mean_omega_rad_s columns are the registry run's summary values (written with 10 significant digits)."""
     import csv
 
-    code, _, err = run_cli(capsys, "sweep", "--vary", "control_rate=500,1000", "--engines", "analytic-unilateral",
+    code, _, err = run_cli(capsys, "sweep", "--vary", "control_rate=500,1000", "--variants", "analytic-unilateral",
                            "--drive", "servo", "--set", "omega_target=10", "--t-end", "0.3", "--workers", "1",
                            "--out", tmp_path / "s")
     assert code == 0, err

@@ -64,3 +64,39 @@ def test_a_bad_declaration_is_refused_where_it_is_made(fields, word):
         Declaration(**fields)
     with pytest.raises(ValueError, match="module's name"):
         Section("k", "title", "../x", 1)
+
+
+# --- one word per meaning: --variant / --variants, the older --engine / --engines for one release ---------------
+
+OLDER_NAMES = [("calibrate", "--variant", "--engine", "analytic-exact", ["--data", "run.csv"]),
+               ("optimize", "--variant", "--engine", "analytic-exact", []),
+               ("sensitivity", "--variant", "--engine", "analytic-exact", []),
+               ("uncertainty", "--variant", "--engine", "analytic-exact", []),
+               ("sweep", "--variants", "--engines", "analytic-approx,analytic-exact", []),
+               ("climb", "--variants", "--engines", "analytic-approx,analytic-exact", [])]
+
+
+@pytest.mark.parametrize("command, newer, older, value, extra", OLDER_NAMES, ids=[o[0] for o in OLDER_NAMES])
+def test_the_older_option_name_sets_the_variant_and_notes_it(command, newer, older, value, extra):
+    parser = build_parser()
+    new = parser.parse_args([command, newer, value, *extra])
+    old = parser.parse_args([command, older, value, *extra])
+    assert getattr(new, newer[2:]) == getattr(old, newer[2:]) == value
+    assert getattr(new, "notes", []) == []
+    assert old.notes == [f"{older} is deprecated and will be removed in the next release; use {newer}"]
+    with pytest.raises(SystemExit) as refused:  # both spellings: argparse's one line, exit 2
+        parser.parse_args([command, newer, value, older, value, *extra])
+    assert refused.value.code == 2
+
+
+def test_a_sweep_under_the_older_name_runs_the_same_and_says_so_in_one_line(capsys, tmp_path):
+    from ipir_mujoco.cli import main
+
+    common = ["sweep", "--vary", "L=0.1,0.2", "--t-end", "0.05", "--workers", "1"]
+    assert main([*common, "--variants", "analytic-approx", "--out", str(tmp_path / "new")]) == 0
+    assert "note" not in capsys.readouterr().err
+    assert main([*common, "--engines", "analytic-approx", "--out", str(tmp_path / "old")]) == 0
+    notes = [line for line in capsys.readouterr().err.splitlines() if "note" in line]
+    assert notes == ["ipir-mujoco sweep: note: --engines is deprecated and will be removed in the next release; "
+                     "use --variants"]
+    assert (tmp_path / "new" / "results.csv").read_bytes() == (tmp_path / "old" / "results.csv").read_bytes()

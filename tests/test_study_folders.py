@@ -17,10 +17,10 @@ from cli_run import run_cli
 from ipir_mujoco.output import FolderLock
 
 OPTIMIZE = ["optimize", "--vary", "L=0.1:0.3", "--objective", "max:mean_speed_m_s", "--budget", "6",
-            "--engine", "analytic-approx", "--verify", "none", "--t-end", "0.2", "--workers", "1"]
-SWEEP = ["sweep", "--vary", "L=0.1:0.3:4", "--engines", "analytic-approx", "--t-end", "0.2", "--workers", "1"]
+            "--variant", "analytic-approx", "--verify", "none", "--t-end", "0.2", "--workers", "1"]
+SWEEP = ["sweep", "--vary", "L=0.1:0.3:4", "--variants", "analytic-approx", "--t-end", "0.2", "--workers", "1"]
 SENSITIVITY = ["sensitivity", "--vary", "L=0.1:0.3", "--metric", "mean_speed_m_s", "--samples", "2",
-               "--engine", "analytic-approx", "--t-end", "0.2", "--workers", "1"]
+               "--variant", "analytic-approx", "--t-end", "0.2", "--workers", "1"]
 
 
 @pytest.fixture(scope="module")

@@ -154,7 +154,7 @@ def held_sweep(hold_from: float, argv: list[str], **popen):
 def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
     out = tmp_path / "s"
     # L = 0.07 + k 0.33/23: designs 0-5 run, 6-23 wait (L >= 0.15) until the Ctrl-C
-    with held_sweep(0.15, ["--vary", "L=0.07:0.4:24", "--engines", "analytic-unilateral", "--t-end", "1",
+    with held_sweep(0.15, ["--vary", "L=0.07:0.4:24", "--variants", "analytic-unilateral", "--t-end", "1",
                            "--out", str(out), "--workers", "2"],
                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
         results = out / "results.csv"
@@ -168,7 +168,7 @@ def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
     assert process.returncode == 130 and "--resume" in err
     partial = rows_of(results)  # readable after the interrupt
     assert 3 <= len(partial) < 24
-    assert main(["sweep", "--vary", "L=0.07:0.4:24", "--engines", "analytic-unilateral", "--t-end", "1",
+    assert main(["sweep", "--vary", "L=0.07:0.4:24", "--variants", "analytic-unilateral", "--t-end", "1",
                  "--out", str(out), "--resume", "--workers", "2"]) == 0
     ids = [int(r["design_id"]) for r in rows_of(results)]
     assert ids == list(range(24))  # every design exactly once, in design order once complete
@@ -179,7 +179,7 @@ def test_sigint_mid_sweep_then_resume_completes_every_design_once(tmp_path):
 @pytest.mark.slow
 def test_resume_refuses_another_study_and_a_rerun_without_resume(tmp_path, capsys):
     out = tmp_path / "s"
-    base = ["sweep", "--engines", "analytic-approx", "--t-end", "0.2", "--out", str(out)]
+    base = ["sweep", "--variants", "analytic-approx", "--t-end", "0.2", "--out", str(out)]
     assert main([*base, "--vary", "L=0.1,0.2"]) == 0
     assert main([*base, "--vary", "L=0.1,0.2"]) == 2 and "--resume" in capsys.readouterr().err
     assert main([*base, "--vary", "L=0.1,0.3", "--resume"]) == 2 and "another study" in capsys.readouterr().err
@@ -197,7 +197,7 @@ def test_dask_gives_the_same_results_as_the_local_pool(tmp_path):
         with distributed.Client(cluster) as client:
             remote = rows_of(run_sweep(study, tmp_path / "dask", executor=client.get_executor(), progress=False))
         # and the command line's --scheduler against the same cluster
-        assert main(["sweep", "--vary", "L=0.08,0.2", "--vary", "m2=0.5,1.5", "--engines",
+        assert main(["sweep", "--vary", "L=0.08,0.2", "--vary", "m2=0.5,1.5", "--variants",
                      "analytic-approx,mujoco-ratchet", "--t-end", "0.3", "--out", str(tmp_path / "cli"),
                      "--scheduler", cluster.scheduler_address]) == 0
     by_id = lambda rows: sorted(rows, key=lambda r: int(r["design_id"]))  # noqa: E731
@@ -207,7 +207,7 @@ def test_dask_gives_the_same_results_as_the_local_pool(tmp_path):
 @pytest.mark.slow
 def test_sweep_command_writes_results_heatmap_and_best_designs(tmp_path, capsys):
     out = tmp_path / "s"
-    assert main(["sweep", "--vary", "L=0.08:0.3:3", "--vary", "m2=0.5,1.5", "--engines",
+    assert main(["sweep", "--vary", "L=0.08:0.3:3", "--vary", "m2=0.5,1.5", "--variants",
                  "analytic-unilateral,analytic-approx", "--t-end", "0.5", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert re.search(r"^  best mean_speed_m_s +\(highest\) ", printed, flags=re.M), printed
@@ -223,11 +223,11 @@ def test_sweep_command_writes_results_heatmap_and_best_designs(tmp_path, capsys)
     assert speed["value"] == np.nanmax(columns["analytic-unilateral:mean_speed_m_s"])
     # the first spelling stays in every row, with the same values, for scripts written against it
     assert np.array_equal(columns["analytic-unilateral:mean_speed_mps"], columns["analytic-unilateral:mean_speed_m_s"])
-    assert main(["sweep", "--vary", "L=0.1:0.3:3", "--engines", "analytic-approx", "--t-end", "0.3",
+    assert main(["sweep", "--vary", "L=0.1:0.3:3", "--variants", "analytic-approx", "--t-end", "0.3",
                  "--out", str(tmp_path / "line")]) == 0
     assert (tmp_path / "line" / "sweep_lines.png").is_file()
     for argv, fragment in ((["--vary", "foo=1,2"], "foo"), ([], "at least one --vary"),
-                           (["--vary", "L=0.1,0.2", "--engines", "nope"], "nope")):
+                           (["--vary", "L=0.1,0.2", "--variants", "nope"], "nope")):
         assert main(["sweep", *argv, "--out", str(tmp_path / "bad")]) == 2
         assert fragment in capsys.readouterr().err
 
@@ -277,7 +277,7 @@ def _alive(pid: int) -> bool:
 def test_sigkill_of_the_main_process_leaves_no_worker_alive(tmp_path):
     out = tmp_path / "s"
     # from design 4 on (L >= 0.1) the workers wait: they are alive when the main process is killed
-    with held_sweep(0.1, ["--vary", "L=0.07:0.4:40", "--engines", "analytic-unilateral", "--t-end", "1",
+    with held_sweep(0.1, ["--vary", "L=0.07:0.4:40", "--variants", "analytic-unilateral", "--t-end", "1",
                           "--out", str(out), "--workers", "2"],
                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) as process:
         _wait_for_rows(out / "results.csv", 1, process)
@@ -322,7 +322,7 @@ def test_resume_needs_a_sweep_folder_and_bad_options_create_nothing(tmp_path, ca
     run_folder = tmp_path / "run"
     assert main(["simulate", "--t-end", "0.1", "--out", str(run_folder)]) == 0
     before = sorted(p.name for p in run_folder.iterdir())
-    assert main(["sweep", "--vary", "L=0.1,0.2", "--engines", "analytic-approx", "--resume", "--out",
+    assert main(["sweep", "--vary", "L=0.1,0.2", "--variants", "analytic-approx", "--resume", "--out",
                  str(run_folder)]) == 2
     assert "holds no sweep" in capsys.readouterr().err and sorted(p.name for p in run_folder.iterdir()) == before
     assert main(["sweep", "--vary", "L=0.1:0.2", "--sample", "2", "--seed", "-1", "--out", str(tmp_path / "x")]) == 2

@@ -128,6 +128,8 @@ def _command(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
         prefix = f"ipir-mujoco {args.command}"
+        for note in getattr(args, "notes", ()):  # an option's older name used (studies.command.add_variant_option)
+            print(f"{prefix}: note: {note}", file=sys.stderr)
         notes = _show_notes(prefix)
         try:
             with terminal.command():

@@ -15,8 +15,8 @@ from ipir_mujoco.core.params import DRIVES, FEEDFORWARDS, RobotParams, load_para
 
 from .. import terminal
 
-__all__ = ["add_model_options", "add_study_options", "check_input_file", "compile_first", "files_line",
-           "model_params", "study_progress", "write_study_files"]
+__all__ = ["add_model_options", "add_study_options", "add_variant_option", "check_input_file", "compile_first",
+           "files_line", "model_params", "study_progress", "write_study_files"]
 
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
@@ -46,6 +46,35 @@ def add_study_options(parser: argparse.ArgumentParser, command: str, set_help: s
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
                         help=f"a robot parameter (SI units), {set_help}")
     parser.add_argument("--config", metavar="FILE.toml", help="TOML file of robot parameters; --set wins over it")
+
+
+def add_variant_option(parser: argparse.ArgumentParser, *, many: bool, default: str | None, help: str) -> None:
+    """``--variant NAME`` (``many`` False) or ``--variants A,B`` (``many`` True): the variant(s) a study runs (a
+    model in an engine, ``ENGINE-MODEL[-RULE]``; ``ipir_mujoco.registry``), read as ``args.variant`` or
+    ``args.variants``. The older spelling, ``--engine`` or ``--engines``, stays accepted for one release: it
+    sets the same value and says so (:class:`_OlderName`: a line the command line prints on stderr once the
+    options parsed, ``args.notes``); giving both is refused by argparse (exit 2, one line)."""
+    newer, older, metavar = ("--variants", "--engines", "LIST") if many else ("--variant", "--engine", "NAME")
+    dest = newer[2:]
+    both = parser.add_mutually_exclusive_group()
+    both.add_argument(newer, dest=dest, default=default, metavar=metavar, help=help)
+    both.add_argument(older, dest=dest, default=argparse.SUPPRESS, metavar=metavar, action=_OlderName,
+                      newer=newer, help=f"the older name of {newer}, accepted for one release (with a note on stderr)")
+
+
+class _OlderName(argparse.Action):
+    """An option's older name: stores its value under the newer option's name, and in ``notes`` (a list of the
+    namespace, which the command line prints on stderr, one line each, after parsing) that the name is deprecated
+    and which to use."""
+
+    def __init__(self, option_strings, dest, newer: str, **kwargs):
+        super().__init__(option_strings, dest, **kwargs)
+        self.newer = newer
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        note = f"{option_string} is deprecated and will be removed in the next release; use {self.newer}"
+        namespace.notes = [*getattr(namespace, "notes", ()), note]
+        setattr(namespace, self.dest, values)
 
 
 def model_params(args: argparse.Namespace) -> RobotParams:

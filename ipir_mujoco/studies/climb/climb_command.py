@@ -16,7 +16,8 @@ from ipir_mujoco.core.params import check_real
 
 from ...labels import significant
 from ...output import check_output_dir
-from ..command import add_model_options, compile_first, model_params, study_progress, write_study_files
+from ..command import (add_model_options, add_variant_option, compile_first, model_params, study_progress,
+                       write_study_files)
 from ..contract import Declaration, Section
 
 FILES = ("climb.csv", "climb.json", "climb.png")
@@ -29,9 +30,9 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--inclines", metavar="LIST|START:STOP:N", default="0:90:10",
                      help="pipe inclines above the horizontal [deg], -90..90: a comma-separated list or N evenly "
                           "spaced values from START to STOP (default 0:90:10)")
-    cmd.add_argument("--engines", metavar="LIST", default=None,
-                     help=f"comma-separated, from: {', '.join(registry.NAMES)} (default: "
-                          "analytic-unilateral,mujoco-ratchet)")
+    add_variant_option(cmd, many=True, default=None,
+                       help=f"comma-separated, from: {', '.join(registry.NAMES)} (default: "
+                            "analytic-unilateral,mujoco-ratchet)")
     cmd.add_argument("--tolerance", type=float, default=None, metavar="DEG",
                      help="width of the bracket at which the bisection for the motor's steady-climb limit stops "
                           "(default 0.1 deg)")
@@ -55,7 +56,7 @@ def parse_inclines(text: str) -> tuple[float, ...]:
 
 
 def parse_engines(text: str | None) -> tuple[str, ...]:
-    """The engines (variant names of :mod:`ipir_mujoco.registry`) of ``--engines``, or the study's default."""
+    """The variants (names of :mod:`ipir_mujoco.registry`) of ``--variants``, or the study's default."""
     from .climbing import CLIMB_VARIANTS
 
     if text is None:
@@ -63,7 +64,7 @@ def parse_engines(text: str | None) -> tuple[str, ...]:
     names = tuple(dict.fromkeys(e.strip() for e in text.split(",") if e.strip()))
     unknown = [e for e in names if e not in registry.VARIANTS and e not in registry.ALIASES]
     if not names or unknown:
-        raise ParameterError(f"--engines {text!r}: " + (f"unknown {', '.join(unknown)}" if unknown else "no engine")
+        raise ParameterError(f"--variants {text!r}: " + (f"unknown {', '.join(unknown)}" if unknown else "no variant")
                              + f"; allowed: a comma-separated list from: {', '.join(registry.NAMES)}")
     return names
 
@@ -75,7 +76,7 @@ def run(args: argparse.Namespace, figures) -> None:
     if params.incline != 0.0:
         raise ParameterError(f"incline={params.incline!r} in --set or --config: the study sets it; allowed: --inclines")
     inclines = parse_inclines(args.inclines)
-    engines = parse_engines(args.engines)
+    engines = parse_engines(args.variants)
     tolerance = climbing.TOLERANCE_DEG if args.tolerance is None else check_real(
         "--tolerance", args.tolerance, high=90.0, unit="deg")
     t_end = climbing.default_t_end(params) if args.t_end is None else args.t_end

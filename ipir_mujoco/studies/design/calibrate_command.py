@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..command import add_model_options, check_input_file, compile_first, files_line, model_params, study_progress
+from ..command import (add_model_options, add_variant_option, check_input_file, compile_first, files_line,
+                       model_params, study_progress)
 from ..contract import Declaration
 
 
@@ -16,8 +17,8 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
                           "v1 v2 [m/s]; irregular times and noise are fine")
     cmd.add_argument("--fit", action="append", default=[], metavar="NAME=LO:HI",
                      help="a parameter to fit and its range (inside its allowed range; several allowed)")
-    cmd.add_argument("--engine", default="analytic-unilateral",
-                     help="the model fitted (default analytic-unilateral; a MuJoCo variant works, slowly)")
+    add_variant_option(cmd, many=False, default="analytic-unilateral",
+                       help="the variant fitted (default analytic-unilateral; a MuJoCo variant works, slowly)")
     add_model_options(cmd)
     cmd.add_argument("--out", metavar="DIR", default="calibration", help="results folder (default ./calibration)")
 
@@ -32,8 +33,8 @@ def run(args: argparse.Namespace, figures) -> None:
     fits = [parse_fit(f) for f in args.fit]
     base = model_params(args)
     measured = read_measured(args.data)
-    compile_first((args.engine,))
-    result = calibrate(measured, fits, base=base, engine=args.engine, progress=study_progress("calibrate"))
+    compile_first((args.variant,))
+    result = calibrate(measured, fits, base=base, engine=args.variant, progress=study_progress("calibrate"))
     figure = write_files(args.out, result, measured, figure=figures.plot_calibration)
     print(format_result(result))
     print(f"  files: {files_line(args.out, 'calibration.json', 'posterior.toml', figure)}")

@@ -8,7 +8,7 @@ import sys
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ..command import add_model_options, compile_first, files_line, model_params
+from ..command import add_model_options, add_variant_option, compile_first, files_line, model_params
 from ..contract import Declaration
 from ..design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
@@ -21,9 +21,9 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--constraint", action="append", default=[], metavar="KEY<=V|KEY>=V",
                      help="a constraint on a metric or parameter; a stalled or failed design is infeasible")
     cmd.add_argument("--budget", type=int, default=None, help="designs to evaluate, >= 1 (default 100)")
-    cmd.add_argument("--engine", default=None, help="engine of the search (default analytic-unilateral)")
-    cmd.add_argument("--verify", default=None, metavar="ENGINE|none",
-                     help="engine re-running the optimum / front (default mujoco-ratchet; none: skip)")
+    add_variant_option(cmd, many=False, default=None, help="variant of the search (default analytic-unilateral)")
+    cmd.add_argument("--verify", default=None, metavar="VARIANT|none",
+                     help="variant re-running the optimum / front (default mujoco-ratchet; none: skip)")
     add_design_run_options(cmd)
     add_model_options(cmd)
     add_output_options(cmd, "optimize", "optimization")
@@ -42,7 +42,7 @@ def problem_from_args(args: argparse.Namespace):
         raise ParameterError(f"--verify {args.verify!r} names no model; allowed: a model variant (default "
                              f"{DEFAULT_VERIFY}), or none to skip the verification")
     verify = DEFAULT_VERIFY if args.verify is None else (None if args.verify.strip() == "none" else args.verify)
-    engine = DEFAULT_ENGINE if args.engine is None else args.engine  # '' is refused by name, not read as the default
+    engine = DEFAULT_ENGINE if args.variant is None else args.variant  # '' is refused by name, not read as the default
     return Problem(axes, objectives, constraints, model_params(args), engine, verify,
                    design_t_end(args), bool(args.until_steady), DEFAULT_BUDGET if args.budget is None else args.budget,
                    0 if args.seed is None else args.seed)

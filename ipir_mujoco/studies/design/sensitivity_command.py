@@ -7,7 +7,7 @@ import argparse
 
 from ipir_mujoco.core.errors import ParameterError
 
-from ..command import add_model_options, compile_first, files_line, model_params
+from ..command import add_model_options, add_variant_option, compile_first, files_line, model_params
 from ..contract import Declaration
 from ..design_runs import add_design_run_options, add_output_options, design_t_end, scheduler_executor
 
@@ -17,7 +17,7 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--metric", action="append", default=[], metavar="KEY", help="a sweep metric (several allowed)")
     cmd.add_argument("--samples", type=int, default=None, metavar="N",
                      help="Saltelli base samples (designs: N x (parameters + 2); a power of 2; default 64)")
-    cmd.add_argument("--engine", default=None, help="engine (default analytic-unilateral)")
+    add_variant_option(cmd, many=False, default=None, help="the variant run (default analytic-unilateral)")
     add_design_run_options(cmd)
     add_model_options(cmd)
     add_output_options(cmd, "sensitivity", "study")
@@ -32,17 +32,18 @@ def run(args: argparse.Namespace, figures) -> None:
         raise ParameterError("sensitivity needs at least one --vary NAME=LO:HI")
     axes = tuple(parse_vary(v) for v in args.vary)
     metrics = tuple(check_key(m, f"--metric {m!r}") for m in args.metric)
-    compile_first((args.engine or "analytic-unilateral",))  # before the pool: compiled once, said at once
+    compile_first((args.variant or "analytic-unilateral",))  # before the pool: compiled once, said at once
     drawn = []
     with scheduler_executor(args.scheduler) as executor:
         indices = run_sensitivity(axes, metrics, args.out, base=model_params(args),
-                                  engine="analytic-unilateral" if args.engine is None else args.engine,
+                                  engine="analytic-unilateral" if args.variant is None else args.variant,
                                   t_end=design_t_end(args),
                                   until_steady=bool(args.until_steady),
                                   samples=64 if args.samples is None else args.samples,
                                   seed=0 if args.seed is None else args.seed, resume=args.resume,
                                   workers=args.workers, executor=executor,
-                                  figure=lambda out, found: drawn.append(figures.plot_indices(out, found, list(metrics))))
+                                  figure=lambda out, found: drawn.append(
+                                      figures.plot_indices(out, found, list(metrics))))
     figure = drawn[0]
     for i in indices:
         print(f"  {i['metric']:22s} {i['parameter']:12s} S1 {i['S1']:+.3f} +- {i['S1_conf']:.3f}   "

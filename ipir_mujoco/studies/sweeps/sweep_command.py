@@ -12,7 +12,7 @@ from ... import registry
 from ...labels import significant
 from .sweep_metrics import METRICS, UNITS
 from .sweep_space import DEFAULT_VARIANTS, T_END_STEADY
-from ..command import add_model_options, check_input_file, compile_first, model_params
+from ..command import add_model_options, add_variant_option, check_input_file, compile_first, model_params
 from ..contract import Declaration
 from ..design_runs import add_scheduler_option, scheduler_executor
 
@@ -22,9 +22,9 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
                      help="NAME=START:STOP:N[:log] (grid), NAME=A,B,C (list) or NAME=LO:HI[:log] (with --sample)")
     cmd.add_argument("--sample", type=int, default=None, metavar="N", help="N space-filling (Sobol) designs")
     cmd.add_argument("--seed", type=int, default=None, help="seed of the Sobol sample, >= 0 (default 0)")
-    cmd.add_argument("--engines", default=None, metavar="LIST",
-                     help=f"comma-separated, first one is the reference for divergence; from: {', '.join(registry.NAMES)} "
-                          f"(default: {','.join(DEFAULT_VARIANTS)})")
+    add_variant_option(cmd, many=True, default=None,
+                       help=f"comma-separated, first one is the reference for divergence; from: "
+                            f"{', '.join(registry.NAMES)} (default: {','.join(DEFAULT_VARIANTS)})")
     cmd.add_argument("--t-end", type=float, default=None, metavar="SECONDS",
                      help="simulated time per design (default 1 s); with --until-steady, the cap (default 10 s)")
     cmd.add_argument("--until-steady", action="store_true", default=None,
@@ -58,10 +58,10 @@ def study_from_args(args: argparse.Namespace):
     options = read_study(args.study, base) if args.study else {"base": base}
     if args.vary:
         options["axes"] = tuple(parse_vary(v) for v in args.vary)
-    if args.engines is not None:
-        names = tuple(e.strip() for e in args.engines.split(",") if e.strip())
+    if args.variants is not None:
+        names = tuple(e.strip() for e in args.variants.split(",") if e.strip())
         if not names:
-            raise ParameterError(f"--engines {args.engines!r} names no engine; allowed: a comma-separated list "
+            raise ParameterError(f"--variants {args.variants!r} names no variant; allowed: a comma-separated list "
                                  f"from: {', '.join(registry.NAMES)}")
         options["engines"] = names
     for key in ("sample", "seed", "t_end", "until_steady"):  # options given on the command line win over the file

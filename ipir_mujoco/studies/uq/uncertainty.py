@@ -145,7 +145,7 @@ def parse_event(text: str) -> Event:
 
 
 def engine_pair(engine: str | None) -> tuple[str, str]:
-    """(the equations' variant, MuJoCo's variant) for ``--engine``: either side names the other by its clutch
+    """(the equations' variant, MuJoCo's variant) for ``--variant``: either side names the other by its clutch
     rule (one-way clutches: analytic-unilateral and mujoco-ratchet, the default; the paper's rule:
     analytic-exact and mujoco-lock)."""
     if engine is None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..command import add_model_options, compile_first, files_line, model_params
+from ..command import add_model_options, add_variant_option, compile_first, files_line, model_params
 from ..contract import Declaration
 from ..design_runs import add_design_run_options, design_t_end
 
@@ -27,9 +27,9 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
     cmd.add_argument("--mujoco-samples", type=int, default=0, metavar="M",
                      help="of them, how many also run in MuJoCo (default 0; 3 or more for the multi-fidelity "
                           "estimate, e.g. 20)")
-    cmd.add_argument("--engine", default=None,
-                     help="either engine of the pair (the other matches its clutch rule): analytic-unilateral with "
-                          "mujoco-ratchet (default), or analytic-exact with mujoco-lock")
+    add_variant_option(cmd, many=False, default=None,
+                       help="either variant of the pair (the other matches its clutch rule): analytic-unilateral "
+                            "with mujoco-ratchet (default), or analytic-exact with mujoco-lock")
     add_design_run_options(cmd)
     add_model_options(cmd)
     cmd.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
@@ -48,7 +48,7 @@ def run(args: argparse.Namespace, figures) -> None:
     metrics = tuple(dict.fromkeys(check_metric(m) for m in args.metric))
     events = tuple(parse_event(e) for e in args.event)
     compile_first()  # before the pool: compiled once, said at once (the equations run every sample)
-    result = run_uncertainty(dists, metrics, events, base=base, engine=args.engine, samples=args.samples,
+    result = run_uncertainty(dists, metrics, events, base=base, engine=args.variant, samples=args.samples,
                              mujoco_samples=args.mujoco_samples, t_end=design_t_end(args),
                              until_steady=bool(args.until_steady), seed=0 if args.seed is None else args.seed,
                              correlation=correlation, workers=args.workers)
