@@ -105,8 +105,9 @@ accel.compilation_pending = lambda: True  # a cold cache, as on a machine's firs
 
 
 def compile_kernels():  # what the command has loaded, and run, when it compiles
-    heavy = sorted(m for m in ("matplotlib", "ipir_mujoco.report.validation", "ipir_mujoco.studies.atlas",
-                               "ipir_mujoco.studies.sweep") if m in sys.modules)
+    heavy = sorted(m for m in ("matplotlib", "ipir_mujoco.report.validation",
+                               "ipir_mujoco.studies.idealizations.atlas", "ipir_mujoco.studies.sweeps.sweep")
+                   if m in sys.modules)
     print("COMPILE", heavy, flush=True)
     raise SystemExit(0)
 
@@ -129,6 +130,7 @@ def test_a_long_command_compiles_the_kernels_first_on_a_cold_cache(tmp_path, arg
                           capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert done.returncode == 0 and done.stdout.startswith("COMPILE"), (done.stdout, done.stderr)
     loaded = done.stdout.split(" ", 1)[1].strip()
-    heavy = {"validate": "[]", "atlas": "['ipir_mujoco.studies.atlas', 'ipir_mujoco.studies.sweep']",  # checks
-             "sweep": "['ipir_mujoco.studies.sweep', 'matplotlib']"}
+    heavy = {"validate": "[]",  # atlas's checks: its study and the sweep's
+             "atlas": "['ipir_mujoco.studies.idealizations.atlas', 'ipir_mujoco.studies.sweeps.sweep']",
+             "sweep": "['ipir_mujoco.studies.sweeps.sweep', 'matplotlib']"}
     assert loaded == heavy[argv[0]] and done.stderr == "" and not (tmp_path / "o").exists()
