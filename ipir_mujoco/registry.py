@@ -24,110 +24,39 @@ through :func:`from_flags`.
 What the parameter set decides stays in it: a finite ``clutch_stiffness`` makes a one-way variant's clutches
 compliant (both engines), ``drive`` chooses the constant torque or the motor, ``incline`` the slope.
 
-The MuJoCo engine is imported only when a MuJoCo variant runs (its import is slow beside the rest).
+The MuJoCo engine is imported only when a MuJoCo variant runs (its import is slow beside the rest). The
+variants' table and the flags that name one live in :mod:`ipir_mujoco.variants`, the speed controller's
+feedforward table in :mod:`ipir_mujoco.feedforward`; each name is the registry's too.
 """
 
 from __future__ import annotations
 
 import functools
-import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+import inspect
+from typing import TYPE_CHECKING, Any, Callable, ParamSpec, Sequence, TypeVar
 
 from . import interrupts
 from .core.errors import ParameterError, ParameterTypeError
-from .core.limits import CLUTCH_RULES as RULES  # the clutch rules (--clutch)
-from .core.limits import MAX_T_END, check_run_options
+from .core.limits import CLUTCH_RULES as RULES  # noqa: F401 (the clutch rules, --clutch: the command line's)
+from .core.limits import check_run_options
 from .core.params import RobotParams, check_real, check_whole, require_params
-from .engine.kinds import KINDS  # the model kinds' declarations (no MuJoCo: engine/kinds/__init__.py)
-from .engine.kinds.base import MUJOCO_CLUTCHES  # the MuJoCo clutches a variant names (--mujoco-clutch)
+from .engine.kinds.base import MUJOCO_CLUTCHES  # noqa: F401 (the MuJoCo clutches a variant names, --mujoco-clutch)
+from .feedforward import feedforward_table  # the speed controller's table, computed above the engines
+# the variants' names and flags (ipir_mujoco/variants.py), the registry's by their first place
+from .variants import (ALIASES, ANALYTIC_ROUTES, ENGINES, MUJOCO_MODELS, NAMES, ROUTE_MODELS,  # noqa: F401
+                       ROUTE_VARIANTS, VARIANTS, Variant, check_route_flag, from_flags, variant)
 
 if TYPE_CHECKING:  # annotations only: the names, flags and checks above load without numpy (``--help``)
+    import os
+
     from .core.control import FeedforwardTable
     from .core.results import RunResult
+    from .core.route import Route
+    from .engine import CrankServo, SolverSettings
 
 __all__ = ["NAMES", "VARIANTS", "Variant", "feedforward_table", "run", "timestep", "variant"]
 # beside these, from_flags, check_options and prepare_for_many serve the command line and the studies (not part of
 # the public surface: they may change with them)
-
-ENGINES = ("analytic", "mujoco")  # the two engines; a variant (VARIANTS) is one model in one of them
-
-
-@dataclass(frozen=True)
-class Variant:
-    """One model of the robot in one engine (see the module docstring for the names)."""
-
-    name: str  # canonical
-    engine: str  # 'analytic' | 'mujoco'
-    rule: str  # the clutch rule: 'kinematic' (the paper's) | 'unilateral' (one-way clutches)
-    geometry: str  # 'approx' | 'exact' (MuJoCo always models the exact linkage)
-    clutch: str | None  # MuJoCo's clutch: 'ratchet' | 'lock'; None for the equations
-    label: str  # in words, for figures and reports
-    model: str = "slides"  # MuJoCo's model of the robot: 'slides' | 'wheels' (the equations: 'slides')
-    clutches: str = ""  # its clutches in words, where its model has only those (for a refused flag's message)
-    mechanism: str = ""  # its clutches' mechanism for a figure's title, where MuJoCo's clutch alone does not say it
-    routes: bool = False  # whether it runs along a route of straights and bends (``route=``, ``--route``)
-
-    @property
-    def mechanism_words(self) -> str:
-        """The clutches' mechanism in a title's words: MuJoCo's clutch ('ratchet' | 'lock'), or the model's own
-        (``mechanism``: the wheels' hub ratchets)."""
-        return self.mechanism or self.clutch or ""
-
-    @property
-    def is_mujoco(self) -> bool:
-        return self.engine == "mujoco"
-
-    def describe(self) -> dict[str, Any]:
-        """The variant as a run's JSON records it: name, engine, geometry, clutch rule and MuJoCo's clutch."""
-        described = {"variant": self.name, "engine": self.engine, "geometry": self.geometry, "clutch": self.rule,
-                     "mujoco_clutch": self.clutch}
-        if self.model != "slides":
-            described["mujoco_model"] = self.model
-        return described
-
-
-# every variant by its canonical name: {name: Variant}; ``run(name, ...)`` runs one
-VARIANTS: dict[str, Variant] = {v.name: v for v in (
-    Variant("analytic-approx", "analytic", "kinematic", "approx", None, "paper's model"),
-    Variant("analytic-exact", "analytic", "kinematic", "exact", None, "analytic, paper's rule", routes=True),
-    Variant("analytic-approx-unilateral", "analytic", "unilateral", "approx", None,
-            "analytic first order, one-way clutches"),
-    Variant("analytic-unilateral", "analytic", "unilateral", "exact", None, "analytic one-way clutches",
-            routes=True),
-    # MuJoCo's: each model kind declares its own (engine/kinds/<kind>/__init__.py), in the kinds' order
-    *(Variant(engine="mujoco", geometry="exact", model=kind.model, **row) for kind in KINDS.values()
-      for row in kind.variants),
-)}
-ALIASES = {
-    "analytic-approx-kinematic": "analytic-approx", "analytic-exact-kinematic": "analytic-exact",
-    "analytic-exact-unilateral": "analytic-unilateral", "mujoco-ratchet-unilateral": "mujoco-ratchet",
-    "mujoco-lock-kinematic": "mujoco-lock",
-}
-NAMES = tuple(VARIANTS)
-# MuJoCo's models of the robot (``--mujoco-model``): the modules on slides, or on wheels on the pipe walls, ...
-MUJOCO_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.engine == "mujoco"))
-# MuJoCo's models that take ``--route``, and every variant that does (the exact equations, MuJoCo's wheels)
-ROUTE_MODELS = tuple(dict.fromkeys(v.model for v in VARIANTS.values() if v.routes and v.is_mujoco))
-ROUTE_VARIANTS = tuple(v.name for v in VARIANTS.values() if v.routes)
-ANALYTIC_ROUTES = tuple(name for name in ROUTE_VARIANTS if not VARIANTS[name].is_mujoco)
-
-
-def check_route_flag(route: str | None, model: "str | Variant") -> None:
-    """ParameterError (one line) for ``--route`` with a variant, or MuJoCo's ``--mujoco-model``, that runs along no
-    route: the command line's check before any work (:func:`run` refuses a Python caller's route)."""
-    if route is None or isinstance(model, Variant) and model.routes:
-        return
-    wheels = " or ".join(f"--mujoco-model {m}" for m in ROUTE_MODELS)
-    if isinstance(model, Variant) and not model.is_mujoco:
-        raise ParameterError(f"--route {route} with {model.name}: the paper's first-order geometry has no linkage to "
-                             f"span a bend's chord; allowed: --geometry exact ({', '.join(ANALYTIC_ROUTES)}), or "
-                             f"--engine mujoco {wheels}")
-    if (model.model if isinstance(model, Variant) else model) not in ROUTE_MODELS:
-        raise ParameterError(f"--route {route}: of MuJoCo's models only the {' or '.join(ROUTE_MODELS)} model runs "
-                             f"along a route; allowed: --engine mujoco {wheels}, or the equations: --engine analytic "
-                             "--geometry exact")
-
 
 # the keywords each engine's run takes beside the common ones of core.options.RunOptions (dt_out,
 # until_steady, steady_tol, steady_cycles, progress, wall_budget_s)
@@ -137,81 +66,10 @@ MUJOCO_OPTIONS = ("settings", "timestep", "mjcf", "accuracy", "servo", "every_st
 # (the variants whose ``routes`` says so: :data:`ROUTE_VARIANTS`)
 COMMON_OPTIONS = ("dt_out", "until_steady", "steady_tol", "steady_cycles", "progress", "wall_budget_s", "feedforward",
                   "route")
+OPTIONS = (*COMMON_OPTIONS, *ANALYTIC_OPTIONS, *MUJOCO_OPTIONS)  # run()'s keyword-only options, every one
 _WHY_NOT = {"analytic": "the analytic engines hold their solver tolerance and have no timestep, clutch "
                         "implementation or MJCF",
             "mujoco": "MuJoCo's cost is its step count, t_end / timestep, and its accuracy its own monitor's"}
-
-
-def variant(name: str | Variant) -> Variant:
-    """The variant named ``name`` (canonical or an alias); ParameterError listing the names otherwise."""
-    if isinstance(name, Variant):
-        return name
-    if not isinstance(name, str):
-        raise ParameterTypeError(f"variant {name!r} ({type(name).__name__}) is not a variant's name; allowed: "
-                                 f"{', '.join(NAMES)}")
-    key = ALIASES.get(name, name)
-    if key in VARIANTS:
-        return VARIANTS[key]
-    raise ParameterError(f"variant {name!r} is unknown (a model in an engine, ENGINE-MODEL[-RULE]); allowed: "
-                         f"{', '.join(NAMES)}")
-
-
-def from_flags(engine: str = "analytic", geometry: str | None = None, rule: str | None = "kinematic",
-               clutch: str | None = None, model: str = "slides") -> Variant:
-    """The variant the command line's ``--engine``, ``--geometry``, ``--clutch``, ``--mujoco-clutch`` and
-    ``--mujoco-model`` name (each refused in one line where it does not apply): the analytic geometry defaults
-    to the paper's first order, MuJoCo's clutch to the lock for the paper's rule and to the ratchet for one-way
-    clutches; ``rule`` None is the paper's rule, or one-way clutches on the wheeled model (its only ones)."""
-    if model not in MUJOCO_MODELS:
-        raise ParameterError(f"--mujoco-model {model!r} is unknown; allowed: {', '.join(MUJOCO_MODELS)}")
-    if model != "slides":
-        return _model_from_flags(engine, geometry, rule, clutch, model)
-    rule = "kinematic" if rule is None else rule
-    if engine not in ENGINES:
-        raise ParameterError(f"--engine {engine!r} is unknown; allowed: {', '.join(ENGINES)}")
-    if rule not in RULES:
-        raise ParameterError(f"--clutch {rule!r} is unknown; allowed: {', '.join(RULES)}")
-    if engine == "analytic":
-        if clutch is not None:
-            raise ParameterError(f"--mujoco-clutch {clutch} applies only to --engine mujoco")
-        geometry = geometry or "approx"
-        if geometry not in ("approx", "exact"):
-            raise ParameterError(f"--geometry {geometry!r} is unknown; allowed: approx, exact")
-        return _find(engine, rule, geometry, None)
-    if geometry == "approx":
-        raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real linkage; "
-                             "allowed: --geometry exact (or leave it out)")
-    clutch = clutch or ("lock" if rule == "kinematic" else "ratchet")
-    if clutch == "ratchet" and rule == "kinematic":
-        raise ParameterError("--clutch kinematic with the ratchet: a ratchet is a one-way clutch; use "
-                             "--mujoco-clutch lock for the paper's rule, or --clutch unilateral")
-    if clutch not in MUJOCO_CLUTCHES:
-        raise ParameterError(f"--mujoco-clutch {clutch!r} is unknown; allowed: {', '.join(MUJOCO_CLUTCHES)}")
-    return _find(engine, rule, "exact", clutch)
-
-
-def _model_from_flags(engine: str, geometry: str | None, rule: str | None, clutch: str | None,
-                      model: str) -> Variant:
-    """The one variant of MuJoCo's model ``model`` (not the slides: ``mujoco-wheels`` for 'wheels'), after
-    refusing the flags it does not take (one line each)."""
-    v = next(v for v in VARIANTS.values() if v.model == model)
-    if engine != "mujoco":
-        raise ParameterError(f"--mujoco-model {model} applies only to --engine mujoco")
-    if geometry == "approx":
-        raise ParameterError("--geometry approx with --engine mujoco: MuJoCo always models the real linkage; "
-                             "allowed: --geometry exact (or leave it out)")
-    if rule not in (None, v.rule):
-        raise ParameterError(f"--clutch {rule} with --mujoco-model {model}: its clutches are {v.clutches}; "
-                             f"allowed: --clutch {v.rule} (or leave it out)")
-    if clutch not in (None, v.clutch):
-        raise ParameterError(f"--mujoco-clutch {clutch} with --mujoco-model {model}: its clutches are {v.clutches}; "
-                             f"allowed: --mujoco-clutch {v.clutch} (or leave it out)")
-    return v
-
-
-def _find(engine: str, rule: str, geometry: str, clutch: str | None) -> Variant:
-    return next(v for v in VARIANTS.values()
-                if (v.engine, v.rule, v.geometry, v.clutch, v.model) == (engine, rule, geometry, clutch, "slides"))
 
 
 def check_options(name: str | Variant, options: dict[str, Any], spelled: Callable[[str], str] = str) -> Variant:
@@ -243,7 +101,31 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
     starts from; a run whose wheels skid is kept at this step halved as many times as its skid check records
     (``RunResult.settings['skid_check']``, one entry a halving; its ``settings['timestep']`` is the step kept), and
     a slide run on finite grip whose modules skid is this run, its figures extrapolated from coarser ones
-    (``settings['extrapolation']``); None for the analytic engines."""
+    (``settings['extrapolation']``).
+
+    Parameters
+    ----------
+    name : str or Variant
+        The variant (:func:`variant`).
+    params : RobotParams
+        The robot.
+    t_end : float
+        The run's simulated time [s].
+    dt_out : float
+        Its output interval [s].
+    route : Route, optional
+        A route (:class:`ipir_mujoco.core.route.Route`) for the wheeled model; None: a straight pipe.
+
+    Returns
+    -------
+    float or None
+        The timestep [s]; None for the analytic engines.
+
+    Raises
+    ------
+    ParameterError
+        An unknown variant, or ``t_end`` or ``dt_out`` outside their ranges (one line).
+    """
     v, params = variant(name), require_params(params)
     t_end, dt_out = check_run_options(t_end, dt_out)
     if not v.is_mujoco:
@@ -253,8 +135,40 @@ def timestep(name: str | Variant, params: RobotParams, t_end: float, dt_out: flo
     return kind_for(v.model, params).settings(params, t_end, dt_out, None, v.clutch, route=route)[0].timestep
 
 
-def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options) -> RunResult:
+_P, _R = ParamSpec("_P"), TypeVar("_R")
+
+
+def _unknown_options_refused(func: Callable[_P, _R]) -> Callable[_P, _R]:
+    """``func`` (:func:`run`) with a misspelt or unknown keyword refused as bad input, a one-line
+    :class:`ParameterTypeError` naming it and the options the variant's engine takes, rather than Python's bare
+    TypeError; its signature stays ``func``'s for editors, type checkers and ``inspect.signature``."""
+    known = inspect.signature(func).parameters
+
+    @functools.wraps(func)
+    def checked(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        unknown = [k for k in kwargs if k not in known]
+        if unknown:
+            v = variant(args[0] if args else kwargs.get("name"))
+            allowed = (*COMMON_OPTIONS, *(MUJOCO_OPTIONS if v.is_mujoco else ANALYTIC_OPTIONS))
+            raise ParameterTypeError(f"option {unknown[0]}={kwargs[unknown[0]]!r} is unknown to {v.name}; "
+                                     f"allowed: {', '.join(allowed)}")
+        return func(*args, **kwargs)
+    return checked
+
+
+@_unknown_options_refused
+def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, *,
+        dt_out: float | None = None, until_steady: bool | None = None, steady_tol: float | None = None,
+        steady_cycles: int | None = None, progress: Callable[[float], None] | None = None,
+        wall_budget_s: float | None = None, feedforward: FeedforwardTable | None = None, route: Route | None = None,
+        rtol: float | None = None, atol: float | None = None, max_switches: int | None = None,
+        method: str | None = None, torque: Callable[[float, float, float], float] | None = None,
+        settings: SolverSettings | None = None, timestep: float | None = None, mjcf: str | os.PathLike | None = None,
+        accuracy: str | None = None, servo: CrankServo | None = None, every_step: bool | None = None) -> RunResult:
     """Run the variant ``name`` on ``params`` for ``t_end`` [s] (with ``until_steady``, the cap).
+
+    Every option is keyword-only; None (the default of each) is the engine's own default. An option of the other
+    engine given as None or False counts as not given; given otherwise it is refused.
 
     Parameters
     ----------
@@ -265,17 +179,46 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
         clutches compliant, a finite ``mu_wall`` its grip finite, ``drive`` the drive, ``incline`` the slope).
     t_end : float
         Simulated time [s]; with ``until_steady`` the cap.
-    **options
-        Every engine: ``dt_out`` [s], ``until_steady``, ``steady_tol``, ``steady_cycles``, ``progress``,
-        ``wall_budget_s`` [s] (:class:`ipir_mujoco.core.options.RunOptions`); the variants of
-        :data:`ROUTE_VARIANTS` ``route`` (a :class:`ipir_mujoco.core.route.Route`). The analytic engines also
-        ``rtol``, ``atol``, ``max_switches``, ``method`` (compliant clutches) and ``torque`` (a torque
-        profile); MuJoCo ``settings`` (:class:`ipir_mujoco.engine.SolverSettings`), ``timestep`` [s] (short for
-        settings with that step), ``mjcf``, ``accuracy`` ('stop' | 'warn'), ``servo`` and
-        ``every_step`` (sample at every step of the timestep MuJoCo chooses, :func:`timestep`: a sample holds
-        its step's force, so a mean over a window is the impulse and no engagement peak falls between
-        samples). With ``params.drive = 'servo'`` the speed controller's ``feedforward`` table
-        (:func:`feedforward_table`) is computed here unless given.
+    dt_out : float, optional
+        Every engine: the output interval [s] (default 1e-4; MuJoCo: a whole number of its timesteps).
+    until_steady : bool, optional
+        Every engine: stop at the end of the revolution where the periodic steady state is reached.
+    steady_tol : float, optional
+        Every engine: the steady-state test's relative tolerance (:class:`ipir_mujoco.core.options.RunOptions`).
+    steady_cycles : int, optional
+        Every engine: the revolutions the steady-state test compares.
+    progress : callable, optional
+        Every engine: ``progress(t)``, called with the simulated time [s] about every 0.1 s of it.
+    wall_budget_s : float, optional
+        Every engine: the most wall-clock time [s] the run may take (None: the package's default budget;
+        ``math.inf``: none).
+    feedforward : FeedforwardTable, optional
+        Every engine, with ``params.drive = 'servo'``: the speed controller's table; computed here
+        (:func:`feedforward_table`) unless given.
+    route : Route, optional
+        The variants of :data:`ROUTE_VARIANTS`: a :class:`ipir_mujoco.core.route.Route` to run along.
+    rtol, atol : float, optional
+        The analytic engines: the integrator's relative and absolute tolerances.
+    max_switches : int, optional
+        The analytic engines: the most mode switches a run may make.
+    method : str, optional
+        The analytic engines with compliant clutches: the integrator's method.
+    torque : callable, optional
+        The analytic engines: a torque profile ``torque(t, phi, omega)`` [N m] in place of the drive.
+    settings : SolverSettings, optional
+        MuJoCo: its solver settings (:class:`ipir_mujoco.engine.SolverSettings`); None: chosen from the motion.
+    timestep : float, optional
+        MuJoCo: short for ``settings`` with that timestep [s] (not with ``settings``).
+    mjcf : str or os.PathLike, optional
+        MuJoCo: an MJCF template in place of the shipped one.
+    accuracy : str, optional
+        MuJoCo: 'stop' (a failed accuracy check is a SimulationError) or 'warn' (recorded); None: the model
+        kind's own.
+    servo : CrankServo, optional
+        MuJoCo: a crank servo in place of the drive.
+    every_step : bool, optional
+        MuJoCo: sample at every step of the timestep it chooses (:func:`timestep`): a sample holds its step's
+        force, so a mean over a window is the impulse and no engagement peak falls between samples.
 
     Returns
     -------
@@ -291,13 +234,9 @@ def run(name: str | Variant, params: RobotParams, t_end: float = 1.0, **options)
     KeyboardInterrupt
         Ctrl-C during the run, wherever it landed (compiled code included), never another exception or a result.
     """
+    options = {key: value for key, value in locals().items() if key in OPTIONS and value is not None}
     v = check_options(name, options)
     require_params(params)
-    unknown = [k for k in options if k not in (*COMMON_OPTIONS, *ANALYTIC_OPTIONS, *MUJOCO_OPTIONS)]
-    if unknown:  # (an option of the other engine given as None or False counts as not given: check_options)
-        known = (*COMMON_OPTIONS, *(MUJOCO_OPTIONS if v.is_mujoco else ANALYTIC_OPTIONS))
-        raise ParameterTypeError(f"option {unknown[0]}={options[unknown[0]]!r} is unknown to {v.name}; "
-                                 f"allowed: {', '.join(known)}")
     if options.get("route") is not None and not v.routes:
         raise ParameterError(f"route: {v.name} runs along no route; allowed: {', '.join(ROUTE_VARIANTS)} (the exact "
                              "equations, MuJoCo's wheeled model)")
@@ -332,46 +271,6 @@ def _run(v: Variant, params: RobotParams, t_end: float, options: dict[str, Any])
     if v.model != "slides":
         options["model"] = v.model
     return simulate_mujoco(params, v.rule, v.clutch, t_end, **options)
-
-
-FEEDFORWARD_MODELS = {"paper": "approx", "exact": "exact"}  # feedforward -> the inverse kinetostatics' geometry
-FEEDFORWARD_REVOLUTIONS = 2  # the table is the last: the modules start at rest and settle within the first
-
-
-def feedforward_table(params: RobotParams) -> FeedforwardTable | None:
-    """The speed controller's feedforward (``params.feedforward``): the torque [N m] a crank following its speed
-    target exactly (``omega_target``, or the profile of ``speed_dip``) needs at each crank angle, by the
-    package's inverse kinetostatics with one-way clutches
-    (:func:`ipir_mujoco.analytic.inverse.inverse_kinetostatics`) on the paper's first-order geometry
-    ('paper', L >> r) or the exact slider-crank ('exact'); None for 'none'. Computed above the engines and
-    handed to each as data (the MuJoCo engine never runs the equations); cached per parameter set."""
-    if require_params(params).drive != "servo" or params.feedforward == "none":
-        return None
-    return _table(params)
-
-
-@functools.lru_cache(maxsize=64)
-def _table(params: RobotParams) -> FeedforwardTable:
-    from .analytic.inverse import CrankMotion, inverse_kinetostatics
-    from .core.control import TABLE_POINTS, FeedforwardTable, reference_motion
-
-    omega, dip = params.omega_target, params.speed_dip
-    lasts = FEEDFORWARD_REVOLUTIONS * 2 * math.pi / omega  # s: the table's motion, at the mean speed omega
-    if lasts > MAX_T_END:  # named by what the user gave, not the table's derived run length
-        raise ParameterError(f"omega_target={omega:g} rad/s with feedforward={params.feedforward!r}: the feedforward "
-                             f"table follows the crank through {FEEDFORWARD_REVOLUTIONS} revolutions at that speed, "
-                             f"{lasts:.3g} s, past the {MAX_T_END:g} s a run may take; allowed: omega_target >= "
-                             f"{FEEDFORWARD_REVOLUTIONS * 2 * math.pi / MAX_T_END:.3g} rad/s with a feedforward, or "
-                             "feedforward=none")
-    if dip == 0.0:
-        motion = CrankMotion.constant_speed(omega, params.phi0, FEEDFORWARD_REVOLUTIONS)
-    else:  # the profile through the dead centres: phi(t) sampled finely, a spline through it
-        motion = CrankMotion.from_samples(*reference_motion(omega, dip, params.phi0, FEEDFORWARD_REVOLUTIONS))
-    run = inverse_kinetostatics(params, motion, FEEDFORWARD_MODELS[params.feedforward], "unilateral",
-                                dt_out=2 * math.pi / omega / TABLE_POINTS)
-    s = run.series
-    last = s["phi"] >= params.phi0 + 2 * math.pi * (FEEDFORWARD_REVOLUTIONS - 1)
-    return FeedforwardTable.from_samples(s["phi"][last], s["motor_torque"][last], params.feedforward, omega, dip)
 
 
 def halved_settings(run: RunResult):
