@@ -292,24 +292,29 @@ def wall_lines(s: dict, params) -> list[str]:
     leg's press; sideways grip: the largest ring load over what the ring holds across the pipe, none with
     unlimited grip), and what happened with no prediction."""
     lift = "a wheel lifts" if s["lift_predicted"] else "no wheel lifts"
-    if params.mu_wall is None:
-        check = "unlimited grip: the wheels hold across the pipe"
-    else:
-        check = (f"sideways-grip check {s['side_use1']:.3g} / {s['side_use2']:.3g} ("
-                 + ("a slide predicted" if s["scrub_predicted"] else "held")
-                 + "; a module that skids or lifts a wheel holds nothing across)")
     grip = "" if s.get("grip1_n") is None else (
         f"; grip {s['grip1_n']:.4g} N / {s['grip2_n']:.4g} N (mu_wall x press; the equations' mu_wall F_n "
         f"{params.mu_wall * params.F_n1:.4g} N / {params.mu_wall * params.F_n2:.4g} N)")
     lines = [f"  wall press {s['press1_n']:.4g} N / {s['press2_n']:.4g} N (mean){grip}",
              f"  a wheel off its wall {s['wheel_off_s']:.3f} s; lift-off check: least-pressed leg "
              f"{s['least_press1_n']:.3g} N / {s['least_press2_n']:.3g} N ({lift})"]
-    if "across1_m" in s:
+    if "across1_m" in s:  # the straight pipe's sideways check beside the rings' slide (not given along a route)
+        if params.mu_wall is None:
+            check = "unlimited grip: the wheels hold across the pipe"
+        else:
+            check = (f"sideways-grip check {_ratio(s['side_use1'])} / {_ratio(s['side_use2'])} ("
+                     + ("a slide predicted" if s["scrub_predicted"] else "held")
+                     + "; a module that skids or lifts a wheel holds nothing across)")
         lines.append(f"  rings moved across the pipe {1e3 * s['across1_m']:.3g} mm / {1e3 * s['across2_m']:.3g} mm"
                      + (" (slid: the wheels scrubbed)" if s["scrubbed"] else "") + f"; {check}")
     if s.get("unpredicted"):
         lines.append(f"  not predicted: {s['unpredicted']}")
     return lines
+
+
+def _ratio(value) -> str:
+    """A check's ratio in the text: 'unbounded' where it is (no grip at all against a load: inf, null in JSON)."""
+    return "unbounded" if value is None or value == float("inf") else f"{value:.3g}"
 
 
 def route_lines(s: dict) -> list[str]:

@@ -121,8 +121,9 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
     Returns per module i: ``least_press{i}_n`` [N], its least-pressed leg's press over the samples (the weight on
     the springs and the ring's place; < 0 a lift); ``slid{i}_m`` [m], the path its rings move across the pipe (the
     longer ring's); ``side_use{i}``, its largest load over what its wheels hold across the pipe while they grip along
-    it (over the samples and legs, > 1 where they slide; 0 with unlimited grip; a module that skids along the pipe
-    holds less across it, Coulomb's cone, and nothing while it skids: :func:`held`).
+    it (over the samples and legs, > 1 where they slide; 0 with unlimited grip, inf with mu_wall 0 under a load; a
+    module that skids along the pipe holds less across it, Coulomb's cone, and nothing while it skids:
+    :func:`held`).
     ``lift_predicted``: a least press below 0. ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
     outcome, ``scrubbed``, is the run's path from the same floor)."""
     from .pipe import SCRUB_FLOOR
@@ -155,7 +156,8 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             if params.mu_wall is not None:  # against the whole grip: a skidding module's share is in held()
                 across = np.abs(load @ u.T)
                 with np.errstate(divide="ignore", invalid="ignore"):
-                    ratio = max(ratio, float(np.max(np.where(holds[None, :] > 0, across / holds[None, :], 0.0))))
+                    # a leg's direction its wheels hold nothing along (mu_wall 0) against a load: unbounded (inf)
+                    ratio = max(ratio, float(np.max(np.where(across > 0, across / holds[None, :], 0.0))))
         out[f"least_press{i}_n"] = least
         out[f"slid{i}_m"] = path
         out[f"side_use{i}"] = ratio
