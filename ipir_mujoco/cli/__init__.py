@@ -56,7 +56,10 @@ __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_INTERRUPTED", "EXIT_OK", "bui
 TOOLS = (simulate, validate, compare, kinetostatics, params, render)
 
 
-def build_parser() -> Parser:
+def build_parser(command: str | None = None) -> Parser:
+    """The command line's parser: every subcommand, or with ``command`` naming a tool (:data:`TOOLS`) that one
+    alone (the studies' declarations are then not read: a tool's start-up does not pay for them)."""
+    only = {_tool_name(t): t for t in TOOLS}.get(command)
     parser = Parser(prog="ipir-mujoco",
                     description="Cross-check the analytic model of a two-module inchworm in-pipe robot "
                                 "against MuJoCo physics. 'ipir-mujoco params' lists every parameter.",
@@ -66,14 +69,26 @@ def build_parser() -> Parser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     add_global_options(parser, top=True)
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for tool in TOOLS:
+    for tool in (only,) if only is not None else TOOLS:
         tool.add_parser(commands)
-    for study in declared():
+    for study in () if only is not None else declared():
         if study.command:
             add_study(commands, study)
     for subparser in set(commands.choices.values()):
         add_global_options(subparser)
     return parser
+
+
+def _tool_name(tool) -> str:
+    """A tool's subcommand: its module's name (``cli.simulate``: ``simulate``)."""
+    return tool.__name__.rsplit(".", 1)[-1]
+
+
+def _named_command(argv: Sequence[str] | None) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option (the only option before it, --debug,
+    takes no value), or None."""
+    words = sys.argv[1:] if argv is None else argv
+    return next((w for w in words if not str(w).startswith("-")), None)
 
 
 def add_study(commands, study) -> None:
@@ -126,7 +141,7 @@ def console() -> int:
 
 def _command(argv: Sequence[str] | None) -> int:
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser(_named_command(argv)).parse_args(argv)
         prefix = f"ipir-mujoco {args.command}"
         for note in getattr(args, "notes", ()):  # an option's older name used (studies.command.add_variant_option)
             print(f"{prefix}: note: {note}", file=sys.stderr)
