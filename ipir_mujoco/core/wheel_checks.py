@@ -111,8 +111,8 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
 
     Per ring and sample: where its wheels hold the load by their sideways friction (:func:`held`) the ring stays
     where it is; where they do not, its springs carry the load, and a module that rolls meanwhile also carries
-    its wheels' sideways scrub along it (:func:`.pipe.scrub_force`, the bend's law: a module turned on its springs
-    steers its rolling wheels across the pipe, and their friction drags its rings on until they slide). The ring
+    its wheels' sideways scrub along it (:func:`_steering_scrub`: a module turned on its springs steers its rolling
+    wheels across the pipe, and their friction drags its rings on until they slide). The ring
     follows the springs' load as a mass on springs, the module's sprung mass m on n k of them (translation across
     the pipe, undamped: the legs have no damper, and a load faster than its period sqrt(m / (n k)) moves it less
     than the same load held, a load held as long as it more, up to twice), solved exactly from sample to sample
@@ -169,9 +169,11 @@ SCRUB_BINS = 720  # directions across the pipe the steering scrub is taken at (0
 
 def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray) -> np.ndarray:
     """The wheels' sideways scrub [N] along each sample's spring load (shape (n, 2)) where ``moving`` (the module
-    rolls and the ring slides), :func:`.pipe.scrub_force` at the load's direction rounded to one of SCRUB_BINS
-    (the law is called once per direction, not per sample); zero elsewhere."""
-    from .pipe import scrub_force
+    rolls and the ring slides): the ring's whole sideways friction, :func:`.pipe.ring_side_grip`, at the load's
+    direction rounded to one of SCRUB_BINS (the law is called once per direction, not per sample); zero elsewhere.
+    A ring slides only where its load is beyond what its wheels hold, so every wheel slides: a steer-compliant
+    wheel past its slip angle's limit pushes mu_wall P sideways, as a rigid one does."""
+    from .pipe import ring_side_grip
 
     size = np.hypot(spring[:, 0], spring[:, 1])
     where = moving & (size > 0)
@@ -183,7 +185,7 @@ def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray)
     force = np.empty(where.sum())
     for b in np.unique(bins):
         a = 2 * math.pi * b / SCRUB_BINS
-        force[bins == b] = scrub_force(params, module, (math.cos(a), math.sin(a)))
+        force[bins == b] = ring_side_grip(params, module, (math.cos(a), math.sin(a)))
     out[where] = force[:, None] * spring[where] / size[where, None]
     return out
 
