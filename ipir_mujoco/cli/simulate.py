@@ -294,6 +294,8 @@ def wall_lines(s: dict, params) -> list[str]:
     lift = "a wheel lifts" if s["lift_predicted"] else "no wheel lifts"
     if params.mu_wall is None:
         check = "unlimited grip: the wheels hold across the pipe"
+    elif "side_use1" not in s:  # along a route: the bends' checks (route_fit) and the lift-off check above
+        check = "along a route the bends' scrub is in the closed-form fit"
     else:
         check = (f"sideways-grip check {s['side_use1']:.3g} / {s['side_use2']:.3g} ("
                  + ("a slide predicted" if s["scrub_predicted"] else "held")
