@@ -226,6 +226,12 @@ def test_a_rolling_module_yawed_by_a_couple_steers_both_rings_the_way_its_nose_p
     assert places[0][-1, 0] == pytest.approx(F - 2 * sigma * F, rel=1e-6)
     assert places[1][-1, 0] == pytest.approx(-F - 2 * sigma * F, rel=1e-6) and sigma == pytest.approx(0.4)
     assert not slid[0].any() and not slid[1].any()
+    # the check at rest (dt None) puts the same on the springs: module 1 rolling, its fore ring's leg at +30 deg
+    # (u . y = cos 30 deg) loses (2 / 3) (1 + 2 sigma) F cos 30 deg of its preload
+    loads = {"1aft": aft[:1], "1fore": fore[:1], "2aft": np.zeros((1, 2)), "2fore": np.zeros((1, 2))}
+    static = W.check(p, loads, rolling=(True, False))
+    assert static["least_press1_n"] == pytest.approx(
+        p.F_n1 / 6 - 2 / 3 * (1 + 2 * sigma) * F * math.cos(math.radians(30)), rel=1e-12)
 
 
 def test_a_rolling_modules_steer_compliant_wheels_let_its_ring_roll_across_to_its_springs():

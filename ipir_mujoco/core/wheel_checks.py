@@ -169,14 +169,16 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             if params.mu_wall is not None and moving.any():
                 spring = spring + _steering_scrub(params, module, spring, moving)
             rings.append((load, grip, creep, still, spring))
-        if dt is None:
-            moves = [(r[4], ~r[1]) for r in rings]
+        steer = params.cornering_coefficient * params.suspension_travel / params.ring_spacing if compliant else 0.0
+        if dt is None:  # at rest on the springs; rings that creep together carry the heading's steering too
+            both = (rings[0][2] & rings[1][2])[:, None]
+            turn = np.where(both, steer * (rings[1][4] - rings[0][4]), 0.0)
+            moves = [(r[4] + turn, ~r[1]) for r in rings]
         elif rings[0][2].any() or rings[1][2].any():
             damping = creep_damping(params, module, speed[module])
             places, slides = rings_motion([r[4] for r in rings], [r[3] for r in rings],
-                                          [np.where(r[2], damping, 0.0) for r in rings], frequency, dt,
-                                          params.cornering_coefficient * params.suspension_travel
-                                          / params.ring_spacing, wheel_walls(params, module))
+                                          [np.where(r[2], damping, 0.0) for r in rings], frequency, dt, steer,
+                                          wheel_walls(params, module))
             moves = [(place, slid & ~r[3]) for place, slid, r in zip(places, slides, rings)]
         else:
             moves = [(ring_response(r[4], r[1], frequency * dt), ~r[1]) for r in rings]
