@@ -38,6 +38,8 @@ from .pipe import leg_direction, sprung_mass
 from .ring_motion import ring_response, rings_motion  # noqa: F401 (rings_motion: the tests' too)
 
 RINGS = ("aft", "fore")
+LIFT_SHARE = 0.05  # a leg is off its wall while its spring presses with less than this share of its preload (the
+# runs' wheel_off_s counts it so; the check predicts a lift from the same press on)
 MOVING_SPEED = 1e-3  # m/s: a module this fast along the pipe, not skidding, rolls (a held one creeps at ~3e-6 m/s)
 
 
@@ -137,7 +139,8 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
     longer ring's); ``side_use{i}``, its largest load over what its wheels hold across the pipe while they grip along
     it (over the samples and legs, > 1 where they slide; 0 with unlimited grip; a module that skids along the pipe
     holds less across it, Coulomb's cone, and nothing while it skids: :func:`held`).
-    ``lift_predicted``: a least press below 0. ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
+    ``lift_predicted``: a least press below LIFT_SHARE of the leg's preload (where the run's ``wheel_off_s``
+    counts a wheel off its wall). ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
     outcome, ``scrubbed``, is the run's path from the same floor)."""
     from .pipe import SCRUB_FLOOR, rigid_wheels
 
@@ -193,7 +196,8 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
         out[f"least_press{i}_n"] = least
         out[f"slid{i}_m"] = path
         out[f"side_use{i}"] = ratio
-    out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
+    floor = [LIFT_SHARE * F / (2 * n) for F in (params.F_n1, params.F_n2)]
+    out["lift_predicted"] = out["least_press1_n"] < floor[0] or out["least_press2_n"] < floor[1]
     out["scrub_predicted"] = max(out["slid1_m"], out["slid2_m"]) >= SCRUB_FLOOR
     return out
 
