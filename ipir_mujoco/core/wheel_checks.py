@@ -191,8 +191,9 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             path = max(path, float(np.sum(np.hypot(shifts[:, 0], shifts[:, 1])[slides[:-1]])))  # creep rolls
             if params.mu_wall is not None:  # against the whole grip: a skidding module's share is in held()
                 across = np.abs(load @ u.T)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    ratio = max(ratio, float(np.max(np.where(holds[None, :] > 0, across / holds[None, :], 0.0))))
+                with np.errstate(divide="ignore", invalid="ignore"):  # no grip: any load is beyond it (inf)
+                    ratio = max(ratio, float(np.max(np.where(holds[None, :] > 0, across / holds[None, :],
+                                                             np.where(across > 0, math.inf, 0.0)))))
         out[f"least_press{i}_n"] = least
         out[f"slid{i}_m"] = path
         out[f"side_use{i}"] = ratio
