@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from .common import EXIT_OK, add_model_options, check_input_file, model_params
 
@@ -26,6 +25,7 @@ def add_parser(commands) -> None:
 def run(args: argparse.Namespace) -> int:
     from ipir_mujoco.engine.builders.wheels_model import check_wheels_params
 
+    from ..core.results import json_text
     from ..studies.design_rules import design_rules
 
     params = model_params(args)
@@ -38,8 +38,8 @@ def run(args: argparse.Namespace) -> int:
         route = read_route(args.route)
         route.check_pipe(params.pipe_diameter)
     result = design_rules(params, route)
-    if args.json:
-        print(json.dumps(result, allow_nan=False))
+    if args.json:  # a figure without bound (a side load where the wheels hold nothing) is null, as in a summary
+        print(json_text(result))
     else:
         print(format_rules(result))
     return EXIT_OK
