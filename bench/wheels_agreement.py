@@ -3,7 +3,7 @@
 Run on demand from the repository root (an hour or more for 100 designs on 2 busy cores; ``--smoke``: 4 designs
 of 0.3 s at a given 1e-4 s step, seconds):
 
-    python bench/wheels_agreement.py [--designs 200] [--seed 1] [--workers 2] [--log FILE.jsonl]
+    python bench/wheels_agreement.py [--designs 200] [--seed 1] [--workers 2] [--log FILE.jsonl] [--recheck]
                                      [--wall-budget S] [--skip N] [--only N,M,...] [--timestep S] [--smoke]
 
 Each design is drawn over the envelope (log-uniform where a range spans decades): m1, m2 0.2-5 kg; r 0.02-0.07 m
@@ -32,7 +32,9 @@ nothing happened and of the predictions, and its misses; and, for comparison, th
 before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_check`).
 
 ``--log FILE.jsonl`` appends each design's record as it finishes; a rerun with the same log skips the designs it
-holds (reprinting their lines), so a stopped benchmark resumes. The tables in mjcf/README.md ("The round pipe")
+holds (reprinting their lines), so a stopped benchmark resumes; with ``--recheck`` it runs nothing on MuJoCo and
+takes the logged designs' equations' checks again with the check as it is now (a new analytic run each; MuJoCo's
+outcome and the run's own checks as logged), deciding their class again. The tables in mjcf/README.md ("The round pipe")
 are this script's output.
 """
 
@@ -60,6 +62,7 @@ from ipir_mujoco.core.wheel_checks import check, ring_loads
 TRAVEL_REL, TRAVEL_FLOOR = 0.01, 1e-3  # the acceptance: travel within 1 % (or 1 mm)
 SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
 CLASSES = ("agree", "lifted", "scrubbed", "stopped", "outside")
+EQUATIONS_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "slid1_m", "slid2_m", "scrub_predicted")
 CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"), ("lift", "quasi-static"))
 
 
@@ -92,12 +95,12 @@ def skid_within(a: float, b: float) -> bool:
 def equations_checks(analytic, params: RobotParams) -> dict:
     """The lift-off and scrub checks (:func:`ipir_mujoco.core.wheel_checks.check`) on the analytic run's loads:
     the linkage's forces across the pipe (module 1's at A, module 2's at C: :func:`.kinetostatics.pin_forces`),
-    its drive's torque, its modules' grip use and rolling, its samples' interval."""
+    its drive's torque, its modules' grip use, rolling and speeds, its samples' interval."""
     s = analytic.series
     _, on_rod_y, _, pin_y = pin_forces(s, OneDofDynamics(params, analytic.geometry))
     loads = ring_loads(params, -pin_y, -on_rod_y, drive_torque(params, s["omega"]))
     return check(params, loads, (s["grip_use1"], s["grip_use2"]), (s["wheels1"] == 1, s["wheels2"] == 1),
-                 float(s["t"][1] - s["t"][0]))
+                 float(s["t"][1] - s["t"][0]), (s["v1"], s["v2"]))
 
 
 def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None,
@@ -121,8 +124,7 @@ def judge(index: int, params: RobotParams, t_end: float, budget: float | None = 
         row[k] = (a[k], w[k])
     row.update({k: (a["energy"].get(k, 0.0), w["energy"].get(k, 0.0)) for k in ("motor_work_j", "skid_j")})
     eq = equations_checks(analytic, params)
-    row["checks"] = {"equations": {k: eq[k] for k in ("least_press1_n", "least_press2_n", "lift_predicted",
-                                                      "slid1_m", "slid2_m", "scrub_predicted")},
+    row["checks"] = {"equations": {k: eq[k] for k in EQUATIONS_KEYS},
                      "run": {k: w[k] for k in ("least_press1_n", "least_press2_n", "lift_predicted",
                                                "side_use1", "side_use2", "scrub_predicted")}}
     row["happened"] = {"lift": w["wheel_off_s"] > 0, "scrub": bool(w["scrubbed"])}
@@ -130,19 +132,42 @@ def judge(index: int, params: RobotParams, t_end: float, budget: float | None = 
                grip=(w["grip1_n"], w["grip2_n"]), unpredicted=w["unpredicted"], timestep=wheels.settings["timestep"])
     violations = wheels.accuracy.get("violations") or []
     stops = [s for s in (analytic.stall, wheels.stall) if s]
-    if all(travel_within(a[f"x{k}_final"], w[f"x{k}_final"]) and skid_within(a[f"slip{k}_m"], w[f"slip{k}_m"])
-           for k in (1, 2)):
-        return {**row, "class": "agree"}
-    for name, kind in (("lift", "lifted"), ("scrub", "scrubbed")):
-        if row["happened"][name] and eq[f"{name}_predicted"]:
-            return {**row, "class": kind}
-    if stops:
-        return {**row, "class": "stopped", "why": stops[0]}
+    row["agrees"] = all(travel_within(a[f"x{k}_final"], w[f"x{k}_final"])
+                        and skid_within(a[f"slip{k}_m"], w[f"slip{k}_m"]) for k in (1, 2))
+    row["stop"] = stops[0] if stops else None
     if violations:  # the run warned: the accuracy monitor's figure beyond its tolerance, said in the summary
         v = violations[0]
-        return {**row, "class": "stopped", "why": f"flagged by the accuracy monitor: {v['figure']} {v['value']:.3g} "
-                                                  f"(tolerance {v['tolerance']:.3g}) at t = {v['t_s']:.3g} s"}
+        row["stop"] = row["stop"] or (f"flagged by the accuracy monitor: {v['figure']} {v['value']:.3g} (tolerance "
+                                      f"{v['tolerance']:.3g}) at t = {v['t_s']:.3g} s")
+    return classify(row)
+
+
+def classify(row: dict) -> dict:
+    """The record with its class (module docstring) from its travel and skid errors (``agrees``), MuJoCo's
+    outcome, the equations' checks and its stop (a stall, or the accuracy monitor's flag)."""
+    row = {k: v for k, v in row.items() if k not in ("class", "why")}
+    if row["agrees"]:
+        return {**row, "class": "agree"}
+    for name, kind in (("lift", "lifted"), ("scrub", "scrubbed")):
+        if row["happened"][name] and row["checks"]["equations"][f"{name}_predicted"]:
+            return {**row, "class": kind}
+    if row["stop"]:
+        return {**row, "class": "stopped", "why": row["stop"]}
     return {**row, "class": "outside"}
+
+
+def recheck(row: dict) -> dict:
+    """A logged record with the equations' checks taken again (the check as it is now, on a new analytic run of
+    the design) and its class decided again; MuJoCo's outcome and the run's own checks as logged."""
+    if "checks" not in row:
+        return row
+    params = RobotParams(**row["params"])
+    eq = equations_checks(registry.run("analytic-unilateral", params, row["t_end"], dt_out=1e-3), params)
+    row = {**row, "checks": {**row["checks"], "equations": {k: eq[k] for k in EQUATIONS_KEYS}}}
+    if "agrees" not in row:  # a record from before Dec 7, 10:00: its class says whether it agreed, or its stop
+        row["agrees"] = row["class"] == "agree"
+        row["stop"] = row.get("why")
+    return classify(row)
 
 
 def error_text(a: float, w: float) -> str:
@@ -215,6 +240,9 @@ def main(argv=None) -> int:
     parser.add_argument("--only", default=None, metavar="N,M,...",
                         help="run only these designs (their numbers as printed; with --skip, these and those after it)")
     parser.add_argument("--timestep", type=float, default=None, help="the MuJoCo runs' step [s] (default: automatic)")
+    parser.add_argument("--recheck", action="store_true",
+                        help="with --log: the logged designs' equations' checks taken again with the check as it is "
+                             "now (a new analytic run each; MuJoCo's outcome and the run's own checks as logged)")
     parser.add_argument("--smoke", action="store_true", help="4 designs of 0.3 s at the 1e-4 s step unless "
                         "--timestep gives one (no skid check's reruns): the script runs")
     args = parser.parse_args(argv)
@@ -234,9 +262,9 @@ def main(argv=None) -> int:
         params, t_end = design(rng)
         if (k >= args.skip and only is None) or (only is not None and (k in only or (args.skip and k >= args.skip))):
             if k in done:
-                rows.append(done[k])
-                print(line(done[k]), flush=True)
-            else:
+                rows.append(recheck(done[k]) if args.recheck else done[k])
+                print(line(rows[-1]), flush=True)
+            elif not args.recheck:
                 jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep))
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = [pool.submit(judge, *job) for job in jobs]

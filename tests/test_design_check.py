@@ -36,6 +36,19 @@ def test_design_check_prints_every_rule_and_exits_0_whatever_the_verdicts(capsys
     assert code == 0 and all(name in out for name in by_name if name != "lift_at_speed")
 
 
+def test_a_side_load_where_the_wheels_hold_nothing_is_null_in_the_json(capsys):
+    """A module heavier than its press sags until its upper legs press nothing: along them its wheels hold
+    nothing across the pipe, so the sideways grip rule's ratio has no bound: inf in Python, null in the JSON (as
+    a summary's side_use), and the rule does not hold."""
+    code, out, err = run_cli(capsys, "design-check", "--json", "--drive", "motor", "--set", "m1=3",
+                             "--set", "F_n1=20", "--set", "mu_wall=0.8")
+    assert code == 0 and err == ""
+    side = {r["name"]: r for r in json.loads(out)["rules"]}["side_grip_at_stall"]
+    assert side["value"] is None and side["margin"] is None and side["holds"] is False
+    params = RobotParams(drive="motor", m1=3.0, F_n1=20.0, mu_wall=0.8)
+    assert {r["name"]: r for r in design_rules(params)["rules"]}["side_grip_at_stall"]["value"] == math.inf
+
+
 @pytest.mark.parametrize("argv,word", [(("--set", "wheel_radius=0.05"), "wheel_radius"),
                                        (("--set", "suspension_travel=0.02"), "suspension_travel"),
                                        (("--route", "no-such-route.toml"), "--route")])

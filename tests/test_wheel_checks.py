@@ -51,11 +51,13 @@ def test_ring_loads_carry_the_linkage_force_and_the_motors_couple():
 
 def test_a_leg_lifts_where_the_springs_load_along_it_reaches_a_quarter_of_the_press():
     """Beyond the wheels' friction the springs carry the load: leg j's press is P + (2 / n) F . u_j, 0 where
-    F . u_j = -F_n / 4, whatever n (3 and 5 legs), with the module skidding (no friction across)."""
+    F . u_j = -F_n / 4, whatever n (3 and 5 legs), with the module skidding (no friction across); the check says
+    a lift from LIFT_SHARE of the preload on, where the run counts a wheel off its wall."""
     for n in (3, 5):
         p = GRIP.replace(wheel_legs=float(n))
         u = np.array(leg_direction(0, n)[1:])
-        for scale, lifts in ((1 - 1e-9, False), (1 + 1e-9, True)):
+        for scale, lifts in ((1 - 1e-9, True), (1 - W.LIFT_SHARE * (1 + 1e-9), False),
+                             (1 - W.LIFT_SHARE * (1 - 1e-9), True)):
             load = -scale * p.F_n1 / 4 * u
             loads = {"1aft": load[None, :], "1fore": np.zeros((1, 2)), "2aft": np.zeros((1, 2)),
                      "2fore": np.zeros((1, 2))}
@@ -161,3 +163,94 @@ def test_the_constant_press_measures_say_the_wheels_grip_as_mujoco_has_it():
     assert _press(summary) == ("the wheels pressed 30.2 / 40.1 N on the mean, a wheel off its wall 0 s, a grip of "
                                "15.1 / 20.05 N (mu_wall x press)")
     assert "grip" not in _press({**summary, "grip1_n": None})
+
+
+def one_ring(spring, still, omega, dt, damping, walls=None):
+    """rings_motion for one ring (the other still, no heading): (place, slid)."""
+    count = len(spring)
+    places, slid = W.rings_motion([spring, np.zeros((count, 2))], [still, np.ones(count, dtype=bool)],
+                                  [np.broadcast_to(damping, (count,)), np.zeros(count)], omega, dt, 0.0, walls)
+    return places[0], slid[0]
+
+
+@pytest.mark.parametrize("zeta", [0.1, 0.7, 3.0])
+def test_a_rolling_rings_creep_is_a_damped_mass_on_springs(zeta):
+    """A ring with damping 2 zeta omega from rest under a load held: the textbook step response (under- and
+    overdamped), to round-off; with no damping it is ring_response's undamped motion; a still sample keeps it."""
+    omega, dt, steps = 70.0, 1e-3, 400
+    load = np.zeros((steps, 2))
+    load[:, 1] = -2.0
+    place, slid = one_ring(load, np.zeros(steps, dtype=bool), omega, dt, 2 * zeta * omega)
+    t = dt * np.arange(steps)
+    h = zeta * omega
+    if zeta < 1:
+        wd = omega * math.sqrt(1 - zeta ** 2)
+        step = 1 - np.exp(-h * t) * (np.cos(wd * t) + h / wd * np.sin(wd * t))
+    else:
+        l1, l2 = -h + omega * math.sqrt(zeta ** 2 - 1), -h - omega * math.sqrt(zeta ** 2 - 1)
+        step = 1 - (l2 * np.exp(l1 * t) - l1 * np.exp(l2 * t)) / (l2 - l1)
+    assert np.abs(place[:, 1] - (-2.0) * step).max() < 1e-12 and not place[:, 0].any() and not slid.any()
+    rng = np.random.default_rng(5)
+    spring, still = rng.normal(size=(300, 2)), rng.random(300) < 0.3
+    free, slides = one_ring(spring, still, omega, dt, 0.0)
+    assert np.abs(free - W.ring_response(spring, still, omega * dt)).max() < 1e-12 and (slides == ~still).all()
+
+
+def test_a_creeping_ring_slides_where_its_wheels_side_force_would_pass_their_friction():
+    """Heavily damped (a slow roll), as the ring gathers speed under a load applied at once the damper takes most
+    of it (its force damping x the place's speed / omega^2); beyond the wheels' friction they slide, their
+    friction (less than the damper's force) against the ring's way, so the ring runs ahead of the damped one until
+    the damper's force falls back within the friction. With no end to the friction (walls None) it never slides."""
+    omega, dt, steps = 70.0, 1e-4, 2000
+    load = np.zeros((steps, 2))
+    load[:, 0] = 8.0
+    walls = W.wheel_walls(GRIP, 0)  # along y 2 mu P = 5 N at the preload (legs at -90, 30, 150 deg), below 8 N
+    damped, never = one_ring(load, np.zeros(steps, dtype=bool), omega, dt, 6 * omega)
+    place, slid = one_ring(load, np.zeros(steps, dtype=bool), omega, dt, 6 * omega, walls)
+    assert not never.any() and slid.any() and not slid[-1]
+    assert place[50, 0] > damped[50, 0] and place[-1, 0] < 8.0
+
+
+def test_a_rolling_module_yawed_by_a_couple_steers_both_rings_the_way_its_nose_points():
+    """A couple +-F on the aft and fore rings of a rolling module: it yaws on its springs by psi = (d_fore - d_aft)
+    / s, and its wheels, rolling along its axis, push both rings the way the nose points, C_r psi each, so at
+    rest on its springs the rings carry X_aft = F_aft + sigma (F_fore - F_aft), X_fore = F_fore + sigma (F_fore -
+    F_aft), sigma = C_r / (k_r s) = cornering_coefficient suspension_travel / ring_spacing: the fore ring carries
+    (1 + 2 sigma) F, 1.8 F at the defaults."""
+    p = GRIP
+    sigma = p.cornering_coefficient * p.suspension_travel / p.ring_spacing
+    steps, F = 6000, 1.0
+    aft, fore = np.zeros((steps, 2)), np.zeros((steps, 2))
+    aft[:, 0], fore[:, 0] = F, -F
+    still = np.zeros(steps, dtype=bool)
+    damping = np.full(steps, 150.0)  # about critical at omega = 70 rad/s
+    places, slid = W.rings_motion([aft, fore], [still, still], [damping, damping], 70.0, 1e-3, sigma)
+    assert places[0][-1, 0] == pytest.approx(F - 2 * sigma * F, rel=1e-6)
+    assert places[1][-1, 0] == pytest.approx(-F - 2 * sigma * F, rel=1e-6) and sigma == pytest.approx(0.4)
+    assert not slid[0].any() and not slid[1].any()
+    # the check at rest (dt None) puts the same on the springs: module 1 rolling, its fore ring's leg at +30 deg
+    # (u . y = cos 30 deg) loses (2 / 3) (1 + 2 sigma) F cos 30 deg of its preload
+    loads = {"1aft": aft[:1], "1fore": fore[:1], "2aft": np.zeros((1, 2)), "2fore": np.zeros((1, 2))}
+    static = W.check(p, loads, rolling=(True, False))
+    assert static["least_press1_n"] == pytest.approx(
+        p.F_n1 / 6 - 2 / 3 * (1 + 2 * sigma) * F * math.cos(math.radians(30)), rel=1e-12)
+
+
+def test_a_rolling_modules_steer_compliant_wheels_let_its_ring_roll_across_to_its_springs():
+    """A load across the pipe inside the wheels' friction: a standing module's wheels hold it (no press change);
+    rolling at 0.5 m/s its steer-compliant wheels creep (a damped ring), its springs take the load, so its
+    least-pressed leg loses (2 / n) F of press, without a slide; rigid wheels hold it rolling too."""
+    p = GRIP
+    P = p.F_n1 / 6
+    F = 0.9 * math.sqrt(3) * p.mu_wall * P  # along leg 0's opposite: inside the zonotope
+    steps = 4000
+    loads = {k: np.zeros((steps, 2)) for k in ("1aft", "1fore", "2aft", "2fore")}
+    loads["1aft"][:, 1] = loads["1fore"][:, 1] = F  # up on both rings, against leg 0 (down): no yaw
+    rolls = (np.ones(steps, dtype=bool), np.zeros(steps, dtype=bool))
+    speed = (np.full(steps, 0.5), np.zeros(steps))
+    standing = W.check(p, loads, dt=1e-3)
+    rolling = W.check(p, loads, rolling=rolls, dt=1e-3, speed=speed)
+    rigid = W.check(p.replace(cornering_coefficient=None), loads, rolling=rolls, dt=1e-3, speed=speed)
+    assert standing["least_press1_n"] == pytest.approx(P, rel=1e-12) == rigid["least_press1_n"]
+    assert rolling["least_press1_n"] == pytest.approx(P - 2 / 3 * F, rel=1e-3)  # settled on its springs
+    assert rolling["slid1_m"] == 0.0 and not rolling["scrub_predicted"]

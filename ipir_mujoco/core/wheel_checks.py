@@ -6,7 +6,9 @@ preload P = F_ni / (2 n) and stiffness k = P / ``suspension_travel``; each leg's
 so across it the wheel holds by friction along its circumferential direction e_k (x cross u_k), up to mu_wall
 times its press. A ring loaded across the pipe by F (y across in the crank's plane, z up in a horizontal pipe):
 
-- **while its wheels grip** the ring does not move: e_1 .. e_n span the plane, so the wheels' friction carries F
+- **while its wheels grip** the ring of a standing module (or on rigid wheels) does not move; rolling
+  steer-compliant wheels let it creep onto its springs (:func:`check`). e_1 .. e_n span the plane, so the wheels'
+  friction carries F
   as long as it lies inside the zonotope sum_k [-1, 1] mu N_k e_k (N_k each leg's press). Its facets are normal to
   the generators' perpendiculars, the legs' own directions u_j, so the wheels hold F exactly when, for every leg j,
   |F . u_j| <= sum_k mu N_k |e_k . u_j| (:func:`held`). A module that skids along the pipe has its wheels'
@@ -33,8 +35,12 @@ import math
 import numpy as np
 
 from .pipe import leg_direction, sprung_mass
+from .ring_motion import ring_response, rings_motion  # noqa: F401 (rings_motion: the tests' too)
 
 RINGS = ("aft", "fore")
+LIFT_SHARE = 0.05  # a leg is off its wall while its spring presses with less than this share of its preload (the
+# runs' wheel_off_s counts it so; the check predicts a lift from the same press on)
+MOVING_SPEED = 1e-3  # m/s: a module this fast along the pipe, not skidding, rolls (a held one creeps at ~3e-6 m/s)
 
 
 def leg_frames(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -104,64 +110,96 @@ def ring_loads(params, side1, side2, torque, vertical1=0.0, vertical2=0.0) -> di
 
 
 def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(False, False),
-          dt: float | None = None) -> dict:
+          dt: float | None = None, speed=(None, None)) -> dict:
     """The lift-off and scrub checks on the rings' linkage ``loads`` (:func:`ring_loads`, samples along the first
     axis) with each module's ``grip_use`` share along the pipe and whether it ``rolling`` (arrays of the samples'
     shape, or scalars); ``dt`` [s] the samples' interval (None: each sample static).
 
     Per ring and sample: where its wheels hold the load by their sideways friction (:func:`held`) the ring stays
     where it is; where they do not, its springs carry the load, and a module that rolls meanwhile also carries
-    its wheels' sideways scrub along it (:func:`.pipe.scrub_force`, the bend's law: a module turned on its springs
-    steers its rolling wheels across the pipe, and their friction drags its rings on until they slide). The ring
+    its wheels' sideways scrub along it (:func:`_steering_scrub`: a module turned on its springs steers its rolling
+    wheels across the pipe, and their friction drags its rings on until they slide). The ring
     follows the springs' load as a mass on springs, the module's sprung mass m on n k of them (translation across
     the pipe, undamped: the legs have no damper, and a load faster than its period sqrt(m / (n k)) moves it less
     than the same load held, a load held as long as it more, up to twice), solved exactly from sample to sample
     with the load held over each (:func:`ring_response`); with ``dt`` None, statically.
 
+    Steer-compliant wheels (:func:`.pipe.rigid_wheels` false) hold a ring across the pipe only while their module
+    stands: a rolling wheel's side force is its cornering stiffness times its slip angle, the ring's sideways
+    speed over the module's ``speed`` [m/s] along the pipe (per sample, or None: unknown) less the module's
+    heading, so within their grip a rolling module's wheels are a damper across the pipe, C_r / |v| per ring (C_r
+    = cornering_coefficient P n / 2), and its heading (the rings' shifts' difference over ring_spacing) steers
+    both rings the way its nose points: the rings creep until their springs carry the load, the two moved
+    together (:func:`.ring_motion.rings_motion`), overdamped at a walk, nearly free at speed (speed None: no
+    damping, the larger response); where the wheels' force passes their friction they slide, and only that slide
+    counts towards ``slid{i}_m``.
+
     Returns per module i: ``least_press{i}_n`` [N], its least-pressed leg's press over the samples (the weight on
     the springs and the ring's place; < 0 a lift); ``slid{i}_m`` [m], the path its rings move across the pipe (the
     longer ring's); ``side_use{i}``, its largest load over what its wheels hold across the pipe while they grip along
-    it (over the samples and legs, > 1 where they slide; 0 with unlimited grip, inf with mu_wall 0 under a load; a
-    module that skids along the pipe holds less across it, Coulomb's cone, and nothing while it skids:
+    it (over the samples and legs, > 1 where they slide; 0 with unlimited grip, inf with mu_wall 0 under a load;
+    a module that skids along the pipe holds less across it, Coulomb's cone, and nothing while it skids:
     :func:`held`).
-    ``lift_predicted``: a least press below 0. ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
+    ``lift_predicted``: a least press below LIFT_SHARE of the leg's preload (where the run's ``wheel_off_s``
+    counts a wheel off its wall). ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
     outcome, ``scrubbed``, is the run's path from the same floor)."""
-    from .pipe import SCRUB_FLOOR
+    from .pipe import SCRUB_FLOOR, rigid_wheels
 
     n = int(params.wheel_legs)
     u, _ = leg_frames(n)
+    compliant = not rigid_wheels(params)
     out: dict = {}
     for i in (1, 2):
         module = i - 1
-        stiffness = (params.F_n1, params.F_n2)[module] / (2 * n) / params.suspension_travel
+        preload = (params.F_n1, params.F_n2)[module] / (2 * n)
+        stiffness = preload / params.suspension_travel
         frequency = math.sqrt(n * stiffness / sprung_mass(params, module))
         weight = weight_load(params, module)
         use = np.clip(np.asarray(grip_use[module], dtype=float), 0.0, 1.0)
         holds = side_holds(params, module)
         least, path, ratio = math.inf, 0.0, 0.0
+        rings = []
         for ring, sign in zip(RINGS, (1.0, -1.0)):
             load = np.asarray(loads[f"{i}{ring}"], dtype=float).reshape(-1, 2)
             samples = load.shape[0]
             ring_use = np.broadcast_to(use, (samples,)) if use.ndim else np.full(samples, float(use))
             load = load + sign * pitch_couple(params, module)[None, :] * ring_use[:, None]
             grip = held(params, module, load, ring_use)
-            spring = np.where(grip[:, None], 0.0, load)
-            moving = ~grip & np.broadcast_to(np.asarray(rolling[module], dtype=bool), (samples,))
+            rolls = np.broadcast_to(np.asarray(rolling[module], dtype=bool), (samples,))
+            creep = grip & rolls if compliant else np.zeros(samples, dtype=bool)
+            still = grip & ~creep
+            spring = np.where(still[:, None], 0.0, load)
+            moving = ~grip & rolls
             if params.mu_wall is not None and moving.any():
                 spring = spring + _steering_scrub(params, module, spring, moving)
-            place = spring if dt is None else ring_response(spring, grip, frequency * dt)
+            rings.append((load, grip, creep, still, spring))
+        steer = params.cornering_coefficient * params.suspension_travel / params.ring_spacing if compliant else 0.0
+        if dt is None:  # at rest on the springs; rings that creep together carry the heading's steering too
+            both = (rings[0][2] & rings[1][2])[:, None]
+            turn = np.where(both, steer * (rings[1][4] - rings[0][4]), 0.0)
+            moves = [(r[4] + turn, ~r[1]) for r in rings]
+        elif rings[0][2].any() or rings[1][2].any():
+            damping = creep_damping(params, module, speed[module])
+            places, slides = rings_motion([r[4] for r in rings], [r[3] for r in rings],
+                                          [np.where(r[2], damping, 0.0) for r in rings], frequency, dt, steer,
+                                          wheel_walls(params, module))
+            moves = [(place, slid & ~r[3]) for place, slid, r in zip(places, slides, rings)]
+        else:
+            moves = [(ring_response(r[4], r[1], frequency * dt), ~r[1]) for r in rings]
+        for (load, *_), (place, slides) in zip(rings, moves):
             least = min(least, float(np.min(leg_presses(params, module, place + weight))))
             shifts = np.diff(place, axis=0) * (2.0 / (n * stiffness))
-            path = max(path, float(np.sum(np.hypot(shifts[:, 0], shifts[:, 1]))))
+            path = max(path, float(np.sum(np.hypot(shifts[:, 0], shifts[:, 1])[slides[:-1]])))  # creep rolls
             if params.mu_wall is not None:  # against the whole grip: a skidding module's share is in held()
                 across = np.abs(load @ u.T)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    # a leg's direction its wheels hold nothing along (mu_wall 0) against a load: unbounded (inf)
-                    ratio = max(ratio, float(np.max(np.where(across > 0, across / holds[None, :], 0.0))))
+                with np.errstate(divide="ignore", invalid="ignore"):  # no grip: any load is beyond it (inf)
+                    ratio = max(ratio, float(np.max(np.where(holds[None, :] > 0, across / holds[None, :],
+                                                             np.where(across > 0, math.inf, 0.0)))))
         out[f"least_press{i}_n"] = least
         out[f"slid{i}_m"] = path
         out[f"side_use{i}"] = ratio
-    out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
+    floor = [LIFT_SHARE * F / (2 * n) for F in (params.F_n1, params.F_n2)]
+    out["lift_predicted"] = out["least_press1_n"] < floor[0] or out["least_press2_n"] < floor[1]
     out["scrub_predicted"] = max(out["slid1_m"], out["slid2_m"]) >= SCRUB_FLOOR
     return out
 
@@ -171,8 +209,10 @@ SCRUB_BINS = 720  # directions across the pipe the steering scrub is taken at (0
 
 def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray) -> np.ndarray:
     """The wheels' sideways scrub [N] along each sample's spring load (shape (n, 2)) where ``moving`` (the module
-    rolls and the ring slides), :func:`.pipe.ring_side_grip` at the load's direction rounded to one of SCRUB_BINS
-    (the law is called once per direction, not per sample); zero elsewhere."""
+    rolls and the ring slides): the ring's whole sideways friction, :func:`.pipe.ring_side_grip`, at the load's
+    direction rounded to one of SCRUB_BINS (the law is called once per direction, not per sample); zero elsewhere.
+    A ring slides only where its load is beyond what its wheels hold, so every wheel slides: a steer-compliant
+    wheel past its slip angle's limit pushes mu_wall P sideways, as a rigid one does."""
     from .pipe import ring_side_grip
 
     size = np.hypot(spring[:, 0], spring[:, 1])
@@ -190,6 +230,29 @@ def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray)
     return out
 
 
+def wheel_walls(params, module: int) -> tuple:
+    """What a ring of ``module``'s wheels hold by friction, for :func:`rings_motion`: (u, e, P, weight, mu_wall),
+    the legs' outward and sideways directions (n, 2), their preload [N], the ring's weight across the pipe [N]
+    (2,) and the friction coefficient: wheel k presses N_k = P + (2 / n) (X + weight) . u_k (X the springs' load
+    of the ring's place, at least 0) and its friction along a way d is mu_wall N_k |e_k . d|."""
+    n = int(params.wheel_legs)
+    u, e = leg_frames(n)
+    return u, e, (params.F_n1, params.F_n2)[module] / (2 * n), weight_load(params, module), params.mu_wall
+
+
+def creep_damping(params, module: int, speed) -> np.ndarray | float:
+    """The damping rate [1/s] (c / m) of a ring of ``module`` (0 rear, 1 front) across the pipe while its
+    steer-compliant wheels roll at ``speed`` [m/s] (an array, or None): C_r / |v| over half the sprung mass, C_r =
+    cornering_coefficient P n / 2 (sum_k C (e_k . d)^2 over the ring's wheels, C = cornering_coefficient P; a
+    wheel's slip angle is the ring's sideways speed over |v|); 0 with the speed unknown (None)."""
+    if speed is None:
+        return 0.0
+    n = int(params.wheel_legs)
+    C_r = params.cornering_coefficient * (params.F_n1, params.F_n2)[module] / (2 * n) * n / 2
+    with np.errstate(divide="ignore"):
+        return C_r / (0.5 * sprung_mass(params, module) * np.abs(np.asarray(speed, dtype=float)))
+
+
 def pitch_couple(params, module: int) -> np.ndarray:
     """The load [N] on each ring of ``module`` (0 rear, 1 front), (y, z), +- on its aft and fore rings, of the
     couple its wheels' friction along the pipe makes at the wall while it uses all its grip: each wheel's friction
@@ -202,39 +265,6 @@ def pitch_couple(params, module: int) -> np.ndarray:
     if params.mu_wall is None:
         return np.zeros(2)
     return params.mu_wall * 0.5 * params.pipe_diameter * 2.0 * weight_load(params, module) / params.ring_spacing
-
-
-def ring_response(spring: np.ndarray, grip: np.ndarray, step: float) -> np.ndarray:
-    """Where a ring sits [N: the springs' load that holds it there] at each sample, shape (n, 2): a mass on its
-    springs, undamped, pushed by ``spring`` (shape (n, 2)) held over each interval, ``step`` = omega dt its
-    natural frequency times the interval; at rest, where it is, while its wheels hold (``grip``, shape (n,)).
-    Exact for a load constant over each interval: with w = place + i velocity / omega, each interval turns
-    w - load by -``step``: w' = a w + (1 - a) load, a = exp(-i step), summed in closed form over each stretch
-    of samples where the wheels slide (from rest where they held)."""
-    spring = np.asarray(spring, dtype=float).reshape(-1, 2)
-    grip = np.asarray(grip, dtype=bool).reshape(-1)
-    out = np.zeros_like(spring)
-    free = np.flatnonzero(~grip)
-    if not free.size:
-        return out
-    breaks = np.flatnonzero(np.diff(free) > 1)
-    starts = np.concatenate([[free[0]], free[breaks + 1]])
-    ends = np.concatenate([free[breaks] + 1, [free[-1] + 1]])
-    a = complex(math.cos(step), -math.sin(step))
-    place = np.zeros(2)
-    last = 0
-    for j0, j1 in zip(starts, ends):
-        out[last:j0] = place  # held since the last stretch: where the ring stopped, at rest
-        k = np.arange(j1 - j0 + 1)
-        turn = np.exp(-1j * step * k)  # a^k
-        back = np.exp(1j * step * (k[:-1] + 1))  # a^-(m + 1)
-        for c in (0, 1):
-            w = turn * (place[c] + (1 - a) * np.concatenate([[0.0], np.cumsum(back * spring[j0:j1, c])]))
-            out[j0:j1, c] = w.real[:-1]  # the place at each sample's start; after the last, the place it stops at
-            place[c] = w.real[-1]
-        last = j1
-    out[last:] = place
-    return out
 
 
 def run_summary(params, series: dict, route_fit: dict | None = None, straight: bool = True) -> dict:
@@ -258,8 +288,13 @@ def run_summary(params, series: dict, route_fit: dict | None = None, straight: b
         loads = ring_loads(params, series["link_y1"], series["link_y2"], series["motor_torque"], series["link_z1"],
                            series["link_z2"])
         grip = tuple(series.get(f"grip_use{k}", 0.0) for k in (1, 2))
-        rolling = tuple(np.asarray(series[f"wheels{k}"]) == 1.0 for k in (1, 2))
-        result = check(params, loads, grip, rolling, float(np.median(np.diff(t))) if len(t) > 1 else None)
+        # rolling: its hubs turn free (+1), or, not skidding, it moves on (a light wheel's hub can stick while its
+        # module rolls: the state then says standing)
+        rolling = tuple((np.asarray(series[f"wheels{k}"]) == 1.0) | ((np.asarray(series[f"wheels{k}"]) != -1.0)
+                                                                    & (np.asarray(series[f"v{k}"]) > MOVING_SPEED))
+                        for k in (1, 2))
+        result = check(params, loads, grip, rolling, float(np.median(np.diff(t))) if len(t) > 1 else None,
+                       (series["v1"], series["v2"]))
         across = across_paths(series, params)
         out.update({key: result[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted", "side_use1",
                                                  "side_use2", "scrub_predicted")})

@@ -4,7 +4,6 @@ no simulation. Its rules: :mod:`.design_rules`."""
 from __future__ import annotations
 
 import argparse
-import json
 
 from ..command import add_model_options, check_input_file, model_params
 from ..contract import Declaration
@@ -18,8 +17,9 @@ def add_options(cmd: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace, figures) -> None:
-    from ipir_mujoco.engine.builders.wheels_model import check_wheels_params
+    from ipir_mujoco.engine.kinds.wheels.model import check_wheels_params
 
+    from ipir_mujoco.core.results import json_text
     from .design_rules import design_rules
 
     params = model_params(args)
@@ -32,8 +32,8 @@ def run(args: argparse.Namespace, figures) -> None:
         route = read_route(args.route)
         route.check_pipe(params.pipe_diameter)
     result = design_rules(params, route)
-    if args.json:
-        print(json.dumps(result, allow_nan=False))
+    if args.json:  # a figure without bound (a side load where the wheels hold nothing) is null, as in a summary
+        print(json_text(result))
     else:
         print(format_rules(result))
 

@@ -33,6 +33,7 @@ from ipir_mujoco.core.errors import ParameterError
 from ipir_mujoco.core.params import RobotParams
 
 from ipir_mujoco.core.results import REST_SPEED
+from ipir_mujoco.core.wheel_checks import LIFT_SHARE
 
 from ...builders.model import CRANK_HINGE, MOTOR, SLIDES, SolverSettings, dof_address, drive_torque_slope, qpos_address
 from .model import HOUSINGS, contact_friction, leg_names, wheels_timestep
@@ -195,7 +196,6 @@ class WheelRatchet(ControllerBase):
         return normal[0], normal[1], off[0] + off[1]
 
 
-LIFT_SHARE = 0.05  # a leg is off its wall while its spring presses with less than this share of its preload
 
 
 def leg_press(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
