@@ -100,3 +100,38 @@ def test_a_sweep_under_the_older_name_runs_the_same_and_says_so_in_one_line(caps
     assert notes == ["ipir-mujoco sweep: note: --engines is deprecated and will be removed in the next release; "
                      "use --variants"]
     assert (tmp_path / "new" / "results.csv").read_bytes() == (tmp_path / "old" / "results.csv").read_bytes()
+
+
+# a study's command with the least it needs to start its work: each refuses a declared file's name taken by a folder
+STARTS = {"sweep": ["--vary", "L=0.1,0.2"], "optimize": ["--vary", "L=0.1:0.3", "--objective", "max:revolutions"],
+          "sensitivity": ["--vary", "L=0.1:0.3", "--metric", "revolutions"], "atlas": ["--vary", "L=0.1:0.3"],
+          "clutch-study": ["--quick"], "climb": [], "control-study": ["--quick"]}
+
+
+@pytest.mark.parametrize("name", sorted(STARTS))
+def test_a_study_checks_the_files_its_declaration_names_before_any_work(name, tmp_path, capsys):
+    """Every file a study's declaration names is checked before the work (a folder already of that name: exit 2,
+    one line naming it, nothing written)."""
+    from ipir_mujoco.cli import main
+
+    study = next(s for s in declared() if s.name == name)
+    assert study.files
+    for file in study.files:
+        out = tmp_path / file.replace(".", "_")
+        (out / file).mkdir(parents=True)
+        code = main([name, *STARTS[name], "--out", str(out)])
+        err = capsys.readouterr().err
+        assert code == 2 and file in err and err.count("\n") == 1, (file, err)
+        assert sorted(p.name for p in out.iterdir()) == [file]
+
+
+def test_the_studies_that_check_their_files_in_their_own_module_check_the_declared_ones():
+    """sweep, atlas, optimize and sensitivity run from Python as well (run_sweep, run_atlas, ...), so their own module
+    checks its files; the list is the declaration's (a light module cannot import theirs)."""
+    from ipir_mujoco.studies.design import optimize, sensitivity
+    from ipir_mujoco.studies.idealizations import atlas
+    from ipir_mujoco.studies.sweeps import sweep
+
+    studies = {s.name: s for s in declared()}
+    for name, module in (("sweep", sweep), ("atlas", atlas), ("optimize", optimize), ("sensitivity", sensitivity)):
+        assert tuple(module.OUTPUT_FILES) == studies[name].files, name

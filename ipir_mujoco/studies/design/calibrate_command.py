@@ -28,7 +28,7 @@ def run(args: argparse.Namespace, figures) -> None:
     from .calibrate import calibrate, parse_fit, write_files
     from ..comparison.measured import read_measured
 
-    check_output_dir(args.out, files=("calibration.json", "posterior.toml", "calibration.png"))
+    check_output_dir(args.out, files=STUDY.files)
     check_input_file("--data", args.data)
     fits = [parse_fit(f) for f in args.fit]
     base = model_params(args)

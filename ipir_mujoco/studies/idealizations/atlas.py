@@ -215,6 +215,9 @@ def _costs(rows: list[dict], metric: str) -> np.ndarray:
     return np.array([np.nan if r["cost"].get(metric) is None else r["cost"][metric] for r in rows], dtype=float)
 
 
+OUTPUT_FILES = ("atlas.json", "samples.csv")  # its declaration's (atlas_command), held equal by a test
+
+
 def run_atlas(atlas: Atlas, out: str | Path, *, resume: bool = False, workers: int | None = None,
               progress: Callable[[str], None] = lambda _m: None, show_bars: bool = True) -> dict:
     """Run the atlas, write OUT/samples.csv and OUT/atlas.json; return atlas.json's content plus, under
@@ -225,7 +228,7 @@ def run_atlas(atlas: Atlas, out: str | Path, *, resume: bool = False, workers: i
     if workers is not None:
         check_whole("workers", workers, low=1, high=1024)
     workers = workers or os.cpu_count() or 1
-    out = check_output_dir(out, files=("samples.csv", "atlas.json"))
+    out = check_output_dir(out, files=OUTPUT_FILES)
     meta = out / "atlas.json"
     fingerprint = atlas.fingerprint()
     _check_resume(out, fingerprint, resume)

@@ -218,6 +218,9 @@ def _batch_design_metrics(outcome: dict) -> dict:
     return metrics
 
 
+OUTPUT_FILES = ("results.csv", "sweep.json", "best.json")  # its declaration's (sweep_command), held equal by a test
+
+
 def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_design, batch_size) -> Path:
     """The options of a sweep beside the study, checked before anything is created."""
     if workers is not None:
@@ -226,7 +229,7 @@ def check_sweep_options(out: str | Path, resume: bool, workers, timeout_per_desi
         check_real("timeout_per_design", timeout_per_design, high=1e6, unit="s")
     if batch_size is not None:
         check_whole("batch_size", batch_size, low=1, high=100_000)
-    out = check_output_dir(out, files=("results.csv", "sweep.json", "best.json"))
+    out = check_output_dir(out, files=OUTPUT_FILES)
     meta = out / "sweep.json"
     if resume and out.is_dir() and any(out.iterdir()) and not meta.is_file():
         raise ParameterError(f"--resume --out {str(out)!r}: the folder holds no sweep (no sweep.json); give the "

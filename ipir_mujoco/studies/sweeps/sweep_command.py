@@ -117,4 +117,4 @@ STUDY = Declaration(
     "sweep", "what-if studies: engines over a grid or a sample of designs",
     "Vary parameters over a grid, a list or a space-filling sample; run the chosen engines on every design; stream "
     "the results to DIR/results.csv and draw them. Ctrl-C keeps what is done; --resume completes it.",
-    options=add_options, run=run, files=("results.csv", "best.json"), figures="sweep_plots")
+    options=add_options, run=run, files=("results.csv", "sweep.json", "best.json"), figures="sweep_plots")

@@ -41,7 +41,7 @@ def run(args: argparse.Namespace, figures) -> None:
     from .uncertainty import check_metric, parse_event, run_uncertainty, write_files
     from .uq_dists import combine, parse_dist, read_dist_file
 
-    check_output_dir(args.out, files=("uncertainty.json", "samples.csv", "uncertainty.png"))
+    check_output_dir(args.out, files=STUDY.files)
     base = model_params(args)
     from_file, correlation = read_dist_file(args.dist_file) if args.dist_file is not None else ([], None)
     dists = combine([parse_dist(d) for d in args.dist], from_file)
