@@ -12,7 +12,7 @@ affects both alike. A skidding run is the first of a family of runs extrapolated
 run's (the run the same design makes where it does not skid: the same model at the same step), measured within
 the one run, and in steps; beside it the ratio to the unlimited-grip run (finite grip adds two carriages and four
 constraint rows per step). The compliant clutch on finite grip is not extrapolated: its ratio is its spring's
-step (timestep.clutch_rate). Which loop steps: IPIR_MUJOCO_STEPPER=python forces the Python loop.
+step on its skidding carriage (timestep.carriage_rate). Which loop steps: IPIR_MUJOCO_STEPPER=python forces the Python loop.
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
 """What the studies' cap on samples per run (``ipir_mujoco.core.options.STUDY_SAMPLES``) costs clutch-study.
 
 clutch-study samples MuJoCo's compliant runs at every step so that no engagement peaks between samples. With a
-finite grip the step is ~30 times finer (MuJoCo's skidding carriage, 1e-3 of its module's mass, on the clutch
-spring), and a 10 s cruise at every step kept 3.2e6 samples (a 1.9 GB study at ``--quick``). The cap samples such
+finite grip the step is finer (MuJoCo's skidding carriage, 1e-3 of its module's mass, on the clutch spring: ~30
+times until Dec 7, ~10 times since, ``timestep.CARRIAGE_STEP_SHARE``), and a 10 s cruise at every step kept 3.2e6
+samples (a 1.9 GB study at ``--quick``). The cap samples such
 a run every n-th step. This bench runs each of ``clutch-study --quick``'s MuJoCo compliant runs at a finite grip
 (and at unlimited grip, where the cap does not bind) twice: sampled at every step and as the study samples it,
 and prints per run the samples kept, the peak clutch force both ways, their relative difference and the bound the

@@ -19,6 +19,7 @@ from ipir_mujoco.engine.controllers.compliant import CompliantClutches
 from ipir_mujoco.engine.builders.model import (FRONT_CLUTCH, FRONT_SLIDE, MOTOR, REAR_CLUTCH, REAR_SLIDE, SolverSettings,
                                       build_model, dof_address, drive_control, set_closed_loop_state)
 from ipir_mujoco.engine.loop.monitor import RESIDUAL_TOL
+from ipir_mujoco.engine.builders.grip_model import COMPLIANT_CARRIAGE_SHARE
 from ipir_mujoco.engine.modelkinds.timestep import CLUTCH_SHARE, choose_settings, clutch_rate
 
 EPS = np.finfo(float).eps
@@ -256,6 +257,22 @@ def test_the_timestep_resolves_the_clutch_spring():
     with pytest.raises(ParameterError, match=r"clutch_stiffness=1e\+11 N/m: MuJoCo would need a timestep of "
                                              r"3.2e-07 s .*\(a stiffness up to 1e\+10 N/m here"):
         choose_settings(RobotParams(clutch_stiffness=1e11), 0.5, 1e-4)
+
+
+def test_on_finite_grip_the_timestep_resolves_the_skidding_carriage_at_its_own_share():
+    """With finite grip the spring also rings on the carriage (1e-3 of its module's mass): dt <= 0.3 / omega_s,
+    omega_s = sqrt(k (1/m + 1/m_c)), which is 6.7 times inside the explicit spring's stability (omega_s dt < 2)
+    and looser than the module's own 0.1 / omega_c would be on it; the refusal names the stiffness that fits."""
+    for k, m2 in ((1e6, 1.0), (1e5, 0.25), (1e4, 1.0)):
+        params = RobotParams(clutch_stiffness=k, m2=m2, mu_wall=0.5)
+        lightest = min(params.m1, m2)
+        omega_s = math.sqrt(k * (1 / lightest + 1 / (COMPLIANT_CARRIAGE_SHARE * lightest)))
+        settings, why = choose_settings(params, 0.5, 1e-4)
+        assert why["clutch_s"] == pytest.approx(min(0.1 * math.sqrt(lightest / k), 0.3 / omega_s))
+        assert omega_s * settings.timestep <= 0.3 * (1 + 1e-12) < 2
+    with pytest.raises(ParameterError, match=r"clutch_stiffness=1e\+09 N/m: .*on the skidding carriage.*"
+                                             r"\(a stiffness up to 8.99e\+07 N/m here"):
+        choose_settings(RobotParams(clutch_stiffness=1e9, mu_wall=0.5), 0.5, 1e-4)
 
 
 

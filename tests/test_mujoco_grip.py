@@ -343,7 +343,7 @@ def test_compliant_clutches_on_finite_grip_close_the_energy_audit():
 
 def test_a_compliant_clutch_far_below_its_grip_runs_as_without_grip():
     """10 kN of grip: the carriages never slide; the run equals the compliant one on unlimited grip within
-    MuJoCo's accuracy target, 0.1 % (the timestep differs: the carriage's rule, timestep.clutch_rate)."""
+    MuJoCo's accuracy target, 0.1 % (the timestep differs: the carriage's rule, timestep.clutch_step)."""
     base = dict(drive="motor", clutch_stiffness=1e5, clutch_damping=20.0)
     unlimited = mujoco_run(RobotParams(**base), 0.5)
     far = mujoco_run(RobotParams(**base, mu_wall=1.0, F_n1=1e4, F_n2=1e4), 0.5)

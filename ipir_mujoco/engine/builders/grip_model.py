@@ -59,7 +59,7 @@ ROLLS = ("rear_roll", "front_roll")  # tendons L_i = x_i - c_i
 # one-way limits give: at 1e-4 a 40 deg design's limits gave 3.3e-3 m at 1e-4 s (1.2e-10 m at 3e-4 and 1e-3);
 # the solver's rare unconverged steps, ~2e-4 N for one step, were as frequent at 1e-3, 1e-4 and 1e-5
 CARRIAGE_SHARE = 3e-4
-COMPLIANT_CARRIAGE_SHARE = 1e-3  # compliant clutches: the spring on it sets the step (timestep.clutch_rate)
+COMPLIANT_CARRIAGE_SHARE = 1e-3  # compliant clutches: the spring on it sets the step (timestep.carriage_rate)
 BODY_MASS = 1e-12  # kg, inertia 1e-12 kg m^2: the carriage body's own (MuJoCo needs > 1e-15 on a moving body)
 MARGIN = 1e-9  # m: the one-way limits' margin, as the ratchet's (clutches.Ratchet)
 

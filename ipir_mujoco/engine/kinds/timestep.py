@@ -37,7 +37,21 @@ interval. Further limits:
   turning point, each up to (omega dt)^2 / 8); tests/test_mujoco_compliant.py
   holds the impacts of the paper's start and the default motor's cruise to it
   against the analytic clutch, while revolutions and travel are set by the
-  speed rule above.
+  speed rule above;
+- compliant clutches on finite grip: the spring also acts on the skidding
+  carriage (:mod:`.grip_model`), an inertia m_c = COMPLIANT_CARRIAGE_SHARE m_i
+  the model adds (the analytic anchor has none), whose mode is
+  omega_s = sqrt(k (1 / min(m1, m2) + 1 / min(m_c1, m_c2))), about 32 omega_c:
+  dt <= CARRIAGE_STEP_SHARE / omega_s. CARRIAGE_STEP_SHARE = 0.3 (21 steps per
+  period): 6.7 times inside the explicit spring's stability limit
+  (omega_s dt < 2; beyond it a skid runs 3.6 times too long, mjcf/README.md),
+  and the mode decides only how far the clutch force overshoots G_i while the
+  carriage slides (its inertia force). Resolving it at 0.1 as the module's mode
+  cost clutch-study --quick on finite grip 7.4 times its time on unlimited
+  grip; at 0.3 revolutions and travel stay within 3.3e-4 of the analytic model,
+  undamped peak forces move by about 1e-3 and damped ones by up to 1.1 %,
+  inside the peak's stated bound (omega_s dt)^2 / 4 (mjcf/README.md has the
+  measurements, ``python bench/carriage_step.py`` makes them).
 
 Bounds on the crank: for a constant torque M, the energy the drive put in
 bounds the crank's kinetic energy, J_A omega^2 / 2 <= KE(0) + |M| (phi - phi0),
@@ -72,23 +86,42 @@ TARGET = 0.5 * RESIDUAL_TOL  # predicted residual ratio to aim at: half the moni
 RESIDUAL_CONSTANT = {"ratchet": 0.36, "lock": 2.4, "none": 0.36}  # C of the law above, per clutch
 LEAK_RATIO = 3e4  # module-to-rod mass ratio from which a light rod shortens the step
 SERVO_SHARE = 0.2  # of 1 / (servo rate)
-CLUTCH_SHARE = 0.1  # of 1 / omega_c, the fastest clutch spring's angular frequency (see the module docstring)
+CLUTCH_SHARE = 0.1  # of 1 / omega_c, the clutch spring's angular frequency on a module (see the module docstring)
+CARRIAGE_STEP_SHARE = 0.3  # of 1 / omega_s, the spring's mode on a skidding carriage (finite grip; module docstring)
 # the slide model on finite grip (rigid clutches): its grip rows' time constant over its step, in the runs of the rigid
 # limit's family (ipir_mujoco.engine.kinds.slides_grip.rigid_limit; mjcf/README.md, "Finite grip: the rigid limit", says why 8)
 STEPS_PER_TIME_CONSTANT = 8
 
 
 def clutch_rate(params: RobotParams) -> float:
-    """omega_c = sqrt(k / min(m1, m2)) [rad/s]: no clutch spring oscillates faster (0 for rigid clutches).
-    With finite grip the spring acts between the module and its carriage (:mod:`.grip_model`), whose inertia
-    m_c = COMPLIANT_CARRIAGE_SHARE m_i moves with it while the carriage slides: then
-    omega_c = sqrt(k (1 / min(m1, m2) + 1 / min(m_c1, m_c2))) (the Rayleigh quotient k (u - w)^2 / (m u^2 + m_c w^2) is at most k (1/m + 1/m_c))."""
+    """omega_c = sqrt(k / min(m1, m2)) [rad/s]: no clutch spring oscillates faster on the modules (0 for rigid
+    clutches); the analytic model's clutch rate whatever the grip (its anchor has no mass)."""
     if params.clutch_stiffness is None:
         return 0.0
+    return math.sqrt(params.clutch_stiffness / min(params.m1, params.m2))
+
+
+def carriage_rate(params: RobotParams) -> float:
+    """omega_s [rad/s], the clutch spring's fastest mode in MuJoCo: with finite grip the spring acts between the
+    module and its carriage (:mod:`.grip_model`), whose inertia m_c = COMPLIANT_CARRIAGE_SHARE m_i moves with it
+    while the carriage slides, so omega_s = sqrt(k (1 / min(m1, m2) + 1 / min(m_c1, m_c2))) (the Rayleigh
+    quotient k (u - w)^2 / (m u^2 + m_c w^2) is at most k (1/m + 1/m_c)); :func:`clutch_rate` on unlimited grip,
+    0 for rigid clutches."""
+    if params.clutch_stiffness is None or params.grip is None:
+        return clutch_rate(params)
     lightest = min(params.m1, params.m2)
+    return math.sqrt(params.clutch_stiffness * (1.0 / lightest + 1.0 / (COMPLIANT_CARRIAGE_SHARE * lightest)))
+
+
+def clutch_step(params: RobotParams) -> float:
+    """The longest step [s] that resolves the compliant clutches (module docstring): CLUTCH_SHARE / omega_c, and
+    with finite grip CARRIAGE_STEP_SHARE / omega_s too; inf for rigid clutches."""
+    if params.clutch_stiffness is None:
+        return math.inf
+    step = CLUTCH_SHARE / clutch_rate(params)
     if params.grip is not None:
-        return math.sqrt(params.clutch_stiffness * (1.0 / lightest + 1.0 / (COMPLIANT_CARRIAGE_SHARE * lightest)))
-    return math.sqrt(params.clutch_stiffness / lightest)
+        step = min(step, CARRIAGE_STEP_SHARE / carriage_rate(params))
+    return step
 
 
 def crank_bounds(params: RobotParams, t_end: float) -> tuple[float, float]:
@@ -112,10 +145,13 @@ def _too_small(limit: str, needed: float, params: RobotParams, t_end: float, ome
     below = f"MuJoCo would need a timestep of {needed:.2g} s"
     allowed = f"allowed: runs needing a timestep >= {DT_MIN:g} s"
     if limit == "clutch_s":
+        rule = f"{CLUTCH_SHARE:g} sqrt(min(m1, m2) / k)"
+        if params.grip is not None:
+            rule += (f", and {CARRIAGE_STEP_SHARE:g} / sqrt(k (1/m + 1/m_c)) on the skidding carriage, "
+                     f"m_c = {COMPLIANT_CARRIAGE_SHARE:g} m")
         return (f"clutch_stiffness={params.clutch_stiffness:g} N/m: {below} to resolve the clutch spring "
-                f"({CLUTCH_SHARE:g} sqrt(min(m1, m2) / k)); {allowed} (a stiffness up to "
-                f"{min(params.m1, params.m2) * (CLUTCH_SHARE / DT_MIN) ** 2:.3g} N/m here, or give the timestep "
-                "yourself)")
+                f"({rule}); {allowed} (a stiffness up to {params.clutch_stiffness * (needed / DT_MIN) ** 2:.3g} "
+                "N/m here, or give the timestep yourself)")
     if limit == "rod_mass_s":
         ratio = max(params.m1, params.m2) / params.rod_mass
         return (f"rod_mass={params.rod_mass:g} kg: the module-to-rod mass ratio {ratio:.3g} makes MuJoCo's soft "
@@ -150,7 +186,7 @@ def choose_settings(params: RobotParams, t_end: float, dt_out: float, servo=None
     if params.drive == "servo":
         limits["control_s"] = 1.0 / params.control_rate
     if params.clutch_stiffness is not None:
-        limits["clutch_s"] = CLUTCH_SHARE / clutch_rate(params)
+        limits["clutch_s"] = clutch_step(params)
     needed = min(limits.values())
     if needed < DT_MIN:
         raise ParameterError(_too_small(min(limits, key=limits.get), needed, params, t_end, omega_b, servo))

@@ -24,10 +24,12 @@ Per run (:func:`run_metrics`; cruise: over the steady window, the last
   h <= 0.1 / omega_c: its peak lies within (omega_c h)^2 / 4 <= 2.5e-3 of the
   converged one (entering the spring between two steps, and the turning point
   between samples, each up to (omega_c h)^2 / 8; mjcf/README.md); every n-th
-  step where that would keep more than STUDY_SAMPLES samples: with a finite
+  step where that would keep more than STUDY_SAMPLES samples. With a finite
   grip MuJoCo's skidding carriage (1e-3 of its module's mass) rings on the
-  spring ~30 times faster than omega_c, its step is that much finer, and the
-  bound (carriage rate x n h)^2 / 4 (at most 1) no longer resolves the peak;
+  spring ~32 times faster than omega_c, at 0.3 / its rate per step
+  (:mod:`ipir_mujoco.engine.kinds.timestep`): the bound is then
+  (carriage rate x n h)^2 / 4 (0.0225 at every step, at most 1) on the peak's
+  excess over the grip, which is that carriage's inertia force;
   ``python bench/study_samples.py`` measures the difference every n-th step
   makes to each peak.
 * ``peak_acceleration_m_s2`` [m/s^2]: the largest |a1|, |a2| (the linkage's
@@ -70,7 +72,7 @@ from ipir_mujoco.core.options import study_dt_out
 from ipir_mujoco.core.params import (RobotParams, check_whole, refuse_idle_parameters, refuse_idle_under,
                                      require_params)
 
-from ...engine.kinds.timestep import clutch_rate
+from ...engine.kinds.timestep import carriage_rate, clutch_rate
 from ..pool import map_unordered
 
 
@@ -168,18 +170,12 @@ def design(base: RobotParams, point: OperatingPoint, stiffness: float | None, ba
     return base.replace(drive=point.drive, clutch_stiffness=stiffness, clutch_backlash=backlash)
 
 
-def spring_rate(params: RobotParams) -> float:
-    """sqrt(k / min(m1, m2)) [rad/s]: the clutch spring's fastest oscillation on a module (0: rigid). The analytic
-    model's clutch anchor has no mass (a finite grip's skid slides it at the grip), so this is its clutch's rate
-    whatever the grip; MuJoCo's skidding carriage adds a faster mode of its own (:func:`.timestep.clutch_rate`)."""
-    return 0.0 if params.clutch_stiffness is None else math.sqrt(params.clutch_stiffness / min(params.m1, params.m2))
-
-
 def analytic_dt_out(params: RobotParams, t_end: float | None = None) -> float:
-    """Output interval [s]: at most 1/500 of the clutch spring's period (:func:`spring_rate`), at most 1e-4 s, and
+    """Output interval [s]: at most 1/500 of the clutch spring's period (:func:`.timestep.clutch_rate`: the analytic
+    anchor has no mass, so that is its clutch's rate whatever the grip), at most 1e-4 s, and
     with ``t_end`` [s] coarse enough to keep at most STUDY_SAMPLES samples (:func:`.options.study_dt_out`: the
     peak force is sampled whatever the grid, the module docstring)."""
-    rate = spring_rate(params)
+    rate = clutch_rate(params)
     wanted = DT_OUT_MAX if rate == 0 else min(DT_OUT_MAX, 2 * math.pi / rate / OUTPUT_PERIODS)
     return wanted if t_end is None else study_dt_out(t_end, wanted)
 
@@ -251,13 +247,13 @@ def run_task(base: RobotParams, point: OperatingPoint, task: Task) -> dict:
 def _peak_bound(params: RobotParams, task: Task, run, dt_out: float) -> float | None:
     """Relative error bound of the peak force as sampled (see the module docstring); None for rigid runs. MuJoCo's
     at its sampling interval ``dt_out`` [s] (its step, or n of them), with the fastest mode its spring takes part
-    in (with a finite grip the skidding carriage's: :func:`.timestep.clutch_rate`), at most 1: past
+    in (with a finite grip the skidding carriage's: :func:`.timestep.carriage_rate`), at most 1: past
     omega dt_out ~ 2 sampling resolves no peak."""
     if task.stiffness is None:
         return None
     if task.engine == "analytic":  # a maximum located on the dense output to the search's time tolerance
-        return 0.0 if params.clutch_damping == 0 else (spring_rate(params) * PEAK_TIME_TOL * run.t_end) ** 2
-    return min(1.0, (clutch_rate(params) * max(run.settings["timestep"], dt_out)) ** 2 / 4)
+        return 0.0 if params.clutch_damping == 0 else (clutch_rate(params) * PEAK_TIME_TOL * run.t_end) ** 2
+    return min(1.0, (carriage_rate(params) * max(run.settings["timestep"], dt_out)) ** 2 / 4)
 
 
 def run_metrics(run, point: OperatingPoint) -> dict:
