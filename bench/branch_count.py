@@ -27,7 +27,7 @@ modules of an effect (``*grip*.py``). Reported by where they stand, each group w
   kinds").
 - ``analytic``: the analytic model choosing its own model from the parameters (``analytic/__init__.py``,
   the run loops): the analytic side's counterpart of ``kind_for``; it has no seam with the engine by design.
-- ``core``: the parameter's own definition and checks (``core/params.py``), the grip-use figure, the pipe fit.
+- ``core``: the parameter's own definition and checks (``core/param_table.py``), the grip-use figure, the pipe fit.
 - ``studies``: studies, reports and their command-line output whose subject is finite grip (traction,
   climbing, bends, the atlas's axes).
 - ``drawing``: the replay, the video and ``render`` drawing the wheeled model's legs or the slide model.

@@ -1,6 +1,6 @@
 """Every value the parameter table allows runs cleanly: the table's limits walked through each command.
 
-The cases come from the table itself (:class:`ipir_mujoco.core.params.RobotParams`' field metadata): each
+The cases come from the table itself (:class:`ipir_mujoco.core.param_table.RobotParams`' field metadata): each
 numeric field at its lowest and highest allowed value (the nearest float inside an open bound), its word for
 None where it has one, and every choice of the choice fields. A limit one field allows may still be refused
 for the set it makes with the others (L at its lowest is below r): that is bad input, one line, exit 2. A

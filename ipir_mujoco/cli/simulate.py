@@ -262,7 +262,7 @@ def accuracy_line(accuracy: dict) -> str:
 
 
 def drive_text(params) -> str:
-    """What turns the crank, in words with the parameters it acts through (core.params.DRIVE_FIELDS)."""
+    """What turns the crank, in words with the parameters it acts through (core.drive_fields.DRIVE_FIELDS)."""
     motor = f"M_stall {params.M_stall:g} N m, no-load {params.omega_noload:g} rad/s"
     if params.drive == "torque":
         return f"constant torque M {params.M:g} N m (the paper's)"

@@ -82,7 +82,7 @@ def model_params(args: argparse.Namespace) -> RobotParams:
     --feedforward (refused in one line with a drive other than servo)."""
     drive = getattr(args, "drive", None)
     # --drive as the last --set, not a replace(): a drive's parameters given with another drive are refused by
-    # the run (core.params.refuse_idle_parameters), where replace() would quietly reset them
+    # the run (core.drive_fields.refuse_idle_parameters), where replace() would quietly reset them
     params = load_params(args.config, [*args.overrides, *([f"drive={drive}"] if drive is not None else [])])
     feedforward = getattr(args, "feedforward", None)
     if feedforward is not None:

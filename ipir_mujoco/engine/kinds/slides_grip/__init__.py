@@ -17,7 +17,7 @@ RATCHETS = "ipir_mujoco.engine.kinds.slides_grip.ratchet"  # where the header of
 def refuse_grip(params, implementation: str) -> None:
     """ParameterError (one line) for a finite ``mu_wall`` with a clutch that has no grip: the locks (an equality
     holds whatever the load) and no clutch. (Wheel normal forces given with unlimited grip are refused for
-    every engine by :func:`ipir_mujoco.core.params.refuse_idle_parameters`.)"""
+    every engine by :func:`ipir_mujoco.core.drive_fields.refuse_idle_parameters`.)"""
     from ipir_mujoco.core.errors import ParameterError
 
     if params.mu_wall is not None and implementation != "ratchet":
