@@ -74,7 +74,7 @@ _TOL_V, _TOL_F = 1e-8, 1e-7
 # [m/s] the absolute floor of the regime logic's rest test (|v| <= _TOL_V * v_scale + floor): as the one-way
 # model's _MODE_REST_FLOOR (1e-12), but a hundred times its switches' hysteresis speed (_HYSTERESIS_SPEED, 1e-12),
 # so that a module let go at the hysteresis speed reads as rest, not as moving; far below the series' rest
-# (core.results.REST_SPEED, 1e-6)
+# (core.columns.REST_SPEED, 1e-6)
 _REGIME_REST_FLOOR = 1e-10
 # [rad] how far on from a dead centre at rest the friction states are decided: the module loads then are
 # O(K' step) = 5e-7 of the stroke's (far above roundoff), the gap has moved O(K' step^2) = 1e-12 of it

@@ -15,7 +15,7 @@ instant are unique (they minimise a strictly convex function); only which of two
 states a module at rest is in can tie, on the boundary between them.
 
 Modes (:class:`GripMode`): the one-way model's four kinematics (which modules
-stand, :class:`.results.Mode`) with each moving module rolling forward or
+stand, :class:`.columns.Mode`) with each moving module rolling forward or
 skidding back; nine in all. The equations of a mode are the one-way model's
 with a skidding module's resistance F_ri replaced by -G_i (the force then pushes
 it forward): :meth:`.OneDofDynamics.with_resistance`. The kernels integrate them

@@ -12,7 +12,7 @@ A model's constants travel as one float array ``p`` (:func:`pack`, the
 [phi, omega, x1, x2, motor work]; one event, S_dot = K omega) and
 :data:`UNILATERAL` (one-way clutches; state [phi, omega, x1, x2, v1, motor
 work]; event k of a mode watches module k: its velocity while it moves, its
-hold margin R_k + F_rk while held), both with :class:`.results.Mode` values as
+hold margin R_k + F_rk while held), both with :class:`.columns.Mode` values as
 modes, :data:`COMPLIANT` (compliant one-way clutches, see below) and :data:`GRIP`
 (one-way clutches on wheels of finite grip, :mod:`.grip_model`: the one-way model's
 right-hand sides, its own events).

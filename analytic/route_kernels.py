@@ -44,7 +44,7 @@ from .route_geometry import add, combine, cross, dot, module_pose, scale, sub
 from .route_scrub import module_scrub
 
 ROUTE = 4  # the kernels' model number
-CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # results.Mode; 0 (both held) is statics
+CONTRACTION, EXPANSION, BOTH_MOVING = 1, 2, 3  # columns.Mode; 0 (both held) is statics
 # per mode: each module's grip G_i [N] (inf: unlimited), its state (+1 rolling, -1 skidding, 0 held), the clutch
 # rule (RULE_ONE_WAY, RULE_PAPER); the robot: half its ring spacing h [m], the modules' transverse inertias
 # [kg m^2]; gravity's acceleration vector g_vec [m/s^2] in route coordinates; the route's length [m], how many

@@ -25,7 +25,7 @@ HELD = {Mode.CONTRACTION: (False, True), Mode.EXPANSION: (True, False),
 _TOL_V, _TOL_A, _TOL_F = 1e-8, 1e-7, 1e-7
 # [m/s] the absolute floor of the mode logic's rest test (|v| <= _TOL_V * v_scale + floor): a speed below it (a
 # nanometre in a quarter hour) is rest to the event logic; without a floor a crank started at 1e-12 rad/s with no
-# torque is neither at rest nor able to move in any mode. A numerical zero, not core.results.REST_SPEED (1e-6 m/s,
+# torque is neither at rest nor able to move in any mode. A numerical zero, not core.columns.REST_SPEED (1e-6 m/s,
 # the series' rest, which reads MuJoCo's soft creep as rest): this model's rest is exact, so its floor sits just
 # above round-off. The compliant model's floor (compliant_state._REGIME_REST_FLOOR) is higher for its hysteresis.
 _MODE_REST_FLOOR = 1e-12

@@ -30,7 +30,7 @@ SUMMARY: dict[str, tuple[str, str]] = {
     "speed_ripple": ("crank speed ripple, peak-to-peak / mean", "-"),
 }
 
-# time-series column -> name; its unit is the result container's (core.results.SERIES_UNITS). ``SERIES``
+# time-series column -> name; its unit is the result container's (core.columns.SERIES_UNITS). ``SERIES``
 # (column -> (name, unit)) is built at its first use: core.results loads numpy, which a command's --help does not
 SERIES_NAMES = {"t": "time", "phi": "crank angle", "omega": "crank speed", "x1": "module 1 position",
                 "x2": "module 2 position", "v1": "module 1 velocity", "v2": "module 2 velocity", "S": "gap S",

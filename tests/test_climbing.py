@@ -122,7 +122,7 @@ def test_the_default_motor_stalls_in_a_vertical_pipe_in_both_engines_at_the_same
     found = {name: climbing.run_metrics(run) for name, run in runs.items()}
     an, mj = found["analytic"], found["mujoco"]
     assert an["stalled"] and mj["stalled"]
-    # each says why, in one line, in the same words (core.results.stall_reason): only the figures differ
+    # each says why, in one line, in the same words (core.summary.stall_reason): only the figures differ
     assert "cannot move the linkage against the resistances and gravity" in an["stall_reason"]
     assert re.sub(r"[0-9.]+", "#", an["stall_reason"]) == re.sub(r"[0-9.]+", "#", mj["stall_reason"])
     # and each run ends REST_TIME after its robot came to rest (MuJoCo at its next 0.05 s check)

@@ -1,5 +1,5 @@
 """The grip keys mean the same in every engine: one skidding design run by every variant that models finite
-grip, read through the one definition in core (``ipir_mujoco.core.results.grip_use``, ``peak_grip_use``).
+grip, read through the one definition in core (``ipir_mujoco.core.summary.grip_use``, ``peak_grip_use``).
 
 A variant whose clutch cannot skid (the paper's rule, MuJoCo's locks) refuses a finite grip in one line."""
 

@@ -1,7 +1,7 @@
 """Every summary a run gives is writable as the documented JSON, on the designs that push its figures to their
 extremes: no grip (mu_wall 0), unlimited grip, a stall, a lift, a skid; in every engine that takes the design.
 
-A figure that is not finite is null in the JSON (core.results.json_ready: one rule at the writer). Which keys
+A figure that is not finite is null in the JSON (core.json_out.json_ready: one rule at the writer). Which keys
 may be non-finite is held here, so that a new inf or nan in a summary is a decision documented in docs/cli.md
 (what its null means) and not a bug the writer hides.
 """

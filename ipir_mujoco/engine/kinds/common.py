@@ -139,7 +139,7 @@ def rest_since(t: np.ndarray, omega: np.ndarray, v1: np.ndarray, v2: np.ndarray,
 
 
 def stall_reason(params: RobotParams, since: float, phi: float) -> str:
-    """The one-line RunResult.stall (core.results.stall_reason: the same words as every engine's) of a robot
+    """The one-line RunResult.stall (core.summary.stall_reason: the same words as every engine's) of a robot
     at rest from ``since`` [s] with the crank at ``phi`` [rad]; the drive's torque at rest is its actuator's
     at zero speed (M, or the motor's M_stall)."""
     torque = params.M_stall if params.drive in ("motor", "servo") else params.M  # the servo stalls at u = 1

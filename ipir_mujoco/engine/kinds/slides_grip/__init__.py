@@ -72,7 +72,7 @@ class GripSlidesKind(SlidesKind):
     def columns(self, model, params, q, scalars, out):
         """slip1/2 [m], each carriage's backward travel below its start (its running minimum over the samples:
         the carriage only skids back, its limit holds it from going forward), grip_use1/2
-        (:func:`~ipir_mujoco.core.results.grip_use`), the grips' cumulative work skid_work [J] and the wheels'
+        (:func:`~ipir_mujoco.core.summary.grip_use`), the grips' cumulative work skid_work [J] and the wheels'
         states wheels1/2."""
         import numpy as np
 

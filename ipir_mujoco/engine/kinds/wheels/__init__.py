@@ -100,7 +100,7 @@ class WheelsKind(ModelKind):
 
     def columns(self, model, params, q, scalars, out):
         """slip1/2 [m], each module's backward steps (:func:`.ratchet.wheel_slip`); grip_use1/2
-        (:func:`~ipir_mujoco.core.results.grip_use`) with finite grip; the contacts' cumulative work skid_work [J],
+        (:func:`~ipir_mujoco.core.summary.grip_use`) with finite grip; the contacts' cumulative work skid_work [J],
         the wheels' states wheels1/2; the legs' press press1/2 [N] and wheels_off (:func:`.ratchet.press_columns`);
         the modules' pose across the pipe y1/2, z1/2 [m], roll1/2, pitch1/2, yaw1/2 [rad]
         (:func:`.ratchet.pose_columns`), which with x1, x2, phi pose the robot for a replay; slid1/2 [m], how far
