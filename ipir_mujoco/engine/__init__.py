@@ -36,7 +36,7 @@ from ipir_mujoco.core.older_paths import keep_older_paths
 
 # the engine's public names, each imported from its module when first asked for (importing the package, as the
 # registry does to read the model kinds' variants, loads no MuJoCo)
-PUBLIC = {"CrankServo": "run.simulate", "SolverSettings": "builders.model", "build_model": "builders.model",
+PUBLIC = {"CrankServo": "run.simulate", "SolverSettings": "builders.solver_settings", "build_model": "builders.model",
           "captured_warnings": "run.simulate", "compiled_mjcf": "run.export", "save_mjcf": "run.export",
           "simulate_mujoco": "run.simulate"}
 __all__ = sorted(PUBLIC)

@@ -82,7 +82,8 @@ class RowTimes:
     against the wall), ``limit`` (the hubs' ratchets and friction, the arms' stops). MuJoCo needs each >= 2 steps;
     :func:`wheels_timestep` picks the step from them. The loop's pin (the rod on module 2) is no such row: it is
     a rigid joint, its softness numerical only, so it follows the step as the slide model's constraints do
-    (:attr:`.model.SolverSettings.time_constant`, 2 steps: :func:`build_wheels_spec`)."""
+    (:attr:`ipir_mujoco.engine.builders.solver_settings.SolverSettings.time_constant`, 2 steps:
+    :func:`build_wheels_spec`)."""
 
     contact: float = 2e-4
     limit: float = 2e-4
