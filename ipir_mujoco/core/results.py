@@ -245,8 +245,8 @@ class RunResult:
         """The paper's figures (crank, modules, gap against time) of this run and any ``others`` drawn over it:
         a list of three matplotlib figures; with ``path`` (a folder) also written there as fig2-4 PNG.
 
-        A thin call of :func:`ipir_mujoco.report.plots.plot_runs` (the drawing lives in the report layer, which
-        imports nothing of this module: no import cycle)."""
+        A thin call of :func:`ipir_mujoco.core.figures.plot_runs` (the drawing, which imports nothing of this
+        module at run time: no import cycle)."""
         from ipir_mujoco.core.figures import plot_runs  # matplotlib is loaded only when a run is drawn
 
         return plot_runs([self, *others], path)

@@ -31,7 +31,7 @@ class SolverSettings:
 
     ``timestep`` [s]: 1e-4 is the largest the engine chooses by itself; a run
     given no settings has its step chosen from the motion
-    (:func:`ipir_mujoco.engine.modelkinds.timestep.choose_settings`).
+    (:func:`ipir_mujoco.engine.kinds.timestep.choose_settings`).
     ``constraint_time_constant`` [s] (default: 2 timesteps) is the solref time
     constant of every constraint: the loop, clutch limits and locks, and the
     resistances' friction rows. ``solimp`` is MuJoCo's impedance triple, by
