@@ -62,7 +62,8 @@ from ipir_mujoco.core.wheel_checks import check, ring_loads
 TRAVEL_REL, TRAVEL_FLOOR = 0.01, 1e-3  # the acceptance: travel within 1 % (or 1 mm)
 SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
 CLASSES = ("agree", "lifted", "scrubbed", "stopped", "outside")
-EQUATIONS_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "slid1_m", "slid2_m", "scrub_predicted")
+EQUATIONS_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "slid1_m", "slid2_m", "stuck1", "stuck2",
+                  "scrub_predicted")
 CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"), ("lift", "quasi-static"))
 
 
@@ -191,7 +192,8 @@ def line(row: dict) -> str:
     eq, run = row["checks"]["equations"], row["checks"]["run"]
     checks = (f"lift: eq {eq['least_press1_n']:+.2f}/{eq['least_press2_n']:+.2f} N run "
               f"{run['least_press1_n']:+.2f}/{run['least_press2_n']:+.2f} N off {row['wheel_off_s']:.3f} s; "
-              f"scrub: eq slid {1e3 * eq['slid1_m']:.2f}/{1e3 * eq['slid2_m']:.2f} mm run "
+              f"scrub: eq slid {1e3 * eq['slid1_m']:.2f}/{1e3 * eq['slid2_m']:.2f} mm stuck "
+              f"{'/'.join('yes' if eq.get(f'stuck{k}') else 'no' for k in (1, 2))} run "
               f"{'yes' if run['scrub_predicted'] else 'no'} across {1e3 * row['across'][0]:.2f}/"
               f"{1e3 * row['across'][1]:.2f} mm")
     grip = "" if row["grip"][0] is None else (f" | grip {row['grip'][0]:.1f}/{row['grip'][1]:.1f} N against "

@@ -64,6 +64,9 @@ def test_a_leg_lifts_where_the_springs_load_along_it_reaches_a_quarter_of_the_pr
             result = W.check(p, loads, grip_use=(1.0, 1.0))
             assert result["least_press1_n"] == pytest.approx(p.F_n1 / (2 * n) * (1 - scale), abs=1e-9)
             assert result["lift_predicted"] is lifts
+            # one sample: no path on the springs; a lift is a slide all the same (its wheel rides off the wall
+            # with its ring, the suspension's whole travel across the pipe)
+            assert result["slid1_m"] == 0.0 and result["scrub_predicted"] is lifts
     # the same load within the wheels' grip (the module rolls): the ring does not move, no leg lifts
     load = -0.9 * GRIP.F_n1 / 4 * np.array(leg_direction(0, 3)[1:])
     assert np.abs(load @ W.leg_frames(3)[0].T).max() > W.side_holds(GRIP, 0).max()  # beyond the grip: it slides
@@ -254,3 +257,45 @@ def test_a_rolling_modules_steer_compliant_wheels_let_its_ring_roll_across_to_it
     assert standing["least_press1_n"] == pytest.approx(P, rel=1e-12) == rigid["least_press1_n"]
     assert rolling["least_press1_n"] == pytest.approx(P - 2 / 3 * F, rel=1e-3)  # settled on its springs
     assert rolling["slid1_m"] == 0.0 and not rolling["scrub_predicted"]
+
+
+def test_a_rolling_modules_wheel_that_cannot_turn_its_hub_skids_and_scrubs():
+    """A wheel turns on the wall only while its friction mu_wall N can turn its hub against its share of the
+    rolling resistance, F_r / (2 n) (the hub's frictionloss): weightless, every leg at its preload P = F_n / 6, so
+    a rolling module's wheels skid from F_r = 6 mu_wall P on (a hair either side here), and the check says a
+    scrub with no slide on the springs and no lift; a standing module's wheels need not turn."""
+    p = GRIP
+    P = p.F_n1 / 6
+    zero = {key: np.zeros((1, 2)) for key in ("1aft", "1fore", "2aft", "2fore")}
+    for factor, stuck in ((1 - 1e-9, False), (1 + 1e-9, True)):
+        q = p.replace(F_r1=factor * 6 * p.mu_wall * P)
+        rolling = W.check(q, zero, rolling=(True, False))
+        assert rolling["stuck1"] is stuck and rolling["scrub_predicted"] is stuck and not rolling["stuck2"]
+        assert rolling["slid1_m"] == 0.0 and not rolling["lift_predicted"]
+        standing = W.check(q, zero)
+        assert not standing["stuck1"] and not standing["scrub_predicted"]
+    assert not W.check(p.replace(mu_wall=None, F_r1=5.0), zero, rolling=(True, True))["stuck1"]  # unlimited grip
+
+
+def test_a_rolling_modules_stuck_wheels_skid_at_the_wall_and_pitch_it():
+    """A heavy module's upper wheels press least: where their friction mu N cannot turn their hubs against F_r /
+    (2 n) and the lower wheel's can, the two upper wheels of each ring skid along the pipe, mu N_up each at the wall
+    D / 2 out along legs at 30 and 150 deg (u_z = 1/2 each): the rings carry 2 mu (D / 2) N_up / s along z, down on
+    the aft ring (a friction against the way, at the top); nothing with unlimited grip or with every wheel turning."""
+    p = RobotParams(mu_wall=0.5, m1=1.0, F_n1=12.0, ring_spacing=0.1)
+    N_up, N_down = W.leg_presses(p, 0, W.weight_load(p, 0))[[1, 0]]
+    stuck = p.replace(F_r1=6 * p.mu_wall * 0.5 * (N_up + N_down))  # between the two: the upper wheels stick
+    assert N_up < N_down
+    expected = 2 * p.mu_wall * 0.5 * p.pipe_diameter * N_up / p.ring_spacing
+    assert W.stuck_couple(stuck, 0) == pytest.approx([0.0, expected], abs=1e-12 * expected)
+    assert not W.stuck_couple(p.replace(F_r1=6 * p.mu_wall * 0.99 * N_up), 0).any()  # all turn
+    assert not W.stuck_couple(stuck.replace(mu_wall=None), 0).any()
+    zero = {key: np.zeros((1, 2)) for key in ("1aft", "1fore", "2aft", "2fore")}
+    rigid = stuck.replace(cornering_coefficient=None)  # held by its wheels' friction: the couple moves nothing
+    assert W.check(rigid, zero, rolling=(True, False))["least_press1_n"] == pytest.approx(N_up, rel=1e-12)
+    # steer-compliant wheels rolling: the rings creep onto their springs, -+e on aft and fore, and the heading steers
+    # both by sigma (X_fore - X_aft) = 2 sigma e up: the aft ring carries -(1 - 2 sigma) e, its upper legs losing
+    # (2 / n) u_z of it
+    sigma = stuck.cornering_coefficient * stuck.suspension_travel / stuck.ring_spacing
+    rolling = W.check(stuck, zero, rolling=(True, False))
+    assert rolling["least_press1_n"] == pytest.approx(N_up - 2 / 3 * (1 - 2 * sigma) * expected * 0.5, rel=1e-9)

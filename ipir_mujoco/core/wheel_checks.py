@@ -24,8 +24,14 @@ carries only what is added later): half the sprung weight across the pipe per ri
 The linkage's loads per ring: module 1 feels the crank's bearing force across the pipe at A, split half to each
 ring (A is the rings' middle), and the drive's reaction couple -T about z as -+T / s on its aft and fore rings;
 module 2 the rod's force at C, half to each ring; each module the rod's force along the pipe's normal where the
-rod leaves the crank's plane (``vertical``). :func:`ring_loads` builds them from any run's forces (the analytic
+rod leaves the crank's plane (``vertical``); and the couples of its wheels' friction at the wall, off its axis
+(:func:`pitch_couple` while it grips along the pipe, :func:`stuck_couple` while it rolls on wheels that cannot turn). :func:`ring_loads` builds them from any run's forces (the analytic
 run's pin forces, MuJoCo's loop force); :func:`check` applies the two rules to every sample.
+
+A wheel also slides without its ring sliding: one whose friction mu_wall N_k cannot turn its hub against its share
+F_ri / (2 n) of the module's rolling resistance stays put while its module rolls, skidding along the pipe (and a
+steer-compliant one swivels as it skids, sliding along its axle); and a wheel off its wall goes across the pipe
+with its ring, which moved the suspension's whole travel to lift it. :func:`check` predicts a scrub for either.
 """
 
 from __future__ import annotations
@@ -140,9 +146,14 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
     it (over the samples and legs, > 1 where they slide; 0 with unlimited grip, inf with mu_wall 0 under a load;
     a module that skids along the pipe holds less across it, Coulomb's cone, and nothing while it skids:
     :func:`held`).
+    ``stuck{i}``: a wheel of it that cannot turn while it rolls: its friction mu_wall N_k at the ring's place below
+    its share F_ri / (2 n) of the rolling resistance (its hub's friction), so it skids along the pipe under its
+    module, and a skidding steer-compliant wheel slides along its axle as it swivels (false with unlimited grip).
     ``lift_predicted``: a least press below LIFT_SHARE of the leg's preload (where the run's ``wheel_off_s``
-    counts a wheel off its wall). ``scrub_predicted``: a path of SCRUB_FLOOR or more (the summary's
-    outcome, ``scrubbed``, is the run's path from the same floor)."""
+    counts a wheel off its wall). ``scrub_predicted``: a path of SCRUB_FLOOR or more, a lift (a leg that lifts
+    has moved its ring the suspension's whole travel across the pipe, and its wheel, off the wall, goes with it)
+    or a stuck wheel (the summary's outcome, ``scrubbed``, is the run's most-slid wheel's path along its axle from
+    the same floor)."""
     from .pipe import SCRUB_FLOOR, rigid_wheels
 
     n = int(params.wheel_legs)
@@ -157,22 +168,26 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
         weight = weight_load(params, module)
         use = np.clip(np.asarray(grip_use[module], dtype=float), 0.0, 1.0)
         holds = side_holds(params, module)
-        least, path, ratio = math.inf, 0.0, 0.0
+        least, path, ratio, stuck = math.inf, 0.0, 0.0, False
+        # a wheel turns on the wall only while its friction mu_wall N_k can turn its hub against its share of the
+        # module's rolling resistance (the hub's frictionloss, F_ri R / (2 n))
+        turning = (params.F_r1, params.F_r2)[module] / (2 * n)
         rings = []
         for ring, sign in zip(RINGS, (1.0, -1.0)):
             load = np.asarray(loads[f"{i}{ring}"], dtype=float).reshape(-1, 2)
             samples = load.shape[0]
             ring_use = np.broadcast_to(use, (samples,)) if use.ndim else np.full(samples, float(use))
-            load = load + sign * pitch_couple(params, module)[None, :] * ring_use[:, None]
-            grip = held(params, module, load, ring_use)
             rolls = np.broadcast_to(np.asarray(rolling[module], dtype=bool), (samples,))
+            load = (load + sign * pitch_couple(params, module)[None, :] * ring_use[:, None]
+                    - sign * stuck_couple(params, module)[None, :] * rolls[:, None])
+            grip = held(params, module, load, ring_use)
             creep = grip & rolls if compliant else np.zeros(samples, dtype=bool)
             still = grip & ~creep
             spring = np.where(still[:, None], 0.0, load)
             moving = ~grip & rolls
             if params.mu_wall is not None and moving.any():
                 spring = spring + _steering_scrub(params, module, spring, moving)
-            rings.append((load, grip, creep, still, spring))
+            rings.append((load, grip, creep, still, spring, rolls))
         steer = params.cornering_coefficient * params.suspension_travel / params.ring_spacing if compliant else 0.0
         if dt is None:  # at rest on the springs; rings that creep together carry the heading's steering too
             both = (rings[0][2] & rings[1][2])[:, None]
@@ -186,8 +201,11 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             moves = [(place, slid & ~r[3]) for place, slid, r in zip(places, slides, rings)]
         else:
             moves = [(ring_response(r[4], r[1], frequency * dt), ~r[1]) for r in rings]
-        for (load, *_), (place, slides) in zip(rings, moves):
-            least = min(least, float(np.min(leg_presses(params, module, place + weight))))
+        for (load, *_, rolls), (place, slides) in zip(rings, moves):
+            presses = leg_presses(params, module, place + weight)
+            least = min(least, float(np.min(presses)))
+            if params.mu_wall is not None:  # a rolling module's wheel that cannot turn its hub skids under it
+                stuck = stuck or bool(np.any(rolls & (params.mu_wall * np.min(presses, axis=-1) < turning)))
             shifts = np.diff(place, axis=0) * (2.0 / (n * stiffness))
             path = max(path, float(np.sum(np.hypot(shifts[:, 0], shifts[:, 1])[slides[:-1]])))  # creep rolls
             if params.mu_wall is not None:  # against the whole grip: a skidding module's share is in held()
@@ -198,9 +216,11 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
         out[f"least_press{i}_n"] = least
         out[f"slid{i}_m"] = path
         out[f"side_use{i}"] = ratio
+        out[f"stuck{i}"] = stuck
     floor = [LIFT_SHARE * F / (2 * n) for F in (params.F_n1, params.F_n2)]
     out["lift_predicted"] = out["least_press1_n"] < floor[0] or out["least_press2_n"] < floor[1]
-    out["scrub_predicted"] = max(out["slid1_m"], out["slid2_m"]) >= SCRUB_FLOOR
+    out["scrub_predicted"] = (max(out["slid1_m"], out["slid2_m"]) >= SCRUB_FLOOR or out["lift_predicted"]
+                              or out["stuck1"] or out["stuck2"])
     return out
 
 
@@ -265,6 +285,24 @@ def pitch_couple(params, module: int) -> np.ndarray:
     if params.mu_wall is None:
         return np.zeros(2)
     return params.mu_wall * 0.5 * params.pipe_diameter * 2.0 * weight_load(params, module) / params.ring_spacing
+
+
+def stuck_couple(params, module: int) -> np.ndarray:
+    """The load [N] on each ring of ``module`` (0 rear, 1 front), (y, z), -+ on its aft and fore rings, of the couple
+    its stuck wheels make while it rolls: a wheel whose friction mu_wall N_k (N_k its press under the weight, as
+    :func:`pitch_couple` takes it) cannot turn its hub against its share F_ri / (2 n) of the rolling resistance
+    skids along the pipe, its friction mu_wall N_k against the module's way at the wall, D / 2 from the axis along
+    its leg: the rings carry sum_k mu N_k (D / 2) u_k / s over both rings' stuck wheels, as :func:`pitch_couple`
+    carries the gripping wheels' (the other way: a rolling module moves forward, a held one is pushed back). A
+    heavy module's upper wheels stick first: the couple presses its aft ring towards its lower legs. Zero with
+    unlimited grip."""
+    if params.mu_wall is None:
+        return np.zeros(2)
+    n = int(params.wheel_legs)
+    u, _ = leg_frames(n)
+    press = np.maximum(leg_presses(params, module, weight_load(params, module)), 0.0)
+    stuck = params.mu_wall * press < (params.F_r1, params.F_r2)[module] / (2 * n)
+    return 2.0 * params.mu_wall * 0.5 * params.pipe_diameter * ((stuck * press) @ u) / params.ring_spacing
 
 
 def run_summary(params, series: dict, route_fit: dict | None = None, straight: bool = True) -> dict:

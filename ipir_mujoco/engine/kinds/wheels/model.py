@@ -348,7 +348,8 @@ def sag(params: RobotParams, module: int) -> float:
 def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotParams) -> None:
     """The loop closed at ``phi0`` with module 1 at 0, each module sagged by its own weight on its springs
     (:func:`sag`, at most to its lower legs' stops: a module heavier than its press rests on them, and a larger
-    drop would start its housing inside the wall), every wheel on its wall, at rest or with the crank at
+    drop would start its housing inside the wall), every wheel on its round wall (its arm's reach exact, not the
+    sag's component along the leg alone: that set the upper wheels into the wall), at rest or with the crank at
     ``omega0`` (the slide model's rule, :func:`.model.start_closed_loop`). Where the two sags differ the rod
     leaves the crank's plane on its cross pin (``rod_tilt``) by asin((delta2 - delta1) / L) and the loop closes
     in the plane on the rod's projection, L cos of that: started at a common height, the module with the
@@ -364,14 +365,20 @@ def set_wheels_state(model: mujoco.MjModel, data: mujoco.MjData, params: RobotPa
     data.qpos[qpos_address(model, FRONT_SLIDE)] += projected - params.L
     data.qpos[qpos_address(model, ROD_TILT)] = tilt
     n = leg_count(params)
+    reach = 0.5 * params.pipe_diameter - params.wheel_radius  # a wheel's centre from the axis, its arm at 0
     for i in (0, 1):
         data.qpos[qpos_address(model, VERTICALS[i])] = -drops[i]
         for prefix in leg_names(params)[i]:
             u = leg_direction(int(prefix.split("_leg")[1]), n)
             # the arm reaches what the module left, and SEAT into the wall: a contact at a distance of exactly 0
-            # is left out of MuJoCo's first step, and the module would drop until its wheels meet the wall
+            # is left out of MuJoCo's first step, and the module would drop until its wheels meet the wall. The
+            # wall is round: a module dropped by delta moves a leg's wheel delta u_y along the wall as well, so
+            # the arm reaches delta u_z + sqrt(reach^2 - (delta u_y)^2) - reach (delta u_z alone would set the
+            # upper wheels (delta u_y)^2 / (2 reach) into the wall, 0.3 mm at a 7 mm sag, and their contacts would
+            # kick the arms off at the first steps, sliding the wheels a millimetre or more across the wall)
+            reached = drops[i] * u[2] + math.sqrt((reach + SEAT) ** 2 - (drops[i] * u[1]) ** 2) - reach
             lo, hi = model.jnt_range[model.joint(prefix + "_arm").id]
-            data.qpos[qpos_address(model, prefix + "_arm")] = min(max(drops[i] * u[2] + SEAT, lo), hi)
+            data.qpos[qpos_address(model, prefix + "_arm")] = min(max(reached, lo), hi)
     if freed is not None:  # the wheels of the moving module roll with it
         target, speed = freed
         for prefix in leg_names(params)[0 if target == REAR_SLIDE else 1]:
