@@ -102,6 +102,16 @@ def test_a_sweep_under_the_older_name_runs_the_same_and_says_so_in_one_line(caps
     assert (tmp_path / "new" / "results.csv").read_bytes() == (tmp_path / "old" / "results.csv").read_bytes()
 
 
+def test_a_failure_under_the_older_name_stays_one_line(capsys, tmp_path):
+    """The note comes once the command succeeded: bad input under --engine is the contract's one line, exit 2."""
+    from ipir_mujoco.cli import main
+
+    assert main(["optimize", "--engine", "nan", "--vary", "m1=0.5:1", "--objective", "max:steady_speed_m_s",
+                 "--out", str(tmp_path / "o")]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 1 and "variant 'nan' is unknown" in lines[0] and "deprecated" not in lines[0]
+
+
 # a study's command with the least it needs to start its work: each refuses a declared file's name taken by a folder
 STARTS = {"sweep": ["--vary", "L=0.1,0.2"], "optimize": ["--vary", "L=0.1:0.3", "--objective", "max:revolutions"],
           "sensitivity": ["--vary", "L=0.1:0.3", "--metric", "revolutions"], "atlas": ["--vary", "L=0.1:0.3"],

@@ -143,12 +143,15 @@ def _command(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser(_named_command(argv)).parse_args(argv)
         prefix = f"ipir-mujoco {args.command}"
-        for note in getattr(args, "notes", ()):  # an option's older name used (studies.command.add_variant_option)
-            print(f"{prefix}: note: {note}", file=sys.stderr)
         notes = _show_notes(prefix)
         try:
             with terminal.command():
-                return args.handler(args)
+                code = args.handler(args)
+            # an option's older name used (studies.command.add_variant_option): said once the command succeeded,
+            # so that a failure stays one line
+            for note in getattr(args, "notes", ()) if code == 0 else ():
+                print(f"{prefix}: note: {note}", file=sys.stderr)
+            return code
         except BaseException as exc:  # noqa: B902 (every failure becomes one line, or a traceback with --debug)
             if args.debug or isinstance(exc, SystemExit):
                 raise

@@ -53,7 +53,7 @@ def add_variant_option(parser: argparse.ArgumentParser, *, many: bool, default: 
     model in an engine, ``ENGINE-MODEL[-RULE]``; ``ipir_mujoco.registry``), read as ``args.variant`` or
     ``args.variants``. The older spelling, ``--engine`` or ``--engines``, stays accepted for one release: it
     sets the same value and says so (:class:`_OlderName`: a line the command line prints on stderr once the
-    options parsed, ``args.notes``); giving both is refused by argparse (exit 2, one line)."""
+    command succeeded, ``args.notes``); giving both is refused by argparse (exit 2, one line)."""
     newer, older, metavar = ("--variants", "--engines", "LIST") if many else ("--variant", "--engine", "NAME")
     dest = newer[2:]
     both = parser.add_mutually_exclusive_group()
@@ -64,8 +64,8 @@ def add_variant_option(parser: argparse.ArgumentParser, *, many: bool, default: 
 
 class _OlderName(argparse.Action):
     """An option's older name: stores its value under the newer option's name, and in ``notes`` (a list of the
-    namespace, which the command line prints on stderr, one line each, after parsing) that the name is deprecated
-    and which to use."""
+    namespace, which the command line prints on stderr, one line each, once the command succeeded) that the name
+    is deprecated and which to use."""
 
     def __init__(self, option_strings, dest, newer: str, **kwargs):
         super().__init__(option_strings, dest, **kwargs)
