@@ -16,7 +16,7 @@ that angle.
 **The module.** Its rings ride on the centreline (:func:`.route_geometry.module_pose`: at P(s -+ h), the module
 the chord between them, axis e1, frame e2, e3), each moving at v along the centreline's tangent t_j at its own
 point. Leg k of n (k = 0 .. n-1) points out along u_k = cos(a_k) e2 + sin(a_k) e3, a_k = -90 deg + 360 deg k / n
-(leg 0 down at the start: :func:`ipir_mujoco.core.pipe.leg_direction` in the module's frame), its wheel rolling
+(leg 0 down at the start: :func:`ipir_mujoco.core.wheel_legs.leg_direction` in the module's frame), its wheel rolling
 along e1 and sideways along e_k = e1 x u_k, its hub rho = pipe_diameter / 2 - wheel_radius off the axis. The
 module turns as its axis does (its frame is rotation-minimizing: no roll about e1), so the hub of leg k on ring j
 moves at w = v (t_j - rho (e1' . u_k) e1) (e1' = d e1 / ds): the inside wheels of a bend slower than the outside

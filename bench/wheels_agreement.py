@@ -17,7 +17,7 @@ the skid check's halvings included) run it. Per design, whatever its class: each
 - ``agree``: each module's travel within 1 % of the equations' (or 1 mm) and its skid within 5 % + 2 mm;
 - ``lifted``: a wheel left its wall (``wheel_off_s`` > 0) and the lift-off check predicted it;
 - ``scrubbed``: a module's rings slid across the pipe (``scrubbed``: their path across it at least
-  :data:`ipir_mujoco.core.pipe.SCRUB_FLOOR`) and the scrub check predicted it;
+  :data:`ipir_mujoco.core.side_check.SCRUB_FLOOR`) and the scrub check predicted it;
 - ``stopped``: refused (bad input for a model), stopped (a stall) or flagged by MuJoCo's accuracy monitor, with
   its reason;
 - ``outside``: none of these.

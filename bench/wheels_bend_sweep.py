@@ -34,7 +34,7 @@ route's fit) and the step the run kept. The lift check's record over the rows en
 happened (a wheel off in the bend's run longer than in its twin's), false alarms and misses.
 
 ``--closed-form`` runs nothing: per mu_wall and R/D, the rings' slip angle asin(b / R), the module's cock and the
-side force its fore ring's legs carry (:func:`ipir_mujoco.core.pipe.scrub_force`, module 1, a horizontal bend),
+side force its fore ring's legs carry (:func:`ipir_mujoco.core.wheel_legs.scrub_force`, module 1, a horizontal bend),
 the rings' whole sideways friction beside it, and the bend's lift-off check (the route's fit: the least-pressed
 leg, ``lift_predicted``).
 """

@@ -55,7 +55,7 @@ def _constants():
         ("steady accuracy MuJoCo", r"analytic and ([\d.e-]+) MuJoCo, see `steady_test`",
          steady_test.LIMIT_ACCURACY["mujoco"]),
         ("stall end", r"A stalled run ends ([\d.]+) s after", results.REST_TIME),
-        ("scrub floor", r"either at least (\d+) mm \(`core.pipe.SCRUB_FLOOR`", 1e3 * pipe.SCRUB_FLOOR),
+        ("scrub floor", r"either at least (\d+) mm \(`core.side_check.SCRUB_FLOOR`", 1e3 * pipe.SCRUB_FLOOR),
         ("skid halvings", r"at half its step \(at most (\w+) halvings\)", skid_check.HALVINGS),
         ("route segments", r"(\d+) to (?:\d+) segments; any other key", 1),
         ("route segments most", r"\d+ to (\d+) segments; any other key", route.MAX_SEGMENTS),

@@ -150,7 +150,7 @@ def test_weight_sags_the_module_and_its_press_stays_F_n(legs):
         assert forces[i].sum() == pytest.approx(expected, rel=1e-3)
         assert press[0, i].sum() == pytest.approx(expected, rel=1e-3)  # the springs' press is the contacts'
         # each leg's: its spring's press plus its arm's and wheel's weight along its line (16.5 g each here:
-        # core.pipe.ARM_SHARE, WHEEL_SHARE; leg 0 down), the wall's normal off that line by delta / rho at most
+        # core.wheel_legs.ARM_SHARE, WHEEL_SHARE; leg 0 down), the wall's normal off that line by delta / rho at most
         legs_down = np.array([-leg_direction(k, legs)[2] for k in range(legs)] * 2)
         own = (ARM_SHARE + WHEEL_SHARE) * (p.m1, p.m2)[i] * p.g * legs_down
         assert np.allclose(press[0, i] + own, forces[i], rtol=delta / rho, atol=1e-3 * F_n)

@@ -1,4 +1,4 @@
-"""The closed-form sideways-grip check of the wheeled model (:func:`ipir_mujoco.core.pipe.side_grip_check`) and
+"""The closed-form sideways-grip check of the wheeled model (:func:`ipir_mujoco.core.side_check.side_grip_check`) and
 the linkage's forces across the pipe it reads (:func:`ipir_mujoco.analytic.kinetostatics.pin_forces`).
 
 Tolerances: the hand cases are exact up to round-off (1e-12 relative); the run's decomposition is the same

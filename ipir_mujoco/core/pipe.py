@@ -15,15 +15,22 @@ The rod length L does not enter a straight pipe's fit (the rod swings inside the
 A bend's fit has three closed forms here, all reported beside MuJoCo's outcome of a route (``route_fit``): a
 rigid box's (:func:`bend_max_length`), the spread sprung wheels need (:func:`bend_wheel_spread`) and the rod's
 clearance from the inner wall (:func:`bend_rod_clearance`).
+
+The wheeled model's legs keep their wall where the closed-form lift-off checks here say so (:func:`lift_check`,
+:func:`bend_lift_check`, :func:`lift_summary`). The legs' geometry, masses and a ring's sideways grip and side
+force live in :mod:`.wheel_legs`, the sideways-grip check in :mod:`.side_check`; this module re-exports their
+names, so every import from ``core.pipe`` keeps working.
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .errors import ParameterError
+from .wheel_legs import (  # noqa: F401  (re-exported: every name stays importable from here)
+    ARM_SHARE, COCK_HALVINGS, WHEEL_SHARE, bend_cock, bend_slip_angle, hub_tangent, leg_direction, rigid_wheels,
+    ring_side_force, ring_side_grip, rod_side_force, scrub_force, sprung_mass)
+from .side_check import SCRUB_FLOOR, across_paths, side_grip_check, side_summary  # noqa: F401  (re-exported)
 
 
 def check_fit(params) -> None:
@@ -106,38 +113,8 @@ def bend_rod_clearance(length: float, rod_radius: float, radius: float, diameter
 
 
 # ----------------------------------------------------------------------------------------------------
-# The round pipe's wheel legs (the wheeled MuJoCo model), the closed-form lift-off and sideways-grip checks
-
-# Each leg's masses, shares of its module's mass m_i (inside m_i): its arm (the slider and axle the spring presses
-# out) and its wheel. The wheel is light: a rolling module carries its wheels' spin, J / R^2 = m_w / 2 each, the
-# one mass term the analytic model lacks. The arm is ten times heavier: at 1e-3 the scrubbing wheels of a bend were
-# resolved only below 3e-6 s (a R/D 5 bend's revolutions fell 0.4-0.6 % a halving from 2.5e-5 s); at 1e-2 they
-# converge from 5e-5 s, a bend's step (mjcf/README.md, "The round pipe: convergence"). Both ride with their module
-# along the pipe, so a straight pipe's travel does not change with them (the cruise's to 5 digits).
-ARM_SHARE = 1e-2
-WHEEL_SHARE = 1e-3
-
-
-def sprung_mass(params, module: int) -> float:
-    """The mass [kg] of module ``module`` (0 rear, 1 front) that its legs' springs carry: m_i less its 2 n legs'
-    arms and wheels, whose weight goes to the wall through their own wheels."""
-    m = (params.m1, params.m2)[module]
-    return m * (1.0 - 2 * int(params.wheel_legs) * (ARM_SHARE + WHEEL_SHARE))
-
-
-def leg_direction(k: int, n: int) -> tuple[float, float, float]:
-    """Leg ``k``'s outward unit vector of ``n`` evenly spaced about the pipe's axis x, leg 0 pointing down (-z in
-    a horizontal pipe): (0, cos a, sin a) with a = -90 deg + 360 deg k / n."""
-    angle = -0.5 * math.pi + 2.0 * math.pi * k / n
-    return (0.0, math.cos(angle), math.sin(angle))
-
-
-def rod_side_force(torque: float, r: float, L: float) -> float:
-    """The largest force [N] across the pipe that a crank torque ``torque`` [N m] puts through the rod on its
-    ends (A on module 1, C on module 2), quasi-static, over a turn: the rod (r crank, L rod [m]) carries
-    F = T / (r |sin(phi - beta)|) along itself, sin beta = -r sin(phi) / L, and its side part F |sin beta| grows
-    from T / (L + r) at the outer dead centre (phi = 0) to T / (L - r) at the inner one (phi = 180 deg)."""
-    return abs(torque) / (L - r)
+# The round pipe's wheel legs (the wheeled MuJoCo model): the closed-form lift-off checks (the legs' geometry,
+# masses and grip: :mod:`.wheel_legs`)
 
 
 def lift_check(params) -> dict:
@@ -176,149 +153,6 @@ def lift_check(params) -> dict:
         weight_only.append(min(P + (2.0 / n) * (-down * uz) for (_, _, uz) in legs))
     out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
     out["weight_press_n"] = tuple(weight_only)
-    return out
-
-
-def hub_tangent(u: tuple[float, float, float]) -> tuple[float, float]:
-    """(y, z) of the wall's circumferential direction x cross u at a leg of outward direction ``u``: the way its
-    wheel slides across the pipe (it rolls only along x)."""
-    return (-u[2], u[1])
-
-
-def ring_side_grip(params, module: int, toward: tuple[float, float]) -> float:
-    """The sideways friction [N] each ring of module ``module`` (0 rear, 1 front) gives along the unit (y, z)
-    ``toward`` across the pipe before its wheels slide: each wheel rolls only along the pipe, so it carries a load
-    across it by friction along its circumferential direction e_k, up to mu_wall P (its spring takes the radial
-    part, and only as it deflects), and a ring gives mu_wall P sum_k |e_k . toward| (at the defaults' 3 legs
-    2 mu_wall P across a horizontal pipe, 1.73 mu_wall P up or down). Coulomb, the legs at their preload P."""
-    n = int(params.wheel_legs)
-    P = (params.F_n1, params.F_n2)[module] / (2 * n)
-    # unlimited grip: no finite coefficient to take; 1 stands for it, a lower bound (the model's wheels then grip
-    # with MU_UNLIMITED, 100, and turn in a bend only as far as their springs let them: a lift whatever this says)
-    mu = params.mu_wall if params.mu_wall is not None else 1.0
-    return mu * P * sum(abs(e[0] * toward[0] + e[1] * toward[1])
-                        for e in (hub_tangent(leg_direction(k, n)) for k in range(n)))
-
-
-def rigid_wheels(params) -> bool:
-    """Whether the wheeled model's wheels are fixed on their axles: ``cornering_coefficient`` rigid, or unlimited
-    grip (a steer-compliant wheel held against any load along the pipe would turn off its axis: the wheeled
-    model then builds rigid ones, :func:`ipir_mujoco.engine.kinds.wheels.model.steer_compliant`)."""
-    return params.cornering_coefficient is None or params.mu_wall is None
-
-
-def bend_slip_angle(params, radius: float) -> float:
-    """Each ring's slip angle [rad] in a bend of centreline radius ``radius`` [m]: a module whose rings, b =
-    ``ring_spacing`` / 2 either side of its middle, both ride on the centreline is a chord of it, and turning
-    through the bend each ring moves along the centreline's tangent there, asin(b / R) off the module's axis (the
-    fore ring's towards the bend's inside, the aft ring's out)."""
-    return math.asin(min(1.0, 0.5 * params.ring_spacing / radius))
-
-
-def ring_side_force(params, module: int, toward: tuple[float, float], slip: float) -> float:
-    """The side force [N] along the unit (y, z) ``toward`` across the pipe that a ring of module ``module`` (0 rear,
-    1 front) carries when it rolls at the slip angle ``slip`` [rad] towards ``toward`` (its velocity that far off
-    the module's axis). Wheel k, its sideways direction e_k (:func:`hub_tangent`), slips at alpha_k = slip
-    (e_k . toward) and pushes along e_k with
-
-        F_k = min(C |alpha_k|, mu_wall P),   C = cornering_coefficient P   (P the leg's preload)
-
-    (docs/model.md, "The wheels' side force"), so the ring carries sum_k F_k |e_k . toward|: C slip n / 2 while no
-    wheel slides (n = wheel_legs evenly spaced: sum_k (e_k . toward)^2 = n / 2), :func:`ring_side_grip` when
-    all do. Rigid wheels (``cornering_coefficient`` rigid, fixed on their axles; the wheeled model's wheels with
-    unlimited grip too) carry :func:`ring_side_grip` at any slip angle but zero (unlimited grip counted as
-    mu_wall 1, as there)."""
-    if slip == 0.0:
-        return 0.0
-    if rigid_wheels(params):
-        return math.copysign(ring_side_grip(params, module, toward), slip)
-    n = int(params.wheel_legs)
-    P = (params.F_n1, params.F_n2)[module] / (2 * n)
-    mu = params.mu_wall
-    C = params.cornering_coefficient * P
-    total = 0.0
-    for e in (hub_tangent(leg_direction(k, n)) for k in range(n)):
-        share = abs(e[0] * toward[0] + e[1] * toward[1])
-        total += min(C * abs(slip) * share, mu * P) * share
-    return math.copysign(total, slip)
-
-
-COCK_HALVINGS = 60  # bisections of the bend's cock (:func:`scrub_force`): its bracket halves each time, to 1e-18
-
-
-def scrub_force(params, module: int, toward: tuple[float, float], radius: float) -> float:
-    """The side force [N] on module ``module``'s (0 rear, 1 front) fore ring, the more loaded, while it rolls through
-    a bend of centreline radius ``radius`` [m] turning across the pipe towards the unit (y, z) ``toward``, steady
-    and quasi-static (docs/model.md, "The wheels' side force"). Its wheels roll only along the module's axis, so
-    its rings slip at +-a, a = :func:`bend_slip_angle` (the fore ring's velocity turned towards the bend's
-    inside, the aft ring's out); their side forces :func:`ring_side_force` push the fore ring out and the aft
-    ring in, a couple that the legs' springs carry as the module cocks (its nose out) by psi, which adds psi to
-    both rings' slip: the fore ring slips at a + psi and the aft at a - psi, their net push out, G(a + psi) -
-    G(a - psi), is carried by both rings' springs moving out, and the couple, b (G(a + psi) + G(a - psi)), by
-    the springs across the rings' spacing: psi = (G(a + psi) + G(a - psi)) / (2 k_r b), k_r = n k / 2 a ring's
-    springs' stiffness across the pipe (k = P / suspension_travel), b = ring_spacing / 2. The fore ring's
-    springs then carry G(a + psi). While no wheel slides G(x) = C x n / 2 and psi = C_r a / (k_r b) (C_r = C n / 2,
-    C_r / k_r = cornering_coefficient suspension_travel), so the fore ring carries C_r a (1 + C_r / (k_r b)),
-    falling as 1 / R; where every wheel slides, the ring's whole sideways friction :func:`ring_side_grip`
-    whatever the radius (rigid wheels: at any radius). 0 for a module at rest, as each is half of every
-    revolution."""
-    a = bend_slip_angle(params, radius)
-    if rigid_wheels(params):
-        return ring_side_force(params, module, toward, a)
-    return ring_side_force(params, module, toward, a + bend_cock(params, module, toward, radius))
-
-
-def bend_cock(params, module: int, toward: tuple[float, float], radius: float) -> float:
-    """How far [rad] module ``module`` (0 rear, 1 front) cocks, nose out, on its legs' springs while it rolls through
-    a bend of centreline radius ``radius`` [m] turning towards the unit (y, z) ``toward``: psi solving
-    2 k_r b psi = G(a + psi) + G(a - psi) (:func:`scrub_force`; G = :func:`ring_side_force`, a =
-    :func:`bend_slip_angle`); rigid wheels (and unlimited grip): the rings' whole sideways friction over k_r b."""
-    a = bend_slip_angle(params, radius)
-    n = int(params.wheel_legs)
-    P = (params.F_n1, params.F_n2)[module] / (2 * n)
-    lever = 0.5 * params.ring_spacing * n * P / (2 * params.suspension_travel)  # k_r b [N/rad]
-    if rigid_wheels(params):
-        return ring_side_force(params, module, toward, a) / lever
-    # 2 k_r b psi - (G(a + psi) + G(a - psi)) grows with psi (G is concave for a positive slip and odd), from
-    # -2 G(a) at 0 to >= 0 where 2 k_r b psi reaches twice the rings' whole sideways friction: one root, bisected
-    low, high = 0.0, ring_side_grip(params, module, toward) / lever
-    for _ in range(COCK_HALVINGS):
-        psi = 0.5 * (low + high)
-        couple = ring_side_force(params, module, toward, a + psi) + ring_side_force(params, module, toward, a - psi)
-        low, high = (psi, high) if 2.0 * lever * psi < couple else (low, psi)
-    return 0.5 * (low + high)
-
-
-def side_grip_check(params, side1, side2, torque, grip_use=(0.0, 0.0)) -> dict:
-    """The closed-form sideways-grip check of the wheeled model's modules, on a run's linkage forces.
-
-    The analytic model holds each module on rails: whatever the linkage pushes across the pipe, the rails carry
-    without moving. The wheeled model's rings carry it by their wheels' sideways friction
-    (:func:`ring_side_grip`, along y: the crank's plane, where the linkage's forces lie); a ring loaded beyond it
-    slides across the pipe until its legs' springs take the rest (the wheels scrub: energy lost, and a sliding
-    wheel's friction points along its slip, so less of it holds the module along the pipe). The ring loads: half
-    the linkage's force across the pipe on the module (``side1`` at A, through the crank's bearing; ``side2`` at
-    C, the rod's pin: :func:`ipir_mujoco.analytic.kinetostatics.pin_forces`, its inertia forces included) and on
-    module 1 the drive's reaction couple ``torque`` about z as +-torque / ring_spacing on its two rings (as in
-    :func:`lift_check`). A module that holds along the pipe with the share u of its grip (``grip_use``, the
-    analytic run's grip_use1/2: 1 while it skids) leaves each wheel sqrt(1 - u^2) of its friction across the
-    pipe (Coulomb's cone, every wheel using the same share), so a skidding module slides across under any side
-    load. The arrays [N], [N m], [-] are a run's samples, shape (n,). The check leaves out the springs' part (they
-    carry a side load only as the ring moves), so it errs on the side of predicting a slide.
-
-    Returns {'side_use1', 'side_use2': each module's largest ring load over what its ring's wheels hold across
-    the pipe (> 1: they slide across it; inf: a load while its wheels skid; 0 with unlimited grip),
-    'scrub_predicted': bool}.
-    """
-    out = {}
-    for i, (side, couple) in enumerate(((side1, torque), (side2, 0.0)), start=1):
-        load = 0.5 * np.abs(np.asarray(side, dtype=float)) + np.abs(np.asarray(couple, dtype=float)) / params.ring_spacing
-        use = np.clip(np.asarray(grip_use[i - 1], dtype=float), 0.0, 1.0)
-        hold = ring_side_grip(params, i - 1, (1.0, 0.0)) * np.sqrt(1.0 - use * use)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.where(load > 0, load / hold, 0.0)
-        out[f"side_use{i}"] = 0.0 if params.mu_wall is None else float(np.max(ratio))
-    out["scrub_predicted"] = out["side_use1"] > 1 or out["side_use2"] > 1
     return out
 
 
@@ -384,51 +218,3 @@ def lift_summary(params, fit: dict | None = None) -> dict:
                 out[key] = min(out[key], bend[key])
     out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0
     return out
-
-
-# a ring whose wheels all grip cannot move across the pipe (their circumferential directions span its plane): only
-# the contacts' softness moves it. In the wheeled model's agreement benchmark (mjcf/README.md, "The round pipe
-# against the analytic finite-grip model"), designs whose sideways-grip check on the analytic run's forces stayed
-# below 1 with no wheel off moved their rings at most 0.12 mm in 1-2 s, those above it 17.1 mm and more: 1 mm lies a
-# factor 8 above the one and 17 below the other
-SCRUB_FLOOR = 1e-3  # m
-
-
-def across_paths(series: dict, params) -> tuple[float, float]:
-    """How far [m] each module's wheels slid across the pipe over a wheeled run: its most-slid wheel's sideways
-    slide, the series' ``slid1``, ``slid2`` where the run has them (the engine's, from MuJoCo's kinematics: a
-    steer-compliant wheel rolls its ring across the pipe without sliding); else from its pose columns (``y``,
-    ``z``, ``roll``, ``pitch``, ``yaw`` and 1 or 2; small turns), as rigid wheels slide: the longer of its two
-    rings' paths in (y, z) (ring centres ``ring_spacing`` / 2 fore and aft of the module's point) plus its
-    wheels' path round the pipe from its roll (D / 2 |d roll|), sample to sample. (module 1's, module 2's)."""
-    if "slid1" in series and "slid2" in series:
-        return float(series["slid1"][-1]), float(series["slid2"][-1])
-    a, out = 0.5 * params.ring_spacing, []
-    for k in (1, 2):
-        y, z, roll, pitch, yaw = (np.asarray(series[f"{c}{k}"], dtype=float) for c in ("y", "z", "roll", "pitch", "yaw"))
-        rings = [np.hypot(np.diff(y + side * a * yaw), np.diff(z - side * a * pitch)) for side in (-1.0, 1.0)]
-        out.append(float(np.sum(np.maximum(*rings) + 0.5 * params.pipe_diameter * np.abs(np.diff(roll)))))
-    return out[0], out[1]
-
-
-def side_summary(params, series: dict) -> dict:
-    """The sideways-grip keys of a wheeled run's summary: the closed-form check beside MuJoCo's outcome.
-
-    - ``side_use1``, ``side_use2``: :func:`side_grip_check` on the drive's loads, quasi-static as
-      :func:`lift_check` takes them (the rod's largest side force :func:`rod_side_force` at the drive's largest
-      torque, M or M_stall, on both modules; the motor's reaction couple on module 1), with the modules holding
-      along the pipe (no skid): each module's largest ring load across the pipe over what its ring's wheels hold
-      across it. Above 1 the rings slide across the pipe; a module that skids along the pipe holds nothing across
-      it whatever this says (its wheels' friction is all along the pipe), nor does a lifted wheel.
-    - ``scrub_predicted``: either above 1.
-    - ``across1_m``, ``across2_m`` [m]: how far MuJoCo's wheels slid across the pipe (:func:`across_paths`); a
-      slide from SCRUB_FLOOR on.
-    - ``scrubbed``: either at least SCRUB_FLOOR: the wheels slid across the pipe, a loss the equations' rails lack.
-    """
-    torque = abs(params.M) if params.drive == "torque" else params.M_stall
-    side = rod_side_force(torque, params.r, params.L)
-    check = side_grip_check(params, [side], [side], [torque])
-    across = across_paths(series, params)
-    return {"side_use1": check["side_use1"], "side_use2": check["side_use2"],
-            "scrub_predicted": check["scrub_predicted"], "across1_m": across[0], "across2_m": across[1],
-            "scrubbed": max(across) >= SCRUB_FLOOR}

@@ -20,7 +20,7 @@ times its press. A ring loaded across the pipe by F (y across in the crank's pla
   friction, which still holds some of it, left out), so it errs towards a lift.
 
 The weight is on the springs from the start (the robot starts at rest sagged on them; its wheels' friction
-carries only what is added later): half the sprung weight across the pipe per ring (:func:`~.pipe.sprung_mass`).
+carries only what is added later): half the sprung weight across the pipe per ring (:func:`~.wheel_legs.sprung_mass`).
 The linkage's loads per ring: module 1 feels the crank's bearing force across the pipe at A, split half to each
 ring (A is the rings' middle), and the drive's reaction couple -T about z as -+T / s on its aft and fore rings;
 module 2 the rod's force at C, half to each ring; each module the rod's force along the pipe's normal where the
@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from .pipe import leg_direction, sprung_mass
+from .wheel_legs import leg_direction, sprung_mass
 from .ring_motion import ring_response, rings_motion  # noqa: F401 (rings_motion: the tests' too)
 
 RINGS = ("aft", "fore")
@@ -130,7 +130,7 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
     than the same load held, a load held as long as it more, up to twice), solved exactly from sample to sample
     with the load held over each (:func:`ring_response`); with ``dt`` None, statically.
 
-    Steer-compliant wheels (:func:`.pipe.rigid_wheels` false) hold a ring across the pipe only while their module
+    Steer-compliant wheels (:func:`.wheel_legs.rigid_wheels` false) hold a ring across the pipe only while their module
     stands: a rolling wheel's side force is its cornering stiffness times its slip angle, the ring's sideways
     speed over the module's ``speed`` [m/s] along the pipe (per sample, or None: unknown) less the module's
     heading, so within their grip a rolling module's wheels are a damper across the pipe, C_r / |v| per ring (C_r
@@ -154,7 +154,8 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
     has moved its ring the suspension's whole travel across the pipe, and its wheel, off the wall, goes with it)
     or a stuck wheel (the summary's outcome, ``scrubbed``, is the run's most-slid wheel's path along its axle from
     the same floor)."""
-    from .pipe import SCRUB_FLOOR, rigid_wheels
+    from .side_check import SCRUB_FLOOR
+    from .wheel_legs import rigid_wheels
 
     n = int(params.wheel_legs)
     u, _ = leg_frames(n)
@@ -229,11 +230,11 @@ SCRUB_BINS = 720  # directions across the pipe the steering scrub is taken at (0
 
 def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray) -> np.ndarray:
     """The wheels' sideways scrub [N] along each sample's spring load (shape (n, 2)) where ``moving`` (the module
-    rolls and the ring slides): the ring's whole sideways friction, :func:`.pipe.ring_side_grip`, at the load's
+    rolls and the ring slides): the ring's whole sideways friction, :func:`.wheel_legs.ring_side_grip`, at the load's
     direction rounded to one of SCRUB_BINS (the law is called once per direction, not per sample); zero elsewhere.
     A ring slides only where its load is beyond what its wheels hold, so every wheel slides: a steer-compliant
     wheel past its slip angle's limit pushes mu_wall P sideways, as a rigid one does."""
-    from .pipe import ring_side_grip
+    from .wheel_legs import ring_side_grip
 
     size = np.hypot(spring[:, 0], spring[:, 1])
     where = moving & (size > 0)
@@ -312,13 +313,14 @@ def run_summary(params, series: dict, route_fit: dict | None = None, straight: b
     checks of :func:`check` on the run's own loads (the loop's pin force, the drive's torque, each module's grip
     use and rolling, the samples' interval): ``least_press1_n``, ``least_press2_n``, ``lift_predicted``,
     ``side_use1``, ``side_use2``, ``scrub_predicted``; beside them MuJoCo's outcome, ``across1_m``,
-    ``across2_m`` and ``scrubbed`` (:func:`.pipe.side_summary`'s). Otherwise (along a route, or a series
+    ``across2_m`` and ``scrubbed`` (:func:`.side_check.side_summary`'s). Otherwise (along a route, or a series
     without those columns): the quasi-static checks of :func:`.pipe.lift_summary` (with the route's bends) and,
-    in a straight pipe with the pose columns, :func:`.pipe.side_summary`. Always: ``grip1_n``, ``grip2_n`` [N],
+    in a straight pipe with the pose columns, :func:`.side_check.side_summary`. Always: ``grip1_n``, ``grip2_n`` [N],
     each module's grip limit as MuJoCo has it, mu_wall times its measured mean press (None with unlimited grip:
     beside mu_wall F_ni, the equations'), and ``unpredicted``: a lift (``wheel_off_s`` > 0) or a slide across
     the pipe (``scrubbed``) the checks did not predict, in words, else None."""
-    from .pipe import across_paths, lift_summary, side_summary, SCRUB_FLOOR
+    from .pipe import lift_summary
+    from .side_check import SCRUB_FLOOR, across_paths, side_summary
 
     out: dict = {}
     if straight and "link_y1" in series:

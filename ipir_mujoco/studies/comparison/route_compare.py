@@ -18,10 +18,10 @@ acceptance's classes (mjcf/README.md, "MuJoCo against the equations in bends"):
   the equations' net motor work, or what their resistances dissipated where a route downhill makes that more);
 - ``lift``, ``scrub``: beyond AGREE, and a wheel left its wall (MuJoCo's ``route_wheel_off_s`` > 0) where the
   lift-off check predicted it (``lift_predicted``: the straight pipe's and every bend's, :mod:`.core.pipe`), or the
-  wheels slid sideways on the wall (MuJoCo's ``slid1``, ``slid2``, from ``core.pipe.SCRUB_FLOOR`` on) where the
+  wheels slid sideways on the wall (MuJoCo's ``slid1``, ``slid2``, from ``core.side_check.SCRUB_FLOOR`` on) where the
   equations' closed form has a wheel beyond its friction limit in a bend (their ``scrub_j`` > 0) or the
   straight pipe's sideways-grip check predicted a slide under the drive's loads (``scrub_predicted``: the
-  summary's, or along a route :func:`ipir_mujoco.core.pipe.side_summary`'s);
+  summary's, or along a route :func:`ipir_mujoco.core.side_check.side_summary`'s);
 - ``stopped``: an engine did not reach the route's end, each engine's ``route_stop`` line says why (``both``
   where both stopped, else which);
 - ``over budget``: a run exceeded its wall-time budget (no verdict on its physics);

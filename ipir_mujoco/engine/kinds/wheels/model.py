@@ -27,7 +27,7 @@ For symmetric legs on linear springs the sum of a ring's normal forces does not 
 across the pipe (the outward directions sum to zero), so the module's press stays F_ni while its weight sags it;
 the arms' stops and a wheel off its wall end that (the closed-form check: :func:`ipir_mujoco.core.pipe.lift_check`).
 
-Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i (:mod:`ipir_mujoco.core.pipe`,
+Masses: each arm and each wheel ARM_SHARE and WHEEL_SHARE of its module's mass m_i (:mod:`ipir_mujoco.core.wheel_legs`,
 which says why), inside m_i; the module's inertia is a solid cylinder of its mass, as long as its ring spacing, of
 the radius inside its wheels. The pipe's wall: :func:`write_pipe_wall` (round and exact, :mod:`.pipe_walls`; flat
 walls along each leg's track let a skidding module roll off them: a rolled wheel's normal on a plane has a moment
@@ -125,7 +125,7 @@ def leg_names(params: RobotParams) -> tuple[tuple[str, ...], tuple[str, ...]]:
 
 def leg_direction(k: int, n: int) -> np.ndarray:
     """Leg k's outward unit vector (of n evenly spaced, leg 0 pointing down, -z), shape (3,)
-    (:func:`ipir_mujoco.core.pipe.leg_direction`, the lift-off check's)."""
+    (:func:`ipir_mujoco.core.wheel_legs.leg_direction`, the lift-off check's)."""
     return np.array(core_leg_direction(k, n))
 
 
@@ -156,7 +156,7 @@ def wheel_mass(params: RobotParams, module: int) -> float:
 
 def steer_compliant(params: RobotParams) -> bool:
     """Whether the wheels steer on their hinges (a finite ``cornering_coefficient`` and a finite ``mu_wall``,
-    :func:`ipir_mujoco.core.pipe.rigid_wheels`): unlimited grip asks a held wheel to take any load along the pipe,
+    :func:`ipir_mujoco.core.wheel_legs.rigid_wheels`): unlimited grip asks a held wheel to take any load along the pipe,
     and a steer-compliant wheel pushed back harder than its cornering stiffness C [N/rad] swings off its axis (its
     trail's lever beats its spring), so with unlimited grip the wheels are rigid."""
     return not rigid_wheels(params)
@@ -340,7 +340,7 @@ def build_wheels_model(params: RobotParams, settings: SolverSettings | None = No
 def sag(params: RobotParams, module: int) -> float:
     """How far [m] module ``module``'s weight sags it across the pipe on its legs' springs, closed form: the two
     rings' n legs each stiffen it by n k / 2, so delta = m g cos(incline) / (n k), m the mass its springs carry
-    (:func:`~ipir_mujoco.core.pipe.sprung_mass`: m_i less its legs), while no wheel lifts."""
+    (:func:`~ipir_mujoco.core.wheel_legs.sprung_mass`: m_i less its legs), while no wheel lifts."""
     weight = sprung_mass(params, module) * params.g * math.cos(math.radians(params.incline))
     return weight / (leg_count(params) * leg_stiffness(params, module))
 
