@@ -20,7 +20,7 @@ import pytest
 from ipir_mujoco import analytic
 from ipir_mujoco.analytic import ParameterError, RobotParams, SimulationError
 from ipir_mujoco.core.results import COLUMNS, RunResult
-from ipir_mujoco.studies import sweep as sweep_module
+from ipir_mujoco.studies.sweeps import sweep_design
 from ipir_mujoco.cli import main
 from ipir_mujoco.studies.sweep import run_sweep
 from ipir_mujoco.engine.run.batch import run_ratchet_batch
@@ -109,8 +109,9 @@ def test_a_failing_design_is_recorded_and_the_sweep_goes_on(tmp_path):
 HELD_SWEEP = """
 import sys, time
 from ipir_mujoco.studies import sweep as sweep_module
+from ipir_mujoco.studies.sweeps import sweep_design
 HOLD_FROM = float(sys.argv.pop(1))
-real_engine, real_chunk = sweep_module.run_engine, sweep_module.run_batch_chunk
+real_engine, real_chunk = sweep_design.run_engine, sweep_module.run_batch_chunk
 
 def wait_for_the_interrupt():
     while True:
@@ -126,7 +127,7 @@ def run_batch_chunk(values, *args, **kwargs):
         wait_for_the_interrupt()
     return real_chunk(values, *args, **kwargs)
 
-sweep_module.run_engine, sweep_module.run_batch_chunk = run_engine, run_batch_chunk
+sweep_design.run_engine, sweep_module.run_batch_chunk = run_engine, run_batch_chunk
 from ipir_mujoco.cli import console
 sys.exit(console())
 """
@@ -306,11 +307,11 @@ def _hang_on_short_rods(engine, params, t_end, dt_out, options):
     return _real_run_engine(engine, params, t_end, dt_out, {})
 
 
-_real_run_engine = sweep_module.run_engine
+_real_run_engine = sweep_design.run_engine
 
 
 def test_a_design_past_its_time_budget_is_a_recorded_failure_not_a_hang(tmp_path, monkeypatch):
-    monkeypatch.setattr(sweep_module, "run_engine", _hang_on_short_rods)  # pool workers fork with it
+    monkeypatch.setattr(sweep_design, "run_engine", _hang_on_short_rods)  # pool workers fork with it
     study = Study((parse_vary("L=0.1,0.2"),), engines=("analytic-approx",), t_end=0.2)
     rows = {int(r["design_id"]): r for r in rows_of(run_sweep(study, tmp_path / "s", progress=False, workers=2,
                                                                 timeout_per_design=0.5))}

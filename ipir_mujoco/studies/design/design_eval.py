@@ -1,7 +1,7 @@
 """Evaluate designs for the optimizer and the sensitivity study: on the sweep's pool, streamed, resumable.
 
 :class:`Evaluator` runs one engine on designs given as {varied name: value} through
-:func:`ipir_mujoco.studies.sweep.run_design` (the sweep's own per-design task, its metrics
+:func:`ipir_mujoco.studies.sweeps.sweep_design.run_design` (the sweep's own per-design task, its metrics
 :data:`~ipir_mujoco.studies.sweep_metrics.METRICS`), on a process pool whose workers die with the
 caller (:mod:`ipir_mujoco.studies.pool`), and appends one flushed row per design to
 ``evaluations.csv`` (:class:`~ipir_mujoco.studies.sweep_files.ResultsFile`, the sweep's streaming).
