@@ -2,12 +2,14 @@
 
 Run on demand (not part of the test suite):
 
-    python bench/grip_random.py [--designs 40] [--seed 3] [--t-end 1] [--budget 60] [--workers 2]
+    python bench/grip_random.py [--designs 40] [--seed 3] [--t-end 1] [--budget 60] [--workers 2] [--compliant]
     python bench/grip_random.py --smoke    # 2 designs of 0.05 s: a check that it runs
 
 Designs: ipir_mujoco.studies.agreement.draw (geometry, masses, resistances, drive, incline over wide
-ranges; see its docstring) with rigid one-way clutches (this branch's analytic engine has no compliant
-clutch on finite grip), on a grip drawn per design: mu_wall uniform in [0, 1] and each F_ni log-uniform
+ranges; see its docstring) with rigid one-way clutches, or with ``--compliant`` compliant ones (k log-uniform
+in 1e4-1e7 N/m, a damper log-uniform in 1-100 N s/m half the time, play up to 2 % of the stroke half the time:
+draw's own ranges; MuJoCo's step then follows the spring on the skidding carriage, timestep.clutch_step), on a
+grip drawn per design: mu_wall uniform in [0, 1] and each F_ni log-uniform
 in [1, 200] N, so that grips run from none to far above the demand. Each design runs the analytic one-way
 model and MuJoCo's ratchet at their default settings and is judged as the agreement study judges
 (revolutions and travel within 0.1 %, 1 %, refused, failed, DISAGREE); the skids are compared against
@@ -26,10 +28,14 @@ import numpy as np
 from ipir_mujoco.studies.agreement import describe, draw, judged, run_pair
 
 
-def grip_design(rng: np.random.Generator):
+def grip_design(rng: np.random.Generator, compliant: bool = False):
     base = replace(draw(rng), clutch_stiffness=None, clutch_damping=0.0, clutch_backlash=0.0)
     log = lambda lo, hi: float(math.exp(rng.uniform(math.log(lo), math.log(hi))))  # noqa: E731
-    return replace(base, mu_wall=float(rng.uniform(0, 1)), F_n1=log(1, 200), F_n2=log(1, 200))
+    grip = dict(mu_wall=float(rng.uniform(0, 1)), F_n1=log(1, 200), F_n2=log(1, 200))
+    if compliant:
+        grip.update(clutch_stiffness=log(1e4, 1e7), clutch_damping=log(1, 100) if rng.uniform() < 0.5 else 0.0,
+                    clutch_backlash=float(rng.uniform(0, 0.02 * 2 * base.r)) if rng.uniform() < 0.5 else 0.0)
+    return replace(base, **grip)
 
 
 def run_one(index: int, params, t_end: float, budget: float) -> dict:
@@ -47,12 +53,13 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=1.0, help="simulated time per design [s]")
     parser.add_argument("--budget", type=float, default=60.0, help="wall-time budget per engine and design [s]")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--compliant", action="store_true", help="compliant one-way clutches (module docstring)")
     parser.add_argument("--smoke", action="store_true", help="every code path once, in seconds (not a measurement)")
     args = parser.parse_args()
     if args.smoke:
         args.designs, args.t_end = 2, 0.05
     rng = np.random.default_rng(args.seed)
-    designs = [grip_design(rng) for _ in range(args.designs)]
+    designs = [grip_design(rng, args.compliant) for _ in range(args.designs)]
     counts: dict[str, int] = {}
     worst = 0.0
     started = time.perf_counter()
