@@ -134,6 +134,12 @@ class Route:
         piece, u = self._piece(s)
         return piece.direction_xyz(u)
 
+    def curvature_xyz(self, s: float) -> tuple[float, float, float]:
+        """The centreline's curvature vector [1/m] at ``s`` [m] (clamped): 1 / R towards a bend's centre, zeros
+        in a straight."""
+        piece, u = self._piece(s)
+        return piece.curvature_xyz(u)
+
     def piece_at(self, s: float) -> int:
         """Index of the piece at ``s`` [m] (the last for s beyond the end)."""
         for k, piece in enumerate(self.pieces):

@@ -117,6 +117,16 @@ class Piece:
         c, s = math.cos(phi), math.sin(phi)
         return c * t[0] + s * d[0], c * t[1] + s * d[1], c * t[2] + s * d[2]
 
+    def curvature_xyz(self, u: float) -> tuple[float, float, float]:
+        """The centreline's curvature vector [1/m] ``u`` [m] along the piece: 1 / radius towards the bend's centre,
+        zeros along a straight; in Python floats."""
+        if self.kind == "straight":
+            return 0.0, 0.0, 0.0
+        _, t, d, _, _ = self._floats
+        phi = u / self.radius
+        c, s = math.cos(phi), math.sin(phi)
+        return tuple((c * d[k] - s * t[k]) / self.radius for k in range(3))
+
     def nearest3(self, p: np.ndarray) -> tuple[float, float]:
         """(distance [m] from the point ``p`` (3,) to the piece's centreline, u [m] along it of the nearest
         point)."""

@@ -3,12 +3,15 @@ the side force its wheels carry rolling through a bend.
 
 Shared by both closed-form checks of a wheeled run, the lift-off check (:mod:`.pipe`) and the sideways-grip
 check (:mod:`.side_check`), and by the wheeled model's builder (the legs' directions, masses and whether its
-wheels are rigid). Statics of one ring on the robot's parameters; no dynamics of the robot.
+wheels are rigid); and a module's frame (:func:`in_module_frame`, :func:`module_gravity`: the run's loads and
+gravity as its rings feel them). Statics of one ring on the robot's parameters; no dynamics of the robot.
 """
 
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 
 # Each leg's masses, shares of its module's mass m_i (inside m_i): its arm (the slider and axle the spring presses
@@ -152,3 +155,24 @@ def bend_cock(params, module: int, toward: tuple[float, float], radius: float) -
         couple = ring_side_force(params, module, toward, a + psi) + ring_side_force(params, module, toward, a - psi)
         low, high = (psi, high) if 2.0 * lever * psi < couple else (low, psi)
     return 0.5 * (low + high)
+
+
+def module_gravity(params, rotation) -> np.ndarray:
+    """Gravity's components across the pipe [m/s^2] in a module's frame, shape (..., 2) (y, z): ``rotation``
+    (..., 3) the module's rotation vector [rad] (the run's roll, pitch and yaw columns: axis times angle, its frame
+    in the world's). The world's up is (sin(incline), 0, cos(incline)): a straight pipe's, and a route's (its
+    first straight's incline, :attr:`.route.Route.up`, which a run along it takes as ``incline``)."""
+    angle = math.radians(params.incline)
+    up = np.array([math.sin(angle), 0.0, math.cos(angle)])
+    return in_module_frame(rotation, -params.g * up)[..., 1:]
+
+
+def in_module_frame(rotation, vector) -> np.ndarray:
+    """World vectors ``vector`` ((..., 3) or (3,)) in a module's frame, shape (..., 3): R^T v, R the rotation of
+    rotation vector ``rotation`` (..., 3) [rad] (axis times angle; Rodrigues' formula turned by -angle)."""
+    rot = np.asarray(rotation, dtype=float)
+    v = np.asarray(vector, dtype=float)
+    theta = np.linalg.norm(rot, axis=-1, keepdims=True)
+    axis = rot / np.where(theta > 1e-12, theta, 1.0)
+    c, s = np.cos(theta), np.sin(theta)
+    return v * c - np.cross(axis, v) * s + axis * np.sum(axis * v, axis=-1, keepdims=True) * (1.0 - c)

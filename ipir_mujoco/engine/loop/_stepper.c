@@ -28,8 +28,8 @@
 
 /* what record() writes per sample: one row of each (Recorder's scalars and deferred arrays, in this order) */
 #define SCALAR_FIELDS(X)                                                                          \
-  X(motor_torque) X(loop_fx) X(loop_fy) X(held1) X(held2) X(lambda1) X(lambda2) X(motor_work)     \
-  X(friction_work) X(clutch_damper_work) X(skid_work) X(wheels1) X(wheels2)
+  X(motor_torque) X(loop_fx) X(loop_fy) X(loop_fz) X(held1) X(held2) X(lambda1) X(lambda2)         \
+  X(motor_work) X(friction_work) X(clutch_damper_work) X(skid_work) X(wheels1) X(wheels2)
 #define DEFERRED_FIELDS(X)                                                                        \
   X(kinetic) X(potential) X(loop_gap) X(momentum) X(clutch_force1) X(clutch_force2)               \
   X(clutch_overlap1) X(clutch_overlap2) X(clutch_spring)
@@ -125,6 +125,7 @@ static int sample(const int64_t *cfg, const double *st, int64_t row) {
   out[R_motor_torque] = st[S_torque];
   out[R_loop_fx] = ne >= loop + 3 ? efc_force[loop] : 0.0;
   out[R_loop_fy] = ne >= loop + 3 ? efc_force[loop + 1] : 0.0;
+  out[R_loop_fz] = ne >= loop + 3 ? efc_force[loop + 2] : 0.0;
   out[R_held1] = held[0];
   out[R_held2] = held[1];
   out[R_lambda1] = held[2];

@@ -50,7 +50,7 @@ from .rows import equality_row
 EXTRA_COLUMNS = ("rod_force", "motor_power", "momentum", "motor_torque", "loop_gap")
 # the per-sample scalars, in their order in Recorder.scalars (the compiled loop writes them too: native.py checks
 # the order against _stepper.c's)
-SCALARS = ("motor_torque", "loop_fx", "loop_fy", "held1", "held2", "lambda1", "lambda2", "motor_work",
+SCALARS = ("motor_torque", "loop_fx", "loop_fy", "loop_fz", "held1", "held2", "lambda1", "lambda2", "motor_work",
            "friction_work", "clutch_damper_work", "skid_work", "wheels1", "wheels2")
 # MuJoCo's values at the start of the next step, per sample (clutch_spring: the stepped spring energy [J])
 DEFERRED = ("kinetic", "potential", "loop_gap", "momentum", "clutch_force1", "clutch_force2", "clutch_overlap1",
@@ -103,8 +103,8 @@ class Recorder:
         self.qpos[i] = d.qpos
         self.qvel[i] = d.qvel
         row = equality_row(self.model, d, self.loop_id)
-        fx, fy = d.efc_force[row:row + 2].tolist() if d.ne >= row + 3 else (0.0, 0.0)
-        self.scalars[i] = (torque, fx, fy, *reactions, motor_work, friction_work, damper_work, skid_work, *wheels)
+        fx, fy, fz = d.efc_force[row:row + 3].tolist() if d.ne >= row + 3 else (0.0, 0.0, 0.0)
+        self.scalars[i] = (torque, fx, fy, fz, *reactions, motor_work, friction_work, damper_work, skid_work, *wheels)
         self.excursion[i] = excursion
         self.count += 1
         return i

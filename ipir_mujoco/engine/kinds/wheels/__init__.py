@@ -122,7 +122,7 @@ class WheelsKind(ModelKind):
         cols.update(press_columns(model, params, q))
         cols.update(pose_columns(model, q))
         cols.update(slide_columns(model, params, q))
-        cols.update(link_columns(params, scalars, out, cols))
+        cols.update(link_columns(scalars, cols))
         return cols
 
     def skid_rule(self, params):

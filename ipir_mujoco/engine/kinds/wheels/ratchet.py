@@ -274,17 +274,23 @@ def press_columns(model: mujoco.MjModel, params: RobotParams, q: np.ndarray) -> 
     return {"press1": press[:, 0].sum(axis=1), "press2": press[:, 1].sum(axis=1), "wheels_off": off}
 
 
-def link_columns(params: RobotParams, scalars: dict, out: dict, pose: dict) -> dict[str, np.ndarray]:
-    """The linkage's forces on each module [N] from the samples of a straight-pipe run: link_y1/2 across the pipe
-    in the crank's plane, link_z1/2 along z. Module 2 feels the loop's pin force at C (the recorder's
-    ``loop_fx``, ``loop_fy``: MuJoCo's connect rows act on the rod, module 2 takes their opposite); module 1
-    the opposite through the crank's bearing at A (the rod's and the crank's own inertia left out: they weigh
-    1 % of a module). Along z: the rod's force ``rod_force`` (tension > 0) along its slope out of the plane,
-    (z2 - z1) / L, from the modules' heights (``pose``: :func:`pose_columns`): where the two modules sag
-    differently on their springs the rod pulls one down and the other up."""
-    across = -scalars["loop_fy"]
-    vertical = -out["rod_force"] * (pose["z2"] - pose["z1"]) / params.L
-    return {"link_y1": -across, "link_y2": across.copy(), "link_z1": -vertical, "link_z2": vertical}
+def link_columns(scalars: dict, pose: dict) -> dict[str, np.ndarray]:
+    """The linkage's forces on each module across the pipe [N], in the module's own frame (``pose``'s roll, pitch
+    and yaw: :func:`pose_columns`, so along a route's bends too): link_y1/2 along its y (in a straight pipe the
+    crank's plane), link_z1/2 along its z. Module 2 feels the loop's pin force at C (the recorder's ``loop_fx``,
+    ``loop_fy``, ``loop_fz``, in the world: MuJoCo's connect rows act on the rod, module 2 takes their opposite);
+    module 1 the opposite through the crank's bearing at A (the rod's and the crank's own inertia left out: they
+    weigh 1 % of a module). In a bend the rod runs along the chord between the modules, so its tension has a part
+    across each module's axis."""
+    from ipir_mujoco.core.wheel_legs import in_module_frame
+
+    on_rod = np.stack([scalars["loop_fx"], scalars["loop_fy"], scalars["loop_fz"]], axis=-1)
+    cols = {}
+    for k, sign in ((1, 1.0), (2, -1.0)):
+        rotation = np.stack([pose[f"roll{k}"], pose[f"pitch{k}"], pose[f"yaw{k}"]], axis=-1)
+        local = in_module_frame(rotation, sign * on_rod)
+        cols[f"link_y{k}"], cols[f"link_z{k}"] = local[:, 1].copy(), local[:, 2].copy()
+    return cols
 
 
 def wheel_loop_options(model: mujoco.MjModel, data: mujoco.MjData) -> dict:

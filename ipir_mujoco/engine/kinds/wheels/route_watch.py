@@ -212,8 +212,10 @@ class RouteWatch:
         module's C distances along the centreline from where they started [m] (as x1, x2 are in a straight
         pipe), ``v1``, ``v2`` their velocities along it (the velocity's component along the centreline's
         direction there) [m/s] and ``a1``, ``a2`` the rates of those [m/s^2]; the world positions stay as
-        ``x1_world``, ``y1_world``, ``z1_world`` (and 2) [m]. Every figure and summary figure drawn from x and v
-        then reads along the route."""
+        ``x1_world``, ``y1_world``, ``z1_world`` (and 2) [m], and the centreline's curvature where each is,
+        ``bend_x1``, ``bend_y1``, ``bend_z1`` (and 2) [1/m] in the world (1 / R towards a bend's centre, 0 in a
+        straight: the lift-off and scrub checks' bends, :mod:`ipir_mujoco.core.route_loads`). Every figure and
+        summary figure drawn from x and v then reads along the route."""
         n = len(series["t"])
         rec = self.rec
         out = dict(series)
@@ -231,6 +233,8 @@ class RouteWatch:
             directions = np.array([self.route.direction_xyz(float(si)) for si in s]).reshape(n, 3)
             speed = np.einsum("ij,ij->i", velocities[k].reshape(n, 3), directions)
             out[f"v{column}"] = speed
+            bend = np.array([self.route.curvature_xyz(float(si)) for si in s]).reshape(n, 3)
+            out[f"bend_x{column}"], out[f"bend_y{column}"], out[f"bend_z{column}"] = bend.T.copy()
             out[f"a{column}"] = np.gradient(speed, series["t"]) if n > 1 else np.zeros(n)
         return out
 
