@@ -4,7 +4,8 @@ and the lift and scrub checks' record against what MuJoCo did.
 Run on demand from the repository root (about a minute of wall time per route and worker on 2 busy cores):
 
     python bench/route_agreement.py [--routes N] [--seed S] [--first K] [--workers N] [--log FILE.jsonl]
-                                    [--set NAME=VALUE]... [--wall-budget SECONDS] [--smoke]
+                                    [--series DIR] [--recheck] [--set NAME=VALUE]... [--wall-budget SECONDS]
+                                    [--smoke]
 
 Route k of seed S (its own random stream, so any route can be rerun alone: ``--first k --routes 1``): a 0.3 m
 first straight rising at an incline drawn from -90..90 deg, or exactly 90, -90 or 0 (a quarter each), then 1-3
@@ -29,7 +30,10 @@ misses), the largest differences among the routes that agree, and the wall time 
 
 ``--log FILE.jsonl`` appends each finished route's record (its spec, both engines' records) and, on a later run
 with the same file, skips the routes it holds (printing their lines first): a long run can be stopped and resumed.
-``--smoke``: one short route, one worker (a check that the script runs).
+``--series DIR`` keeps each route's MuJoCo series there (``route_K.npz``); with it and ``--log``, ``--recheck`` runs
+nothing and takes the logged routes' lift-off and scrub checks again on their kept series with the checks as they are
+now (:func:`ipir_mujoco.core.wall_summary.run_summary`; the series are MuJoCo's, which the checks do not change),
+deciding their classes again. ``--smoke``: one short route, one worker (a check that the script runs).
 """
 
 from __future__ import annotations
@@ -47,7 +51,7 @@ import numpy as np
 from ipir_mujoco.core.params import RobotParams, load_params, parse_overrides
 from ipir_mujoco.core.route import route_from_tables
 from ipir_mujoco.studies.pool import map_unordered
-from ipir_mujoco.studies.comparison.route_compare import AGREE, compare_route, confusion, percent
+from ipir_mujoco.studies.comparison.route_compare import AGREE, compare_route, confusion, judge, percent
 
 D = RobotParams().pipe_diameter  # m: the default pipe, to name the bends' R / D
 ARC = 0.6  # m: a bend's longest arc
@@ -75,12 +79,16 @@ def spec(seed: int, k: int, overrides: dict) -> dict:
     return {"k": k, "segments": tables, "params": params}
 
 
-def run_route(item: dict, wall_budget_s: float) -> dict:
-    """One route in a worker: its spec and :func:`compare_route`'s record, and the wall time [s]."""
+def run_route(item: dict, wall_budget_s: float, series_dir: str | None = None) -> dict:
+    """One route in a worker: its spec and :func:`ipir_mujoco.studies.comparison.route_compare.compare_route`'s
+    record, and the wall time [s]; MuJoCo's series kept in ``series_dir`` (None: not kept)."""
     started = time.perf_counter()
     route = route_from_tables(item["segments"], f"route {item['k']}")
     params = load_params(None, item["params"])
-    record = compare_route(params, route, T_CAP[0] + T_CAP[1] * route.length, wall_budget_s=wall_budget_s)
+    keep = None if series_dir is None else (
+        lambda run: np.savez_compressed(Path(series_dir) / f"route_{item['k']}.npz", **run.series))
+    record = compare_route(params, route, T_CAP[0] + T_CAP[1] * route.length, wall_budget_s=wall_budget_s,
+                           keep=keep)
     record.update(spec=item, wall_s=time.perf_counter() - started, length_m=route.length,
                   bends=[(round(p.radius / D, 2), round(math.degrees(p.angle), 1), round(math.degrees(p.plane)))
                          for p in route.bends])
@@ -99,6 +107,8 @@ def line(r: dict) -> str:
     seen = (f"off {off:.3f} s" if off else "no wheel off") + (f", slid {1e3 * slid:.1f} mm" if slid is not None
                                                                 else "")
     said = ", ".join(k for k in ("lift", "scrub") if r[k]["predicted"]) or "nothing"
+    if m.get("least_press1_n") is not None:  # the lift-off check's least-pressed legs, modules 1 and 2
+        said += f" (least press {m['least_press1_n']:.2f} / {m['least_press2_n']:.2f} N)"
     text = (f"{r['spec']['k']:4d} {r['outcome']:19s} incline {r['spec']['segments'][0]['incline']:+6.1f}, bends "
             f"(R/D/deg/plane) {bends}; {r['length_m']:.2f} m; mu {p['mu_wall']:.3f} F_n {p['F_n1']:.0f}/"
             f"{p['F_n2']:.0f} M_stall {p['M_stall']:.2f}: time {fig(e.get('time_s'), 's')} / "
@@ -111,6 +121,25 @@ def line(r: dict) -> str:
             if not rec.get("route_done"):
                 text += f"\n       {name}: {rec.get('route_stop')}"
     return text
+
+
+def recheck(record: dict, series_dir: str) -> dict:
+    """A logged route's record with MuJoCo's lift-off and scrub checks taken again on its kept series (module
+    docstring), its class decided again; as logged where no series was kept (a run that failed)."""
+    from ipir_mujoco.core.wall_summary import run_summary
+    from ipir_mujoco.engine.kinds.wheels.route_watch import check_route, pipe_fit
+
+    path = Path(series_dir) / f"route_{record['spec']['k']}.npz"
+    if not path.is_file():
+        return record
+    with np.load(path) as kept:
+        series = {key: kept[key] for key in kept.files}
+    route = route_from_tables(record["spec"]["segments"], f"route {record['spec']['k']}")
+    params = check_route(route, "wheels", load_params(None, record["spec"]["params"]), False)
+    checks = run_summary(params, series, pipe_fit(route, params), straight=False)
+    mujoco = {**record["mujoco"], **{key: checks[key] for key in ("lift_predicted", "least_press1_n",
+                                                                  "least_press2_n", "scrub_predicted")}}
+    return {**record, **judge(record["equations"], mujoco)}
 
 
 def report(records: list[dict]) -> None:
@@ -145,10 +174,17 @@ def main(argv=None) -> int:
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     parser.add_argument("--wall-budget", type=float, default=WALL_BUDGET_S, metavar="SECONDS",
                         help="each run's wall-time budget (default %(default)g s)")
+    parser.add_argument("--series", default=None, metavar="DIR", help="keep each route's MuJoCo series here")
+    parser.add_argument("--recheck", action="store_true",
+                        help="with --log and --series: the logged routes' checks taken again on their kept series")
     parser.add_argument("--smoke", action="store_true", help="one short route (a check that the script runs)")
     args = parser.parse_args(argv)
     overrides = parse_overrides(args.set)
     load_params(None, overrides)  # bad input: one line, before any run
+    if args.recheck and not (args.log and args.series):
+        parser.error("--recheck takes the routes of --log and their series in --series: give both")
+    if args.series:
+        Path(args.series).mkdir(parents=True, exist_ok=True)
     if args.smoke:  # one short level route, one gentle bend
         items = [spec(args.seed, 0, overrides)]
         items[0]["segments"] = [dict(kind="straight", length=0.35, incline=0.0),
@@ -165,9 +201,9 @@ def main(argv=None) -> int:
             if r["spec"] in items:
                 held[r["spec"]["k"]] = r
     for k in sorted(held):
-        records.append(held[k])
-        print(line(held[k]), flush=True)
-    todo = [item for item in items if item["k"] not in held]
+        records.append(recheck(held[k], args.series) if args.recheck else held[k])
+        print(line(records[-1]), flush=True)
+    todo = [] if args.recheck else [item for item in items if item["k"] not in held]
     print(f"{len(held)} routes from {args.log}, {len(todo)} to run on {args.workers} workers", file=sys.stderr,
           flush=True)
 
@@ -178,7 +214,8 @@ def main(argv=None) -> int:
             with open(args.log, "a") as handle:
                 handle.write(json.dumps(record) + "\n")
 
-    map_unordered(functools.partial(run_route, wall_budget_s=args.wall_budget), todo, args.workers, done)
+    map_unordered(functools.partial(run_route, wall_budget_s=args.wall_budget, series_dir=args.series), todo,
+                  args.workers, done)
     report(records)
     return 0
 

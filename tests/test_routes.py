@@ -185,9 +185,13 @@ def test_a_bend_route_ends_or_stops_with_a_reason_and_the_summary_says_which(cap
     bend = s["route_fit"]["bends"][0]
     assert bend["wall_press_share"] > 0.8 and not bend["wheels_keep_wall"]
     assert bend["scrub_n"] == pytest.approx([0.8 * 50 / 3] * 2, rel=1e-12)
-    assert "may leave the wall in bend 1" in s["route_fit"]["predicted"] and s["lift_predicted"] is True
-    assert min(s["least_press1_n"], s["least_press2_n"]) == pytest.approx(
-        min(min(bend["least_press1_n"], bend["least_press2_n"]), s["least_press1_n"]), rel=1e-12)
+    assert "may leave the wall in bend 1" in s["route_fit"]["predicted"]
+    # the summary's check takes the run's own loads with the bend's (docs/model.md, "Along a route"): a leg below
+    # LIFT_SHARE of its preload F_n / 6, as MuJoCo's wheels are off their walls
+    from ipir_mujoco.core.wheel_checks import LIFT_SHARE
+
+    floor = LIFT_SHARE * 50 / 6
+    assert s["lift_predicted"] is True and min(s["least_press1_n"], s["least_press2_n"]) < floor
     assert s["route_wheel_off_s"] > 0 and s["wheel_off_s"] > 0
     from ipir_mujoco.cli.simulate import route_lines  # what simulate prints without --json
 

@@ -298,15 +298,19 @@ def wall_lines(s: dict, params) -> list[str]:
     lines = [f"  wall press {s['press1_n']:.4g} N / {s['press2_n']:.4g} N (mean){grip}",
              f"  a wheel off its wall {s['wheel_off_s']:.3f} s; lift-off check: least-pressed leg "
              f"{s['least_press1_n']:.3g} N / {s['least_press2_n']:.3g} N ({lift})"]
-    if "across1_m" in s:  # the straight pipe's sideways check beside the rings' slide (not given along a route)
+    if "side_use1" in s:  # the sideways check; in a straight pipe beside the rings' slide across it
         if params.mu_wall is None:
             check = "unlimited grip: the wheels hold across the pipe"
         else:
             check = (f"sideways-grip check {_ratio(s['side_use1'])} / {_ratio(s['side_use2'])} ("
                      + ("a slide predicted" if s["scrub_predicted"] else "held")
                      + "; a module that skids or lifts a wheel holds nothing across)")
-        lines.append(f"  rings moved across the pipe {1e3 * s['across1_m']:.3g} mm / {1e3 * s['across2_m']:.3g} mm"
-                     + (" (slid: the wheels scrubbed)" if s["scrubbed"] else "") + f"; {check}")
+        if "across1_m" in s:
+            lines.append(f"  rings moved across the pipe {1e3 * s['across1_m']:.3g} mm / "
+                         f"{1e3 * s['across2_m']:.3g} mm" + (" (slid: the wheels scrubbed)" if s["scrubbed"] else "")
+                         + f"; {check}")
+        else:  # along a route the wheels' own slide is the outcome (route_compare's slid_m)
+            lines.append(f"  {check}")
     if s.get("unpredicted"):
         lines.append(f"  not predicted: {s['unpredicted']}")
     return lines

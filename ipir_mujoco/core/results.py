@@ -76,7 +76,7 @@ import numpy as np
 from .cycles import STEADY_CYCLES, STEADY_TOL, cycle_summary
 from .errors import ParameterError
 from .params import RobotParams
-from .wheel_checks import run_summary
+from .wall_summary import run_summary
 from .steady_test import steady_target
 # re-exported (their home was here): the series' vocabulary, the summary's figures, the JSON writers
 from .columns import COLUMNS, MODE_NAMES, REST_SPEED, REST_TIME, SERIES_UNITS, Mode  # noqa: F401

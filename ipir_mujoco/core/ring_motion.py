@@ -48,7 +48,7 @@ def ring_response(spring: np.ndarray, grip: np.ndarray, step: float) -> np.ndarr
 
 
 def rings_motion(springs, stills, dampings, omega: float, dt: float, steer: float,
-                 walls: tuple | None = None) -> tuple[list[np.ndarray], list[np.ndarray]]:
+                 walls: tuple | None = None, slips=None) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Where a module's aft and fore rings sit [N: the springs' load that holds each there] at each sample's start,
     shapes (n, 2), and whether each slides on its wheels over each sample, shapes (n,): each a mass on its springs
     (natural frequency ``omega`` [rad/s]) pushed by its ``springs`` load (shape (n, 2)) held over each interval
@@ -59,6 +59,8 @@ def rings_motion(springs, stills, dampings, omega: float, dt: float, steer: floa
     suspension_travel / ring_spacing), taken at each interval's start. That force ends at the wheels' friction:
     where it would pass it (``walls``: :func:`wheel_walls`, each wheel's friction mu_wall times its press at the
     ring's place; None: no end) they slide, their friction along the force over the interval, undamped. A ring with no damping slides.
+    ``slips`` (per ring, shape (n, 2) [N], or None): the wheels' side force of a slip angle the pipe gives them (a
+    bend's, :func:`ipir_mujoco.core.route_loads.route_loads`), added to the heading's.
     Exact for coefficients and loads constant over an interval (the interval's matrix exponential), the heading
     held at its start (:func:`ring_response` sums one undamped ring in closed form)."""
     count = np.asarray(springs[0]).reshape(-1, 2).shape[0]
@@ -81,16 +83,20 @@ def rings_motion(springs, stills, dampings, omega: float, dt: float, steer: floa
     c0, s0 = math.cos(omega * dt), math.sin(omega * dt)  # undamped, sliding
     if walls is not None:
         legs = [(float(a), float(b), float(c), float(d)) for (a, b), (c, d) in zip(walls[0], walls[1])]
-        preload, (w0, w1), mu, share = walls[2], (float(walls[3][0]), float(walls[3][1])), walls[4], 2.0 / len(legs)
+        preload, mu, share = walls[2], walls[4], 2.0 / len(legs)
+        weights = np.broadcast_to(np.asarray(walls[3], dtype=float).reshape(-1, 2), (count, 2)).tolist()
     loads = [np.asarray(sp, dtype=float).reshape(-1, 2).tolist() for sp in springs]
     rests = [np.asarray(st, dtype=bool).reshape(-1).tolist() for st in stills]
+    bends = [None if slips is None or slip is None else np.asarray(slip, dtype=float).reshape(-1, 2).tolist()
+             for slip in (slips or (None, None))]
     places = [np.empty((count, 2)), np.empty((count, 2))]
     slid = [np.zeros(count, dtype=bool), np.zeros(count, dtype=bool)]
     x, v = [[0.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 0.0]]
     for j in range(count):
         places[0][j], places[1][j] = x[0], x[1]
-        heading = (steer * (x[1][0] - x[0][0]), steer * (x[1][1] - x[0][1]))
+        turned = (steer * (x[1][0] - x[0][0]), steer * (x[1][1] - x[0][1]))
         for r in (0, 1):
+            heading = turned if bends[r] is None else (turned[0] + bends[r][j][0], turned[1] + bends[r][j][1])
             rate = rate_list[r][j]
             if rests[r][j] or rate == math.inf:
                 v[r] = [0.0, 0.0]
@@ -99,6 +105,7 @@ def rings_motion(springs, stills, dampings, omega: float, dt: float, steer: floa
             sliding = rate == 0.0
             if not sliding:
                 push = (heading[0] - rate * vr[0], heading[1] - rate * vr[1])
+                w0, w1 = weights[j] if walls is not None else (0.0, 0.0)
                 size = math.hypot(*push)
                 friction = 0.0 if walls is None or size == 0.0 else mu * sum(
                     max(preload + share * ((xr[0] + w0) * u0 + (xr[1] + w1) * u1), 0.0)

@@ -55,10 +55,13 @@ def leg_frames(n: int) -> tuple[np.ndarray, np.ndarray]:
     return u, np.stack([-u[:, 1], u[:, 0]], axis=1)
 
 
-def weight_load(params, module: int) -> np.ndarray:
-    """The load [N] of its weight on each ring of ``module`` (0 rear, 1 front) across a straight pipe, (y, z):
-    half its sprung mass's weight across the pipe, down."""
-    return np.array([0.0, -0.5 * sprung_mass(params, module) * params.g * math.cos(math.radians(params.incline))])
+def weight_load(params, module: int, gravity=None) -> np.ndarray:
+    """The load [N] of its weight on each ring of ``module`` (0 rear, 1 front) across the pipe, (y, z): half its
+    sprung mass times ``gravity``, gravity's components across the pipe in the module's frame [m/s^2] ((..., 2):
+    per sample along a route, :func:`.wheel_legs.module_gravity`); None: a straight pipe's, (0, -g cos(incline))."""
+    if gravity is None:
+        gravity = (0.0, -params.g * math.cos(math.radians(params.incline)))
+    return 0.5 * sprung_mass(params, module) * np.asarray(gravity, dtype=float)
 
 
 def leg_presses(params, module: int, spring_load) -> np.ndarray:
@@ -70,28 +73,29 @@ def leg_presses(params, module: int, spring_load) -> np.ndarray:
     return preload + (2.0 / n) * np.asarray(spring_load, dtype=float) @ u.T
 
 
-def side_holds(params, module: int) -> np.ndarray:
+def side_holds(params, module: int, gravity=None) -> np.ndarray:
     """What each ring of ``module``'s wheels hold across the pipe by friction along each leg's direction u_j [N],
-    shape (n,): sum_k mu_wall N_k |e_k . u_j|, N_k each leg's press under the weight (module docstring); inf with
-    unlimited grip (a finite model's friction still ends somewhere: MuJoCo's is 100 times the press)."""
+    shape (n,) (with ``gravity`` per sample, :func:`weight_load`: (..., n)): sum_k mu_wall N_k |e_k . u_j|, N_k
+    each leg's press under the weight (module docstring); inf with unlimited grip (a finite model's friction still
+    ends somewhere: MuJoCo's is 100 times the press)."""
     n = int(params.wheel_legs)
-    if params.mu_wall is None:
-        return np.full(n, math.inf)
     u, e = leg_frames(n)
-    press = np.maximum(leg_presses(params, module, weight_load(params, module)), 0.0)
-    return params.mu_wall * (np.abs(e @ u.T) * press[:, None]).sum(axis=0)
+    press = np.maximum(leg_presses(params, module, weight_load(params, module, gravity)), 0.0)
+    if params.mu_wall is None:
+        return np.full(press.shape, math.inf)
+    return params.mu_wall * press @ np.abs(e @ u.T)
 
 
-def held(params, module: int, load, grip_use=0.0) -> np.ndarray:
+def held(params, module: int, load, grip_use=0.0, gravity=None) -> np.ndarray:
     """Whether ``module``'s ring holds the linkage's ``load`` [N] ((..., 2): y, z) by its wheels' friction, shape
     (...): |F . u_j| <= sqrt(1 - u^2) sum_k mu N_k |e_k . u_j| for every leg j, u = ``grip_use`` the share of
-    the module's grip used along the pipe (1 while it skids)."""
+    the module's grip used along the pipe (1 while it skids); ``gravity`` as :func:`weight_load` takes it."""
     n = int(params.wheel_legs)
     u, _ = leg_frames(n)
     left = np.sqrt(1.0 - np.clip(np.asarray(grip_use, dtype=float), 0.0, 1.0) ** 2)[..., None]
     across = np.abs(np.asarray(load, dtype=float) @ u.T)
     with np.errstate(invalid="ignore"):  # inf * 0 where an unlimited grip skids (it does not)
-        hold = np.nan_to_num(side_holds(params, module) * left, nan=math.inf)
+        hold = np.nan_to_num(side_holds(params, module, gravity) * left, nan=math.inf)
     return np.all(across <= hold, axis=-1)
 
 
@@ -116,10 +120,18 @@ def ring_loads(params, side1, side2, torque, vertical1=0.0, vertical2=0.0) -> di
 
 
 def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(False, False),
-          dt: float | None = None, speed=(None, None)) -> dict:
+          dt: float | None = None, speed=(None, None), gravity=(None, None), press_loss=(None, None),
+          slips=None) -> dict:
     """The lift-off and scrub checks on the rings' linkage ``loads`` (:func:`ring_loads`, samples along the first
     axis) with each module's ``grip_use`` share along the pipe and whether it ``rolling`` (arrays of the samples'
-    shape, or scalars); ``dt`` [s] the samples' interval (None: each sample static).
+    shape, or scalars); ``dt`` [s] the samples' interval (None: each sample static); ``gravity`` per module,
+    gravity's components across the pipe in its frame [m/s^2] (samples, 2) (:func:`.wheel_legs.module_gravity`:
+    along a route, or a module that rolls about its axis), None: a straight pipe's. The weight across the pipe is
+    on the springs at every sample (it changes slowly along a route's bends: a rolling module's rings creep to
+    it). ``press_loss`` per module, each leg's press lost to the pipe's shape [N] (samples, n) (a bend's spread,
+    :mod:`.route_loads`), None: none; ``slips``, keyed as ``loads``, the side force [N] (samples, 2) of a slip
+    angle the pipe gives a ring's rolling steer-compliant wheels (a bend's), which acts through their cornering
+    compliance as the heading's does (:func:`.ring_motion.rings_motion`), None: none.
 
     Per ring and sample: where its wheels hold the load by their sideways friction (:func:`held`) the ring stays
     where it is; where they do not, its springs carry the load, and a module that rolls meanwhile also carries
@@ -166,9 +178,10 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
         preload = (params.F_n1, params.F_n2)[module] / (2 * n)
         stiffness = preload / params.suspension_travel
         frequency = math.sqrt(n * stiffness / sprung_mass(params, module))
-        weight = weight_load(params, module)
+        along = gravity[module]
+        weight = weight_load(params, module, along)
         use = np.clip(np.asarray(grip_use[module], dtype=float), 0.0, 1.0)
-        holds = side_holds(params, module)
+        holds = side_holds(params, module, along).reshape(-1, n)
         least, path, ratio, stuck = math.inf, 0.0, 0.0, False
         # a wheel turns on the wall only while its friction mu_wall N_k can turn its hub against its share of the
         # module's rolling resistance (the hub's frictionloss, F_ri R / (2 n))
@@ -179,9 +192,9 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             samples = load.shape[0]
             ring_use = np.broadcast_to(use, (samples,)) if use.ndim else np.full(samples, float(use))
             rolls = np.broadcast_to(np.asarray(rolling[module], dtype=bool), (samples,))
-            load = (load + sign * pitch_couple(params, module)[None, :] * ring_use[:, None]
-                    - sign * stuck_couple(params, module)[None, :] * rolls[:, None])
-            grip = held(params, module, load, ring_use)
+            load = (load + sign * pitch_couple(params, module, along).reshape(-1, 2) * ring_use[:, None]
+                    - sign * stuck_couple(params, module, along).reshape(-1, 2) * rolls[:, None])
+            grip = held(params, module, load, ring_use, along)
             creep = grip & rolls if compliant else np.zeros(samples, dtype=bool)
             still = grip & ~creep
             spring = np.where(still[:, None], 0.0, load)
@@ -193,17 +206,22 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
         if dt is None:  # at rest on the springs; rings that creep together carry the heading's steering too
             both = (rings[0][2] & rings[1][2])[:, None]
             turn = np.where(both, steer * (rings[1][4] - rings[0][4]), 0.0)
-            moves = [(r[4] + turn, ~r[1]) for r in rings]
+            bent = [0.0 if slips is None else np.where(r[2][:, None], slips[f"{i}{ring}"], 0.0)
+                    for ring, r in zip(RINGS, rings)]
+            moves = [(r[4] + turn + b, ~r[1]) for r, b in zip(rings, bent)]
         elif rings[0][2].any() or rings[1][2].any():
             damping = creep_damping(params, module, speed[module])
             places, slides = rings_motion([r[4] for r in rings], [r[3] for r in rings],
                                           [np.where(r[2], damping, 0.0) for r in rings], frequency, dt, steer,
-                                          wheel_walls(params, module))
+                                          wheel_walls(params, module, along),
+                                          None if slips is None else [slips[f"{i}{ring}"] for ring in RINGS])
             moves = [(place, slid & ~r[3]) for place, slid, r in zip(places, slides, rings)]
         else:
             moves = [(ring_response(r[4], r[1], frequency * dt), ~r[1]) for r in rings]
         for (load, *_, rolls), (place, slides) in zip(rings, moves):
             presses = leg_presses(params, module, place + weight)
+            if press_loss[module] is not None:
+                presses = presses - press_loss[module]
             least = min(least, float(np.min(presses)))
             if params.mu_wall is not None:  # a rolling module's wheel that cannot turn its hub skids under it
                 stuck = stuck or bool(np.any(rolls & (params.mu_wall * np.min(presses, axis=-1) < turning)))
@@ -212,7 +230,7 @@ def check(params, loads: dict[str, np.ndarray], grip_use=(0.0, 0.0), rolling=(Fa
             if params.mu_wall is not None:  # against the whole grip: a skidding module's share is in held()
                 across = np.abs(load @ u.T)
                 with np.errstate(divide="ignore", invalid="ignore"):  # no grip: any load is beyond it (inf)
-                    ratio = max(ratio, float(np.max(np.where(holds[None, :] > 0, across / holds[None, :],
+                    ratio = max(ratio, float(np.max(np.where(holds > 0, across / holds,
                                                              np.where(across > 0, math.inf, 0.0)))))
         out[f"least_press{i}_n"] = least
         out[f"slid{i}_m"] = path
@@ -251,14 +269,15 @@ def _steering_scrub(params, module: int, spring: np.ndarray, moving: np.ndarray)
     return out
 
 
-def wheel_walls(params, module: int) -> tuple:
+def wheel_walls(params, module: int, gravity=None) -> tuple:
     """What a ring of ``module``'s wheels hold by friction, for :func:`rings_motion`: (u, e, P, weight, mu_wall),
     the legs' outward and sideways directions (n, 2), their preload [N], the ring's weight across the pipe [N]
-    (2,) and the friction coefficient: wheel k presses N_k = P + (2 / n) (X + weight) . u_k (X the springs' load
+    (2,), or per sample with ``gravity`` (:func:`weight_load`: (samples, 2)), and the friction coefficient: wheel
+    k presses N_k = P + (2 / n) (X + weight) . u_k (X the springs' load
     of the ring's place, at least 0) and its friction along a way d is mu_wall N_k |e_k . d|."""
     n = int(params.wheel_legs)
     u, e = leg_frames(n)
-    return u, e, (params.F_n1, params.F_n2)[module] / (2 * n), weight_load(params, module), params.mu_wall
+    return u, e, (params.F_n1, params.F_n2)[module] / (2 * n), weight_load(params, module, gravity), params.mu_wall
 
 
 def creep_damping(params, module: int, speed) -> np.ndarray | float:
@@ -274,7 +293,7 @@ def creep_damping(params, module: int, speed) -> np.ndarray | float:
         return C_r / (0.5 * sprung_mass(params, module) * np.abs(np.asarray(speed, dtype=float)))
 
 
-def pitch_couple(params, module: int) -> np.ndarray:
+def pitch_couple(params, module: int, gravity=None) -> np.ndarray:
     """The load [N] on each ring of ``module`` (0 rear, 1 front), (y, z), +- on its aft and fore rings, of the
     couple its wheels' friction along the pipe makes at the wall while it uses all its grip: each wheel's friction
     mu N_k acts at the wall, D / 2 from the axis along its leg, and the weight across the pipe presses the lower
@@ -282,13 +301,15 @@ def pitch_couple(params, module: int) -> np.ndarray:
     by D / 2 times W / F_n of it: a couple mu (D / 2) W about the axis across the pipe and the weight, which the
     two rings carry as +- mu (D / 2) W / s along the weight. Scaled by the share of the grip in use (with the
     friction shared as the presses are: Coulomb's law while it skids, and towards it as the least-pressed wheels
-    reach their limit first); zero with unlimited grip (its skid does not happen)."""
+    reach their limit first); zero with unlimited grip (its skid does not happen). ``gravity`` as
+    :func:`weight_load` takes it (then shape (..., 2))."""
+    weight = weight_load(params, module, gravity)
     if params.mu_wall is None:
-        return np.zeros(2)
-    return params.mu_wall * 0.5 * params.pipe_diameter * 2.0 * weight_load(params, module) / params.ring_spacing
+        return np.zeros_like(weight)
+    return params.mu_wall * 0.5 * params.pipe_diameter * 2.0 * weight / params.ring_spacing
 
 
-def stuck_couple(params, module: int) -> np.ndarray:
+def stuck_couple(params, module: int, gravity=None) -> np.ndarray:
     """The load [N] on each ring of ``module`` (0 rear, 1 front), (y, z), -+ on its aft and fore rings, of the couple
     its stuck wheels make while it rolls: a wheel whose friction mu_wall N_k (N_k its press under the weight, as
     :func:`pitch_couple` takes it) cannot turn its hub against its share F_ri / (2 n) of the rolling resistance
@@ -296,71 +317,12 @@ def stuck_couple(params, module: int) -> np.ndarray:
     its leg: the rings carry sum_k mu N_k (D / 2) u_k / s over both rings' stuck wheels, as :func:`pitch_couple`
     carries the gripping wheels' (the other way: a rolling module moves forward, a held one is pushed back). A
     heavy module's upper wheels stick first: the couple presses its aft ring towards its lower legs. Zero with
-    unlimited grip."""
+    unlimited grip. ``gravity`` as :func:`weight_load` takes it (then shape (..., 2))."""
+    weight = weight_load(params, module, gravity)
     if params.mu_wall is None:
-        return np.zeros(2)
+        return np.zeros_like(weight)
     n = int(params.wheel_legs)
     u, _ = leg_frames(n)
-    press = np.maximum(leg_presses(params, module, weight_load(params, module)), 0.0)
+    press = np.maximum(leg_presses(params, module, weight), 0.0)
     stuck = params.mu_wall * press < (params.F_r1, params.F_r2)[module] / (2 * n)
     return 2.0 * params.mu_wall * 0.5 * params.pipe_diameter * ((stuck * press) @ u) / params.ring_spacing
-
-
-def run_summary(params, series: dict, route_fit: dict | None = None, straight: bool = True) -> dict:
-    """The wall's keys of a wheeled run's summary: the closed-form checks beside MuJoCo's outcome.
-
-    In a straight pipe (``straight``, a run with the linkage's force columns ``link_y1`` .. ``link_z2``): the
-    checks of :func:`check` on the run's own loads (the loop's pin force, the drive's torque, each module's grip
-    use and rolling, the samples' interval): ``least_press1_n``, ``least_press2_n``, ``lift_predicted``,
-    ``side_use1``, ``side_use2``, ``scrub_predicted``; beside them MuJoCo's outcome, ``across1_m``,
-    ``across2_m`` and ``scrubbed`` (:func:`.side_check.side_summary`'s). Otherwise (along a route, or a series
-    without those columns): the quasi-static checks of :func:`.pipe.lift_summary` (with the route's bends) and,
-    in a straight pipe with the pose columns, :func:`.side_check.side_summary`. Always: ``grip1_n``, ``grip2_n`` [N],
-    each module's grip limit as MuJoCo has it, mu_wall times its measured mean press (None with unlimited grip:
-    beside mu_wall F_ni, the equations'), and ``unpredicted``: a lift (``wheel_off_s`` > 0) or a slide across
-    the pipe (``scrubbed``) the checks did not predict, in words, else None."""
-    from .pipe import lift_summary
-    from .side_check import SCRUB_FLOOR, across_paths, side_summary
-
-    out: dict = {}
-    if straight and "link_y1" in series:
-        t = np.asarray(series["t"], dtype=float)
-        loads = ring_loads(params, series["link_y1"], series["link_y2"], series["motor_torque"], series["link_z1"],
-                           series["link_z2"])
-        grip = tuple(series.get(f"grip_use{k}", 0.0) for k in (1, 2))
-        # rolling: its hubs turn free (+1), or, not skidding, it moves on (a light wheel's hub can stick while its
-        # module rolls: the state then says standing)
-        rolling = tuple((np.asarray(series[f"wheels{k}"]) == 1.0) | ((np.asarray(series[f"wheels{k}"]) != -1.0)
-                                                                    & (np.asarray(series[f"v{k}"]) > MOVING_SPEED))
-                        for k in (1, 2))
-        result = check(params, loads, grip, rolling, float(np.median(np.diff(t))) if len(t) > 1 else None,
-                       (series["v1"], series["v2"]))
-        across = across_paths(series, params)
-        out.update({key: result[key] for key in ("least_press1_n", "least_press2_n", "lift_predicted", "side_use1",
-                                                 "side_use2", "scrub_predicted")})
-        out.update(across1_m=across[0], across2_m=across[1], scrubbed=max(across) >= SCRUB_FLOOR)
-    else:
-        out.update(lift_summary(params, route_fit))
-        if straight and "yaw2" in series:
-            out.update(side_summary(params, series))
-    presses = (float(np.mean(series["press1"])), float(np.mean(series["press2"])))
-    out.update({f"grip{k}_n": None if params.mu_wall is None else params.mu_wall * presses[k - 1] for k in (1, 2)})
-    out["unpredicted"] = unpredicted(out, series)
-    return out
-
-
-def unpredicted(keys: dict, series: dict) -> str | None:
-    """A lift or a slide across the pipe that happened with no prediction, in words (None if none): a wheel off
-    its wall (the summary's ``wheel_off_s``, from the samples' ``wheels_off``) where ``lift_predicted`` is
-    false; rings that slid (``scrubbed``) where ``scrub_predicted`` is false."""
-    t, off = np.asarray(series["t"], dtype=float), np.asarray(series["wheels_off"], dtype=float)
-    off_s = float(np.sum(np.diff(t)[off[:-1] > 0]))
-    said = []
-    if off_s > 0 and not keys.get("lift_predicted"):
-        first = float(t[np.flatnonzero(off > 0)[0]])
-        said.append(f"a wheel was off its wall {off_s:.3g} s from t = {first:.3g} s with no lift predicted (least "
-                    f"press {keys['least_press1_n']:.3g} N / {keys['least_press2_n']:.3g} N)")
-    if keys.get("scrubbed") and not keys.get("scrub_predicted"):
-        said.append(f"the rings slid {1e3 * keys['across1_m']:.3g} mm / {1e3 * keys['across2_m']:.3g} mm across the "
-                    "pipe with no slide predicted")
-    return "; ".join(said) or None

@@ -17,11 +17,11 @@ acceptance's classes (mjcf/README.md, "MuJoCo against the equations in bends"):
   compare the engines' phases), its difference over the energy put through the robot (:func:`work_difference`:
   the equations' net motor work, or what their resistances dissipated where a route downhill makes that more);
 - ``lift``, ``scrub``: beyond AGREE, and a wheel left its wall (MuJoCo's ``route_wheel_off_s`` > 0) where the
-  lift-off check predicted it (``lift_predicted``: the straight pipe's and every bend's, :mod:`.core.pipe`), or the
-  wheels slid sideways on the wall (MuJoCo's ``slid1``, ``slid2``, from ``core.side_check.SCRUB_FLOOR`` on) where the
-  equations' closed form has a wheel beyond its friction limit in a bend (their ``scrub_j`` > 0) or the
-  straight pipe's sideways-grip check predicted a slide under the drive's loads (``scrub_predicted``: the
-  summary's, or along a route :func:`ipir_mujoco.core.side_check.side_summary`'s);
+  lift-off check predicted it (``lift_predicted``: the check on the run's own loads with what each bend adds,
+  :func:`ipir_mujoco.core.wall_summary.run_summary`), or the wheels slid sideways on the wall (MuJoCo's ``slid1``,
+  ``slid2``, from ``core.side_check.SCRUB_FLOOR`` on) where the equations' closed form has a wheel beyond its
+  friction limit in a bend (their ``scrub_j`` > 0) or the same check predicted a slide (``scrub_predicted``; a
+  series without the linkage's force columns: :func:`ipir_mujoco.core.side_check.side_summary`'s);
 - ``stopped``: an engine did not reach the route's end, each engine's ``route_stop`` line says why (``both``
   where both stopped, else which);
 - ``over budget``: a run exceeded its wall-time budget (no verdict on its physics);
@@ -88,8 +88,8 @@ def engine_record(run) -> dict:
                                                                                       s.get("slip2_m")))
     if "slid1" in run.series:
         out["slid_m"] = max(float(run.series["slid1"][-1]), float(run.series["slid2"][-1]))
-        if out["scrub_predicted"] is None:  # along a route the summary has none: the straight pipe's check on the
-            # drive's loads (the rod's side force and the motor's couple against the rings' sideways grip)
+        if out["scrub_predicted"] is None:  # a series without the linkage's force columns: the straight pipe's
+            # check on the drive's loads (the rod's side force and the motor's couple against the rings' sideways grip)
             out["scrub_predicted"] = bool(side_summary(run.params, run.series)["scrub_predicted"])
     return out
 
@@ -112,13 +112,17 @@ def run_engine(variant: str, params, route, t_cap: float, dt_out: float = DT_OUT
     return run, record
 
 
-def compare_route(params, route, t_cap: float, dt_out: float = DT_OUT, wall_budget_s: float | None = None) -> dict:
+def compare_route(params, route, t_cap: float, dt_out: float = DT_OUT, wall_budget_s: float | None = None,
+                  keep=None) -> dict:
     """Both engines along ``route`` (module docstring) with ``params``, each for at most ``t_cap`` [s] and
     ``wall_budget_s`` [s] of wall time: {'equations': record, 'mujoco': record, 'time_diff', 'work_diff' (MuJoCo's
     over the equations' less 1, None where either did not reach the end), 'lift', 'scrub' ({'predicted',
-    'happened'}), 'outcome' (:func:`classify`)}."""
+    'happened'}), 'outcome' (:func:`classify`)}; ``keep``, if given, is called with MuJoCo's run where it
+    finished (a benchmark keeps its series)."""
     _, equations = run_engine(EQUATIONS, params, route, t_cap, dt_out, wall_budget_s)
-    _, mujoco = run_engine(MUJOCO, params, route, t_cap, dt_out, wall_budget_s)
+    run, mujoco = run_engine(MUJOCO, params, route, t_cap, dt_out, wall_budget_s)
+    if keep is not None and run is not None:
+        keep(run)
     return judge(equations, mujoco)
 
 
