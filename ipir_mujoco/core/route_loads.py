@@ -70,17 +70,19 @@ def route_loads(params, series: dict, rolling) -> BendLoads:
         side, spread, steady = np.zeros((count, 2)), np.zeros((count, n)), np.zeros((count, n))
         P = (params.F_n1, params.F_n2)[k - 1] / (2 * n)
         if f"bend_x{k}" in series:
-            curvature = in_module_frame(rotation, np.stack([np.asarray(series[f"bend_{a}{k}"], dtype=float)
-                                                            for a in ("x", "y", "z")], -1))[:, 1:]
+            world = np.stack([np.asarray(series[f"bend_{a}{k}"], dtype=float) for a in ("x", "y", "z")], -1)
+            curvature = in_module_frame(rotation, world)[:, 1:]
             speed = np.asarray(series[f"v{k}"], dtype=float)
             across = across - speed[:, None] ** 2 * curvature
             size = np.hypot(curvature[:, 0], curvature[:, 1])
             inside = size > 0
             toward = np.where(inside[:, None], curvature / np.where(inside, size, 1.0)[:, None], 0.0)
             rolls = np.asarray(rolling[k - 1], dtype=bool) & inside
-            # per (radius, direction) met: a route has a few bends, its modules few directions in them
+            # per (radius, direction) met: the bends' own radii (the world's curvature, exact per bend) and the
+            # directions rounded to TOWARD_BINS; a route has a few bends, its modules few directions in them
             angle = np.round(np.arctan2(toward[:, 1], toward[:, 0]) / (2 * math.pi) * TOWARD_BINS).astype(int)
-            radius = np.round(np.where(inside, 1.0 / np.where(inside, size, 1.0), 0.0), 6)
+            bent = np.linalg.norm(world, axis=-1)
+            radius = np.round(np.where(inside, 1.0 / np.where(inside, bent, 1.0), 0.0), 9)
             force, held = np.zeros(count), np.zeros(count)
             for key in set(zip(radius[inside].tolist(), angle[inside].tolist())):
                 where = inside & (radius == key[0]) & (angle == key[1])
