@@ -29,8 +29,9 @@ less in its twin (the wheels' sliding, and the soft contacts' creep under the si
 ended where it did not pass (its ``route_stop``); how long some wheel was off its wall in the bend's run and in
 its twin's (``route_wheel_off_s``, the whole run); how far MuJoCo's most-slid wheel slid sideways (``slid1``,
 ``slid2``), bend / twin; each module's cock in the bend, MuJoCo's rolling and standing beside the closed form's
-(:func:`cocks`); the closed-form lift-off check of the bend (``lift_predicted`` and the least-pressed leg, the
-route's fit) and the step the run kept. The lift check's record over the rows ends the output: predicted and
+(:func:`cocks`); the summary's lift-off check (``lift_predicted``: on the run's own loads with what the bend adds,
+docs/model.md "Along a route") beside the bend's quasi-static closed form's least-pressed leg (the route's fit) and
+the step the run kept. The lift check's record over the rows ends the output: predicted and
 happened (a wheel off in the bend's run longer than in its twin's), false alarms and misses.
 
 ``--closed-form`` runs nothing: per mu_wall and R/D, the rings' slip angle asin(b / R), the module's cock and the
@@ -213,7 +214,7 @@ def main(argv=None) -> int:
           "straight [s] | equations penalty | MuJoCo - equations in the bend: time / energy | energy bend / straight "
           "[J]: MuJoCo; equations | scrub [J]: equations / MuJoCo's skid, bend less straight | outcome | wheel off "
           "bend / straight [s] | slid bend / straight [mm] | cock [rad] module 1; 2: MuJoCo rolling / standing, closed "
-          "form | lift predicted (least press [N]) | step [s] |")
+          "form | lift predicted (the fit's least press [N]) | step [s] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     record = {"predicted and lifted": 0, "predicted, no lift (false alarm)": 0, "lifted, not predicted (miss)": 0,
               "neither": 0}
