@@ -29,7 +29,7 @@ import math
 from .errors import ParameterError
 from .wheel_legs import (  # noqa: F401  (re-exported: every name stays importable from here)
     ARM_SHARE, COCK_HALVINGS, WHEEL_SHARE, bend_cock, bend_slip_angle, hub_tangent, leg_direction, rigid_wheels,
-    ring_side_force, ring_side_grip, rod_side_force, scrub_force, sprung_mass)
+    ring_side_force, ring_side_grip, rod_side_force, scrub_force, spread_unload, sprung_mass)
 from .side_check import SCRUB_FLOOR, across_paths, side_grip_check, side_summary  # noqa: F401  (re-exported)
 
 
@@ -198,7 +198,7 @@ def bend_lift_check(params, radius: float, toward: tuple[float, float], across) 
                     fy = 0.5 * m * gy + lateral + bend_load * ty
                     fz = 0.5 * m * gz + bend_load * tz
                     for (_, uy, uz) in legs:
-                        spread_loss = P * (uy * ty + uz * tz) ** 2 * 0.5 * spread / params.suspension_travel
+                        spread_loss = spread_unload(params, P, uy * ty + uz * tz, spread)
                         least = min(least, P - spread_loss + (2.0 / n) * (fy * uy + fz * uz))
         out[f"least_press{i}_n"] = least
     out["lift_predicted"] = out["least_press1_n"] < 0 or out["least_press2_n"] < 0

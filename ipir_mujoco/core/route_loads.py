@@ -31,9 +31,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .wheel_legs import in_module_frame, leg_direction, module_gravity
+from .wheel_checks import SCRUB_BINS
+from .wheel_legs import in_module_frame, leg_direction, module_gravity, spread_unload
 
-TOWARD_BINS = 720  # directions across the pipe a bend's side force is taken at (0.5 deg apart: to cos 0.25 deg)
 
 
 @dataclass
@@ -79,20 +79,21 @@ def route_loads(params, series: dict, rolling) -> BendLoads:
             toward = np.where(inside[:, None], curvature / np.where(inside, size, 1.0)[:, None], 0.0)
             rolls = np.asarray(rolling[k - 1], dtype=bool) & inside
             # per (radius, direction) met: the bends' own radii (the world's curvature, exact per bend) and the
-            # directions rounded to TOWARD_BINS; a route has a few bends, its modules few directions in them
-            angle = np.round(np.arctan2(toward[:, 1], toward[:, 0]) / (2 * math.pi) * TOWARD_BINS).astype(int)
+            # directions rounded to the steering scrub's SCRUB_BINS; a route has a few bends, its modules few
+            # directions in them
+            angle = np.round(np.arctan2(toward[:, 1], toward[:, 0]) / (2 * math.pi) * SCRUB_BINS).astype(int)
             bent = np.linalg.norm(world, axis=-1)
             radius = np.round(np.where(inside, 1.0 / np.where(inside, bent, 1.0), 0.0), 9)
             force, held = np.zeros(count), np.zeros(count)
             for key in set(zip(radius[inside].tolist(), angle[inside].tolist())):
                 where = inside & (radius == key[0]) & (angle == key[1])
-                a = 2 * math.pi * key[1] / TOWARD_BINS
+                a = 2 * math.pi * key[1] / SCRUB_BINS
                 way = (math.cos(a), math.sin(a))
                 force[where] = (ring_side_grip(params, k - 1, way) if rigid else
                                 params.cornering_coefficient * P * n / 2 * bend_slip_angle(params, key[0]))
                 held[where] = scrub_force(params, k - 1, way, key[0])
                 gap = bend_wheel_spread(0.5 * params.ring_spacing, params.wheel_radius, key[0], params.pipe_diameter)
-                spread[where] = P * ((u @ np.array(way)) ** 2 * 0.5 * gap / params.suspension_travel)[None, :]
+                spread[where] = spread_unload(params, P, u @ np.array(way), gap)[None, :]
             side = np.where(rolls[:, None], force[:, None] * toward, 0.0)
             steady = np.where(rolls[:, None], (2.0 / n) * held[:, None] * np.abs(toward @ u.T), 0.0)
         out.gravity.append(across)

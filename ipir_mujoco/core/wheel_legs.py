@@ -157,6 +157,14 @@ def bend_cock(params, module: int, toward: tuple[float, float], radius: float) -
     return 0.5 * (low + high)
 
 
+def spread_unload(params, preload, along, spread: float):
+    """The press [N] a leg of preload ``preload`` [N] loses to the pipe's spread off its ring's plane in a bend,
+    ``spread`` [m] (:func:`ipir_mujoco.core.pipe.bend_wheel_spread`), the leg's direction's cosine ``along`` with the
+    way the bend turns (a float or an array): P along^2 spread / (2 suspension_travel), the ring's plane cutting the
+    bend obliquely so the wall is farther by half the spread along the turn."""
+    return preload * along ** 2 * 0.5 * spread / params.suspension_travel
+
+
 def module_gravity(params, rotation) -> np.ndarray:
     """Gravity's components across the pipe [m/s^2] in a module's frame, shape (..., 2) (y, z): ``rotation``
     (..., 3) the module's rotation vector [rad] (the run's roll, pitch and yaw columns: axis times angle, its frame

@@ -46,12 +46,11 @@ interval. Further limits:
   period): 6.7 times inside the explicit spring's stability limit
   (omega_s dt < 2; beyond it a skid runs 3.6 times too long, mjcf/README.md),
   and the mode decides only how far the clutch force overshoots G_i while the
-  carriage slides (its inertia force). Resolving it at 0.1 as the module's mode
-  cost clutch-study --quick on finite grip 7.4 times its time on unlimited
-  grip; at 0.3 revolutions and travel stay within 3.3e-4 of the analytic model,
-  undamped peak forces move by about 1e-3 and damped ones by up to 1.1 %,
-  inside the peak's stated bound (omega_s dt)^2 / 4 (mjcf/README.md has the
-  measurements, ``python bench/carriage_step.py`` makes them).
+  carriage slides (its inertia force), within the peak's stated bound
+  (omega_s dt)^2 / 4; resolving it as finely as the module's own mode (0.1)
+  costs several times the run's time for nothing the figures show
+  (``python bench/carriage_step.py`` measures both rules against the analytic
+  model; mjcf/README.md quotes it).
 
 Bounds on the crank: for a constant torque M, the energy the drive put in
 bounds the crank's kinetic energy, J_A omega^2 / 2 <= KE(0) + |M| (phi - phi0),
