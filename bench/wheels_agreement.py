@@ -4,7 +4,8 @@ Run on demand from the repository root (an hour or more for 100 designs on 2 bus
 of 0.3 s at a given 1e-4 s step, seconds):
 
     python bench/wheels_agreement.py [--designs 200] [--seed 1] [--workers 2] [--log FILE.jsonl] [--recheck]
-                                     [--wall-budget S] [--skip N] [--only N,M,...] [--timestep S] [--smoke]
+                                     [--series DIR] [--wall-budget S] [--skip N] [--only N,M,...] [--timestep S]
+                                     [--smoke]
 
 Each design is drawn over the envelope (log-uniform where a range spans decades): m1, m2 0.2-5 kg; r 0.02-0.07 m
 (the crank fits the 0.16 m pipe); L / r 1.5-6; J_A 1e-4-1e-2 kg m^2; F_r1, F_r2 0.2-5 N; the drive a constant
@@ -34,8 +35,11 @@ before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_che
 ``--log FILE.jsonl`` appends each design's record as it finishes; a rerun with the same log skips the designs it
 holds (reprinting their lines), so a stopped benchmark resumes; with ``--recheck`` it runs nothing on MuJoCo and
 takes the logged designs' equations' checks again with the check as it is now (a new analytic run each; MuJoCo's
-outcome and the run's own checks as logged), deciding their class again. The tables in mjcf/README.md ("The round pipe")
-are this script's output.
+outcome and the run's own checks as logged), deciding their class again. ``--series DIR`` keeps each design's
+MuJoCo series there (``design_K.npz``); with it, ``--recheck`` also takes the run's own checks again on the kept
+series (:func:`ipir_mujoco.core.wall_summary.run_summary`: MuJoCo's series, which the checks do not change), so a
+change to a check is measured on both sets of loads without running MuJoCo. The tables in mjcf/README.md ("The
+round pipe") are this script's output.
 """
 
 from __future__ import annotations
@@ -64,6 +68,7 @@ SKID_REL, SKID_FLOOR = 0.05, 2e-3  # skid within 5 % + 2 mm
 CLASSES = ("agree", "lifted", "scrubbed", "stopped", "outside")
 EQUATIONS_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "slid1_m", "slid2_m", "stuck1", "stuck2",
                   "scrub_predicted")
+RUN_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "side_use1", "side_use2", "scrub_predicted")
 CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"), ("lift", "quasi-static"))
 
 
@@ -105,10 +110,11 @@ def equations_checks(analytic, params: RobotParams) -> dict:
 
 
 def judge(index: int, params: RobotParams, t_end: float, budget: float | None = None,
-          timestep: float | None = None) -> dict:
+          timestep: float | None = None, series_dir: str | None = None) -> dict:
     """Run one design in both engines and classify it (module docstring); ``budget`` [s]: the MuJoCo run's
     wall-time budget (a run past it stops with that reason); ``timestep`` [s]: the MuJoCo run's step (default its
-    automatic one). A JSON-ready record."""
+    automatic one); ``series_dir``: where MuJoCo's series is kept (``design_K.npz``; None: not kept). A
+    JSON-ready record."""
     row = {"design": index, "params": params.as_dict(), "t_end": t_end}
     started = time.perf_counter()
     try:
@@ -120,14 +126,14 @@ def judge(index: int, params: RobotParams, t_end: float, budget: float | None = 
     except (ParameterError, SimulationError) as exc:
         return {**row, "class": "stopped", "why": " ".join(str(exc).split()), "wall_s": time.perf_counter() - started}
     row["wall_s"] = time.perf_counter() - started
+    if series_dir is not None:
+        np.savez_compressed(Path(series_dir) / f"design_{index}.npz", **wheels.series)
     a, w = analytic.summary, wheels.summary
     for k in ("x1_final", "x2_final", "slip1_m", "slip2_m", "revolutions"):
         row[k] = (a[k], w[k])
     row.update({k: (a["energy"].get(k, 0.0), w["energy"].get(k, 0.0)) for k in ("motor_work_j", "skid_j")})
     eq = equations_checks(analytic, params)
-    row["checks"] = {"equations": {k: eq[k] for k in EQUATIONS_KEYS},
-                     "run": {k: w[k] for k in ("least_press1_n", "least_press2_n", "lift_predicted",
-                                               "side_use1", "side_use2", "scrub_predicted")}}
+    row["checks"] = {"equations": {k: eq[k] for k in EQUATIONS_KEYS}, "run": {k: w[k] for k in RUN_KEYS}}
     row["happened"] = {"lift": w["wheel_off_s"] > 0, "scrub": bool(w["scrubbed"])}
     row.update(wheel_off_s=w["wheel_off_s"], across=(w["across1_m"], w["across2_m"]), press=(w["press1_n"], w["press2_n"]),
                grip=(w["grip1_n"], w["grip2_n"]), unpredicted=w["unpredicted"], timestep=wheels.settings["timestep"])
@@ -157,14 +163,23 @@ def classify(row: dict) -> dict:
     return {**row, "class": "outside"}
 
 
-def recheck(row: dict) -> dict:
+def recheck(row: dict, series_dir: str | None = None) -> dict:
     """A logged record with the equations' checks taken again (the check as it is now, on a new analytic run of
-    the design) and its class decided again; MuJoCo's outcome and the run's own checks as logged."""
+    the design) and its class decided again; MuJoCo's outcome as logged, the run's own checks taken again on its
+    series kept in ``series_dir`` (as logged where none was kept)."""
     if "checks" not in row:
         return row
     params = RobotParams(**row["params"])
     eq = equations_checks(registry.run("analytic-unilateral", params, row["t_end"], dt_out=1e-3), params)
-    row = {**row, "checks": {**row["checks"], "equations": {k: eq[k] for k in EQUATIONS_KEYS}}}
+    run = row["checks"]["run"]
+    kept = None if series_dir is None else Path(series_dir) / f"design_{row['design']}.npz"
+    if kept is not None and kept.exists():
+        from ipir_mujoco.core.wall_summary import run_summary
+
+        with np.load(kept) as data:
+            summary = run_summary(params, {key: data[key] for key in data.files})
+        run = {k: summary[k] for k in RUN_KEYS}
+    row = {**row, "checks": {**row["checks"], "equations": {k: eq[k] for k in EQUATIONS_KEYS}, "run": run}}
     if "agrees" not in row:  # a record from before Dec 7, 10:00: its class says whether it agreed, or its stop
         row["agrees"] = row["class"] == "agree"
         row["stop"] = row.get("why")
@@ -245,6 +260,9 @@ def main(argv=None) -> int:
     parser.add_argument("--recheck", action="store_true",
                         help="with --log: the logged designs' equations' checks taken again with the check as it is "
                              "now (a new analytic run each; MuJoCo's outcome and the run's own checks as logged)")
+    parser.add_argument("--series", default=None, metavar="DIR",
+                        help="keep each design's MuJoCo series here; with --recheck, the run's own checks taken again "
+                             "on them")
     parser.add_argument("--smoke", action="store_true", help="4 designs of 0.3 s at the 1e-4 s step unless "
                         "--timestep gives one (no skid check's reruns): the script runs")
     args = parser.parse_args(argv)
@@ -253,6 +271,8 @@ def main(argv=None) -> int:
     count = 4 if args.smoke else args.designs
     if args.smoke and args.timestep is None:  # a given step is not checked (the skid check reruns up to 15x)
         args.timestep = 1e-4
+    if args.series:
+        Path(args.series).mkdir(parents=True, exist_ok=True)
     done: dict[int, dict] = {}
     if args.log and Path(args.log).exists():
         for text in Path(args.log).read_text(encoding="utf-8").splitlines():
@@ -264,10 +284,10 @@ def main(argv=None) -> int:
         params, t_end = design(rng)
         if (k >= args.skip and only is None) or (only is not None and (k in only or (args.skip and k >= args.skip))):
             if k in done:
-                rows.append(recheck(done[k]) if args.recheck else done[k])
+                rows.append(recheck(done[k], args.series) if args.recheck else done[k])
                 print(line(rows[-1]), flush=True)
             elif not args.recheck:
-                jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep))
+                jobs.append((k, params, 0.3 if args.smoke else t_end, args.wall_budget, args.timestep, args.series))
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = [pool.submit(judge, *job) for job in jobs]
         for finished, future in enumerate(as_completed(futures), start=1):
