@@ -248,7 +248,7 @@ def add_leg(body, prefix: str, u: np.ndarray, x: float, params: RobotParams, mod
     ``u`` (3,) across the pipe, ``x`` [m] along the body's axis from its origin, its names ``prefix`` + '_arm',
     '_steer', '_hub', '_wheel', '_strut', '_tyre' (module docstring): the arm on its sprung slide, the wheel on
     its steer hinge (steer-compliant wheels, ``cornering_coefficient`` finite: about u through the point the
-    trail e ahead of the wheel's centre, its spring C e and critical damping) and its hub hinge, the sphere
+    trail e ahead of the wheel's centre, its spring C e, undamped: mjcf/README.md) and its hub hinge, the sphere
     touching the wall."""
     R, travel, n = params.wheel_radius, params.suspension_travel, leg_count(params)
     reach = 0.5 * params.pipe_diameter - R  # the wheel's centre from the axis, the arm at 0
