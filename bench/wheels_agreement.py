@@ -30,7 +30,9 @@ and the MuJoCo run's own (its summary's ``lift_predicted``, ``scrub_predicted``:
 and its wheels' states). The end prints the counts per class and each check's confusion matrix (predicted or not
 against happened or not), with its false alarms (predicted, did not happen) as a share of the designs where
 nothing happened and of the predictions, and its misses; and, for comparison, the lift check the summary gave
-before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_check`).
+before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_check`). Last, on each set of loads,
+the lift check's false alarms and misses had it predicted a lift below other shares of the preload than its
+LIFT_SHARE (FLOORS): how far moving the floor trades one for the other.
 
 ``--log FILE.jsonl`` appends each design's record as it finishes; a rerun with the same log skips the designs it
 holds (reprinting their lines), so a stopped benchmark resumes; with ``--recheck`` it runs nothing on MuJoCo and
@@ -244,6 +246,32 @@ def confusion(rows: list[dict], name: str, source: str) -> str:
             f"{cells[(False, True)]}; false alarms {cells[(True, False)]}")
 
 
+FLOORS = (0.0, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5)  # least presses over the preload the trade-off is printed at
+
+
+def least_share(row: dict, source: str) -> float:
+    """The lift check's least press on ``source``'s loads over its leg's preload F_ni / (2 n), the lower of the
+    two modules' (the check predicts a lift below LIFT_SHARE, 0.05)."""
+    p, checks = row["params"], row["checks"][source]
+    return min(checks[f"least_press{k}_n"] / (p[f"F_n{k}"] / (2 * p["wheel_legs"])) for k in (1, 2))
+
+
+def trade_off(rows: list[dict], source: str) -> str:
+    """The lift check's false alarms and misses had it predicted a lift below each of FLOORS of the preload
+    instead of LIFT_SHARE: how far a floor trades one for the other (designs that ran)."""
+    ran = [r for r in rows if "checks" in r]
+    shares = [(least_share(r, source), bool(r["happened"]["lift"])) for r in ran]
+    quiet = sum(not lifted for _, lifted in shares)
+    cells = []
+    for floor in FLOORS:
+        alarms = sum(share < floor and not lifted for share, lifted in shares)
+        misses = sum(share >= floor and lifted for share, lifted in shares)
+        cells.append(f"{floor:g}: {alarms} ({100 * alarms / max(quiet, 1):.0f} %) / {misses}")
+    whose = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads"}[source]
+    return f"lift check on {whose}, false alarms / misses with a lift below each share of the preload: " + \
+        ", ".join(cells)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--designs", type=int, default=100)
@@ -302,6 +330,8 @@ def main(argv=None) -> int:
     print(" ".join(f"{c}: {sum(r['class'] == c for r in rows)}" for c in CLASSES))
     for name, source in CHECKS:
         print(confusion(rows, name, source))
+    for source in ("equations", "run"):
+        print(trade_off(rows, source))
     unsaid = [r["design"] for r in rows if r.get("unpredicted")]
     print(f"runs whose summary says 'unpredicted': {unsaid}")
     return 0
