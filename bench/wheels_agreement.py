@@ -1,7 +1,7 @@
 """The wheeled MuJoCo model (a robot in a round pipe) against the analytic finite-grip model, random designs.
 
-Run on demand from the repository root (an hour or more for 100 designs on 2 busy cores; ``--smoke``: 4 designs
-of 0.3 s at a given 1e-4 s step, seconds):
+Run on demand from the repository root (minutes to an hour for 200 designs, by the machine and its load; each
+design's wall time is in its record; ``--smoke``: 4 designs of 0.3 s at a given 1e-4 s step, seconds):
 
     python bench/wheels_agreement.py [--designs 200] [--seed 1] [--workers 2] [--log FILE.jsonl] [--recheck]
                                      [--series DIR] [--wall-budget S] [--skip N] [--only N,M,...] [--timestep S]
@@ -287,7 +287,8 @@ def main(argv=None) -> int:
     parser.add_argument("--timestep", type=float, default=None, help="the MuJoCo runs' step [s] (default: automatic)")
     parser.add_argument("--recheck", action="store_true",
                         help="with --log: the logged designs' equations' checks taken again with the check as it is "
-                             "now (a new analytic run each; MuJoCo's outcome and the run's own checks as logged)")
+                             "now (a new analytic run each; MuJoCo's outcome as logged; the run's own checks as "
+                             "logged, or taken again on the series kept in --series)")
     parser.add_argument("--series", default=None, metavar="DIR",
                         help="keep each design's MuJoCo series here; with --recheck, the run's own checks taken again "
                              "on them")
