@@ -32,7 +32,9 @@ against happened or not), with its false alarms (predicted, did not happen) as a
 nothing happened and of the predictions, and its misses; and, for comparison, the lift check the summary gave
 before Dec 7 (quasi-static, springs alone: :func:`ipir_mujoco.core.pipe.lift_check`). Last, on each set of loads,
 the lift check's false alarms and misses had it predicted a lift below other shares of the preload than its
-LIFT_SHARE (FLOORS): how far moving the floor trades one for the other.
+LIFT_SHARE (FLOORS): how far moving the floor trades one for the other; and read as a resolution, with the
+designs whose least press lies in a band about the floor left undecided (BANDS). With ``--series``, the last line:
+how far MuJoCo's modules turned about the pipe's axis where a wheel lifted and where none did.
 
 ``--log FILE.jsonl`` appends each design's record as it finishes; a rerun with the same log skips the designs it
 holds (reprinting their lines), so a stopped benchmark resumes; with ``--recheck`` it runs nothing on MuJoCo and
@@ -71,6 +73,8 @@ CLASSES = ("agree", "lifted", "scrubbed", "stopped", "outside")
 EQUATIONS_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "slid1_m", "slid2_m", "stuck1", "stuck2",
                   "scrub_predicted")
 RUN_KEYS = ("least_press1_n", "least_press2_n", "lift_predicted", "side_use1", "side_use2", "scrub_predicted")
+WHOSE = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads",
+         "quasi-static": "springs alone, quasi-static (the check before Dec 7)"}
 CHECKS = (("lift", "equations"), ("lift", "run"), ("scrub", "equations"), ("scrub", "run"), ("lift", "quasi-static"))
 
 
@@ -238,15 +242,15 @@ def confusion(rows: list[dict], name: str, source: str) -> str:
             cells[(predicted(row, name, source), bool(row["happened"][name]))].append(row["design"])
     tp, fa, miss, tn = (len(cells[k]) for k in ((True, True), (True, False), (False, True), (False, False)))
     share = (lambda a, b: f"{a}/{b} = {100 * a / b:.0f} %" if b else f"{a}/0")
-    whose = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads",
-             "quasi-static": "springs alone, quasi-static (the check before Dec 7)"}[source]
-    return (f"{name} check on {whose}: predicted and happened {tp}, predicted but not (false alarms) "
+    return (f"{name} check on {WHOSE[source]}: predicted and happened {tp}, predicted but not (false alarms) "
             f"{fa}, happened but not predicted (misses) {miss}, neither {tn}; false alarms {share(fa, fa + tn)} of the "
             f"designs where it did not happen, {share(fa, fa + tp)} of the predictions; misses "
             f"{cells[(False, True)]}; false alarms {cells[(True, False)]}")
 
 
-FLOORS = (0.0, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5)  # least presses over the preload the trade-off is printed at
+FLOORS = (-0.5, 0.0, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5)  # least presses over the preload the trade-off is printed at
+BANDS = ((-0.5, 0.3), (-0.5, 0.4))  # least presses over the preload left undecided (mjcf/README.md, "Four seeds")
+TURNED_DEG = (2.0, 10.0)  # a module's turn about the pipe's axis counted as begun, and as large
 
 
 def least_share(row: dict, source: str) -> float:
@@ -267,9 +271,49 @@ def trade_off(rows: list[dict], source: str) -> str:
         alarms = sum(share < floor and not lifted for share, lifted in shares)
         misses = sum(share >= floor and lifted for share, lifted in shares)
         cells.append(f"{floor:g}: {alarms} ({100 * alarms / max(quiet, 1):.0f} %) / {misses}")
-    whose = {"equations": "the equations' loads", "run": "the MuJoCo run's own loads"}[source]
-    return f"lift check on {whose}, false alarms / misses with a lift below each share of the preload: " + \
+    return f"lift check on {WHOSE[source]}, false alarms / misses with a lift below each share of the preload: " + \
         ", ".join(cells)
+
+
+def undecided(rows: list[dict], source: str) -> str:
+    """The lift check read as a resolution: a lift predicted below the lower end of each of BANDS, none from its
+    upper end, the designs between undecided; its false alarms and misses among the rest."""
+    shares = [(least_share(r, source), bool(r["happened"]["lift"])) for r in rows if "checks" in r]
+    cells = []
+    for lo, hi in BANDS:
+        alarms = sum(share < lo and not lifted for share, lifted in shares)
+        misses = sum(share >= hi and lifted for share, lifted in shares)
+        cells.append(f"{lo:g} to {hi:g}: {sum(lo <= share < hi for share, _ in shares)} undecided, {alarms} false "
+                     f"alarms, {misses} misses")
+    return f"lift check on {WHOSE[source]} with an undecided band: " + "; ".join(cells)
+
+
+def turns(rows: list[dict], series_dir: str) -> str:
+    """How far MuJoCo's modules turned about the pipe's axis (the kept series' roll1, roll2) in the designs that
+    lifted a wheel and in those that did not, and whether the turn began (TURNED_DEG[0]) before or after the
+    first wheel left its wall (the series' wheels_off)."""
+    begun, large = (math.radians(a) for a in TURNED_DEG)
+    counts = {True: [0, 0], False: [0, 0]}  # lifted: [designs, turned by more than TURNED_DEG[1]]
+    before, delays = 0, []
+    for row in rows:
+        path = Path(series_dir) / f"design_{row['design']}.npz"
+        if "checks" not in row or not path.is_file():
+            continue
+        with np.load(path) as kept:
+            t, off = kept["t"], kept["wheels_off"] > 0
+            turn = np.maximum(np.abs(kept["roll1"]), np.abs(kept["roll2"]))
+        lifted = bool(row["happened"]["lift"])
+        counts[lifted][0] += 1
+        counts[lifted][1] += bool(turn.max() > large)
+        if lifted and (turn > begun).any():
+            delay = float(t[np.argmax(turn > begun)] - t[np.argmax(off)])
+            before += delay < 0
+            delays.append(delay)
+    after = f"{np.median(delays):.3g}" if delays else "-"
+    return (f"modules turned about the pipe by more than {TURNED_DEG[1]:g} deg: {counts[True][1]} of {counts[True][0]} "
+            f"designs that lifted a wheel, {counts[False][1]} of {counts[False][0]} that did not; of the "
+            f"{len(delays)} lifted that turned by {TURNED_DEG[0]:g} deg, {len(delays) - before} after their first "
+            f"wheel left its wall (median {after} s after), {before} before")
 
 
 def main(argv=None) -> int:
@@ -333,6 +377,9 @@ def main(argv=None) -> int:
         print(confusion(rows, name, source))
     for source in ("equations", "run"):
         print(trade_off(rows, source))
+        print(undecided(rows, source))
+    if args.series:
+        print(turns(rows, args.series))
     unsaid = [r["design"] for r in rows if r.get("unpredicted")]
     print(f"runs whose summary says 'unpredicted': {unsaid}")
     return 0
