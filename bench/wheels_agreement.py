@@ -260,11 +260,15 @@ def least_share(row: dict, source: str) -> float:
     return min(checks[f"least_press{k}_n"] / (p[f"F_n{k}"] / (2 * p["wheel_legs"])) for k in (1, 2))
 
 
+def shares_lifted(rows: list[dict], source: str) -> list[tuple[float, bool]]:
+    """Per design that ran: its :func:`least_share` on ``source``'s loads and whether a wheel lifted in MuJoCo."""
+    return [(least_share(r, source), bool(r["happened"]["lift"])) for r in rows if "checks" in r]
+
+
 def trade_off(rows: list[dict], source: str) -> str:
     """The lift check's false alarms and misses had it predicted a lift below each of FLOORS of the preload
     instead of LIFT_SHARE: how far a floor trades one for the other (designs that ran)."""
-    ran = [r for r in rows if "checks" in r]
-    shares = [(least_share(r, source), bool(r["happened"]["lift"])) for r in ran]
+    shares = shares_lifted(rows, source)
     quiet = sum(not lifted for _, lifted in shares)
     cells = []
     for floor in FLOORS:
@@ -278,7 +282,7 @@ def trade_off(rows: list[dict], source: str) -> str:
 def undecided(rows: list[dict], source: str) -> str:
     """The lift check read as a resolution: a lift predicted below the lower end of each of BANDS, none from its
     upper end, the designs between undecided; its false alarms and misses among the rest."""
-    shares = [(least_share(r, source), bool(r["happened"]["lift"])) for r in rows if "checks" in r]
+    shares = shares_lifted(rows, source)
     cells = []
     for lo, hi in BANDS:
         alarms = sum(share < lo and not lifted for share, lifted in shares)

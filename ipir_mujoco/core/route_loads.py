@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .wheel_checks import SCRUB_BINS
-from .wheel_legs import in_module_frame, leg_direction, module_gravity, spread_unload
+from .wheel_checks import SCRUB_BINS, leg_frames
+from .wheel_legs import in_module_frame, module_gravity, spread_unload
 
 
 
@@ -60,7 +60,7 @@ def route_loads(params, series: dict, rolling) -> BendLoads:
     from .wheel_legs import bend_slip_angle, rigid_wheels, ring_side_grip, scrub_force
 
     n = int(params.wheel_legs)
-    u = np.array([leg_direction(k, n)[1:] for k in range(n)])
+    u, _ = leg_frames(n)
     rigid = rigid_wheels(params)
     out = BendLoads([], {}, {}, [], [])
     for k in (1, 2):
